@@ -1,0 +1,29 @@
+//! Gaze and headset abstraction for fovea (no Vulkan).
+//!
+//! - [`sample`]: OpenXR-shaped gaze samples ([`GazeSample`], [`XrTime`]).
+//! - [`hmd`]: headset profiles from strict TOML ([`HmdDescription`]) and pixel ↔ direction ↔
+//!   eccentricity conversions.
+//! - [`source`]: the [`GazeSource`] trait, [`InvalidGazePolicy`], [`FixedGaze`].
+//! - [`sim`]: simulated FOVE 0 ([`SimulatedFove`]).
+//! - [`trace`]: the gaze trace format, importers, [`Playback`] and [`Recorder`].
+//! - [`spec`]: parsing of the CLI's `--gaze` argument ([`GazeSpec`]).
+//! - `openxr` (cargo feature `openxr`): a real runtime through `XR_EXT_eye_gaze_interaction`.
+
+pub mod error;
+pub mod hmd;
+pub mod sample;
+pub mod sim;
+pub mod source;
+pub mod spec;
+pub mod trace;
+
+#[cfg(feature = "openxr")]
+pub mod openxr;
+
+pub use error::HalError;
+pub use hmd::{builtin_names, Capabilities, EyeView, Fov, HmdDescription, TrackerSpec};
+pub use sample::{Eye, EyeState, GazeRay, GazeSample, SampleTimeKind, XrTime};
+pub use sim::{SimConfig, SimulatedFove};
+pub use source::{FixedGaze, GazeOrigin, GazeSource, InvalidGazePolicy, ResolvedGaze};
+pub use spec::GazeSpec;
+pub use trace::{Playback, Recorder, Trace, TraceHeader};

@@ -1,0 +1,70 @@
+//! `--gaze center | X,Y | sim[:seed] | <trace path>` for the CLI.
+
+use crate::error::HalError;
+use crate::hmd::HmdDescription;
+use crate::sample::Eye;
+use crate::sim::{SimConfig, SimulatedFove};
+use crate::source::{FixedGaze, GazeSource};
+use crate::trace::Playback;
+use glam::{Vec2, Vec3};
+use std::path::PathBuf;
+use std::str::FromStr;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum GazeSpec {
+    /// Straight ahead.
+    Center,
+    /// A fixed pixel position in the left eye's image (x right, y down).
+    Fixed { x: f32, y: f32 },
+    Simulated { seed: u64 },
+    Trace(PathBuf),
+}
+
+impl FromStr for GazeSpec {
+    type Err = HalError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let err = |reason: &str| HalError::GazeSpec { input: s.to_string(), reason: reason.to_string() };
+        let t = s.trim();
+        if t.is_empty() {
+            return Err(err("empty; expected center, X,Y, sim[:seed] or a trace file path"));
+        }
+        if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
+            return Ok(GazeSpec::Center);
+        }
+        if t == "sim" {
+            return Ok(GazeSpec::Simulated { seed: SimConfig::default().seed });
+        }
+        if let Some(seed) = t.strip_prefix("sim:") {
+            let seed = seed.parse().map_err(|_| err("the seed after `sim:` must be a non-negative integer"))?;
+            return Ok(GazeSpec::Simulated { seed });
+        }
+        // Something that starts like a number and has a comma is meant as pixel coordinates.
+        let numeric_start = t.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+' || c == '.');
+        if let Some((x, y)) = t.split_once(',') {
+            if numeric_start {
+                let parse = |v: &str| v.trim().parse::<f32>().ok().filter(|v| v.is_finite());
+                return match (parse(x), parse(y)) {
+                    (Some(x), Some(y)) => Ok(GazeSpec::Fixed { x, y }),
+                    _ => Err(err("expected X,Y as two finite pixel coordinates, e.g. 640,720")),
+                };
+            }
+        }
+        Ok(GazeSpec::Trace(PathBuf::from(t)))
+    }
+}
+
+impl GazeSpec {
+    /// Build the gaze source this spec names for a headset.
+    pub fn open(&self, hmd: HmdDescription) -> Result<Box<dyn GazeSource>, HalError> {
+        Ok(match self {
+            GazeSpec::Center => Box::new(FixedGaze::new(hmd, Vec3::NEG_Z)),
+            GazeSpec::Fixed { x, y } => {
+                let dir = hmd.pixel_to_direction(Eye::Left, Vec2::new(*x, *y));
+                Box::new(FixedGaze::new(hmd, dir))
+            }
+            GazeSpec::Simulated { seed } => Box::new(SimulatedFove::new(hmd, SimConfig::seeded(*seed))?),
+            GazeSpec::Trace(path) => Box::new(Playback::open(path, hmd)?),
+        })
+    }
+}

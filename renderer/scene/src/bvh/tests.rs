@@ -1,0 +1,209 @@
+use super::*;
+use crate::intersect::{brute_force, Hit, Ray};
+use crate::test_util::*;
+
+/// Every triangle in exactly one leaf; every child box contains its subtree; leaves ≤ 8.
+fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]]) {
+    let mut seen = vec![0u32; tris.len()];
+    let mut sorted = bvh.tri_order.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, (0..tris.len() as u32).collect::<Vec<_>>(), "tri_order is a permutation");
+    let mut stack = vec![0u32];
+    let mut visited_nodes = 0;
+    while let Some(node) = stack.pop() {
+        visited_nodes += 1;
+        let n = &bvh.nodes[node as usize];
+        for slot in 0..2 {
+            if n.is_empty_child(slot) {
+                assert!(n.child_bounds(slot).is_empty(), "an empty child has the inverted box");
+                continue;
+            }
+            let bounds = n.child_bounds(slot);
+            if n.child_count[slot] > 0 {
+                assert!(n.child_count[slot] as usize <= LEAF_MAX, "leaf of {} triangles", n.child_count[slot]);
+                let start = n.child_ref[slot] as usize;
+                for &t in &bvh.tri_order[start..start + n.child_count[slot] as usize] {
+                    seen[t as usize] += 1;
+                    tris[t as usize].iter().for_each(|&p| assert!(bounds.contains_point(p), "leaf box contains its triangles"));
+                }
+            } else {
+                let child = &bvh.nodes[n.child_ref[slot] as usize];
+                for s in (0..2).filter(|&s| !child.is_empty_child(s)) {
+                    let inner = child.child_bounds(s);
+                    assert!(bounds.contains_point(inner.min) && bounds.contains_point(inner.max), "child box contains grandchildren");
+                }
+                stack.push(n.child_ref[slot]);
+            }
+        }
+    }
+    assert_eq!(visited_nodes, bvh.nodes.len(), "every node is reachable exactly once");
+    assert!(seen.iter().all(|&c| c == 1), "every triangle in exactly one leaf");
+}
+
+/// The BVH must report the brute-force hit. When a ray passes exactly through an edge or vertex,
+/// both neighbours may report a hit at the same t and box culling can hide the lower-indexed one
+/// from the BVH; then the BVH's triangle must be a genuine tie (hit by the ray at the same t).
+fn assert_same_hit(name: &str, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, got: Option<Hit>, expected: Option<Hit>) {
+    match (got, expected) {
+        (Some(g), Some(e)) if g.triangle != e.triangle => {
+            let [a, b, c] = tris[g.triangle as usize];
+            let tie = crate::intersect::intersect_triangle(ray, a, b, c, t_max);
+            assert!(tie.is_some_and(|(t, _, _)| (t - e.t).abs() <= 1e-6 * e.t), "{name}: {ray:?}: BVH {g:?}, brute force {e:?}");
+        }
+        _ => assert_eq!(got, expected, "{name}: {ray:?} t_max {t_max}"),
+    }
+}
+
+/// Random rays that mostly point at the mesh, plus a few random ones.
+fn compare_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u64) {
+    let bvh = Bvh::build(tris);
+    check_invariants(&bvh, tris);
+    let bounds = Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>());
+    let (center, radius) = (bounds.center(), bounds.bounding_sphere_radius().max(1e-3));
+    let mut rng = TestRng::new(seed);
+    let mut hits = 0;
+    for i in 0..rays {
+        let origin = center + rng.unit_vector() * radius * rng.range(0.2, 2.0);
+        let target = center + rng.vec3(-radius, radius) * 0.5;
+        let dir = if i % 8 == 0 { rng.unit_vector() } else { target - origin };
+        let ray = Ray { origin, dir };
+        let t_max = if i % 5 == 0 { rng.range(0.1, 1.0) } else { f32::INFINITY };
+        let expected = brute_force(tris, &ray, t_max, false);
+        let got = bvh.intersect(tris, &ray, t_max, false);
+        assert_same_hit(name, tris, &ray, t_max, got, expected);
+        let any = bvh.intersect(tris, &ray, t_max, true);
+        assert_eq!(any.is_some(), expected.is_some(), "{name}: any-hit ray {i}");
+        if let Some(h) = any {
+            assert!(h.t > 0.0 && h.t < t_max);
+        }
+        hits += expected.is_some() as usize;
+    }
+    assert!(hits > rays / 20, "{name}: only {hits} of {rays} rays hit; the test would prove little");
+}
+
+#[test]
+fn bvh_equals_brute_force_on_a_sphere() {
+    compare_with_brute_force("sphere", &sphere(Vec3::new(0.3, -0.2, 1.0), 1.5, 24, 48), 3000, 1);
+}
+
+#[test]
+fn bvh_equals_brute_force_on_a_triangle_soup() {
+    let mut rng = TestRng::new(2);
+    compare_with_brute_force("soup", &triangle_soup(&mut rng, 3000, 2.0, 0.3), 3000, 3);
+}
+
+#[test]
+fn bvh_equals_brute_force_on_slivers() {
+    let mut rng = TestRng::new(4);
+    compare_with_brute_force("slivers", &slivers(&mut rng, 20000), 3000, 5);
+}
+
+#[test]
+fn bvh_equals_brute_force_on_the_bunny() {
+    if let Some(bunny) = bunny() {
+        assert_eq!(bunny.len(), 3674);
+        compare_with_brute_force("bunny", &bunny, 3000, 6);
+    }
+}
+
+#[test]
+fn bvh_handles_coincident_and_tiny_inputs() {
+    let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 40]; // identical centroids force median splits
+    compare_with_brute_force("coincident", &same, 200, 7);
+    let empty = Bvh::build(&[]);
+    assert_eq!(empty.nodes.len(), 1);
+    assert!(empty.intersect(&[], &Ray { origin: Vec3::ZERO, dir: Vec3::X }, f32::INFINITY, false).is_none());
+    let one = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+    let bvh = Bvh::build(&one);
+    assert_eq!((bvh.nodes.len(), bvh.nodes[0].child_count, bvh.nodes[0].child_ref), (1, [1, 0], [0, 0]));
+    assert_eq!(bvh.nodes[0].child_min[1], Vec3::splat(1e30));
+    assert_eq!(bvh.nodes[0].child_max[1], Vec3::splat(-1e30));
+    assert_eq!(bvh.depth(), 1);
+}
+
+/// Rays aimed exactly at grid vertices and edges of a tessellated plane, from many directions,
+/// including axis-parallel ones: a watertight test never lets one through.
+#[test]
+fn rays_through_shared_edges_and_vertices_never_leak() {
+    let n = 8;
+    let tris = quad_grid(n);
+    let bvh = Bvh::build(&tris);
+    check_invariants(&bvh, &tris);
+    let mut rng = TestRng::new(8);
+    let mut tested = 0;
+    for gy in 1..n * 2 {
+        for gx in 1..n * 2 {
+            // Half-integer steps: grid vertices, edge midpoints and quad centres (diagonals).
+            let target = Vec3::new(gx as f32 * 0.5, gy as f32 * 0.5, 0.0);
+            for k in 0..6 {
+                let dir = match k {
+                    0 => Vec3::new(0.0, 0.0, -1.0),
+                    1 => Vec3::new(0.0, 0.0, 1.0),
+                    _ => {
+                        let mut d = rng.unit_vector();
+                        d.z = -d.z.abs().max(0.05);
+                        d
+                    }
+                };
+                let origin = target - dir * rng.range(0.5, 4.0);
+                let ray = Ray { origin, dir };
+                let expected = brute_force(&tris, &ray, f32::INFINITY, false);
+                assert!(expected.is_some(), "leak at {target:?} dir {dir:?}");
+                assert_same_hit("grid", &tris, &ray, f32::INFINITY, bvh.intersect(&tris, &ray, f32::INFINITY, false), expected);
+                tested += 1;
+            }
+        }
+    }
+    assert!(tested > 1000);
+}
+
+#[test]
+fn texels_follow_the_gpu_layout() {
+    let tris = sphere(Vec3::ZERO, 1.0, 8, 16);
+    let bvh = Bvh::build(&tris);
+    let nodes = bvh.node_texels();
+    assert_eq!(nodes.len(), bvh.nodes.len() * 4);
+    for (i, n) in bvh.nodes.iter().enumerate() {
+        let t = &nodes[i * 4..i * 4 + 4];
+        assert_eq!([t[0][0], t[0][1], t[0][2]], n.child_min[0].to_array());
+        assert_eq!([t[1][0], t[1][1], t[1][2]], n.child_max[0].to_array());
+        assert_eq!([t[2][0], t[2][1], t[2][2]], n.child_min[1].to_array());
+        assert_eq!([t[3][0], t[3][1], t[3][2]], n.child_max[1].to_array());
+        assert_eq!([t[0][3], t[1][3], t[2][3], t[3][3]].map(f32::to_bits), [n.child_ref[0], n.child_ref[1], n.child_count[0], n.child_count[1]]);
+    }
+    let tex = bvh.triangle_texels(&tris);
+    assert_eq!(tex.len(), tris.len() * 3);
+    for (k, &orig) in bvh.tri_order.iter().enumerate() {
+        assert_eq!(tex[k * 3][3].to_bits(), orig);
+        for c in 0..3 {
+            assert_eq!(&tex[k * 3 + c][..3], &tris[orig as usize][c].to_array()[..]);
+        }
+    }
+    assert_eq!(bvh.memory_bytes(), bvh.nodes.len() * 64 + tris.len() * 48);
+}
+
+/// Build rate on ≥ 250k triangles. Timing is printed, not asserted (shared machine); run with
+/// `cargo test -p fovea-scene --release -- --ignored --nocapture bvh_build_rate`.
+#[test]
+#[ignore]
+fn bvh_build_rate() {
+    let mut tris = Vec::new();
+    for i in 0..64 {
+        tris.extend(sphere(Vec3::new((i % 8) as f32 * 3.0, 0.0, (i / 8) as f32 * 3.0), 1.0, 45, 45));
+    }
+    let mut rng = TestRng::new(9);
+    tris.extend(triangle_soup(&mut rng, 10_000, 12.0, 0.2));
+    let start = std::time::Instant::now();
+    let bvh = Bvh::build(&tris);
+    let secs = start.elapsed().as_secs_f64();
+    println!(
+        "BVH: {} triangles in {:.3} s = {:.2} M tris/s; {} nodes, depth {}, {:.1} MiB on the GPU",
+        tris.len(),
+        secs,
+        tris.len() as f64 / secs / 1e6,
+        bvh.nodes.len(),
+        bvh.depth(),
+        bvh.memory_bytes() as f64 / (1 << 20) as f64
+    );
+    check_invariants(&bvh, &tris);
+}

@@ -1,0 +1,112 @@
+//! GPU texel packing and the CPU traversal (the reference for the GLSL one, same algorithm).
+
+use super::{Bvh, BvhNode};
+use crate::intersect::{Hit, Ray, WatertightRay};
+use glam::Vec3;
+
+/// Conservative slack for the slab test, 1 + 2·γ(3) (Ize, "Robust BVH Ray Traversal", JCGT 2013):
+/// without it, a triangle lying exactly on a box face can be culled by rounding.
+pub const SLAB_SLACK: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+
+/// A zero direction component would make `(plane − origin) · (1/0)` NaN when the origin lies on
+/// the plane; a tiny signed component gives the same answer without NaN (the GPU does the same).
+pub fn safe_inverse_dir(dir: Vec3) -> Vec3 {
+    let fix = |d: f32| if d == 0.0 { 1.0 / 1e-30f32.copysign(d) } else { 1.0 / d };
+    Vec3::new(fix(dir.x), fix(dir.y), fix(dir.z))
+}
+
+/// Entry distance into the box if the ray overlaps it within `[0, t_limit]` (conservatively).
+#[inline]
+pub fn slab_test(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, t_limit: f32) -> Option<f32> {
+    let t0 = (min - origin) * inv_dir;
+    let t1 = (max - origin) * inv_dir;
+    let near = t0.min(t1);
+    let far = t0.max(t1);
+    let t_near = near.x.max(near.y).max(near.z).max(0.0);
+    let t_far = far.x.min(far.y).min(far.z) * SLAB_SLACK;
+    (t_near <= t_far && t_near <= t_limit * SLAB_SLACK).then_some(t_near)
+}
+
+impl Bvh {
+    /// 4 RGBA32F texels per node:
+    /// (left.min, bits(left.ref)), (left.max, bits(right.ref)), (right.min, bits(left.count)), (right.max, bits(right.count)).
+    pub fn node_texels(&self) -> Vec<[f32; 4]> {
+        let bits = f32::from_bits;
+        self.nodes
+            .iter()
+            .flat_map(|n| {
+                let (lmin, lmax, rmin, rmax) = (n.child_min[0], n.child_max[0], n.child_min[1], n.child_max[1]);
+                [
+                    [lmin.x, lmin.y, lmin.z, bits(n.child_ref[0])],
+                    [lmax.x, lmax.y, lmax.z, bits(n.child_ref[1])],
+                    [rmin.x, rmin.y, rmin.z, bits(n.child_count[0])],
+                    [rmax.x, rmax.y, rmax.z, bits(n.child_count[1])],
+                ]
+            })
+            .collect()
+    }
+
+    /// 3 texels per triangle in `tri_order` order: (v0, bits(original index)), (v1, 0), (v2, 0).
+    pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
+        self.tri_order
+            .iter()
+            .flat_map(|&i| {
+                let [a, b, c] = tris[i as usize];
+                [[a.x, a.y, a.z, f32::from_bits(i)], [b.x, b.y, b.z, 0.0], [c.x, c.y, c.z, 0.0]]
+            })
+            .collect()
+    }
+
+    /// Closest hit (ties by the rule in [`crate::intersect`]) or, with `any_hit`, the first hit
+    /// found, for `0 < t < t_max`. `tris` must be the array the tree was built from.
+    pub fn intersect(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> Option<Hit> {
+        let wray = WatertightRay::new(ray);
+        let inv_dir = safe_inverse_dir(ray.dir);
+        let mut best: Option<Hit> = None;
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        let mut node = 0u32;
+        loop {
+            let n: &BvhNode = &self.nodes[node as usize];
+            let limit = best.map_or(t_max, |h| h.t);
+            let near = [0, 1].map(|c| {
+                if n.is_empty_child(c) { None } else { slab_test(n.child_min[c], n.child_max[c], ray.origin, inv_dir, limit) }
+            });
+            // Visit the nearer child first; leaves are tested on the spot, interior children queued.
+            let first = if let (Some(a), Some(b)) = (near[0], near[1]) { usize::from(b < a) } else { 0 };
+            let mut next: [Option<u32>; 2] = [None, None];
+            for (k, c) in [first, 1 - first].into_iter().enumerate() {
+                if near[c].is_none() {
+                    continue;
+                }
+                if n.child_count[c] == 0 {
+                    next[k] = Some(n.child_ref[c]);
+                    continue;
+                }
+                let start = n.child_ref[c] as usize;
+                for &tri in &self.tri_order[start..start + n.child_count[c] as usize] {
+                    let [a, b, cc] = tris[tri as usize];
+                    if let Some((t, u, v)) = wray.intersect(a, b, cc, t_max) {
+                        let hit = Hit { t, triangle: tri, u, v };
+                        if any_hit {
+                            return Some(hit);
+                        }
+                        if best.is_none_or(|b| hit.is_closer_than(&b)) {
+                            best = Some(hit);
+                        }
+                    }
+                }
+            }
+            match next {
+                [Some(a), Some(b)] => {
+                    stack.push(b);
+                    node = a;
+                }
+                [Some(a), None] | [None, Some(a)] => node = a,
+                [None, None] => match stack.pop() {
+                    Some(a) => node = a,
+                    None => return best,
+                },
+            }
+        }
+    }
+}

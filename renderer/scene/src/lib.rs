@@ -1,0 +1,235 @@
+//! CPU scene data for the fovea renderer: glTF 2.0 loading, a binned-SAH BVH laid out for GPU
+//! traversal, a watertight CPU ray–triangle intersector (the reference the GPU is tested against)
+//! and the light-selection table. No Vulkan here: the renderer uploads what this crate produces.
+//!
+//! Everything a [`Scene`] holds is already in world space (node transforms applied), because the
+//! path tracer traverses one BVH over all triangles and has no instancing level.
+
+pub mod bvh;
+mod geometry;
+pub mod intersect;
+pub mod lights;
+mod load;
+mod load_material;
+
+#[cfg(test)]
+mod test_util;
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use std::path::{Path, PathBuf};
+
+pub use bvh::{Bvh, BvhNode};
+pub use intersect::{Hit, Ray};
+pub use lights::{build_light_table, AliasSlot, LightEntry, LightKind, LightTable};
+
+/// A loaded scene, flattened to world space.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub vertices: Vec<Vertex>,
+    pub triangles: Vec<Triangle>,
+    /// glTF materials in document order; when some primitive has no material, one default material
+    /// (all glTF defaults) is appended at the end.
+    pub materials: Vec<Material>,
+    /// One entry per glTF *image* (materials refer to images, so two glTF textures that share an
+    /// image share the texels).
+    pub textures: Vec<Texture>,
+    pub punctual_lights: Vec<PunctualLight>,
+    /// Perspective cameras in scene-traversal order; `cameras[0]` is the default camera.
+    pub cameras: Vec<Camera>,
+    /// Indexed by [`Triangle::mesh`]: the glTF mesh name, or `mesh<i>` when unnamed.
+    pub mesh_names: Vec<String>,
+    pub source: PathBuf,
+}
+
+/// A world-space vertex. `tangent.w` is the bitangent sign: `bitangent = cross(normal, tangent.xyz) * w`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vertex {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub uv: Vec2,
+    pub tangent: Vec4,
+}
+
+/// Indices into [`Scene::vertices`], counter-clockwise seen from the front face (also after
+/// mirroring node transforms, which the loader compensates by swapping two indices).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Triangle {
+    pub indices: [u32; 3],
+    pub material: u32,
+    /// Index of the glTF mesh this triangle came from (shared by all instances of that mesh).
+    pub mesh: u32,
+}
+
+/// PBR metallic-roughness material plus the KHR extensions the tracer uses.
+/// Texture fields index [`Scene::textures`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub base_color: Vec4,
+    pub base_color_texture: Option<u32>,
+    pub metallic: f32,
+    pub roughness: f32,
+    pub metallic_roughness_texture: Option<u32>,
+    pub normal_texture: Option<u32>,
+    pub normal_scale: f32,
+    /// emissiveFactor × KHR_materials_emissive_strength.
+    pub emissive: Vec3,
+    pub emissive_texture: Option<u32>,
+    pub specular_factor: f32,
+    pub specular_texture: Option<u32>,
+    pub specular_color: Vec3,
+    pub specular_color_texture: Option<u32>,
+    pub ior: f32,
+    pub double_sided: bool,
+}
+
+impl Default for Material {
+    /// The glTF default material ("a material with no properties specified"): white, metallic 1,
+    /// roughness 1, with the extension defaults (specular 1, specular colour 1, ior 1.5).
+    fn default() -> Self {
+        Material {
+            base_color: Vec4::ONE,
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            specular_factor: 1.0,
+            specular_texture: None,
+            specular_color: Vec3::ONE,
+            specular_color_texture: None,
+            ior: 1.5,
+            double_sided: false,
+        }
+    }
+}
+
+/// Raw RGBA8 texels, row-major from the top-left. Colour-space decoding is the shader's job
+/// (base colour, emissive and specular colour are sRGB; the others are linear).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+/// KHR_lights_punctual lights in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PunctualLight {
+    Point { position: Vec3, intensity: Vec3, range: Option<f32> },
+    Spot { position: Vec3, direction: Vec3, intensity: Vec3, range: Option<f32>, inner_cone: f32, outer_cone: f32 },
+    Directional { direction: Vec3, illuminance: Vec3 },
+}
+
+/// A perspective camera. `world_from_view` maps glTF view space (−Z forward, +Y up, +X right)
+/// to world space; any node scale is removed so its 3×3 part is a rotation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub world_from_view: Mat4,
+    /// Vertical field of view in radians.
+    pub yfov: f32,
+    pub aspect: Option<f32>,
+    pub znear: f32,
+    pub name: String,
+}
+
+/// Axis-aligned bounding box. The empty box has min = +1e30 and max = −1e30 so that a slab
+/// test against it always misses (the same sentinel the GPU node layout uses).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(1e30), max: Vec3::splat(-1e30) };
+
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+    pub fn grow(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb { min: self.min.min(other.min), max: self.max.max(other.max) }
+    }
+    pub fn contains_point(&self, p: Vec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+    /// Surface area; 0 for an empty box (used by the SAH).
+    pub fn surface_area(&self) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let d = self.max - self.min;
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+    /// Radius of the sphere around `center()` that encloses the box; 0 when empty.
+    pub fn bounding_sphere_radius(&self) -> f32 {
+        if self.is_empty() { 0.0 } else { (self.max - self.min).length() * 0.5 }
+    }
+    pub fn of_points(points: &[Vec3]) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        points.iter().for_each(|&p| b.grow(p));
+        b
+    }
+}
+
+/// Everything that can go wrong loading a scene. Every message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{}: cannot read the file: {source}", file.display())]
+    Io { file: PathBuf, source: std::io::Error },
+    #[error("{}: not a readable glTF/GLB file (malformed JSON or binary container): {detail}", file.display())]
+    Malformed { file: PathBuf, detail: String },
+    #[error("{}: invalid glTF: {detail}", file.display())]
+    Invalid { file: PathBuf, detail: String },
+    #[error("{}: unsupported glTF feature: {feature}", file.display())]
+    Unsupported { file: PathBuf, feature: String },
+    #[error("{}: cannot load buffer or image data: {detail}", file.display())]
+    Data { file: PathBuf, detail: String },
+    #[error("{}: mesh '{mesh}' primitive {primitive}: {problem}", file.display())]
+    BadPrimitive { file: PathBuf, mesh: String, primitive: usize, problem: String },
+}
+
+impl Scene {
+    /// Loads a `.gltf` (with embedded or external buffers/images) or `.glb` file.
+    /// Orthographic cameras are ignored (the tracer only has a perspective model); a scene without
+    /// a perspective camera loads with `cameras` empty and the caller chooses a fallback.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        load::load(path)
+    }
+
+    /// World-space bounds of all triangles (empty box for an empty scene).
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for t in &self.triangles {
+            for &i in &t.indices {
+                b.grow(self.vertices[i as usize].position);
+            }
+        }
+        b
+    }
+
+    /// World-space triangle corners, by triangle index (the BVH's input).
+    pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
+        self.triangles
+            .iter()
+            .map(|t| t.indices.map(|i| self.vertices[i as usize].position))
+            .collect()
+    }
+
+    /// The first perspective camera, if any.
+    pub fn default_camera(&self) -> Option<&Camera> {
+        self.cameras.first()
+    }
+}
+
+#[cfg(test)]
+mod load_tests;

@@ -1,0 +1,1 @@
+//! Empty: this crate exists for the link directives of its build script.

@@ -1,0 +1,187 @@
+//! Uploads a CPU scene (`fovea_scene::Scene`) into the GPU buffers the tracing passes bind:
+//! BVH nodes and leaf triangles as texel buffers, shading data as std430 storage buffers.
+
+use crate::error::{Error, Result};
+use crate::graph::{read_buffer, read_texels, Bind};
+use crate::layouts::{
+    LightGpu, MaterialGpu, TextureGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_POINT,
+    LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
+};
+use crate::scene::bvh::Bvh;
+use crate::scene::lights::{build_light_table, LightKind};
+use crate::scene::{Aabb, PunctualLight, Scene};
+use crate::vk::{Buffer, Context};
+use ash::vk;
+use glam::{UVec4, Vec4};
+use std::sync::Arc;
+
+/// Must match BVH_STACK_SIZE in shaders/common/bvh.glsl: deeper trees could lose hits.
+pub const MAX_BVH_DEPTH: u32 = 64;
+
+pub struct GpuScene {
+    pub bvh_nodes: Buffer,
+    pub bvh_triangles: Buffer,
+    pub vertices: Buffer,
+    pub triangles: Buffer,
+    pub materials: Buffer,
+    pub textures: Buffer,
+    pub texels: Buffer,
+    pub lights: Buffer,
+    pub light_count: u32,
+    pub triangle_count: u32,
+    pub material_count: u32,
+    pub texture_count: u32,
+    pub bounds: Aabb,
+    pub bvh_depth: u32,
+    pub bvh_bytes: usize,
+}
+
+impl GpuScene {
+    pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
+        let positions = scene.triangle_positions();
+        let bvh = Bvh::build(&positions);
+        GpuScene::upload_with_bvh(ctx, scene, &positions, &bvh)
+    }
+
+    pub fn upload_with_bvh(ctx: &Arc<Context>, scene: &Scene, positions: &[[glam::Vec3; 3]], bvh: &Bvh) -> Result<GpuScene> {
+        let depth = bvh.depth();
+        if depth > MAX_BVH_DEPTH {
+            return Err(Error::Invalid(format!(
+                "{}: BVH depth {depth} exceeds the traversal stack ({MAX_BVH_DEPTH})",
+                scene.source.display()
+            )));
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let vertices: Vec<VertexGpu> = scene
+            .vertices
+            .iter()
+            .map(|v| VertexGpu {
+                position_u: v.position.extend(v.uv.x),
+                normal_v: v.normal.extend(v.uv.y),
+                tangent: v.tangent,
+            })
+            .collect();
+        let mut triangles = Vec::with_capacity(scene.triangles.len());
+        for t in &scene.triangles {
+            if t.material > 0xffff || t.mesh > 0xffff {
+                return Err(Error::Invalid(format!("{}: more than 65536 materials or meshes", scene.source.display())));
+            }
+            triangles.push(TriangleGpu { vertices: UVec4::new(t.indices[0], t.indices[1], t.indices[2], t.material | (t.mesh << 16)) });
+        }
+        let materials: Vec<MaterialGpu> = scene.materials.iter().map(material_gpu).collect();
+        let (textures, texels) = pack_textures(scene);
+        let lights = light_entries(scene);
+
+        Ok(GpuScene {
+            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &bvh.node_texels())?,
+            bvh_triangles: Buffer::texels(ctx, "bvh_triangles", &bvh.triangle_texels(positions))?,
+            vertices: Buffer::with_data(ctx, "vertices", &vertices, storage)?,
+            triangles: Buffer::with_data(ctx, "triangles", &triangles, storage)?,
+            materials: Buffer::with_data(ctx, "materials", &materials, storage)?,
+            textures: Buffer::with_data(ctx, "textures", &textures, storage)?,
+            texels: Buffer::with_data(ctx, "texels", &texels, storage)?,
+            lights: Buffer::with_data(ctx, "lights", &lights, storage)?,
+            light_count: lights.len() as u32,
+            triangle_count: triangles.len() as u32,
+            material_count: materials.len() as u32,
+            texture_count: textures.len() as u32,
+            bounds: scene.bounds(),
+            bvh_depth: depth,
+            bvh_bytes: bvh.memory_bytes(),
+        })
+    }
+
+    /// The scene bindings of `shaders/common/scene.glsl` (all read-only).
+    pub fn binds(&self) -> [Bind<'_>; 8] {
+        [
+            read_texels("bvh_nodes", &self.bvh_nodes),
+            read_texels("bvh_triangles", &self.bvh_triangles),
+            read_buffer("vertices", &self.vertices),
+            read_buffer("triangles", &self.triangles),
+            read_buffer("materials", &self.materials),
+            read_buffer("textures", &self.textures),
+            read_buffer("texels", &self.texels),
+            read_buffer("lights", &self.lights),
+        ]
+    }
+
+    /// Centre and radius of the scene's bounding sphere.
+    pub fn bounding_sphere(&self) -> Vec4 {
+        let centre = (self.bounds.min + self.bounds.max) * 0.5;
+        centre.extend((self.bounds.max - self.bounds.min).length() * 0.5)
+    }
+}
+
+fn texture_index(t: Option<u32>) -> u32 {
+    t.unwrap_or(NO_TEXTURE)
+}
+
+fn material_gpu(m: &crate::scene::Material) -> MaterialGpu {
+    MaterialGpu {
+        base_color: m.base_color,
+        emissive: m.emissive.extend(0.0),
+        specular: m.specular_color.extend(m.specular_factor),
+        surface: Vec4::new(m.metallic, m.roughness, m.ior, m.normal_scale),
+        textures: UVec4::new(
+            texture_index(m.base_color_texture),
+            texture_index(m.metallic_roughness_texture),
+            texture_index(m.normal_texture),
+            texture_index(m.emissive_texture),
+        ),
+        textures2: UVec4::new(
+            texture_index(m.specular_texture),
+            texture_index(m.specular_color_texture),
+            if m.double_sided { MATERIAL_DOUBLE_SIDED } else { 0 },
+            0,
+        ),
+    }
+}
+
+/// All textures in one RGBA8 texel array (one u32 per texel), each with its offset and size.
+fn pack_textures(scene: &Scene) -> (Vec<TextureGpu>, Vec<u32>) {
+    let total: usize = scene.textures.iter().map(|t| (t.width * t.height) as usize).sum();
+    let mut texels = Vec::with_capacity(total);
+    let mut infos = Vec::with_capacity(scene.textures.len());
+    for t in &scene.textures {
+        infos.push(TextureGpu { extent: UVec4::new(texels.len() as u32, t.width, t.height, 0) });
+        texels.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+    }
+    (infos, texels)
+}
+
+fn light_entries(scene: &Scene) -> Vec<LightGpu> {
+    let table = build_light_table(scene);
+    table
+        .entries
+        .iter()
+        .zip(&table.alias)
+        .map(|(entry, slot)| {
+            let mut gpu = LightGpu {
+                kind_index: UVec4::new(LIGHT_KIND_TRIANGLE, entry.index, slot.alias, 0),
+                sampling: Vec4::new(slot.threshold, slot.pdf, 0.0, 0.0),
+                ..Default::default()
+            };
+            if entry.kind != LightKind::EmissiveTriangle {
+                match &scene.punctual_lights[entry.index as usize] {
+                    PunctualLight::Point { position, intensity, range } => {
+                        gpu.kind_index.x = LIGHT_KIND_POINT;
+                        gpu.position = position.extend(range.unwrap_or(0.0));
+                        gpu.intensity = intensity.extend(1.0);
+                    }
+                    PunctualLight::Spot { position, direction, intensity, range, inner_cone, outer_cone } => {
+                        gpu.kind_index.x = LIGHT_KIND_SPOT;
+                        gpu.position = position.extend(range.unwrap_or(0.0));
+                        gpu.direction = direction.extend(outer_cone.cos());
+                        gpu.intensity = intensity.extend(inner_cone.cos());
+                    }
+                    PunctualLight::Directional { direction, illuminance } => {
+                        gpu.kind_index.x = LIGHT_KIND_DIRECTIONAL;
+                        gpu.direction = direction.extend(0.0);
+                        gpu.intensity = illuminance.extend(0.0);
+                    }
+                }
+            }
+            gpu
+        })
+        .collect()
+}

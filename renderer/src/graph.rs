@@ -1,0 +1,371 @@
+//! Records one frame: a sequence of compute passes whose resource accesses are declared at bind
+//! time, so barriers are derived here instead of being written at each call site. Every pass is
+//! wrapped in a debug label and a pair of GPU timestamps.
+//!
+//! All passes are compute (plus copies), all images stay in GENERAL layout, so a hazard needs only
+//! a global memory barrier: read-after-write, write-after-write and write-after-read are detected
+//! per resource since the last barrier.
+
+use crate::error::{Error, Result};
+use crate::vk::{Buffer, ComputePipeline, Context, Image, ResourceId};
+use ash::vk;
+use std::sync::Arc;
+
+const MAX_BINDINGS: usize = 24;
+
+#[derive(Clone, Copy)]
+pub enum Resource<'a> {
+    Buffer(&'a Buffer),
+    Texels(&'a Buffer),
+    Image(&'a Image),
+}
+
+impl Resource<'_> {
+    fn id(&self) -> ResourceId {
+        match self {
+            Resource::Buffer(b) | Resource::Texels(b) => b.id,
+            Resource::Image(i) => i.id,
+        }
+    }
+}
+
+/// One shader binding: its GLSL name, the resource, and whether the pass writes it.
+#[derive(Clone, Copy)]
+pub struct Bind<'a> {
+    pub name: &'static str,
+    pub resource: Resource<'a>,
+    pub write: bool,
+}
+
+pub fn read_buffer<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
+    Bind { name, resource: Resource::Buffer(b), write: false }
+}
+pub fn write_buffer<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
+    Bind { name, resource: Resource::Buffer(b), write: true }
+}
+pub fn read_texels<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
+    Bind { name, resource: Resource::Texels(b), write: false }
+}
+pub fn read_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
+    Bind { name, resource: Resource::Image(i), write: false }
+}
+pub fn write_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
+    Bind { name, resource: Resource::Image(i), write: true }
+}
+
+/// GPU time of one pass in the last submitted frame.
+#[derive(Clone, Copy, Debug)]
+pub struct PassTiming {
+    pub name: &'static str,
+    pub ms: f64,
+}
+
+pub struct FrameRecorder {
+    ctx: Arc<Context>,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    queries: vk::QueryPool,
+    max_passes: u32,
+    passes: Vec<&'static str>,
+    read_since_barrier: Vec<ResourceId>,
+    written_since_barrier: Vec<ResourceId>,
+    timings: Vec<PassTiming>,
+    recording: bool,
+}
+
+impl FrameRecorder {
+    pub fn new(ctx: &Arc<Context>, max_passes: u32) -> Result<FrameRecorder> {
+        let pool = *ctx.pool.lock().expect("command pool lock");
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc)? }[0];
+        let fence = unsafe { ctx.device.create_fence(&vk::FenceCreateInfo::default(), None)? };
+        let query_info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(max_passes * 2);
+        let queries = unsafe { ctx.device.create_query_pool(&query_info, None)? };
+        Ok(FrameRecorder {
+            ctx: ctx.clone(),
+            cmd,
+            fence,
+            queries,
+            max_passes,
+            passes: Vec::with_capacity(max_passes as usize),
+            read_since_barrier: Vec::with_capacity(64),
+            written_since_barrier: Vec::with_capacity(64),
+            timings: Vec::with_capacity(max_passes as usize),
+            recording: false,
+        })
+    }
+
+    pub fn begin(&mut self) -> Result<()> {
+        let device = &self.ctx.device;
+        unsafe {
+            device.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
+            let info = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            device.begin_command_buffer(self.cmd, &info)?;
+            device.cmd_reset_query_pool(self.cmd, self.queries, 0, self.max_passes * 2);
+        }
+        self.passes.clear();
+        self.read_since_barrier.clear();
+        self.written_since_barrier.clear();
+        self.recording = true;
+        Ok(())
+    }
+
+    /// Records one compute dispatch covering `threads` invocations.
+    pub fn dispatch(
+        &mut self,
+        pass: &'static str,
+        pipeline: &ComputePipeline,
+        binds: &[Bind],
+        push: &[u8],
+        threads: [u32; 3],
+    ) -> Result<()> {
+        self.check_bindings(pass, pipeline, binds, push)?;
+        let used = |b: &&Bind| pipeline.bindings.iter().any(|x| x.name == b.name);
+        self.barrier_for(binds.iter().filter(used).map(|b| (b.resource.id(), b.write)));
+        let index = self.open_pass(pass)?;
+        let device = &self.ctx.device;
+
+        let mut buffer_infos = [vk::DescriptorBufferInfo::default(); MAX_BINDINGS];
+        let mut image_infos = [vk::DescriptorImageInfo::default(); MAX_BINDINGS];
+        let mut views = [vk::BufferView::null(); MAX_BINDINGS];
+        for (i, b) in binds.iter().enumerate() {
+            match b.resource {
+                Resource::Buffer(buf) => {
+                    buffer_infos[i] = vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }
+                }
+                Resource::Texels(buf) => views[i] = buf.texel_view.unwrap_or_default(),
+                Resource::Image(img) => {
+                    image_infos[i] = vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: img.view,
+                        image_layout: vk::ImageLayout::GENERAL,
+                    }
+                }
+            }
+        }
+        let mut writes = [vk::WriteDescriptorSet::default(); MAX_BINDINGS];
+        let mut count = 0;
+        for (i, b) in binds.iter().enumerate() {
+            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else { continue };
+            let w = vk::WriteDescriptorSet::default().dst_binding(info.binding).descriptor_type(info.ty);
+            writes[count] = match b.resource {
+                Resource::Buffer(_) => w.buffer_info(std::slice::from_ref(&buffer_infos[i])),
+                Resource::Texels(_) => w.texel_buffer_view(std::slice::from_ref(&views[i])),
+                Resource::Image(_) => w.image_info(std::slice::from_ref(&image_infos[i])),
+            };
+            count += 1;
+        }
+        let groups = pipeline.groups_for(threads);
+        unsafe {
+            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw);
+            self.ctx.push_descriptor.cmd_push_descriptor_set(
+                self.cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                pipeline.layout,
+                0,
+                &writes[..count],
+            );
+            if !push.is_empty() {
+                device.cmd_push_constants(self.cmd, pipeline.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+            }
+            device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
+        }
+        self.close_pass(index);
+        Ok(())
+    }
+
+    /// Fills a buffer with a 32-bit value (clearing counters).
+    pub fn fill_buffer(&mut self, pass: &'static str, buffer: &Buffer, value: u32) -> Result<()> {
+        self.barrier_for([(buffer.id, true)].into_iter());
+        let index = self.open_pass(pass)?;
+        unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value) };
+        self.close_pass(index);
+        Ok(())
+    }
+
+    /// Copies an image into a host-visible buffer (tightly packed rows) for read-back.
+    pub fn copy_image_to_buffer(&mut self, pass: &'static str, image: &Image, buffer: &Buffer) -> Result<()> {
+        if buffer.size < image.width as u64 * image.height as u64 * image.texel_bytes() {
+            return Err(Error::Binding { pass: pass.into(), reason: format!("buffer '{}' too small for image '{}'", buffer.name, image.name) });
+        }
+        self.barrier_for([(image.id, false), (buffer.id, true)].into_iter());
+        let index = self.open_pass(pass)?;
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            })
+            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::GENERAL, buffer.raw, &[region])
+        };
+        self.close_pass(index);
+        Ok(())
+    }
+
+    /// Submits the frame, waits for it and reads the pass timings back.
+    pub fn submit_and_wait(&mut self) -> Result<&[PassTiming]> {
+        let device = &self.ctx.device;
+        let all = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
+        let to_host = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(vk::AccessFlags::HOST_READ);
+        unsafe {
+            device.cmd_pipeline_barrier(
+                self.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &[to_host],
+                &[],
+                &[],
+            );
+            device.end_command_buffer(self.cmd)?;
+        }
+        self.recording = false;
+        let last_pass = || self.passes.last().copied().unwrap_or("<none>").to_string();
+        let lost = |e: vk::Result| match e {
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { last_pass: last_pass() },
+            other => Error::Vulkan(other),
+        };
+        let cmds = [self.cmd];
+        let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+        unsafe {
+            let _guard = self.ctx.queue_lock.lock().expect("queue lock");
+            device.queue_submit(self.ctx.queue, &[submit], self.fence).map_err(lost)?;
+        }
+        unsafe {
+            device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(lost)?;
+            device.reset_fences(&[self.fence])?;
+        }
+        self.timings.clear();
+        if !self.passes.is_empty() {
+            let mut stamps = [0u64; 256];
+            let count = (self.passes.len() * 2).min(stamps.len());
+            unsafe {
+                device.get_query_pool_results(
+                    self.queries,
+                    0,
+                    &mut stamps[..count],
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )?
+            };
+            let period_ms = self.ctx.info.timestamp_period_ns as f64 * 1e-6;
+            for (i, name) in self.passes.iter().enumerate() {
+                let ticks = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
+                self.timings.push(PassTiming { name, ms: ticks as f64 * period_ms });
+            }
+        }
+        Ok(&self.timings)
+    }
+
+    pub fn timings(&self) -> &[PassTiming] {
+        &self.timings
+    }
+
+    fn check_bindings(&self, pass: &str, pipeline: &ComputePipeline, binds: &[Bind], push: &[u8]) -> Result<()> {
+        let fail = |reason: String| Err(Error::Binding { pass: pass.to_string(), reason });
+        if !self.recording {
+            return fail("recorded outside begin()/submit_and_wait()".into());
+        }
+        if push.len() as u32 != pipeline.push_size {
+            return fail(format!("{} push-constant bytes given, shader takes {}", push.len(), pipeline.push_size));
+        }
+        if binds.len() > MAX_BINDINGS {
+            return fail(format!("more than {MAX_BINDINGS} bindings"));
+        }
+        for b in binds {
+            // Names the shader does not declare are skipped: the optimiser drops unused
+            // bindings, so a shared binding list (the scene's) may name more than a kernel uses.
+            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else { continue };
+            let ok = matches!(
+                (b.resource, info.ty),
+                (Resource::Buffer(_), vk::DescriptorType::STORAGE_BUFFER)
+                    | (Resource::Texels(_), vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                    | (Resource::Image(_), vk::DescriptorType::STORAGE_IMAGE)
+            );
+            if !ok {
+                return fail(format!("binding '{}' is a {:?} in the shader", b.name, info.ty));
+            }
+        }
+        for info in &pipeline.bindings {
+            if binds.iter().filter(|b| b.name == info.name).count() != 1 {
+                return fail(format!("shader binding '{}' must be bound exactly once", info.name));
+            }
+        }
+        Ok(())
+    }
+
+    fn barrier_for(&mut self, accesses: impl Iterator<Item = (ResourceId, bool)> + Clone) {
+        let hazard = accesses.clone().any(|(id, write)| {
+            self.written_since_barrier.contains(&id) || (write && self.read_since_barrier.contains(&id))
+        });
+        if hazard {
+            let all = vk::AccessFlags::SHADER_READ
+                | vk::AccessFlags::SHADER_WRITE
+                | vk::AccessFlags::TRANSFER_READ
+                | vk::AccessFlags::TRANSFER_WRITE;
+            let barrier = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(all);
+            let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+            unsafe {
+                self.ctx.device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[])
+            };
+            self.read_since_barrier.clear();
+            self.written_since_barrier.clear();
+        }
+        for (id, write) in accesses {
+            if write {
+                self.written_since_barrier.push(id);
+            } else {
+                self.read_since_barrier.push(id);
+            }
+        }
+    }
+
+    fn open_pass(&mut self, pass: &'static str) -> Result<u32> {
+        let index = self.passes.len() as u32;
+        if index >= self.max_passes {
+            return Err(Error::Binding { pass: pass.into(), reason: format!("more than {} passes in one frame", self.max_passes) });
+        }
+        self.passes.push(pass);
+        unsafe {
+            if let Some(du) = &self.ctx.debug_utils {
+                let mut name = [0u8; 64];
+                let n = pass.len().min(63);
+                name[..n].copy_from_slice(&pass.as_bytes()[..n]);
+                let label = vk::DebugUtilsLabelEXT::default()
+                    .label_name(std::ffi::CStr::from_bytes_until_nul(&name).unwrap_or(c"pass"));
+                du.cmd_begin_debug_utils_label(self.cmd, &label);
+            }
+            self.ctx.device.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::COMPUTE_SHADER, self.queries, 2 * index);
+        }
+        Ok(index)
+    }
+
+    fn close_pass(&mut self, index: u32) {
+        unsafe {
+            self.ctx.device.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::COMPUTE_SHADER, self.queries, 2 * index + 1);
+            if let Some(du) = &self.ctx.debug_utils {
+                du.cmd_end_debug_utils_label(self.cmd);
+            }
+        }
+    }
+}
+
+impl Drop for FrameRecorder {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            self.ctx.device.destroy_query_pool(self.queries, None);
+            self.ctx.device.destroy_fence(self.fence, None);
+            if let Ok(pool) = self.ctx.pool.lock() {
+                self.ctx.device.free_command_buffers(*pool, &[self.cmd]);
+            }
+        }
+    }
+}

@@ -1,0 +1,18 @@
+//! The fovea engine: records Vulkan compute command buffers that trace, filter and remap
+//! foveated samples. Read the modules in pipeline order:
+//! `scene` (what is traced, CPU side, crate `fovea_scene`) → `gpu_scene` (its upload) →
+//! `sampling` (where samples go) → `passes` (trace, accumulate, tonemap) → `pipeline` (one frame).
+//! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
+
+pub mod error;
+pub mod gpu_scene;
+pub mod graph;
+pub mod layouts;
+pub mod passes;
+pub mod pipeline;
+pub mod sampling;
+pub mod shaders;
+pub mod vk;
+
+pub use error::{Error, Result};
+pub use fovea_scene as scene;

@@ -1,0 +1,90 @@
+//! The path-tracing pass: one sample per sampling-grid texel, writing the per-sample G-buffer.
+
+use super::push_bytes;
+use crate::error::Result;
+use crate::gpu_scene::GpuScene;
+use crate::graph::{read_buffer, write_buffer, write_image, FrameRecorder};
+use crate::layouts::TracePush;
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use ash::vk;
+use glam::{UVec2, UVec4};
+use std::sync::Arc;
+
+/// Everything the tracer writes per sample, sized to the sampling grid. Denoisers read these.
+pub struct GBuffer {
+    pub size: UVec2,
+    /// Full radiance (what a viewer sees without a denoiser).
+    pub color: Image,
+    /// Radiance divided by albedo (demodulated; exactly `color / albedo`).
+    pub radiance: Image,
+    pub albedo: Image,
+    /// Shading normal (xyz) and linear view depth (w, 0 where nothing was hit).
+    pub normal_depth: Image,
+    /// Hit position relative to the camera (xyz) and the depth change per pixel (w).
+    pub position: Image,
+    /// x: triangle index + 1 (0: miss); y: material | mesh << 16.
+    pub ids: Image,
+    /// Previous frame's screen position of the surface (−1: none).
+    pub motion: Image,
+}
+
+impl GBuffer {
+    pub fn new(ctx: &Arc<Context>, size: UVec2) -> Result<GBuffer> {
+        let image = |name: &str, format| Image::new(ctx, name, size.x, size.y, format);
+        Ok(GBuffer {
+            size,
+            color: image("gbuffer.color", vk::Format::R32G32B32A32_SFLOAT)?,
+            radiance: image("gbuffer.radiance", vk::Format::R32G32B32A32_SFLOAT)?,
+            albedo: image("gbuffer.albedo", vk::Format::R16G16B16A16_SFLOAT)?,
+            normal_depth: image("gbuffer.normal_depth", vk::Format::R32G32B32A32_SFLOAT)?,
+            position: image("gbuffer.position", vk::Format::R32G32B32A32_SFLOAT)?,
+            ids: image("gbuffer.ids", vk::Format::R32G32_UINT)?,
+            motion: image("gbuffer.motion", vk::Format::R32G32_SFLOAT)?,
+        })
+    }
+}
+
+pub struct TracePass {
+    pipeline: ComputePipeline,
+}
+
+/// Counters the trace kernel fills: primary, shadow and continuation rays (one u32 each).
+pub const RAY_COUNTERS: usize = 4;
+
+impl TracePass {
+    pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {
+        let shader = format!("passes/trace.{sampling_variant}");
+        Ok(TracePass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<TracePush>() as u32)? })
+    }
+
+    /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
+    /// frame (reference accumulation); real-time frames use 0.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        scene: &GpuScene,
+        frame: &Buffer,
+        sampling: &Buffer,
+        ray_counters: &Buffer,
+        out: &GBuffer,
+        sample_index: u32,
+    ) -> Result<()> {
+        let s = scene.binds();
+        let binds = [
+            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
+            read_buffer("frame", frame),
+            read_buffer("sampling", sampling),
+            write_buffer("ray_counters", ray_counters),
+            write_image("out_color", &out.color),
+            write_image("out_radiance", &out.radiance),
+            write_image("out_albedo", &out.albedo),
+            write_image("out_normal_depth", &out.normal_depth),
+            write_image("out_position", &out.position),
+            write_image("out_ids", &out.ids),
+            write_image("out_motion", &out.motion),
+        ];
+        let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
+        rec.dispatch("trace", &self.pipeline, &binds, push_bytes(&push), [out.size.x, out.size.y, 1])
+    }
+}

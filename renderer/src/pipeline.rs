@@ -1,0 +1,256 @@
+//! Composes a frame: sampling space → trace → (denoiser slot) → screen image → tonemap → read-back.
+//! Also renders converged references by accumulating many samples.
+
+use crate::error::{Error, Result};
+use crate::gpu_scene::GpuScene;
+use crate::graph::{FrameRecorder, PassTiming};
+use crate::layouts::{FrameData, FRAME_FLAG_REFERENCE};
+use crate::passes::accumulate::AccumulatePass;
+use crate::passes::tonemap::{TonemapPass, ToneCurve};
+use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::sampling::SamplingSpace;
+use crate::scene::{Camera, Scene};
+use crate::vk::{Buffer, Context, Image};
+use ash::vk;
+use glam::{Mat4, UVec4, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// The real-time path: primary ray, one indirect bounce, next-event estimation at both hits.
+pub const REALTIME_MAX_DEPTH: u32 = 3;
+/// Passes one reference submission may hold (trace + accumulate per sample).
+const REFERENCE_SAMPLES_PER_SUBMIT: u32 = 8;
+
+/// A pinhole camera: rigid pose and the tangents of its four half-angles (left/down negative).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraPose {
+    pub world_from_view: Mat4,
+    pub fov_tan: Vec4,
+}
+
+impl CameraPose {
+    /// A glTF camera fitted to an output size: `yfov` is kept and the horizontal extent follows
+    /// the output's aspect ratio, so pixels stay square.
+    pub fn from_scene_camera(camera: &Camera, width: u32, height: u32) -> CameraPose {
+        let ty = (camera.yfov * 0.5).tan();
+        let tx = ty * width as f32 / height as f32;
+        CameraPose { world_from_view: camera.world_from_view, fov_tan: Vec4::new(-tx, tx, -ty, ty) }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    pub max_depth: u32,
+    pub seed: u32,
+    pub exposure: f32,
+    pub tone_curve: ToneCurve,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings { max_depth: REALTIME_MAX_DEPTH, seed: 1, exposure: 1.0, tone_curve: ToneCurve::Aces }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInput {
+    pub camera: CameraPose,
+    pub frame_index: u32,
+    /// Also copy the linear screen image back (EXR output).
+    pub read_hdr: bool,
+}
+
+/// Exact counts for one frame (from the GPU's own counters).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    pub samples_traced: u64,
+    pub primary_rays: u64,
+    pub shadow_rays: u64,
+    pub continuation_rays: u64,
+}
+
+impl FrameStats {
+    pub fn rays_traced(&self) -> u64 {
+        self.primary_rays + self.shadow_rays + self.continuation_rays
+    }
+}
+
+pub struct Renderer {
+    ctx: Arc<Context>,
+    pub scene: GpuScene,
+    space: Box<dyn SamplingSpace>,
+    pub settings: RenderSettings,
+    frame_data: Buffer,
+    sampling: Buffer,
+    ray_counters: Buffer,
+    trace: TracePass,
+    accumulate: AccumulatePass,
+    tonemap: TonemapPass,
+    pub gbuffer: GBuffer,
+    accum: Image,
+    ldr: Image,
+    ldr_readback: Buffer,
+    hdr_readback: Buffer,
+    recorder: FrameRecorder,
+    prev_camera: Option<CameraPose>,
+}
+
+impl Renderer {
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
+        let gpu_scene = GpuScene::upload(ctx, scene)?;
+        Renderer::with_gpu_scene(ctx, gpu_scene, space, settings)
+    }
+
+    pub fn with_gpu_scene(ctx: &Arc<Context>, scene: GpuScene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
+        if settings.max_depth == 0 {
+            return Err(Error::Invalid("max depth must be at least 1 (1 = emission seen directly)".into()));
+        }
+        let grid = space.grid_size();
+        let screen = space.screen_size();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let readback = |name: &str, bytes: u64| {
+            Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
+        };
+        let pixels = screen.x as u64 * screen.y as u64;
+        Ok(Renderer {
+            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], storage)?,
+            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], storage)?,
+            ray_counters: Buffer::new(
+                ctx,
+                "ray_counters",
+                (RAY_COUNTERS * 4) as u64,
+                storage | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?,
+            trace: TracePass::new(ctx, space.shader_variant())?,
+            accumulate: AccumulatePass::new(ctx)?,
+            tonemap: TonemapPass::new(ctx)?,
+            gbuffer: GBuffer::new(ctx, grid)?,
+            accum: Image::new(ctx, "accum", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?,
+            ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
+            ldr_readback: readback("ldr_readback", pixels * 4)?,
+            hdr_readback: readback("hdr_readback", pixels * 16)?,
+            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 8)?,
+            prev_camera: None,
+            ctx: ctx.clone(),
+            scene,
+            space,
+            settings,
+        })
+    }
+
+    pub fn space(&self) -> &dyn SamplingSpace {
+        self.space.as_ref()
+    }
+
+    pub fn context(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
+    /// GPU time of each pass of the last submission.
+    pub fn timings(&self) -> &[PassTiming] {
+        self.recorder.timings()
+    }
+
+    fn write_frame_data(&self, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32) -> Result<()> {
+        let screen = self.space.screen_size().as_vec2();
+        let prev = self.prev_camera.unwrap_or(*camera);
+        let data = FrameData {
+            world_from_view: camera.world_from_view,
+            prev_view_from_world: prev.world_from_view.inverse(),
+            fov_tan: camera.fov_tan,
+            prev_fov_tan: prev.fov_tan,
+            screen: Vec4::new(screen.x, screen.y, 1.0 / screen.x, 1.0 / screen.y),
+            frame: UVec4::new(frame_index, self.settings.seed, max_depth, flags),
+            counts: UVec4::new(
+                self.scene.light_count,
+                self.scene.triangle_count,
+                self.scene.material_count,
+                self.scene.texture_count,
+            ),
+            scene_sphere: self.scene.bounding_sphere(),
+        };
+        self.frame_data.write(&[data])
+    }
+
+    /// Renders one real-time frame into the screen image and reads the tonemapped result back.
+    pub fn render_frame(&mut self, input: &FrameInput) -> Result<FrameStats> {
+        self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, 0)?;
+        self.sampling.write(&[self.space.params()])?;
+        let rec = &mut self.recorder;
+        rec.begin()?;
+        rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
+        self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.ray_counters, &self.gbuffer, 0)?;
+        // Denoisers and the remap to screen slot in here; Cartesian samples are the screen.
+        let screen_hdr = &self.gbuffer.color;
+        self.tonemap.record(rec, screen_hdr, &self.ldr, self.settings.exposure, self.settings.tone_curve)?;
+        rec.copy_image_to_buffer("readback", &self.ldr, &self.ldr_readback)?;
+        if input.read_hdr {
+            rec.copy_image_to_buffer("readback_hdr", screen_hdr, &self.hdr_readback)?;
+        }
+        rec.submit_and_wait()?;
+        self.prev_camera = Some(input.camera);
+        let counters: Vec<u32> = self.ray_counters.read()?;
+        Ok(FrameStats {
+            samples_traced: counters[0] as u64,
+            primary_rays: counters[0] as u64,
+            shadow_rays: counters[1] as u64,
+            continuation_rays: counters[2] as u64,
+        })
+    }
+
+    /// The last frame's tonemapped pixels, RGBA8, rows top to bottom.
+    pub fn read_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
+        let bytes: Vec<u8> = self.ldr_readback.read()?;
+        out.clear();
+        out.extend_from_slice(&bytes);
+        Ok(())
+    }
+
+    /// The last frame's (or reference's) linear screen image, RGBA32F.
+    pub fn read_hdr(&self, out: &mut Vec<[f32; 4]>) -> Result<()> {
+        let texels: Vec<[f32; 4]> = self.hdr_readback.read()?;
+        out.clear();
+        out.extend_from_slice(&texels);
+        Ok(())
+    }
+
+    /// Converged linear radiance: the mean of `spp` samples per pixel with paths of up to
+    /// `max_depth` vertices. `progress` gets the number of samples done after each submission.
+    pub fn render_reference(
+        &mut self,
+        camera: &CameraPose,
+        spp: u32,
+        max_depth: u32,
+        mut progress: impl FnMut(u32),
+    ) -> Result<Vec<[f32; 4]>> {
+        if spp == 0 || max_depth == 0 {
+            return Err(Error::Invalid("reference needs spp ≥ 1 and max depth ≥ 1".into()));
+        }
+        if self.space.grid_size() != self.space.screen_size() {
+            return Err(Error::Invalid("references are rendered in Cartesian space".into()));
+        }
+        self.prev_camera = None;
+        self.write_frame_data(camera, 0, max_depth, FRAME_FLAG_REFERENCE)?;
+        self.sampling.write(&[self.space.params()])?;
+        let mut done = 0;
+        while done < spp {
+            let batch = (spp - done).min(REFERENCE_SAMPLES_PER_SUBMIT);
+            let rec = &mut self.recorder;
+            rec.begin()?;
+            for s in done..done + batch {
+                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.ray_counters, &self.gbuffer, s)?;
+                self.accumulate.record(rec, &self.gbuffer.color, &self.accum, s)?;
+            }
+            if done + batch == spp {
+                rec.copy_image_to_buffer("readback_hdr", &self.accum, &self.hdr_readback)?;
+            }
+            rec.submit_and_wait()?;
+            done += batch;
+            progress(done);
+        }
+        let mut out = Vec::new();
+        self.read_hdr(&mut out)?;
+        Ok(out)
+    }
+}

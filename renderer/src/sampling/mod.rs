@@ -1,0 +1,28 @@
+//! Sampling spaces: where the tracer's samples lie on the screen. Each space describes its grid,
+//! gives CPU forward/inverse mappings (tests and tools) and names the trace-kernel variant whose
+//! GLSL include (`shaders/sampling/`) implements the same mapping on the GPU.
+
+mod cartesian;
+
+pub use cartesian::Cartesian;
+
+use crate::layouts::SamplingParams;
+use glam::{UVec2, Vec2};
+
+pub trait SamplingSpace {
+    /// Name used in reports and on the command line (`--method`).
+    fn name(&self) -> &'static str;
+    /// Variant suffix of the kernels compiled for this space (e.g. `passes/trace.cartesian`).
+    fn shader_variant(&self) -> &'static str;
+    /// Size of the sampling grid in texels (the size of every per-sample image).
+    fn grid_size(&self) -> UVec2;
+    fn screen_size(&self) -> UVec2;
+    /// Texels that hold a sample (clipped texels are not traced).
+    fn sample_count(&self) -> u64;
+    /// The GPU parameters of this space (binding `sampling`).
+    fn params(&self) -> SamplingParams;
+    /// Screen position (pixels, y down) of a grid position (texel units, texel centre = +0.5).
+    fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2>;
+    /// Grid position of a screen position; `None` where the space has no sample.
+    fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2>;
+}

@@ -1,0 +1,258 @@
+//! Buffers and images that own their memory and free it on drop.
+
+use super::context::Context;
+use crate::error::{Error, Result};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// Identity of a resource for barrier tracking in the frame graph.
+pub type ResourceId = u64;
+
+fn next_id() -> ResourceId {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+pub struct Buffer {
+    ctx: Arc<Context>,
+    pub raw: vk::Buffer,
+    /// A texel view (RGBA32F) when the buffer was made for texel-buffer reads.
+    pub texel_view: Option<vk::BufferView>,
+    pub size: u64,
+    pub id: ResourceId,
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let raw = unsafe { ctx.device.create_buffer(&info, None)? };
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let allocation = match ctx.allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(e);
+            }
+        };
+        let mut buffer = Buffer {
+            ctx: ctx.clone(),
+            raw,
+            texel_view: None,
+            size,
+            id: next_id(),
+            name: name.to_string(),
+            allocation: None,
+        };
+        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset())? };
+        buffer.allocation = Some(allocation);
+        ctx.set_name(raw, name);
+        Ok(buffer)
+    }
+
+    /// A host-visible storage buffer filled with `data` (small per-scene or per-frame data).
+    pub fn with_data<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+        // Zero-sized buffers are invalid in Vulkan; keep one element of room.
+        let size = (std::mem::size_of_val(data) as u64).max(16);
+        let buffer = Buffer::new(ctx, name, size, usage, MemoryLocation::CpuToGpu)?;
+        buffer.write(data)?;
+        Ok(buffer)
+    }
+
+    /// A read-only RGBA32F texel buffer (BVH nodes and triangles: 5–6× faster than std430
+    /// storage reads on lavapipe, see build-notes.md).
+    pub fn texels(ctx: &Arc<Context>, name: &str, texels: &[[f32; 4]]) -> Result<Buffer> {
+        let limit = ctx.info.max_texel_buffer_elements as usize;
+        if texels.len() > limit {
+            return Err(Error::Invalid(format!("{name}: {} texels exceed the device limit {limit}", texels.len())));
+        }
+        let mut buffer = Buffer::with_data(ctx, name, texels, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER)?;
+        let info = vk::BufferViewCreateInfo::default()
+            .buffer(buffer.raw)
+            .format(vk::Format::R32G32B32A32_SFLOAT)
+            .offset(0)
+            .range(vk::WHOLE_SIZE);
+        buffer.texel_view = Some(unsafe { ctx.device.create_buffer_view(&info, None)? });
+        Ok(buffer)
+    }
+
+    pub fn write<T: bytemuck::Pod>(&self, data: &[T]) -> Result<()> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let slice = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_ptr())
+            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
+        if bytes.len() as u64 > self.size {
+            return Err(Error::Invalid(format!("buffer '{}': {} bytes do not fit in {}", self.name, bytes.len(), self.size)));
+        }
+        // SAFETY: mapped host-visible memory of at least `size` bytes, not in use by the GPU
+        // (callers write between submissions).
+        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), slice.as_ptr() as *mut u8, bytes.len()) };
+        Ok(())
+    }
+
+    /// Reads the whole buffer back as `T`s (host-visible buffers only, after the GPU is done).
+    pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
+        let ptr = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_ptr())
+            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
+        let count = self.size as usize / std::mem::size_of::<T>();
+        let mut out = vec![T::zeroed(); count];
+        // SAFETY: as in `write`; `out` holds exactly count × size_of::<T>() bytes.
+        unsafe {
+            std::ptr::copy_nonoverlapping(ptr.as_ptr() as *const u8, out.as_mut_ptr() as *mut u8, count * std::mem::size_of::<T>())
+        };
+        Ok(out)
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        unsafe {
+            if let Some(view) = self.texel_view.take() {
+                self.ctx.device.destroy_buffer_view(view, None);
+            }
+            self.ctx.device.destroy_buffer(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            self.ctx.free(a);
+        }
+    }
+}
+
+/// A 2-D storage image kept in GENERAL layout for its whole life (compute-only engine).
+pub struct Image {
+    ctx: Arc<Context>,
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub width: u32,
+    pub height: u32,
+    pub id: ResourceId,
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl Image {
+    pub fn new(ctx: &Arc<Context>, name: &str, width: u32, height: u32, format: vk::Format) -> Result<Image> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D { width, height, depth: 1 })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(
+                vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
+            )
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let raw = unsafe { ctx.device.create_image(&info, None)? };
+        let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
+        let allocation = match ctx.allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location: MemoryLocation::GpuOnly,
+            linear: false,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_image(raw, None) };
+                return Err(e);
+            }
+        };
+        unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset())? };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(color_range());
+        let view = unsafe { ctx.device.create_image_view(&view_info, None)? };
+        ctx.set_name(raw, name);
+        // Storage images live in GENERAL layout; make the transition once, here.
+        ctx.one_shot(|device, cmd| unsafe {
+            let barrier = vk::ImageMemoryBarrier::default()
+                .image(raw)
+                .old_layout(vk::ImageLayout::UNDEFINED)
+                .new_layout(vk::ImageLayout::GENERAL)
+                .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE)
+                .subresource_range(color_range());
+            device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            );
+            device.cmd_clear_color_image(cmd, raw, vk::ImageLayout::GENERAL, &vk::ClearColorValue::default(), &[color_range()]);
+        })?;
+        Ok(Image {
+            ctx: ctx.clone(),
+            raw,
+            view,
+            format,
+            width,
+            height,
+            id: next_id(),
+            name: name.to_string(),
+            allocation: Some(allocation),
+        })
+    }
+
+    pub fn texel_bytes(&self) -> u64 {
+        format_bytes(self.format)
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        unsafe {
+            self.ctx.device.destroy_image_view(self.view, None);
+            self.ctx.device.destroy_image(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            self.ctx.free(a);
+        }
+    }
+}
+
+pub fn color_range() -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+pub fn format_bytes(format: vk::Format) -> u64 {
+    match format {
+        vk::Format::R32G32B32A32_SFLOAT | vk::Format::R32G32B32A32_UINT => 16,
+        vk::Format::R16G16B16A16_SFLOAT | vk::Format::R32G32_SFLOAT | vk::Format::R32G32_UINT => 8,
+        vk::Format::R8G8B8A8_UNORM | vk::Format::R32_SFLOAT | vk::Format::R32_UINT => 4,
+        other => panic!("format {other:?} not used by this engine"),
+    }
+}

@@ -1,0 +1,111 @@
+// The one source of truth for every struct and constant shared by Rust and GLSL.
+// build.rs (renderer/build/layouts.rs) parses this file and generates the Rust side; a device
+// test reads every field back through this layout. Allowed: `const` scalars and `struct`s of
+// float/int/uint, vec2/vec4 (and i/u variants) and mat4. No vec3, no implicit padding.
+#ifndef FOVEA_LAYOUTS_GLSL
+#define FOVEA_LAYOUTS_GLSL
+
+// Local size of every 2-D image pass (8×8: 64 lanes beat 256 on lavapipe, build-notes.md).
+const uint WORKGROUP_2D = 8u;
+// Local size of 1-D passes over ray or sample lists.
+const uint WORKGROUP_1D = 64u;
+
+const uint NO_TEXTURE = 0xffffffffu;
+const uint MATERIAL_DOUBLE_SIDED = 1u;
+
+const uint LIGHT_KIND_TRIANGLE = 0u;
+const uint LIGHT_KIND_POINT = 1u;
+const uint LIGHT_KIND_SPOT = 2u;
+const uint LIGHT_KIND_DIRECTIONAL = 3u;
+
+// FrameData.frame.w flags.
+const uint FRAME_FLAG_REFERENCE = 1u;
+
+// Everything the passes need to know about the current (and previous) frame.
+struct FrameData {
+    mat4 world_from_view;       // camera: +X right, +Y up, −Z forward (glTF/OpenXR view axes)
+    mat4 prev_view_from_world;  // previous frame's camera, for the previous screen position
+    vec4 fov_tan;               // tangents of the left, right, down, up half-angles (left/down < 0)
+    vec4 prev_fov_tan;          // the same for the previous frame
+    vec4 screen;                // xy screen size in pixels, zw = 1/size
+    uvec4 frame;                // x frame index, y seed, z max path depth, w FRAME_FLAG_* bits
+    uvec4 counts;               // x light entries, y triangles, z materials, w textures
+    vec4 scene_sphere;          // xyz centre, w radius of the scene's bounding sphere
+};
+
+// Where samples lie on the screen; each sampling space gives the slots its own meaning.
+struct SamplingParams {
+    uvec4 grid;                 // xy sampling-grid size in texels, zw screen size in pixels
+    vec4 gaze;                  // xy gaze in screen pixels, z radius scale (pixels), w unused
+    vec4 shape0;                // space-specific parameters
+    vec4 shape1;
+};
+
+struct MaterialGpu {
+    vec4 base_color;            // linear RGBA factor
+    vec4 emissive;              // rgb = emissiveFactor × emissive strength, w unused
+    vec4 specular;              // rgb = KHR_materials_specular colour factor, w = specular factor
+    vec4 surface;               // x metallic, y roughness, z ior, w normal-map scale
+    uvec4 textures;             // base colour, metallic-roughness, normal, emissive (NO_TEXTURE = none)
+    uvec4 textures2;            // specular (alpha channel), specular colour, MATERIAL_* flags, unused
+};
+
+struct TextureGpu {
+    uvec4 extent;               // x first texel in the texel array, y width, z height, w unused
+};
+
+struct VertexGpu {
+    vec4 position_u;            // world position, w = texture u
+    vec4 normal_v;              // world normal, w = texture v
+    vec4 tangent;               // world tangent, w = handedness
+};
+
+struct TriangleGpu {
+    uvec4 vertices;             // xyz vertex indices, w = material | mesh << 16
+};
+
+struct LightGpu {
+    uvec4 kind_index;           // x LIGHT_KIND_*, y triangle or punctual light index, z alias slot, w unused
+    vec4 position;              // point/spot position, w = range (0: unlimited)
+    vec4 direction;             // direction the light travels (spot, directional), w = cos(outer cone)
+    vec4 intensity;             // rgb intensity (cd) or illuminance (lux), w = cos(inner cone)
+    vec4 sampling;              // x alias threshold, y probability of choosing this entry, zw unused
+};
+
+// Push constants of the trace pass.
+struct TracePush {
+    uvec4 config;               // x sample index within the frame (reference accumulation), yzw unused
+};
+
+// Push constants of the accumulate pass.
+struct AccumulatePush {
+    uvec4 config;               // x number of samples already in the accumulator
+};
+
+// Push constants of the tonemap pass.
+struct TonemapPush {
+    vec4 params;                // x exposure multiplier, yzw unused
+    uvec4 config;               // x operator (0 clamp, 1 ACES fitted), yzw unused
+};
+
+// Push constants of the raycast pass (BVH tests and ray-throughput benchmarks).
+struct RaycastPush {
+    uvec4 config;               // x ray count, y any-hit (shadow) mode, zw unused
+};
+
+// One ray for the raycast pass.
+struct RayGpu {
+    vec4 origin_tmin;
+    vec4 direction_tmax;
+};
+
+// One hit from the raycast pass.
+struct HitGpu {
+    vec4 t_u_v;                 // t (negative: miss), barycentrics u, v, unused
+    uvec4 triangle;             // x original triangle index (0xffffffff: miss), yzw unused
+};
+
+const uint TONEMAP_CLAMP = 0u;
+const uint TONEMAP_ACES = 1u;
+
+#endif

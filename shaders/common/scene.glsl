@@ -1,0 +1,129 @@
+// Scene bindings shared by every pass that traces rays, and the surface record at a hit.
+// Binding numbers live only here; the engine binds by name (reflected from SPIR-V).
+#ifndef FOVEA_SCENE_GLSL
+#define FOVEA_SCENE_GLSL
+
+#include "layouts.glsl"
+
+layout(set = 0, binding = 0) uniform samplerBuffer bvh_nodes;
+layout(set = 0, binding = 1) uniform samplerBuffer bvh_triangles;
+layout(std430, set = 0, binding = 2) readonly buffer VertexBuffer { VertexGpu data[]; } vertices;
+layout(std430, set = 0, binding = 3) readonly buffer TriangleBuffer { TriangleGpu data[]; } triangles;
+layout(std430, set = 0, binding = 4) readonly buffer MaterialBuffer { MaterialGpu data[]; } materials;
+layout(std430, set = 0, binding = 5) readonly buffer TextureBuffer { TextureGpu data[]; } textures;
+layout(std430, set = 0, binding = 6) readonly buffer TexelBuffer { uint data[]; } texels;     // RGBA8
+layout(std430, set = 0, binding = 7) readonly buffer LightBuffer { LightGpu data[]; } lights;
+layout(std430, set = 0, binding = 8) readonly buffer FrameBuffer { FrameData data; } frame;
+
+#include "bvh.glsl"
+
+vec3 srgb_to_linear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec4 texel_rgba8(uint index) {
+    return unpackUnorm4x8(texels.data[index]);
+}
+
+// Bilinear, wrap-repeat; `srgb` decodes before filtering (base colour, emissive, specular colour).
+vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
+    TextureGpu info = textures.data[tex];
+    uvec2 size = info.extent.yz;
+    vec2 p = uv * vec2(size) - 0.5;
+    vec2 f = fract(p);
+    ivec2 i0 = ivec2(floor(p));
+    vec4 acc = vec4(0.0);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        uvec2 q = uvec2((i0 + o) % ivec2(size) + ivec2(size)) % size;
+        vec4 c = texel_rgba8(info.extent.x + q.y * size.x + q.x);
+        if (srgb) c.rgb = srgb_to_linear(c.rgb);
+        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+        acc += w * c;
+    }
+    return acc;
+}
+
+struct Surface {
+    vec3 position;
+    vec3 geometric_normal;  // faces the incoming ray
+    vec3 normal;            // shading normal (normal-mapped), same hemisphere as geometric_normal
+    vec2 uv;
+    vec3 base_color;
+    float metallic;
+    float roughness;
+    vec3 emission;          // radiance leaving the front face (zero from the back unless double-sided)
+    vec3 dielectric_f0;     // F0 × specular colour, KHR_materials_ior/_specular
+    float specular_factor;
+    uint material;
+    uint mesh;
+};
+
+Surface fetch_surface(Hit hit, vec3 ray_dir) {
+    TriangleGpu tri = triangles.data[hit.triangle];
+    VertexGpu a = vertices.data[tri.vertices.x];
+    VertexGpu b = vertices.data[tri.vertices.y];
+    VertexGpu c = vertices.data[tri.vertices.z];
+    vec3 w = vec3(1.0 - hit.u - hit.v, hit.u, hit.v);
+    Surface s;
+    s.material = tri.vertices.w & 0xffffu;
+    s.mesh = tri.vertices.w >> 16u;
+    s.position = w.x * a.position_u.xyz + w.y * b.position_u.xyz + w.z * c.position_u.xyz;
+    s.uv = w.x * vec2(a.position_u.w, a.normal_v.w) + w.y * vec2(b.position_u.w, b.normal_v.w) + w.z * vec2(c.position_u.w, c.normal_v.w);
+    vec3 ng = normalize(cross(b.position_u.xyz - a.position_u.xyz, c.position_u.xyz - a.position_u.xyz));
+    bool front = dot(ng, ray_dir) < 0.0;
+    vec3 n = normalize(w.x * a.normal_v.xyz + w.y * b.normal_v.xyz + w.z * c.normal_v.xyz);
+
+    MaterialGpu m = materials.data[s.material];
+    vec4 base = m.base_color;
+    if (m.textures.x != NO_TEXTURE) base *= sample_texture(m.textures.x, s.uv, true);
+    s.base_color = base.rgb;
+    s.metallic = m.surface.x;
+    s.roughness = m.surface.y;
+    if (m.textures.y != NO_TEXTURE) {
+        vec4 mr = sample_texture(m.textures.y, s.uv, false);
+        s.roughness *= mr.g;
+        s.metallic *= mr.b;
+    }
+    if (m.textures.z != NO_TEXTURE) {
+        vec4 t4 = w.x * a.tangent + w.y * b.tangent + w.z * c.tangent;
+        vec3 t = normalize(t4.xyz - n * dot(n, t4.xyz));
+        vec3 bt = cross(n, t) * (t4.w < 0.0 ? -1.0 : 1.0);
+        vec3 tn = sample_texture(m.textures.z, s.uv, false).xyz * 2.0 - 1.0;
+        tn.xy *= m.surface.w;
+        vec3 mapped = normalize(tn.x * t + tn.y * bt + tn.z * n);
+        if (all(equal(mapped, mapped))) n = mapped; // keep the vertex normal if the map gives NaN
+    }
+    bool double_sided = (m.textures2.z & MATERIAL_DOUBLE_SIDED) != 0u;
+    vec3 emission = m.emissive.rgb;
+    if (m.textures.w != NO_TEXTURE) emission *= sample_texture(m.textures.w, s.uv, true).rgb;
+    s.emission = (front || double_sided) ? emission : vec3(0.0);
+    s.geometric_normal = front ? ng : -ng;
+    if (dot(n, s.geometric_normal) < 0.0) n = -n;
+    s.normal = n;
+    float ior = m.surface.z;
+    float f0 = (ior - 1.0) / (ior + 1.0);
+    vec3 spec_color = m.specular.rgb;
+    s.specular_factor = m.specular.w;
+    if (m.textures2.x != NO_TEXTURE) s.specular_factor *= sample_texture(m.textures2.x, s.uv, false).a;
+    if (m.textures2.y != NO_TEXTURE) spec_color *= sample_texture(m.textures2.y, s.uv, true).rgb;
+    s.dielectric_f0 = min(vec3(f0 * f0) * spec_color, vec3(1.0));
+    return s;
+}
+
+// Ray origin pushed off the surface along the geometric normal, robust at any scale
+// (Wächter & Binder, Ray Tracing Gems ch. 6).
+vec3 offset_ray(vec3 p, vec3 n) {
+    const float origin = 1.0 / 32.0, float_scale = 1.0 / 65536.0, int_scale = 256.0;
+    ivec3 of_i = ivec3(int_scale * n);
+    vec3 p_i = vec3(
+        intBitsToFloat(floatBitsToInt(p.x) + ((p.x < 0.0) ? -of_i.x : of_i.x)),
+        intBitsToFloat(floatBitsToInt(p.y) + ((p.y < 0.0) ? -of_i.y : of_i.y)),
+        intBitsToFloat(floatBitsToInt(p.z) + ((p.z < 0.0) ? -of_i.z : of_i.z)));
+    return vec3(
+        abs(p.x) < origin ? p.x + float_scale * n.x : p_i.x,
+        abs(p.y) < origin ? p.y + float_scale * n.y : p_i.y,
+        abs(p.z) < origin ? p.z + float_scale * n.z : p_i.z);
+}
+
+#endif

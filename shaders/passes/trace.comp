@@ -1,0 +1,122 @@
+#version 460
+// Path tracer, one sample per sampling-grid texel: primary ray, next-event estimation at every
+// hit, BRDF-sampled continuation (real-time: depth 3 = one indirect bounce). Writes the per-sample
+// G-buffer that the denoisers read, sized to the sampling grid.
+//! variant cartesian: SAMPLING_CARTESIAN
+
+#include "../common/scene.glsl"
+#include "../common/random.glsl"
+#include "../common/brdf.glsl"
+#include "../common/lights.glsl"
+#include "../common/camera.glsl"
+#include "../sampling/space.glsl"
+
+layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
+
+layout(push_constant) uniform Push { TracePush p; } push;
+
+layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D out_color;        // full radiance
+layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D out_radiance;     // radiance / albedo
+layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_albedo;
+layout(set = 0, binding = 13, rgba32f) uniform writeonly image2D out_normal_depth; // normal, linear depth (0: miss)
+layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;     // camera-relative position, depth gradient
+layout(set = 0, binding = 15, rg32ui) uniform writeonly uimage2D out_ids;          // triangle + 1 (0: miss), material | mesh << 16
+layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;         // previous-frame screen position (−1: none)
+// Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays.
+layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
+
+uint shadow_rays = 0u;
+uint continuation_rays = 0u;
+
+bool visible(vec3 p, vec3 n, LightSample ls) {
+    Hit h;
+    shadow_rays++;
+    return !bvh_trace(offset_ray(p, n), ls.direction, 0.0, ls.distance * (1.0 - 1e-4), true, h);
+}
+
+vec3 direct_light(Surface s, vec3 v, inout uint rng) {
+    LightSample ls;
+    if (!sample_light(s.position, rng, ls)) return vec3(0.0);
+    vec3 f = brdf_eval_cos(s, v, ls.direction);
+    if (all(equal(f, vec3(0.0))) || !visible(s.position, s.geometric_normal, ls)) return vec3(0.0);
+    return f * ls.radiance_over_pdf;
+}
+
+void main() {
+    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(texel, ivec2(sampling.data.grid.xy)))) return;
+    FrameData fd = frame.data;
+    uint rng = rng_seed(uvec2(texel), fd.frame.x, fd.frame.y, push.p.config.x);
+    vec2 screen;
+    if (!sample_screen_position(texel, rng_next2(rng), screen)) {
+        imageStore(out_color, texel, vec4(0.0));
+        imageStore(out_radiance, texel, vec4(0.0));
+        imageStore(out_albedo, texel, vec4(0.0));
+        imageStore(out_normal_depth, texel, vec4(0.0));
+        imageStore(out_position, texel, vec4(0.0));
+        imageStore(out_ids, texel, uvec4(0u));
+        imageStore(out_motion, texel, vec4(-1.0));
+        return;
+    }
+    vec3 org = fd.world_from_view[3].xyz;
+    vec3 view_dir = view_direction(screen, fd.fov_tan, fd.screen.xy);
+    vec3 dir = normalize(mat3(fd.world_from_view) * view_dir);
+    uint max_depth = fd.frame.z;
+
+    Hit hit;
+    vec3 color = vec3(0.0);
+    vec3 albedo = vec3(1.0);
+    vec4 normal_depth = vec4(0.0);
+    vec4 position = vec4(0.0);
+    uvec2 ids = uvec2(0u);
+    vec2 prev_screen = vec2(-1.0);
+    if (!bvh_trace(org, dir, 0.0, 1e30, false, hit)) {
+        // Nothing hit: no environment light; the previous position is the same direction.
+        vec3 prev_view = mat3(fd.prev_view_from_world) * dir;
+        project_view(prev_view, fd.prev_fov_tan, fd.screen.xy, prev_screen);
+    } else {
+        Surface s = fetch_surface(hit, dir);
+        vec3 p_rel = s.position - org;
+        float depth = dot(p_rel, mat3(fd.world_from_view) * vec3(0.0, 0.0, -1.0));
+        float cos_view = max(abs(dot(s.geometric_normal, dir)), 0.05);
+        float pixel_tan = (fd.fov_tan.y - fd.fov_tan.x) * fd.screen.z;
+        float depth_gradient = depth * pixel_tan * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
+        albedo = max(s.base_color, vec3(0.01));
+        normal_depth = vec4(s.normal, depth);
+        position = vec4(p_rel, depth_gradient);
+        ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
+        project_view((fd.prev_view_from_world * vec4(s.position, 1.0)).xyz, fd.prev_fov_tan, fd.screen.xy, prev_screen);
+
+        if (max_depth >= 1u) color += s.emission;
+        vec3 throughput = vec3(1.0);
+        vec3 v = -dir;
+        for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
+            color += throughput * direct_light(s, v, rng);
+            if (depth_i + 1u >= max_depth) break;
+            vec3 l, weight;
+            bool delta;
+            vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
+            if (!brdf_sample(s, v, u3, l, weight, delta)) break;
+            throughput *= weight;
+            vec3 o = offset_ray(s.position, s.geometric_normal);
+            continuation_rays++;
+            if (!bvh_trace(o, l, 0.0, 1e30, false, hit)) break;
+            s = fetch_surface(hit, l);
+            // A mirror bounce cannot be found by next-event estimation: count what it sees.
+            if (delta) color += throughput * s.emission;
+            v = -l;
+        }
+    }
+    atomicAdd(ray_counters.data[0], 1u);
+    if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);
+    if (continuation_rays > 0u) atomicAdd(ray_counters.data[2], continuation_rays);
+    // Never let a NaN/Inf from a degenerate triangle poison the accumulators downstream.
+    if (any(isnan(color)) || any(isinf(color))) color = vec3(0.0);
+    imageStore(out_color, texel, vec4(color, 1.0));
+    imageStore(out_radiance, texel, vec4(color / albedo, 1.0));
+    imageStore(out_albedo, texel, vec4(albedo, 1.0));
+    imageStore(out_normal_depth, texel, normal_depth);
+    imageStore(out_position, texel, position);
+    imageStore(out_ids, texel, uvec4(ids, 0u, 0u));
+    imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
+}

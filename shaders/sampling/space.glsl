@@ -1,0 +1,16 @@
+// Selects the sampling space a kernel variant is compiled for. Every space provides
+// `bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen)`.
+#ifndef FOVEA_SAMPLING_SPACE_GLSL
+#define FOVEA_SAMPLING_SPACE_GLSL
+
+#include "../common/layouts.glsl"
+
+layout(std430, set = 0, binding = 9) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
+
+#if defined(SAMPLING_CARTESIAN)
+#include "cartesian.glsl"
+#else
+#error "no sampling space selected"
+#endif
+
+#endif
