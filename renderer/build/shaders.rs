@@ -36,7 +36,9 @@ pub fn compile_all(root: &Path, out_dir: &Path, generated: &[(String, String)]) 
         match compiler.compile_into_spirv(source, shaderc::ShaderKind::Compute, &path.to_string_lossy(), "main", Some(&options)) {
             Ok(artifact) => {
                 let file = spv_dir.join(format!("{}.spv", name.replace('/', "__")));
-                std::fs::write(&file, artifact.as_binary_u8()).map_err(|e| e.to_string())?;
+                let words = strip_source_debug(artifact.as_binary());
+                let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+                std::fs::write(&file, bytes).map_err(|e| e.to_string())?;
                 writeln!(table, "    (\"{name}\", include_bytes!(\"{}\")),", file.display()).unwrap();
             }
             Err(e) => writeln!(errors, "shader {name}:\n{e}").unwrap(),
@@ -49,11 +51,33 @@ pub fn compile_all(root: &Path, out_dir: &Path, generated: &[(String, String)]) 
     std::fs::write(out_dir.join("shaders.rs"), table).map_err(|e| e.to_string())
 }
 
+/// Drops the source text and line tables that debug info adds (they bloat the binary and split
+/// UTF-8 comments mid-character) while keeping OpName, which binding-by-name needs.
+fn strip_source_debug(words: &[u32]) -> Vec<u32> {
+    const DROPPED: [u32; 7] = [2, 3, 4, 7, 8, 317, 330]; // OpSourceContinued, OpSource, OpSourceExtension, OpString, OpLine, OpNoLine, OpModuleProcessed
+    let mut out = words[..5].to_vec();
+    let mut i = 5;
+    while i < words.len() {
+        let count = (words[i] >> 16) as usize;
+        let opcode = words[i] & 0xffff;
+        if count == 0 {
+            break;
+        }
+        if !DROPPED.contains(&opcode) {
+            out.extend_from_slice(&words[i..(i + count).min(words.len())]);
+        }
+        i += count;
+    }
+    out
+}
+
 fn options<'a>(root: &Path, defines: &[(String, Option<String>)]) -> Result<shaderc::CompileOptions<'a>, String> {
     let mut options = shaderc::CompileOptions::new().map_err(|e| format!("shaderc options: {e}"))?;
     options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
     options.set_optimization_level(shaderc::OptimizationLevel::Performance);
     options.set_warnings_as_errors();
+    // Keeps OpName through the optimiser: the engine binds resources by their GLSL names.
+    options.set_generate_debug_info();
     for (k, v) in defines {
         options.add_macro_definition(k, v.as_deref());
     }

@@ -203,9 +203,27 @@ impl FrameRecorder {
                 layer_count: 1,
             })
             .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
-        unsafe {
-            self.ctx.device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::GENERAL, buffer.raw, &[region])
+        // Copies prefer TRANSFER_SRC_OPTIMAL (the validation layer warns otherwise): switch for
+        // the copy and back to GENERAL, the layout every pass expects.
+        let transition = |from, to, src, dst| {
+            vk::ImageMemoryBarrier::default()
+                .image(image.raw)
+                .old_layout(from)
+                .new_layout(to)
+                .src_access_mask(src)
+                .dst_access_mask(dst)
+                .subresource_range(crate::vk::color_range())
         };
+        let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+        let any = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
+        let device = &self.ctx.device;
+        unsafe {
+            let to_src = transition(vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, any, vk::AccessFlags::TRANSFER_READ);
+            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[to_src]);
+            device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &[region]);
+            let back = transition(vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL, vk::AccessFlags::TRANSFER_READ, any | vk::AccessFlags::TRANSFER_READ);
+            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[back]);
+        }
         self.close_pass(index);
         Ok(())
     }

@@ -1,3 +1,8 @@
-//! Library side of the `fovea` tools: everything the binary glues together.
+//! Library side of the `fovea` tools: everything the binary glues together (scene resolution,
+//! output writers, camera paths, commands), kept here so integration tests can call it.
 
+pub mod camera_path;
+pub mod commands;
+pub mod output;
 pub mod scenegen;
+pub mod scenes;

@@ -1,1 +1,154 @@
-fn main() {}
+//! `fovea`: the command line of the foveated path tracer. See README.md for the contract.
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use fovea_tools::commands;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(name = "fovea", version, about = "Foveated real-time path tracing in Visual-Polar space (Vulkan compute)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(clap::Args)]
+struct DeviceArgs {
+    /// Vulkan device: index from `fovea info` or a name substring (default: best GPU, else CPU).
+    #[arg(long, global = true)]
+    device: Option<String>,
+    /// Turn on Vulkan validation (always on in debug builds); any message fails the run.
+    #[arg(long, global = true)]
+    validation: bool,
+}
+
+#[derive(clap::Args)]
+struct RenderOpts {
+    /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
+    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    scene: String,
+    /// Sampling method.
+    #[arg(long, default_value = "cartesian")]
+    method: String,
+    #[arg(long, default_value_t = 320)]
+    width: u32,
+    #[arg(long, default_value_t = 360)]
+    height: u32,
+    #[arg(long, default_value_t = 24)]
+    frames: u32,
+    /// Output folder (created; must hold only fovea's own outputs if it exists).
+    #[arg(long, default_value = "out/render")]
+    out: PathBuf,
+    /// Also write linear EXR frames.
+    #[arg(long)]
+    exr: bool,
+    /// Move the camera along the scene's default path (a slow orbit) instead of holding it still.
+    #[arg(long)]
+    camera_path: bool,
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Path vertices: 1 = emission seen directly, 2 = + direct light, 3 = + one indirect bounce.
+    #[arg(long, default_value_t = 3)]
+    max_depth: u32,
+    /// Linear exposure multiplier before tonemapping.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+}
+
+/// `fovea` with no arguments renders with every default.
+#[derive(Parser)]
+struct DefaultRender {
+    #[command(flatten)]
+    opts: RenderOpts,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render frames to PNG (and EXR) with a timing report.
+    Render {
+        #[command(flatten)]
+        opts: RenderOpts,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Render a converged linear-radiance reference EXR.
+    Reference {
+        #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+        scene: String,
+        #[arg(long, default_value_t = 256)]
+        width: u32,
+        #[arg(long, default_value_t = 256)]
+        height: u32,
+        #[arg(long, default_value_t = 1024)]
+        spp: u32,
+        #[arg(long, default_value_t = 3)]
+        max_depth: u32,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace FILE if it exists.
+        #[arg(long)]
+        force: bool,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// List Vulkan devices, the chosen one and its limits.
+    Info {
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Write one of the project's procedural scenes as glTF.
+    GenScene {
+        /// cornell-box, stress or large.
+        kind: String,
+        #[arg(long)]
+        out: PathBuf,
+        /// Minimum triangle count of the large scene.
+        #[arg(long)]
+        min_triangles: Option<usize>,
+        #[arg(long)]
+        force: bool,
+    },
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    let command = cli.command.unwrap_or_else(|| Command::Render {
+        opts: DefaultRender::parse_from(["fovea"]).opts,
+        device: DeviceArgs { device: None, validation: false },
+    });
+    match command {
+        Command::Render { opts, device } => commands::render::run(&commands::render::RenderArgs {
+            scene: &opts.scene,
+            method: &opts.method,
+            width: opts.width,
+            height: opts.height,
+            frames: opts.frames,
+            out: &opts.out,
+            exr: opts.exr,
+            camera_path: opts.camera_path,
+            seed: opts.seed,
+            max_depth: opts.max_depth,
+            exposure: opts.exposure,
+            device: device.device.as_deref(),
+            validation: device.validation,
+        }),
+        Command::Reference { scene, width, height, spp, max_depth, seed, out, force, device } => {
+            commands::reference::run(&commands::reference::ReferenceArgs {
+                scene: &scene,
+                width,
+                height,
+                spp,
+                max_depth,
+                seed,
+                out: &out,
+                force,
+                device: device.device.as_deref(),
+                validation: device.validation,
+            })
+        }
+        Command::Info { device } => commands::info::run(device.device.as_deref()),
+        Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
+    }
+}

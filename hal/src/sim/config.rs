@@ -36,7 +36,7 @@ pub struct SimConfig {
     pub pursuit_max_speed_deg_s: f64,
     /// Position error that triggers a catch-up saccade during pursuit.
     pub catch_up_threshold_deg: f64,
-    /// Tracker accuracy bias varies as an OU process with this time constant.
+    /// The tracker accuracy bias drifts to a new random value over this many seconds.
     pub bias_time_constant_s: f64,
     /// Reported convergence distance and per-eye ray convergence point.
     pub convergence_distance_m: f64,

@@ -48,6 +48,9 @@ pub struct SimulatedFove {
     noise_rng: Pcg64,
     bias: DVec2,
     bias_sd: f64,
+    /// Bias keyframes (start of the current segment, end of it) drawn every time constant.
+    bias_keys: [DVec2; 2],
+    bias_segment: u64,
     next_tick: u64,
     latency_ns: i64,
     history: VecDeque<GazeSample>,
@@ -69,14 +72,17 @@ impl SimulatedFove {
         // Mean 2D error magnitude of an isotropic Gaussian is σ·√(π/2): accuracy is that mean.
         let bias_sd = hmd.tracker.accuracy_deg as f64 / (std::f64::consts::PI / 2.0).sqrt();
         let mut noise_rng = stream(3);
-        let bias = DVec2::new(noise_rng.sample(StandardNormal), noise_rng.sample(StandardNormal)) * bias_sd;
+        let mut key = || DVec2::new(noise_rng.sample(StandardNormal), noise_rng.sample(StandardNormal)) * bias_sd;
+        let bias_keys = [key(), key()];
         Ok(SimulatedFove {
             latency_ns: (hmd.tracker.latency_ms as f64 * 1e6).round() as i64,
             eye: EyeModel::new(&cfg, stream(1)),
             blinks: BlinkSchedule::new(&cfg, stream(2)),
             noise_rng,
-            bias,
+            bias: bias_keys[0],
             bias_sd,
+            bias_keys,
+            bias_segment: 0,
             next_tick: 0,
             history: VecDeque::with_capacity(HISTORY_LEN),
             newest_available: None,
@@ -106,10 +112,9 @@ impl SimulatedFove {
         self.next_tick += 1;
         let time = self.tick_time(k);
         let t = (time - self.cfg.start_time_ns) as f64 / 1e9;
-        let dt = 1.0 / self.hmd.tracker.rate_hz as f64;
         let (truth, phase) = self.eye.advance(t);
         let blinking = self.blinks.blinking(t);
-        self.step_bias(dt);
+        self.update_bias(t);
         let noise = DVec2::new(self.noise_rng.sample(StandardNormal), self.noise_rng.sample(StandardNormal))
             * self.hmd.tracker.precision_deg as f64;
         let sample = if blinking {
@@ -124,11 +129,19 @@ impl SimulatedFove {
         SimTick { sample, truth: truth.as_vec3(), phase, blinking, bias_deg: self.bias.as_vec2() }
     }
 
-    fn step_bias(&mut self, dt: f64) {
-        let decay = (-dt / self.cfg.bias_time_constant_s).exp();
-        let sd = self.bias_sd * (1.0 - decay * decay).sqrt();
-        let n = DVec2::new(self.noise_rng.sample(StandardNormal), self.noise_rng.sample(StandardNormal));
-        self.bias = self.bias * decay + n * sd;
+    /// Slowly varying accuracy bias: independent Gaussian keyframes every time constant, blended
+    /// as cos·k0 + sin·k1 — smooth, and with exactly constant variance (cos² + sin² = 1), so the
+    /// mean error equals the configured accuracy at every moment.
+    fn update_bias(&mut self, t: f64) {
+        let period = self.cfg.bias_time_constant_s;
+        let segment = (t / period).floor().max(0.0) as u64;
+        while self.bias_segment < segment {
+            let next = DVec2::new(self.noise_rng.sample(StandardNormal), self.noise_rng.sample(StandardNormal)) * self.bias_sd;
+            self.bias_keys = [self.bias_keys[1], next];
+            self.bias_segment += 1;
+        }
+        let phase = (t / period - segment as f64) * std::f64::consts::FRAC_PI_2;
+        self.bias = self.bias_keys[0] * phase.cos() + self.bias_keys[1] * phase.sin();
     }
 
     fn measured_sample(&self, time: XrTime, k: u64, dir: DVec3) -> GazeSample {

@@ -10,6 +10,10 @@ use std::path::Path;
 pub struct Playback {
     hmd: HmdDescription,
     trace: Trace,
+    /// Sample times alone: a compact array keeps the binary search in cache.
+    times: Vec<XrTime>,
+    /// Index found by the previous query; frame-by-frame queries hit it or its neighbour.
+    cursor: usize,
     /// Added to trace times to map them onto the session clock.
     time_offset: i64,
     align_on_first_frame: bool,
@@ -21,7 +25,8 @@ pub struct Playback {
 impl Playback {
     pub fn new(trace: Trace, hmd: HmdDescription) -> Self {
         let max_gap_ns = trace.header.period_ns().saturating_mul(3) / 2;
-        Playback { hmd, trace, time_offset: 0, align_on_first_frame: false, max_gap_ns, now: None }
+        let times = trace.samples.iter().map(|s| s.time).collect();
+        Playback { hmd, trace, times, cursor: 0, time_offset: 0, align_on_first_frame: false, max_gap_ns, now: None }
     }
 
     pub fn open(path: &Path, hmd: HmdDescription) -> Result<Self, HalError> {
@@ -57,9 +62,9 @@ impl Playback {
     /// apart than 1.5 tracker periods → interpolated at `t`; next to an invalid sample → the
     /// earlier sample as is (never interpolate across invalid data); inside a longer gap → the
     /// earlier sample for up to 1.5 periods, then "no gaze".
-    fn lookup(&self, t: XrTime) -> GazeSample {
+    fn lookup(&mut self, t: XrTime) -> GazeSample {
+        let i = self.partition(t);
         let s = &self.trace.samples;
-        let i = s.partition_point(|x| x.time <= t);
         if i == 0 {
             return s[0];
         }
@@ -75,6 +80,22 @@ impl Playback {
             return *a;
         }
         interpolate(a, b, t)
+    }
+
+    /// Number of samples with time ≤ t, trying the previous answer first.
+    fn partition(&mut self, t: XrTime) -> usize {
+        let times = &self.times;
+        let c = self.cursor;
+        let fits = |i: usize| (i == 0 || times[i - 1] <= t) && (i == times.len() || times[i] > t);
+        let i = if fits(c) {
+            c
+        } else if c < times.len() && fits(c + 1) {
+            c + 1
+        } else {
+            times.partition_point(|&x| x <= t)
+        };
+        self.cursor = i;
+        i
     }
 }
 
@@ -129,7 +150,7 @@ impl GazeSource for Playback {
     fn latest(&self) -> GazeSample {
         let samples = &self.trace.samples;
         let t = self.now.map_or(samples[0].time, |n| n.saturating_sub(self.time_offset));
-        let i = samples.partition_point(|x| x.time <= t).saturating_sub(1);
+        let i = self.times.partition_point(|&x| x <= t).saturating_sub(1);
         self.shifted(&samples[i])
     }
 }

@@ -29,6 +29,15 @@ struct Loader<'a> {
 }
 
 pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
+    // The checks below cover every panicking path of the gltf crate we know of; this is the
+    // backstop for ones we don't, so malformed input can never take the renderer down.
+    std::panic::catch_unwind(|| load_unguarded(path)).unwrap_or_else(|panic| {
+        let what = panic.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| panic.downcast_ref::<String>().cloned());
+        Err(SceneError::Invalid { file: path.to_path_buf(), detail: format!("the glTF parser failed: {}", what.unwrap_or_default()) })
+    })
+}
+
+fn load_unguarded(path: &Path) -> Result<Scene, SceneError> {
     let file = path.to_path_buf();
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { file: file.clone(), source })?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes)
@@ -47,6 +56,7 @@ pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
     let mut json = document.into_json();
     json.extensions_required.clear(); // vetted above
     check_images_have_sources(&json, &file)?;
+    check_position_accessors_exist(&json, &file)?;
     let document = gltf::Document::from_json(json).map_err(|e| SceneError::Invalid { file: file.clone(), detail: describe(e) })?;
 
     let base = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
@@ -73,6 +83,26 @@ fn check_images_have_sources(json: &gltf::json::Root, file: &Path) -> Result<(),
                 file: file.to_path_buf(),
                 detail: format!("images[{i}] needs a uri, or a bufferView with a mimeType"),
             });
+        }
+    }
+    Ok(())
+}
+
+/// gltf-json 1.4.1's validator indexes `accessors[POSITION]` unchecked (mesh.rs:151).
+fn check_position_accessors_exist(json: &gltf::json::Root, file: &Path) -> Result<(), SceneError> {
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = prim.attributes.get(&gltf::json::validation::Checked::Valid(gltf::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= json.accessors.len()) {
+                return Err(SceneError::Invalid {
+                    file: file.to_path_buf(),
+                    detail: format!(
+                        "meshes[{m}].primitives[{p}].attributes.POSITION = {}: index out of range (there are {} accessors)",
+                        index.value(),
+                        json.accessors.len()
+                    ),
+                });
+            }
         }
     }
     Ok(())
@@ -178,7 +208,8 @@ impl Loader<'_> {
         }
         let triangles = match mode {
             Mode::Triangles => {
-                if indices.len() % 3 != 0 {
+                let leftover = indices.len() % 3;
+                if leftover > 0 {
                     return Err(self.bad(mesh, pi, format!("{} indices is not a multiple of 3", indices.len())));
                 }
                 indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()

@@ -208,12 +208,8 @@ fn binary_glb_loads_and_truncated_glb_fails() {
         "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]
     });
     let mut json_chunk = doc.to_string().into_bytes();
-    while json_chunk.len() % 4 != 0 {
-        json_chunk.push(b' ');
-    }
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
+    json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
+    bin.resize(bin.len().next_multiple_of(4), 0);
     let total = 12 + 8 + json_chunk.len() + 8 + bin.len();
     let mut glb = Vec::new();
     glb.extend(b"glTF");

@@ -29,9 +29,8 @@ pub struct GltfWriter {
 impl GltfWriter {
     /// Appends bytes as a new buffer view (4-byte aligned, as accessors require).
     fn push_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.buffer.len() % 4 != 0 {
-            self.buffer.push(0);
-        }
+        let padding = (4 - self.buffer.len() % 4) % 4;
+        self.buffer.resize(self.buffer.len() + padding, 0);
         let mut view = json!({"buffer": 0, "byteOffset": self.buffer.len(), "byteLength": bytes.len()});
         if let Some(target) = target {
             view["target"] = json!(target);

@@ -101,7 +101,10 @@ pub fn build(min_triangles: usize) -> GltfWriter {
         json!({"name": "sun", "type": "directional", "color": [1.0, 0.95, 0.85], "intensity": 3.0}),
         json!({"name": "sun", "rotation": sun.to_array()}),
     );
-    let look = Quat::from_rotation_y(-0.35) * Quat::from_rotation_x(-0.12);
-    w.add_camera("camera", 60f32.to_radians(), 1280.0 / 1440.0, [half_x - 2.0, 1.7, half_z - 1.0], look.normalize().to_array());
+    // From a corner of the courtyard towards the courtyard's centre (yaw, then pitch: no roll).
+    let eye = Vec3::new(half_x - 2.2, 1.7, half_z - 1.2);
+    let dir = (Vec3::new(0.0, 1.0, 0.0) - eye).normalize();
+    let look = Quat::from_rotation_y((-dir.x).atan2(-dir.z)) * Quat::from_rotation_x(dir.y.asin());
+    w.add_camera("camera", 60f32.to_radians(), 1280.0 / 1440.0, eye.to_array(), look.normalize().to_array());
     w
 }

@@ -19,9 +19,8 @@ pub fn near_checker_png(size: u32, square: u32, dark: [u8; 3], light: [u8; 3], r
     let squares = column_of.last().copied().unwrap_or(0) as usize + 1;
     let noise: Vec<f32> = (0..squares * (row_of.last().copied().unwrap_or(0) as usize + 1)).map(|_| rng.range(0.85, 1.0)).collect();
     let mut pixels = Vec::with_capacity((size * size * 3) as usize);
-    for y in 0..size as usize {
-        for x in 0..size as usize {
-            let (c, r) = (column_of[x], row_of[y]);
+    for &r in &row_of {
+        for &c in &column_of {
             let base = if (c + r) % 2 == 0 { dark } else { light };
             let k = noise[r as usize * squares + c as usize];
             pixels.extend(base.map(|v| (v as f32 * k).round() as u8));

@@ -18,7 +18,7 @@ mod traverse;
 mod tests;
 
 use crate::Aabb;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// One BVH2 node with both children's boxes (see the module doc for the meaning of the fields).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,53 +70,96 @@ const LEAF_MAX: usize = 8;
 /// Cost of one node visit relative to one triangle test, in the SAH.
 const TRAVERSAL_COST: f32 = 1.0;
 
+/// Builder-internal box on SIMD vectors (the build is bound by these unions).
+#[derive(Clone, Copy)]
+struct Box3 {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3 {
+    const EMPTY: Box3 = Box3 { min: Vec3A::splat(1e30), max: Vec3A::splat(-1e30) };
+    #[inline]
+    fn union(self, o: Box3) -> Box3 {
+        Box3 { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+    #[inline]
+    fn grow(self, p: Vec3A) -> Box3 {
+        Box3 { min: self.min.min(p), max: self.max.max(p) }
+    }
+    #[inline]
+    fn half_area(self) -> f32 {
+        let d = (self.max - self.min).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+    fn to_aabb(self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
+    }
+}
+
+/// A range's triangle bounds and centroid bounds.
+#[derive(Clone, Copy)]
+struct RangeBounds {
+    bounds: Box3,
+    centroids: Box3,
+}
+
+impl RangeBounds {
+    const EMPTY: RangeBounds = RangeBounds { bounds: Box3::EMPTY, centroids: Box3::EMPTY };
+    fn union(self, o: RangeBounds) -> RangeBounds {
+        RangeBounds { bounds: self.bounds.union(o.bounds), centroids: self.centroids.union(o.centroids) }
+    }
+}
+
 enum Plan {
     Leaf,
-    Split(usize),
+    /// Partition point plus both halves' bounds (from the bins, so no second pass is needed).
+    Split(usize, RangeBounds, RangeBounds),
 }
 
 #[derive(Clone, Copy)]
 struct Bin {
-    bounds: Aabb,
+    range: RangeBounds,
     count: u32,
 }
 
 struct Builder {
-    prim_bounds: Vec<Aabb>,
-    centroids: Vec<Vec3>,
+    prim_bounds: Vec<Box3>,
+    centroids: Vec<Vec3A>,
     order: Vec<u32>,
 }
 
 impl Bvh {
     /// Builds the tree over `tris` (world-space corners, by triangle index).
     pub fn build(tris: &[[Vec3; 3]]) -> Bvh {
-        let prim_bounds: Vec<Aabb> = tris.iter().map(|t| Aabb::of_points(t)).collect();
-        let centroids = prim_bounds.iter().map(Aabb::center).collect();
+        let prim_bounds: Vec<Box3> =
+            tris.iter().map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into()))).collect();
+        let centroids = prim_bounds.iter().map(|b| (b.min + b.max) * 0.5).collect();
         let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect() };
         let n = tris.len();
         let mut nodes = vec![BvhNode::EMPTY];
-        let (root_bounds, root_centroids) = b.range_bounds(0, n);
-        let (left, right) = match b.plan(0, n, &root_bounds, &root_centroids) {
+        let root = b.range_bounds(0, n);
+        let (mid, left, right) = match b.plan(0, n, root) {
             Plan::Leaf => {
                 if n > 0 {
-                    nodes[0].set_child(0, &root_bounds, 0, n as u32);
+                    nodes[0].set_child(0, &root.bounds.to_aabb(), 0, n as u32);
                 }
                 return Bvh { nodes, tri_order: b.order };
             }
-            Plan::Split(mid) => ((0, mid), (mid, n)),
+            Plan::Split(mid, left, right) => (mid, left, right),
         };
         // Explicit work list instead of recursion: degenerate inputs can make deep trees.
-        let mut work = vec![(0usize, left, right)];
+        let mut work = vec![(0usize, (0, mid, left), (mid, n, right))];
         while let Some((node, left, right)) = work.pop() {
-            for (slot, (start, end)) in [(0, left), (1, right)] {
-                let (bounds, centroid_bounds) = b.range_bounds(start, end);
-                match b.plan(start, end, &bounds, &centroid_bounds) {
+            for (slot, (start, end, range)) in [(0, left), (1, right)] {
+                let bounds = range.bounds.to_aabb();
+                match b.plan(start, end, range) {
                     Plan::Leaf => nodes[node].set_child(slot, &bounds, start as u32, (end - start) as u32),
-                    Plan::Split(mid) => {
+                    Plan::Split(mid, l, r) => {
                         let child = nodes.len();
                         nodes.push(BvhNode::EMPTY);
                         nodes[node].set_child(slot, &bounds, child as u32, 0);
-                        work.push((child, (start, mid), (mid, end)));
+                        work.push((child, (start, mid, l), (mid, end, r)));
                     }
                 }
             }
@@ -148,79 +191,81 @@ impl Bvh {
 }
 
 impl Builder {
-    fn range_bounds(&self, start: usize, end: usize) -> (Aabb, Aabb) {
-        let (mut bounds, mut centroid_bounds) = (Aabb::EMPTY, Aabb::EMPTY);
-        for &p in &self.order[start..end] {
-            bounds = bounds.union(&self.prim_bounds[p as usize]);
-            centroid_bounds.grow(self.centroids[p as usize]);
-        }
-        (bounds, centroid_bounds)
+    fn range_bounds(&self, start: usize, end: usize) -> RangeBounds {
+        self.order[start..end].iter().fold(RangeBounds::EMPTY, |r, &p| RangeBounds {
+            bounds: r.bounds.union(self.prim_bounds[p as usize]),
+            centroids: r.centroids.grow(self.centroids[p as usize]),
+        })
     }
 
     /// Decides leaf or split for `order[start..end]`, partitioning the range for a split.
-    fn plan(&mut self, start: usize, end: usize, bounds: &Aabb, centroid_bounds: &Aabb) -> Plan {
+    fn plan(&mut self, start: usize, end: usize, range: RangeBounds) -> Plan {
         let count = end - start;
         if count <= LEAF_TARGET {
             return Plan::Leaf;
         }
-        let extent = centroid_bounds.max - centroid_bounds.min;
-        let parent_area = bounds.surface_area().max(f32::MIN_POSITIVE);
-        let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bin on the right)
-        for axis in 0..3 {
-            if extent[axis] <= 0.0 {
-                continue;
+        let lo = range.centroids.min;
+        let extent = range.centroids.max - lo;
+        // Bin all three axes in one pass over the triangles (one centroid load for three bins).
+        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(BINS as f32) / extent, Vec3A::ZERO);
+        let mut bins = [[Bin { range: RangeBounds::EMPTY, count: 0 }; BINS]; 3];
+        for &p in &self.order[start..end] {
+            let (c, pb) = (self.centroids[p as usize], self.prim_bounds[p as usize]);
+            let k = bin_index(c, lo, scale);
+            for axis in 0..3 {
+                let bin = &mut bins[axis][k[axis]];
+                bin.range.bounds = bin.range.bounds.union(pb);
+                bin.range.centroids = bin.range.centroids.grow(c);
+                bin.count += 1;
             }
-            let bins = self.fill_bins(start, end, axis, centroid_bounds.min[axis], extent[axis]);
+        }
+        let parent_area = range.bounds.half_area().max(f32::MIN_POSITIVE);
+        let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bin on the right)
+        for axis in (0..3).filter(|&a| extent[a] > 0.0) {
+            let bins = &bins[axis];
             // Right-to-left sweep for the right side's area·count, then left-to-right for the cost.
             let mut right_cost = [0.0f32; BINS];
-            let (mut acc, mut n) = (Aabb::EMPTY, 0u32);
+            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
             for i in (1..BINS).rev() {
-                acc = acc.union(&bins[i].bounds);
+                acc = acc.union(bins[i].range.bounds);
                 n += bins[i].count;
-                right_cost[i] = acc.surface_area() * n as f32;
+                right_cost[i] = acc.half_area() * n as f32;
             }
-            let (mut acc, mut n) = (Aabb::EMPTY, 0u32);
+            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
             for split in 1..BINS {
-                acc = acc.union(&bins[split - 1].bounds);
+                acc = acc.union(bins[split - 1].range.bounds);
                 n += bins[split - 1].count;
                 if n == 0 || n as usize == count {
                     continue;
                 }
-                let cost = TRAVERSAL_COST + (acc.surface_area() * n as f32 + right_cost[split]) / parent_area;
+                let cost = TRAVERSAL_COST + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, split));
                 }
             }
         }
-        let leaf_cost = count as f32;
         match best {
-            Some((cost, _, _)) if cost >= leaf_cost && count <= LEAF_MAX => Plan::Leaf,
+            Some((cost, _, _)) if cost >= count as f32 && count <= LEAF_MAX => Plan::Leaf,
             None if count <= LEAF_MAX => Plan::Leaf,
             Some((_, axis, split)) => {
-                let (lo, scale) = (centroid_bounds.min[axis], BINS as f32 / extent[axis]);
+                let (lo, scale) = (lo[axis], scale[axis]);
                 let centroids = &self.centroids;
                 let mid = start + partition(&mut self.order[start..end], |p| bin_of(centroids[p as usize][axis], lo, scale) < split);
-                if mid == start || mid == end { self.median_split(start, end, centroid_bounds) } else { Plan::Split(mid) }
+                let union = |bins: &[Bin]| bins.iter().fold(RangeBounds::EMPTY, |r, b| r.union(b.range));
+                if mid == start || mid == end {
+                    self.median_split(start, end, range)
+                } else {
+                    Plan::Split(mid, union(&bins[axis][..split]), union(&bins[axis][split..]))
+                }
             }
-            None => self.median_split(start, end, centroid_bounds),
+            None => self.median_split(start, end, range),
         }
-    }
-
-    fn fill_bins(&self, start: usize, end: usize, axis: usize, lo: f32, extent: f32) -> [Bin; BINS] {
-        let mut bins = [Bin { bounds: Aabb::EMPTY, count: 0 }; BINS];
-        let scale = BINS as f32 / extent;
-        for &p in &self.order[start..end] {
-            let bin = &mut bins[bin_of(self.centroids[p as usize][axis], lo, scale)];
-            bin.bounds = bin.bounds.union(&self.prim_bounds[p as usize]);
-            bin.count += 1;
-        }
-        bins
     }
 
     /// Fallback when SAH finds no useful split of a range too big for one leaf: halve it along the
     /// widest centroid axis (by index when all centroids coincide).
-    fn median_split(&mut self, start: usize, end: usize, centroid_bounds: &Aabb) -> Plan {
-        let extent = centroid_bounds.max - centroid_bounds.min;
+    fn median_split(&mut self, start: usize, end: usize, range: RangeBounds) -> Plan {
+        let extent = range.centroids.max - range.centroids.min;
         let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
         let mid = (end - start) / 2;
         if extent[axis] > 0.0 {
@@ -229,8 +274,15 @@ impl Builder {
                 centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
             });
         }
-        Plan::Split(start + mid)
+        let mid = start + mid;
+        Plan::Split(mid, self.range_bounds(start, mid), self.range_bounds(mid, end))
     }
+}
+
+#[inline]
+fn bin_index(c: Vec3A, lo: Vec3A, scale: Vec3A) -> [usize; 3] {
+    let k = ((c - lo) * scale).min(Vec3A::splat((BINS - 1) as f32));
+    [k.x as usize, k.y as usize, k.z as usize]
 }
 
 #[inline]

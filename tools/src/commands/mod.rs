@@ -1,0 +1,26 @@
+pub mod gen_scene;
+pub mod info;
+pub mod reference;
+pub mod render;
+
+use anyhow::{Context as _, Result};
+use fovea_renderer::vk::{Context, ContextOptions, DeviceSelector};
+use std::sync::Arc;
+
+/// Opens the Vulkan device. Validation is on in debug builds and with `--validation`.
+pub fn open_device(device: Option<&str>, validation: bool) -> Result<Arc<Context>> {
+    let options = ContextOptions {
+        validation: validation || cfg!(debug_assertions),
+        device: device.map(|d| d.parse::<DeviceSelector>().expect("infallible")).unwrap_or_default(),
+    };
+    Context::new(&options).context("opening the Vulkan device")
+}
+
+/// Fails the run if the validation layer reported any warning or error.
+pub fn check_validation(ctx: &Context) -> Result<()> {
+    let problems = ctx.validation.problems();
+    if problems > 0 {
+        anyhow::bail!("{problems} Vulkan validation warning(s)/error(s): {:?}", ctx.validation.messages());
+    }
+    Ok(())
+}
