@@ -6,6 +6,11 @@
 
 const int BVH_STACK_SIZE = 64; // the upload refuses deeper trees
 
+// The traversal stack lives in shared memory, one slice per invocation: lavapipe lowers a
+// dynamically indexed private array into chains of selects, which made traversal ~20× slower.
+// Every kernel that traces uses 64 invocations per workgroup (WORKGROUP_2D² = WORKGROUP_1D).
+shared uint bvh_stack[64 * BVH_STACK_SIZE];
+
 struct Hit {
     float t;
     float u;            // barycentric weight of v1
@@ -54,12 +59,34 @@ bool intersect_triangle(vec3 org, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float 
 
 // Slab test of one box; returns the entry distance or +inf when missed.
 float box_entry(vec3 bmin, vec3 bmax, vec3 org_over_dir, vec3 inv_dir, float tmin, float tmax) {
+    if (bmin.x > bmax.x) return 1e30; // an empty child (inverted box): the slab test would accept it
     vec3 t0 = bmin * inv_dir - org_over_dir;
     vec3 t1 = bmax * inv_dir - org_over_dir;
     vec3 lo = min(t0, t1), hi = max(t0, t1);
     float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
     float leave = min(min(hi.x, hi.y), min(hi.z, tmax));
     return enter <= leave ? enter : 1e30;
+}
+
+// Tests the triangles of one leaf, shrinking hit.t; true when any was hit.
+bool intersect_leaf(vec3 org, RayShear sh, uint first, uint count, float tmin, bool any_hit, inout Hit hit) {
+    bool found = false;
+    for (uint i = first; i < first + count; ++i) {
+        int tb = int(i) * 3;
+        vec4 t0 = texelFetch(bvh_triangles, tb + 0);
+        vec4 t1 = texelFetch(bvh_triangles, tb + 1);
+        vec4 t2 = texelFetch(bvh_triangles, tb + 2);
+        vec3 tuv;
+        if (intersect_triangle(org, sh, t0.xyz, t1.xyz, t2.xyz, tmin, hit.t, tuv)) {
+            hit.t = tuv.x;
+            hit.u = tuv.y;
+            hit.v = tuv.z;
+            hit.triangle = floatBitsToUint(t0.w);
+            found = true;
+            if (any_hit) return true;
+        }
+    }
+    return found;
 }
 
 // Closest hit (any_hit = false) or first hit found (shadow rays, any_hit = true).
@@ -73,7 +100,7 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
     vec3 safe = mix(dir, vec3(1e-20), lessThan(abs(dir), vec3(1e-20)));
     vec3 inv_dir = 1.0 / safe;
     vec3 ood = org * inv_dir;
-    uint stack[BVH_STACK_SIZE];
+    uint stack_base = gl_LocalInvocationIndex * uint(BVH_STACK_SIZE);
     int sp = 0;
     uint node = 0u;
     while (true) {
@@ -82,41 +109,30 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
         vec4 n1 = texelFetch(bvh_nodes, base + 1);
         vec4 n2 = texelFetch(bvh_nodes, base + 2);
         vec4 n3 = texelFetch(bvh_nodes, base + 3);
-        uvec2 child = uvec2(floatBitsToUint(n0.w), floatBitsToUint(n1.w));
-        uvec2 count = uvec2(floatBitsToUint(n2.w), floatBitsToUint(n3.w));
+        uint child0 = floatBitsToUint(n0.w), child1 = floatBitsToUint(n1.w);
+        uint count0 = floatBitsToUint(n2.w), count1 = floatBitsToUint(n3.w);
         float e0 = box_entry(n0.xyz, n1.xyz, ood, inv_dir, tmin, hit.t);
         float e1 = box_entry(n2.xyz, n3.xyz, ood, inv_dir, tmin, hit.t);
         bool hit0 = e0 < 1e30, hit1 = e1 < 1e30;
-        for (int c = 0; c < 2; ++c) {
-            bool entered = (c == 0) ? hit0 : hit1;
-            if (!entered || count[c] == 0u) continue;
-            for (uint i = child[c]; i < child[c] + count[c]; ++i) {
-                int tb = int(i) * 3;
-                vec4 t0 = texelFetch(bvh_triangles, tb + 0);
-                vec4 t1 = texelFetch(bvh_triangles, tb + 1);
-                vec4 t2 = texelFetch(bvh_triangles, tb + 2);
-                vec3 tuv;
-                if (intersect_triangle(org, sh, t0.xyz, t1.xyz, t2.xyz, tmin, hit.t, tuv)) {
-                    hit.t = tuv.x;
-                    hit.u = tuv.y;
-                    hit.v = tuv.z;
-                    hit.triangle = floatBitsToUint(t0.w);
-                    if (any_hit) return true;
-                }
-            }
-            if (c == 0) hit0 = false; else hit1 = false;
+        if (hit0 && count0 != 0u) {
+            if (intersect_leaf(org, sh, child0, count0, tmin, any_hit, hit) && any_hit) return true;
+            hit0 = false;
+        }
+        if (hit1 && count1 != 0u) {
+            if (intersect_leaf(org, sh, child1, count1, tmin, any_hit, hit) && any_hit) return true;
+            hit1 = false;
         }
         if (hit0 && hit1) {
             bool left_first = e0 <= e1;
-            if (sp < BVH_STACK_SIZE) stack[sp++] = left_first ? child.y : child.x;
-            node = left_first ? child.x : child.y;
+            if (sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp++)] = left_first ? child1 : child0;
+            node = left_first ? child0 : child1;
         } else if (hit0) {
-            node = child.x;
+            node = child0;
         } else if (hit1) {
-            node = child.y;
+            node = child1;
         } else {
             if (sp == 0) break;
-            node = stack[--sp];
+            node = bvh_stack[stack_base + uint(--sp)];
         }
     }
     return hit.triangle != 0xffffffffu;

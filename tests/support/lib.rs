@@ -1,1 +1,73 @@
-//! Shared helpers for the integration tests.
+//! Shared helpers for the integration tests: a validated Vulkan context, scenes built in code,
+//! image statistics. Every test opens its own context with validation on and ends with
+//! `assert_clean`, so any validation warning or error fails the test that caused it.
+
+pub mod scenes;
+
+use fovea_renderer::vk::{Context, ContextOptions};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// A context on the default device (lavapipe without a GPU) with validation on.
+pub fn gpu() -> Arc<Context> {
+    Context::new(&ContextOptions { validation: true, ..Default::default() }).expect("Vulkan device with validation layers")
+}
+
+/// Fails when the validation layer reported any warning or error.
+pub fn assert_clean(ctx: &Context) {
+    assert_eq!(ctx.validation.problems(), 0, "validation messages: {:#?}", ctx.validation.messages());
+}
+
+/// The repository root (tests may read `scenes/` and, when present, `../shared/`).
+pub fn repo_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// A file of the shared reference data, if this checkout has `../shared/` beside it.
+pub fn shared_data(name: &str) -> Option<PathBuf> {
+    let p = repo_root().join("../shared/data").join(name);
+    p.exists().then_some(p)
+}
+
+/// Where tests write images worth looking at when they fail.
+pub fn artifacts_dir() -> PathBuf {
+    let dir = repo_root().join("target/test-artifacts");
+    std::fs::create_dir_all(&dir).expect("create target/test-artifacts");
+    dir
+}
+
+/// Mean of the RGB channels over all pixels.
+pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
+    let mut sum = [0f64; 3];
+    for p in pixels {
+        for c in 0..3 {
+            sum[c] += p[c] as f64;
+        }
+    }
+    sum.map(|s| s / pixels.len() as f64)
+}
+
+/// Root-mean-square difference over RGB.
+pub fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>())
+        .sum();
+    (sum / (3 * a.len()) as f64).sqrt()
+}
+
+/// Writes a linear image as a PNG (clamped, sRGB-ish gamma) for a human to look at.
+pub fn save_preview(name: &str, width: u32, height: u32, pixels: &[[f32; 4]]) -> PathBuf {
+    let bytes: Vec<u8> = pixels
+        .iter()
+        .flat_map(|p| {
+            let g = |v: f32| (v.max(0.0).min(1.0).powf(1.0 / 2.2) * 255.0 + 0.5) as u8;
+            [g(p[0]), g(p[1]), g(p[2]), 255]
+        })
+        .collect();
+    let path = artifacts_dir().join(name);
+    image::save_buffer(&path, &bytes, width, height, image::ExtendedColorType::Rgba8).expect("write preview");
+    path
+}

@@ -93,6 +93,22 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Benchmark: BVH build, rays per second, per-pass GPU milliseconds (one run, one device).
+    Bench {
+        /// Scenes to measure.
+        #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
+        scenes: Vec<String>,
+        /// Frame sizes WxH.
+        #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]
+        sizes: Vec<String>,
+        /// Whole frames rendered per size for the per-pass timings.
+        #[arg(long, default_value_t = 2)]
+        frames: u32,
+        #[arg(long, default_value = "out/bench")]
+        out: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
     /// List Vulkan devices, the chosen one and its limits.
     Info {
         #[command(flatten)]
@@ -148,7 +164,25 @@ fn main() -> Result<()> {
                 validation: device.validation,
             })
         }
+        Command::Bench { scenes, sizes, frames, out, device } => {
+            let sizes = sizes.iter().map(|s| parse_size(s)).collect::<Result<Vec<_>>>()?;
+            commands::bench::run(&commands::bench::BenchArgs {
+                scenes: &scenes,
+                sizes: &sizes,
+                frames,
+                out: &out,
+                device: device.device.as_deref(),
+            })
+        }
         Command::Info { device } => commands::info::run(device.device.as_deref()),
         Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
+    }
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let parsed = s.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => anyhow::bail!("size '{s}' is not WIDTHxHEIGHT (e.g. 320x360)"),
     }
 }

@@ -53,8 +53,9 @@ impl WatertightRay {
     pub fn new(ray: &Ray) -> WatertightRay {
         let d = ray.dir;
         let abs = d.abs();
-        // kz: the dimension where |dir| is largest; kx, ky follow cyclically.
-        let kz = if abs.x >= abs.y && abs.x >= abs.z { 0 } else if abs.y >= abs.z { 1 } else { 2 };
+        // kz: the dimension where |dir| is largest; kx, ky follow cyclically. Ties resolve exactly
+        // as in shaders/common/bvh.glsl (strict comparisons), so both pick the same permutation.
+        let kz = if abs.x > abs.y { if abs.x > abs.z { 0 } else { 2 } } else if abs.y > abs.z { 1 } else { 2 };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if d[kz] < 0.0 {
@@ -88,19 +89,12 @@ impl WatertightRay {
         if det == 0.0 {
             return None;
         }
-        let az = self.sz * a[kz];
-        let bz = self.sz * b[kz];
-        let cz = self.sz * c[kz];
-        let t_scaled = eu * az + ev * bz + ew * cz;
-        // Sign-corrected range test 0 < t < t_max without the division.
-        let (t_scaled, det_abs) = if det < 0.0 { (-t_scaled, -det) } else { (t_scaled, det) };
-        if t_scaled <= 0.0 || t_scaled >= t_max * det_abs {
-            return None;
-        }
+        // Same operation order as the GLSL (Sz applied after the sum), so t rounds the same way.
+        let t_scaled = self.sz * (eu * a[kz] + ev * b[kz] + ew * c[kz]);
         let rcp = 1.0 / det;
-        let t = if det < 0.0 { -t_scaled * rcp } else { t_scaled * rcp };
+        let t = t_scaled * rcp;
         if !(t > 0.0 && t < t_max) {
-            return None; // rounding of the division can push t to the boundary
+            return None;
         }
         Some((t, ev * rcp, ew * rcp))
     }

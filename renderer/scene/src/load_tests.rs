@@ -100,6 +100,15 @@ fn out_of_range_vertex_index_is_reported() {
 fn out_of_range_json_references_are_reported() {
     let doc = triangle_gltf([0, 1, 2], |d| d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(9));
     expect_error("bad_accessor", load_json("bad_accessor", &doc), &["accessors", "POSITION"]);
+    let doc = triangle_gltf([0, 1, 2], |d| d["meshes"][0]["primitives"][0]["material"] = json!(9));
+    expect_error("bad_material", load_json("bad_material", &doc), &["material"]);
+    let doc = triangle_gltf([0, 1, 2], |d| d["nodes"][0]["mesh"] = json!(9));
+    expect_error("bad_mesh", load_json("bad_mesh", &doc), &["mesh"]);
+    let doc = triangle_gltf([0, 1, 2], |d| {
+        d["textures"] = json!([{"source": 9}]);
+        d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    });
+    expect_error("bad_texture", load_json("bad_texture", &doc), &["source"]);
     let doc = triangle_gltf([0, 1, 2], |d| d["bufferViews"][0]["byteLength"] = json!(400));
     let result = load_json("short_buffer", &doc);
     assert!(result.is_err(), "a view past the end of its buffer must not load");

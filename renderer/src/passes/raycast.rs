@@ -43,3 +43,49 @@ impl RaycastPass {
         rec.dispatch(pass_name, &self.pipeline, &binds, push_bytes(&push), [count, 1, 1])
     }
 }
+
+/// Runs ray lists through the raycast pass outside a frame: owns the ray/hit buffers (grown as
+/// needed) and reports the GPU time of the traversal alone.
+pub struct RayCaster {
+    ctx: Arc<Context>,
+    pass: RaycastPass,
+    frame: Buffer,
+    rays: Option<Buffer>,
+    hits: Option<Buffer>,
+    recorder: crate::graph::FrameRecorder,
+}
+
+impl RayCaster {
+    pub fn new(ctx: &Arc<Context>) -> Result<RayCaster> {
+        let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
+        Ok(RayCaster {
+            ctx: ctx.clone(),
+            pass: RaycastPass::new(ctx)?,
+            frame: Buffer::with_data(ctx, "frame", &[crate::layouts::FrameData::default()], storage)?,
+            rays: None,
+            hits: None,
+            recorder: crate::graph::FrameRecorder::new(ctx, 4)?,
+        })
+    }
+
+    /// Traces `rays` (closest hit, or any hit for shadow rays); returns the hits and GPU ms.
+    pub fn trace(&mut self, scene: &GpuScene, rays: &[crate::layouts::RayGpu], any_hit: bool) -> Result<(Vec<crate::layouts::HitGpu>, f64)> {
+        use gpu_allocator::MemoryLocation;
+        let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
+        let ray_bytes = (std::mem::size_of_val(rays) as u64).max(16);
+        let hit_bytes = (rays.len() * std::mem::size_of::<crate::layouts::HitGpu>()) as u64;
+        if self.rays.as_ref().is_none_or(|b| b.size < ray_bytes) {
+            self.rays = Some(Buffer::new(&self.ctx, "rays", ray_bytes, storage, MemoryLocation::CpuToGpu)?);
+            self.hits = Some(Buffer::new(&self.ctx, "hits", hit_bytes.max(32), storage, MemoryLocation::GpuToCpu)?);
+        }
+        let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());
+        ray_buf.write(rays)?;
+        self.recorder.begin()?;
+        let name = if any_hit { "raycast_any" } else { "raycast_closest" };
+        self.pass.record(&mut self.recorder, name, scene, &self.frame, ray_buf, hit_buf, rays.len() as u32, any_hit)?;
+        let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
+        let mut hits: Vec<crate::layouts::HitGpu> = hit_buf.read()?;
+        hits.truncate(rays.len());
+        Ok((hits, ms))
+    }
+}

@@ -1,3 +1,4 @@
+pub mod bench;
 pub mod gen_scene;
 pub mod info;
 pub mod reference;

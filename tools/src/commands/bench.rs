@@ -1,0 +1,204 @@
+//! `fovea bench`: BVH build rate and memory on the large scene; primary, shadow and indirect rays
+//! per second on the current device; per-pass GPU milliseconds of whole frames. All figures
+//! come from one run on one device (GPU timestamps for the GPU parts).
+
+use anyhow::{bail, Result};
+use fovea_renderer::gpu_scene::GpuScene;
+use fovea_renderer::layouts::{HitGpu, RayGpu};
+use fovea_renderer::passes::raycast::RayCaster;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::bvh::Bvh;
+use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
+use fovea_renderer::scene::{PunctualLight, Scene};
+use glam::{UVec2, Vec3, Vec4};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+pub struct BenchArgs<'a> {
+    pub scenes: &'a [String],
+    pub sizes: &'a [(u32, u32)],
+    pub frames: u32,
+    pub out: &'a Path,
+    pub device: Option<&'a str>,
+}
+
+#[derive(Serialize)]
+struct BvhReport {
+    scene: String,
+    triangles: usize,
+    build_seconds: f64,
+    triangles_per_second: f64,
+    memory_bytes: usize,
+    depth: u32,
+}
+
+#[derive(Serialize)]
+struct RayReport {
+    scene: String,
+    width: u32,
+    height: u32,
+    primary_mrays_per_s: f64,
+    shadow_mrays_per_s: f64,
+    indirect_mrays_per_s: f64,
+    frame_passes_ms: BTreeMap<String, f64>,
+    frame_rays: u64,
+}
+
+#[derive(Serialize)]
+struct BenchReport {
+    device: String,
+    bvh: Vec<BvhReport>,
+    rays: Vec<RayReport>,
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    crate::output::prepare_output_dir(args.out)?;
+    let ctx = super::open_device(args.device, false)?;
+    let mut report = BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new() };
+    for name in args.scenes {
+        let scene = crate::scenes::load(name)?;
+        let positions = scene.triangle_positions();
+        let started = Instant::now();
+        let bvh = Bvh::build(&positions);
+        let seconds = started.elapsed().as_secs_f64();
+        let bvh_report = BvhReport {
+            scene: name.clone(),
+            triangles: positions.len(),
+            build_seconds: seconds,
+            triangles_per_second: positions.len() as f64 / seconds,
+            memory_bytes: bvh.memory_bytes(),
+            depth: bvh.depth(),
+        };
+        println!(
+            "{name}: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB, depth {}",
+            bvh_report.triangles,
+            seconds,
+            bvh_report.triangles_per_second * 1e-6,
+            bvh_report.memory_bytes as f64 / (1 << 20) as f64,
+            bvh_report.depth
+        );
+        report.bvh.push(bvh_report);
+        let Some(camera) = scene.default_camera() else { bail!("{name}: no camera") };
+        let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
+        let mut caster = RayCaster::new(&ctx)?;
+        for &(w, h) in args.sizes {
+            let pose = CameraPose::from_scene_camera(camera, w, h);
+            let primary = primary_rays(&pose, w, h);
+            let (hits, primary_ms) = caster.trace(&gpu, &primary, false)?;
+            let (shadow, indirect) = secondary_rays(&scene, &positions, &primary, &hits);
+            let (_, shadow_ms) = caster.trace(&gpu, &shadow, true)?;
+            let (_, indirect_ms) = caster.trace(&gpu, &indirect, false)?;
+            let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
+
+            let space = Box::new(Cartesian { screen: UVec2::new(w, h) });
+            let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
+            let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
+            let mut sums: BTreeMap<String, f64> = BTreeMap::new();
+            let mut frame_rays = 0;
+            for frame in 0..args.frames {
+                let stats = renderer.render_frame(&FrameInput { camera: pose, frame_index: frame, read_hdr: false })?;
+                frame_rays = stats.rays_traced();
+                for t in renderer.timings() {
+                    *sums.entry(t.name.to_string()).or_default() += t.ms / args.frames as f64;
+                }
+            }
+            let r = RayReport {
+                scene: name.clone(),
+                width: w,
+                height: h,
+                primary_mrays_per_s: rate(primary.len(), primary_ms),
+                shadow_mrays_per_s: rate(shadow.len(), shadow_ms),
+                indirect_mrays_per_s: rate(indirect.len(), indirect_ms),
+                frame_passes_ms: sums,
+                frame_rays,
+            };
+            println!(
+                "{name} {w}×{h}: primary {:.2} Mrays/s, shadow {:.2} Mrays/s, indirect {:.2} Mrays/s; frame passes (ms) {:?}",
+                r.primary_mrays_per_s, r.shadow_mrays_per_s, r.indirect_mrays_per_s, r.frame_passes_ms
+            );
+            report.rays.push(r);
+        }
+    }
+    super::check_validation(&ctx)?;
+    let path = args.out.join("report.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
+    let origin = pose.world_from_view.w_axis.truncate();
+    let t = pose.fov_tan;
+    let mut rays = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let fx = (x as f32 + 0.5) / w as f32;
+            let fy = (y as f32 + 0.5) / h as f32;
+            let view = Vec3::new(t.x + fx * (t.y - t.x), t.w + fy * (t.z - t.w), -1.0);
+            let dir = pose.world_from_view.transform_vector3(view).normalize();
+            rays.push(RayGpu { origin_tmin: origin.extend(0.0), direction_tmax: dir.extend(1e30) });
+        }
+    }
+    rays
+}
+
+/// A small deterministic hash → [0, 1) for the CPU-side ray generation.
+fn hash01(i: u32, salt: u32) -> f32 {
+    let mut x = i.wrapping_mul(0x9E37_79B9) ^ salt.wrapping_mul(0x85EB_CA6B);
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7FEB_352D);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846C_A68B);
+    x ^= x >> 16;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
+
+/// From each primary hit: one shadow ray to a random point on a random light and one
+/// cosine-distributed indirect ray, like the path tracer's first vertex.
+fn secondary_rays(scene: &Scene, tris: &[[Vec3; 3]], primary: &[RayGpu], hits: &[HitGpu]) -> (Vec<RayGpu>, Vec<RayGpu>) {
+    let table = build_light_table(scene);
+    let (mut shadow, mut indirect) = (Vec::new(), Vec::new());
+    for (i, (ray, hit)) in primary.iter().zip(hits).enumerate() {
+        if hit.t_u_v.x < 0.0 {
+            continue;
+        }
+        let i = i as u32;
+        let [a, b, c] = tris[hit.triangle.x as usize];
+        let mut n = (b - a).cross(c - a).normalize();
+        let dir = ray.direction_tmax.truncate();
+        if n.dot(dir) > 0.0 {
+            n = -n;
+        }
+        let p = ray.origin_tmin.truncate() + dir * hit.t_u_v.x + n * 1e-4;
+        if !table.entries.is_empty() {
+            let entry = &table.entries[sample_alias(&table.alias, hash01(i, 1))];
+            let target = match entry.kind {
+                LightKind::EmissiveTriangle => {
+                    let [la, lb, lc] = tris[entry.index as usize];
+                    let (u, v) = (hash01(i, 2).sqrt(), hash01(i, 3));
+                    Some(la * (1.0 - u) + lb * (u * (1.0 - v)) + lc * (u * v))
+                }
+                _ => match &scene.punctual_lights[entry.index as usize] {
+                    PunctualLight::Point { position, .. } | PunctualLight::Spot { position, .. } => Some(*position),
+                    PunctualLight::Directional { direction, .. } => Some(p - *direction * 1e4),
+                },
+            };
+            if let Some(q) = target {
+                let to = q - p;
+                let d = to.length();
+                shadow.push(RayGpu { origin_tmin: p.extend(0.0), direction_tmax: (to / d).extend(d * (1.0 - 1e-4)) });
+            }
+        }
+        let (u1, u2) = (hash01(i, 4), hash01(i, 5));
+        let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+        let local = Vec4::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt(), 0.0);
+        let t = if n.x.abs() > 0.5 { Vec3::Y } else { Vec3::X }.cross(n).normalize();
+        let bt = n.cross(t);
+        let d = (t * local.x + bt * local.y + n * local.z).normalize();
+        indirect.push(RayGpu { origin_tmin: p.extend(0.0), direction_tmax: d.extend(1e30) });
+    }
+    (shadow, indirect)
+}
