@@ -20,90 +20,91 @@ struct Hit {
 
 // Watertight ray/triangle test (Woop, Benthin, Wald 2013), two-sided; same algorithm as
 // fovea_scene::intersect::intersect_triangle so the CPU reference agrees.
+//
+// lavapipe runs 8 lanes in SIMD and executes both sides of every `if` under a mask, so cost is the
+// static instruction count of the loop bodies. The per-lane axis permutation is therefore resolved
+// once per ray into select masks (a dynamic vector index costs a compare+select chain each time).
 struct RayShear {
-    ivec3 k;            // kx, ky, kz axis permutation
+    bvec2 kx, ky, kz;   // (k == 0, k == 1) for each of kx, ky, kz
+    vec3 org;           // origin permuted to (kx, ky, kz)
     vec3 s;             // Sx, Sy, Sz
 };
 
-RayShear ray_shear(vec3 dir) {
+float pick(vec3 v, bvec2 k) { return k.x ? v.x : (k.y ? v.y : v.z); }
+
+RayShear ray_shear(vec3 org, vec3 dir) {
     vec3 a = abs(dir);
     int kz = (a.x > a.y) ? ((a.x > a.z) ? 0 : 2) : ((a.y > a.z) ? 1 : 2);
     int kx = (kz + 1) % 3;
     int ky = (kx + 1) % 3;
     if (dir[kz] < 0.0) { int tmp = kx; kx = ky; ky = tmp; }
     RayShear r;
-    r.k = ivec3(kx, ky, kz);
-    r.s = vec3(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+    r.kx = bvec2(kx == 0, kx == 1);
+    r.ky = bvec2(ky == 0, ky == 1);
+    r.kz = bvec2(kz == 0, kz == 1);
+    r.org = vec3(pick(org, r.kx), pick(org, r.ky), pick(org, r.kz));
+    vec3 d = vec3(pick(dir, r.kx), pick(dir, r.ky), pick(dir, r.kz));
+    r.s = vec3(d.x / d.z, d.y / d.z, 1.0 / d.z);
     return r;
 }
 
+// A vertex moved to ray space before the shear: (v[kx], v[ky], v[kz]) − permuted origin. Exactly
+// (v − org)[k] of the textbook form, so results are bit-identical to the CPU reference.
+vec3 to_ray(RayShear sh, vec3 v) {
+    return vec3(pick(v, sh.kx), pick(v, sh.ky), pick(v, sh.kz)) - sh.org;
+}
+
 // Returns true and (t, u, v) when the ray hits inside (tmin, tmax).
-bool intersect_triangle(vec3 org, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax, out vec3 tuv) {
-    vec3 A = v0 - org, B = v1 - org, C = v2 - org;
-    float Ax = A[sh.k.x] - sh.s.x * A[sh.k.z], Ay = A[sh.k.y] - sh.s.y * A[sh.k.z];
-    float Bx = B[sh.k.x] - sh.s.x * B[sh.k.z], By = B[sh.k.y] - sh.s.y * B[sh.k.z];
-    float Cx = C[sh.k.x] - sh.s.x * C[sh.k.z], Cy = C[sh.k.y] - sh.s.y * C[sh.k.z];
+bool intersect_triangle(RayShear sh, vec3 v0, vec3 v1, vec3 v2, float tmin, float tmax, out vec3 tuv) {
+    vec3 A = to_ray(sh, v0), B = to_ray(sh, v1), C = to_ray(sh, v2);
+    float Ax = A.x - sh.s.x * A.z, Ay = A.y - sh.s.y * A.z;
+    float Bx = B.x - sh.s.x * B.z, By = B.y - sh.s.y * B.z;
+    float Cx = C.x - sh.s.x * C.z, Cy = C.y - sh.s.y * C.z;
     float U = Cx * By - Cy * Bx;
     float V = Ax * Cy - Ay * Cx;
     float W = Bx * Ay - By * Ax;
-    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
     float det = U + V + W;
-    if (det == 0.0) return false;
-    float T = sh.s.z * (U * A[sh.k.z] + V * B[sh.k.z] + W * C[sh.k.z]);
+    float T = sh.s.z * (U * A.z + V * B.z + W * C.z);
     float inv = 1.0 / det;
     float t = T * inv;
-    if (!(t > tmin && t < tmax)) return false;
     tuv = vec3(t, V * inv, W * inv);
-    return true;
+    bool outside = (U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0);
+    return !outside && det != 0.0 && t > tmin && t < tmax;
 }
 
-// Slab test of one box; returns the entry distance or +inf when missed.
-float box_entry(vec3 bmin, vec3 bmax, vec3 org_over_dir, vec3 inv_dir, float tmin, float tmax) {
-    if (bmin.x > bmax.x) return 1e30; // an empty child (inverted box): the slab test would accept it
-    vec3 t0 = bmin * inv_dir - org_over_dir;
-    vec3 t1 = bmax * inv_dir - org_over_dir;
+// Box tests over-estimate the exit distance by 2γ₃ (Ize 2013) so rounding never culls a box that
+// holds a hit; identical to fovea_scene::bvh::slab_test.
+const float SLAB_SLACK = 1.0 + 2.0 * (3.0 * 5.9604645e-8) / (1.0 - 3.0 * 5.9604645e-8);
+
+// Slab test of one box; returns the entry distance or 1e30 when missed.
+float box_entry(vec3 bmin, vec3 bmax, vec3 org, vec3 inv_dir, float tmin, float limit) {
+    vec3 t0 = (bmin - org) * inv_dir;
+    vec3 t1 = (bmax - org) * inv_dir;
     vec3 lo = min(t0, t1), hi = max(t0, t1);
     float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
-    float leave = min(min(hi.x, hi.y), min(hi.z, tmax));
-    return enter <= leave ? enter : 1e30;
+    float leave = min(min(hi.x, hi.y), hi.z) * SLAB_SLACK;
+    // An empty child is an inverted box: the slab test alone would accept it.
+    return (enter <= leave && enter <= limit && bmin.x <= bmax.x) ? enter : 1e30;
 }
 
-// Tests the triangles of one leaf, shrinking hit.t; true when any was hit.
-bool intersect_leaf(vec3 org, RayShear sh, uint first, uint count, float tmin, bool any_hit, inout Hit hit) {
-    bool found = false;
-    for (uint i = first; i < first + count; ++i) {
-        int tb = int(i) * 3;
-        vec4 t0 = texelFetch(bvh_triangles, tb + 0);
-        vec4 t1 = texelFetch(bvh_triangles, tb + 1);
-        vec4 t2 = texelFetch(bvh_triangles, tb + 2);
-        vec3 tuv;
-        if (intersect_triangle(org, sh, t0.xyz, t1.xyz, t2.xyz, tmin, hit.t, tuv)) {
-            hit.t = tuv.x;
-            hit.u = tuv.y;
-            hit.v = tuv.z;
-            hit.triangle = floatBitsToUint(t0.w);
-            found = true;
-            if (any_hit) return true;
-        }
-    }
-    return found;
-}
-
-// Closest hit (any_hit = false) or first hit found (shadow rays, any_hit = true).
+// Closest hit (any_hit = false: smallest (t, triangle index), the CPU reference's tie rule) or
+// the first hit found (shadow rays, any_hit = true).
 bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit hit) {
     hit.t = tmax;
     hit.triangle = 0xffffffffu;
     hit.u = 0.0;
     hit.v = 0.0;
-    RayShear sh = ray_shear(dir);
-    // Avoid inf*0 = NaN in the slab test for axis-parallel rays.
-    vec3 safe = mix(dir, vec3(1e-20), lessThan(abs(dir), vec3(1e-20)));
-    vec3 inv_dir = 1.0 / safe;
-    vec3 ood = org * inv_dir;
+    RayShear sh = ray_shear(org, dir);
+    // Like fovea_scene::bvh::safe_inverse_dir: a zero component becomes ±1e-30 (no 0·inf = NaN).
+    bvec3 zero = equal(dir, vec3(0.0));
+    vec3 signed_tiny = uintBitsToFloat((floatBitsToUint(dir) & 0x80000000u) | floatBitsToUint(1e-30));
+    vec3 inv_dir = 1.0 / mix(dir, signed_tiny, zero);
+    float limit = tmax * SLAB_SLACK;
     uint stack_base = gl_LocalInvocationIndex * uint(BVH_STACK_SIZE);
     int sp = 0;
     uint node = 0u;
-    while (true) {
+    bool done = false;
+    while (!done) {
         int base = int(node) * 4;
         vec4 n0 = texelFetch(bvh_nodes, base + 0);
         vec4 n1 = texelFetch(bvh_nodes, base + 1);
@@ -111,27 +112,43 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
         vec4 n3 = texelFetch(bvh_nodes, base + 3);
         uint child0 = floatBitsToUint(n0.w), child1 = floatBitsToUint(n1.w);
         uint count0 = floatBitsToUint(n2.w), count1 = floatBitsToUint(n3.w);
-        float e0 = box_entry(n0.xyz, n1.xyz, ood, inv_dir, tmin, hit.t);
-        float e1 = box_entry(n2.xyz, n3.xyz, ood, inv_dir, tmin, hit.t);
+        float e0 = box_entry(n0.xyz, n1.xyz, org, inv_dir, tmin, limit);
+        float e1 = box_entry(n2.xyz, n3.xyz, org, inv_dir, tmin, limit);
         bool hit0 = e0 < 1e30, hit1 = e1 < 1e30;
-        if (hit0 && count0 != 0u) {
-            if (intersect_leaf(org, sh, child0, count0, tmin, any_hit, hit) && any_hit) return true;
-            hit0 = false;
+        // Leaves are tested on the spot, nearer one first (the CPU traversal's order), in one loop
+        // over both leaves' triangles.
+        bool swap = hit0 && hit1 && e1 < e0;
+        uint leaf_a = (hit0 && count0 != 0u) ? count0 : 0u;
+        uint leaf_b = (hit1 && count1 != 0u) ? count1 : 0u;
+        uint first_a = swap ? child1 : child0, first_b = swap ? child0 : child1;
+        uint n_a = swap ? leaf_b : leaf_a, n_leaf = leaf_a + leaf_b;
+        for (uint i = 0u; i < n_leaf; ++i) {
+            int tb = int(i < n_a ? first_a + i : first_b + (i - n_a)) * 3;
+            vec4 t0 = texelFetch(bvh_triangles, tb + 0);
+            vec4 t1 = texelFetch(bvh_triangles, tb + 1);
+            vec4 t2 = texelFetch(bvh_triangles, tb + 2);
+            uint id = floatBitsToUint(t0.w);
+            vec3 tuv;
+            if (intersect_triangle(sh, t0.xyz, t1.xyz, t2.xyz, tmin, tmax, tuv)
+                && (tuv.x < hit.t || (tuv.x == hit.t && id < hit.triangle))) {
+                hit.t = tuv.x;
+                hit.u = tuv.y;
+                hit.v = tuv.z;
+                hit.triangle = id;
+                limit = hit.t * SLAB_SLACK;
+                if (any_hit) { done = true; break; }
+            }
         }
-        if (hit1 && count1 != 0u) {
-            if (intersect_leaf(org, sh, child1, count1, tmin, any_hit, hit) && any_hit) return true;
-            hit1 = false;
-        }
-        if (hit0 && hit1) {
-            bool left_first = e0 <= e1;
-            if (sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp++)] = left_first ? child1 : child0;
-            node = left_first ? child0 : child1;
-        } else if (hit0) {
-            node = child0;
-        } else if (hit1) {
-            node = child1;
+        if (done) break;
+        bool in0 = hit0 && count0 == 0u, in1 = hit1 && count1 == 0u;
+        if (in0 && in1) {
+            if (sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp++)] = swap ? child0 : child1;
+            node = swap ? child1 : child0;
+        } else if (in0 || in1) {
+            node = in0 ? child0 : child1;
+        } else if (sp == 0) {
+            done = true;
         } else {
-            if (sp == 0) break;
             node = bvh_stack[stack_base + uint(--sp)];
         }
     }

@@ -3,6 +3,7 @@
 
 pub mod camera_path;
 pub mod commands;
+pub mod gaze;
 pub mod output;
 pub mod scenegen;
 pub mod scenes;

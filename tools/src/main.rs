@@ -30,10 +30,22 @@ struct RenderOpts {
     /// Sampling method.
     #[arg(long, default_value = "cartesian")]
     method: String,
-    #[arg(long, default_value_t = 320)]
-    width: u32,
-    #[arg(long, default_value_t = 360)]
-    height: u32,
+    /// Headset profile: a name from `fovea headsets` or a TOML path.
+    #[arg(long, default_value = "fove0")]
+    headset: String,
+    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file.
+    #[arg(long, default_value = "sim:1")]
+    gaze: String,
+    /// Render width (default: the headset's per-eye width × --scale).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Render height (default: the headset's per-eye height × --scale).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Fraction of the headset's per-eye resolution when --width/--height are not given
+    /// (0.25 keeps the default run near a minute on lavapipe; 1 is the full 1280×1440 FOVE eye).
+    #[arg(long, default_value_t = 0.25)]
+    scale: f32,
     #[arg(long, default_value_t = 24)]
     frames: u32,
     /// Output folder (created; must hold only fovea's own outputs if it exists).
@@ -114,6 +126,8 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// List the headset profiles built in (config/headsets/*.toml).
+    Headsets,
     /// Write one of the project's procedural scenes as glTF.
     GenScene {
         /// cornell-box, stress or large.
@@ -140,6 +154,9 @@ fn main() -> Result<()> {
             method: &opts.method,
             width: opts.width,
             height: opts.height,
+            scale: opts.scale,
+            headset: &opts.headset,
+            gaze: &opts.gaze,
             frames: opts.frames,
             out: &opts.out,
             exr: opts.exr,
@@ -174,6 +191,7 @@ fn main() -> Result<()> {
                 device: device.device.as_deref(),
             })
         }
+        Command::Headsets => commands::headsets::run(),
         Command::Info { device } => commands::info::run(device.device.as_deref()),
         Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
     }

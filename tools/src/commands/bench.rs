@@ -133,7 +133,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 }
 
 /// Runs of each ray set after the untimed warm-up; the median GPU time is reported.
-const TIMED_RUNS: usize = 3;
+const TIMED_RUNS: usize = 5;
 
 /// Traces `rays` once untimed (warm-up), then `TIMED_RUNS` times; returns the hits and the
 /// median GPU milliseconds.

@@ -1,5 +1,6 @@
 pub mod bench;
 pub mod gen_scene;
+pub mod headsets;
 pub mod info;
 pub mod reference;
 pub mod render;

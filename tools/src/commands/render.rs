@@ -3,7 +3,9 @@
 
 use crate::camera_path;
 use crate::output::{prepare_output_dir, write_exr, write_png};
-use anyhow::{bail, Result};
+use crate::gaze::GazeDriver;
+use anyhow::{bail, Context, Result};
+use fovea_hal::GazeOrigin;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace};
 use glam::UVec2;
@@ -15,8 +17,12 @@ use std::path::Path;
 pub struct RenderArgs<'a> {
     pub scene: &'a str,
     pub method: &'a str,
-    pub width: u32,
-    pub height: u32,
+    /// Render size; `None` = the headset's per-eye recommended size × `scale`.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub scale: f32,
+    pub headset: &'a str,
+    pub gaze: &'a str,
     pub frames: u32,
     pub out: &'a Path,
     pub exr: bool,
@@ -32,6 +38,15 @@ pub struct RenderArgs<'a> {
 struct Report {
     method: String,
     scene: String,
+    headset: String,
+    gaze_source: String,
+    /// Gaze point per frame in render pixels (the Cartesian method traces uniformly and only
+    /// records it; foveated methods centre their sampling on it).
+    gaze: Vec<[f32; 2]>,
+    /// Frames whose gaze was live / held after a lost sample / the view centre.
+    gaze_live: u32,
+    gaze_held: u32,
+    gaze_centre: u32,
     device: String,
     width: u32,
     height: u32,
@@ -61,9 +76,17 @@ struct RayReport {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    if args.width == 0 || args.height == 0 || args.frames == 0 {
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+    if !(args.scale > 0.0 && args.scale <= 4.0) {
+        bail!("--scale {} must be in (0, 4]", args.scale);
+    }
+    let eye = hmd.eye(fovea_hal::Eye::Left);
+    let width = args.width.unwrap_or(((eye.recommended_width as f32 * args.scale).round() as u32).max(1));
+    let height = args.height.unwrap_or(((eye.recommended_height as f32 * args.scale).round() as u32).max(1));
+    if width == 0 || height == 0 || args.frames == 0 {
         bail!("--width, --height and --frames must be at least 1");
     }
+    let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
     if args.method != "cartesian" {
         bail!("--method {}: only 'cartesian' is implemented so far (Visual-Polar is not done yet)", args.method);
     }
@@ -72,10 +95,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("{}: the scene has no perspective camera", scene.source.display());
     };
     prepare_output_dir(args.out)?;
-    let start_pose = CameraPose::from_scene_camera(camera, args.width, args.height);
+    let start_pose = CameraPose::from_scene_camera(camera, width, height);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, exposure: args.exposure, ..Default::default() };
-    let space = Box::new(Cartesian { screen: UVec2::new(args.width, args.height) });
+    let space = Box::new(Cartesian { screen: UVec2::new(width, height) });
     let screen_pixels = space.screen_size().x as u64 * space.screen_size().y as u64;
     let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
     let centre = scene.bounds().center();
@@ -85,9 +108,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let mut pass_sums: BTreeMap<String, f64> = BTreeMap::new();
     let (mut samples, mut rays) = (0u64, RayReport::default());
+    let mut gaze_points = Vec::with_capacity(args.frames as usize);
+    let mut origins = [0u32; 3];
     let mut ldr = Vec::new();
     let mut hdr = Vec::new();
     for frame in 0..args.frames {
+        let frame_gaze = gaze.frame(frame)?;
+        gaze_points.push(frame_gaze.pixel.to_array());
+        origins[match frame_gaze.origin {
+            GazeOrigin::Live => 0,
+            GazeOrigin::Held => 1,
+            GazeOrigin::Centre => 2,
+        }] += 1;
         let camera = if args.camera_path { camera_path::orbit(&start_pose, centre, frame, args.frames) } else { start_pose };
         let stats = renderer.render_frame(&FrameInput { camera, frame_index: frame, read_hdr: args.exr })?;
         samples += stats.samples_traced;
@@ -98,10 +130,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             *pass_sums.entry(t.name.to_string()).or_default() += t.ms;
         }
         renderer.read_ldr(&mut ldr)?;
-        write_png(&args.out.join(format!("frame_{frame:04}.png")), args.width, args.height, &ldr)?;
+        write_png(&args.out.join(format!("frame_{frame:04}.png")), width, height, &ldr)?;
         if args.exr {
             renderer.read_hdr(&mut hdr)?;
-            write_exr(&args.out.join(format!("frame_{frame:04}.exr")), args.width, args.height, &hdr)?;
+            write_exr(&args.out.join(format!("frame_{frame:04}.exr")), width, height, &hdr)?;
         }
         bar.inc(1);
     }
@@ -114,9 +146,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let report = Report {
         method: args.method.to_string(),
         scene: scene.source.display().to_string(),
+        headset: hmd.id.clone(),
+        gaze_source: args.gaze.to_string(),
+        gaze: gaze_points,
+        gaze_live: origins[0],
+        gaze_held: origins[1],
+        gaze_centre: origins[2],
         device: ctx.info.name.clone(),
-        width: args.width,
-        height: args.height,
+        width,
+        height,
         frames: args.frames,
         samples_traced: samples / n,
         screen_pixels,
@@ -134,8 +172,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     println!(
         "rendered {} frame(s) of {}×{} ({}) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
         args.frames,
-        args.width,
-        args.height,
+        width,
+        height,
         report.method,
         report.device,
         report.frame_gpu_ms,

@@ -1,0 +1,124 @@
+//! The `fovea` command-line contract through its library: report.json keys and exact counts,
+//! bad input named clearly, and user files never overwritten.
+
+use fovea_tools::commands::reference::{run as reference, ReferenceArgs};
+use fovea_tools::commands::render::{run as render, RenderArgs};
+use std::path::{Path, PathBuf};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = fovea_tests::artifacts_dir().join(format!("cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
+    RenderArgs {
+        scene,
+        method: "cartesian",
+        width: Some(40),
+        height: Some(36),
+        scale: 0.25,
+        headset: "fove0",
+        gaze: "sim:3",
+        frames: 2,
+        out,
+        exr: true,
+        camera_path: true,
+        seed: 1,
+        max_depth: 3,
+        exposure: 1.0,
+        device: None,
+        validation: true,
+    }
+}
+
+#[test]
+fn render_writes_frames_and_a_report_with_exact_counts() {
+    let out = temp_dir("render");
+    render(&render_args("cornell-box", &out)).unwrap();
+    for f in ["frame_0000.png", "frame_0001.png", "frame_0000.exr", "frame_0001.exr", "report.json"] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    for key in ["method", "width", "height", "frames", "samples_traced", "screen_pixels", "rays_traced", "passes"] {
+        assert!(report.get(key).is_some(), "report.json lacks '{key}'");
+    }
+    assert_eq!(report["samples_traced"], 40 * 36);
+    assert_eq!(report["screen_pixels"], 40 * 36);
+    assert_eq!(report["frames"], 2);
+    assert_eq!(report["gaze"].as_array().unwrap().len(), 2);
+    assert!(report["rays_traced"].as_u64().unwrap() > 40 * 36);
+    assert!(report["passes"]["trace"].as_f64().unwrap() > 0.0);
+    // Rendering again into the same folder replaces only fovea's own files.
+    render(&render_args("cornell-box", &out)).unwrap();
+}
+
+#[test]
+fn output_folders_with_user_files_are_refused() {
+    let out = temp_dir("userfile");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let err = render(&render_args("cornell-box", &out)).unwrap_err().to_string();
+    assert!(err.contains("notes.txt"), "{err}");
+    assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
+
+    let exr = out.join("notes.txt");
+    let args = ReferenceArgs {
+        scene: "cornell-box",
+        width: 8,
+        height: 8,
+        spp: 1,
+        max_depth: 3,
+        seed: 1,
+        out: &exr,
+        force: false,
+        device: None,
+        validation: true,
+    };
+    let err = reference(&args).unwrap_err().to_string();
+    assert!(err.contains("already exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&exr).unwrap(), "mine");
+}
+
+#[test]
+fn bad_scene_input_is_named_in_the_error() {
+    let dir = temp_dir("badscene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("out");
+    let err = format!("{:#}", render(&render_args("no/such/scene.gltf", &out)).unwrap_err());
+    assert!(err.contains("no/such/scene.gltf"), "{err}");
+
+    let malformed = dir.join("malformed.gltf");
+    std::fs::write(&malformed, "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ ").unwrap();
+    let err = format!("{:#}", render(&render_args(malformed.to_str().unwrap(), &out)).unwrap_err());
+    assert!(err.contains("malformed.gltf"), "{err}");
+
+    let draco = dir.join("draco.gltf");
+    std::fs::write(
+        &draco,
+        r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"]}"#,
+    )
+    .unwrap();
+    let err = format!("{:#}", render(&render_args(draco.to_str().unwrap(), &out)).unwrap_err());
+    assert!(err.contains("draco.gltf") && err.contains("KHR_draco_mesh_compression"), "{err}");
+
+    let err = format!("{:#}", render(&render_args("no-such-builtin", &out)).unwrap_err());
+    assert!(err.contains("no-such-builtin"), "{err}");
+}
+
+#[test]
+fn bad_headset_and_gaze_arguments_are_named() {
+    let out = temp_dir("badargs");
+    let mut args = render_args("cornell-box", &out);
+    args.headset = "no_such_headset";
+    let err = format!("{:#}", render(&args).unwrap_err());
+    assert!(err.contains("no_such_headset"), "{err}");
+    let mut args = render_args("cornell-box", &out);
+    args.gaze = "sim:notanumber";
+    let err = format!("{:#}", render(&args).unwrap_err());
+    assert!(err.contains("sim:notanumber"), "{err}");
+    let mut args = render_args("cornell-box", &out);
+    args.method = "magic";
+    let err = format!("{:#}", render(&args).unwrap_err());
+    assert!(err.contains("magic"), "{err}");
+}

@@ -1,0 +1,62 @@
+//! Per-frame gaze for the renderer: a hal gaze source (simulated FOVE 0, trace playback, fixed)
+//! sampled at each frame's display time, run through the invalid-gaze policy and turned into a
+//! pixel of the rendered (possibly scaled) left-eye image. This is the only place that glues hal
+//! backends to rendering.
+
+use anyhow::{Context, Result};
+use fovea_hal::{Eye, GazeOrigin, GazeSource, GazeSpec, HmdDescription, InvalidGazePolicy, XrTime};
+use glam::Vec2;
+
+pub struct GazeDriver {
+    source: Box<dyn GazeSource>,
+    policy: InvalidGazePolicy,
+    hmd: HmdDescription,
+    /// Render pixels per headset pixel.
+    scale: Vec2,
+    frame_period_ns: f64,
+}
+
+/// The gaze used for one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameGaze {
+    /// Gaze point in render pixels (x right, y down).
+    pub pixel: Vec2,
+    pub origin: GazeOrigin,
+    pub time_ns: XrTime,
+}
+
+impl GazeDriver {
+    /// `spec`: center | X,Y (render pixels) | sim[:seed] | trace path.
+    pub fn open(spec: &str, hmd: &HmdDescription, render_width: u32, render_height: u32) -> Result<GazeDriver> {
+        let eye = hmd.eye(Eye::Left);
+        let scale = Vec2::new(
+            render_width as f32 / eye.recommended_width as f32,
+            render_height as f32 / eye.recommended_height as f32,
+        );
+        let mut parsed: GazeSpec = spec.parse().with_context(|| format!("--gaze {spec}"))?;
+        if let GazeSpec::Fixed { x, y } = &mut parsed {
+            *x /= scale.x;
+            *y /= scale.y;
+        }
+        let source = parsed.open(hmd.clone()).with_context(|| format!("opening gaze source '{spec}'"))?;
+        Ok(GazeDriver {
+            source,
+            policy: InvalidGazePolicy::default(),
+            hmd: hmd.clone(),
+            scale,
+            frame_period_ns: 1e9 / hmd.refresh_hz as f64,
+        })
+    }
+
+    /// Gaze for frame `index`, displayed at `index` refresh periods after the start.
+    pub fn frame(&mut self, index: u32) -> Result<FrameGaze> {
+        let t = (index as f64 * self.frame_period_ns) as XrTime;
+        self.source.begin_frame(t)?;
+        let sample = self.source.sample_at(t);
+        let resolved = self.policy.resolve(&sample, t);
+        let eye = self.hmd.eye(Eye::Left);
+        let centre = Vec2::new(eye.recommended_width as f32, eye.recommended_height as f32) * 0.5;
+        let headset_px = self.hmd.direction_to_pixel(Eye::Left, resolved.direction).unwrap_or(centre);
+        Ok(FrameGaze { pixel: headset_px * self.scale, origin: resolved.source, time_ns: t })
+    }
+}
