@@ -72,6 +72,7 @@ fn output_folders_with_user_files_are_refused() {
         seed: 1,
         out: &exr,
         force: false,
+        preview: false,
         device: None,
         validation: true,
     };

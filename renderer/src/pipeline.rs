@@ -190,7 +190,8 @@ impl Renderer {
         }
         rec.submit_and_wait()?;
         self.prev_camera = Some(input.camera);
-        let counters: Vec<u32> = self.ray_counters.read()?;
+        let mut counters = [0u32; RAY_COUNTERS];
+        self.ray_counters.read_into(&mut counters)?;
         Ok(FrameStats {
             samples_traced: counters[0] as u64,
             primary_rays: counters[0] as u64,
@@ -201,18 +202,14 @@ impl Renderer {
 
     /// The last frame's tonemapped pixels, RGBA8, rows top to bottom.
     pub fn read_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
-        let bytes: Vec<u8> = self.ldr_readback.read()?;
-        out.clear();
-        out.extend_from_slice(&bytes);
-        Ok(())
+        out.resize(self.ldr_readback.size as usize, 0);
+        self.ldr_readback.read_into(out)
     }
 
     /// The last frame's (or reference's) linear screen image, RGBA32F.
     pub fn read_hdr(&self, out: &mut Vec<[f32; 4]>) -> Result<()> {
-        let texels: Vec<[f32; 4]> = self.hdr_readback.read()?;
-        out.clear();
-        out.extend_from_slice(&texels);
-        Ok(())
+        out.resize(self.hdr_readback.size as usize / 16, [0.0; 4]);
+        self.hdr_readback.read_into(out)
     }
 
     /// Converged linear radiance: the mean of `spp` samples per pixel with paths of up to

@@ -102,6 +102,9 @@ enum Command {
         /// Replace FILE if it exists.
         #[arg(long)]
         force: bool,
+        /// Also write a tonemapped PNG preview (FILE with .png).
+        #[arg(long)]
+        preview: bool,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -167,7 +170,7 @@ fn main() -> Result<()> {
             device: device.device.as_deref(),
             validation: device.validation,
         }),
-        Command::Reference { scene, width, height, spp, max_depth, seed, out, force, device } => {
+        Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {
             commands::reference::run(&commands::reference::ReferenceArgs {
                 scene: &scene,
                 width,
@@ -177,6 +180,7 @@ fn main() -> Result<()> {
                 seed,
                 out: &out,
                 force,
+                preview,
                 device: device.device.as_deref(),
                 validation: device.validation,
             })

@@ -67,3 +67,16 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     let size = image.layer_data.size;
     Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
 }
+
+/// Linear radiance → sRGB RGBA8 with the same fitted ACES curve as the tonemap pass (previews).
+pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32) -> Vec<u8> {
+    let curve = |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+    let srgb = |c: f32| if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    texels
+        .iter()
+        .flat_map(|t| {
+            let px = |c: f32| (srgb(curve((c * exposure).max(0.0))) * 255.0 + 0.5) as u8;
+            [px(t[0]), px(t[1]), px(t[2]), 255]
+        })
+        .collect()
+}

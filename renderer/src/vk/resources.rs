@@ -105,6 +105,22 @@ impl Buffer {
         Ok(())
     }
 
+    /// Copies the first `out.len()` elements back without allocating (render-loop read-backs).
+    pub fn read_into<T: bytemuck::Pod>(&self, out: &mut [T]) -> Result<()> {
+        let ptr = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_ptr())
+            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
+        let bytes = std::mem::size_of_val(out);
+        if bytes as u64 > self.size {
+            return Err(Error::Invalid(format!("buffer '{}': {bytes} bytes requested from {}", self.name, self.size)));
+        }
+        // SAFETY: mapped host-visible memory of at least `bytes`; the GPU is done with it.
+        unsafe { std::ptr::copy_nonoverlapping(ptr.as_ptr() as *const u8, out.as_mut_ptr() as *mut u8, bytes) };
+        Ok(())
+    }
+
     /// Reads the whole buffer back as `T`s (host-visible buffers only, after the GPU is done).
     pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
         let ptr = self

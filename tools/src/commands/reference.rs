@@ -1,6 +1,6 @@
 //! `fovea reference`: a converged linear-radiance EXR (many samples per pixel, chosen depth).
 
-use crate::output::{check_new_file, write_exr};
+use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Result};
 use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
@@ -17,6 +17,8 @@ pub struct ReferenceArgs<'a> {
     pub seed: u32,
     pub out: &'a Path,
     pub force: bool,
+    /// Also write a tonemapped PNG next to the EXR (same name, .png).
+    pub preview: bool,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
@@ -26,6 +28,10 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         bail!("--width, --height, --spp and --max-depth must be at least 1");
     }
     check_new_file(args.out, args.force)?;
+    let preview = args.out.with_extension("png");
+    if args.preview {
+        check_new_file(&preview, args.force)?;
+    }
     let scene = crate::scenes::load(args.scene)?;
     let Some(camera) = scene.default_camera() else {
         bail!("{}: the scene has no perspective camera", scene.source.display());
@@ -41,6 +47,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let image = renderer.render_reference(&pose, args.spp, args.max_depth, |done| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     write_exr(args.out, args.width, args.height, &image)?;
+    if args.preview {
+        write_png(&preview, args.width, args.height, &tonemap_preview(&image, 1.0))?;
+    }
     super::check_validation(&ctx)?;
     println!(
         "wrote {} ({}×{}, {} spp, max depth {}) in {:.1} s on {}",
