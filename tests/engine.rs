@@ -6,13 +6,9 @@ use fovea_renderer::graph::{read_image, FrameRecorder};
 use fovea_renderer::layouts::STRUCT_LAYOUTS;
 use fovea_renderer::vk::{Buffer, ComputePipeline, Image};
 use fovea_renderer::Error;
+use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::sampling::Cartesian;
 use fovea_tests::{assert_clean, gpu};
-use gpu_allocator_free::*;
-
-mod gpu_allocator_free {
-    pub use fovea_renderer::pipeline::{RenderSettings, Renderer};
-    pub use fovea_renderer::sampling::Cartesian;
-}
 
 #[test]
 fn validation_counter_catches_a_deliberate_misuse() {

@@ -63,7 +63,7 @@ pub fn save_preview(name: &str, width: u32, height: u32, pixels: &[[f32; 4]]) ->
     let bytes: Vec<u8> = pixels
         .iter()
         .flat_map(|p| {
-            let g = |v: f32| (v.max(0.0).min(1.0).powf(1.0 / 2.2) * 255.0 + 0.5) as u8;
+            let g = |v: f32| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0 + 0.5) as u8;
             [g(p[0]), g(p[1]), g(p[2]), 255]
         })
         .collect();
