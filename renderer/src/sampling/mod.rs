@@ -3,8 +3,10 @@
 //! GLSL include (`shaders/sampling/`) implements the same mapping on the GPU.
 
 mod cartesian;
+mod visual_polar;
 
 pub use cartesian::Cartesian;
+pub use visual_polar::{VisualPolar, VisualPolarParams, InverseCdf, RadiusMode};
 
 use crate::layouts::SamplingParams;
 use glam::{UVec2, Vec2};

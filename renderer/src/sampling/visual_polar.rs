@@ -1,0 +1,392 @@
+//! Visual-Polar space (Koskela et al., EGSR 2019): the pure mapping math, no Vulkan.
+//! See `shared/design/visual-polar.md`. `shaders/sampling/visual_polar_math.glsl` mirrors every
+//! function here line for line (same constants, same f32 order of operations) so that a device test
+//! can compare them; change both together.
+//!
+//! Grid: x (columns) = ρ, normalised u = x / width; y (rows) = φ ∈ [0, 2π), measured from +x toward
+//! +y in pixels (y down). Fovea u < u_f: r linear in u. Periphery: u maps linearly onto the acuity
+//! CDF fraction p ∈ [p_f, 1], e(p) through the inverse CDF, r = e / e_norm · r_max.
+//!
+//! Discrete clip layout (the triangular φ clip): a fovea column `c` (centre u_c = (c + ½)/width <
+//! u_f) keeps `n(c) = clamp(floor(height · u_c/u_f + ½), 1, height)` rows, the first n(c) rows
+//! (rows n(c).. of that column are clipped, i.e. the triangle is cut from the top-left corner).
+//! Its rows still span the whole circle: row y of column c sits at φ = 2π · y / n(c). Since n ∝ r
+//! the fovea has uniform areal density. Continuous grid coordinates use the same per-column step
+//! (φ = 2π·y/n(floor x)), so forward and inverse are exact inverses and a jittered texel stays in its
+//! column. Removed area ≈ u_f/2 of the grid, so u_f = 2 · clip_fraction.
+
+use crate::layouts::SamplingParams;
+use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
+use std::f32::consts::TAU;
+
+/// Reddy's acuity knee (degrees): V(e) is flat below it.
+pub const ACUITY_KNEE_DEG: f32 = 5.79;
+/// The paper's maximum "eccentricity": the normalised distance that r_max maps to.
+pub const E_MAX_DEG: f32 = 80.0;
+/// Steps of the exact inverse: from the polynomial guess 3 suffice for k = 1; the rest cover other
+/// density exponents, where some steps may fall back to bisection.
+const NEWTON_STEPS: u32 = 12;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InverseCdf {
+    /// The paper's fitted quartic (Eq. 3): no log/division on the GPU. Only defined for k = 1;
+    /// other density exponents fall back to `Exact`.
+    Polynomial,
+    /// Newton on the CDF (Eq. 2 for k = 1, its generalisation for other k).
+    Exact,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RadiusMode {
+    /// r_max = largest distance from the gaze to a screen corner (the paper's): the whole screen
+    /// is covered, the sample count is gaze-independent and the fovea grows near edges.
+    FarthestCorner,
+    /// A fixed r_max in pixels (screen parts beyond it get u > 1: clamp-to-edge when addressing).
+    Fixed(f32),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisualPolarParams {
+    /// Per-axis grid scale relative to the screen (2/3: 853×960 for 1280×1440).
+    pub axis_scale: f32,
+    /// Share of the grid removed by the fovea's triangular φ clip (0 < c < 0.5).
+    pub clip_fraction: f32,
+    /// Fovea radius as normalised eccentricity (80 ↦ r_max).
+    pub fovea_deg: f32,
+    /// Areal sample density ∝ V(e)^k (k = 1 is the paper's).
+    pub density_exponent: f32,
+    pub inverse_cdf: InverseCdf,
+    pub radius_mode: RadiusMode,
+}
+
+impl Default for VisualPolarParams {
+    fn default() -> Self {
+        Self {
+            axis_scale: 2.0 / 3.0,
+            clip_fraction: 0.12,
+            fovea_deg: ACUITY_KNEE_DEG,
+            density_exponent: 1.0,
+            inverse_cdf: InverseCdf::Polynomial,
+            radius_mode: RadiusMode::FarthestCorner,
+        }
+    }
+}
+
+impl VisualPolarParams {
+    /// The clip that makes the fovea hold exactly the fraction p_f of the samples, i.e. density
+    /// ∝ V^k everywhere (≈ 0.088 for k = 1): fovea share (u_f/2)/(1 − u_f/2) = p_f.
+    pub fn acuity_exact_clip_fraction(&self) -> f32 {
+        let p_f = fovea_fraction(self.fovea_deg, self.density_exponent);
+        p_f / (1.0 + p_f)
+    }
+}
+
+/// Reddy's acuity model V(e) in cycles per degree.
+pub fn acuity(e: f32) -> f32 {
+    if e <= ACUITY_KNEE_DEG {
+        60.0
+    } else {
+        let t = 0.3 * e + 1.0;
+        449.4 / (t * t)
+    }
+}
+
+/// Eq. 2 of the paper, literally: CDF(d) = (1/(0.3d+1) + ln(0.3d+1))·166.4π − 612.3 (d ≥ 5.79),
+/// ≈ (π/30)∫₀^d V(e)·e de. Below the knee it continues as the fovea part ∝ d² (continuous).
+pub fn cdf_eq2(d: f32) -> f32 {
+    const A: f32 = 166.4 * std::f32::consts::PI;
+    if d < ACUITY_KNEE_DEG {
+        let t0 = 0.3 * ACUITY_KNEE_DEG + 1.0;
+        let c0 = (1.0 / t0 + t0.ln()) * A - 612.3;
+        c0 * (d / ACUITY_KNEE_DEG) * (d / ACUITY_KNEE_DEG)
+    } else {
+        let t = 0.3 * d + 1.0;
+        (1.0 / t + t.ln()) * A - 612.3
+    }
+}
+
+/// ∫ t^a dt = t^(a+1)/(a+1), written with `a1 = a + 1` (ln t when a1 = 0).
+fn power_antiderivative(t: f32, a1: f32) -> f32 {
+    if a1.abs() < 1e-6 {
+        t.ln()
+    } else {
+        t.powf(a1) / a1
+    }
+}
+
+/// Generalised Eq. 2: (π/30)∫₀^d V(e)^k·e de; exactly `cdf_eq2` for k = 1 (the paper's constants).
+/// Past the knee, with t = 0.3e + 1: ∫ e·t^(−2k) de = (1/0.09)·∫ (t − 1)·t^(−2k) dt.
+pub fn cdf(d: f32, k: f32) -> f32 {
+    if k == 1.0 {
+        return cdf_eq2(d);
+    }
+    const S: f32 = std::f32::consts::PI / 30.0;
+    let dk = d.min(ACUITY_KNEE_DEG);
+    let fovea = S * 60f32.powf(k) * 0.5 * dk * dk;
+    if d <= ACUITY_KNEE_DEG {
+        return fovea;
+    }
+    let g =
+        |t: f32| power_antiderivative(t, 2.0 - 2.0 * k) - power_antiderivative(t, 1.0 - 2.0 * k);
+    let t0 = 0.3 * ACUITY_KNEE_DEG + 1.0;
+    fovea + S * 449.4f32.powf(k) / 0.09 * (g(0.3 * d + 1.0) - g(t0))
+}
+
+/// d cdf / d d, for Newton (the fovea part of `cdf_eq2` is scaled to continuity, so use it there).
+pub fn cdf_derivative(d: f32, k: f32) -> f32 {
+    if d < ACUITY_KNEE_DEG {
+        return 2.0 * cdf(ACUITY_KNEE_DEG, k) * d / (ACUITY_KNEE_DEG * ACUITY_KNEE_DEG);
+    }
+    if k == 1.0 {
+        let t = 0.3 * d + 1.0;
+        return 166.4 * std::f32::consts::PI * 0.3 * (t - 1.0) / (t * t);
+    }
+    std::f32::consts::PI / 30.0 * acuity(d).powf(k) * d
+}
+
+/// p_f = CDF(fovea)/CDF(80): the share of the acuity mass inside the fovea (≈ 0.0963 for k = 1).
+pub fn fovea_fraction(fovea_deg: f32, k: f32) -> f32 {
+    cdf(fovea_deg, k) / cdf(E_MAX_DEG, k)
+}
+
+/// Eq. 3, the paper's fitted inverse of the normalised CDF (degrees; p = CDF(e)/CDF(80)).
+/// Only meant for p ≥ p_f; e(1) ≈ 79.97.
+pub fn inverse_cdf_poly(p: f32) -> f32 {
+    (((25.09 * p + 0.1680) * p + 27.61) * p + 23.87) * p + 3.232
+}
+
+fn inverse_cdf_poly_derivative(p: f32) -> f32 {
+    ((100.36 * p + 0.504) * p + 55.22) * p + 23.87
+}
+
+/// Exact inverse of the normalised CDF: e with cdf(e, k) = p · cdf_max (cdf_max = cdf(80, k)).
+/// Safeguarded Newton from the polynomial guess: the bracket [lo, hi] shrinks every step and a
+/// Newton step leaving it is replaced by bisection (far from k = 1 the quartic guess can be poor
+/// and a plain step from a flat tail overshoots into the fovea). The GLSL twin does the same in f32.
+pub fn inverse_cdf_exact(p: f32, k: f32, cdf_max: f32) -> f32 {
+    let target = p * cdf_max;
+    let (mut lo, mut hi) = (0.0f32, if p <= 1.0 { E_MAX_DEG } else { 4.0 * E_MAX_DEG });
+    let mut e = inverse_cdf_poly(p).clamp(lo, hi);
+    for _ in 0..NEWTON_STEPS {
+        let f = cdf(e, k) - target;
+        if f < 0.0 {
+            lo = e;
+        } else {
+            hi = e;
+        }
+        let next = e - f / cdf_derivative(e, k).max(1e-6);
+        e = if next >= lo && next <= hi {
+            next
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    e
+}
+
+/// Inverse of Eq. 3 (p from e, periphery): Newton on the quartic from the exact CDF fraction,
+/// which the quartic fits to within 0.03°, so three steps reach f32 precision.
+pub fn poly_fraction_of(e: f32, cdf_max: f32) -> f32 {
+    let mut p = cdf_eq2(e) / cdf_max;
+    for _ in 0..3 {
+        p -= (inverse_cdf_poly(p) - e) / inverse_cdf_poly_derivative(p);
+    }
+    p
+}
+
+/// One gaze's Visual-Polar space on one screen. All derived constants are precomputed here and
+/// handed unchanged to the GPU (`sampling_params`), so both sides compute from the same numbers.
+#[derive(Clone, Copy, Debug)]
+pub struct VisualPolar {
+    screen: UVec2,
+    gaze: Vec2,
+    params: VisualPolarParams,
+    grid: UVec2,
+    /// Fovea width in u (clip triangle width).
+    u_f: f32,
+    /// CDF fraction at the fovea edge.
+    p_f: f32,
+    r_max: f32,
+    /// Fovea radius in pixels: e(p_f)/e_norm · r_max (continuous with the periphery).
+    r_f: f32,
+    /// e(1): e_poly(1) ≈ 79.97 for the polynomial, 80 for the exact inverse.
+    e_norm: f32,
+    cdf_max: f32,
+    exact: bool,
+}
+
+impl VisualPolar {
+    pub fn new(screen: UVec2, gaze: Vec2, params: VisualPolarParams) -> Self {
+        assert!(
+            params.clip_fraction > 0.0 && params.clip_fraction < 0.5,
+            "clip_fraction must be in (0, 0.5): the fovea spans u_f = 2·clip"
+        );
+        let grid = (screen.as_vec2() * params.axis_scale)
+            .round()
+            .as_uvec2()
+            .max(UVec2::ONE);
+        let k = params.density_exponent;
+        // The quartic is a fit for k = 1 only.
+        let exact = params.inverse_cdf == InverseCdf::Exact || k != 1.0;
+        let cdf_max = cdf(E_MAX_DEG, k);
+        let p_f = fovea_fraction(params.fovea_deg, k);
+        let r_max = match params.radius_mode {
+            RadiusMode::FarthestCorner => {
+                let far = gaze.max(screen.as_vec2() - gaze).abs();
+                far.length()
+            }
+            RadiusMode::Fixed(r) => r,
+        };
+        let (e_f, e_norm) = if exact {
+            (params.fovea_deg, E_MAX_DEG)
+        } else {
+            (inverse_cdf_poly(p_f), inverse_cdf_poly(1.0))
+        };
+        Self {
+            screen,
+            gaze,
+            params,
+            grid,
+            u_f: 2.0 * params.clip_fraction,
+            p_f,
+            r_max,
+            r_f: e_f / e_norm * r_max,
+            e_norm,
+            cdf_max,
+            exact,
+        }
+    }
+
+    pub fn screen(&self) -> UVec2 {
+        self.screen
+    }
+    pub fn gaze(&self) -> Vec2 {
+        self.gaze
+    }
+    pub fn params(&self) -> &VisualPolarParams {
+        &self.params
+    }
+    pub fn grid_size(&self) -> UVec2 {
+        self.grid
+    }
+    pub fn r_max(&self) -> f32 {
+        self.r_max
+    }
+    /// Fovea radius on screen in pixels.
+    pub fn r_fovea(&self) -> f32 {
+        self.r_f
+    }
+    /// Width of the clip triangle in normalised u: clipped area u_f/2 = clip_fraction.
+    pub fn u_fovea(&self) -> f32 {
+        self.u_f
+    }
+    pub fn p_fovea(&self) -> f32 {
+        self.p_f
+    }
+
+    /// Rows of φ that column `col` keeps (the triangular clip; see the module docs).
+    pub fn rows_in_column(&self, col: u32) -> u32 {
+        let h = self.grid.y;
+        let u_c = (col as f32 + 0.5) / self.grid.x as f32;
+        if u_c >= self.u_f {
+            return h;
+        }
+        ((h as f32 * u_c / self.u_f + 0.5).floor() as u32).clamp(1, h)
+    }
+
+    pub fn is_valid_texel(&self, t: IVec2) -> bool {
+        t.x >= 0
+            && t.y >= 0
+            && (t.x as u32) < self.grid.x
+            && (t.y as u32) < self.rows_in_column(t.x as u32)
+    }
+
+    /// Number of traced texels (all columns' kept rows).
+    pub fn sample_count(&self) -> u64 {
+        (0..self.grid.x)
+            .map(|c| self.rows_in_column(c) as u64)
+            .sum()
+    }
+
+    /// Normalised ρ coordinate → screen distance (pixels).
+    pub fn r_of_u(&self, u: f32) -> f32 {
+        if u < self.u_f {
+            return u / self.u_f * self.r_f;
+        }
+        let p = self.p_f + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - self.p_f);
+        let e = if self.exact {
+            inverse_cdf_exact(p, self.params.density_exponent, self.cdf_max)
+        } else {
+            inverse_cdf_poly(p)
+        };
+        e / self.e_norm * self.r_max
+    }
+
+    /// Screen distance (pixels) → normalised ρ coordinate (inverse of `r_of_u`).
+    pub fn u_of_r(&self, r: f32) -> f32 {
+        if r < self.r_f {
+            return r / self.r_f * self.u_f;
+        }
+        let e = r / self.r_max * self.e_norm;
+        let p = if self.exact {
+            cdf(e, self.params.density_exponent) / self.cdf_max
+        } else {
+            poly_fraction_of(e, self.cdf_max)
+        };
+        self.u_f + (p - self.p_f) / (1.0 - self.p_f) * (1.0 - self.u_f)
+    }
+
+    /// The column a continuous grid x belongs to (clamped, so u = 1 stays in the last column).
+    fn column_of(&self, x: f32) -> u32 {
+        (x.max(0.0).floor() as u32).min(self.grid.x - 1)
+    }
+
+    /// Screen position (pixels, y down) → continuous grid coordinates (texel units). y ∈ [0, n(col)).
+    pub fn screen_to_vp(&self, s: Vec2) -> Vec2 {
+        let d = s - self.gaze;
+        let r = d.length();
+        let mut phi = d.y.atan2(d.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let x = self.u_of_r(r) * self.grid.x as f32;
+        let n = self.rows_in_column(self.column_of(x)) as f32;
+        // atan2 may round to exactly 2π after the wrap: keep y inside [0, n).
+        let y = phi / TAU * n;
+        Vec2::new(x, if y >= n { 0.0 } else { y })
+    }
+
+    /// Continuous grid coordinates → screen position (pixels). φ wraps (any y is accepted).
+    pub fn vp_to_screen(&self, g: Vec2) -> Vec2 {
+        let n = self.rows_in_column(self.column_of(g.x)) as f32;
+        let phi = g.y / n * TAU;
+        let r = self.r_of_u(g.x / self.grid.x as f32);
+        self.gaze + r * Vec2::new(phi.cos(), phi.sin())
+    }
+
+    /// The parameters as the GPU gets them (binding `sampling`; unpacked by `vp_unpack` in
+    /// `visual_polar_math.glsl`): grid = (grid w, grid h, screen w, screen h),
+    /// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, exact, fovea°, 0).
+    pub fn sampling_params(&self) -> SamplingParams {
+        SamplingParams {
+            grid: UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y),
+            gaze: Vec4::new(
+                self.gaze.x,
+                self.gaze.y,
+                self.r_max,
+                self.params.density_exponent,
+            ),
+            shape0: Vec4::new(self.u_f, self.p_f, self.r_f, self.e_norm),
+            shape1: Vec4::new(
+                self.cdf_max,
+                self.exact as u32 as f32,
+                self.params.fovea_deg,
+                0.0,
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "visual_polar_tests.rs"]
+mod tests;

@@ -1,0 +1,372 @@
+//! Tests of the Visual-Polar mapping (`visual_polar.rs`).
+
+use super::*;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+fn vp(w: u32, h: u32, gx: f32, gy: f32, params: VisualPolarParams) -> VisualPolar {
+    VisualPolar::new(UVec2::new(w, h), Vec2::new(gx, gy), params)
+}
+
+fn with_inverse(inverse_cdf: InverseCdf) -> VisualPolarParams {
+    VisualPolarParams {
+        inverse_cdf,
+        ..Default::default()
+    }
+}
+
+/// f64 bisection on the generalised CDF: the reference the f32 Newton solver is held to.
+fn bisect_inverse(p: f64, k: f32) -> f64 {
+    let target = p * cdf(E_MAX_DEG, k) as f64;
+    let cdf64 = |d: f64| -> f64 {
+        if k == 1.0 && d >= 5.79 {
+            let t = 0.3 * d + 1.0;
+            (1.0 / t + t.ln()) * 166.4 * std::f64::consts::PI - 612.3
+        } else {
+            cdf(d as f32, k) as f64 // only used off the k = 1 periphery (f32 is ample there)
+        }
+    };
+    let (mut lo, mut hi) = (0.0f64, 4.0 * E_MAX_DEG as f64);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if cdf64(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn csv_vectors_reproduced() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/vp_mapping_vectors.csv"
+    );
+    let Ok(text) = std::fs::read_to_string(path) else {
+        println!("note: {path} absent, skipping the Visual-Polar vector test");
+        return;
+    };
+    let (mut rows, mut worst) = (0, 0.0f32);
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("screen_w"))
+    {
+        let f: Vec<&str> = line.split(',').collect();
+        let n = |i: usize| f[i].trim().parse::<f32>().unwrap();
+        let mode = match f[4] {
+            "poly" => InverseCdf::Polynomial,
+            "exact" => InverseCdf::Exact,
+            other => panic!("unknown mode {other}"),
+        };
+        let s = vp(n(0) as u32, n(1) as u32, n(2), n(3), with_inverse(mode));
+        let (u, phi) = (n(5), n(6));
+        let r = s.r_of_u(u);
+        // Through the grid API too: x = u·width, y = φ/2π · rows of that column.
+        let x = u * s.grid_size().x as f32;
+        let col = (x.floor() as u32).min(s.grid_size().x - 1);
+        let y = phi / TAU * s.rows_in_column(col) as f32;
+        let p = s.vp_to_screen(Vec2::new(x, y));
+        let err = (r - n(7))
+            .abs()
+            .max((p.x - n(8)).abs())
+            .max((p.y - n(9)).abs());
+        assert!(err < 1e-3, "row {line}: r {r} screen {p} (err {err})");
+        worst = worst.max(err);
+        rows += 1;
+    }
+    assert!(rows >= 600, "only {rows} vectors read");
+    println!("{rows} vectors, worst error {worst:.2e} px");
+}
+
+#[test]
+fn polynomial_matches_exact_inverse() {
+    let p_f = fovea_fraction(ACUITY_KNEE_DEG, 1.0);
+    let cdf_max = cdf(E_MAX_DEG, 1.0);
+    let (mut worst_poly, mut worst_newton) = (0.0f64, 0.0f64);
+    for i in 0..=2000 {
+        let p = p_f + (1.0 - p_f) * i as f32 / 2000.0;
+        let exact = bisect_inverse(p as f64, 1.0);
+        worst_poly = worst_poly.max((inverse_cdf_poly(p) as f64 - exact).abs());
+        worst_newton = worst_newton.max((inverse_cdf_exact(p, 1.0, cdf_max) as f64 - exact).abs());
+        // The quartic's inverse (used by screen → VP) undoes Eq. 3.
+        let back = poly_fraction_of(inverse_cdf_poly(p), cdf_max);
+        assert!((back - p).abs() < 2e-6, "poly inverse at p {p}: {back}");
+    }
+    println!("poly vs exact: {worst_poly:.4}°, f32 Newton vs f64 bisection: {worst_newton:.2e}°");
+    assert!(worst_poly < 0.05, "polynomial off by {worst_poly}°");
+    assert!(worst_newton < 1e-4, "Newton off by {worst_newton}°");
+    // Other density exponents go through the generalised CDF (Newton from the k = 1 guess).
+    for k in [0.5f32, 1.5, 2.0] {
+        let cdf_max = cdf(E_MAX_DEG, k);
+        let p_f = fovea_fraction(ACUITY_KNEE_DEG, k);
+        for i in 0..=200 {
+            let p = p_f + (1.0 - p_f) * i as f32 / 200.0;
+            let err = (inverse_cdf_exact(p, k, cdf_max) as f64 - bisect_inverse(p as f64, k)).abs();
+            assert!(err < 1e-3, "k {k} p {p}: Newton off by {err}°");
+        }
+    }
+}
+
+#[test]
+fn cdf_generalisation_is_consistent() {
+    // Eq. 2 is (π/30)∫V·e: the generalised form at k = 1 (paper constants rounded) agrees closely.
+    let general = |d: f32| {
+        let s = std::f32::consts::PI / 30.0;
+        let t = 0.3 * d + 1.0;
+        let t0 = 0.3 * ACUITY_KNEE_DEG + 1.0;
+        s * 60.0 * 0.5 * 5.79 * 5.79
+            + s * 449.4 / 0.09 * ((t.ln() + 1.0 / t) - (t0.ln() + 1.0 / t0))
+    };
+    assert!((cdf_eq2(80.0) / general(80.0) - 1.0).abs() < 3e-3);
+    assert!((cdf_eq2(ACUITY_KNEE_DEG) - 105.05).abs() < 0.05);
+    assert!((cdf_eq2(80.0) - 1091.3).abs() < 0.1);
+    for k in [0.5f32, 1.5] {
+        // Numerical derivative of cdf matches cdf_derivative (and so the Newton steps are right).
+        for d in [2.0f32, 10.0, 40.0, 75.0] {
+            let num = (cdf(d + 0.01, k) - cdf(d - 0.01, k)) / 0.02;
+            assert!(
+                (num / cdf_derivative(d, k) - 1.0).abs() < 2e-2,
+                "k {k} d {d}"
+            );
+        }
+    }
+}
+
+const GAZES_1280: [(f32, f32); 4] = [
+    (640.0, 720.0),
+    (1279.0, 720.0),
+    (200.0, 300.0),
+    (10.0, 10.0),
+];
+
+#[test]
+fn round_trips() {
+    let mut rng = Pcg64::seed_from_u64(4);
+    for (w, h, scale) in [(1280u32, 1440u32, 1.0f32), (640, 720, 0.5)] {
+        for (gx, gy) in GAZES_1280 {
+            for mode in [InverseCdf::Polynomial, InverseCdf::Exact] {
+                let s = vp(w, h, gx * scale, gy * scale, with_inverse(mode));
+                let grid = s.grid_size();
+                let mut worst = 0.0f32;
+                for _ in 0..10_000 {
+                    let p = Vec2::new(
+                        rng.random::<f32>() * w as f32,
+                        rng.random::<f32>() * h as f32,
+                    );
+                    let g = s.screen_to_vp(p);
+                    let n = s.rows_in_column((g.x as u32).min(grid.x - 1)) as f32;
+                    assert!(g.x >= 0.0 && g.x <= grid.x as f32 + 1e-3 && g.y >= 0.0 && g.y < n);
+                    worst = worst.max((s.vp_to_screen(g) - p).length());
+                }
+                assert!(
+                    worst < 5e-3,
+                    "{w}x{h} gaze ({gx},{gy}) {mode:?}: {worst} px"
+                );
+                // And grid → screen → grid (away from the gaze, where φ is ill-conditioned, and
+                // from column edges, where a rounding can pick the neighbour's φ step).
+                for _ in 0..10_000 {
+                    let x = rng.random::<f32>() * grid.x as f32;
+                    if x.fract() < 1e-3 || x.fract() > 1.0 - 1e-3 {
+                        continue;
+                    }
+                    let y = rng.random::<f32>() * s.rows_in_column(x as u32) as f32;
+                    let p = s.vp_to_screen(Vec2::new(x, y));
+                    if (p - s.gaze()).length() < 1.0 {
+                        continue;
+                    }
+                    let g = s.screen_to_vp(p);
+                    let n = s.rows_in_column(x as u32) as f32;
+                    let dy = (g.y - y).abs().min(n - (g.y - y).abs());
+                    assert!(
+                        (g.x - x).abs() < 2e-3 && dy < 1e-2,
+                        "({x},{y}) -> {p} -> {g}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn phi_wraps() {
+    let s = vp(1280, 1440, 200.0, 300.0, Default::default());
+    for x in [0.5f32, 50.3, 204.5, 300.0, 852.9] {
+        let n = s.rows_in_column(x as u32) as f32;
+        for y in [0.0f32, 0.25, n * 0.5, n - 0.1] {
+            let a = s.vp_to_screen(Vec2::new(x, y));
+            assert!((s.vp_to_screen(Vec2::new(x, y + n)) - a).length() < 1e-2);
+            assert!((s.vp_to_screen(Vec2::new(x, y - n)) - a).length() < 1e-2);
+        }
+        // Just below and just above φ = 0 land at the two ends of the column.
+        let r = s.r_of_u(x / s.grid_size().x as f32);
+        let below = s.screen_to_vp(s.gaze() + r * Vec2::new(1e-3f32.cos(), -1e-3f32.sin()));
+        let above = s.screen_to_vp(s.gaze() + r * Vec2::new(1e-3f32.cos(), 1e-3f32.sin()));
+        let dy = 1e-3 / TAU * n;
+        assert!(
+            (below.y - (n - dy)).abs() < 1e-3 && below.y < n,
+            "x {x}: {below}"
+        );
+        assert!((above.y - dy).abs() < 1e-3, "x {x}: {above}");
+    }
+}
+
+#[test]
+fn derived_numbers() {
+    let s = vp(1280, 1440, 640.0, 720.0, Default::default());
+    assert!((s.p_fovea() - 0.0963).abs() < 1e-4, "p_f {}", s.p_fovea());
+    assert!((s.u_fovea() - 0.24).abs() < 1e-6);
+    assert_eq!(s.grid_size(), UVec2::new(853, 960));
+    assert_eq!(
+        vp(640, 720, 320.0, 360.0, Default::default()).grid_size(),
+        UVec2::new(427, 480)
+    );
+    let share = s.sample_count() as f64 / (1280.0 * 1440.0);
+    let clipped = 1.0 - s.sample_count() as f64 / (853.0 * 960.0);
+    println!(
+        "grid 853x960, samples {}, traced share {share:.4}, clipped {clipped:.4}",
+        s.sample_count()
+    );
+    assert!((share / 0.391 - 1.0).abs() < 0.01, "traced share {share}");
+    assert!((clipped - 0.12).abs() < 0.002, "clipped {clipped}");
+    // The sample count does not depend on the gaze (FarthestCorner).
+    assert_eq!(
+        vp(1280, 1440, 10.0, 10.0, Default::default()).sample_count(),
+        s.sample_count()
+    );
+    // Clip layout: column 0 keeps a couple of rows, the last fovea column nearly all, then full.
+    assert_eq!(s.rows_in_column(0), 2);
+    assert!(s.rows_in_column(204) >= 958 && s.rows_in_column(205) == 960);
+    assert!(s.is_valid_texel(IVec2::new(0, 1)) && !s.is_valid_texel(IVec2::new(0, 2)));
+    assert!(!s.is_valid_texel(IVec2::new(853, 0)) && !s.is_valid_texel(IVec2::new(-1, 0)));
+    let acuity_clip = VisualPolarParams::default().acuity_exact_clip_fraction();
+    assert!(
+        (acuity_clip - 0.088).abs() < 1e-3,
+        "acuity-exact clip {acuity_clip}"
+    );
+}
+
+/// Screen-space sample density per eccentricity ring (ρ = distance / r_max · 80), on screen only:
+/// samples (4 jitters along ρ per texel, so ring edges do not quantise whole columns) against
+/// the target integrated over the ring's on-screen pixels. Returns (ρ_lo, measured/target, density).
+fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)>, f32) {
+    let (w, h) = (s.screen().x as usize, s.screen().y as usize);
+    let k = s.params().density_exponent;
+    let f = s.params().fovea_deg;
+    let edges: Vec<f32> = (0..=4)
+        .map(|i| f * i as f32 / 4.0)
+        .chain(
+            (1..=rings_periphery).map(|i| f + (E_MAX_DEG - f) * i as f32 / rings_periphery as f32),
+        )
+        .collect();
+    let ring = |rho: f32| {
+        edges
+            .iter()
+            .rposition(|&e| e <= rho)
+            .filter(|&i| i + 1 < edges.len())
+    };
+    let grid = s.grid_size();
+    // Target densities: uniform fovea; periphery ∝ V^k with the periphery's whole sample budget.
+    let n_fovea = grid.x as f32 * grid.y as f32 * s.u_fovea() * 0.5;
+    let fovea_density = n_fovea / (std::f32::consts::PI * s.r_fovea() * s.r_fovea());
+    let n_periph = (grid.x as f32 * (1.0 - s.u_fovea())) * grid.y as f32;
+    let scale = (E_MAX_DEG / s.r_max()).powi(2) / (60.0 * (cdf(E_MAX_DEG, k) - cdf(f, k)));
+    let target = |rho: f32| {
+        if rho < f {
+            fovea_density
+        } else {
+            n_periph * acuity(rho).powf(k) * scale
+        }
+    };
+    let mut expected = vec![0f64; edges.len()];
+    let mut pixels = vec![0u64; edges.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - s.gaze();
+            let rho = d.length() / s.r_max() * E_MAX_DEG;
+            if let Some(i) = ring(rho) {
+                expected[i] += target(rho) as f64;
+                pixels[i] += 1;
+            }
+        }
+    }
+    let mut got = vec![0f64; edges.len()];
+    let (mut onscreen, mut total) = (0f64, 0f64);
+    for c in 0..grid.x {
+        for j in 0..s.rows_in_column(c) {
+            for jx in 0..4 {
+                let p = s.vp_to_screen(Vec2::new(
+                    c as f32 + (jx as f32 + 0.5) / 4.0,
+                    j as f32 + 0.5,
+                ));
+                total += 0.25;
+                if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32 {
+                    onscreen += 0.25;
+                    if let Some(i) = ring((p - s.gaze()).length() / s.r_max() * E_MAX_DEG) {
+                        got[i] += 0.25;
+                    }
+                }
+            }
+        }
+    }
+    let rows = (0..edges.len() - 1)
+        .filter(|&i| pixels[i] >= 500) // rings barely on screen say nothing
+        .map(|i| {
+            (
+                edges[i],
+                (got[i] / expected[i]) as f32,
+                (got[i] / pixels[i] as f64) as f32,
+            )
+        })
+        .collect();
+    (rows, (1.0 - onscreen / total) as f32)
+}
+
+#[test]
+fn ring_density_follows_acuity() {
+    let centre = (640.0, 720.0);
+    let cases = [
+        (1280u32, 1440u32, centre, VisualPolarParams::default()),
+        (1280, 1440, (1270.0, 720.0), VisualPolarParams::default()),
+        (1280, 1440, (10.0, 10.0), VisualPolarParams::default()),
+        (640, 720, (320.0, 360.0), with_inverse(InverseCdf::Exact)),
+        (
+            640,
+            720,
+            (100.0, 150.0),
+            VisualPolarParams {
+                density_exponent: 1.5,
+                ..Default::default()
+            },
+        ),
+    ];
+    for (w, h, (gx, gy), params) in cases {
+        let s = vp(w, h, gx, gy, params);
+        let (rows, offscreen) = ring_density(&s, 16);
+        let fovea: Vec<f32> = rows
+            .iter()
+            .filter(|r| r.0 < params.fovea_deg)
+            .map(|r| r.2)
+            .collect();
+        println!(
+            "{w}x{h} gaze ({gx},{gy}) k {}: off-screen {:.1} %, fovea spp {:?}, periphery ratio {:?}",
+            params.density_exponent,
+            100.0 * offscreen,
+            fovea.iter().map(|d| format!("{d:.2}")).collect::<Vec<_>>(),
+            rows.iter().filter(|r| r.0 >= params.fovea_deg).map(|r| format!("{:.3}", r.1)).collect::<Vec<_>>()
+        );
+        for &(rho, ratio, density) in &rows {
+            assert!(
+                (ratio - 1.0).abs() < 0.10,
+                "ring at ρ {rho}: measured/target {ratio}"
+            );
+            if rho < params.fovea_deg {
+                assert!(
+                    density >= 1.0,
+                    "fovea ring at ρ {rho}: {density} samples/pixel"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,186 @@
+// Visual-Polar mapping (Koskela et al., EGSR 2019): GLSL twin of
+// renderer/src/sampling/visual_polar.rs. Every function mirrors the Rust one of the same name
+// (same constants, same f32 order of operations) so a device test can compare them point by
+// point; change both together. Design: shared/design/visual-polar.md.
+//
+// Grid: x = ρ (u = x / width), y = φ ∈ [0, 2π) from +x toward +y (pixels, y down). Fovea u < u_f:
+// r linear in u. Periphery: u maps linearly onto p ∈ [p_f, 1], e(p) by the inverse CDF,
+// r = e / e_norm · r_max. Triangular clip: fovea column c keeps n(c) = clamp(floor(H·u_c/u_f + ½),
+// 1, H) rows (u_c = (c + ½)/W), the first n(c); row y of column c sits at φ = 2π·y/n(c).
+//
+// Self-contained on purpose (no layouts.glsl): the parameters come as the four vectors of the
+// `SamplingParams` slots, packed by `VisualPolar::sampling_params()`, and `vp_unpack` names them.
+#ifndef FOVEA_SAMPLING_VISUAL_POLAR_MATH_GLSL
+#define FOVEA_SAMPLING_VISUAL_POLAR_MATH_GLSL
+
+const float VP_ACUITY_KNEE_DEG = 5.79;
+const float VP_E_MAX_DEG = 80.0;
+const float VP_PI = 3.14159265358979;
+const float VP_TAU = 6.28318530717959;
+const int VP_NEWTON_STEPS = 12;
+
+struct VpParams {
+    uvec2 grid;      // VP grid size in texels
+    vec2 screen;     // screen size in pixels
+    vec2 gaze;       // gaze in screen pixels
+    float r_max;     // pixels that e_norm maps to
+    float k;         // density exponent
+    float u_f;       // fovea width in u (2 · clip fraction)
+    float p_f;       // CDF fraction at the fovea edge
+    float r_f;       // fovea radius in pixels
+    float e_norm;    // e(1): e_poly(1) for the polynomial, 80 for the exact inverse
+    float cdf_max;   // cdf(80, k)
+    bool exact;      // exact inverse CDF instead of the paper's quartic
+};
+
+// Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
+// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, exact, fovea°, 0).
+VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
+    VpParams p;
+    p.grid = grid.xy;
+    p.screen = vec2(grid.zw);
+    p.gaze = gaze.xy;
+    p.r_max = gaze.z;
+    p.k = gaze.w;
+    p.u_f = shape0.x;
+    p.p_f = shape0.y;
+    p.r_f = shape0.z;
+    p.e_norm = shape0.w;
+    p.cdf_max = shape1.x;
+    p.exact = shape1.y != 0.0;
+    return p;
+}
+
+// Reddy's acuity V(e), cycles per degree.
+float vp_acuity(float e) {
+    if (e <= VP_ACUITY_KNEE_DEG) return 60.0;
+    float t = 0.3 * e + 1.0;
+    return 449.4 / (t * t);
+}
+
+// Eq. 2 literally (d >= 5.79); below the knee the fovea part ∝ d², continuous.
+float vp_cdf_eq2(float d) {
+    const float A = 166.4 * VP_PI;
+    if (d < VP_ACUITY_KNEE_DEG) {
+        float t0 = 0.3 * VP_ACUITY_KNEE_DEG + 1.0;
+        float c0 = (1.0 / t0 + log(t0)) * A - 612.3;
+        return c0 * (d / VP_ACUITY_KNEE_DEG) * (d / VP_ACUITY_KNEE_DEG);
+    }
+    float t = 0.3 * d + 1.0;
+    return (1.0 / t + log(t)) * A - 612.3;
+}
+
+// ∫ t^a dt with a1 = a + 1 (ln t when a1 = 0).
+float vp_power_antiderivative(float t, float a1) {
+    return abs(a1) < 1e-6 ? log(t) : pow(t, a1) / a1;
+}
+
+float vp_g(float t, float k) {
+    return vp_power_antiderivative(t, 2.0 - 2.0 * k) - vp_power_antiderivative(t, 1.0 - 2.0 * k);
+}
+
+// Generalised Eq. 2: (π/30)∫₀^d V(e)^k·e de; exactly vp_cdf_eq2 for k = 1.
+float vp_cdf(float d, float k) {
+    if (k == 1.0) return vp_cdf_eq2(d);
+    const float S = VP_PI / 30.0;
+    float dk = min(d, VP_ACUITY_KNEE_DEG);
+    float fovea = S * pow(60.0, k) * 0.5 * dk * dk;
+    if (d <= VP_ACUITY_KNEE_DEG) return fovea;
+    float t0 = 0.3 * VP_ACUITY_KNEE_DEG + 1.0;
+    return fovea + S * pow(449.4, k) / 0.09 * (vp_g(0.3 * d + 1.0, k) - vp_g(t0, k));
+}
+
+float vp_cdf_derivative(float d, float k) {
+    if (d < VP_ACUITY_KNEE_DEG)
+        return 2.0 * vp_cdf(VP_ACUITY_KNEE_DEG, k) * d / (VP_ACUITY_KNEE_DEG * VP_ACUITY_KNEE_DEG);
+    if (k == 1.0) {
+        float t = 0.3 * d + 1.0;
+        return 166.4 * VP_PI * 0.3 * (t - 1.0) / (t * t);
+    }
+    return VP_PI / 30.0 * pow(vp_acuity(d), k) * d;
+}
+
+// Eq. 3, the paper's quartic (p = CDF(e)/CDF(80), meant for p >= p_f).
+float vp_inverse_cdf_poly(float p) {
+    return (((25.09 * p + 0.1680) * p + 27.61) * p + 23.87) * p + 3.232;
+}
+
+float vp_inverse_cdf_poly_derivative(float p) {
+    return ((100.36 * p + 0.504) * p + 55.22) * p + 23.87;
+}
+
+// Exact inverse: safeguarded Newton from the quartic's guess (bisection when a step leaves the
+// bracket), as in Rust.
+float vp_inverse_cdf_exact(float p, float k, float cdf_max) {
+    float target = p * cdf_max;
+    float lo = 0.0;
+    float hi = p <= 1.0 ? VP_E_MAX_DEG : 4.0 * VP_E_MAX_DEG;
+    float e = clamp(vp_inverse_cdf_poly(p), lo, hi);
+    for (int i = 0; i < VP_NEWTON_STEPS; ++i) {
+        float f = vp_cdf(e, k) - target;
+        if (f < 0.0) lo = e; else hi = e;
+        float next = e - f / max(vp_cdf_derivative(e, k), 1e-6);
+        e = (next >= lo && next <= hi) ? next : 0.5 * (lo + hi);
+    }
+    return e;
+}
+
+// Inverse of Eq. 3 (p from e): Newton on the quartic from the exact CDF fraction.
+float vp_poly_fraction_of(float e, float cdf_max) {
+    float p = vp_cdf_eq2(e) / cdf_max;
+    for (int i = 0; i < 3; ++i)
+        p -= (vp_inverse_cdf_poly(p) - e) / vp_inverse_cdf_poly_derivative(p);
+    return p;
+}
+
+uint vp_rows_in_column(VpParams P, uint col) {
+    uint h = P.grid.y;
+    float u_c = (float(col) + 0.5) / float(P.grid.x);
+    if (u_c >= P.u_f) return h;
+    return clamp(uint(floor(float(h) * u_c / P.u_f + 0.5)), 1u, h);
+}
+
+bool vp_is_valid_texel(VpParams P, ivec2 t) {
+    return t.x >= 0 && t.y >= 0 && uint(t.x) < P.grid.x && uint(t.y) < vp_rows_in_column(P, uint(t.x));
+}
+
+float vp_r_of_u(VpParams P, float u) {
+    if (u < P.u_f) return u / P.u_f * P.r_f;
+    float p = P.p_f + (u - P.u_f) / (1.0 - P.u_f) * (1.0 - P.p_f);
+    float e = P.exact ? vp_inverse_cdf_exact(p, P.k, P.cdf_max) : vp_inverse_cdf_poly(p);
+    return e / P.e_norm * P.r_max;
+}
+
+float vp_u_of_r(VpParams P, float r) {
+    if (r < P.r_f) return r / P.r_f * P.u_f;
+    float e = r / P.r_max * P.e_norm;
+    float p = P.exact ? vp_cdf(e, P.k) / P.cdf_max : vp_poly_fraction_of(e, P.cdf_max);
+    return P.u_f + (p - P.p_f) / (1.0 - P.p_f) * (1.0 - P.u_f);
+}
+
+uint vp_column_of(VpParams P, float x) {
+    return min(uint(floor(max(x, 0.0))), P.grid.x - 1u);
+}
+
+// Screen position (pixels) → continuous grid coordinates; y in [0, rows of the column).
+vec2 vp_screen_to_vp(VpParams P, vec2 s) {
+    vec2 d = s - P.gaze;
+    float r = length(d);
+    // GLSL atan(y, x) is undefined at the origin; the gaze itself maps to φ = 0 like Rust's atan2.
+    float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
+    if (phi < 0.0) phi += VP_TAU;
+    float x = vp_u_of_r(P, r) * float(P.grid.x);
+    float n = float(vp_rows_in_column(P, vp_column_of(P, x)));
+    float y = phi / VP_TAU * n;
+    return vec2(x, y >= n ? 0.0 : y);
+}
+
+// Continuous grid coordinates → screen position (pixels); φ wraps.
+vec2 vp_vp_to_screen(VpParams P, vec2 g) {
+    float n = float(vp_rows_in_column(P, vp_column_of(P, g.x)));
+    float phi = g.y / n * VP_TAU;
+    float r = vp_r_of_u(P, g.x / float(P.grid.x));
+    return P.gaze + r * vec2(cos(phi), sin(phi));
+}
+
+#endif
