@@ -6,8 +6,9 @@
 
 const int BVH_STACK_SIZE = 64; // the upload refuses deeper trees
 
-// The traversal stack lives in shared memory, one slice per invocation: lavapipe lowers a
-// dynamically indexed private array into chains of selects, which made traversal ~20× slower.
+// Overflow of the traversal stack (below its 8 register entries) lives in shared memory, one slice
+// per invocation: lavapipe turns a dynamically indexed array (private or shared) into per-lane
+// scalar loops, so the hot top of the stack is kept in registers instead.
 // Every kernel that traces uses 64 invocations per workgroup (WORKGROUP_2D² = WORKGROUP_1D).
 shared uint bvh_stack[64 * BVH_STACK_SIZE];
 
@@ -100,6 +101,9 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
     vec3 signed_tiny = uintBitsToFloat((floatBitsToUint(dir) & 0x80000000u) | floatBitsToUint(1e-30));
     vec3 inv_dir = 1.0 / mix(dir, signed_tiny, zero);
     float limit = tmax * SLAB_SLACK;
+    // Traversal stack: the top 8 entries in registers (s0 = top), shifted on push/pop; deeper
+    // entries in this invocation's slice of shared memory.
+    uint s0 = 0u, s1 = 0u, s2 = 0u, s3 = 0u, s4 = 0u, s5 = 0u, s6 = 0u, s7 = 0u;
     uint stack_base = gl_LocalInvocationIndex * uint(BVH_STACK_SIZE);
     int sp = 0;
     uint node = 0u;
@@ -142,14 +146,18 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
         if (done) break;
         bool in0 = hit0 && count0 == 0u, in1 = hit1 && count1 == 0u;
         if (in0 && in1) {
-            if (sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp++)] = swap ? child0 : child1;
+            // Push: the deepest register entry spills to shared memory when all 8 are in use.
+            if (sp >= 8 && sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp - 8)] = s7;
+            s7 = s6; s6 = s5; s5 = s4; s4 = s3; s3 = s2; s2 = s1; s1 = s0; s0 = swap ? child0 : child1;
+            sp = min(sp + 1, BVH_STACK_SIZE + 8);
             node = swap ? child1 : child0;
         } else if (in0 || in1) {
             node = in0 ? child0 : child1;
         } else if (sp == 0) {
             done = true;
         } else {
-            node = bvh_stack[stack_base + uint(--sp)];
+            node = s0; s0 = s1; s1 = s2; s2 = s3; s3 = s4; s4 = s5; s5 = s6; s6 = s7;
+            if (--sp >= 8) s7 = bvh_stack[stack_base + uint(sp - 8)];
         }
     }
     return hit.triangle != 0xffffffffu;

@@ -75,28 +75,54 @@ Surface fetch_surface(Hit hit, vec3 ray_dir) {
     vec3 n = normalize(w.x * a.normal_v.xyz + w.y * b.normal_v.xyz + w.z * c.normal_v.xyz);
 
     MaterialGpu m = materials.data[s.material];
+    // All texture lookups go through ONE sample_texture in a loop over the lane's bound slots:
+    // lavapipe executes both sides of every branch under a lane mask, so six guarded calls cost six
+    // full lookups per hit even for untextured materials; the loop costs max(bound slots, 1).
+    // Slots: 0 base colour, 1 metallic-roughness, 2 normal, 3 emissive, 4 specular, 5 specular colour.
+    uvec3 tex_lo = m.textures.xyz;
+    uint tex_emissive = m.textures.w;
+    uvec2 tex_hi = m.textures2.xy;
+    uint pending = (tex_lo.x != NO_TEXTURE ? 1u : 0u) | (tex_lo.y != NO_TEXTURE ? 2u : 0u)
+        | (tex_lo.z != NO_TEXTURE ? 4u : 0u) | (tex_emissive != NO_TEXTURE ? 8u : 0u)
+        | (tex_hi.x != NO_TEXTURE ? 16u : 0u) | (tex_hi.y != NO_TEXTURE ? 32u : 0u);
+    uint bound = pending;
+    vec4 t_base = vec4(1.0), t_mr = vec4(1.0), t_normal = vec4(0.0), t_emissive = vec4(1.0), t_spec = vec4(1.0), t_spec_color = vec4(1.0);
+    while (pending != 0u) {
+        int slot = findLSB(pending);
+        pending &= pending - 1u;
+        uint tex = slot == 0 ? tex_lo.x : slot == 1 ? tex_lo.y : slot == 2 ? tex_lo.z
+            : slot == 3 ? tex_emissive : slot == 4 ? tex_hi.x : tex_hi.y;
+        bool srgb = slot == 0 || slot == 3 || slot == 5;
+        vec4 c = sample_texture(tex, s.uv, srgb);
+        if (slot == 0) t_base = c;
+        if (slot == 1) t_mr = c;
+        if (slot == 2) t_normal = c;
+        if (slot == 3) t_emissive = c;
+        if (slot == 4) t_spec = c;
+        if (slot == 5) t_spec_color = c;
+    }
+
     vec4 base = m.base_color;
-    if (m.textures.x != NO_TEXTURE) base *= sample_texture(m.textures.x, s.uv, true);
+    if ((bound & 1u) != 0u) base *= t_base;
     s.base_color = base.rgb;
     s.metallic = m.surface.x;
     s.roughness = m.surface.y;
-    if (m.textures.y != NO_TEXTURE) {
-        vec4 mr = sample_texture(m.textures.y, s.uv, false);
-        s.roughness *= mr.g;
-        s.metallic *= mr.b;
+    if ((bound & 2u) != 0u) {
+        s.roughness *= t_mr.g;
+        s.metallic *= t_mr.b;
     }
-    if (m.textures.z != NO_TEXTURE) {
+    if ((bound & 4u) != 0u) {
         vec4 t4 = w.x * a.tangent + w.y * b.tangent + w.z * c.tangent;
         vec3 t = normalize(t4.xyz - n * dot(n, t4.xyz));
         vec3 bt = cross(n, t) * (t4.w < 0.0 ? -1.0 : 1.0);
-        vec3 tn = sample_texture(m.textures.z, s.uv, false).xyz * 2.0 - 1.0;
+        vec3 tn = t_normal.xyz * 2.0 - 1.0;
         tn.xy *= m.surface.w;
         vec3 mapped = normalize(tn.x * t + tn.y * bt + tn.z * n);
         if (all(equal(mapped, mapped))) n = mapped; // keep the vertex normal if the map gives NaN
     }
     bool double_sided = (m.textures2.z & MATERIAL_DOUBLE_SIDED) != 0u;
     vec3 emission = m.emissive.rgb;
-    if (m.textures.w != NO_TEXTURE) emission *= sample_texture(m.textures.w, s.uv, true).rgb;
+    if ((bound & 8u) != 0u) emission *= t_emissive.rgb;
     s.emission = (front || double_sided) ? emission : vec3(0.0);
     s.geometric_normal = front ? ng : -ng;
     if (dot(n, s.geometric_normal) < 0.0) n = -n;
@@ -105,8 +131,8 @@ Surface fetch_surface(Hit hit, vec3 ray_dir) {
     float f0 = (ior - 1.0) / (ior + 1.0);
     vec3 spec_color = m.specular.rgb;
     s.specular_factor = m.specular.w;
-    if (m.textures2.x != NO_TEXTURE) s.specular_factor *= sample_texture(m.textures2.x, s.uv, false).a;
-    if (m.textures2.y != NO_TEXTURE) spec_color *= sample_texture(m.textures2.y, s.uv, true).rgb;
+    if ((bound & 16u) != 0u) s.specular_factor *= t_spec.a;
+    if ((bound & 32u) != 0u) spec_color *= t_spec_color.rgb;
     s.dielectric_f0 = min(vec3(f0 * f0) * spec_color, vec3(1.0));
     return s;
 }
