@@ -7,12 +7,15 @@
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
+/// Macro definitions of one variant: (name, optional value).
+type Defines = Vec<(String, Option<String>)>;
+
 pub fn compile_all(root: &Path, out_dir: &Path, generated: &[(String, String)]) -> Result<(), String> {
     let compiler = shaderc::Compiler::new().map_err(|e| format!("shaderc: {e}"))?;
     let spv_dir = out_dir.join("spv");
     std::fs::create_dir_all(&spv_dir).map_err(|e| e.to_string())?;
 
-    let mut jobs: Vec<(String, PathBuf, String, Vec<(String, Option<String>)>)> = Vec::new();
+    let mut jobs: Vec<(String, PathBuf, String, Defines)> = Vec::new();
     for path in find_shaders(root) {
         let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let stem = path.strip_prefix(root).unwrap().with_extension("").to_string_lossy().replace('\\', "/");
@@ -104,7 +107,7 @@ fn options<'a>(root: &Path, defines: &[(String, Option<String>)]) -> Result<shad
     Ok(options)
 }
 
-fn parse_variants(source: &str) -> Vec<(String, Vec<(String, Option<String>)>)> {
+fn parse_variants(source: &str) -> Vec<(String, Defines)> {
     source
         .lines()
         .filter_map(|l| l.trim().strip_prefix("//! variant "))
