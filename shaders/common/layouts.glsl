@@ -105,6 +105,11 @@ struct HitGpu {
     uvec4 triangle;             // x original triangle index (0xffffffff: miss), yzw unused
 };
 
+// Push constants of the Visual-Polar mapping probe (device test of Rust vs GLSL).
+struct VpProbePush {
+    uvec4 config;               // x point count, yzw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 

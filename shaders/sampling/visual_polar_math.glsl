@@ -58,16 +58,34 @@ float vp_acuity(float e) {
     return 449.4 / (t * t);
 }
 
+// ln x (x > 0, normal) in plain arithmetic, op for op as Rust's ln_f32: the driver's log may be
+// several ulp off, which the exact inverse CDF near e = 80 amplifies to ~1e-3 px.
+float vp_ln(float x) {
+    int k;
+    float m = frexp(x, k); // x = m·2^k, m ∈ [0.5, 1)
+    if (m < 0.70710677) {
+        m *= 2.0;
+        k -= 1;
+    }
+    float s = (m - 1.0) / (m + 1.0);
+    float s2 = s * s;
+    float q = (((0.11111111 * s2 + 0.14285715) * s2 + 0.2) * s2 + 0.33333334) * s2;
+    float l = float(k) * 0.6931472 + (2.0 * s + 2.0 * s * q);
+    return l;
+}
+
 // Eq. 2 literally (d >= 5.79); below the knee the fovea part ∝ d², continuous.
 float vp_cdf_eq2(float d) {
     const float A = 166.4 * VP_PI;
     if (d < VP_ACUITY_KNEE_DEG) {
         float t0 = 0.3 * VP_ACUITY_KNEE_DEG + 1.0;
-        float c0 = (1.0 / t0 + log(t0)) * A - 612.3;
-        return c0 * (d / VP_ACUITY_KNEE_DEG) * (d / VP_ACUITY_KNEE_DEG);
+        float c0 = (1.0 / t0 + vp_ln(t0)) * A - 612.3;
+        float c = c0 * (d / VP_ACUITY_KNEE_DEG) * (d / VP_ACUITY_KNEE_DEG);
+        return c;
     }
     float t = 0.3 * d + 1.0;
-    return (1.0 / t + log(t)) * A - 612.3;
+    float c = (1.0 / t + vp_ln(t)) * A - 612.3;
+    return c;
 }
 
 // ∫ t^a dt with a1 = a + 1 (ln t when a1 = 0).

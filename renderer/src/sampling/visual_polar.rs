@@ -91,17 +91,37 @@ pub fn acuity(e: f32) -> f32 {
     }
 }
 
+/// ln x (x > 0, normal) in plain f32 arithmetic, mirrored op for op by `vp_ln` in the GLSL, so
+/// that both sides agree to ~1 ulp: driver `log`s differ by several ulp (lavapipe's does), and the
+/// exact inverse CDF turns one ulp of ln(0.3e + 1) near e = 80 into ~3e-4 px at r_max ≈ 1900 px
+/// (the CDF is flat there). x = m·2^k with m ∈ [√½, √2); ln m = 2s(1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9),
+/// s = (m − 1)/(m + 1), |s| ≤ 0.172 (truncation < 1e-9).
+pub fn ln_f32(x: f32) -> f32 {
+    let bits = x.to_bits();
+    // frexp: x = m·2^k, m ∈ [0.5, 1).
+    let mut k = ((bits >> 23) & 0xff) as i32 - 126;
+    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f00_0000);
+    if m < 0.707_106_77 {
+        m *= 2.0;
+        k -= 1;
+    }
+    let s = (m - 1.0) / (m + 1.0);
+    let s2 = s * s;
+    let q = (((0.111_111_11 * s2 + 0.142_857_15) * s2 + 0.2) * s2 + 0.333_333_34) * s2;
+    k as f32 * 0.693_147_2 + (2.0 * s + 2.0 * s * q)
+}
+
 /// Eq. 2 of the paper, literally: CDF(d) = (1/(0.3d+1) + ln(0.3d+1))·166.4π − 612.3 (d ≥ 5.79),
 /// ≈ (π/30)∫₀^d V(e)·e de. Below the knee it continues as the fovea part ∝ d² (continuous).
 pub fn cdf_eq2(d: f32) -> f32 {
     const A: f32 = 166.4 * std::f32::consts::PI;
     if d < ACUITY_KNEE_DEG {
         let t0 = 0.3 * ACUITY_KNEE_DEG + 1.0;
-        let c0 = (1.0 / t0 + t0.ln()) * A - 612.3;
+        let c0 = (1.0 / t0 + ln_f32(t0)) * A - 612.3;
         c0 * (d / ACUITY_KNEE_DEG) * (d / ACUITY_KNEE_DEG)
     } else {
         let t = 0.3 * d + 1.0;
-        (1.0 / t + t.ln()) * A - 612.3
+        (1.0 / t + ln_f32(t)) * A - 612.3
     }
 }
 
