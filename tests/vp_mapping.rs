@@ -165,7 +165,7 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
         let gazes = [("centre", s * 0.5), ("edge", Vec2::new(0.02, 0.45) * s), ("corner", Vec2::new(0.97, 0.985) * s)];
         for (gaze_name, gaze) in gazes {
             for inverse_cdf in [InverseCdf::Polynomial, InverseCdf::Exact] {
-                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { inverse_cdf, ..Default::default() });
+                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { inverse_cdf, ..Default::default() }).unwrap();
                 seed += 1;
                 let r = run_case(&ctx, &pipeline, &mut recorder, &vp, seed);
                 let line = format!(

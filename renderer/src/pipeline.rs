@@ -67,6 +67,9 @@ pub struct FrameStats {
     pub primary_rays: u64,
     pub shadow_rays: u64,
     pub continuation_rays: u64,
+    /// Traced samples whose screen position lies off the screen (Visual-Polar covers the r_max
+    /// circle; always 0 for Cartesian).
+    pub samples_offscreen: u64,
 }
 
 impl FrameStats {
@@ -197,6 +200,7 @@ impl Renderer {
             primary_rays: counters[0] as u64,
             shadow_rays: counters[1] as u64,
             continuation_rays: counters[2] as u64,
+            samples_offscreen: counters[3] as u64,
         })
     }
 

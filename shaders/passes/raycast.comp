@@ -5,20 +5,21 @@
 
 layout(local_size_x = WORKGROUP_1D) in;
 layout(push_constant) uniform Push { RaycastPush p; } push;
-layout(std430, set = 0, binding = 10) readonly buffer RayBuffer { RayGpu data[]; } rays;
+layout(set = 0, binding = 10) uniform samplerBuffer rays;   // RayGpu = 2 RGBA32F texels
 layout(std430, set = 0, binding = 11) writeonly buffer HitBuffer { HitGpu data[]; } hits;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= push.p.config.x) return;
-    RayGpu r = rays.data[i];
+    vec4 origin_tmin = texelFetch(rays, int(i) * 2 + 0);
+    vec4 direction_tmax = texelFetch(rays, int(i) * 2 + 1);
     Hit h;
     bool any_hit = push.p.config.y != 0u;
-    if (bvh_trace(r.origin_tmin.xyz, r.direction_tmax.xyz, r.origin_tmin.w, r.direction_tmax.w, any_hit, h)) {
-        hits.data[i].t_u_v = vec4(h.t, h.u, h.v, 0.0);
-        hits.data[i].triangle = uvec4(h.triangle, 0u, 0u, 0u);
-    } else {
-        hits.data[i].t_u_v = vec4(-1.0, 0.0, 0.0, 0.0);
-        hits.data[i].triangle = uvec4(0xffffffffu, 0u, 0u, 0u);
-    }
+    // One unconditional store per field: lavapipe runs both sides of a branch under a mask, and
+    // each per-lane storage write is a scalar loop over the lanes.
+    bool found = bvh_trace(origin_tmin.xyz, direction_tmax.xyz, origin_tmin.w, direction_tmax.w, any_hit, h);
+    HitGpu o;
+    o.t_u_v = found ? vec4(h.t, h.u, h.v, 0.0) : vec4(-1.0, 0.0, 0.0, 0.0);
+    o.triangle = uvec4(found ? h.triangle : 0xffffffffu, 0u, 0u, 0u);
+    hits.data[i] = o;
 }

@@ -3,6 +3,7 @@
 // hit, BRDF-sampled continuation (real-time: depth 3 = one indirect bounce). Writes the per-sample
 // G-buffer that the denoisers read, sized to the sampling grid.
 //! variant cartesian: SAMPLING_CARTESIAN
+//! variant visual_polar: SAMPLING_VISUAL_POLAR
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -22,7 +23,8 @@ layout(set = 0, binding = 13, rgba32f) uniform writeonly image2D out_normal_dept
 layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;     // camera-relative position, depth gradient
 layout(set = 0, binding = 15, rg32ui) uniform writeonly uimage2D out_ids;          // triangle + 1 (0: miss), material | mesh << 16
 layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;         // previous-frame screen position (−1: none)
-// Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays.
+// Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays,
+// [3] traced samples whose screen position is off the screen.
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
 
 uint shadow_rays = 0u;
@@ -58,6 +60,7 @@ void main() {
         imageStore(out_motion, texel, vec4(-1.0));
         return;
     }
+    if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, fd.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
     vec3 org = fd.world_from_view[3].xyz;
     vec3 view_dir = view_direction(screen, fd.fov_tan, fd.screen.xy);
     vec3 dir = normalize(mat3(fd.world_from_view) * view_dir);

@@ -9,6 +9,8 @@ layout(std430, set = 0, binding = 9) readonly buffer SamplingBuffer { SamplingPa
 
 #if defined(SAMPLING_CARTESIAN)
 #include "cartesian.glsl"
+#elif defined(SAMPLING_VISUAL_POLAR)
+#include "visual_polar.glsl"
 #else
 #error "no sampling space selected"
 #endif

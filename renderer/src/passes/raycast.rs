@@ -3,7 +3,7 @@
 use super::push_bytes;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
-use crate::graph::{read_buffer, write_buffer, FrameRecorder};
+use crate::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use crate::layouts::RaycastPush;
 use crate::vk::{Buffer, ComputePipeline, Context};
 use glam::UVec4;
@@ -18,7 +18,8 @@ impl RaycastPass {
         Ok(RaycastPass { pipeline: ComputePipeline::new(ctx, "passes/raycast", std::mem::size_of::<RaycastPush>() as u32)? })
     }
 
-    /// `rays` holds `count` RayGpu; `hits` receives `count` HitGpu. `any_hit` stops at the first
+    /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::host_texels`: texel
+    /// reads are far cheaper than std430 reads on lavapipe); `hits` receives `count` HitGpu. `any_hit` stops at the first
     /// hit found (shadow rays).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
@@ -36,7 +37,7 @@ impl RaycastPass {
         let binds = [
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
             read_buffer("frame", frame),
-            read_buffer("rays", rays),
+            read_texels("rays", rays),
             write_buffer("hits", hits),
         ];
         let push = RaycastPush { config: UVec4::new(count, any_hit as u32, 0, 0) };
@@ -75,7 +76,7 @@ impl RayCaster {
         let ray_bytes = (std::mem::size_of_val(rays) as u64).max(16);
         let hit_bytes = (rays.len() * std::mem::size_of::<crate::layouts::HitGpu>()) as u64;
         if self.rays.as_ref().is_none_or(|b| b.size < ray_bytes) {
-            self.rays = Some(Buffer::new(&self.ctx, "rays", ray_bytes, storage, MemoryLocation::CpuToGpu)?);
+            self.rays = Some(Buffer::host_texels(&self.ctx, "rays", ray_bytes)?);
             self.hits = Some(Buffer::new(&self.ctx, "hits", hit_bytes.max(32), storage, MemoryLocation::GpuToCpu)?);
         }
         let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());

@@ -48,7 +48,8 @@ pub struct TracePass {
     pipeline: ComputePipeline,
 }
 
-/// Counters the trace kernel fills: primary, shadow and continuation rays (one u32 each).
+/// Counters the trace kernel fills (one u32 each): primary, shadow and continuation rays, and
+/// traced samples whose screen position lies off the screen.
 pub const RAY_COUNTERS: usize = 4;
 
 impl TracePass {

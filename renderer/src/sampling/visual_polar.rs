@@ -15,6 +15,8 @@
 //! (φ = 2π·y/n(floor x)), so forward and inverse are exact inverses and a jittered texel stays in its
 //! column. Removed area ≈ u_f/2 of the grid, so u_f = 2 · clip_fraction.
 
+use super::SamplingSpace;
+use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
 use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
 use std::f32::consts::TAU;
@@ -72,7 +74,36 @@ impl Default for VisualPolarParams {
     }
 }
 
+fn invalid(msg: String) -> Error {
+    Error::Invalid(format!("visual-polar: {msg}"))
+}
+
 impl VisualPolarParams {
+    /// Range checks of every parameter, each error naming the parameter.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.axis_scale.is_finite() && self.axis_scale > 0.0 && self.axis_scale <= 4.0) {
+            return Err(invalid(format!("axis_scale must be in (0, 4], got {}", self.axis_scale)));
+        }
+        if !(self.clip_fraction > 0.0 && self.clip_fraction < 0.5) {
+            return Err(invalid(format!(
+                "clip_fraction must be in (0, 0.5) (the fovea spans u_f = 2·clip_fraction), got {}",
+                self.clip_fraction
+            )));
+        }
+        if !(self.fovea_deg > 0.0 && self.fovea_deg < E_MAX_DEG) {
+            return Err(invalid(format!("fovea_deg must be in (0, {E_MAX_DEG}), got {}", self.fovea_deg)));
+        }
+        if !(self.density_exponent >= 0.0 && self.density_exponent <= 4.0) {
+            return Err(invalid(format!("density_exponent must be in [0, 4], got {}", self.density_exponent)));
+        }
+        if let RadiusMode::Fixed(r) = self.radius_mode {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
+            }
+        }
+        Ok(())
+    }
+
     /// The clip that makes the fovea hold exactly the fraction p_f of the samples, i.e. density
     /// ∝ V^k everywhere (≈ 0.088 for k = 1): fovea share (u_f/2)/(1 − u_f/2) = p_f.
     pub fn acuity_exact_clip_fraction(&self) -> f32 {
@@ -96,6 +127,8 @@ pub fn acuity(e: f32) -> f32 {
 /// exact inverse CDF turns one ulp of ln(0.3e + 1) near e = 80 into ~3e-4 px at r_max ≈ 1900 px
 /// (the CDF is flat there). x = m·2^k with m ∈ [√½, √2); ln m = 2s(1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9),
 /// s = (m − 1)/(m + 1), |s| ≤ 0.172 (truncation < 1e-9).
+// 0.693_147_2 is ln 2 spelled as the GLSL twin spells it (the point is op-for-op agreement).
+#[allow(clippy::approx_constant)]
 pub fn ln_f32(x: f32) -> f32 {
     let bits = x.to_bits();
     // frexp: x = m·2^k, m ∈ [0.5, 1).
@@ -236,11 +269,16 @@ pub struct VisualPolar {
 }
 
 impl VisualPolar {
-    pub fn new(screen: UVec2, gaze: Vec2, params: VisualPolarParams) -> Self {
-        assert!(
-            params.clip_fraction > 0.0 && params.clip_fraction < 0.5,
-            "clip_fraction must be in (0, 0.5): the fovea spans u_f = 2·clip"
-        );
+    /// Checks the parameters (they come from the user: TOML and CLI) and precomputes the space.
+    /// Errors name the offending parameter; nothing here panics.
+    pub fn new(screen: UVec2, gaze: Vec2, params: VisualPolarParams) -> Result<Self> {
+        params.validate()?;
+        if screen.x == 0 || screen.y == 0 {
+            return Err(invalid(format!("screen size must be non-zero, got {}x{}", screen.x, screen.y)));
+        }
+        if !gaze.is_finite() {
+            return Err(invalid(format!("gaze must be finite, got ({}, {})", gaze.x, gaze.y)));
+        }
         let grid = (screen.as_vec2() * params.axis_scale)
             .round()
             .as_uvec2()
@@ -262,7 +300,7 @@ impl VisualPolar {
         } else {
             (inverse_cdf_poly(p_f), inverse_cdf_poly(1.0))
         };
-        Self {
+        let vp = Self {
             screen,
             gaze,
             params,
@@ -274,7 +312,19 @@ impl VisualPolar {
             e_norm,
             cdf_max,
             exact,
+        };
+        // Guards against parameter combinations that pass the range checks but break the math
+        // (e.g. an extreme density exponent overflowing the CDF).
+        if !(vp.r_max > 0.0 && vp.r_f.is_finite() && vp.r_f > 0.0 && vp.cdf_max.is_finite() && vp.cdf_max > 0.0)
+            || !(vp.p_f > 0.0 && vp.p_f < 1.0)
+        {
+            return Err(invalid(format!(
+                "parameters give a degenerate space (r_max {}, fovea radius {} px, p_f {}, cdf_max {}): check \
+                 density_exponent and fovea_deg",
+                vp.r_max, vp.r_f, vp.p_f, vp.cdf_max
+            )));
         }
+        Ok(vp)
     }
 
     pub fn screen(&self) -> UVec2 {
@@ -404,6 +454,57 @@ impl VisualPolar {
                 0.0,
             ),
         }
+    }
+}
+
+/// The tracer's view of the space: one sample per kept texel; the GPU twin is
+/// `shaders/sampling/visual_polar.glsl` (kernel variant `visual_polar`). Samples may land off the
+/// screen (the r_max circle covers the corners); they are traced, as in the paper.
+impl SamplingSpace for VisualPolar {
+    fn name(&self) -> &'static str {
+        "vp"
+    }
+    fn shader_variant(&self) -> &'static str {
+        "visual_polar"
+    }
+    fn grid_size(&self) -> UVec2 {
+        self.grid
+    }
+    fn screen_size(&self) -> UVec2 {
+        self.screen
+    }
+    fn sample_count(&self) -> u64 {
+        VisualPolar::sample_count(self)
+    }
+    fn params(&self) -> SamplingParams {
+        self.sampling_params()
+    }
+    /// `None` outside the grid and in clipped texels (the texel is `floor(grid)`).
+    fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
+        if !grid.is_finite() {
+            return None;
+        }
+        let t = grid.floor();
+        // Range-check in f32 before converting, so huge values cannot wrap into the grid.
+        if t.x < 0.0 || t.y < 0.0 || t.x >= self.grid.x as f32 || t.y >= self.grid.y as f32 {
+            return None;
+        }
+        self.is_valid_texel(t.as_ivec2()).then(|| self.vp_to_screen(grid))
+    }
+    /// `None` where no texel samples the position: beyond r_max (only possible on screen with
+    /// `RadiusMode::Fixed`). Off-screen positions inside r_max do have samples. r = r_max itself
+    /// (the farthest corner) maps to u = 1 up to rounding and is kept inside the last column.
+    fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
+        if !screen.is_finite() {
+            return None;
+        }
+        let g = self.screen_to_vp(screen);
+        let w = self.grid.x as f32;
+        if !(g.x >= 0.0 && g.x <= w * (1.0 + 1e-5) && g.y >= 0.0 && g.y < self.grid.y as f32) {
+            return None;
+        }
+        let last = f32::from_bits(w.to_bits() - 1); // largest f32 below w (w ≥ 1)
+        Some(Vec2::new(g.x.min(last), g.y))
     }
 }
 

@@ -5,7 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 fn vp(w: u32, h: u32, gx: f32, gy: f32, params: VisualPolarParams) -> VisualPolar {
-    VisualPolar::new(UVec2::new(w, h), Vec2::new(gx, gy), params)
+    VisualPolar::new(UVec2::new(w, h), Vec2::new(gx, gy), params).expect("valid visual-polar parameters")
 }
 
 fn with_inverse(inverse_cdf: InverseCdf) -> VisualPolarParams {
@@ -369,4 +369,78 @@ fn ring_density_follows_acuity() {
             }
         }
     }
+}
+
+/// Bad user parameters are errors naming the parameter, never panics.
+#[test]
+fn invalid_parameters_are_errors() {
+    let screen = UVec2::new(640, 720);
+    let gaze = Vec2::new(320.0, 360.0);
+    let cases: Vec<(VisualPolarParams, &str)> = vec![
+        (VisualPolarParams { clip_fraction: 0.0, ..Default::default() }, "clip_fraction"),
+        (VisualPolarParams { clip_fraction: 0.5, ..Default::default() }, "clip_fraction"),
+        (VisualPolarParams { clip_fraction: -0.1, ..Default::default() }, "clip_fraction"),
+        (VisualPolarParams { clip_fraction: f32::NAN, ..Default::default() }, "clip_fraction"),
+        (VisualPolarParams { axis_scale: 0.0, ..Default::default() }, "axis_scale"),
+        (VisualPolarParams { axis_scale: f32::INFINITY, ..Default::default() }, "axis_scale"),
+        (VisualPolarParams { fovea_deg: 0.0, ..Default::default() }, "fovea_deg"),
+        (VisualPolarParams { fovea_deg: 80.0, ..Default::default() }, "fovea_deg"),
+        (VisualPolarParams { density_exponent: -1.0, ..Default::default() }, "density_exponent"),
+        (VisualPolarParams { density_exponent: f32::NAN, ..Default::default() }, "density_exponent"),
+        (VisualPolarParams { radius_mode: RadiusMode::Fixed(0.0), ..Default::default() }, "radius_mode"),
+        (VisualPolarParams { radius_mode: RadiusMode::Fixed(f32::NAN), ..Default::default() }, "radius_mode"),
+    ];
+    for (params, name) in cases {
+        match VisualPolar::new(screen, gaze, params) {
+            Err(e) => assert!(e.to_string().contains(name), "{params:?}: error '{e}' should name {name}"),
+            Ok(_) => panic!("{params:?} accepted"),
+        }
+    }
+    assert!(VisualPolar::new(UVec2::new(0, 720), gaze, Default::default()).unwrap_err().to_string().contains("screen"));
+    assert!(VisualPolar::new(screen, Vec2::new(f32::NAN, 0.0), Default::default()).unwrap_err().to_string().contains("gaze"));
+    // The acuity-exact clip and an off-screen gaze are fine.
+    let exact_clip = VisualPolarParams::default().acuity_exact_clip_fraction();
+    VisualPolar::new(screen, gaze, VisualPolarParams { clip_fraction: exact_clip, ..Default::default() }).unwrap();
+    VisualPolar::new(screen, Vec2::new(-50.0, 900.0), Default::default()).unwrap();
+}
+
+/// The `SamplingSpace` view: names, sizes and mappings delegate to the VP mapping; clipped and
+/// out-of-grid positions have no sample.
+#[test]
+fn sampling_space_impl() {
+    use crate::sampling::SamplingSpace;
+    let s = vp(160, 180, 80.0, 90.0, Default::default());
+    let space: &dyn SamplingSpace = &s;
+    assert_eq!(space.name(), "vp");
+    assert_eq!(space.shader_variant(), "visual_polar");
+    assert_eq!(space.grid_size(), UVec2::new(107, 120));
+    assert_eq!(space.screen_size(), UVec2::new(160, 180));
+    assert_eq!(space.sample_count(), s.sample_count());
+    assert_eq!(space.params().gaze, s.sampling_params().gaze);
+    let g = s.grid_size();
+    for x in 0..g.x {
+        for y in 0..g.y {
+            let t = Vec2::new(x as f32, y as f32) + 0.5;
+            let valid = s.is_valid_texel(IVec2::new(x as i32, y as i32));
+            match space.grid_to_screen(t) {
+                Some(p) => {
+                    assert!(valid, "clipped texel ({x}, {y}) mapped");
+                    assert!((p - s.vp_to_screen(t)).length() < 1e-6);
+                    let back = space.screen_to_grid(p).expect("a sample's position has a grid position");
+                    assert!((back.x - t.x).abs() < 2e-2, "({x}, {y}): x {} vs {}", back.x, t.x);
+                }
+                None => assert!(!valid, "valid texel ({x}, {y}) not mapped"),
+            }
+        }
+    }
+    for bad in [Vec2::new(-0.5, 0.5), Vec2::new(0.5, -0.5), Vec2::new(g.x as f32 + 0.5, 0.5), Vec2::new(0.5, g.y as f32), Vec2::NAN, Vec2::new(1e30, 0.5)] {
+        assert_eq!(space.grid_to_screen(bad), None, "{bad}");
+    }
+    assert_eq!(space.screen_to_grid(Vec2::NAN), None);
+    // A corner of the screen is at r_max: still inside the grid (the last column).
+    assert!(space.screen_to_grid(Vec2::ZERO).is_some());
+    // With a fixed radius, positions beyond it have no sample.
+    let fixed = vp(160, 180, 80.0, 90.0, VisualPolarParams { radius_mode: RadiusMode::Fixed(50.0), ..Default::default() });
+    assert_eq!(SamplingSpace::screen_to_grid(&fixed, Vec2::ZERO), None);
+    assert!(SamplingSpace::screen_to_grid(&fixed, Vec2::new(100.0, 90.0)).is_some());
 }

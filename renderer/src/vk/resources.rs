@@ -89,6 +89,24 @@ impl Buffer {
         Ok(buffer)
     }
 
+    /// An empty host-visible (CpuToGpu) RGBA32F texel buffer of `size` bytes, refilled with
+    /// `write` between submissions (ray lists read with `texelFetch`).
+    pub fn host_texels(ctx: &Arc<Context>, name: &str, size: u64) -> Result<Buffer> {
+        let size = size.max(16).next_multiple_of(16);
+        let limit = ctx.info.max_texel_buffer_elements as u64;
+        if size / 16 > limit {
+            return Err(Error::Invalid(format!("{name}: {} texels exceed the device limit {limit}", size / 16)));
+        }
+        let mut buffer = Buffer::new(ctx, name, size, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, MemoryLocation::CpuToGpu)?;
+        let info = vk::BufferViewCreateInfo::default()
+            .buffer(buffer.raw)
+            .format(vk::Format::R32G32B32A32_SFLOAT)
+            .offset(0)
+            .range(vk::WHOLE_SIZE);
+        buffer.texel_view = Some(unsafe { ctx.device.create_buffer_view(&info, None)? });
+        Ok(buffer)
+    }
+
     pub fn write<T: bytemuck::Pod>(&self, data: &[T]) -> Result<()> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         let slice = self

@@ -1,0 +1,23 @@
+// Visual-Polar sampling (Koskela et al., EGSR 2019): one sample per kept texel of the VP grid
+// (x = ρ, y = φ), mapped to the screen by visual_polar_math.glsl with the parameters packed by
+// VisualPolar::sampling_params() (the `sampling` buffer). Jitter is applied in VP space, inside the
+// texel, so a sample never leaves its column. Texels cut by the fovea's triangular clip hold no
+// sample. Positions off the screen are returned (and traced, as in the paper): the camera model
+// handles any screen position.
+#ifndef FOVEA_SAMPLING_VISUAL_POLAR_GLSL
+#define FOVEA_SAMPLING_VISUAL_POLAR_GLSL
+
+#include "visual_polar_math.glsl"
+
+// Screen position (pixels, y down) of the sample held by `texel`; false when the texel holds none.
+bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen) {
+    SamplingParams s = sampling.data;
+    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+    screen = vec2(0.0);
+    if (!vp_is_valid_texel(P, texel)) return false;
+    // rng_next gives [0, 1): texel + jitter stays in the texel, so floor(x) is its column.
+    screen = vp_vp_to_screen(P, vec2(texel) + jitter);
+    return true;
+}
+
+#endif

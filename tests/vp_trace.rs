@@ -1,0 +1,224 @@
+//! The tracer fed by the Visual-Polar sampling space (issue 4, pipeline step 1): one traced sample
+//! per kept VP texel, nothing traced in the clipped fovea triangle, off-screen samples traced and
+//! counted (`FrameStats::samples_offscreen`, ray counter slot 3).
+//!
+//! The off-screen count is checked two ways:
+//! - exactly, against a CPU replay of the kernel's jitter (the same PCG hash seeded the same way
+//!   as `rng_seed(texel, frame, seed, 0)` in `trace.comp`; the jitter is the first `rng_next2`)
+//!   mapped by the Rust twin `VisualPolar::vp_to_screen`, allowing for the texels whose CPU
+//!   position lies within 2e-3 px of the screen border (Rust and GLSL agree to < 1e-3 px,
+//!   `tests/vp_mapping.rs`);
+//! - jitter-independently: between the texels whose whole cell is off-screen and the texels
+//!   with any part off-screen (each cell probed on a 9×9 lattice).
+
+use ash::vk;
+use fovea_renderer::graph::FrameRecorder;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSettings, Renderer};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
+use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_scene::Scene;
+use fovea_tests::{assert_clean, gpu};
+use glam::{IVec2, UVec2, Vec2};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+const SCREEN: UVec2 = UVec2::new(160, 180);
+const FRAME_INDEX: u32 = 3;
+
+fn pcg_hash(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// `rng_seed` + the first `rng_next2` of `shaders/common/random.glsl`.
+fn kernel_jitter(texel: UVec2, frame: u32, seed: u32, sample_index: u32) -> Vec2 {
+    let mut state = pcg_hash(
+        texel.x.wrapping_add(pcg_hash(
+            texel.y.wrapping_add(pcg_hash(frame.wrapping_add(pcg_hash(seed.wrapping_add(pcg_hash(sample_index)))))),
+        )),
+    );
+    let mut next = || {
+        state = pcg_hash(state);
+        (state >> 8) as f32 * (1.0 / 16_777_216.0)
+    };
+    let x = next();
+    let y = next();
+    Vec2::new(x, y)
+}
+
+fn offscreen(p: Vec2) -> bool {
+    let s = SCREEN.as_vec2();
+    p.x < 0.0 || p.y < 0.0 || p.x >= s.x || p.y >= s.y
+}
+
+/// Distance from p to the screen border (positive both inside and outside).
+fn border_distance(p: Vec2) -> f32 {
+    let s = SCREEN.as_vec2();
+    if offscreen(p) {
+        let dx = (-p.x).max(p.x - s.x).max(0.0);
+        let dy = (-p.y).max(p.y - s.y).max(0.0);
+        dx.max(dy).max(1e-9)
+    } else {
+        p.x.min(p.y).min(s.x - p.x).min(s.y - p.y)
+    }
+}
+
+struct CpuCounts {
+    /// Replay of the kernel's jitter: off-screen samples, and those within 2e-3 px of the border.
+    replay: u64,
+    replay_ambiguous: u64,
+    /// At texel centres (for the report).
+    centres: u64,
+    /// Cells entirely off-screen / with any probe off-screen.
+    cell_all: u64,
+    cell_any: u64,
+}
+
+fn cpu_counts(vp: &VisualPolar, seed: u32) -> CpuCounts {
+    let g = vp.grid_size();
+    let mut c = CpuCounts { replay: 0, replay_ambiguous: 0, centres: 0, cell_all: 0, cell_any: 0 };
+    for x in 0..g.x {
+        for y in 0..vp.rows_in_column(x) {
+            assert!(vp.is_valid_texel(IVec2::new(x as i32, y as i32)));
+            let t = Vec2::new(x as f32, y as f32);
+            let p = vp.vp_to_screen(t + kernel_jitter(UVec2::new(x, y), FRAME_INDEX, seed, 0));
+            c.replay += offscreen(p) as u64;
+            c.replay_ambiguous += (border_distance(p) < 2e-3) as u64;
+            c.centres += offscreen(vp.vp_to_screen(t + 0.5)) as u64;
+            let (mut all, mut any) = (true, false);
+            for i in 0..9 {
+                for j in 0..9 {
+                    let o = offscreen(vp.vp_to_screen(t + Vec2::new(i as f32, j as f32) * (0.9999 / 8.0)));
+                    all &= o;
+                    any |= o;
+                }
+            }
+            c.cell_all += all as u64;
+            c.cell_any += any as u64;
+        }
+    }
+    c
+}
+
+/// Copies a G-buffer image back (tightly packed texels of `T`).
+fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image: &Image) -> Vec<T> {
+    let texels = image.width as usize * image.height as usize;
+    let bytes = (texels * std::mem::size_of::<T>()) as u64;
+    let buffer = Buffer::new(ctx, "gbuffer_readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    rec.copy_image_to_buffer("read_gbuffer", image, &buffer).unwrap();
+    rec.submit_and_wait().unwrap();
+    let mut out = vec![T::default(); texels];
+    buffer.read_into(&mut out).unwrap();
+    out
+}
+
+fn cornell() -> Scene {
+    Scene::load(&fovea_tests::repo_root().join("scenes/cornell-box.gltf")).unwrap()
+}
+
+fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (Renderer, FrameStats) {
+    let settings = RenderSettings::default();
+    let mut r = Renderer::new(ctx, scene, space, settings).unwrap();
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    let stats = r.render_frame(&FrameInput { camera, frame_index: FRAME_INDEX, read_hdr: false }).unwrap();
+    (r, stats)
+}
+
+/// Renders one VP frame and checks counts and the G-buffer; returns the off-screen share.
+fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2) -> f64 {
+    let vp = VisualPolar::new(SCREEN, gaze, VisualPolarParams::default()).unwrap();
+    let (r, stats) = render(ctx, scene, Box::new(vp));
+    let g = vp.grid_size();
+    let samples = vp.sample_count();
+    let cpu = cpu_counts(&vp, r.settings.seed);
+    let share = stats.samples_offscreen as f64 / samples as f64;
+    println!(
+        "gaze {gaze_name} {gaze}: grid {}x{}, {} samples ({:.1} % of {} screen pixels), traced {}, off-screen {} = {:.1} % \
+         (CPU replay {} ± {}, at texel centres {}, cell bounds [{}, {}])",
+        g.x,
+        g.y,
+        samples,
+        100.0 * samples as f64 / (SCREEN.x * SCREEN.y) as f64,
+        SCREEN.x * SCREEN.y,
+        stats.samples_traced,
+        stats.samples_offscreen,
+        100.0 * share,
+        cpu.replay,
+        cpu.replay_ambiguous,
+        cpu.centres,
+        cpu.cell_all,
+        cpu.cell_any,
+    );
+    assert_eq!(stats.samples_traced, samples, "one traced sample per kept texel");
+    assert_eq!(stats.primary_rays, samples);
+    assert!(
+        cpu.cell_all <= stats.samples_offscreen && stats.samples_offscreen <= cpu.cell_any,
+        "off-screen count {} outside the jitter-independent bounds [{}, {}]",
+        stats.samples_offscreen,
+        cpu.cell_all,
+        cpu.cell_any
+    );
+    assert!(
+        stats.samples_offscreen.abs_diff(cpu.replay) <= cpu.replay_ambiguous,
+        "off-screen count {} vs CPU replay of the kernel's jitter {} (± {} border cases)",
+        stats.samples_offscreen,
+        cpu.replay,
+        cpu.replay_ambiguous
+    );
+
+    // G-buffer: clipped texels are written as "nothing" (zeros, motion −1); kept on-screen
+    // texels of the closed Cornell box hit geometry.
+    let color: Vec<[f32; 4]> = read_image(ctx, &r.gbuffer.color);
+    let normal_depth: Vec<[f32; 4]> = read_image(ctx, &r.gbuffer.normal_depth);
+    let ids: Vec<[u32; 2]> = read_image(ctx, &r.gbuffer.ids);
+    let motion: Vec<[f32; 2]> = read_image(ctx, &r.gbuffer.motion);
+    let (mut clipped, mut kept_on_screen, mut hits_on_screen) = (0u64, 0u64, 0u64);
+    for y in 0..g.y {
+        for x in 0..g.x {
+            let i = (y * g.x + x) as usize;
+            if vp.is_valid_texel(IVec2::new(x as i32, y as i32)) {
+                if !offscreen(vp.vp_to_screen(Vec2::new(x as f32, y as f32) + 0.5)) {
+                    kept_on_screen += 1;
+                    hits_on_screen += (ids[i][0] != 0) as u64;
+                }
+                continue;
+            }
+            clipped += 1;
+            assert_eq!(color[i], [0.0; 4], "colour at clipped texel ({x}, {y})");
+            assert_eq!(normal_depth[i], [0.0; 4], "normal/depth at clipped texel ({x}, {y})");
+            assert_eq!(ids[i], [0, 0], "ids at clipped texel ({x}, {y})");
+            assert_eq!(motion[i], [-1.0, -1.0], "motion at clipped texel ({x}, {y})");
+        }
+    }
+    assert_eq!(clipped, g.x as u64 * g.y as u64 - samples);
+    assert!(clipped > 0, "the default 12 % clip removes texels");
+    assert!(
+        hits_on_screen as f64 > 0.9 * kept_on_screen as f64,
+        "on-screen samples should see the Cornell box: {hits_on_screen} of {kept_on_screen} hit"
+    );
+    share
+}
+
+#[test]
+fn visual_polar_tracing_counts_samples_and_offscreen() {
+    let ctx = gpu();
+    let scene = cornell();
+    let centre = check_vp_frame(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5);
+    let corner = check_vp_frame(&ctx, &scene, "corner", Vec2::new(2.0, 2.0));
+    assert!(centre < 0.3 && 0.3 < corner, "off-screen share: centre {centre:.3}, corner {corner:.3}");
+    assert_clean(&ctx);
+}
+
+/// Cartesian samples are the screen: nothing off-screen.
+#[test]
+fn cartesian_has_no_offscreen_samples() {
+    let ctx = gpu();
+    let scene = cornell();
+    let (_r, stats) = render(&ctx, &scene, Box::new(Cartesian { screen: SCREEN }));
+    assert_eq!(stats.samples_traced, (SCREEN.x * SCREEN.y) as u64);
+    assert_eq!(stats.samples_offscreen, 0);
+    assert_clean(&ctx);
+}
