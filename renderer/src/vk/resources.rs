@@ -75,17 +75,8 @@ impl Buffer {
     /// A read-only RGBA32F texel buffer (BVH nodes and triangles: 5–6× faster than std430
     /// storage reads on lavapipe, see build-notes.md).
     pub fn texels(ctx: &Arc<Context>, name: &str, texels: &[[f32; 4]]) -> Result<Buffer> {
-        let limit = ctx.info.max_texel_buffer_elements as usize;
-        if texels.len() > limit {
-            return Err(Error::Invalid(format!("{name}: {} texels exceed the device limit {limit}", texels.len())));
-        }
-        let mut buffer = Buffer::with_data(ctx, name, texels, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER)?;
-        let info = vk::BufferViewCreateInfo::default()
-            .buffer(buffer.raw)
-            .format(vk::Format::R32G32B32A32_SFLOAT)
-            .offset(0)
-            .range(vk::WHOLE_SIZE);
-        buffer.texel_view = Some(unsafe { ctx.device.create_buffer_view(&info, None)? });
+        let buffer = Buffer::host_texels(ctx, name, std::mem::size_of_val(texels) as u64)?;
+        buffer.write(texels)?;
         Ok(buffer)
     }
 
@@ -107,13 +98,17 @@ impl Buffer {
         Ok(buffer)
     }
 
-    pub fn write<T: bytemuck::Pod>(&self, data: &[T]) -> Result<()> {
-        let bytes: &[u8] = bytemuck::cast_slice(data);
-        let slice = self
-            .allocation
+    /// The mapped pointer of a host-visible buffer.
+    fn mapped(&self) -> Result<std::ptr::NonNull<std::ffi::c_void>> {
+        self.allocation
             .as_ref()
             .and_then(|a| a.mapped_ptr())
-            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
+            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))
+    }
+
+    pub fn write<T: bytemuck::Pod>(&self, data: &[T]) -> Result<()> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let slice = self.mapped()?;
         if bytes.len() as u64 > self.size {
             return Err(Error::Invalid(format!("buffer '{}': {} bytes do not fit in {}", self.name, bytes.len(), self.size)));
         }
@@ -125,11 +120,7 @@ impl Buffer {
 
     /// Copies the first `out.len()` elements back without allocating (render-loop read-backs).
     pub fn read_into<T: bytemuck::Pod>(&self, out: &mut [T]) -> Result<()> {
-        let ptr = self
-            .allocation
-            .as_ref()
-            .and_then(|a| a.mapped_ptr())
-            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
+        let ptr = self.mapped()?;
         let bytes = std::mem::size_of_val(out);
         if bytes as u64 > self.size {
             return Err(Error::Invalid(format!("buffer '{}': {bytes} bytes requested from {}", self.name, self.size)));
@@ -141,17 +132,8 @@ impl Buffer {
 
     /// Reads the whole buffer back as `T`s (host-visible buffers only, after the GPU is done).
     pub fn read<T: bytemuck::Pod>(&self) -> Result<Vec<T>> {
-        let ptr = self
-            .allocation
-            .as_ref()
-            .and_then(|a| a.mapped_ptr())
-            .ok_or_else(|| Error::Invalid(format!("buffer '{}' is not host-visible", self.name)))?;
-        let count = self.size as usize / std::mem::size_of::<T>();
-        let mut out = vec![T::zeroed(); count];
-        // SAFETY: as in `write`; `out` holds exactly count × size_of::<T>() bytes.
-        unsafe {
-            std::ptr::copy_nonoverlapping(ptr.as_ptr() as *const u8, out.as_mut_ptr() as *mut u8, count * std::mem::size_of::<T>())
-        };
+        let mut out = vec![T::zeroed(); self.size as usize / std::mem::size_of::<T>()];
+        self.read_into(&mut out)?;
         Ok(out)
     }
 }
