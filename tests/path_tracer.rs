@@ -109,7 +109,7 @@ fn direct_light_matches_lamberts_formula_and_the_inverse_square_law() {
 #[test]
 fn max_depth_adds_exactly_one_kind_of_light_per_vertex() {
     let ctx = gpu();
-    let scene = Scene::load(&fovea_tests::repo_root().join("scenes/cornell-box.gltf")).unwrap();
+    let scene = fovea_tests::owned_scene("cornell-box");
     let size = 32;
     let mut r = renderer(&ctx, &scene, size, 1);
     let means: Vec<f64> = (1..=3)
@@ -131,7 +131,7 @@ fn max_depth_adds_exactly_one_kind_of_light_per_vertex() {
 #[test]
 fn error_falls_like_one_over_sqrt_spp() {
     let ctx = gpu();
-    let scene = Scene::load(&fovea_tests::repo_root().join("scenes/cornell-box.gltf")).unwrap();
+    let scene = fovea_tests::owned_scene("cornell-box");
     let size = 40;
     let reference = renderer(&ctx, &scene, size, 100).render_reference(&pose(&scene, size), 1024, 3, |_| {}).unwrap();
     let mut r = renderer(&ctx, &scene, size, 200);
@@ -147,7 +147,7 @@ fn error_falls_like_one_over_sqrt_spp() {
 #[test]
 fn same_seed_gives_identical_frames_and_new_frames_give_new_noise() {
     let ctx = gpu();
-    let scene = Scene::load(&fovea_tests::repo_root().join("scenes/cornell-box.gltf")).unwrap();
+    let scene = fovea_tests::owned_scene("cornell-box");
     let size = 32;
     let camera = pose(&scene, size);
     let frame = |r: &mut Renderer, index: u32| {
@@ -172,7 +172,7 @@ fn same_seed_gives_identical_frames_and_new_frames_give_new_noise() {
 #[test]
 fn realtime_frames_report_exact_ray_counts_and_finite_output() {
     let ctx = gpu();
-    let scene = Scene::load(&fovea_tests::repo_root().join("scenes/stress.gltf")).unwrap();
+    let scene = fovea_tests::owned_scene("stress");
     let size = 48;
     let mut r = renderer(&ctx, &scene, size, 1);
     let stats = r.render_frame(&FrameInput { camera: pose(&scene, size), frame_index: 0, read_hdr: true }).unwrap();

@@ -116,7 +116,7 @@ fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image: &Im
 }
 
 fn cornell() -> Scene {
-    Scene::load(&fovea_tests::repo_root().join("scenes/cornell-box.gltf")).unwrap()
+    fovea_tests::owned_scene("cornell-box")
 }
 
 fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (Renderer, FrameStats) {

@@ -23,6 +23,12 @@ pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// One of the project's stored scenes (`scenes/<name>.gltf`).
+pub fn owned_scene(name: &str) -> fovea_scene::Scene {
+    let path = repo_root().join("scenes").join(format!("{name}.gltf"));
+    fovea_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// A file of the shared reference data, if this checkout has `../shared/` beside it.
 pub fn shared_data(name: &str) -> Option<PathBuf> {
     let p = repo_root().join("../shared/data").join(name);
