@@ -54,7 +54,7 @@ fn every_allocation_is_freed_when_resources_drop() {
     let ctx = gpu();
     let scene = fovea_tests::scenes::furnace(0.5, 1.0);
     {
-        let space = Box::new(Cartesian { screen: glam::UVec2::new(16, 16) });
+        let space = Box::new(Cartesian::new(glam::UVec2::new(16, 16)));
         let _renderer = Renderer::new(&ctx, &scene, space, RenderSettings::default()).unwrap();
         assert!(ctx.live_allocations() > 10);
     }

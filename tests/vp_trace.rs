@@ -17,7 +17,7 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSetting
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_scene::Scene;
-use fovea_tests::{assert_clean, gpu};
+use fovea_tests::{assert_clean, gpu, read_image};
 use glam::{IVec2, UVec2, Vec2};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
@@ -101,20 +101,6 @@ fn cpu_counts(vp: &VisualPolar, seed: u32) -> CpuCounts {
     c
 }
 
-/// Copies a G-buffer image back (tightly packed texels of `T`).
-fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image: &Image) -> Vec<T> {
-    let texels = image.width as usize * image.height as usize;
-    let bytes = (texels * std::mem::size_of::<T>()) as u64;
-    let buffer = Buffer::new(ctx, "gbuffer_readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
-    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
-    rec.begin().unwrap();
-    rec.copy_image_to_buffer("read_gbuffer", image, &buffer).unwrap();
-    rec.submit_and_wait().unwrap();
-    let mut out = vec![T::default(); texels];
-    buffer.read_into(&mut out).unwrap();
-    out
-}
-
 fn cornell() -> Scene {
     fovea_tests::owned_scene("cornell-box")
 }
@@ -123,7 +109,7 @@ fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (
     let settings = RenderSettings::default();
     let mut r = Renderer::new(ctx, scene, space, settings).unwrap();
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let stats = r.render_frame(&FrameInput { camera, frame_index: FRAME_INDEX, read_hdr: false }).unwrap();
+    let stats = r.render_frame(&FrameInput { camera, frame_index: FRAME_INDEX, gaze: None, read_hdr: false, read_grid: false }).unwrap();
     (r, stats)
 }
 
@@ -217,7 +203,7 @@ fn visual_polar_tracing_counts_samples_and_offscreen() {
 fn cartesian_has_no_offscreen_samples() {
     let ctx = gpu();
     let scene = cornell();
-    let (_r, stats) = render(&ctx, &scene, Box::new(Cartesian { screen: SCREEN }));
+    let (_r, stats) = render(&ctx, &scene, Box::new(Cartesian::new(SCREEN)));
     assert_eq!(stats.samples_traced, (SCREEN.x * SCREEN.y) as u64);
     assert_eq!(stats.samples_offscreen, 0);
     assert_clean(&ctx);

@@ -190,10 +190,19 @@ impl FrameRecorder {
 
     /// Copies an image into a host-visible buffer (tightly packed rows) for read-back.
     pub fn copy_image_to_buffer(&mut self, pass: &'static str, image: &Image, buffer: &Buffer) -> Result<()> {
+        self.copy_between(pass, image, buffer, false)
+    }
+
+    /// Fills an image from a buffer of tightly packed rows (test inputs, uploads).
+    pub fn copy_buffer_to_image(&mut self, pass: &'static str, buffer: &Buffer, image: &Image) -> Result<()> {
+        self.copy_between(pass, image, buffer, true)
+    }
+
+    fn copy_between(&mut self, pass: &'static str, image: &Image, buffer: &Buffer, to_image: bool) -> Result<()> {
         if buffer.size < image.width as u64 * image.height as u64 * image.texel_bytes() {
             return Err(Error::Binding { pass: pass.into(), reason: format!("buffer '{}' too small for image '{}'", buffer.name, image.name) });
         }
-        self.barrier_for([(image.id, false), (buffer.id, true)].into_iter());
+        self.barrier_for([(image.id, to_image), (buffer.id, !to_image)].into_iter());
         let index = self.open_pass(pass)?;
         let region = vk::BufferImageCopy::default()
             .image_subresource(vk::ImageSubresourceLayers {
@@ -203,8 +212,13 @@ impl FrameRecorder {
                 layer_count: 1,
             })
             .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
-        // Copies prefer TRANSFER_SRC_OPTIMAL (the validation layer warns otherwise): switch for
-        // the copy and back to GENERAL, the layout every pass expects.
+        // Copies prefer the TRANSFER_*_OPTIMAL layouts (the validation layer warns otherwise):
+        // switch for the copy and back to GENERAL, the layout every pass expects.
+        let (layout, access) = if to_image {
+            (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::AccessFlags::TRANSFER_WRITE)
+        } else {
+            (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::AccessFlags::TRANSFER_READ)
+        };
         let transition = |from, to, src, dst| {
             vk::ImageMemoryBarrier::default()
                 .image(image.raw)
@@ -218,10 +232,14 @@ impl FrameRecorder {
         let any = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
         let device = &self.ctx.device;
         unsafe {
-            let to_src = transition(vk::ImageLayout::GENERAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, any, vk::AccessFlags::TRANSFER_READ);
-            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[to_src]);
-            device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &[region]);
-            let back = transition(vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::GENERAL, vk::AccessFlags::TRANSFER_READ, any | vk::AccessFlags::TRANSFER_READ);
+            let enter = transition(vk::ImageLayout::GENERAL, layout, any, access);
+            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[enter]);
+            if to_image {
+                device.cmd_copy_buffer_to_image(self.cmd, buffer.raw, image.raw, layout, &[region]);
+            } else {
+                device.cmd_copy_image_to_buffer(self.cmd, image.raw, layout, buffer.raw, &[region]);
+            }
+            let back = transition(layout, vk::ImageLayout::GENERAL, access, any | vk::AccessFlags::TRANSFER_READ);
             device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[back]);
         }
         self.close_pass(index);

@@ -1,7 +1,8 @@
 //! The fovea engine: records Vulkan compute command buffers that trace, filter and remap
 //! foveated samples. Read the modules in pipeline order:
 //! `scene` (what is traced, CPU side, crate `fovea_scene`) → `gpu_scene` (its upload) →
-//! `sampling` (where samples go) → `passes` (trace, accumulate, tonemap) → `pipeline` (one frame).
+//! `sampling` (where samples go) → `passes` (trace; mip_phi, remap, blur; tonemap; accumulate) →
+//! `to_screen` (VP grid → screen) → `pipeline` (one frame).
 //! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
 
 pub mod error;
@@ -12,6 +13,7 @@ pub mod passes;
 pub mod pipeline;
 pub mod sampling;
 pub mod shaders;
+pub mod to_screen;
 pub mod vk;
 
 pub use error::{Error, Result};

@@ -1,4 +1,5 @@
-//! Composes a frame: sampling space → trace → (denoiser slot) → screen image → tonemap → read-back.
+//! Composes a frame: sampling space → trace → (denoiser slot) → screen image (Visual-Polar: φ-mips,
+//! remap, foveated blur) → tonemap → read-back.
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
@@ -9,10 +10,11 @@ use crate::passes::accumulate::AccumulatePass;
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::sampling::SamplingSpace;
+use crate::to_screen::{BlurSettings, ToScreen};
 use crate::scene::{Camera, Scene};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
-use glam::{Mat4, UVec4, Vec4};
+use glam::{Mat4, UVec4, Vec2, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
@@ -44,11 +46,19 @@ pub struct RenderSettings {
     pub seed: u32,
     pub exposure: f32,
     pub tone_curve: ToneCurve,
+    /// Foveated blur after the remap (Visual-Polar only).
+    pub blur: BlurSettings,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { max_depth: REALTIME_MAX_DEPTH, seed: 1, exposure: 1.0, tone_curve: ToneCurve::Aces }
+        RenderSettings {
+            max_depth: REALTIME_MAX_DEPTH,
+            seed: 1,
+            exposure: 1.0,
+            tone_curve: ToneCurve::Aces,
+            blur: BlurSettings::default(),
+        }
     }
 }
 
@@ -56,8 +66,12 @@ impl Default for RenderSettings {
 pub struct FrameInput {
     pub camera: CameraPose,
     pub frame_index: u32,
+    /// Gaze point in screen pixels; `None` keeps the space's current gaze.
+    pub gaze: Option<Vec2>,
     /// Also copy the linear screen image back (EXR output).
     pub read_hdr: bool,
+    /// Also tonemap the sampling-grid image and copy it back (`read_grid_ldr`; debug views).
+    pub read_grid: bool,
 }
 
 /// Exact counts for one frame (from the GPU's own counters).
@@ -91,9 +105,13 @@ pub struct Renderer {
     tonemap: TonemapPass,
     pub gbuffer: GBuffer,
     accum: Image,
+    /// Visual-Polar spaces only: the way back to the screen.
+    to_screen: Option<ToScreen>,
     ldr: Image,
     ldr_readback: Buffer,
     hdr_readback: Buffer,
+    grid_ldr: Image,
+    grid_readback: Buffer,
     recorder: FrameRecorder,
     prev_camera: Option<CameraPose>,
 }
@@ -115,6 +133,10 @@ impl Renderer {
             Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
         };
         let pixels = screen.x as u64 * screen.y as u64;
+        let to_screen = match space.visual_polar() {
+            Some(_) => Some(ToScreen::new(ctx, grid, screen)?),
+            None => None,
+        };
         Ok(Renderer {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], storage)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], storage)?,
@@ -133,7 +155,10 @@ impl Renderer {
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             ldr_readback: readback("ldr_readback", pixels * 4)?,
             hdr_readback: readback("hdr_readback", pixels * 16)?,
-            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 8)?,
+            grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
+            grid_readback: readback("grid_readback", grid.x as u64 * grid.y as u64 * 4)?,
+            to_screen,
+            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 24)?,
             prev_camera: None,
             ctx: ctx.clone(),
             scene,
@@ -178,18 +203,30 @@ impl Renderer {
 
     /// Renders one real-time frame into the screen image and reads the tonemapped result back.
     pub fn render_frame(&mut self, input: &FrameInput) -> Result<FrameStats> {
+        if let Some(gaze) = input.gaze {
+            self.space.set_gaze(gaze)?;
+        }
         self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, 0)?;
         self.sampling.write(&[self.space.params()])?;
         let rec = &mut self.recorder;
         rec.begin()?;
         rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
         self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.ray_counters, &self.gbuffer, 0)?;
-        // Denoisers and the remap to screen slot in here; Cartesian samples are the screen.
-        let screen_hdr = &self.gbuffer.color;
-        self.tonemap.record(rec, screen_hdr, &self.ldr, self.settings.exposure, self.settings.tone_curve)?;
+        // Denoisers slot in here, in the sampling grid. Cartesian samples are the screen.
+        let grid_hdr = &self.gbuffer.color;
+        let screen_hdr = match (&self.to_screen, self.space.visual_polar()) {
+            (Some(to_screen), Some(vp)) => to_screen.record(rec, &self.sampling, vp, grid_hdr, &self.settings.blur)?,
+            _ => grid_hdr,
+        };
+        let (exposure, curve) = (self.settings.exposure, self.settings.tone_curve);
+        self.tonemap.record(rec, "tonemap", screen_hdr, &self.ldr, exposure, curve)?;
         rec.copy_image_to_buffer("readback", &self.ldr, &self.ldr_readback)?;
         if input.read_hdr {
             rec.copy_image_to_buffer("readback_hdr", screen_hdr, &self.hdr_readback)?;
+        }
+        if input.read_grid {
+            self.tonemap.record(rec, "tonemap_grid", grid_hdr, &self.grid_ldr, exposure, curve)?;
+            rec.copy_image_to_buffer("readback_grid", &self.grid_ldr, &self.grid_readback)?;
         }
         rec.submit_and_wait()?;
         self.prev_camera = Some(input.camera);
@@ -208,6 +245,12 @@ impl Renderer {
     pub fn read_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
         out.resize(self.ldr_readback.size as usize, 0);
         self.ldr_readback.read_into(out)
+    }
+
+    /// The last frame's tonemapped sampling-grid image (`FrameInput::read_grid`), RGBA8.
+    pub fn read_grid_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
+        out.resize(self.grid_readback.size as usize, 0);
+        self.grid_readback.read_into(out)
     }
 
     /// The last frame's (or reference's) linear screen image, RGBA32F.

@@ -105,6 +105,29 @@ struct HitGpu {
     uvec4 triangle;             // x original triangle index (0xffffffff: miss), yzw unused
 };
 
+// Deepest φ-only mip level of a Visual-Polar image (level 0 is the traced image itself). The φ
+// footprint of a screen pixel stays below 2^3 rows except right at the gaze, so 8 is ample.
+const uint PHI_MIP_LEVELS = 8u;
+// Largest foveated-blur kernel radius in pixels (σ ≈ 21 px at the far periphery at 1280×1440
+// would need 63; the tail beyond 32 px holds < 10 % of the weight there and costs 2× the taps).
+const uint BLUR_MAX_RADIUS = 32u;
+
+// Push constants of the φ-only mip pass: builds level config.x + 1 from level config.x.
+struct MipPhiPush {
+    uvec4 config;               // x source level (0 = the VP image), yzw unused
+};
+
+// Push constants of the remap-to-screen pass.
+struct RemapPush {
+    uvec4 config;               // x φ mip levels built (1 = only the VP image), yzw unused
+};
+
+// Push constants of the foveated blur (one pass per axis).
+struct BlurPush {
+    vec4 shape;                 // xy gaze (pixels), z fovea radius (pixels), w σ per pixel beyond it
+    uvec4 config;               // x axis (0 horizontal, 1 vertical), y max kernel radius, zw unused
+};
+
 // Push constants of the Visual-Polar mapping probe (device test of Rust vs GLSL).
 struct VpProbePush {
     uvec4 config;               // x point count, yzw unused

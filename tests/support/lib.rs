@@ -4,7 +4,10 @@
 
 pub mod scenes;
 
-use fovea_renderer::vk::{Context, ContextOptions};
+use ash::vk;
+use fovea_renderer::graph::FrameRecorder;
+use fovea_renderer::vk::{Buffer, Context, ContextOptions, Image};
+use gpu_allocator::MemoryLocation;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -76,4 +79,28 @@ pub fn save_preview(name: &str, width: u32, height: u32, pixels: &[[f32; 4]]) ->
     let path = artifacts_dir().join(name);
     image::save_buffer(&path, &bytes, width, height, image::ExtendedColorType::Rgba8).expect("write preview");
     path
+}
+
+/// Copies an image back (tightly packed texels of `T`, which must match the image format).
+pub fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image: &Image) -> Vec<T> {
+    let texels = image.width as usize * image.height as usize;
+    let bytes = (texels * std::mem::size_of::<T>()) as u64;
+    let buffer = Buffer::new(ctx, "test_readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    rec.copy_image_to_buffer("test_read_image", image, &buffer).unwrap();
+    rec.submit_and_wait().unwrap();
+    let mut out = vec![T::default(); texels];
+    buffer.read_into(&mut out).unwrap();
+    out
+}
+
+/// Fills an RGBA32F image with `texels` (row-major, `width × height`).
+pub fn write_image(ctx: &Arc<Context>, image: &Image, texels: &[[f32; 4]]) {
+    assert_eq!(texels.len(), image.width as usize * image.height as usize);
+    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    rec.copy_buffer_to_image("test_write_image", &buffer, image).unwrap();
+    rec.submit_and_wait().unwrap();
 }

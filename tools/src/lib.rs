@@ -3,7 +3,11 @@
 
 pub mod camera_path;
 pub mod commands;
+pub mod density;
 pub mod gaze;
+pub mod metrics;
 pub mod output;
+pub mod plot;
+pub mod render_profile;
 pub mod scenegen;
 pub mod scenes;

@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use fovea_tools::commands;
+use fovea_tools::render_profile::{ProfileOverrides, RenderProfile};
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -27,8 +28,8 @@ struct RenderOpts {
     /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
-    /// Sampling method.
-    #[arg(long, default_value = "cartesian")]
+    /// Sampling method: vp (Visual-Polar, Koskela et al. 2019) or cartesian (uniform, 1 spp).
+    #[arg(long, default_value = "vp")]
     method: String,
     /// Headset profile: a name from `fovea headsets` or a TOML path.
     #[arg(long, default_value = "fove0")]
@@ -65,6 +66,52 @@ struct RenderOpts {
     /// Linear exposure multiplier before tonemapping.
     #[arg(long, default_value_t = 1.0)]
     exposure: f32,
+    /// Render profile TOML (Visual-Polar parameters, blur); see config/render/default.toml.
+    #[arg(long)]
+    profile: Option<PathBuf>,
+    /// Visual-Polar grid size per axis relative to the screen (default 2/3).
+    #[arg(long)]
+    vp_scale: Option<f32>,
+    /// Share of the VP grid removed by the fovea's triangular clip (default 0.12).
+    #[arg(long)]
+    vp_clip: Option<f32>,
+    /// Fovea radius in the paper's normalised degrees (default 5.79).
+    #[arg(long)]
+    vp_fovea_deg: Option<f32>,
+    /// Sample density ∝ acuity^k (default 1).
+    #[arg(long)]
+    vp_density_exponent: Option<f32>,
+    /// Inverse CDF: polynomial (the paper's Eq. 3, default) or exact.
+    #[arg(long)]
+    vp_inverse_cdf: Option<String>,
+    /// VP radius: corner (largest gaze-to-corner distance, default) or pixels.
+    #[arg(long)]
+    vp_radius: Option<String>,
+    /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
+    #[arg(long)]
+    blur_sigma: Option<f32>,
+    /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
+    #[arg(long)]
+    debug_views: bool,
+}
+
+impl RenderOpts {
+    /// The profile file (or the built-in defaults) with the flags applied.
+    fn profile(&self) -> Result<RenderProfile> {
+        let base = match &self.profile {
+            Some(path) => RenderProfile::load(path)?,
+            None => RenderProfile::default(),
+        };
+        base.override_with(&ProfileOverrides {
+            axis_scale: self.vp_scale,
+            clip_fraction: self.vp_clip,
+            fovea_deg: self.vp_fovea_deg,
+            density_exponent: self.vp_density_exponent,
+            inverse_cdf: self.vp_inverse_cdf.clone(),
+            radius: self.vp_radius.clone(),
+            blur_sigma: self.blur_sigma,
+        })
+    }
 }
 
 /// `fovea` with no arguments renders with every default.
@@ -143,6 +190,24 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
+    Eval {
+        /// Reference linear EXR (e.g. from `fovea reference`).
+        #[arg(long)]
+        reference: PathBuf,
+        /// Frame to evaluate: a linear EXR of the same size (e.g. `fovea render --exr`).
+        #[arg(long)]
+        test: PathBuf,
+        /// Gaze point X,Y in image pixels (y down), or center; rings are centred on it.
+        #[arg(long)]
+        gaze: String,
+        /// Equal-width rings from the gaze out to the farthest image corner.
+        #[arg(long, default_value_t = 20)]
+        rings: usize,
+        /// Output folder for eval.json and eval.png (must hold only fovea's own outputs).
+        #[arg(long, default_value = "out/eval")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> Result<()> {
@@ -167,6 +232,8 @@ fn main() -> Result<()> {
             seed: opts.seed,
             max_depth: opts.max_depth,
             exposure: opts.exposure,
+            profile: opts.profile()?,
+            debug_views: opts.debug_views,
             device: device.device.as_deref(),
             validation: device.validation,
         }),
@@ -198,6 +265,13 @@ fn main() -> Result<()> {
         Command::Headsets => commands::headsets::run(),
         Command::Info { device } => commands::info::run(device.device.as_deref()),
         Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
+        Command::Eval { reference, test, gaze, rings, out } => commands::eval::run(&commands::eval::EvalArgs {
+            reference: &reference,
+            test: &test,
+            gaze: &gaze,
+            rings,
+            out: &out,
+        }),
     }
 }
 

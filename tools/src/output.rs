@@ -13,8 +13,9 @@ pub fn prepare_output_dir(dir: &Path) -> Result<()> {
         }
         for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
             let name = entry?.file_name().to_string_lossy().into_owned();
-            let ours = name == "report.json"
-                || ((name.starts_with("frame_") || name.starts_with("debug_")) && (name.ends_with(".png") || name.ends_with(".exr")));
+            let ours = matches!(name.as_str(), "report.json" | "eval.json" | "eval.png")
+                || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
+                || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)));
             if !ours {
                 bail!(
                     "output folder {} holds '{name}', which fovea did not write; choose an empty or new folder",

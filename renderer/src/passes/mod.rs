@@ -2,7 +2,10 @@
 //! records into a `FrameRecorder`.
 
 pub mod accumulate;
+pub mod blur;
+pub mod mip_phi;
 pub mod raycast;
+pub mod remap;
 pub mod tonemap;
 pub mod trace;
 

@@ -26,13 +26,22 @@ impl TonemapPass {
         Ok(TonemapPass { pipeline: ComputePipeline::new(ctx, "passes/tonemap", std::mem::size_of::<TonemapPush>() as u32)? })
     }
 
-    pub fn record(&self, rec: &mut FrameRecorder, hdr: &Image, ldr: &Image, exposure: f32, curve: ToneCurve) -> Result<()> {
+    /// `pass` names the dispatch in the timing report (the frame and the debug grid view differ).
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        pass: &'static str,
+        hdr: &Image,
+        ldr: &Image,
+        exposure: f32,
+        curve: ToneCurve,
+    ) -> Result<()> {
         let binds = [read_image("hdr", hdr), write_image("ldr", ldr)];
         let op = match curve {
             ToneCurve::Clamp => TONEMAP_CLAMP,
             ToneCurve::Aces => TONEMAP_ACES,
         };
         let push = TonemapPush { params: Vec4::new(exposure, 0.0, 0.0, 0.0), config: UVec4::new(op, 0, 0, 0) };
-        rec.dispatch("tonemap", &self.pipeline, &binds, push_bytes(&push), [ldr.width, ldr.height, 1])
+        rec.dispatch(pass, &self.pipeline, &binds, push_bytes(&push), [ldr.width, ldr.height, 1])
     }
 }

@@ -1,12 +1,22 @@
 //! Uniform Cartesian sampling: one sample per screen pixel (the quality and cost reference).
 
 use super::SamplingSpace;
+use crate::error::Result;
 use crate::layouts::SamplingParams;
 use glam::{UVec2, UVec4, Vec2, Vec4};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Cartesian {
     pub screen: UVec2,
+    /// Recorded for reports; uniform sampling does not depend on it.
+    pub gaze: Vec2,
+}
+
+impl Cartesian {
+    /// Uniform sampling of `screen`, gaze at its centre.
+    pub fn new(screen: UVec2) -> Cartesian {
+        Cartesian { screen, gaze: screen.as_vec2() * 0.5 }
+    }
 }
 
 impl SamplingSpace for Cartesian {
@@ -28,7 +38,7 @@ impl SamplingSpace for Cartesian {
     fn params(&self) -> SamplingParams {
         SamplingParams {
             grid: UVec4::new(self.screen.x, self.screen.y, self.screen.x, self.screen.y),
-            gaze: Vec4::new(self.screen.x as f32 * 0.5, self.screen.y as f32 * 0.5, 0.0, 0.0),
+            gaze: Vec4::new(self.gaze.x, self.gaze.y, 0.0, 0.0),
             shape0: Vec4::ZERO,
             shape1: Vec4::ZERO,
         }
@@ -39,5 +49,12 @@ impl SamplingSpace for Cartesian {
     }
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
         self.grid_to_screen(screen)
+    }
+    fn gaze(&self) -> Vec2 {
+        self.gaze
+    }
+    fn set_gaze(&mut self, gaze: Vec2) -> Result<()> {
+        self.gaze = gaze;
+        Ok(())
     }
 }

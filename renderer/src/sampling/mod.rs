@@ -8,6 +8,7 @@ mod visual_polar;
 pub use cartesian::Cartesian;
 pub use visual_polar::{VisualPolar, VisualPolarParams, InverseCdf, RadiusMode};
 
+use crate::error::Result;
 use crate::layouts::SamplingParams;
 use glam::{UVec2, Vec2};
 
@@ -27,4 +28,14 @@ pub trait SamplingSpace {
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2>;
     /// Grid position of a screen position; `None` where the space has no sample.
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2>;
+    /// Current gaze point (screen pixels).
+    fn gaze(&self) -> Vec2;
+    /// Re-centres the space on a new gaze point (screen pixels); the grid size never changes, so
+    /// per-sample images stay valid. Spaces that ignore the gaze only record it.
+    fn set_gaze(&mut self, gaze: Vec2) -> Result<()>;
+    /// The Visual-Polar space, when this is one: its grid is not the screen, so the renderer maps
+    /// it back (φ-mips, remap) and applies the foveated blur.
+    fn visual_polar(&self) -> Option<&VisualPolar> {
+        None
+    }
 }

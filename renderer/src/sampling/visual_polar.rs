@@ -354,6 +354,16 @@ impl VisualPolar {
         self.p_f
     }
 
+    /// Screen distance (pixels) of the paper's normalised eccentricity `e` (e_norm ↦ r_max).
+    pub fn radius_of_eccentricity(&self, e: f32) -> f32 {
+        e / self.e_norm * self.r_max
+    }
+
+    /// The paper's normalised eccentricity of a screen distance (pixels).
+    pub fn eccentricity_of_radius(&self, r: f32) -> f32 {
+        r / self.r_max * self.e_norm
+    }
+
     /// Rows of φ that column `col` keeps (the triangular clip; see the module docs).
     pub fn rows_in_column(&self, col: u32) -> u32 {
         let h = self.grid.y;
@@ -505,6 +515,16 @@ impl SamplingSpace for VisualPolar {
         }
         let last = f32::from_bits(w.to_bits() - 1); // largest f32 below w (w ≥ 1)
         Some(Vec2::new(g.x.min(last), g.y))
+    }
+    fn gaze(&self) -> Vec2 {
+        self.gaze
+    }
+    fn set_gaze(&mut self, gaze: Vec2) -> Result<()> {
+        *self = VisualPolar::new(self.screen, gaze, self.params)?;
+        Ok(())
+    }
+    fn visual_polar(&self) -> Option<&VisualPolar> {
+        Some(self)
     }
 }
 

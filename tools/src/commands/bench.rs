@@ -93,16 +93,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let (_, indirect_ms) = timed_trace(&mut caster, &gpu, &indirect, false)?;
             let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
 
-            let space = Box::new(Cartesian { screen: UVec2::new(w, h) });
+            let space = Box::new(Cartesian::new(UVec2::new(w, h)));
             let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
             let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
             let mut sums: BTreeMap<String, f64> = BTreeMap::new();
             let mut frame_rays = 0;
             // One untimed frame first: the first dispatch of a pipeline pays one-off costs
             // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
-            renderer.render_frame(&FrameInput { camera: pose, frame_index: 0, read_hdr: false })?;
+            renderer.render_frame(&FrameInput { camera: pose, frame_index: 0, gaze: None, read_hdr: false, read_grid: false })?;
             for frame in 0..args.frames {
-                let stats = renderer.render_frame(&FrameInput { camera: pose, frame_index: frame, read_hdr: false })?;
+                let stats = renderer.render_frame(&FrameInput { camera: pose, frame_index: frame, gaze: None, read_hdr: false, read_grid: false })?;
                 frame_rays = stats.rays_traced();
                 for t in renderer.timings() {
                     *sums.entry(t.name.to_string()).or_default() += t.ms / args.frames as f64;

@@ -1,4 +1,6 @@
 pub mod bench;
+pub mod eval;
+pub mod debug_views;
 pub mod gen_scene;
 pub mod headsets;
 pub mod info;

@@ -39,7 +39,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let pose = CameraPose::from_scene_camera(camera, args.width, args.height);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, ..Default::default() };
-    let space = Box::new(Cartesian { screen: UVec2::new(args.width, args.height) });
+    let space = Box::new(Cartesian::new(UVec2::new(args.width, args.height)));
     let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")?);

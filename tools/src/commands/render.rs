@@ -7,7 +7,8 @@ use crate::gaze::GazeDriver;
 use anyhow::{bail, Context, Result};
 use fovea_hal::GazeOrigin;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace};
+use crate::render_profile::RenderProfile;
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar};
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -30,9 +31,16 @@ pub struct RenderArgs<'a> {
     pub seed: u32,
     pub max_depth: u32,
     pub exposure: f32,
+    /// Visual-Polar parameters and blur (profile file + flags, already merged).
+    pub profile: RenderProfile,
+    /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
+    pub debug_views: bool,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
+
+/// The sampling methods `--method` accepts.
+pub const METHODS: &[&str] = &["vp", "cartesian"];
 
 #[derive(Serialize)]
 struct Report {
@@ -50,9 +58,14 @@ struct Report {
     device: String,
     width: u32,
     height: u32,
+    /// Sampling-grid size (the screen for Cartesian).
+    vp_width: u32,
+    vp_height: u32,
     frames: u32,
     /// Samples traced in one frame.
     samples_traced: u64,
+    /// Traced samples per frame (mean) whose screen position is off the screen.
+    samples_offscreen: u64,
     screen_pixels: u64,
     /// Rays traced in one frame (mean over frames): primary + shadow + continuation.
     rays_traced: u64,
@@ -60,12 +73,26 @@ struct Report {
     max_depth: u32,
     seed: u32,
     camera_path: bool,
+    /// Visual-Polar parameters (vp only).
+    visual_polar: Option<VpReport>,
+    /// Foveated blur σ at 30° for a 1280×1440 eye (vp only; 0 = off).
+    blur_sigma_at_30: Option<f32>,
     /// Pass name → mean GPU milliseconds per frame.
     passes: BTreeMap<String, f64>,
     /// Sum of the pass means.
     frame_gpu_ms: f64,
     /// Wall-clock seconds for all frames, including read-back and file writing.
     wall_seconds: f64,
+}
+
+#[derive(Serialize)]
+struct VpReport {
+    axis_scale: f32,
+    clip_fraction: f32,
+    fovea_deg: f32,
+    density_exponent: f32,
+    inverse_cdf: String,
+    radius: String,
 }
 
 #[derive(Serialize, Default)]
@@ -86,10 +113,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if width == 0 || height == 0 || args.frames == 0 {
         bail!("--width, --height and --frames must be at least 1");
     }
-    let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
-    if args.method != "cartesian" {
-        bail!("--method {}: only 'cartesian' is implemented so far (Visual-Polar is not done yet)", args.method);
+    if !METHODS.contains(&args.method) {
+        bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
     }
+    let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
     let scene = crate::scenes::load(args.scene)?;
     let Some(camera) = scene.default_camera() else {
         bail!("{}: the scene has no perspective camera", scene.source.display());
@@ -97,17 +124,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     prepare_output_dir(args.out)?;
     let start_pose = CameraPose::from_scene_camera(camera, width, height);
     let ctx = super::open_device(args.device, args.validation)?;
-    let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, exposure: args.exposure, ..Default::default() };
-    let space = Box::new(Cartesian { screen: UVec2::new(width, height) });
-    let screen_pixels = space.screen_size().x as u64 * space.screen_size().y as u64;
+    let settings = RenderSettings {
+        max_depth: args.max_depth,
+        seed: args.seed,
+        exposure: args.exposure,
+        blur: args.profile.blur,
+        ..Default::default()
+    };
+    let screen = UVec2::new(width, height);
+    let first_gaze = gaze.frame(0)?.pixel;
+    let space: Box<dyn SamplingSpace> = match args.method {
+        "vp" => Box::new(VisualPolar::new(screen, first_gaze, args.profile.visual_polar).context("Visual-Polar space")?),
+        _ => Box::new(Cartesian::new(screen)),
+    };
+    let grid = space.grid_size();
+    let screen_pixels = screen.x as u64 * screen.y as u64;
     let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
+    let mut debug = args.debug_views.then(|| super::debug_views::DebugViews::new(args.out, screen, grid));
     let centre = scene.bounds().center();
 
     let bar = ProgressBar::new(args.frames as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} frame {pos}/{len}  {elapsed} (eta {eta})")?);
     let started = std::time::Instant::now();
     let mut pass_sums: BTreeMap<String, f64> = BTreeMap::new();
-    let (mut samples, mut rays) = (0u64, RayReport::default());
+    let (mut samples, mut offscreen, mut rays) = (0u64, 0u64, RayReport::default());
     let mut gaze_points = Vec::with_capacity(args.frames as usize);
     let mut origins = [0u32; 3];
     let mut ldr = Vec::new();
@@ -121,8 +161,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Centre => 2,
         }] += 1;
         let camera = if args.camera_path { camera_path::orbit(&start_pose, centre, frame, args.frames) } else { start_pose };
-        let stats = renderer.render_frame(&FrameInput { camera, frame_index: frame, read_hdr: args.exr })?;
+        let input = FrameInput {
+            camera,
+            frame_index: frame,
+            gaze: Some(frame_gaze.pixel),
+            read_hdr: args.exr,
+            read_grid: debug.is_some(),
+        };
+        let stats = renderer.render_frame(&input)?;
         samples += stats.samples_traced;
+        offscreen += stats.samples_offscreen;
         rays.primary += stats.primary_rays;
         rays.shadow += stats.shadow_rays;
         rays.continuation += stats.continuation_rays;
@@ -135,9 +183,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             renderer.read_hdr(&mut hdr)?;
             write_exr(&args.out.join(format!("frame_{frame:04}.exr")), width, height, &hdr)?;
         }
+        if let Some(debug) = &mut debug {
+            debug.frame(frame, &renderer)?;
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
+    if let Some(debug) = &debug {
+        debug.finish(&renderer)?;
+    }
     super::check_validation(&ctx)?;
 
     let n = args.frames as u64;
@@ -155,14 +209,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         device: ctx.info.name.clone(),
         width,
         height,
+        vp_width: grid.x,
+        vp_height: grid.y,
         frames: args.frames,
         samples_traced: samples / n,
+        samples_offscreen: offscreen / n,
         screen_pixels,
         rays_traced: rays.primary + rays.shadow + rays.continuation,
         rays,
         max_depth: args.max_depth,
         seed: args.seed,
         camera_path: args.camera_path,
+        visual_polar: (args.method == "vp").then(|| vp_report(&args.profile)),
+        blur_sigma_at_30: (args.method == "vp").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -170,15 +229,37 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let path = args.out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     println!(
-        "rendered {} frame(s) of {}×{} ({}) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
+        "rendered {} frame(s) of {}×{} ({}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
         args.frames,
         width,
         height,
         report.method,
+        grid.x,
+        grid.y,
+        report.samples_traced,
         report.device,
         report.frame_gpu_ms,
         report.rays_traced,
         args.out.display()
     );
     Ok(())
+}
+
+fn vp_report(profile: &RenderProfile) -> VpReport {
+    use fovea_renderer::sampling::{InverseCdf, RadiusMode};
+    let p = &profile.visual_polar;
+    VpReport {
+        axis_scale: p.axis_scale,
+        clip_fraction: p.clip_fraction,
+        fovea_deg: p.fovea_deg,
+        density_exponent: p.density_exponent,
+        inverse_cdf: match p.inverse_cdf {
+            InverseCdf::Polynomial => "polynomial".into(),
+            InverseCdf::Exact => "exact".into(),
+        },
+        radius: match p.radius_mode {
+            RadiusMode::FarthestCorner => "corner".into(),
+            RadiusMode::Fixed(r) => format!("{r}"),
+        },
+    }
 }

@@ -1,0 +1,91 @@
+//! Back to the screen from a Visual-Polar grid (visual-polar.md §6–7): φ-only mips → remap by
+//! backward mapping → foveated blur. Owns the passes and their screen-sized images.
+
+use crate::error::Result;
+use crate::graph::FrameRecorder;
+use crate::passes::blur::{BlurPass, BlurShape};
+use crate::passes::mip_phi::{MipPhiPass, PhiMips};
+use crate::passes::remap::RemapPass;
+use crate::sampling::VisualPolar;
+use crate::vk::{Buffer, Context, Image};
+use ash::vk;
+use glam::UVec2;
+use std::sync::Arc;
+
+/// The paper's blur strength: σ = 6.8 px at 30° on the 1280×1440 FOVE 0 eye.
+pub const FOVE_SIGMA_AT_30: f32 = 6.8;
+/// Eccentricity (the paper's normalised degrees) at which the blur reaches its nominal σ.
+const SIGMA_REFERENCE_DEG: f32 = 30.0;
+/// Pixels of the screen the paper's σ was chosen for.
+const FOVE_EYE_PIXELS: f32 = 1280.0 * 1440.0;
+
+/// Foveated-blur settings; σ scales with resolution (per unit of screen length).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlurSettings {
+    /// σ in pixels at 30° for a 1280×1440 screen (0 turns the blur off).
+    pub sigma_at_30: f32,
+}
+
+impl Default for BlurSettings {
+    fn default() -> Self {
+        BlurSettings { sigma_at_30: FOVE_SIGMA_AT_30 }
+    }
+}
+
+impl BlurSettings {
+    /// The blur for one gaze: σ = 0 inside the fovea, linear beyond, `sigma_at_30` (scaled to
+    /// this screen) at 30°.
+    pub fn shape(&self, vp: &VisualPolar) -> BlurShape {
+        let screen = vp.screen().as_vec2();
+        let sigma_30 = self.sigma_at_30 * (screen.x * screen.y / FOVE_EYE_PIXELS).sqrt();
+        let r_f = vp.r_fovea();
+        let r_30 = vp.radius_of_eccentricity(SIGMA_REFERENCE_DEG);
+        let slope = if r_30 > r_f { sigma_30 / (r_30 - r_f) } else { 0.0 };
+        BlurShape { gaze: vp.gaze(), fovea_radius: r_f, sigma_slope: slope }
+    }
+}
+
+pub struct ToScreen {
+    mip_phi: MipPhiPass,
+    remap: RemapPass,
+    blur: BlurPass,
+    pub mips: PhiMips,
+    /// Remapped linear radiance (before the blur).
+    pub remapped: Image,
+    scratch: Image,
+    /// Final linear radiance on the screen.
+    pub blurred: Image,
+}
+
+impl ToScreen {
+    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2) -> Result<ToScreen> {
+        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
+        Ok(ToScreen {
+            mip_phi: MipPhiPass::new(ctx)?,
+            remap: RemapPass::new(ctx)?,
+            blur: BlurPass::new(ctx)?,
+            mips: PhiMips::new(ctx, grid)?,
+            remapped: image("screen.remapped")?,
+            scratch: image("screen.blur_scratch")?,
+            blurred: image("screen.blurred")?,
+        })
+    }
+
+    /// Records mips, remap and (unless σ is 0) the blur; returns the screen image to show.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        sampling: &Buffer,
+        vp: &VisualPolar,
+        vp_color: &Image,
+        blur: &BlurSettings,
+    ) -> Result<&Image> {
+        self.mip_phi.record(rec, sampling, vp_color, &self.mips)?;
+        self.remap.record(rec, sampling, vp_color, &self.mips, &self.remapped)?;
+        if blur.sigma_at_30 <= 0.0 {
+            return Ok(&self.remapped);
+        }
+        self.blur.record(rec, &blur.shape(vp), &self.remapped, &self.scratch, &self.blurred)?;
+        Ok(&self.blurred)
+    }
+}

@@ -1,0 +1,34 @@
+#version 460
+// One level of the φ-only mip chain of a Visual-Polar image: level l+1 averages pairs of φ rows
+// of level l inside each column. ρ is never filtered: the remap magnifies (or keeps) ρ, while one
+// screen pixel near the gaze spans many φ rows (visual-polar.md §6).
+#include "../common/layouts.glsl"
+#include "../sampling/visual_polar_math.glsl"
+#include "../sampling/phi_mips.glsl"
+
+layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
+layout(push_constant) uniform Push { MipPhiPush p; } push;
+layout(std430, set = 0, binding = 0) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // level 0
+layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // levels ≥ 1, stacked
+
+vec4 load_level(uint level, uint height, int col, uint row) {
+    if (level == 0u) return imageLoad(vp_color, ivec2(col, row));
+    return imageLoad(mips, ivec2(col, phi_mip_offset(level, height) + row));
+}
+
+void main() {
+    SamplingParams s = sampling.data;
+    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (uint(t.x) >= P.grid.x) return;
+    uint src = push.p.config.x;
+    uint rows0 = vp_rows_in_column(P, uint(t.x));
+    uint src_rows = phi_mip_rows(rows0, src);
+    // Rows past the column's count are never read by the remap.
+    if (uint(t.y) >= phi_mip_rows(rows0, src + 1u)) return;
+    uint a = 2u * uint(t.y);
+    uint b = (a + 1u) % src_rows;
+    vec4 v = 0.5 * (load_level(src, P.grid.y, t.x, a) + load_level(src, P.grid.y, t.x, b));
+    imageStore(mips, ivec2(t.x, phi_mip_offset(src + 1u, P.grid.y) + uint(t.y)), v);
+}

@@ -1,0 +1,146 @@
+//! `fovea eval` through its library entry point (as `tests/cli.rs` does for the other commands):
+//! eval.json's fields and values on small synthetic EXRs, and bad input named in the error.
+//! No GPU needed.
+
+use fovea_tools::commands::eval::{run as eval, EvalArgs};
+use fovea_tools::output::write_exr;
+use std::path::{Path, PathBuf};
+
+const W: u32 = 64;
+const H: u32 = 72;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = fovea_tests::artifacts_dir().join(format!("eval-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A smooth image with some texture, so SSIM has structure to compare.
+fn image(w: u32, h: u32) -> Vec<[f32; 4]> {
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            let v = 0.2 + 0.5 * x / w as f32 + 0.1 * ((x * 0.7).sin() * (y * 0.5).cos());
+            [v, 0.8 * v, 0.3 + 0.2 * y / h as f32, 1.0]
+        })
+        .collect()
+}
+
+fn args<'a>(reference: &'a Path, test: &'a Path, gaze: &'a str, out: &'a Path) -> EvalArgs<'a> {
+    EvalArgs { reference, test, gaze, rings: 10, out }
+}
+
+fn read_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("eval.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn identical_frames_score_perfectly() {
+    let dir = temp_dir("identical");
+    let reference = dir.join("ref.exr");
+    write_exr(&reference, W, H, &image(W, H)).unwrap();
+    let out = dir.join("out");
+    eval(&args(&reference, &reference, "32,36", &out)).unwrap();
+    assert!(out.join("eval.png").exists());
+    let json = read_json(&out);
+    assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(W as u64), Some(H as u64)));
+    assert_eq!(json["frame"]["rmse"], 0.0);
+    assert_eq!(json["frame"]["ssim"], 1.0);
+    assert_eq!(json["frame"]["psnr"], fovea_tools::metrics::PSNR_CAP_DB);
+    assert_eq!(json["frame"]["pixels"], W * H);
+    let rings = json["rings"].as_array().unwrap();
+    assert_eq!(rings.len(), 10);
+    assert_eq!(rings.iter().map(|r| r["pixels"].as_u64().unwrap()).sum::<u64>(), (W * H) as u64);
+    let r_max = json["r_max_px"].as_f64().unwrap();
+    assert!((r_max - (32f64.powi(2) + 36f64.powi(2)).sqrt()).abs() < 1e-9);
+    for r in rings {
+        for key in ["ring", "r_inner_px", "r_outer_px", "ecc_inner", "ecc_outer", "rmse", "psnr", "ssim"] {
+            assert!(r.get(key).is_some(), "ring lacks '{key}'");
+        }
+        assert_eq!((&r["rmse"], &r["ssim"]), (&serde_json::json!(0.0), &serde_json::json!(1.0)));
+    }
+    assert_eq!(rings[9]["ecc_outer"], 80.0);
+    // Running again into the same folder replaces only fovea's own files.
+    eval(&args(&reference, &reference, "center", &out)).unwrap();
+}
+
+#[test]
+fn peripheral_error_shows_only_in_outer_rings() {
+    let dir = temp_dir("periphery");
+    let (reference, test) = (dir.join("ref.exr"), dir.join("test.exr"));
+    let clean = image(W, H);
+    write_exr(&reference, W, H, &clean).unwrap();
+    // Brighten every pixel farther than 30 px from the gaze (r_max ≈ 48.2 px; ring 6 starts at 28.9).
+    let perturbed: Vec<_> = clean
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (dx, dy) = ((i as u32 % W) as f32 + 0.5 - 32.0, (i as u32 / W) as f32 + 0.5 - 36.0);
+            if dx.hypot(dy) > 30.0 {
+                [p[0] + 0.25, p[1] + 0.25, p[2] + 0.25, 1.0]
+            } else {
+                *p
+            }
+        })
+        .collect();
+    write_exr(&test, W, H, &perturbed).unwrap();
+    let out = dir.join("out");
+    eval(&args(&reference, &test, "32,36", &out)).unwrap();
+    let json = read_json(&out);
+    let rings = json["rings"].as_array().unwrap();
+    // Rings 0..=4 end at 24.1 px: their SSIM windows (5 px) stay inside the clean disc.
+    for r in &rings[..5] {
+        assert_eq!(r["rmse"], 0.0, "inner ring {r}");
+        assert_eq!(r["ssim"], 1.0, "inner ring {r}");
+    }
+    for r in &rings[7..] {
+        let rmse = r["rmse"].as_f64().unwrap();
+        assert!((rmse - 0.25).abs() < 1e-6, "outer ring {r}");
+        assert!(r["psnr"].as_f64().unwrap() < 13.0 && r["ssim"].as_f64().unwrap() < 1.0, "outer ring {r}");
+    }
+    assert!(json["frame"]["rmse"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn bad_inputs_are_named_in_the_error() {
+    let dir = temp_dir("bad");
+    let out = dir.join("out");
+    let good = dir.join("good.exr");
+    write_exr(&good, W, H, &image(W, H)).unwrap();
+
+    let mut with_nan = image(W, H);
+    with_nan[5 * W as usize + 3][1] = f32::NAN;
+    let nan = dir.join("nan.exr");
+    write_exr(&nan, W, H, &with_nan).unwrap();
+    let err = format!("{:#}", eval(&args(&good, &nan, "32,36", &out)).unwrap_err());
+    assert!(err.contains("nan.exr") && err.contains("(3, 5)"), "{err}");
+
+    let small = dir.join("small.exr");
+    write_exr(&small, 32, 36, &image(32, 36)).unwrap();
+    let err = format!("{:#}", eval(&args(&good, &small, "16,18", &out)).unwrap_err());
+    assert!(err.contains("small.exr") && err.contains("32×36") && err.contains("64×72"), "{err}");
+
+    let missing = dir.join("missing.exr");
+    let err = format!("{:#}", eval(&args(&missing, &good, "32,36", &out)).unwrap_err());
+    assert!(err.contains("missing.exr"), "{err}");
+
+    let not_exr = dir.join("notes.exr");
+    std::fs::write(&not_exr, "not an image").unwrap();
+    let err = format!("{:#}", eval(&args(&good, &not_exr, "32,36", &out)).unwrap_err());
+    assert!(err.contains("notes.exr"), "{err}");
+
+    for gaze in ["100,10", "10,-1", "nan,3", "inf,3", "12"] {
+        let err = format!("{:#}", eval(&args(&good, &good, gaze, &out)).unwrap_err());
+        assert!(err.contains(gaze), "{gaze}: {err}");
+    }
+    // Nothing was written for failed runs.
+    assert!(!out.exists());
+
+    // A folder holding the user's files is refused and left alone.
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("mine.txt"), "mine").unwrap();
+    let err = format!("{:#}", eval(&args(&good, &good, "32,36", &out)).unwrap_err());
+    assert!(err.contains("mine.txt"), "{err}");
+    assert_eq!(std::fs::read_to_string(out.join("mine.txt")).unwrap(), "mine");
+}

@@ -1,0 +1,98 @@
+//! `fovea eval`: quality of a rendered frame against a reference, whole-frame and per ring of
+//! eccentricity around the gaze → `DIR/eval.json` + `DIR/eval.png`.
+
+use crate::metrics::{evaluate, Evaluation};
+use crate::output::{prepare_output_dir, read_exr};
+use crate::plot::{line_plot, Series};
+use anyhow::{bail, Context, Result};
+use glam::Vec2;
+use std::path::Path;
+
+pub struct EvalArgs<'a> {
+    pub reference: &'a Path,
+    pub test: &'a Path,
+    /// `X,Y` in pixels of the images (y down), or `center`.
+    pub gaze: &'a str,
+    pub rings: usize,
+    pub out: &'a Path,
+}
+
+pub fn run(args: &EvalArgs) -> Result<()> {
+    if args.rings == 0 {
+        bail!("--rings must be at least 1");
+    }
+    let (w, h, reference) = read_checked(args.reference)?;
+    let (tw, th, test) = read_checked(args.test)?;
+    if (tw, th) != (w, h) {
+        bail!(
+            "{} is {tw}×{th} but the reference {} is {w}×{h}; both must have the same size",
+            args.test.display(),
+            args.reference.display()
+        );
+    }
+    let gaze = parse_gaze(args.gaze, w, h)?;
+    prepare_output_dir(args.out)?;
+    let eval = evaluate(&reference, &test, w, h, gaze, args.rings);
+
+    let json_path = args.out.join("eval.json");
+    let mut json = serde_json::to_value(&eval)?;
+    json["reference"] = args.reference.display().to_string().into();
+    json["test"] = args.test.display().to_string().into();
+    std::fs::write(&json_path, serde_json::to_string_pretty(&json)? + "\n").with_context(|| format!("writing {}", json_path.display()))?;
+    write_plot(&args.out.join("eval.png"), &eval)?;
+
+    let f = &eval.frame;
+    let inner = eval.rings.first().and_then(|r| r.metrics.rmse);
+    let outer = eval.rings.last().and_then(|r| r.metrics.rmse);
+    let fmt = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+    println!(
+        "eval {}×{} gaze ({:.1}, {:.1}): RMSE {} PSNR {} dB SSIM {}; RMSE innermost ring {} outermost {} → {}",
+        w,
+        h,
+        gaze.x,
+        gaze.y,
+        fmt(f.rmse),
+        f.psnr.map_or("n/a".to_string(), |v| format!("{v:.2}")),
+        fmt(f.ssim),
+        fmt(inner),
+        fmt(outer),
+        json_path.display()
+    );
+    Ok(())
+}
+
+/// Reads an EXR, refusing NaN and infinite pixels (they would silently poison every mean).
+fn read_checked(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+    let (w, h, pixels) = read_exr(path)?;
+    let bad = |p: &[f32; 4]| p[..3].iter().copied().find(|c| !c.is_finite());
+    if let Some((i, c)) = pixels.iter().enumerate().find_map(|(i, p)| Some((i, bad(p)?))) {
+        bail!("{} has a non-finite value ({c}) at pixel ({}, {})", path.display(), i as u32 % w, i as u32 / w);
+    }
+    Ok((w, h, pixels))
+}
+
+/// `X,Y` (finite, inside the image, edges included) or `center`.
+fn parse_gaze(spec: &str, width: u32, height: u32) -> Result<Vec2> {
+    let t = spec.trim();
+    if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
+        return Ok(Vec2::new(width as f32, height as f32) * 0.5);
+    }
+    let parsed = t.split_once(',').and_then(|(x, y)| Some(Vec2::new(x.trim().parse().ok()?, y.trim().parse().ok()?)));
+    let Some(g) = parsed.filter(|g| g.is_finite()) else {
+        bail!("--gaze '{spec}': expected X,Y as two finite pixel coordinates (e.g. 160,180) or center");
+    };
+    if g.x < 0.0 || g.y < 0.0 || g.x > width as f32 || g.y > height as f32 {
+        bail!("--gaze '{spec}' lies outside the {width}×{height} image");
+    }
+    Ok(g)
+}
+
+fn write_plot(path: &Path, eval: &Evaluation) -> Result<()> {
+    let per_ring = |label: &str, value: &dyn Fn(&crate::metrics::Metrics) -> Option<f64>| Series {
+        label: label.into(),
+        points: eval.rings.iter().filter_map(|r| Some((0.5 * (r.ecc_inner + r.ecc_outer), value(&r.metrics)?))).collect(),
+    };
+    let series = [per_ring("RMSE (linear RGB)", &|m| m.rmse), per_ring("SSIM (luma)", &|m| m.ssim)];
+    let title = format!("Error per eccentricity ring, gaze ({:.0}, {:.0})", eval.gaze[0], eval.gaze[1]);
+    line_plot(path, &title, "normalised eccentricity (r / r_max · 80)", "RMSE, SSIM", &series, false)
+}

@@ -1,0 +1,226 @@
+//! Sample-density debug views of a sampling space: samples per screen pixel, a log-scale heatmap
+//! of it, and a plot of density against eccentricity next to the acuity target, uniform sampling
+//! at the same budget and Cartesian 1 spp.
+
+use crate::metrics::{Rings, ECC_MAX};
+use crate::plot::{line_plot, Series};
+use anyhow::Result;
+use fovea_renderer::sampling::{SamplingSpace, VisualPolar};
+use glam::Vec2;
+use std::path::Path;
+
+/// Heatmap range: log2 density from 1/64 to 64 samples per pixel.
+const LOG2_MIN: f32 = -6.0;
+const LOG2_MAX: f32 = 6.0;
+
+/// Reddy's acuity V(e) (cycles/degree); the same model as the renderer's Visual-Polar space.
+pub fn acuity(e: f64) -> f64 {
+    if e <= 5.79 {
+        60.0
+    } else {
+        449.4 / (0.3 * e + 1.0).powi(2)
+    }
+}
+
+/// Samples per screen pixel (row-major, width×height): every kept grid texel's centre is
+/// counted in the pixel it lands in; off-screen and clipped texels count nowhere.
+pub fn samples_per_pixel(space: &dyn SamplingSpace) -> Vec<f32> {
+    let (grid, screen) = (space.grid_size(), space.screen_size());
+    let mut counts = vec![0f32; screen.x as usize * screen.y as usize];
+    for gy in 0..grid.y {
+        for gx in 0..grid.x {
+            let Some(s) = space.grid_to_screen(Vec2::new(gx as f32 + 0.5, gy as f32 + 0.5)) else { continue };
+            let p = s.floor();
+            if p.x >= 0.0 && p.y >= 0.0 && p.x < screen.x as f32 && p.y < screen.y as f32 {
+                counts[p.y as usize * screen.x as usize + p.x as usize] += 1.0;
+            }
+        }
+    }
+    counts
+}
+
+/// RGBA8 heatmap of a density map: viridis-like ramp over log2 density in [1/64, 64]
+/// (clamped), black where no sample lands, the gaze marked by a white cross in a ring.
+pub fn heatmap_rgba(density: &[f32], width: u32, height: u32, gaze: Vec2) -> Vec<u8> {
+    assert_eq!(density.len(), width as usize * height as usize, "density map size");
+    let mut rgba: Vec<u8> = density
+        .iter()
+        .flat_map(|&d| {
+            let [r, g, b] = if d > 0.0 { ramp((d.log2() - LOG2_MIN) / (LOG2_MAX - LOG2_MIN)) } else { [0, 0, 0] };
+            [r, g, b, 255]
+        })
+        .collect();
+    // Cross of half-length 6 px plus a circle of radius 6 px around the gaze pixel.
+    let centre = gaze.floor() + Vec2::splat(0.5);
+    for y in 0..height {
+        for x in 0..width {
+            let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - centre;
+            let on_cross = (d.x.abs() < 0.5 || d.y.abs() < 0.5) && d.abs().max_element() <= 6.0;
+            let on_circle = (d.length() - 6.0).abs() < 0.5;
+            if on_cross || on_circle {
+                let i = (y * width + x) as usize * 4;
+                rgba[i..i + 4].copy_from_slice(&[255, 255, 255, 255]);
+            }
+        }
+    }
+    rgba
+}
+
+/// Mean of `density` over a (2·radius + 1)² box around each pixel (clipped at the borders).
+/// Peripheral counts are 0 or 1 per pixel; smoothing them first makes the heatmap readable.
+pub fn box_filter(density: &[f32], width: u32, height: u32, radius: u32) -> Vec<f32> {
+    let (w, h, r) = (width as usize, height as usize, radius as usize);
+    // Summed-area table with a zero row and column in front.
+    let mut sat = vec![0f64; (w + 1) * (h + 1)];
+    for y in 0..h {
+        for x in 0..w {
+            sat[(y + 1) * (w + 1) + x + 1] =
+                density[y * w + x] as f64 + sat[y * (w + 1) + x + 1] + sat[(y + 1) * (w + 1) + x] - sat[y * (w + 1) + x];
+        }
+    }
+    let mut out = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let (x0, y0, x1, y1) = (x.saturating_sub(r), y.saturating_sub(r), (x + r + 1).min(w), (y + r + 1).min(h));
+            let sum = sat[y1 * (w + 1) + x1] - sat[y0 * (w + 1) + x1] - sat[y1 * (w + 1) + x0] + sat[y0 * (w + 1) + x0];
+            out.push((sum / ((x1 - x0) * (y1 - y0)) as f64) as f32);
+        }
+    }
+    out
+}
+
+/// Viridis approximated by 5 stops (linear in between); `t` in [0, 1], clamped. Its top is yellow,
+/// so white (the gaze mark) and black (no sample) stay distinct.
+fn ramp(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 5] = [[68.0, 1.0, 84.0], [59.0, 82.0, 139.0], [33.0, 145.0, 140.0], [94.0, 201.0, 98.0], [253.0, 231.0, 37.0]];
+    let x = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f32;
+    let i = (x as usize).min(STOPS.len() - 2);
+    let f = x - i as f32;
+    std::array::from_fn(|c| (STOPS[i][c] + (STOPS[i + 1][c] - STOPS[i][c]) * f).round() as u8)
+}
+
+/// Plot of samples per pixel against normalised eccentricity (r / r_max · 80; r_max is the
+/// farthest-corner radius, which is Visual-Polar's own with the default radius mode), per ring:
+/// VP measured, the acuity target, uniform at VP's sample budget and Cartesian 1 spp.
+pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
+    let screen = vp.screen();
+    let ring_set = Rings::new(screen.x, screen.y, vp.gaze(), rings);
+    let measured: Vec<f64> = samples_per_pixel(vp).iter().map(|&c| c as f64).collect();
+    let budget = vp.sample_count() as f64;
+
+    // Acuity target: density c·V(e(r)) with c chosen so that its integral over the whole r_max
+    // disc equals VP's total sample count (VP spends its budget on that disc, corners off screen
+    // included), i.e. c = budget / ∫₀^r_max V(e(r)) 2πr dr (midpoint rule).
+    let r_max = ring_set.r_max;
+    let e_of = |r: f64| r / r_max * ECC_MAX;
+    let steps = 4096;
+    let dr = r_max / steps as f64;
+    let integral: f64 = (0..steps).map(|i| (i as f64 + 0.5) * dr).map(|r| acuity(e_of(r)) * std::f64::consts::TAU * r * dr).sum();
+    let c = budget / integral;
+    let target: Vec<f64> = (0..screen.y)
+        .flat_map(|y| (0..screen.x).map(move |x| (x, y)))
+        .map(|(x, y)| c * acuity(e_of((Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - vp.gaze()).length() as f64)))
+        .collect();
+
+    let mid = |i: usize| {
+        let (r0, r1) = ring_set.bounds(i);
+        e_of(0.5 * (r0 + r1))
+    };
+    let per_ring = |label: &str, map: &[f64]| Series {
+        label: label.into(),
+        points: ring_set.mean(map).into_iter().enumerate().filter_map(|(i, m)| Some((mid(i), m?))).collect(),
+    };
+    let flat = |label: String, v: f64| Series { label, points: vec![(0.0, v), (ECC_MAX, v)] };
+    let uniform = budget / (screen.x as f64 * screen.y as f64);
+    let series = [
+        per_ring("Visual-Polar (measured)", &measured),
+        per_ring("acuity target (∝ V(e), same budget)", &target),
+        flat(format!("uniform, same budget ({uniform:.2})"), uniform),
+        flat("Cartesian 1 spp".into(), 1.0),
+    ];
+    let title = format!("Sample density, {}×{}, gaze ({:.0}, {:.0})", screen.x, screen.y, vp.gaze().x, vp.gaze().y);
+    line_plot(path, &title, "normalised eccentricity (r / r_max · 80)", "samples per pixel", &series, true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fovea_renderer::sampling::{Cartesian, VisualPolarParams};
+    use glam::UVec2;
+
+    fn centred_vp() -> VisualPolar {
+        VisualPolar::new(UVec2::new(320, 360), Vec2::new(160.0, 180.0), VisualPolarParams::default()).unwrap()
+    }
+
+    #[test]
+    fn cartesian_is_one_sample_everywhere() {
+        let d = samples_per_pixel(&Cartesian::new(UVec2::new(37, 23)));
+        assert_eq!(d.len(), 37 * 23);
+        assert!(d.iter().all(|&c| c == 1.0));
+    }
+
+    #[test]
+    fn totals_match_the_on_screen_texels() {
+        for gaze in [Vec2::new(160.0, 180.0), Vec2::new(20.0, 30.0)] {
+            let vp = VisualPolar::new(UVec2::new(320, 360), gaze, VisualPolarParams::default()).unwrap();
+            let (grid, on_screen) = (vp.grid_size(), |s: Vec2| s.x >= 0.0 && s.y >= 0.0 && s.x < 320.0 && s.y < 360.0);
+            let expected = (0..grid.y)
+                .flat_map(|y| (0..grid.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))
+                .filter(|&g| vp.grid_to_screen(g).is_some_and(on_screen))
+                .count();
+            let total: f64 = samples_per_pixel(&vp).iter().map(|&c| c as f64).sum();
+            assert_eq!(total as usize, expected);
+            assert!(expected as u64 <= vp.sample_count());
+        }
+    }
+
+    #[test]
+    fn visual_polar_is_dense_at_the_gaze_and_sparse_in_the_corners() {
+        let vp = centred_vp();
+        let d = samples_per_pixel(&vp);
+        let mean_where = |keep: &dyn Fn(f32) -> bool| {
+            let v: Vec<f32> = (0..360 * 320)
+                .filter(|i| keep((Vec2::new((i % 320) as f32 + 0.5, (i / 320) as f32 + 0.5) - vp.gaze()).length()))
+                .map(|i| d[i])
+                .collect();
+            v.iter().sum::<f32>() / v.len() as f32
+        };
+        let fovea = mean_where(&|r| r < vp.r_fovea());
+        let corners = mean_where(&|r| r > 0.9 * vp.r_max());
+        assert!(fovea > 2.0, "fovea density {fovea}");
+        assert!(corners < 0.2, "corner density {corners}");
+    }
+
+    #[test]
+    fn heatmap_marks_the_gaze() {
+        let (w, h) = (40u32, 30u32);
+        let density: Vec<f32> = (0..w * h).map(|i| if i % 7 == 0 { 0.0 } else { 2.0 }).collect();
+        let rgba = heatmap_rgba(&density, w, h, Vec2::new(12.3, 20.7));
+        let px = |x: u32, y: u32| &rgba[((y * w + x) * 4) as usize..((y * w + x) * 4 + 4) as usize];
+        assert_eq!(px(12, 20), [255, 255, 255, 255]);
+        assert_eq!(px(12, 14), [255, 255, 255, 255]); // top of the cross
+        assert_eq!(px(0, 0), [0, 0, 0, 255]); // index 0: no sample → black
+        assert_ne!(px(1, 0), [255, 255, 255, 255]);
+        assert_ne!(px(1, 0), [0, 0, 0, 255]);
+        // Denser is brighter on the ramp (viridis rises in green).
+        assert!(ramp(0.9)[1] > ramp(0.1)[1]);
+    }
+
+    #[test]
+    fn box_filter_keeps_the_mean_of_a_flat_map_and_spreads_a_spike() {
+        let flat = box_filter(&[3.0; 12 * 9], 12, 9, 2);
+        assert!(flat.iter().all(|&v| (v - 3.0).abs() < 1e-6));
+        let mut spike = vec![0.0; 9 * 9];
+        spike[4 * 9 + 4] = 25.0;
+        let s = box_filter(&spike, 9, 9, 2);
+        assert_eq!((s[4 * 9 + 4], s[2 * 9 + 2], s[1 * 9 + 4]), (1.0, 1.0, 0.0));
+    }
+
+    #[test]
+    fn density_plot_writes_a_png() {
+        let path = std::env::temp_dir().join(format!("fovea-density-{}.png", std::process::id()));
+        density_plot(&path, &centred_vp(), 24).unwrap();
+        assert!(image::open(&path).is_ok());
+        std::fs::remove_file(&path).unwrap();
+    }
+}

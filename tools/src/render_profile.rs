@@ -1,0 +1,190 @@
+//! Render profiles (`config/render/*.toml`): the Visual-Polar parameters and the foveated blur.
+//! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
+//! Command-line flags override single values (`RenderProfile::override_with`).
+
+use anyhow::{bail, Context, Result};
+use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams};
+use fovea_renderer::to_screen::BlurSettings;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct RenderProfile {
+    pub visual_polar: VisualPolarParams,
+    pub blur: BlurSettings,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ProfileFile {
+    visual_polar: Option<VpSection>,
+    blur: Option<BlurSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct VpSection {
+    axis_scale: Option<f32>,
+    clip_fraction: Option<f32>,
+    fovea_deg: Option<f32>,
+    density_exponent: Option<f32>,
+    inverse_cdf: Option<String>,
+    radius: Option<toml::Value>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct BlurSection {
+    sigma_at_30: Option<f32>,
+}
+
+/// Optional single-value overrides (the `fovea render` flags).
+#[derive(Clone, Debug, Default)]
+pub struct ProfileOverrides {
+    pub axis_scale: Option<f32>,
+    pub clip_fraction: Option<f32>,
+    pub fovea_deg: Option<f32>,
+    pub density_exponent: Option<f32>,
+    pub inverse_cdf: Option<String>,
+    pub radius: Option<String>,
+    pub blur_sigma: Option<f32>,
+}
+
+pub fn parse_inverse_cdf(s: &str) -> Result<InverseCdf> {
+    match s {
+        "polynomial" | "poly" => Ok(InverseCdf::Polynomial),
+        "exact" => Ok(InverseCdf::Exact),
+        other => bail!("'{other}' is not an inverse-CDF mode (polynomial | exact)"),
+    }
+}
+
+pub fn parse_radius(s: &str) -> Result<RadiusMode> {
+    if s == "corner" {
+        return Ok(RadiusMode::FarthestCorner);
+    }
+    match s.parse::<f32>() {
+        Ok(r) if r.is_finite() && r > 0.0 => Ok(RadiusMode::Fixed(r)),
+        _ => bail!("'{s}' is not a radius mode (corner | a radius in pixels > 0)"),
+    }
+}
+
+impl RenderProfile {
+    pub fn load(path: &Path) -> Result<RenderProfile> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading render profile {}", path.display()))?;
+        let file: ProfileFile = toml::from_str(&text).with_context(|| format!("{}: invalid render profile", path.display()))?;
+        let mut profile = RenderProfile::default();
+        let at = |key: &str| format!("{}: [{}]", path.display(), key);
+        if let Some(vp) = file.visual_polar {
+            let p = &mut profile.visual_polar;
+            p.axis_scale = vp.axis_scale.unwrap_or(p.axis_scale);
+            p.clip_fraction = vp.clip_fraction.unwrap_or(p.clip_fraction);
+            p.fovea_deg = vp.fovea_deg.unwrap_or(p.fovea_deg);
+            p.density_exponent = vp.density_exponent.unwrap_or(p.density_exponent);
+            if let Some(mode) = vp.inverse_cdf {
+                p.inverse_cdf = parse_inverse_cdf(&mode).with_context(|| format!("{}.inverse_cdf", at("visual_polar")))?;
+            }
+            if let Some(radius) = vp.radius {
+                let text = match radius {
+                    toml::Value::String(s) => s,
+                    toml::Value::Integer(i) => i.to_string(),
+                    toml::Value::Float(f) => f.to_string(),
+                    other => bail!("{}.radius: expected \"corner\" or pixels, got {other}", at("visual_polar")),
+                };
+                p.radius_mode = parse_radius(&text).with_context(|| format!("{}.radius", at("visual_polar")))?;
+            }
+            p.validate().with_context(|| at("visual_polar"))?;
+        }
+        if let Some(blur) = file.blur {
+            profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
+        }
+        check_blur(&profile.blur).with_context(|| format!("{}.sigma_at_30", at("blur")))?;
+        Ok(profile)
+    }
+
+    /// Applies command-line values on top of the profile and re-checks the result.
+    pub fn override_with(mut self, o: &ProfileOverrides) -> Result<RenderProfile> {
+        let p = &mut self.visual_polar;
+        p.axis_scale = o.axis_scale.unwrap_or(p.axis_scale);
+        p.clip_fraction = o.clip_fraction.unwrap_or(p.clip_fraction);
+        p.fovea_deg = o.fovea_deg.unwrap_or(p.fovea_deg);
+        p.density_exponent = o.density_exponent.unwrap_or(p.density_exponent);
+        if let Some(mode) = &o.inverse_cdf {
+            p.inverse_cdf = parse_inverse_cdf(mode).context("--vp-inverse-cdf")?;
+        }
+        if let Some(radius) = &o.radius {
+            p.radius_mode = parse_radius(radius).context("--vp-radius")?;
+        }
+        p.validate().context("Visual-Polar flags")?;
+        self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
+        check_blur(&self.blur).context("--blur-sigma")?;
+        Ok(self)
+    }
+}
+
+fn check_blur(b: &BlurSettings) -> Result<()> {
+    if !(b.sigma_at_30.is_finite() && (0.0..=64.0).contains(&b.sigma_at_30)) {
+        bail!("σ at 30° must be in [0, 64] pixels, got {}", b.sigma_at_30);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load_str(name: &str, text: &str) -> Result<RenderProfile> {
+        let dir = std::env::temp_dir().join(format!("fovea-profile-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        RenderProfile::load(&path)
+    }
+
+    #[test]
+    fn shipped_default_profile_is_the_paper_defaults() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/render/default.toml");
+        let p = RenderProfile::load(&path).unwrap();
+        let d = VisualPolarParams::default();
+        assert!((p.visual_polar.axis_scale - d.axis_scale).abs() < 1e-3);
+        assert_eq!(p.visual_polar.clip_fraction, d.clip_fraction);
+        assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Polynomial);
+        assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
+        assert_eq!(p.blur.sigma_at_30, 6.8);
+    }
+
+    #[test]
+    fn values_are_read() {
+        let p = load_str("a.toml", "[visual_polar]\nclip_fraction = 0.088\ninverse_cdf = \"exact\"\nradius = 900\n[blur]\nsigma_at_30 = 0\n").unwrap();
+        assert_eq!(p.visual_polar.clip_fraction, 0.088);
+        assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Exact);
+        assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(900.0));
+        assert_eq!(p.blur.sigma_at_30, 0.0);
+    }
+
+    #[test]
+    fn bad_profiles_name_file_and_key() {
+        let cases = [
+            ("unknown.toml", "[visual_polar]\nclip = 0.1\n", "clip"),
+            ("section.toml", "[vp]\n", "vp"),
+            ("range.toml", "[visual_polar]\nclip_fraction = 0.7\n", "clip_fraction"),
+            ("mode.toml", "[visual_polar]\ninverse_cdf = \"cubic\"\n", "inverse_cdf"),
+            ("radius.toml", "[visual_polar]\nradius = -3\n", "radius"),
+            ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
+            ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
+        ];
+        for (name, text, key) in cases {
+            let err = format!("{:#}", load_str(name, text).unwrap_err());
+            assert!(err.contains(name) && err.contains(key), "{name}: {err}");
+        }
+    }
+
+    #[test]
+    fn flags_override_and_are_checked() {
+        let o = ProfileOverrides { clip_fraction: Some(0.2), radius: Some("500".into()), ..Default::default() };
+        let p = RenderProfile::default().override_with(&o).unwrap();
+        assert_eq!(p.visual_polar.clip_fraction, 0.2);
+        assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(500.0));
+        let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));
+    }
+}
