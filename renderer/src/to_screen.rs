@@ -81,7 +81,7 @@ impl ToScreen {
         blur: &BlurSettings,
     ) -> Result<&Image> {
         self.mip_phi.record(rec, sampling, vp_color, &self.mips)?;
-        self.remap.record(rec, sampling, vp_color, &self.mips, &self.remapped)?;
+        self.remap.record(rec, sampling, &self.mips, &self.remapped)?;
         if blur.sigma_at_30 <= 0.0 {
             return Ok(&self.remapped);
         }

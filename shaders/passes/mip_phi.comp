@@ -1,7 +1,8 @@
 #version 460
 // One level of the φ-only mip chain of a Visual-Polar image: level l+1 averages pairs of φ rows
-// of level l inside each column. ρ is never filtered: the remap magnifies (or keeps) ρ, while one
-// screen pixel near the gaze spans many φ rows (visual-polar.md §6).
+// of level l inside each column (building level 1 also copies level 0 into the stack, so the
+// remap reads one image). ρ is never filtered: the remap magnifies (or keeps) ρ, while one screen
+// pixel near the gaze spans many φ rows (visual-polar.md §6).
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_math.glsl"
 #include "../sampling/phi_mips.glsl"
@@ -9,13 +10,8 @@
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { MipPhiPush p; } push;
 layout(std430, set = 0, binding = 0) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
-layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // level 0
-layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // levels ≥ 1, stacked
-
-vec4 load_level(uint level, uint height, int col, uint row) {
-    if (level == 0u) return imageLoad(vp_color, ivec2(col, row));
-    return imageLoad(mips, ivec2(col, phi_mip_offset(level, height) + row));
-}
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // the traced image
+layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // all levels, stacked
 
 void main() {
     SamplingParams s = sampling.data;
@@ -29,6 +25,16 @@ void main() {
     if (uint(t.y) >= phi_mip_rows(rows0, src + 1u)) return;
     uint a = 2u * uint(t.y);
     uint b = (a + 1u) % src_rows;
-    vec4 v = 0.5 * (load_level(src, P.grid.y, t.x, a) + load_level(src, P.grid.y, t.x, b));
-    imageStore(mips, ivec2(t.x, phi_mip_offset(src + 1u, P.grid.y) + uint(t.y)), v);
+    vec4 va, vb;
+    if (src == 0u) {
+        va = imageLoad(vp_color, ivec2(t.x, a));
+        vb = imageLoad(vp_color, ivec2(t.x, b));
+        imageStore(mips, ivec2(t.x, a), va);
+        if (b != 0u) imageStore(mips, ivec2(t.x, b), vb);
+    } else {
+        uint offset = phi_mip_offset(src, P.grid.y);
+        va = imageLoad(mips, ivec2(t.x, offset + a));
+        vb = imageLoad(mips, ivec2(t.x, offset + b));
+    }
+    imageStore(mips, ivec2(t.x, phi_mip_offset(src + 1u, P.grid.y) + uint(t.y)), 0.5 * (va + vb));
 }

@@ -10,12 +10,10 @@
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { RemapPush p; } push;
 layout(std430, set = 0, binding = 0) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
-layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color;      // level 0
-layout(set = 0, binding = 2, rgba32f) uniform readonly image2D mips;          // levels ≥ 1, stacked
-layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D screen_color;
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D mips;          // all levels, stacked
+layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D screen_color;
 
 vec4 fetch(uint level, uint height, uint col, uint row) {
-    if (level == 0u) return imageLoad(vp_color, ivec2(col, row));
     return imageLoad(mips, ivec2(col, phi_mip_offset(level, height) + row));
 }
 

@@ -1,26 +1,23 @@
 // Layout of the φ-only mip chain of a Visual-Polar image (twin of renderer/src/passes/mip_phi.rs).
-// Level 0 is the traced image. Level l ≥ 1 halves every column's φ rows (rounding up: an odd
-// count wraps its last pair onto row 0, φ being periodic) and is stored in one stacked image,
-// level l starting at row phi_mip_offset(l). Columns keep their own row counts (the fovea clip).
+// Level l halves every column's φ rows, rounding up (an odd count wraps its last pair onto row 0:
+// φ is periodic), so a column with n rows keeps ceil(n / 2^l) at level l. All levels, level 0 (a
+// copy of the traced image) included, are stacked in one image: level l starts at row
+// 2·H' − 2·H' / 2^l, where H' is the grid height rounded up to a multiple of 2^(PHI_MIP_LEVELS−1)
+// so every level's block is a whole number of rows. Closed forms on purpose: loops here cost the
+// remap several times over on lavapipe.
 #ifndef FOVEA_SAMPLING_PHI_MIPS_GLSL
 #define FOVEA_SAMPLING_PHI_MIPS_GLSL
 
 // φ rows a column with `rows0` traced rows has at `level`.
 uint phi_mip_rows(uint rows0, uint level) {
-    uint m = rows0;
-    for (uint i = 0u; i < level; ++i) m = (m + 1u) / 2u;
-    return m;
+    return (rows0 + (1u << level) - 1u) >> level;
 }
 
-// First row of `level` (≥ 1) in the stacked image, for a grid `height` rows tall.
+// First row of `level` in the stacked image, for a grid `height` rows tall.
 uint phi_mip_offset(uint level, uint height) {
-    uint offset = 0u;
-    uint h = height;
-    for (uint i = 1u; i < level; ++i) {
-        h = (h + 1u) / 2u;
-        offset += h;
-    }
-    return offset;
+    uint block = 1u << (PHI_MIP_LEVELS - 1u);
+    uint padded2 = 2u * ((height + block - 1u) / block * block);
+    return padded2 - (padded2 >> level);
 }
 
 #endif

@@ -213,7 +213,7 @@ mod tests {
         let mut spike = vec![0.0; 9 * 9];
         spike[4 * 9 + 4] = 25.0;
         let s = box_filter(&spike, 9, 9, 2);
-        assert_eq!((s[4 * 9 + 4], s[2 * 9 + 2], s[1 * 9 + 4]), (1.0, 1.0, 0.0));
+        assert_eq!((s[4 * 9 + 4], s[2 * 9 + 2], s[9 + 4]), (1.0, 1.0, 0.0));
     }
 
     #[test]

@@ -122,7 +122,8 @@ fn peripheral_error_shows_only_in_outer_rings() {
         })
         .collect();
     let e = evaluate(&reference, &test, w, h, gaze, 10);
-    // Rings 0..=4 end at 0.5·r_max ≈ 24 px, more than the SSIM window (5 px) inside the clean disc.
+    // Rings 0..=4 end at 0.5·r_max ≈ 24 px: their 11×11 SSIM windows (reaching 5√2 ≈ 7.1 px) stay
+    // inside the clean disc (0.7·r_max ≈ 33.7 px).
     for r in &e.rings[..5] {
         assert_eq!((r.metrics.rmse, r.metrics.ssim), (Some(0.0), Some(1.0)), "inner ring {}", r.ring);
     }

@@ -32,16 +32,19 @@ fn ensure_font() -> Result<()> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
-            let bytes = std::fs::read(FONT_PATH).map_err(|e| {
-                format!("plot font {FONT_PATH} cannot be read ({e}); install the Debian package fonts-dejavu-core (scripts/setup does)")
-            })?;
             // plotters keeps fonts in a process-wide table of 'static slices; this runs once.
-            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            let bytes: &'static [u8] = Box::leak(read_font(FONT_PATH)?.into_boxed_slice());
             plotters::style::register_font(FONT, FontStyle::Normal, bytes)
                 .map_err(|_| format!("plot font {FONT_PATH} is not a valid TrueType font"))
         })
         .clone()
         .map_err(|e| anyhow!(e))
+}
+
+fn read_font(path: &str) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| {
+        format!("plot font {path} cannot be read ({e}); install the Debian package fonts-dejavu-core (scripts/setup does)")
+    })
 }
 
 /// Writes a 900×600 PNG line plot with axis labels and a legend; `log_y` makes the y axis
@@ -176,6 +179,12 @@ mod tests {
         // An empty plot still has valid ranges.
         line_plot(&dir.join("empty.png"), "empty", "x", "y", &[], true).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_missing_font_names_the_file_and_the_package() {
+        let err = read_font("/no/such/DejaVuSans.ttf").unwrap_err();
+        assert!(err.contains("/no/such/DejaVuSans.ttf") && err.contains("fonts-dejavu-core"), "{err}");
     }
 
     #[test]

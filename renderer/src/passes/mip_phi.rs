@@ -1,7 +1,8 @@
 //! φ-only mip chain of a Visual-Polar image (visual-polar.md §6): near the gaze one screen pixel
 //! spans many φ rows of a column, so the remap samples trilinearly across levels that halve φ
-//! only. Level 0 is the traced image; levels ≥ 1 live stacked in one image (`PhiMips::image`),
-//! laid out by `shaders/sampling/phi_mips.glsl`, which `rows_at_level`/`level_offset` mirror.
+//! only. All levels (level 0 = a copy of the traced image) live stacked in one image
+//! (`PhiMips::image`), laid out by `shaders/sampling/phi_mips.glsl`, which `rows_at_level` and
+//! `level_offset` mirror.
 
 use super::push_bytes;
 use crate::error::Result;
@@ -14,25 +15,27 @@ use std::sync::Arc;
 
 /// φ rows a column with `rows0` traced rows keeps at `level` (halving, rounding up).
 pub fn rows_at_level(rows0: u32, level: u32) -> u32 {
-    (0..level).fold(rows0, |m, _| m.div_ceil(2))
+    rows0.div_ceil(1 << level)
 }
 
-/// First row of `level` (≥ 1) in the stacked mip image of a grid `height` rows tall.
+/// First row of `level` in the stacked mip image of a grid `height` rows tall: blocks of
+/// 2^(L−1)-padded height H' halving per level, level l at 2H' − 2H'/2^l.
 pub fn level_offset(level: u32, height: u32) -> u32 {
-    (1..level).map(|l| rows_at_level(height, l)).sum()
+    let padded2 = 2 * height.next_multiple_of(1 << (PHI_MIP_LEVELS - 1));
+    padded2 - (padded2 >> level)
 }
 
 /// Levels worth building for a grid `height` rows tall (level 0 included): until a full column
-/// is down to one row, at most `PHI_MIP_LEVELS`.
+/// is down to one row, at most `PHI_MIP_LEVELS`, at least 2 (building level 1 copies level 0).
 pub fn level_count(height: u32) -> u32 {
-    let mut levels = 1;
+    let mut levels = 2;
     while levels < PHI_MIP_LEVELS && rows_at_level(height, levels - 1) > 1 {
         levels += 1;
     }
     levels
 }
 
-/// The stacked levels ≥ 1 of one VP grid.
+/// All φ levels of one VP grid, stacked.
 pub struct PhiMips {
     pub image: Image,
     pub levels: u32,
@@ -41,7 +44,7 @@ pub struct PhiMips {
 impl PhiMips {
     pub fn new(ctx: &Arc<Context>, grid: UVec2) -> Result<PhiMips> {
         let levels = level_count(grid.y);
-        let height = level_offset(levels, grid.y).max(1);
+        let height = level_offset(levels, grid.y);
         Ok(PhiMips { image: Image::new(ctx, "phi_mips", grid.x, height, vk::Format::R32G32B32A32_SFLOAT)?, levels })
     }
 }
@@ -55,8 +58,8 @@ impl MipPhiPass {
         Ok(MipPhiPass { pipeline: ComputePipeline::new(ctx, "passes/mip_phi", std::mem::size_of::<MipPhiPush>() as u32)? })
     }
 
-    /// Builds levels 1.. of `vp_color` (the VP grid described by `sampling`) into `mips`, one
-    /// dispatch per level.
+    /// Copies `vp_color` (the VP grid described by `sampling`) into level 0 of `mips` and builds
+    /// the levels above it, one dispatch per level.
     pub fn record(&self, rec: &mut FrameRecorder, sampling: &Buffer, vp_color: &Image, mips: &PhiMips) -> Result<()> {
         for src in 0..mips.levels - 1 {
             let binds = [read_buffer("sampling", sampling), read_image("vp_color", vp_color), write_image("mips", &mips.image)];

@@ -19,12 +19,11 @@ impl RemapPass {
         Ok(RemapPass { pipeline: ComputePipeline::new(ctx, "passes/remap", std::mem::size_of::<RemapPush>() as u32)? })
     }
 
-    /// Fills `screen` (screen size) from `vp_color` and its mips; `sampling` holds the same VP
-    /// parameters (gaze included) the image was traced with.
-    pub fn record(&self, rec: &mut FrameRecorder, sampling: &Buffer, vp_color: &Image, mips: &PhiMips, screen: &Image) -> Result<()> {
+    /// Fills `screen` (screen size) from the mip stack of a VP image; `sampling` holds the same
+    /// VP parameters (gaze included) the image was traced with.
+    pub fn record(&self, rec: &mut FrameRecorder, sampling: &Buffer, mips: &PhiMips, screen: &Image) -> Result<()> {
         let binds = [
             read_buffer("sampling", sampling),
-            read_image("vp_color", vp_color),
             read_image("mips", &mips.image),
             write_image("screen_color", screen),
         ];

@@ -6,6 +6,7 @@ use crate::output::{prepare_output_dir, read_exr};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
 use glam::Vec2;
+use serde::Serialize;
 use std::path::Path;
 
 pub struct EvalArgs<'a> {
@@ -15,6 +16,15 @@ pub struct EvalArgs<'a> {
     pub gaze: &'a str,
     pub rings: usize,
     pub out: &'a Path,
+}
+
+/// eval.json: the inputs, then the metrics (field order kept as written).
+#[derive(Serialize)]
+struct Report<'a> {
+    reference: String,
+    test: String,
+    #[serde(flatten)]
+    eval: &'a Evaluation,
 }
 
 pub fn run(args: &EvalArgs) -> Result<()> {
@@ -35,10 +45,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let eval = evaluate(&reference, &test, w, h, gaze, args.rings);
 
     let json_path = args.out.join("eval.json");
-    let mut json = serde_json::to_value(&eval)?;
-    json["reference"] = args.reference.display().to_string().into();
-    json["test"] = args.test.display().to_string().into();
-    std::fs::write(&json_path, serde_json::to_string_pretty(&json)? + "\n").with_context(|| format!("writing {}", json_path.display()))?;
+    let report = Report { reference: args.reference.display().to_string(), test: args.test.display().to_string(), eval: &eval };
+    std::fs::write(&json_path, serde_json::to_string_pretty(&report)? + "\n")
+        .with_context(|| format!("writing {}", json_path.display()))?;
     write_plot(&args.out.join("eval.png"), &eval)?;
 
     let f = &eval.frame;
