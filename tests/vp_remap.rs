@@ -12,7 +12,7 @@ use fovea_renderer::passes::remap::RemapPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::vk::{Context, Image};
 use fovea_tests::{assert_clean, gpu, read_image, save_preview, write_image};
 use glam::{UVec2, Vec2};
 use std::sync::Arc;
@@ -41,12 +41,12 @@ fn to_screen(ctx: &Arc<Context>, vp: &VisualPolar, texel: impl Fn(u32, u32) -> [
     write_image(ctx, &vp_color, &data);
     let mips = PhiMips::new(ctx, g).unwrap();
     let screen = image(ctx, "screen", vp.screen());
-    let sampling = Buffer::with_data(ctx, "sampling", &[vp.sampling_params()], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+    let params = vp.sampling_params();
     let (mip_phi, remap) = (MipPhiPass::new(ctx).unwrap(), RemapPass::new(ctx).unwrap());
     let mut rec = FrameRecorder::new(ctx, 16).unwrap();
     rec.begin().unwrap();
-    mip_phi.record(&mut rec, &sampling, &vp_color, &mips).unwrap();
-    remap.record(&mut rec, &sampling, &mips, &screen).unwrap();
+    mip_phi.record(&mut rec, &params, &vp_color, &mips).unwrap();
+    remap.record(&mut rec, &params, &mips, &screen).unwrap();
     rec.submit_and_wait().unwrap();
     (read_image(ctx, &mips.image), read_image(ctx, &screen))
 }

@@ -215,7 +215,7 @@ impl Renderer {
         // Denoisers slot in here, in the sampling grid. Cartesian samples are the screen.
         let grid_hdr = &self.gbuffer.color;
         let screen_hdr = match (&self.to_screen, self.space.visual_polar()) {
-            (Some(to_screen), Some(vp)) => to_screen.record(rec, &self.sampling, vp, grid_hdr, &self.settings.blur)?,
+            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, grid_hdr, &self.settings.blur)?,
             _ => grid_hdr,
         };
         let (exposure, curve) = (self.settings.exposure, self.settings.tone_curve);

@@ -7,7 +7,7 @@ use crate::passes::blur::{BlurPass, BlurShape};
 use crate::passes::mip_phi::{MipPhiPass, PhiMips};
 use crate::passes::remap::RemapPass;
 use crate::sampling::VisualPolar;
-use crate::vk::{Buffer, Context, Image};
+use crate::vk::{Context, Image};
 use ash::vk;
 use glam::UVec2;
 use std::sync::Arc;
@@ -75,13 +75,13 @@ impl ToScreen {
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
-        sampling: &Buffer,
         vp: &VisualPolar,
         vp_color: &Image,
         blur: &BlurSettings,
     ) -> Result<&Image> {
-        self.mip_phi.record(rec, sampling, vp_color, &self.mips)?;
-        self.remap.record(rec, sampling, &self.mips, &self.remapped)?;
+        let params = vp.sampling_params();
+        self.mip_phi.record(rec, &params, vp_color, &self.mips)?;
+        self.remap.record(rec, &params, &self.mips, &self.remapped)?;
         if blur.sigma_at_30 <= 0.0 {
             return Ok(&self.remapped);
         }

@@ -108,18 +108,29 @@ struct HitGpu {
 // Deepest φ-only mip level of a Visual-Polar image (level 0 is the traced image itself). The φ
 // footprint of a screen pixel stays below 2^3 rows except right at the gaze, so 8 is ample.
 const uint PHI_MIP_LEVELS = 8u;
-// Largest foveated-blur kernel radius in pixels (σ ≈ 21 px at the far periphery at 1280×1440
-// would need 63; the tail beyond 32 px holds < 10 % of the weight there and costs 2× the taps).
-const uint BLUR_MAX_RADIUS = 32u;
+// Largest foveated-blur kernel radius in pixels: 3σ of the far periphery (σ ≈ 21 px at 80° on
+// a 1280×1440 eye). Taps are spaced with σ, so the cost does not grow with it.
+const uint BLUR_MAX_RADIUS = 64u;
 
 // Push constants of the φ-only mip pass: builds level config.x + 1 from level config.x.
+// The VP parameters travel as push constants, not through the `sampling` buffer: lavapipe
+// turns per-lane storage-buffer reads into scalar loads, which cost these light passes more than
+// their arithmetic.
 struct MipPhiPush {
+    uvec4 vp_grid;              // the space: SamplingParams (VisualPolar::sampling_params)
+    vec4 vp_gaze;               //   field by field
+    vec4 vp_shape0;
+    vec4 vp_shape1;
     uvec4 config;               // x source level (0 = the VP image), yzw unused
 };
 
 // Push constants of the remap-to-screen pass.
 struct RemapPush {
-    uvec4 config;               // x φ mip levels built (1 = only the VP image), yzw unused
+    uvec4 vp_grid;              // the space: SamplingParams (VisualPolar::sampling_params)
+    vec4 vp_gaze;               //   field by field
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    uvec4 config;               // x φ mip levels built (≥ 2), yzw unused
 };
 
 // Push constants of the foveated blur (one pass per axis).

@@ -9,13 +9,11 @@
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { MipPhiPush p; } push;
-layout(std430, set = 0, binding = 0) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // the traced image
 layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // all levels, stacked
 
 void main() {
-    SamplingParams s = sampling.data;
-    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+    VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (uint(t.x) >= P.grid.x) return;
     uint src = push.p.config.x;

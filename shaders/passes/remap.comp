@@ -9,7 +9,6 @@
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { RemapPush p; } push;
-layout(std430, set = 0, binding = 0) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D mips;          // all levels, stacked
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D screen_color;
 
@@ -44,8 +43,7 @@ vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels) {
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, imageSize(screen_color)))) return;
-    SamplingParams s = sampling.data;
-    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+    VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
     vec2 d = vec2(t) + 0.5 - P.gaze;
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;

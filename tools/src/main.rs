@@ -160,9 +160,12 @@ enum Command {
         /// Scenes to measure.
         #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
         scenes: Vec<String>,
-        /// Frame sizes WxH.
+        /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]
         sizes: Vec<String>,
+        /// Screen sizes WxH of the Visual-Polar vs Cartesian comparison ("" skips it).
+        #[arg(long, value_delimiter = ',', default_value = "640x720,1280x1440")]
+        vp_sizes: Vec<String>,
         /// Whole frames rendered per size for the per-pass timings.
         #[arg(long, default_value_t = 2)]
         frames: u32,
@@ -252,11 +255,13 @@ fn main() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, sizes, frames, out, device } => {
-            let sizes = sizes.iter().map(|s| parse_size(s)).collect::<Result<Vec<_>>>()?;
+        Command::Bench { scenes, sizes, vp_sizes, frames, out, device } => {
+            let parse = |v: &[String]| v.iter().filter(|s| !s.is_empty()).map(|s| parse_size(s)).collect::<Result<Vec<_>>>();
+            let (sizes, vp_sizes) = (parse(&sizes)?, parse(&vp_sizes)?);
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
                 sizes: &sizes,
+                vp_sizes: &vp_sizes,
                 frames,
                 out: &out,
                 device: device.device.as_deref(),

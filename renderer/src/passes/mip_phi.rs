@@ -6,9 +6,9 @@
 
 use super::push_bytes;
 use crate::error::Result;
-use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
-use crate::layouts::{MipPhiPush, PHI_MIP_LEVELS};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{MipPhiPush, SamplingParams, PHI_MIP_LEVELS};
+use crate::vk::{ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
 use std::sync::Arc;
@@ -58,12 +58,18 @@ impl MipPhiPass {
         Ok(MipPhiPass { pipeline: ComputePipeline::new(ctx, "passes/mip_phi", std::mem::size_of::<MipPhiPush>() as u32)? })
     }
 
-    /// Copies `vp_color` (the VP grid described by `sampling`) into level 0 of `mips` and builds
-    /// the levels above it, one dispatch per level.
-    pub fn record(&self, rec: &mut FrameRecorder, sampling: &Buffer, vp_color: &Image, mips: &PhiMips) -> Result<()> {
+    /// Copies `vp_color` (the VP grid of `vp`) into level 0 of `mips` and builds the levels above
+    /// it, one dispatch per level.
+    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, vp_color: &Image, mips: &PhiMips) -> Result<()> {
         for src in 0..mips.levels - 1 {
-            let binds = [read_buffer("sampling", sampling), read_image("vp_color", vp_color), write_image("mips", &mips.image)];
-            let push = MipPhiPush { config: UVec4::new(src, 0, 0, 0) };
+            let binds = [read_image("vp_color", vp_color), write_image("mips", &mips.image)];
+            let push = MipPhiPush {
+                vp_grid: vp.grid,
+                vp_gaze: vp.gaze,
+                vp_shape0: vp.shape0,
+                vp_shape1: vp.shape1,
+                config: UVec4::new(src, 0, 0, 0),
+            };
             let rows = rows_at_level(vp_color.height, src + 1);
             rec.dispatch("mip_phi", &self.pipeline, &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
         }

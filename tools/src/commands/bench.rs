@@ -1,6 +1,7 @@
 //! `fovea bench`: BVH build rate and memory on the large scene; primary, shadow and indirect rays
 //! per second on the current device; per-pass GPU milliseconds of whole frames. All figures
-//! come from one run on one device (GPU timestamps for the GPU parts).
+//! come from one run on one device (GPU timestamps for the GPU parts). The Visual-Polar vs
+//! Cartesian comparison lives in `bench_vp.rs`.
 
 use anyhow::{bail, Result};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -19,7 +20,10 @@ use std::time::Instant;
 
 pub struct BenchArgs<'a> {
     pub scenes: &'a [String],
+    /// Sizes of the ray-throughput and Cartesian frame measurements (empty: skip them).
     pub sizes: &'a [(u32, u32)],
+    /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
+    pub vp_sizes: &'a [(u32, u32)],
     pub frames: u32,
     pub out: &'a Path,
     pub device: Option<&'a str>,
@@ -52,12 +56,13 @@ struct BenchReport {
     device: String,
     bvh: Vec<BvhReport>,
     rays: Vec<RayReport>,
+    visual_polar: Vec<super::bench_vp::VpFrameReport>,
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     crate::output::prepare_output_dir(args.out)?;
     let ctx = super::open_device(args.device, false)?;
-    let mut report = BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new() };
+    let mut report = BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new() };
     for name in args.scenes {
         let scene = crate::scenes::load(name)?;
         let positions = scene.triangle_positions();
@@ -96,18 +101,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let space = Box::new(Cartesian::new(UVec2::new(w, h)));
             let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
             let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
-            let mut sums: BTreeMap<String, f64> = BTreeMap::new();
-            let mut frame_rays = 0;
             // One untimed frame first: the first dispatch of a pipeline pays one-off costs
             // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
-            renderer.render_frame(&FrameInput { camera: pose, frame_index: 0, gaze: None, read_hdr: false, read_grid: false })?;
-            for frame in 0..args.frames {
-                let stats = renderer.render_frame(&FrameInput { camera: pose, frame_index: frame, gaze: None, read_hdr: false, read_grid: false })?;
-                frame_rays = stats.rays_traced();
-                for t in renderer.timings() {
-                    *sums.entry(t.name.to_string()).or_default() += t.ms / args.frames as f64;
-                }
-            }
+            let sums = super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
+            let input = FrameInput { camera: pose, frame_index: 0, gaze: None, read_hdr: false, read_grid: false };
+            let frame_rays = renderer.render_frame(&input)?.rays_traced();
             let r = RayReport {
                 scene: name.clone(),
                 width: w,
@@ -124,6 +122,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             );
             report.rays.push(r);
         }
+        for &size in args.vp_sizes {
+            let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?);
+            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, size, args.frames)?);
+        }
     }
     super::check_validation(&ctx)?;
     let path = args.out.join("report.json");
@@ -137,7 +139,7 @@ const TIMED_RUNS: usize = 5;
 
 /// Traces `rays` once untimed (warm-up), then `TIMED_RUNS` times; returns the hits and the
 /// median GPU milliseconds.
-fn timed_trace(caster: &mut RayCaster, gpu: &GpuScene, rays: &[RayGpu], any_hit: bool) -> Result<(Vec<HitGpu>, f64)> {
+pub(crate) fn timed_trace(caster: &mut RayCaster, gpu: &GpuScene, rays: &[RayGpu], any_hit: bool) -> Result<(Vec<HitGpu>, f64)> {
     let (hits, _) = caster.trace(gpu, rays, any_hit)?;
     let mut ms = Vec::with_capacity(TIMED_RUNS);
     for _ in 0..TIMED_RUNS {

@@ -1,4 +1,5 @@
 pub mod bench;
+mod bench_vp;
 pub mod eval;
 pub mod debug_views;
 pub mod gen_scene;

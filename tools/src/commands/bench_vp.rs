@@ -1,0 +1,173 @@
+//! The Visual-Polar part of `fovea bench` (issue 4): whole frames in VP vs Cartesian at full
+//! resolution on the same scene, gaze and device, per pass; the share of the way back to the
+//! screen (φ-mips + remap + blur); and primary-ray coherence: the VP samples traced in VP order
+//! vs the same rays shuffled.
+
+use anyhow::Result;
+use fovea_renderer::gpu_scene::GpuScene;
+use fovea_renderer::layouts::RayGpu;
+use fovea_renderer::passes::raycast::RayCaster;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
+use glam::{UVec2, Vec2, Vec3};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Passes that take the VP image back to the screen.
+const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v"];
+
+#[derive(Serialize)]
+pub struct VpFrameReport {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub vp_width: u32,
+    pub vp_height: u32,
+    pub vp_samples: u64,
+    pub gaze: [f32; 2],
+    /// Median GPU ms per pass over the timed frames.
+    pub cartesian_passes_ms: BTreeMap<String, f64>,
+    pub vp_passes_ms: BTreeMap<String, f64>,
+    pub cartesian_frame_ms: f64,
+    pub vp_frame_ms: f64,
+    /// VP frame / Cartesian frame (issue target ≤ 0.45; samples alone give ≈ 0.39).
+    pub frame_ratio: f64,
+    /// VP trace / Cartesian trace.
+    pub trace_ratio: f64,
+    /// (φ-mips + remap + blur) / VP frame (issue target ≤ 0.10 on lavapipe).
+    pub to_screen_share: f64,
+    /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
+    pub vp_order_mrays_per_s: f64,
+    pub shuffled_mrays_per_s: f64,
+    pub coherence_gain: f64,
+}
+
+/// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
+pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<BTreeMap<String, f64>> {
+    let input = |frame_index| FrameInput { camera, frame_index, gaze, read_hdr: false, read_grid: false };
+    renderer.render_frame(&input(0))?;
+    let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for frame in 0..frames.max(1) {
+        renderer.render_frame(&input(frame + 1))?;
+        // A pass recorded several times in one frame (one mip level each) counts as one.
+        let mut frame_sums: BTreeMap<&str, f64> = BTreeMap::new();
+        for t in renderer.timings() {
+            *frame_sums.entry(t.name).or_default() += t.ms;
+        }
+        for (name, ms) in frame_sums {
+            samples.entry(name.to_string()).or_default().push(ms);
+        }
+    }
+    Ok(samples
+        .into_iter()
+        .map(|(name, mut v)| {
+            v.sort_by(f64::total_cmp);
+            (name, v[v.len() / 2])
+        })
+        .collect())
+}
+
+/// Passes of the displayed frame (read-backs are I/O, not rendering).
+fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {
+    passes.iter().filter(|(k, _)| !k.starts_with("readback") && *k != "clear_counters").map(|(_, v)| v).sum()
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn measure(
+    ctx: &std::sync::Arc<fovea_renderer::vk::Context>,
+    scene_name: &str,
+    make_scene: &dyn Fn() -> Result<GpuScene>,
+    caster: &mut RayCaster,
+    camera: &fovea_renderer::scene::Camera,
+    (w, h): (u32, u32),
+    frames: u32,
+) -> Result<VpFrameReport> {
+    let screen = UVec2::new(w, h);
+    let gaze = screen.as_vec2() * 0.5;
+    let pose = CameraPose::from_scene_camera(camera, w, h);
+    let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), RenderSettings::default())?;
+    let cartesian_passes_ms = pass_medians(&mut cart, pose, None, frames)?;
+    drop(cart);
+    let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
+    let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), RenderSettings::default())?;
+    let vp_passes_ms = pass_medians(&mut vpr, pose, Some(gaze), frames)?;
+    drop(vpr);
+    let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cartesian_passes_ms), frame_ms(&vp_passes_ms));
+    let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
+
+    let rays = vp_primary_rays(&vp, &pose);
+    let gpu = make_scene()?;
+    let (_, ordered_ms) = super::bench::timed_trace(caster, &gpu, &rays, false)?;
+    let shuffled = shuffle(rays.clone());
+    let (_, shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffled, false)?;
+    let rate = |ms: f64| rays.len() as f64 / (ms * 1e-3) * 1e-6;
+    let grid = vp.grid_size();
+    let report = VpFrameReport {
+        scene: scene_name.to_string(),
+        width: w,
+        height: h,
+        vp_width: grid.x,
+        vp_height: grid.y,
+        vp_samples: vp.sample_count(),
+        gaze: gaze.to_array(),
+        trace_ratio: vp_passes_ms["trace"] / cartesian_passes_ms["trace"],
+        frame_ratio: vp_frame_ms / cartesian_frame_ms,
+        to_screen_share: to_screen / vp_frame_ms,
+        cartesian_passes_ms,
+        vp_passes_ms,
+        cartesian_frame_ms,
+        vp_frame_ms,
+        vp_order_mrays_per_s: rate(ordered_ms),
+        shuffled_mrays_per_s: rate(shuffled_ms),
+        coherence_gain: shuffled_ms / ordered_ms,
+    };
+    println!(
+        "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); mips+remap+blur {:.1} % of the VP frame; \
+         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×)",
+        grid.x,
+        grid.y,
+        report.vp_frame_ms,
+        report.cartesian_frame_ms,
+        report.frame_ratio,
+        report.trace_ratio,
+        100.0 * report.to_screen_share,
+        report.vp_order_mrays_per_s,
+        report.shuffled_mrays_per_s,
+        report.coherence_gain
+    );
+    Ok(report)
+}
+
+/// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's
+/// lanes walk the grid), through the same pinhole model as the tracer.
+fn vp_primary_rays(vp: &VisualPolar, pose: &CameraPose) -> Vec<RayGpu> {
+    let grid = vp.grid_size();
+    let screen = vp.screen().as_vec2();
+    let origin = pose.world_from_view.w_axis.truncate();
+    let t = pose.fov_tan;
+    let mut rays = Vec::with_capacity(vp.sample_count() as usize);
+    for y in 0..grid.y {
+        for x in 0..grid.x {
+            if y >= vp.rows_in_column(x) {
+                continue;
+            }
+            let s = vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) / screen;
+            let view = Vec3::new(t.x + s.x * (t.y - t.x), t.w + s.y * (t.z - t.w), -1.0);
+            let dir = pose.world_from_view.transform_vector3(view).normalize();
+            rays.push(RayGpu { origin_tmin: origin.extend(0.0), direction_tmax: dir.extend(1e30) });
+        }
+    }
+    rays
+}
+
+/// Fisher–Yates with a fixed-seed xorshift: the same "random order" every run.
+fn shuffle(mut rays: Vec<RayGpu>) -> Vec<RayGpu> {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for i in (1..rays.len()).rev() {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        rays.swap(i, (state % (i as u64 + 1)) as usize);
+    }
+    rays
+}
