@@ -3,6 +3,7 @@
 
 use fovea_tools::commands::reference::{run as reference, ReferenceArgs};
 use fovea_tools::commands::render::{run as render, RenderArgs};
+use fovea_tools::render_profile::RenderProfile;
 use std::path::{Path, PathBuf};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -27,6 +28,8 @@ fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
         seed: 1,
         max_depth: 3,
         exposure: 1.0,
+        profile: RenderProfile::default(),
+        debug_views: false,
         device: None,
         validation: true,
     }
@@ -51,6 +54,39 @@ fn render_writes_frames_and_a_report_with_exact_counts() {
     assert!(report["passes"]["trace"].as_f64().unwrap() > 0.0);
     // Rendering again into the same folder replaces only fovea's own files.
     render(&render_args("cornell-box", &out)).unwrap();
+}
+
+/// `--method vp`: the grid and its exact sample count, off-screen samples, the passes back to the
+/// screen, and the debug views (grid image, density heat map per frame, one density plot).
+#[test]
+fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
+    use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams};
+    let out = temp_dir("render-vp");
+    let mut args = render_args("cornell-box", &out);
+    args.method = "vp";
+    args.gaze = "2,3";
+    args.camera_path = false;
+    args.debug_views = true;
+    render(&args).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let vp = VisualPolar::new(glam::UVec2::new(40, 36), glam::Vec2::new(2.0, 3.0), VisualPolarParams::default()).unwrap();
+    assert_eq!(report["method"], "vp");
+    assert_eq!(report["vp_width"], vp.grid_size().x);
+    assert_eq!(report["vp_height"], vp.grid_size().y);
+    assert_eq!(report["samples_traced"], vp.sample_count());
+    assert_eq!(report["screen_pixels"], 40 * 36);
+    // Gaze in a corner: most of the r_max circle is off the screen (≈ 76 % at full size).
+    let offscreen = report["samples_offscreen"].as_u64().unwrap();
+    assert!(offscreen > vp.sample_count() / 2 && offscreen < vp.sample_count(), "{offscreen}");
+    assert_eq!(report["visual_polar"]["clip_fraction"], 0.12);
+    for pass in ["trace", "mip_phi", "remap", "blur_h", "blur_v", "tonemap"] {
+        assert!(report["passes"][pass].as_f64().unwrap() > 0.0, "pass {pass} missing");
+    }
+    for f in ["debug_grid_0000.png", "debug_density_0001.png", "debug_density_plot.png", "frame_0001.exr"] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let grid = image::open(out.join("debug_grid_0000.png")).unwrap();
+    assert_eq!((grid.width(), grid.height()), (vp.grid_size().x, vp.grid_size().y));
 }
 
 #[test]
