@@ -2,7 +2,7 @@
 //! remap) and a screen-space sample-density heat map with the gaze marked; once per run a plot of
 //! samples per pixel against eccentricity (VP vs the acuity target vs uniform).
 
-use crate::density::{density_plot, heatmap_rgba, samples_per_pixel};
+use crate::density::{box_filter, density_plot, heatmap_rgba, samples_per_pixel};
 use crate::output::write_png;
 use anyhow::Result;
 use fovea_renderer::pipeline::Renderer;
@@ -30,7 +30,10 @@ impl DebugViews {
         renderer.read_grid_ldr(&mut self.pixels)?;
         write_png(&self.out.join(format!("debug_grid_{index:04}.png")), self.grid.x, self.grid.y, &self.pixels)?;
         let space = renderer.space();
-        let density = samples_per_pixel(space);
+        // Far from the gaze single pixels get 0 or 1 samples: a box average over a few pixels
+        // shows the density rather than the sample pattern.
+        let radius = (self.screen.x / 160).max(2);
+        let density = box_filter(&samples_per_pixel(space), self.screen.x, self.screen.y, radius);
         let heat = heatmap_rgba(&density, self.screen.x, self.screen.y, space.gaze());
         write_png(&self.out.join(format!("debug_density_{index:04}.png")), self.screen.x, self.screen.y, &heat)
     }
