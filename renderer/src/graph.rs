@@ -321,7 +321,7 @@ impl FrameRecorder {
             let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else { continue };
             let ok = matches!(
                 (b.resource, info.ty),
-                (Resource::Buffer(_), vk::DescriptorType::STORAGE_BUFFER)
+                (Resource::Buffer(_), vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER)
                     | (Resource::Texels(_), vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
                     | (Resource::Image(_), vk::DescriptorType::STORAGE_IMAGE)
             );

@@ -129,6 +129,7 @@ impl Renderer {
         let grid = space.grid_size();
         let screen = space.screen_size();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
         let readback = |name: &str, bytes: u64| {
             Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
         };
@@ -138,8 +139,8 @@ impl Renderer {
             None => None,
         };
         Ok(Renderer {
-            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], storage)?,
-            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], storage)?,
+            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], uniform)?,
+            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform)?,
             ray_counters: Buffer::new(
                 ctx,
                 "ray_counters",

@@ -5,7 +5,8 @@
 
 #include "../common/layouts.glsl"
 
-layout(std430, set = 0, binding = 9) readonly buffer SamplingBuffer { SamplingParams data; } sampling;
+// Uniform for the same reason as `frame` (scene.glsl).
+layout(std140, set = 0, binding = 9) uniform SamplingBuffer { SamplingParams data; } sampling;
 
 #if defined(SAMPLING_CARTESIAN)
 #include "cartesian.glsl"

@@ -58,11 +58,11 @@ pub struct RayCaster {
 
 impl RayCaster {
     pub fn new(ctx: &Arc<Context>) -> Result<RayCaster> {
-        let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
+        let uniform = ash::vk::BufferUsageFlags::UNIFORM_BUFFER;
         Ok(RayCaster {
             ctx: ctx.clone(),
             pass: RaycastPass::new(ctx)?,
-            frame: Buffer::with_data(ctx, "frame", &[crate::layouts::FrameData::default()], storage)?,
+            frame: Buffer::with_data(ctx, "frame", &[crate::layouts::FrameData::default()], uniform)?,
             rays: None,
             hits: None,
             recorder: crate::graph::FrameRecorder::new(ctx, 4)?,
