@@ -11,15 +11,12 @@
 //! - jitter-independently: between the texels whose whole cell is off-screen and the texels
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
-use ash::vk;
-use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
 use fovea_tests::{assert_clean, gpu, read_image};
 use glam::{IVec2, UVec2, Vec2};
-use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
 const SCREEN: UVec2 = UVec2::new(160, 180);
