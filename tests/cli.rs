@@ -30,6 +30,7 @@ fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
         exposure: 1.0,
         profile: RenderProfile::default(),
         debug_views: false,
+        denoiser: "none",
         device: None,
         validation: true,
     }
@@ -60,7 +61,7 @@ fn render_writes_frames_and_a_report_with_exact_counts() {
 /// screen, and the debug views (grid image, density heat map per frame, one density plot).
 #[test]
 fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
-    use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams};
+    use fovea_renderer::sampling::{VisualPolar, VisualPolarParams};
     let out = temp_dir("render-vp");
     let mut args = render_args("cornell-box", &out);
     args.method = "vp";

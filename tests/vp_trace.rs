@@ -1,6 +1,9 @@
 //! The tracer fed by the Visual-Polar sampling space (issue 4, pipeline step 1): one traced sample
 //! per kept VP texel, nothing traced in the clipped fovea triangle, off-screen samples traced and
-//! counted (`FrameStats::samples_offscreen`, ray counter slot 3).
+//! counted (`FrameStats::samples_offscreen`, ray counter slot 3). The screen-clipped layout traces
+//! the same number of samples and keeps them on the screen: only jittered samples of texels whose
+//! cell reaches past the border (the cell spans a column's width in radius, its arcs are those of
+//! the centre radius) may leave it.
 //!
 //! The off-screen count is checked two ways:
 //! - exactly, against a CPU replay of the kernel's jitter (the same PCG hash seeded the same way
@@ -12,7 +15,7 @@
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
 use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
 use fovea_tests::{assert_clean, gpu, read_image};
@@ -110,16 +113,17 @@ fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (
     (r, stats)
 }
 
-/// Renders one VP frame and checks counts and the G-buffer; returns the off-screen share.
-fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2) -> f64 {
-    let vp = VisualPolar::new(SCREEN, gaze, VisualPolarParams::default()).unwrap();
+/// Renders one VP frame and checks counts and the G-buffer; returns the off-screen share and the
+/// CPU counts.
+fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2, layout: VpLayout) -> (f64, CpuCounts, u64) {
+    let vp = VisualPolar::new(SCREEN, gaze, VisualPolarParams { layout, ..Default::default() }).unwrap();
     let (r, stats) = render(ctx, scene, Box::new(vp));
     let g = vp.grid_size();
     let samples = vp.sample_count();
     let cpu = cpu_counts(&vp, r.settings.seed);
     let share = stats.samples_offscreen as f64 / samples as f64;
     println!(
-        "gaze {gaze_name} {gaze}: grid {}x{}, {} samples ({:.1} % of {} screen pixels), traced {}, off-screen {} = {:.1} % \
+        "{layout:?} gaze {gaze_name} {gaze}: grid {}x{}, {} samples ({:.1} % of {} screen pixels), traced {}, off-screen {} = {:.1} % \
          (CPU replay {} ± {}, at texel centres {}, cell bounds [{}, {}])",
         g.x,
         g.y,
@@ -182,16 +186,35 @@ fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2
         hits_on_screen as f64 > 0.9 * kept_on_screen as f64,
         "on-screen samples should see the Cornell box: {hits_on_screen} of {kept_on_screen} hit"
     );
-    share
+    (share, cpu, stats.samples_traced)
 }
 
 #[test]
 fn visual_polar_tracing_counts_samples_and_offscreen() {
     let ctx = gpu();
     let scene = cornell();
-    let centre = check_vp_frame(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5);
-    let corner = check_vp_frame(&ctx, &scene, "corner", Vec2::new(2.0, 2.0));
+    let (centre, _, _) = check_vp_frame(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5, VpLayout::Paper);
+    let (corner, _, _) = check_vp_frame(&ctx, &scene, "corner", Vec2::new(2.0, 2.0), VpLayout::Paper);
     assert!(centre < 0.3 && 0.3 < corner, "off-screen share: centre {centre:.3}, corner {corner:.3}");
+    assert_clean(&ctx);
+}
+
+/// The screen-clipped layout: the paper's sample count, and off the screen only samples whose
+/// texel cell reaches past the border (no cell lies wholly off it), a small share.
+#[test]
+fn screen_clipped_layout_keeps_samples_on_screen() {
+    let ctx = gpu();
+    let scene = cornell();
+    let gazes = [("centre", SCREEN.as_vec2() * 0.5), ("edge", Vec2::new(3.0, 90.0)), ("corner", Vec2::new(2.0, 2.0))];
+    for (name, gaze) in gazes {
+        let (paper_share, _, paper_traced) = check_vp_frame(&ctx, &scene, name, gaze, VpLayout::Paper);
+        let (share, cpu, traced) = check_vp_frame(&ctx, &scene, name, gaze, VpLayout::ScreenClipped);
+        println!("gaze {name}: off-screen share paper {:.1} % → screen-clipped {:.2} %", 100.0 * paper_share, 100.0 * share);
+        assert_eq!(traced, paper_traced, "gaze {name}: the same budget");
+        assert_eq!(cpu.centres, 0, "gaze {name}: texel centres lie on their arcs, on the screen");
+        assert_eq!(cpu.cell_all, 0, "gaze {name}: a texel cell wholly off the screen");
+        assert!(share < 0.03, "gaze {name}: {:.2} % off the screen", 100.0 * share);
+    }
     assert_clean(&ctx);
 }
 

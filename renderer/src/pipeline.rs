@@ -1,12 +1,13 @@
-//! Composes a frame: sampling space → trace → (denoiser slot) → screen image (Visual-Polar: φ-mips,
-//! remap, foveated blur) → tonemap → read-back.
+//! Composes a frame: sampling space → trace → denoiser (optional, in the sampling grid) → screen
+//! image (Visual-Polar: φ-mips, remap, foveated blur) → tonemap → read-back.
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::graph::{FrameRecorder, PassTiming};
-use crate::layouts::{FrameData, FRAME_FLAG_REFERENCE};
+use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
+use crate::passes::denoise::{DenoiseFrame, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::sampling::SamplingSpace;
@@ -48,6 +49,8 @@ pub struct RenderSettings {
     pub tone_curve: ToneCurve,
     /// Foveated blur after the remap (Visual-Polar only).
     pub blur: BlurSettings,
+    /// Denoiser between the tracer and the screen (fixed for the renderer's life: it owns state).
+    pub denoiser: DenoiserSettings,
 }
 
 impl Default for RenderSettings {
@@ -58,6 +61,7 @@ impl Default for RenderSettings {
             exposure: 1.0,
             tone_curve: ToneCurve::Aces,
             blur: BlurSettings::default(),
+            denoiser: DenoiserSettings::None,
         }
     }
 }
@@ -99,6 +103,9 @@ pub struct Renderer {
     pub settings: RenderSettings,
     frame_data: Buffer,
     sampling: Buffer,
+    /// The space's per-frame table (`SamplingSpace::sampling_table`), read by the trace and the
+    /// Visual-Polar passes back to the screen.
+    sampling_table: Buffer,
     ray_counters: Buffer,
     trace: TracePass,
     accumulate: AccumulatePass,
@@ -112,8 +119,12 @@ pub struct Renderer {
     hdr_readback: Buffer,
     grid_ldr: Image,
     grid_readback: Buffer,
+    /// Per-eye denoiser state (`settings.denoiser`).
+    denoiser: Option<Denoiser>,
     recorder: FrameRecorder,
     prev_camera: Option<CameraPose>,
+    /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
+    prev_sampling: Option<SamplingParams>,
 }
 
 impl Renderer {
@@ -138,9 +149,12 @@ impl Renderer {
             Some(_) => Some(ToScreen::new(ctx, grid, screen)?),
             None => None,
         };
+        let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
+        let denoiser_passes = denoiser.as_ref().map_or(0, |d| d.max_passes());
         Ok(Renderer {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], uniform)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform)?,
+            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table())?,
             ray_counters: Buffer::new(
                 ctx,
                 "ray_counters",
@@ -159,8 +173,10 @@ impl Renderer {
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_readback: readback("grid_readback", grid.x as u64 * grid.y as u64 * 4)?,
             to_screen,
-            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 24)?,
+            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 24 + denoiser_passes)?,
+            denoiser,
             prev_camera: None,
+            prev_sampling: None,
             ctx: ctx.clone(),
             scene,
             space,
@@ -174,6 +190,11 @@ impl Renderer {
 
     pub fn context(&self) -> &Arc<Context> {
         &self.ctx
+    }
+
+    /// The denoiser and its state, when `settings.denoiser` names one.
+    pub fn denoiser(&self) -> Option<&Denoiser> {
+        self.denoiser.as_ref()
     }
 
     /// GPU time of each pass of the last submission.
@@ -208,15 +229,20 @@ impl Renderer {
             self.space.set_gaze(gaze)?;
         }
         self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, 0)?;
-        self.sampling.write(&[self.space.params()])?;
+        let space = self.space.params();
+        self.sampling.write(&[space])?;
+        self.sampling_table.write(&self.space.sampling_table())?;
         let rec = &mut self.recorder;
         rec.begin()?;
         rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
-        self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.ray_counters, &self.gbuffer, 0)?;
-        // Denoisers slot in here, in the sampling grid. Cartesian samples are the screen.
-        let grid_hdr = &self.gbuffer.color;
+        self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0)?;
+        // Denoisers work in the sampling grid (Cartesian samples are the screen).
+        let grid_hdr = match &mut self.denoiser {
+            Some(d) => d.record(rec, &self.gbuffer, &DenoiseFrame { current: space, previous: self.prev_sampling })?,
+            None => &self.gbuffer.color,
+        };
         let screen_hdr = match (&self.to_screen, self.space.visual_polar()) {
-            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, grid_hdr, &self.settings.blur)?,
+            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &self.sampling_table, grid_hdr, &self.settings.blur)?,
             _ => grid_hdr,
         };
         let (exposure, curve) = (self.settings.exposure, self.settings.tone_curve);
@@ -231,6 +257,7 @@ impl Renderer {
         }
         rec.submit_and_wait()?;
         self.prev_camera = Some(input.camera);
+        self.prev_sampling = Some(space);
         let mut counters = [0u32; RAY_COUNTERS];
         self.ray_counters.read_into(&mut counters)?;
         Ok(FrameStats {
@@ -275,7 +302,9 @@ impl Renderer {
         if self.space.grid_size() != self.space.screen_size() {
             return Err(Error::Invalid("references are rendered in Cartesian space".into()));
         }
+        // The G-buffer is overwritten and the previous camera forgotten: no history survives.
         self.prev_camera = None;
+        self.prev_sampling = None;
         self.write_frame_data(camera, 0, max_depth, FRAME_FLAG_REFERENCE)?;
         self.sampling.write(&[self.space.params()])?;
         let mut done = 0;
@@ -284,7 +313,7 @@ impl Renderer {
             let rec = &mut self.recorder;
             rec.begin()?;
             for s in done..done + batch {
-                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.ray_counters, &self.gbuffer, s)?;
+                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, s)?;
                 self.accumulate.record(rec, &self.gbuffer.color, &self.accum, s)?;
             }
             if done + batch == spp {

@@ -7,7 +7,7 @@ use crate::passes::blur::{BlurPass, BlurShape};
 use crate::passes::mip_phi::{MipPhiPass, PhiMips};
 use crate::passes::remap::RemapPass;
 use crate::sampling::VisualPolar;
-use crate::vk::{Context, Image};
+use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::UVec2;
 use std::sync::Arc;
@@ -72,16 +72,18 @@ impl ToScreen {
     }
 
     /// Records mips, remap and (unless σ is 0) the blur; returns the screen image to show.
+    /// `columns` is a texel buffer holding `vp.column_table()` (the renderer's `sampling_table`).
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
         vp: &VisualPolar,
+        columns: &Buffer,
         vp_color: &Image,
         blur: &BlurSettings,
     ) -> Result<&Image> {
         let params = vp.sampling_params();
-        self.mip_phi.record(rec, &params, vp_color, &self.mips)?;
-        self.remap.record(rec, &params, &self.mips, &self.remapped)?;
+        self.mip_phi.record(rec, &params, columns, vp_color, &self.mips)?;
+        self.remap.record(rec, &params, columns, &self.mips, &self.remapped)?;
         if blur.sigma_at_30 <= 0.0 {
             return Ok(&self.remapped);
         }

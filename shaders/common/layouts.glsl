@@ -144,6 +144,47 @@ struct VpProbePush {
     uvec4 config;               // x point count, yzw unused
 };
 
+// ---- Denoisers (issue 5): they run in the sampling grid (texel = sample). Every pass gets the
+// space as flattened SamplingParams push constants (see MipPhiPush for why not the buffer);
+// Cartesian kernel variants ignore the vp_* fields.
+
+// Luminance ceiling of a sample entering SVGF's history: a firefly may not make the squared
+// moment overflow (demodulated light sources stay far below it).
+const float SVGF_MAX_LUMINANCE = 65504.0;
+
+// Push constants of SVGF's temporal accumulation. The previous frame's space differs from this
+// one only in its gaze-dependent slots (the grid and screen never change for one renderer), so
+// prev_* carry its gaze, shape0 and shape1; that keeps the block at Vulkan's guaranteed 128 bytes.
+struct SvgfTemporalPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
+    vec4 prev_shape0;
+    vec4 prev_shape1;
+    vec4 params;                // x α colour, y α moments, z history cap (frames), w 1 = drop all history
+};
+
+// Push constants of SVGF's variance estimate (spatial 7×7 while the history is short).
+struct SvgfVariancePush {
+    uvec4 vp_grid;              // the space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 params;                // x σ luminance, y σ depth, z σ normal, w history (frames) below which it is spatial
+};
+
+// Push constants of one SVGF à-trous iteration.
+struct SvgfAtrousPush {
+    uvec4 vp_grid;              // the space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 params;                // x σ luminance, y σ depth, z σ normal, w unused
+    uvec4 config;               // x tap spacing (2^iteration texels), yzw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 

@@ -3,14 +3,22 @@
 // of level l inside each column (building level 1 also copies level 0 into the stack, so the
 // remap reads one image). ρ is never filtered: the remap magnifies (or keeps) ρ, while one screen
 // pixel near the gaze spans many φ rows (visual-polar.md §6).
+// Screen-clipped layout (visual_polar_clipped.glsl): a column whose rows cover only its on-screen
+// arcs neither wraps (an odd last row keeps its own value) nor averages across the gap between two
+// arcs (a pair split by a gap keeps the row on the output row's side).
 #include "../common/layouts.glsl"
-#include "../sampling/visual_polar_math.glsl"
+#include "../sampling/visual_polar_clipped.glsl"
 #include "../sampling/phi_mips.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { MipPhiPush p; } push;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // the traced image
 layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // all levels, stacked
+layout(set = 0, binding = 3) uniform samplerBuffer vp_columns;           // VisualPolar::column_table
+
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+}
 
 void main() {
     VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
@@ -34,5 +42,24 @@ void main() {
         va = imageLoad(mips, ivec2(t.x, offset + a));
         vb = imageLoad(mips, ivec2(t.x, offset + b));
     }
-    imageStore(mips, ivec2(t.x, phi_mip_offset(src + 1u, P.grid.y) + uint(t.y)), 0.5 * (va + vb));
+    vec4 v = 0.5 * (va + vb);
+    if (P.clipped) {
+        VpArcs arcs = vp_column_arcs(uint(t.x));
+        if (!vp_arcs_wrap(arcs)) {
+            // Rows by their centres, in level-0 rows.
+            float n = float(rows0);
+            float scale = float(1u << src);
+            if (a + 1u == src_rows) {
+                v = va;
+            } else {
+                int ia = vp_arcs_interval_of_row(arcs, (float(a) + 0.5) * scale, n);
+                int ib = vp_arcs_interval_of_row(arcs, (float(a) + 1.5) * scale, n);
+                if (ia != ib) {
+                    int io = vp_arcs_interval_of_row(arcs, (float(t.y) + 0.5) * 2.0 * scale, n);
+                    v = io == ib ? vb : va;
+                }
+            }
+        }
+    }
+    imageStore(mips, ivec2(t.x, phi_mip_offset(src + 1u, P.grid.y) + uint(t.y)), v);
 }

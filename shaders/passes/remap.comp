@@ -3,14 +3,25 @@
 // its VP coordinate and samples there. ρ: bilinear between the two nearest columns (clamped at
 // the ends); φ: wrapped, bilinear inside each column (its own row count), trilinear across the
 // φ-only mips with the level picked from the pixel's φ footprint in that column.
+// Screen-clipped layout (visual_polar_clipped.glsl): a column whose rows cover only its on-screen
+// arcs is read along its arc position, clamped to the rows of the pixel's own arc at every level
+// (no wrap, nothing across a gap); its rows are denser along φ by 2π/A, which the footprint uses.
+// Near the border a pixel's angle may lie outside the outer column's arcs (that circle leaves the
+// screen sooner): such a clamped column is trusted only within one of its φ texels of the pixel,
+// beyond that the inner column (whose arcs hold the pixel) answers alone.
 #include "../common/layouts.glsl"
-#include "../sampling/visual_polar_math.glsl"
+#include "../sampling/visual_polar_clipped.glsl"
 #include "../sampling/phi_mips.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { RemapPush p; } push;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D mips;          // all levels, stacked
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D screen_color;
+layout(set = 0, binding = 3) uniform samplerBuffer vp_columns;                // VisualPolar::column_table
+
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+}
 
 vec4 fetch(uint level, uint height, uint col, uint row) {
     return imageLoad(mips, ivec2(col, phi_mip_offset(level, height) + row));
@@ -27,12 +38,58 @@ vec4 sample_phi(uint col, uint rows0, float y0, uint level, uint height) {
     return mix(fetch(level, height, col, uint(a)), fetch(level, height, col, b), y - f);
 }
 
-vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels) {
+// Linear along φ at one level, clamped to the rows whose centres lie in [lo0, hi0) (level-0 rows:
+// one arc of a clipped column, the rule of vp_arcs_interval_of_row).
+vec4 sample_phi_clamped(uint col, uint rows0, float y0, float lo0, float hi0, uint level, uint height) {
+    float m = float(phi_mip_rows(rows0, level));
+    float scale = float(1u << level);
+    float first = max(ceil(lo0 / scale - 0.5), 0.0);
+    float last = min(ceil(hi0 / scale - 0.5) - 1.0, m - 1.0);
+    if (last < first) {
+        // The arc is narrower than one row of this level: its nearest row.
+        first = clamp(floor(y0 / scale), 0.0, m - 1.0);
+        last = first;
+    }
+    float y = clamp(y0 / scale - 0.5, first, last);
+    float f = floor(y);
+    uint a = uint(f);
+    uint b = min(a + 1u, uint(last));
+    return mix(fetch(level, height, col, a), fetch(level, height, col, b), y - f);
+}
+
+// Level of detail from the φ footprint: one pixel spans 1/r radians, rows0/arc rows per radian.
+float phi_lod(uint rows0, float arc, float r, uint levels) {
+    float footprint = float(rows0) / (arc * max(r, 0.5));
+    return clamp(log2(max(footprint, 1.0)), 0.0, float(levels - 1u));
+}
+
+// `trust` (out): 1 − the clamp distance in this column's φ texels, at least 0.
+vec4 sample_column_clipped(VpParams P, VpArcs arcs, uint col, float phi, float r, uint levels, out float trust) {
+    uint rows0 = vp_rows_in_column(P, col);
+    float n = float(rows0);
+    vec3 ai = vp_arc_of_phi(arcs, phi);
+    int i = int(ai.y);
+    trust = max(1.0 - vp_arc_row(arcs, ai.z, n), 0.0);
+    float y0 = vp_arc_row(arcs, ai.x, n);
+    float lo0 = i == 0 ? -1e30 : vp_arc_row(arcs, vp_arcs_arc_start(arcs, i), n);
+    float hi0 = i == vp_arcs_count(arcs) - 1 ? 1e30 : vp_arc_row(arcs, arcs.end[i], n);
+    float lod = phi_lod(rows0, vp_arcs_total(arcs), r, levels);
+    uint l0 = uint(lod);
+    uint l1 = min(l0 + 1u, levels - 1u);
+    vec4 v0 = sample_phi_clamped(col, rows0, y0, lo0, hi0, l0, P.grid.y);
+    vec4 v1 = sample_phi_clamped(col, rows0, y0, lo0, hi0, l1, P.grid.y);
+    return mix(v0, v1, lod - float(l0));
+}
+
+vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels, out float trust) {
+    trust = 1.0;
+    if (P.clipped) {
+        VpArcs arcs = vp_column_arcs(col);
+        if (!vp_arcs_wrap(arcs)) return sample_column_clipped(P, arcs, col, phi, r, levels, trust);
+    }
     uint rows0 = vp_rows_in_column(P, col);
     float y0 = phi / VP_TAU * float(rows0);
-    // One pixel spans 1/r radians of φ: that many rows of this column.
-    float footprint = float(rows0) / (VP_TAU * max(r, 0.5));
-    float lod = clamp(log2(max(footprint, 1.0)), 0.0, float(levels - 1u));
+    float lod = phi_lod(rows0, VP_TAU, r, levels);
     uint l0 = uint(lod);
     uint l1 = min(l0 + 1u, levels - 1u);
     vec4 v0 = sample_phi(col, rows0, y0, l0, P.grid.y);
@@ -52,7 +109,15 @@ void main() {
     uint c0 = uint(x);
     uint c1 = min(c0 + 1u, P.grid.x - 1u);
     uint levels = max(push.p.config.x, 1u);
-    vec4 v0 = sample_column(P, c0, phi, r, levels);
-    vec4 v1 = c1 == c0 ? v0 : sample_column(P, c1, phi, r, levels);
-    imageStore(screen_color, t, mix(v0, v1, x - float(c0)));
+    float trust0, trust1;
+    vec4 v0 = sample_column(P, c0, phi, r, levels, trust0);
+    vec4 v1 = c1 == c0 ? v0 : sample_column(P, c1, phi, r, levels, trust1);
+    float w1 = x - float(c0);
+    if (c1 != c0 && trust1 < 1.0) {
+        // Paper layout and full circles: trust is 1, plain linear along ρ.
+        float a0 = (1.0 - w1) * trust0;
+        float a1 = w1 * trust1;
+        if (a0 + a1 > 0.0) w1 = a1 / (a0 + a1);
+    }
+    imageStore(screen_color, t, mix(v0, v1, w1));
 }

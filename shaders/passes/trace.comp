@@ -20,7 +20,7 @@ layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D out_color;     
 layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D out_radiance;     // radiance / albedo
 layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_albedo;
 layout(set = 0, binding = 13, rgba32f) uniform writeonly image2D out_normal_depth; // normal, linear depth (0: miss)
-layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;     // camera-relative position, depth gradient
+layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;     // camera-relative position, depth change per grid texel
 layout(set = 0, binding = 15, rg32ui) uniform writeonly uimage2D out_ids;          // triangle + 1 (0: miss), material | mesh << 16
 layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;         // previous-frame screen position (−1: none)
 // Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays,
@@ -44,13 +44,29 @@ vec3 direct_light(Surface s, vec3 v, inout uint rng) {
     return f * ls.radiance_over_pdf;
 }
 
+// Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
+// two grid axes; 1 in Cartesian space): the denoisers compare depths per grid texel. Visual-Polar
+// texels cover anything from a fraction of a pixel (fovea) to many pixels (periphery).
+float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
+    float size = 0.0;
+    for (int axis = 0; axis < 2; ++axis) {
+        ivec2 step = axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
+        vec2 next;
+        // The last column/row (or a clipped neighbour) has its neighbour on the other side.
+        if (sample_screen_position(texel + step, jitter, next) || sample_screen_position(texel - step, jitter, next))
+            size = max(size, length(next - screen));
+    }
+    return size > 0.0 ? size : 1.0;
+}
+
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(texel, ivec2(sampling.data.grid.xy)))) return;
     FrameData fd = frame.data;
     uint rng = rng_seed(uvec2(texel), fd.frame.x, fd.frame.y, push.p.config.x);
     vec2 screen;
-    if (!sample_screen_position(texel, rng_next2(rng), screen)) {
+    vec2 jitter = rng_next2(rng);
+    if (!sample_screen_position(texel, jitter, screen)) {
         imageStore(out_color, texel, vec4(0.0));
         imageStore(out_radiance, texel, vec4(0.0));
         imageStore(out_albedo, texel, vec4(0.0));
@@ -83,7 +99,8 @@ void main() {
         float depth = dot(p_rel, mat3(fd.world_from_view) * vec3(0.0, 0.0, -1.0));
         float cos_view = max(abs(dot(s.geometric_normal, dir)), 0.05);
         float pixel_tan = (fd.fov_tan.y - fd.fov_tan.x) * fd.screen.z;
-        float depth_gradient = depth * pixel_tan * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
+        float depth_gradient = depth * pixel_tan * texel_footprint(texel, jitter, screen)
+                             * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
         albedo = max(s.base_color, vec3(0.01));
         normal_depth = vec4(s.normal, depth);
         position = vec4(p_rel, depth_gradient);

@@ -2,12 +2,20 @@
 // (x = ρ, y = φ), mapped to the screen by visual_polar_math.glsl with the parameters packed by
 // VisualPolar::sampling_params() (the `sampling` buffer). Jitter is applied in VP space, inside the
 // texel, so a sample never leaves its column. Texels cut by the fovea's triangular clip hold no
-// sample. Positions off the screen are returned (and traced, as in the paper): the camera model
-// handles any screen position.
+// sample. With the paper's layout positions off the screen are returned (and traced, as in the
+// paper): the camera model handles any screen position. The screen-clipped layout
+// (visual_polar_clipped.glsl) keeps them on it, up to the jitter across a column's radius.
 #ifndef FOVEA_SAMPLING_VISUAL_POLAR_GLSL
 #define FOVEA_SAMPLING_VISUAL_POLAR_GLSL
 
-#include "visual_polar_math.glsl"
+#include "visual_polar_clipped.glsl"
+
+// Per-column arcs of the layout (VisualPolar::column_table, two RGBA32F texels per column).
+layout(set = 0, binding = 18) uniform samplerBuffer sampling_table;
+
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(texelFetch(sampling_table, int(2u * col)), texelFetch(sampling_table, int(2u * col + 1u)));
+}
 
 // Screen position (pixels, y down) of the sample held by `texel`; false when the texel holds none.
 bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen) {
@@ -16,7 +24,7 @@ bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen) {
     screen = vec2(0.0);
     if (!vp_is_valid_texel(P, texel)) return false;
     // rng_next gives [0, 1): texel + jitter stays in the texel, so floor(x) is its column.
-    screen = vp_vp_to_screen(P, vec2(texel) + jitter);
+    screen = vp_layout_vp_to_screen(P, vec2(texel) + jitter);
     return true;
 }
 

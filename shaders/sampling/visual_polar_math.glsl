@@ -31,10 +31,12 @@ struct VpParams {
     float e_norm;    // e(1): e_poly(1) for the polynomial, 80 for the exact inverse
     float cdf_max;   // cdf(80, k)
     bool exact;      // exact inverse CDF instead of the paper's quartic
+    bool clipped;    // screen-clipped layout: map with visual_polar_clipped.glsl (vp_layout_*)
 };
 
 // Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
-// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, exact, fovea°, 0).
+// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
+// shape1 = (cdf_max, exact, fovea°, layout: 0 paper, 1 screen-clipped).
 VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     VpParams p;
     p.grid = grid.xy;
@@ -48,6 +50,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.e_norm = shape0.w;
     p.cdf_max = shape1.x;
     p.exact = shape1.y != 0.0;
+    p.clipped = shape1.w != 0.0;
     return p;
 }
 
@@ -181,6 +184,7 @@ uint vp_column_of(VpParams P, float x) {
 }
 
 // Screen position (pixels) → continuous grid coordinates; y in [0, rows of the column).
+// The paper's layout (Rust `paper_screen_to_vp`); vp_layout_screen_to_vp follows P.clipped.
 vec2 vp_screen_to_vp(VpParams P, vec2 s) {
     vec2 d = s - P.gaze;
     float r = length(d);
@@ -194,6 +198,7 @@ vec2 vp_screen_to_vp(VpParams P, vec2 s) {
 }
 
 // Continuous grid coordinates → screen position (pixels); φ wraps.
+// The paper's layout (Rust `paper_vp_to_screen`); vp_layout_vp_to_screen follows P.clipped.
 vec2 vp_vp_to_screen(VpParams P, vec2 g) {
     float n = float(vp_rows_in_column(P, vp_column_of(P, g.x)));
     float phi = g.y / n * VP_TAU;

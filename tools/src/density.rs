@@ -1,11 +1,12 @@
 //! Sample-density debug views of a sampling space: samples per screen pixel, a log-scale heatmap
 //! of it, and a plot of density against eccentricity next to the acuity target, uniform sampling
-//! at the same budget and Cartesian 1 spp.
+//! at the same budget and Cartesian 1 spp (and the paper's layout when the space is screen-clipped);
+//! the per-ring density gain of one space over another (`ring_density_gain`).
 
 use crate::metrics::{Rings, ECC_MAX};
 use crate::plot::{line_plot, Series};
 use anyhow::Result;
-use fovea_renderer::sampling::{SamplingSpace, VisualPolar};
+use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use glam::Vec2;
 use std::path::Path;
 
@@ -37,6 +38,52 @@ pub fn samples_per_pixel(space: &dyn SamplingSpace) -> Vec<f32> {
         }
     }
     counts
+}
+
+/// On-screen samples per pixel of two spaces in one eccentricity ring, and their ratio.
+#[derive(Clone, Copy, Debug)]
+pub struct RingGain {
+    /// Ring bounds in the paper's normalised eccentricity (r / r_max · 80).
+    pub e_lo: f64,
+    pub e_hi: f64,
+    pub pixels: usize,
+    /// Mean samples per pixel of the space measured (`space`) and of the baseline.
+    pub density: f64,
+    pub baseline: f64,
+}
+
+impl RingGain {
+    /// density / baseline (∞ where the baseline has no sample in the ring).
+    pub fn gain(&self) -> f64 {
+        self.density / self.baseline
+    }
+}
+
+/// Per eccentricity ring (`rings` equal rings out to the farthest corner of `space`'s gaze), the
+/// on-screen density of `space` against `baseline` (texel centres counted, as
+/// `samples_per_pixel`); rings holding no pixel are left out. The last entry is the whole screen.
+pub fn ring_density_gain(space: &dyn SamplingSpace, baseline: &dyn SamplingSpace, rings: usize) -> Vec<RingGain> {
+    let screen = space.screen_size();
+    let ring_set = Rings::new(screen.x, screen.y, space.gaze(), rings);
+    let map = |s: &dyn SamplingSpace| samples_per_pixel(s).into_iter().map(f64::from).collect::<Vec<f64>>();
+    let (a, b) = (map(space), map(baseline));
+    let (ma, mb, counts) = (ring_set.mean(&a), ring_set.mean(&b), ring_set.pixel_counts());
+    let e = |r: f64| r / ring_set.r_max * ECC_MAX;
+    let mut out: Vec<RingGain> = (0..rings)
+        .filter_map(|i| {
+            let (r0, r1) = ring_set.bounds(i);
+            Some(RingGain { e_lo: e(r0), e_hi: e(r1), pixels: counts[i], density: ma[i]?, baseline: mb[i]? })
+        })
+        .collect();
+    let pixels = a.len() as f64;
+    out.push(RingGain {
+        e_lo: 0.0,
+        e_hi: ECC_MAX,
+        pixels: a.len(),
+        density: a.iter().sum::<f64>() / pixels,
+        baseline: b.iter().sum::<f64>() / pixels,
+    });
+    out
 }
 
 /// RGBA8 heatmap of a density map: viridis-like ramp over log2 density in [1/64, 64]
@@ -132,12 +179,19 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
     };
     let flat = |label: String, v: f64| Series { label, points: vec![(0.0, v), (ECC_MAX, v)] };
     let uniform = budget / (screen.x as f64 * screen.y as f64);
-    let series = [
+    let mut series = vec![
         per_ring("Visual-Polar (measured)", &measured),
         per_ring("acuity target (∝ V(e), same budget)", &target),
         flat(format!("uniform, same budget ({uniform:.2})"), uniform),
         flat("Cartesian 1 spp".into(), 1.0),
     ];
+    if vp.params().layout != VpLayout::Paper {
+        // What the screen-clipped layout buys: the paper's layout at the same gaze.
+        let paper = VisualPolar::new(screen, vp.gaze(), VisualPolarParams { layout: VpLayout::Paper, ..*vp.params() })?;
+        let paper_map: Vec<f64> = samples_per_pixel(&paper).iter().map(|&c| c as f64).collect();
+        series[0].label = "Visual-Polar, screen-clipped (measured)".into();
+        series.push(per_ring("Visual-Polar, paper's layout (measured)", &paper_map));
+    }
     let title = format!("Sample density, {}×{}, gaze ({:.0}, {:.0})", screen.x, screen.y, vp.gaze().x, vp.gaze().y);
     line_plot(path, &title, "normalised eccentricity (r / r_max · 80)", "samples per pixel", &series, true)
 }
@@ -216,10 +270,39 @@ mod tests {
         assert_eq!((s[4 * 9 + 4], s[2 * 9 + 2], s[9 + 4]), (1.0, 1.0, 0.0));
     }
 
+    /// The screen-clipped layout against the paper's, gaze in a corner of the 1280×1440 FOVE eye
+    /// (853×960 grid), 16 rings of 5°: every ring at least as dense, the screen as a whole ≫.
+    #[test]
+    fn screen_clipped_density_gain_per_ring() {
+        let (screen, gaze) = (UVec2::new(1280, 1440), Vec2::new(10.0, 10.0));
+        let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
+        let clipped = VisualPolar::new(screen, gaze, params).unwrap();
+        let paper = VisualPolar::new(screen, gaze, VisualPolarParams::default()).unwrap();
+        assert_eq!(clipped.grid_size(), UVec2::new(853, 960));
+        let gains = ring_density_gain(&clipped, &paper, 16);
+        println!("eccentricity | pixels | paper spp | screen-clipped spp | gain");
+        for g in &gains {
+            println!("{:>4.0}–{:<3.0}° | {:>7} | {:>9.3} | {:>18.3} | {:>6.2}×", g.e_lo, g.e_hi, g.pixels, g.baseline, g.density, g.gain());
+        }
+        let (rings, whole) = gains.split_at(gains.len() - 1);
+        assert_eq!(rings.len(), 16, "every ring of a corner gaze holds pixels");
+        for g in rings {
+            assert!(g.gain() >= 1.0, "ring {:.0}–{:.0}°: gain {}", g.e_lo, g.e_hi, g.gain());
+        }
+        // The paper's layout keeps ≈ 24 % of its samples on screen with the gaze in a corner.
+        assert!(whole[0].gain() > 3.5, "whole screen: gain {}", whole[0].gain());
+        let total = |s: &VisualPolar| samples_per_pixel(s).iter().map(|&c| c as f64).sum::<f64>();
+        assert_eq!(total(&clipped), clipped.sample_count() as f64, "every texel centre lands on the screen");
+    }
+
     #[test]
     fn density_plot_writes_a_png() {
         let path = std::env::temp_dir().join(format!("fovea-density-{}.png", std::process::id()));
         density_plot(&path, &centred_vp(), 24).unwrap();
+        assert!(image::open(&path).is_ok());
+        // The screen-clipped layout adds the paper's layout as a series.
+        let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
+        density_plot(&path, &VisualPolar::new(UVec2::new(320, 360), Vec2::new(20.0, 30.0), params).unwrap(), 24).unwrap();
         assert!(image::open(&path).is_ok());
         std::fs::remove_file(&path).unwrap();
     }

@@ -87,12 +87,18 @@ struct RenderOpts {
     /// VP radius: corner (largest gaze-to-corner distance, default) or pixels.
     #[arg(long)]
     vp_radius: Option<String>,
+    /// VP layout: paper (default) or screen-clipped (each column's rows on its on-screen arcs).
+    #[arg(long)]
+    vp_layout: Option<String>,
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
+    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017, the paper's parameters).
+    #[arg(long, default_value = "none")]
+    denoiser: String,
 }
 
 impl RenderOpts {
@@ -109,6 +115,7 @@ impl RenderOpts {
             density_exponent: self.vp_density_exponent,
             inverse_cdf: self.vp_inverse_cdf.clone(),
             radius: self.vp_radius.clone(),
+            layout: self.vp_layout.clone(),
             blur_sigma: self.blur_sigma,
         })
     }
@@ -237,6 +244,7 @@ fn main() -> Result<()> {
             exposure: opts.exposure,
             profile: opts.profile()?,
             debug_views: opts.debug_views,
+            denoiser: &opts.denoiser,
             device: device.device.as_deref(),
             validation: device.validation,
         }),

@@ -3,7 +3,7 @@
 //! Command-line flags override single values (`RenderProfile::override_with`).
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams};
+use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::to_screen::BlurSettings;
 use serde::Deserialize;
 use std::path::Path;
@@ -30,6 +30,7 @@ struct VpSection {
     density_exponent: Option<f32>,
     inverse_cdf: Option<String>,
     radius: Option<toml::Value>,
+    layout: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -47,6 +48,7 @@ pub struct ProfileOverrides {
     pub density_exponent: Option<f32>,
     pub inverse_cdf: Option<String>,
     pub radius: Option<String>,
+    pub layout: Option<String>,
     pub blur_sigma: Option<f32>,
 }
 
@@ -55,6 +57,22 @@ pub fn parse_inverse_cdf(s: &str) -> Result<InverseCdf> {
         "polynomial" | "poly" => Ok(InverseCdf::Polynomial),
         "exact" => Ok(InverseCdf::Exact),
         other => bail!("'{other}' is not an inverse-CDF mode (polynomial | exact)"),
+    }
+}
+
+pub fn parse_layout(s: &str) -> Result<VpLayout> {
+    match s {
+        "paper" => Ok(VpLayout::Paper),
+        "screen-clipped" => Ok(VpLayout::ScreenClipped),
+        other => bail!("'{other}' is not a Visual-Polar layout (paper | screen-clipped)"),
+    }
+}
+
+/// The name `parse_layout` reads (report.json, messages).
+pub fn layout_name(layout: VpLayout) -> &'static str {
+    match layout {
+        VpLayout::Paper => "paper",
+        VpLayout::ScreenClipped => "screen-clipped",
     }
 }
 
@@ -92,6 +110,9 @@ impl RenderProfile {
                 };
                 p.radius_mode = parse_radius(&text).with_context(|| format!("{}.radius", at("visual_polar")))?;
             }
+            if let Some(layout) = vp.layout {
+                p.layout = parse_layout(&layout).with_context(|| format!("{}.layout", at("visual_polar")))?;
+            }
             p.validate().with_context(|| at("visual_polar"))?;
         }
         if let Some(blur) = file.blur {
@@ -113,6 +134,9 @@ impl RenderProfile {
         }
         if let Some(radius) = &o.radius {
             p.radius_mode = parse_radius(radius).context("--vp-radius")?;
+        }
+        if let Some(layout) = &o.layout {
+            p.layout = parse_layout(layout).context("--vp-layout")?;
         }
         p.validate().context("Visual-Polar flags")?;
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
@@ -149,12 +173,18 @@ mod tests {
         assert_eq!(p.visual_polar.clip_fraction, d.clip_fraction);
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Polynomial);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
+        assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.blur.sigma_at_30, 6.8);
     }
 
     #[test]
     fn values_are_read() {
-        let p = load_str("a.toml", "[visual_polar]\nclip_fraction = 0.088\ninverse_cdf = \"exact\"\nradius = 900\n[blur]\nsigma_at_30 = 0\n").unwrap();
+        let p = load_str(
+            "a.toml",
+            "[visual_polar]\nclip_fraction = 0.088\ninverse_cdf = \"exact\"\nradius = 900\nlayout = \"screen-clipped\"\n[blur]\nsigma_at_30 = 0\n",
+        )
+        .unwrap();
+        assert_eq!(p.visual_polar.layout, VpLayout::ScreenClipped);
         assert_eq!(p.visual_polar.clip_fraction, 0.088);
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Exact);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(900.0));
@@ -169,6 +199,8 @@ mod tests {
             ("range.toml", "[visual_polar]\nclip_fraction = 0.7\n", "clip_fraction"),
             ("mode.toml", "[visual_polar]\ninverse_cdf = \"cubic\"\n", "inverse_cdf"),
             ("radius.toml", "[visual_polar]\nradius = -3\n", "radius"),
+            ("layout.toml", "[visual_polar]\nlayout = \"clipped\"\n", "layout"),
+            ("layout_type.toml", "[visual_polar]\nlayout = 1\n", "layout"),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
         ];
@@ -180,9 +212,17 @@ mod tests {
 
     #[test]
     fn flags_override_and_are_checked() {
-        let o = ProfileOverrides { clip_fraction: Some(0.2), radius: Some("500".into()), ..Default::default() };
+        let o = ProfileOverrides {
+            clip_fraction: Some(0.2),
+            radius: Some("500".into()),
+            layout: Some("screen-clipped".into()),
+            ..Default::default()
+        };
         let p = RenderProfile::default().override_with(&o).unwrap();
         assert_eq!(p.visual_polar.clip_fraction, 0.2);
+        assert_eq!(p.visual_polar.layout, VpLayout::ScreenClipped);
+        let bad = ProfileOverrides { layout: Some("full".into()), ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-layout"));
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(500.0));
         let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));

@@ -6,9 +6,9 @@
 
 use super::push_bytes;
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{MipPhiPush, SamplingParams, PHI_MIP_LEVELS};
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
 use std::sync::Arc;
@@ -59,10 +59,11 @@ impl MipPhiPass {
     }
 
     /// Copies `vp_color` (the VP grid of `vp`) into level 0 of `mips` and builds the levels above
-    /// it, one dispatch per level.
-    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, vp_color: &Image, mips: &PhiMips) -> Result<()> {
+    /// it, one dispatch per level. `columns` holds the space's `VisualPolar::column_table`: in the
+    /// screen-clipped layout no level averages across the gap between two on-screen arcs.
+    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, columns: &Buffer, vp_color: &Image, mips: &PhiMips) -> Result<()> {
         for src in 0..mips.levels - 1 {
-            let binds = [read_image("vp_color", vp_color), write_image("mips", &mips.image)];
+            let binds = [read_image("vp_color", vp_color), write_image("mips", &mips.image), read_texels("vp_columns", columns)];
             let push = MipPhiPush {
                 vp_grid: vp.grid,
                 vp_gaze: vp.gaze,

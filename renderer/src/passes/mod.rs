@@ -3,6 +3,7 @@
 
 pub mod accumulate;
 pub mod blur;
+pub mod denoise;
 pub mod mip_phi;
 pub mod raycast;
 pub mod remap;

@@ -1,12 +1,13 @@
 //! Visual-Polar image → screen by backward mapping (visual-polar.md §6): bilinear along ρ,
-//! wrapped trilinear along φ over the φ-only mips.
+//! wrapped trilinear along φ over the φ-only mips (clamped to the pixel's on-screen arc in the
+//! screen-clipped layout).
 
 use super::mip_phi::PhiMips;
 use super::push_bytes;
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{RemapPush, SamplingParams};
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::UVec4;
 use std::sync::Arc;
 
@@ -19,10 +20,10 @@ impl RemapPass {
         Ok(RemapPass { pipeline: ComputePipeline::new(ctx, "passes/remap", std::mem::size_of::<RemapPush>() as u32)? })
     }
 
-    /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` holds the same VP
-    /// parameters (gaze included) the image was traced with.
-    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, mips: &PhiMips, screen: &Image) -> Result<()> {
-        let binds = [read_image("mips", &mips.image), write_image("screen_color", screen)];
+    /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` and `columns` (its
+    /// `VisualPolar::column_table`) hold the same space (gaze included) the image was traced with.
+    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, columns: &Buffer, mips: &PhiMips, screen: &Image) -> Result<()> {
+        let binds = [read_image("mips", &mips.image), write_image("screen_color", screen), read_texels("vp_columns", columns)];
         let push = RemapPush {
             vp_grid: vp.grid,
             vp_gaze: vp.gaze,

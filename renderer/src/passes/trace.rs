@@ -3,7 +3,7 @@
 use super::push_bytes;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
-use crate::graph::{read_buffer, write_buffer, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_texels, write_buffer, write_image, FrameRecorder};
 use crate::layouts::TracePush;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
@@ -20,7 +20,8 @@ pub struct GBuffer {
     pub albedo: Image,
     /// Shading normal (xyz) and linear view depth (w, 0 where nothing was hit).
     pub normal_depth: Image,
-    /// Hit position relative to the camera (xyz) and the depth change per pixel (w).
+    /// Hit position relative to the camera (xyz) and the depth change per grid texel (w; per
+    /// pixel in Cartesian space, per VP texel's screen footprint in Visual-Polar space).
     pub position: Image,
     /// x: triangle index + 1 (0: miss); y: material | mesh << 16.
     pub ids: Image,
@@ -59,7 +60,8 @@ impl TracePass {
     }
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
-    /// frame (reference accumulation); real-time frames use 0.
+    /// frame (reference accumulation); real-time frames use 0. `sampling_table` holds the space's
+    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -67,6 +69,7 @@ impl TracePass {
         scene: &GpuScene,
         frame: &Buffer,
         sampling: &Buffer,
+        sampling_table: &Buffer,
         ray_counters: &Buffer,
         out: &GBuffer,
         sample_index: u32,
@@ -76,6 +79,7 @@ impl TracePass {
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
+            read_texels("sampling_table", sampling_table),
             write_buffer("ray_counters", ray_counters),
             write_image("out_color", &out.color),
             write_image("out_radiance", &out.radiance),

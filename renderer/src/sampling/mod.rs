@@ -4,9 +4,11 @@
 
 mod cartesian;
 mod visual_polar;
+mod visual_polar_clipped;
 
 pub use cartesian::Cartesian;
-pub use visual_polar::{VisualPolar, VisualPolarParams, InverseCdf, RadiusMode};
+pub use visual_polar::{VisualPolar, VisualPolarParams, InverseCdf, RadiusMode, VpLayout};
+pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
 
 use crate::error::Result;
 use crate::layouts::SamplingParams;
@@ -24,6 +26,12 @@ pub trait SamplingSpace {
     fn sample_count(&self) -> u64;
     /// The GPU parameters of this space (binding `sampling`).
     fn params(&self) -> SamplingParams;
+    /// A per-frame table the space's kernel variant reads (RGBA32F texels, binding
+    /// `sampling_table`; Visual-Polar: the per-column on-screen arcs). Empty when the space needs
+    /// none; its length never changes for one space.
+    fn sampling_table(&self) -> Vec<[f32; 4]> {
+        Vec::new()
+    }
     /// Screen position (pixels, y down) of a grid position (texel units, texel centre = +0.5).
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2>;
     /// Grid position of a screen position; `None` where the space has no sample.

@@ -14,6 +14,10 @@
 //! the fovea has uniform areal density. Continuous grid coordinates use the same per-column step
 //! (φ = 2π·y/n(floor x)), so forward and inverse are exact inverses and a jittered texel stays in its
 //! column. Removed area ≈ u_f/2 of the grid, so u_f = 2 · clip_fraction.
+//!
+//! That is the paper's layout (`VpLayout::Paper`, the default). `VpLayout::ScreenClipped` keeps
+//! the grid and the row counts but lays each column's rows on the on-screen part of its circle
+//! only: `visual_polar_clipped.rs`.
 
 use super::SamplingSpace;
 use crate::error::{Error, Result};
@@ -47,6 +51,18 @@ pub enum RadiusMode {
     Fixed(f32),
 }
 
+/// How a column's φ rows are laid on its circle around the gaze.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VpLayout {
+    /// The paper's: every column's rows span the whole circle, on the screen or not (with the gaze
+    /// near a corner ≈ 76 % of the samples land off the screen).
+    Paper,
+    /// Each column's rows span only the on-screen part of its circle (at the column's centre
+    /// radius): same grid, same rows per column, the whole budget on the screen
+    /// (`visual_polar_clipped.rs`).
+    ScreenClipped,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VisualPolarParams {
     /// Per-axis grid scale relative to the screen (2/3: 853×960 for 1280×1440).
@@ -59,6 +75,7 @@ pub struct VisualPolarParams {
     pub density_exponent: f32,
     pub inverse_cdf: InverseCdf,
     pub radius_mode: RadiusMode,
+    pub layout: VpLayout,
 }
 
 impl Default for VisualPolarParams {
@@ -70,6 +87,7 @@ impl Default for VisualPolarParams {
             density_exponent: 1.0,
             inverse_cdf: InverseCdf::Polynomial,
             radius_mode: RadiusMode::FarthestCorner,
+            layout: VpLayout::Paper,
         }
     }
 }
@@ -417,12 +435,30 @@ impl VisualPolar {
     }
 
     /// The column a continuous grid x belongs to (clamped, so u = 1 stays in the last column).
-    fn column_of(&self, x: f32) -> u32 {
+    pub fn column_of(&self, x: f32) -> u32 {
         (x.max(0.0).floor() as u32).min(self.grid.x - 1)
     }
 
     /// Screen position (pixels, y down) → continuous grid coordinates (texel units). y ∈ [0, n(col)).
+    /// Follows the layout; GLSL: `vp_layout_screen_to_vp` (`vp_screen_to_vp` is the paper's).
     pub fn screen_to_vp(&self, s: Vec2) -> Vec2 {
+        match self.params.layout {
+            VpLayout::Paper => self.paper_screen_to_vp(s),
+            VpLayout::ScreenClipped => self.clipped_screen_to_vp(s),
+        }
+    }
+
+    /// Continuous grid coordinates → screen position (pixels). Follows the layout; GLSL:
+    /// `vp_layout_vp_to_screen` (`vp_vp_to_screen` is the paper's).
+    pub fn vp_to_screen(&self, g: Vec2) -> Vec2 {
+        match self.params.layout {
+            VpLayout::Paper => self.paper_vp_to_screen(g),
+            VpLayout::ScreenClipped => self.clipped_vp_to_screen(g),
+        }
+    }
+
+    /// The paper layout's `screen_to_vp` (GLSL `vp_screen_to_vp`).
+    pub fn paper_screen_to_vp(&self, s: Vec2) -> Vec2 {
         let d = s - self.gaze;
         let r = d.length();
         let mut phi = d.y.atan2(d.x);
@@ -436,8 +472,8 @@ impl VisualPolar {
         Vec2::new(x, if y >= n { 0.0 } else { y })
     }
 
-    /// Continuous grid coordinates → screen position (pixels). φ wraps (any y is accepted).
-    pub fn vp_to_screen(&self, g: Vec2) -> Vec2 {
+    /// The paper layout's `vp_to_screen` (GLSL `vp_vp_to_screen`). φ wraps (any y is accepted).
+    pub fn paper_vp_to_screen(&self, g: Vec2) -> Vec2 {
         let n = self.rows_in_column(self.column_of(g.x)) as f32;
         let phi = g.y / n * TAU;
         let r = self.r_of_u(g.x / self.grid.x as f32);
@@ -446,7 +482,8 @@ impl VisualPolar {
 
     /// The parameters as the GPU gets them (binding `sampling`; unpacked by `vp_unpack` in
     /// `visual_polar_math.glsl`): grid = (grid w, grid h, screen w, screen h),
-    /// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, exact, fovea°, 0).
+    /// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
+    /// shape1 = (cdf_max, exact, fovea°, layout: 0 paper, 1 screen-clipped).
     pub fn sampling_params(&self) -> SamplingParams {
         SamplingParams {
             grid: UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y),
@@ -461,15 +498,16 @@ impl VisualPolar {
                 self.cdf_max,
                 self.exact as u32 as f32,
                 self.params.fovea_deg,
-                0.0,
+                (self.params.layout == VpLayout::ScreenClipped) as u32 as f32,
             ),
         }
     }
 }
 
 /// The tracer's view of the space: one sample per kept texel; the GPU twin is
-/// `shaders/sampling/visual_polar.glsl` (kernel variant `visual_polar`). Samples may land off the
-/// screen (the r_max circle covers the corners); they are traced, as in the paper.
+/// `shaders/sampling/visual_polar.glsl` (kernel variant `visual_polar`). With the paper's layout
+/// samples may land off the screen (the r_max circle covers the corners); they are traced, as in
+/// the paper. The screen-clipped layout keeps them on it.
 impl SamplingSpace for VisualPolar {
     fn name(&self) -> &'static str {
         "vp"
@@ -488,6 +526,10 @@ impl SamplingSpace for VisualPolar {
     }
     fn params(&self) -> SamplingParams {
         self.sampling_params()
+    }
+    /// The per-column arcs (`column_table`): full circles in the paper's layout.
+    fn sampling_table(&self) -> Vec<[f32; 4]> {
+        self.column_table()
     }
     /// `None` outside the grid and in clipped texels (the texel is `floor(grid)`).
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {

@@ -6,6 +6,7 @@ use crate::output::{prepare_output_dir, write_exr, write_png};
 use crate::gaze::GazeDriver;
 use anyhow::{bail, Context, Result};
 use fovea_hal::GazeOrigin;
+use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use crate::render_profile::RenderProfile;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar};
@@ -35,6 +36,8 @@ pub struct RenderArgs<'a> {
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
+    /// `none` or `svgf` (`DenoiserSettings::NAMES`).
+    pub denoiser: &'a str,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
@@ -45,6 +48,8 @@ pub const METHODS: &[&str] = &["vp", "cartesian"];
 #[derive(Serialize)]
 struct Report {
     method: String,
+    /// Denoiser in the sampling grid (`none`, `svgf`).
+    denoiser: String,
     scene: String,
     headset: String,
     gaze_source: String,
@@ -93,6 +98,8 @@ struct VpReport {
     density_exponent: f32,
     inverse_cdf: String,
     radius: String,
+    /// "paper" or "screen-clipped".
+    layout: String,
 }
 
 #[derive(Serialize, Default)]
@@ -116,6 +123,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !METHODS.contains(&args.method) {
         bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
     }
+    let denoiser = DenoiserSettings::parse(args.denoiser).context("--denoiser")?;
     let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
     let scene = crate::scenes::load(args.scene)?;
     let Some(camera) = scene.default_camera() else {
@@ -129,6 +137,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         seed: args.seed,
         exposure: args.exposure,
         blur: args.profile.blur,
+        denoiser,
         ..Default::default()
     };
     let screen = UVec2::new(width, height);
@@ -199,6 +208,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let rays = RayReport { primary: rays.primary / n, shadow: rays.shadow / n, continuation: rays.continuation / n };
     let report = Report {
         method: args.method.to_string(),
+        denoiser: denoiser.name().to_string(),
         scene: scene.source.display().to_string(),
         headset: hmd.id.clone(),
         gaze_source: args.gaze.to_string(),
@@ -229,11 +239,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let path = args.out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     println!(
-        "rendered {} frame(s) of {}×{} ({}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
+        "rendered {} frame(s) of {}×{} ({}, denoiser {}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
         args.frames,
         width,
         height,
         report.method,
+        report.denoiser,
         grid.x,
         grid.y,
         report.samples_traced,
@@ -261,5 +272,6 @@ fn vp_report(profile: &RenderProfile) -> VpReport {
             RadiusMode::FarthestCorner => "corner".into(),
             RadiusMode::Fixed(r) => format!("{r}"),
         },
+        layout: crate::render_profile::layout_name(p.layout).into(),
     }
 }

@@ -1,0 +1,85 @@
+//! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
+//! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
+//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF now;
+//! A-SVGF, BMFR, TAA fit beside it), one pass = one module + one shader (a variant per sampling
+//! space, `shaders/passes/denoise/`) + one push-constant struct in `layouts.glsl`; the grid
+//! addressing they share is `shaders/denoise/grid.glsl`.
+
+pub mod modulate;
+pub mod svgf;
+
+use crate::error::{Error, Result};
+use crate::graph::FrameRecorder;
+use crate::layouts::SamplingParams;
+use crate::passes::trace::GBuffer;
+use crate::vk::{Context, Image};
+use glam::UVec2;
+use std::sync::Arc;
+use svgf::{Svgf, SvgfSettings};
+
+/// Which denoiser runs after the tracer (`fovea render --denoiser`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum DenoiserSettings {
+    /// The tracer's 1-sample colour goes to the screen as is.
+    #[default]
+    None,
+    Svgf(SvgfSettings),
+}
+
+impl DenoiserSettings {
+    /// The names `parse` accepts.
+    pub const NAMES: &'static [&'static str] = &["none", "svgf"];
+
+    /// A denoiser by name, with its defaults.
+    pub fn parse(name: &str) -> Result<DenoiserSettings> {
+        match name {
+            "none" => Ok(DenoiserSettings::None),
+            "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
+            other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            DenoiserSettings::None => "none",
+            DenoiserSettings::Svgf(_) => "svgf",
+        }
+    }
+}
+
+/// The sampling space of this frame and of the previous one (its gaze differs; `None` when there
+/// is no usable previous frame, which drops all history).
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiseFrame {
+    pub current: SamplingParams,
+    pub previous: Option<SamplingParams>,
+}
+
+/// A denoiser with its per-eye state.
+pub enum Denoiser {
+    Svgf(Box<Svgf>),
+}
+
+impl Denoiser {
+    /// `variant` is the sampling space's kernel variant (`SamplingSpace::shader_variant`).
+    pub fn new(ctx: &Arc<Context>, settings: &DenoiserSettings, grid: UVec2, variant: &str) -> Result<Option<Denoiser>> {
+        Ok(match settings {
+            DenoiserSettings::None => None,
+            DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
+        })
+    }
+
+    /// Dispatches one frame records at most.
+    pub fn max_passes(&self) -> u32 {
+        match self {
+            Denoiser::Svgf(s) => s.max_passes(),
+        }
+    }
+
+    /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
+    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+        match self {
+            Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
+        }
+    }
+}

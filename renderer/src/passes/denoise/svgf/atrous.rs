@@ -1,0 +1,52 @@
+//! One SVGF à-trous iteration: 5×5 B3-spline taps `step` texels apart, edge-stopped by depth,
+//! normal and variance-scaled luminance; variance filtered with the squared weights.
+
+use super::SvgfSettings;
+use crate::error::Result;
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{SamplingParams, SvgfAtrousPush};
+use crate::passes::push_bytes;
+use crate::passes::trace::GBuffer;
+use crate::vk::{ComputePipeline, Context, Image};
+use glam::{UVec4, Vec4};
+use std::sync::Arc;
+
+pub struct AtrousPass {
+    pipeline: ComputePipeline,
+}
+
+impl AtrousPass {
+    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AtrousPass> {
+        let shader = format!("passes/denoise/svgf_atrous.{variant}");
+        Ok(AtrousPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfAtrousPush>() as u32)? })
+    }
+
+    /// `src` → `dst` (both colour, variance), taps `step` texels apart.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        src: &Image,
+        dst: &Image,
+        step: u32,
+        space: &SamplingParams,
+        s: &SvgfSettings,
+    ) -> Result<()> {
+        let binds = [
+            read_image("src", src),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            write_image("dst", dst),
+        ];
+        let push = SvgfAtrousPush {
+            vp_grid: space.grid,
+            vp_gaze: space.gaze,
+            vp_shape0: space.shape0,
+            vp_shape1: space.shape1,
+            params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, 0.0),
+            config: UVec4::new(step, 0, 0, 0),
+        };
+        rec.dispatch("svgf_atrous", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+    }
+}

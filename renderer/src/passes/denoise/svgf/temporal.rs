@@ -1,0 +1,67 @@
+//! SVGF temporal accumulation: reprojection with bilinear same-surface taps (3×3 search when they
+//! all fail), colour and luminance moments blended with α = max(α_min, 1/history).
+
+use super::{SvgfHistory, SvgfSettings};
+use crate::error::Result;
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{SamplingParams, SvgfTemporalPush};
+use crate::passes::push_bytes;
+use crate::passes::trace::GBuffer;
+use crate::vk::{ComputePipeline, Context, Image};
+use glam::Vec4;
+use std::sync::Arc;
+
+pub struct TemporalPass {
+    pipeline: ComputePipeline,
+}
+
+impl TemporalPass {
+    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<TemporalPass> {
+        let shader = format!("passes/denoise/svgf_temporal.{variant}");
+        Ok(TemporalPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfTemporalPush>() as u32)? })
+    }
+
+    /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance). `previous`:
+    /// the previous frame's space, `None` to start every history afresh.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        h: &SvgfHistory,
+        prev: usize,
+        cur: usize,
+        accum: &Image,
+        current: &SamplingParams,
+        previous: Option<&SamplingParams>,
+        s: &SvgfSettings,
+    ) -> Result<()> {
+        let binds = [
+            read_image("radiance", &g.radiance),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            read_image("ids", &g.ids),
+            read_image("motion", &g.motion),
+            read_image("prev_color", &h.color),
+            read_image("prev_moments", &h.moments[prev]),
+            read_image("prev_surface", &h.surface[prev]),
+            write_image("accum", accum),
+            write_image("moments", &h.moments[cur]),
+            write_image("surface", &h.surface[cur]),
+        ];
+        // The grid and screen never change for one renderer: only the gaze-dependent slots travel.
+        let p = previous.unwrap_or(current);
+        let reset = if previous.is_none() { 1.0 } else { 0.0 };
+        let push = SvgfTemporalPush {
+            vp_grid: current.grid,
+            vp_gaze: current.gaze,
+            vp_shape0: current.shape0,
+            vp_shape1: current.shape1,
+            prev_gaze: p.gaze,
+            prev_shape0: p.shape0,
+            prev_shape1: p.shape1,
+            params: Vec4::new(s.alpha_color, s.alpha_moments, s.max_history as f32, reset),
+        };
+        rec.dispatch("svgf_temporal", &self.pipeline, &binds, push_bytes(&push), [accum.width, accum.height, 1])
+    }
+}

@@ -1,0 +1,52 @@
+//! SVGF variance: temporal where the history is long enough, else a 7×7 edge-stopped spatial
+//! estimate from the moments.
+
+use super::SvgfSettings;
+use crate::error::Result;
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{SamplingParams, SvgfVariancePush};
+use crate::passes::push_bytes;
+use crate::passes::trace::GBuffer;
+use crate::vk::{ComputePipeline, Context, Image};
+use glam::Vec4;
+use std::sync::Arc;
+
+pub struct VariancePass {
+    pipeline: ComputePipeline,
+}
+
+impl VariancePass {
+    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<VariancePass> {
+        let shader = format!("passes/denoise/svgf_variance.{variant}");
+        Ok(VariancePass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfVariancePush>() as u32)? })
+    }
+
+    /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        accum: &Image,
+        moments: &Image,
+        dst: &Image,
+        space: &SamplingParams,
+        s: &SvgfSettings,
+    ) -> Result<()> {
+        let binds = [
+            read_image("accum", accum),
+            read_image("moments", moments),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            write_image("dst", dst),
+        ];
+        let push = SvgfVariancePush {
+            vp_grid: space.grid,
+            vp_gaze: space.gaze,
+            vp_shape0: space.shape0,
+            vp_shape1: space.shape1,
+            params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, s.variance_history as f32),
+        };
+        rec.dispatch("svgf_variance", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+    }
+}

@@ -1,0 +1,54 @@
+#version 460
+// SVGF variance estimate (Schied et al. 2017, §4.2): the temporal variance where the history is
+// long enough; below that, colour and moments are averaged over a 7×7 edge-stopped neighbourhood
+// and the variance from those moments is boosted by 4/history (few frames underestimate it).
+//! variant cartesian: SAMPLING_CARTESIAN
+//! variant visual_polar: SAMPLING_VISUAL_POLAR
+#include "../../common/layouts.glsl"
+#include "../../denoise/grid.glsl"
+#include "../../denoise/svgf.glsl"
+
+layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
+layout(push_constant) uniform Push { SvgfVariancePush p; } push;
+layout(set = 0, binding = 0, rgba32f) uniform readonly image2D accum;      // colour, temporal variance
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D moments;    // m1, m2, history length
+layout(set = 0, binding = 2, rgba32f) uniform readonly image2D normal_depth;
+layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;   // w: depth gradient per texel
+layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D dst;       // colour, variance
+
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    if (any(greaterThanEqual(t, g.size))) return;
+    if (!grid_holds_sample(g, t)) {
+        imageStore(dst, t, vec4(0.0));
+        return;
+    }
+    vec4 centre = imageLoad(accum, t);
+    vec3 cm = imageLoad(moments, t).xyz;
+    if (cm.z >= push.p.params.w) {
+        imageStore(dst, t, centre);
+        return;
+    }
+    SvgfSurface s = svgf_surface(imageLoad(normal_depth, t), imageLoad(position, t).w, uvec2(0u));
+    float l = svgf_luminance(centre.rgb);
+    vec3 sum_c = centre.rgb;
+    vec2 sum_m = cm.xy;
+    float sum_w = 1.0;
+    for (int dy = -3; dy <= 3; ++dy) {
+        for (int dx = -3; dx <= 3; ++dx) {
+            ivec2 q;
+            if ((dx == 0 && dy == 0) || !grid_tap(g, t, ivec2(dx, dy), q) || !grid_holds_sample(g, q)) continue;
+            vec3 c = imageLoad(accum, q).rgb;
+            SvgfSurface sq = svgf_surface(imageLoad(normal_depth, q), 0.0, uvec2(0u));
+            float w = svgf_edge_weight(s, sq, length(vec2(dx, dy)), push.p.params.y, push.p.params.z,
+                                       l - svgf_luminance(c), push.p.params.x);
+            sum_c += w * c;
+            sum_m += w * imageLoad(moments, q).xy;
+            sum_w += w;
+        }
+    }
+    vec2 m = sum_m / sum_w;
+    float variance = max(m.y - m.x * m.x, 0.0) * 4.0 / max(cm.z, 1.0);
+    imageStore(dst, t, vec4(sum_c / sum_w, variance));
+}

@@ -1,0 +1,434 @@
+//! Denoisers in the sampling grid (issue 5): SVGF in Cartesian and Visual-Polar space.
+//! Noise reduction against a converged reference on the Cornell box (whole frame, fovea and
+//! eccentricity rings, after the remap for VP); no NaN/Inf/negative output with fireflies, NaNs
+//! and an empty view; no history across a disocclusion (synthetic G-buffers with a moving
+//! occluder); the φ seam filtered like any other angle; the `--denoiser` flag end to end.
+
+use ash::vk;
+use fovea_renderer::graph::FrameRecorder;
+use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
+use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
+use fovea_renderer::passes::trace::GBuffer;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
+use fovea_renderer::to_screen::BlurSettings;
+use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_tests::{assert_clean, gpu, owned_scene, read_image, rmse, save_preview, write_image};
+use glam::{Mat4, UVec2, Vec2};
+use std::sync::Arc;
+
+const SCREEN: UVec2 = UVec2::new(64, 72);
+
+fn hash(mut v: u32) -> f32 {
+    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
+    ((v >> 22) ^ v) as f32 / u32::MAX as f32
+}
+
+fn spaces(screen: UVec2) -> [(&'static str, Box<dyn SamplingSpace>); 2] {
+    let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    [("cartesian", Box::new(Cartesian::new(screen))), ("vp", Box::new(vp))]
+}
+
+/// The blur is off: the VP comparison measures sampling + denoising only.
+fn settings(denoiser: DenoiserSettings) -> RenderSettings {
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, denoiser, ..Default::default() }
+}
+
+fn with_svgf() -> DenoiserSettings {
+    DenoiserSettings::Svgf(SvgfSettings::default())
+}
+
+fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
+    FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
+}
+
+fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
+    for (i, p) in pixels.iter().enumerate() {
+        assert!(p.iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: texel {i} = {p:?}");
+    }
+}
+
+/// RMSE over the pixels `keep` selects.
+fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: impl Fn(usize) -> bool) -> f64 {
+    let (a, b): (Vec<[f32; 4]>, Vec<[f32; 4]>) = a.iter().zip(b).enumerate().filter(|(i, _)| keep(*i)).map(|(_, (x, y))| (*x, *y)).unzip();
+    rmse(&a, &b)
+}
+
+/// Screen pixels whose 3×3 neighbourhood *in the sampling grid* (around the texel the pixel falls
+/// in; Visual-Polar neighbours at the same angle, φ wrapping) is one surface: same material, depth
+/// within 5 %, normals within ~25°, from the space's traced G-buffer. Without TAA (not part of
+/// SVGF) an edge texel shows one surface per frame where the reference averages several: aliasing
+/// at the grid's resolution, not noise.
+fn surface_interiors(ctx: &Arc<Context>, g: &GBuffer, space: &dyn SamplingSpace) -> Vec<bool> {
+    let ids: Vec<[u32; 2]> = read_image(ctx, &g.ids);
+    let nd: Vec<[f32; 4]> = read_image(ctx, &g.normal_depth);
+    let (grid, screen) = (space.grid_size(), space.screen_size());
+    let rows = |c: u32| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(c));
+    let at = |x: u32, y: u32| (y * grid.x + x) as usize;
+    let same = |i: usize, q: usize| {
+        let dot = (0..3).map(|c| nd[i][c] * nd[q][c]).sum::<f32>();
+        ids[q][0] != 0 && ids[q][1] & 0xffff == ids[i][1] & 0xffff && (nd[q][3] - nd[i][3]).abs() < 0.05 * nd[i][3] && dot > 0.9
+    };
+    let cartesian = space.visual_polar().is_none();
+    (0..screen.x * screen.y)
+        .map(|p| {
+            let centre = Vec2::new((p % screen.x) as f32 + 0.5, (p / screen.x) as f32 + 0.5);
+            let Some(gp) = space.screen_to_grid(centre) else { return false };
+            let (tx, ty) = (gp.x as u32, gp.y as u32);
+            let (n, i) = (rows(tx), at(tx, ty));
+            (-1..=1i32).all(|dx| {
+                let c = tx as i32 + dx;
+                if c < 0 || c >= grid.x as i32 {
+                    return true;
+                }
+                let nc = rows(c as u32) as i32;
+                let row = ((ty as f32 + 0.5) * nc as f32 / n as f32) as i32;
+                (-1..=1i32).all(|dy| {
+                    let r = row + dy;
+                    if cartesian && (r < 0 || r >= nc) {
+                        return true;
+                    }
+                    same(i, at(c as u32, r.rem_euclid(nc) as u32))
+                })
+            })
+        })
+        .collect()
+}
+
+/// Still camera on the Cornell box at 128×144 (5 à-trous iterations span ±62 px; at much smaller
+/// sizes they flatten whole walls' shading): 16 SVGF frames against the raw 1-sample frame, both
+/// against a 256-spp Cartesian reference, on the screen (VP after the remap, blur off). Asserted on
+/// surface interiors at the grid's resolution (`surface_interiors`), whole frame and fovea; rings
+/// around the gaze and the whole frame with edges are printed.
+#[test]
+fn svgf_reduces_noise_fourfold_in_both_spaces() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let size = UVec2::new(128, 144);
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
+    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    drop(reference_renderer);
+    save_preview("denoise_reference.png", size.x, size.y, &reference);
+
+    for (name, space) in spaces(size) {
+        let gaze = space.gaze();
+        let vp = space.visual_polar().copied();
+        let r_fovea = vp.map_or(size.x as f32 * 0.1, |v| v.r_fovea());
+        let r_max = (gaze.max(size.as_vec2() - gaze)).length();
+        let radius = |i: usize| (Vec2::new((i as u32 % size.x) as f32 + 0.5, (i as u32 / size.x) as f32 + 0.5) - gaze).length();
+        let ring_edges = [0.0, r_fovea, r_fovea + (r_max - r_fovea) / 3.0, r_fovea + 2.0 * (r_max - r_fovea) / 3.0, r_max + 1.0];
+
+        let mut raw_renderer = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut raw = Vec::new();
+        raw_renderer.render_frame(&frame(camera, 0)).unwrap();
+        raw_renderer.read_hdr(&mut raw).unwrap();
+        drop(raw_renderer);
+
+        let space: Box<dyn SamplingSpace> = match vp {
+            Some(v) => Box::new(v),
+            None => Box::new(Cartesian::new(size)),
+        };
+        let mut r = Renderer::new(&ctx, &scene, space, settings(with_svgf())).unwrap();
+        let mut denoised = Vec::new();
+        for f in 0..16 {
+            r.render_frame(&frame(camera, f)).unwrap();
+        }
+        r.read_hdr(&mut denoised).unwrap();
+        assert_finite_non_negative(name, &denoised);
+        let interior = surface_interiors(&ctx, &r.gbuffer, r.space());
+        save_preview(&format!("denoise_{name}_raw.png"), size.x, size.y, &raw);
+        save_preview(&format!("denoise_{name}_svgf.png"), size.x, size.y, &denoised);
+
+        let factor = |keep: &dyn Fn(usize) -> bool| {
+            let (a, b) = (rmse_where(&raw, &reference, keep), rmse_where(&denoised, &reference, keep));
+            (a, b, a / b)
+        };
+        let (a, b, whole) = factor(&|i| interior[i]);
+        let (_, _, fovea) = factor(&|i| interior[i] && radius(i) < r_fovea);
+        let (ea, eb, with_edges) = factor(&|_| true);
+        let rings: Vec<String> = ring_edges
+            .windows(2)
+            .map(|e| {
+                let (a, b, f) = factor(&|i| interior[i] && radius(i) >= e[0] && radius(i) < e[1]);
+                format!("[{:.0}, {:.0}) px {a:.4} → {b:.4} ({f:.1}×)", e[0], e[1].min(r_max))
+            })
+            .collect();
+        println!(
+            "{name}: surface interiors RMSE {a:.4} → {b:.4}: {whole:.2}× whole frame, {fovea:.2}× fovea (r < {r_fovea:.1} px); \
+             rings {}; with edges {ea:.4} → {eb:.4} ({with_edges:.2}×)",
+            rings.join(", ")
+        );
+        assert!(whole >= 4.0, "{name}: whole-frame RMSE fell only {whole:.2}×");
+        assert!(fovea >= 4.0, "{name}: fovea RMSE fell only {fovea:.2}×");
+        let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
+        for pass in ["svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_modulate"] {
+            assert!(names.contains(&pass), "{name}: pass {pass} missing from {names:?}");
+        }
+    }
+    assert_clean(&ctx);
+}
+
+/// Any plain-old-data texels into an image of the matching format.
+fn upload<T: bytemuck::Pod>(ctx: &Arc<Context>, image: &Image, texels: &[T]) {
+    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    rec.copy_buffer_to_image("test_upload", &buffer, image).unwrap();
+    rec.submit_and_wait().unwrap();
+}
+
+/// One sample of a synthetic G-buffer: a grey radiance on a face-on surface.
+#[derive(Clone, Copy)]
+struct Sample {
+    radiance: f32,
+    depth: f32,
+    mesh: u32,
+    /// Previous screen position.
+    motion: Vec2,
+}
+
+const HALF_ONE: u16 = 0x3c00;
+
+/// Fills the G-buffer like the tracer would: `None` = a texel without a sample.
+fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, samples: &[Option<Sample>]) {
+    let grey = |s: &Option<Sample>| s.map_or([0.0; 4], |s| [s.radiance, s.radiance, s.radiance, 1.0]);
+    let colour: Vec<[f32; 4]> = samples.iter().map(grey).collect();
+    write_image(ctx, &g.color, &colour);
+    write_image(ctx, &g.radiance, &colour);
+    upload(ctx, &g.albedo, &samples.iter().map(|s| if s.is_some() { [HALF_ONE; 4] } else { [0u16; 4] }).collect::<Vec<_>>());
+    write_image(ctx, &g.normal_depth, &samples.iter().map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, 1.0, s.depth])).collect::<Vec<_>>());
+    write_image(ctx, &g.position, &samples.iter().map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, -s.depth, 0.01])).collect::<Vec<_>>());
+    upload(ctx, &g.ids, &samples.iter().map(|s| s.map_or([0u32; 2], |s| [1, s.mesh << 16])).collect::<Vec<_>>());
+    upload(ctx, &g.motion, &samples.iter().map(|s| s.map_or([-1.0f32; 2], |s| s.motion.to_array())).collect::<Vec<_>>());
+}
+
+/// Runs one SVGF frame; returns its output (re-modulated) and moments (z = history length).
+fn denoise(ctx: &Arc<Context>, svgf: &mut Svgf, g: &GBuffer, frame: &DenoiseFrame) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let mut rec = FrameRecorder::new(ctx, 16).unwrap();
+    rec.begin().unwrap();
+    svgf.record(&mut rec, g, frame).unwrap();
+    rec.submit_and_wait().unwrap();
+    (read_image(ctx, &svgf.output), read_image(ctx, svgf.moments()))
+}
+
+/// Screen position of each grid texel's centre (`None`: no sample there).
+fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
+    let g = space.grid_size();
+    (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
+}
+
+/// Fireflies (huge, infinite and NaN radiance injected into a traced Cornell frame) and an empty
+/// view: every output texel stays finite and non-negative, the empty view exactly black.
+#[test]
+fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    // Turned around, the camera looks out of the box's open side into nothing.
+    let away = CameraPose { world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..camera };
+    for (name, space) in spaces(SCREEN) {
+        let grid = space.grid_size();
+        let variant = space.shader_variant();
+        let mut r = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut svgf = Svgf::new(&ctx, grid, variant, SvgfSettings::default()).unwrap();
+        let mut previous = None;
+        let mut peak = 0f32;
+        for f in 0..6 {
+            r.render_frame(&frame(camera, f)).unwrap();
+            let mut radiance: Vec<[f32; 4]> = read_image(&ctx, &r.gbuffer.radiance);
+            let kept: Vec<usize> = (0..radiance.len()).filter(|&i| radiance[i][3] > 0.0).collect();
+            let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
+            radiance[pick(1)] = [1e30, 1e30, 1e30, 1.0];
+            radiance[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
+            radiance[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
+            radiance[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
+            write_image(&ctx, &r.gbuffer.radiance, &radiance);
+            let current = r.space().params();
+            let (out, moments) = denoise(&ctx, &mut svgf, &r.gbuffer, &DenoiseFrame { current, previous });
+            previous = Some(current);
+            assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
+            assert_finite_non_negative(&format!("{name} frame {f} moments"), &moments);
+            peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+        }
+        println!("{name}: brightest output with fireflies {peak:.1}");
+
+        let mut r = Renderer::new(&ctx, &scene, r.space().visual_polar().map_or_else(
+            || Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>,
+            |v| Box::new(*v),
+        ), settings(with_svgf())).unwrap();
+        let mut hdr = Vec::new();
+        for f in 0..3 {
+            r.render_frame(&frame(away, f)).unwrap();
+            r.read_hdr(&mut hdr).unwrap();
+            assert!(hdr.iter().all(|p| p[..3] == [0.0; 3]), "{name}: the empty view is not black (frame {f})");
+        }
+        assert_clean(&ctx);
+    }
+}
+
+/// A bright occluder in front of a dim background moves 16 px to the right after 8 frames: the
+/// background it uncovers must start a new history (length 1, no occluder colour), while the
+/// occluder's own history follows its motion and the static background keeps its history.
+#[test]
+fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
+    let ctx = gpu();
+    let (background, occluder) = (0.25f32, 4.0f32);
+    for (name, space) in spaces(SCREEN) {
+        let screens = texel_screens(space.as_ref());
+        let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
+        let mut svgf = Svgf::new(&ctx, space.grid_size(), space.shader_variant(), SvgfSettings::default()).unwrap();
+        let params = space.params();
+        let mut last = (Vec::new(), Vec::new());
+        for f in 0..9u32 {
+            // Frames 0–7: the occluder covers x < 32 (VP samples beyond the screen too); frame 8: x in
+            // [16, 48), moved by 16 px.
+            let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
+            let samples: Vec<Option<Sample>> = screens
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    let s = (*s)?;
+                    let noise = 0.5 + hash(i as u32 * 31 + f * 7919);
+                    Some(if covered.contains(&s.x) {
+                        Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
+                    } else {
+                        Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
+                    })
+                })
+                .collect();
+            upload_gbuffer(&ctx, &g, &samples);
+            let previous = (f > 0).then_some(params);
+            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous });
+        }
+        let (out, moments) = last;
+        let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
+        for (i, s) in screens.iter().enumerate() {
+            // VP samples beyond the screen edge may have had no sample last frame (outside r_max).
+            let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
+            // Margins of a few pixels keep the 3×3 fallback's legitimate same-surface
+            // neighbours (and coarse peripheral VP texels) out of the checked sets.
+            let (len, lum) = (moments[i][2], out[i][1]);
+            if s.x < 14.0 {
+                uncovered += 1;
+                assert_eq!(len, 1.0, "{name}: uncovered texel {i} at {s} kept a history");
+                assert!(lum < 1.0, "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)");
+            } else if s.x > 18.0 && s.x < 46.0 {
+                followed += 1;
+                assert_eq!(len, 9.0, "{name}: the occluder's history at {s} did not follow its motion");
+                assert!(lum > 2.0, "{name}: occluder texel {i} at {s} shows {lum}");
+            } else if s.x > 50.0 {
+                stayed += 1;
+                assert_eq!(len, 9.0, "{name}: static background at {s} lost its history");
+            }
+        }
+        println!("{name}: {uncovered} uncovered, {followed} moved-occluder and {stayed} static texels checked");
+        assert!(uncovered > 20 && followed > 5 && stayed > 20, "{name}: too few texels checked");
+    }
+    assert_clean(&ctx);
+}
+
+/// Visual-Polar: radiance 0.5 + 0.3·sin φ plus noise on one face-on surface. Rows at the seam
+/// (φ ≈ 0, rows 0 and n − 1) sit on a zero crossing exactly like the rows at φ ≈ π; a filter that
+/// does not wrap sees one side only there and is biased by the slope. The seam's error must be no
+/// larger than at φ ≈ π and than the median row of the same columns.
+#[test]
+fn vp_seam_is_filtered_like_any_other_angle() {
+    let ctx = gpu();
+    let screen = UVec2::new(128, 144);
+    let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    let grid = vp.grid_size();
+    let truth = |x: u32, y: u32| 0.5 + 0.3 * (std::f32::consts::TAU * (y as f32 + 0.5) / vp.rows_in_column(x) as f32).sin();
+    let g = GBuffer::new(&ctx, grid).unwrap();
+    let mut svgf = Svgf::new(&ctx, grid, vp.shader_variant(), SvgfSettings::default()).unwrap();
+    let params = vp.sampling_params();
+    let screens = texel_screens(&vp);
+    let mut out = Vec::new();
+    for f in 0..8u32 {
+        let samples: Vec<Option<Sample>> = screens
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
+                let noise = 0.6 * (hash(i as u32 * 13 + f * 104_729) - 0.5);
+                s.map(|s| Sample { radiance: truth(x, y) + noise, depth: 5.0, mesh: 1, motion: s })
+            })
+            .collect();
+        upload_gbuffer(&ctx, &g, &samples);
+        out = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }).0;
+    }
+    assert_finite_non_negative("seam", &out);
+    // Squared error per row position, as a fraction of the column's rows (16 bins), over columns
+    // with at least 32 rows.
+    const BINS: usize = 16;
+    let (mut sum, mut count) = ([0f64; BINS], [0u32; BINS]);
+    let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
+    for x in 0..grid.x {
+        let n = vp.rows_in_column(x);
+        if n < 32 {
+            continue;
+        }
+        for y in 0..n {
+            let e = (out[(y * grid.x + x) as usize][1] - truth(x, y)) as f64;
+            let bin = (y as usize * BINS) / n as usize;
+            sum[bin] += e * e;
+            count[bin] += 1;
+            if y < 2 || y + 2 >= n {
+                seam += e * e;
+                seam_n += 1;
+            } else if y + 2 >= n / 2 && y < n / 2 + 2 {
+                opposite += e * e;
+                opposite_n += 1;
+            }
+        }
+    }
+    let rms: Vec<f64> = (0..BINS).map(|b| (sum[b] / count[b] as f64).sqrt()).collect();
+    let mut sorted = rms.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[BINS / 2];
+    let (seam, opposite) = ((seam / seam_n as f64).sqrt(), (opposite / opposite_n as f64).sqrt());
+    println!("seam rows RMSE {seam:.4}, rows at φ ≈ π {opposite:.4}, median row bin {median:.4}; per bin {rms:.4?}");
+    assert!(seam <= 1.25 * opposite, "seam error {seam} vs {opposite} at φ ≈ π");
+    assert!(seam <= 1.25 * median, "seam error {seam} vs median {median}");
+    assert_clean(&ctx);
+}
+
+/// `fovea render --denoiser svgf`: the report names the denoiser and times its passes.
+#[test]
+fn render_command_runs_svgf_and_reports_it() {
+    use fovea_tools::commands::render::{run, RenderArgs};
+    let out = fovea_tests::artifacts_dir().join(format!("denoise-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    for (method, denoiser) in [("cartesian", "svgf"), ("vp", "svgf"), ("vp", "none")] {
+        run(&RenderArgs {
+            scene: "cornell-box",
+            method,
+            width: Some(40),
+            height: Some(36),
+            scale: 0.25,
+            headset: "fove0",
+            gaze: "sim:3",
+            frames: 2,
+            out: &out,
+            exr: false,
+            camera_path: true,
+            seed: 1,
+            max_depth: 3,
+            exposure: 1.0,
+            profile: Default::default(),
+            debug_views: false,
+            denoiser,
+            device: None,
+            validation: true,
+        })
+        .unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(report["denoiser"], denoiser);
+        for pass in ["svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_modulate"] {
+            assert_eq!(report["passes"].get(pass).is_some(), denoiser == "svgf", "{method}/{denoiser}: pass {pass}");
+        }
+    }
+    assert!(DenoiserSettings::parse("bmfr").is_err());
+}
+
