@@ -65,7 +65,7 @@ impl ColumnArcs {
     /// the last). The φ mips average only rows of one interval and the remap reads only those of
     /// the pixel's, so nothing is blended across a gap.
     pub fn interval_of_row(&self, y: f32, n: f32) -> usize {
-        (1..4).filter(|&j| self.end[j] > self.end[j - 1] && y >= self.arc_row(self.end[j - 1], n)).last().unwrap_or(0)
+        (1..4).rev().find(|&j| self.end[j] > self.end[j - 1] && y >= self.arc_row(self.end[j - 1], n)).unwrap_or(0)
     }
 
     /// The column's two RGBA32F texels in the GPU table: starts, then ends.
@@ -124,7 +124,7 @@ impl ColumnArcs {
 pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
     use std::f64::consts::{FRAC_PI_2, PI, TAU as TAU64};
     let (g, s, r) = (gaze.as_dvec2(), screen.as_dvec2(), r as f64);
-    if !(r > 0.0) || !g.is_finite() {
+    if r.is_nan() || r <= 0.0 || !g.is_finite() {
         return ColumnArcs::FULL;
     }
     // Cut arcs as [lo, hi) within [0, 2π), split where they cross φ = 0.

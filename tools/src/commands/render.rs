@@ -9,7 +9,7 @@ use fovea_hal::GazeOrigin;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use crate::render_profile::RenderProfile;
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -124,6 +124,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
     }
     let denoiser = DenoiserSettings::parse(args.denoiser).context("--denoiser")?;
+    // SVGF reprojects and filters with the paper's mapping (no per-column arc table yet).
+    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
+        bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
+    }
     let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
     let scene = crate::scenes::load(args.scene)?;
     let Some(camera) = scene.default_camera() else {
