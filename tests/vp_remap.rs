@@ -254,9 +254,9 @@ fn foveated_blur_spares_the_fovea_and_spreads_by_sigma() {
     impulse[(py * SCREEN.x + px) as usize] = [1.0, 0.0, 0.0, 1.0];
     let out = blur(&ctx, &shape, &impulse);
     let (mut total, mut var_x, mut var_y) = (0f64, 0f64, 0f64);
-    for i in 0..n {
+    for (i, texel) in out.iter().enumerate() {
         let d = at(i) - (Vec2::new(px as f32, py as f32) + 0.5);
-        let w = out[i][0] as f64;
+        let w = texel[0] as f64;
         total += w;
         var_x += w * (d.x as f64).powi(2);
         var_y += w * (d.y as f64).powi(2);

@@ -132,8 +132,9 @@ struct DefaultRender {
 enum Command {
     /// Render frames to PNG (and EXR) with a timing report.
     Render {
+        // Boxed: the render options dwarf every other command's.
         #[command(flatten)]
-        opts: RenderOpts,
+        opts: Box<RenderOpts>,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -223,7 +224,7 @@ enum Command {
 fn main() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
-        opts: DefaultRender::parse_from(["fovea"]).opts,
+        opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
         device: DeviceArgs { device: None, validation: false },
     });
     match command {
