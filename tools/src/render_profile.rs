@@ -1,9 +1,11 @@
-//! Render profiles (`config/render/*.toml`): the Visual-Polar parameters and the foveated blur.
+//! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
+//! the SVGF parameters (used when `--denoiser svgf`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::to_screen::BlurSettings;
 use serde::Deserialize;
 use std::path::Path;
@@ -12,6 +14,7 @@ use std::path::Path;
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     pub blur: BlurSettings,
+    pub svgf: SvgfSettings,
 }
 
 #[derive(Deserialize, Default)]
@@ -19,6 +22,20 @@ pub struct RenderProfile {
 struct ProfileFile {
     visual_polar: Option<VpSection>,
     blur: Option<BlurSection>,
+    svgf: Option<SvgfSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SvgfSection {
+    alpha_color: Option<f32>,
+    alpha_moments: Option<f32>,
+    max_history: Option<u32>,
+    variance_history: Option<u32>,
+    atrous_iterations: Option<u32>,
+    sigma_luminance: Option<f32>,
+    sigma_depth: Option<f32>,
+    sigma_normal: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -119,6 +136,18 @@ impl RenderProfile {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
         }
         check_blur(&profile.blur).with_context(|| format!("{}.sigma_at_30", at("blur")))?;
+        if let Some(f) = file.svgf {
+            let s = &mut profile.svgf;
+            s.alpha_color = f.alpha_color.unwrap_or(s.alpha_color);
+            s.alpha_moments = f.alpha_moments.unwrap_or(s.alpha_moments);
+            s.max_history = f.max_history.unwrap_or(s.max_history);
+            s.variance_history = f.variance_history.unwrap_or(s.variance_history);
+            s.atrous_iterations = f.atrous_iterations.unwrap_or(s.atrous_iterations);
+            s.sigma_luminance = f.sigma_luminance.unwrap_or(s.sigma_luminance);
+            s.sigma_depth = f.sigma_depth.unwrap_or(s.sigma_depth);
+            s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
+            s.validate().with_context(|| at("svgf"))?;
+        }
         Ok(profile)
     }
 
@@ -175,6 +204,7 @@ mod tests {
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.blur.sigma_at_30, 6.8);
+        assert_eq!(p.svgf, SvgfSettings::default());
     }
 
     #[test]
@@ -203,6 +233,8 @@ mod tests {
             ("layout_type.toml", "[visual_polar]\nlayout = 1\n", "layout"),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
+            ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
+            ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
         ];
         for (name, text, key) in cases {
             let err = format!("{:#}", load_str(name, text).unwrap_err());

@@ -6,6 +6,8 @@
 use anyhow::Result;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
+use fovea_renderer::passes::denoise::svgf::SvgfSettings;
+use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
@@ -36,6 +38,13 @@ pub struct VpFrameReport {
     pub trace_ratio: f64,
     /// (φ-mips + remap + blur) / VP frame (issue target ≤ 0.10 on lavapipe).
     pub to_screen_share: f64,
+    /// SVGF (all its passes) at the same sizes: ms per frame (median), VP / Cartesian, and the
+    /// bytes of history each space carries between frames.
+    pub svgf_cartesian_ms: f64,
+    pub svgf_vp_ms: f64,
+    pub svgf_ratio: f64,
+    pub svgf_cartesian_history_bytes: u64,
+    pub svgf_vp_history_bytes: u64,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
     pub shuffled_mrays_per_s: f64,
@@ -92,6 +101,13 @@ pub fn measure(
     let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), RenderSettings::default())?;
     let vp_passes_ms = pass_medians(&mut vpr, pose, Some(gaze), frames)?;
     drop(vpr);
+    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
+    let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), svgf)?;
+    let (svgf_cartesian_ms, svgf_cartesian_history_bytes) = svgf_cost(&mut cart, pose, None, frames)?;
+    drop(cart);
+    let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), svgf)?;
+    let (svgf_vp_ms, svgf_vp_history_bytes) = svgf_cost(&mut vpr, pose, Some(gaze), frames)?;
+    drop(vpr);
     let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cartesian_passes_ms), frame_ms(&vp_passes_ms));
     let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
 
@@ -117,13 +133,19 @@ pub fn measure(
         vp_passes_ms,
         cartesian_frame_ms,
         vp_frame_ms,
+        svgf_cartesian_ms,
+        svgf_vp_ms,
+        svgf_ratio: svgf_vp_ms / svgf_cartesian_ms,
+        svgf_cartesian_history_bytes,
+        svgf_vp_history_bytes,
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
         coherence_gain: shuffled_ms / ordered_ms,
     };
     println!(
         "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); mips+remap+blur {:.1} % of the VP frame; \
-         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×)",
+         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×); SVGF {:.1} ms VP vs {:.1} ms Cartesian = {:.3}, \
+         history {:.1} vs {:.1} MiB",
         grid.x,
         grid.y,
         report.vp_frame_ms,
@@ -133,9 +155,22 @@ pub fn measure(
         100.0 * report.to_screen_share,
         report.vp_order_mrays_per_s,
         report.shuffled_mrays_per_s,
-        report.coherence_gain
+        report.coherence_gain,
+        report.svgf_vp_ms,
+        report.svgf_cartesian_ms,
+        report.svgf_ratio,
+        report.svgf_vp_history_bytes as f64 / (1 << 20) as f64,
+        report.svgf_cartesian_history_bytes as f64 / (1 << 20) as f64
     );
     Ok(report)
+}
+
+/// Median ms of the denoiser's passes per frame, and its history bytes.
+fn svgf_cost(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(f64, u64)> {
+    let passes = pass_medians(renderer, camera, gaze, frames)?;
+    let ms = passes.iter().filter(|(k, _)| k.starts_with("svgf_")).map(|(_, v)| v).sum();
+    let bytes = renderer.denoiser().map_or(0, |d| d.history_bytes());
+    Ok((ms, bytes))
 }
 
 /// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's

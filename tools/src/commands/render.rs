@@ -32,7 +32,7 @@ pub struct RenderArgs<'a> {
     pub seed: u32,
     pub max_depth: u32,
     pub exposure: f32,
-    /// Visual-Polar parameters and blur (profile file + flags, already merged).
+    /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
@@ -123,7 +123,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !METHODS.contains(&args.method) {
         bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
     }
-    let denoiser = DenoiserSettings::parse(args.denoiser).context("--denoiser")?;
+    let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
+        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
+        other => other,
+    };
     // SVGF reprojects and filters with the paper's mapping (no per-column arc table yet).
     if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
         bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);

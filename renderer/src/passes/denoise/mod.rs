@@ -69,6 +69,13 @@ impl Denoiser {
         })
     }
 
+    /// GPU bytes of the history carried between frames.
+    pub fn history_bytes(&self) -> u64 {
+        match self {
+            Denoiser::Svgf(s) => s.history.bytes(),
+        }
+    }
+
     /// Dispatches one frame records at most.
     pub fn max_passes(&self) -> u32 {
         match self {

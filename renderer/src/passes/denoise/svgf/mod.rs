@@ -115,6 +115,14 @@ impl SvgfHistory {
     fn current(&self) -> usize {
         (self.frames % 2) as usize
     }
+
+    /// GPU bytes of the state carried between frames (the per-eye memory cost of the filter).
+    pub fn bytes(&self) -> u64 {
+        [&self.color, &self.moments[0], &self.moments[1], &self.surface[0], &self.surface[1]]
+            .iter()
+            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
+            .sum()
+    }
 }
 
 pub struct Svgf {
