@@ -6,9 +6,19 @@
 // Screen-clipped layout (visual_polar_clipped.glsl): a column whose rows cover only its on-screen
 // arcs neither wraps (an odd last row keeps its own value) nor averages across the gap between two
 // arcs (a pair split by a gap keeps the row on the output row's side).
+// Two variants: lavapipe executes both sides of every branch, so the paper's layout gets a kernel
+// with the screen-clipped path compiled out.
+//! variant paper: VP_LAYOUT_PAPER
+//! variant clipped: VP_LAYOUT_CLIPPED
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_clipped.glsl"
 #include "../sampling/phi_mips.glsl"
+
+#if defined(VP_LAYOUT_PAPER)
+const bool VP_LAYOUT_MAY_CLIP = false;
+#else
+const bool VP_LAYOUT_MAY_CLIP = true;
+#endif
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { MipPhiPush p; } push;
@@ -43,7 +53,7 @@ void main() {
         vb = imageLoad(mips, ivec2(t.x, offset + b));
     }
     vec4 v = 0.5 * (va + vb);
-    if (P.clipped) {
+    if (VP_LAYOUT_MAY_CLIP && P.clipped) {
         VpArcs arcs = vp_column_arcs(uint(t.x));
         if (!vp_arcs_wrap(arcs)) {
             // Rows by their centres, in level-0 rows.

@@ -9,9 +9,19 @@
 // Near the border a pixel's angle may lie outside the outer column's arcs (that circle leaves the
 // screen sooner): such a clamped column is trusted only within one of its φ texels of the pixel,
 // beyond that the inner column (whose arcs hold the pixel) answers alone.
+// Two variants: lavapipe executes both sides of every branch, so the paper's layout gets a kernel
+// with the screen-clipped path compiled out.
+//! variant paper: VP_LAYOUT_PAPER
+//! variant clipped: VP_LAYOUT_CLIPPED
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_clipped.glsl"
 #include "../sampling/phi_mips.glsl"
+
+#if defined(VP_LAYOUT_PAPER)
+const bool VP_LAYOUT_MAY_CLIP = false;
+#else
+const bool VP_LAYOUT_MAY_CLIP = true;
+#endif
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { RemapPush p; } push;
@@ -83,7 +93,7 @@ vec4 sample_column_clipped(VpParams P, VpArcs arcs, uint col, float phi, float r
 
 vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels, out float trust) {
     trust = 1.0;
-    if (P.clipped) {
+    if (VP_LAYOUT_MAY_CLIP && P.clipped) {
         VpArcs arcs = vp_column_arcs(col);
         if (!vp_arcs_wrap(arcs)) return sample_column_clipped(P, arcs, col, phi, r, levels, trust);
     }

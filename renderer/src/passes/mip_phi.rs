@@ -50,12 +50,19 @@ impl PhiMips {
 }
 
 pub struct MipPhiPass {
-    pipeline: ComputePipeline,
+    /// The paper's layout and the screen-clipped one (`VpLayout`): separate kernels, because
+    /// lavapipe pays for both sides of a branch.
+    paper: ComputePipeline,
+    clipped: ComputePipeline,
 }
 
 impl MipPhiPass {
     pub fn new(ctx: &Arc<Context>) -> Result<MipPhiPass> {
-        Ok(MipPhiPass { pipeline: ComputePipeline::new(ctx, "passes/mip_phi", std::mem::size_of::<MipPhiPush>() as u32)? })
+        let size = std::mem::size_of::<MipPhiPush>() as u32;
+        Ok(MipPhiPass {
+            paper: ComputePipeline::new(ctx, "passes/mip_phi.paper", size)?,
+            clipped: ComputePipeline::new(ctx, "passes/mip_phi.clipped", size)?,
+        })
     }
 
     /// Copies `vp_color` (the VP grid of `vp`) into level 0 of `mips` and builds the levels above
@@ -72,8 +79,17 @@ impl MipPhiPass {
                 config: UVec4::new(src, 0, 0, 0),
             };
             let rows = rows_at_level(vp_color.height, src + 1);
-            rec.dispatch("mip_phi", &self.pipeline, &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
+            rec.dispatch("mip_phi", self.pipeline_for(vp), &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
         }
         Ok(())
+    }
+
+    fn pipeline_for(&self, vp: &SamplingParams) -> &ComputePipeline {
+        // shape1.w: the layout (VisualPolar::sampling_params).
+        if vp.shape1.w != 0.0 {
+            &self.clipped
+        } else {
+            &self.paper
+        }
     }
 }

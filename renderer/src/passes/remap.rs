@@ -12,12 +12,19 @@ use glam::UVec4;
 use std::sync::Arc;
 
 pub struct RemapPass {
-    pipeline: ComputePipeline,
+    /// The paper's layout and the screen-clipped one (`VpLayout`): separate kernels, because
+    /// lavapipe pays for both sides of a branch.
+    paper: ComputePipeline,
+    clipped: ComputePipeline,
 }
 
 impl RemapPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RemapPass> {
-        Ok(RemapPass { pipeline: ComputePipeline::new(ctx, "passes/remap", std::mem::size_of::<RemapPush>() as u32)? })
+        let size = std::mem::size_of::<RemapPush>() as u32;
+        Ok(RemapPass {
+            paper: ComputePipeline::new(ctx, "passes/remap.paper", size)?,
+            clipped: ComputePipeline::new(ctx, "passes/remap.clipped", size)?,
+        })
     }
 
     /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` and `columns` (its
@@ -31,6 +38,15 @@ impl RemapPass {
             vp_shape1: vp.shape1,
             config: UVec4::new(mips.levels, 0, 0, 0),
         };
-        rec.dispatch("remap", &self.pipeline, &binds, push_bytes(&push), [screen.width, screen.height, 1])
+        rec.dispatch("remap", self.pipeline_for(vp), &binds, push_bytes(&push), [screen.width, screen.height, 1])
+    }
+
+    fn pipeline_for(&self, vp: &SamplingParams) -> &ComputePipeline {
+        // shape1.w: the layout (VisualPolar::sampling_params).
+        if vp.shape1.w != 0.0 {
+            &self.clipped
+        } else {
+            &self.paper
+        }
     }
 }
