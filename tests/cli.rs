@@ -31,6 +31,7 @@ fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
         profile: RenderProfile::default(),
         debug_views: false,
         denoiser: "none",
+        taa: "off",
         device: None,
         validation: true,
     }

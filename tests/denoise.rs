@@ -3,10 +3,13 @@
 //! eccentricity rings, after the remap for VP); no NaN/Inf/negative output with fireflies, NaNs
 //! and an empty view; no history across a disocclusion (synthetic G-buffers with a moving
 //! occluder); the φ seam filtered like any other angle; the `--denoiser` flag end to end.
+//! TAA in the sampling grid (Karis 2014): noise and edge aliasing reduced against the reference,
+//! fireflies, disocclusion resets, the tracer's Halton jitter, the `--taa` flag.
 
 use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
+use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
 use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
@@ -419,6 +422,7 @@ fn render_command_runs_svgf_and_reports_it() {
             profile: Default::default(),
             debug_views: false,
             denoiser,
+            taa: "off",
             device: None,
             validation: true,
         })
@@ -432,3 +436,262 @@ fn render_command_runs_svgf_and_reports_it() {
     assert!(DenoiserSettings::parse("bmfr").is_err());
 }
 
+
+fn with_taa(denoiser: DenoiserSettings) -> RenderSettings {
+    RenderSettings { taa: TaaMode::SamplingGrid(TaaSettings::default()), ..settings(denoiser) }
+}
+
+/// Runs one TAA frame on `color`; returns its output.
+fn resolve(ctx: &Arc<Context>, taa: &mut Taa, g: &GBuffer, color: &Image, frame: &DenoiseFrame, jitter: Vec2) -> Vec<[f32; 4]> {
+    let mut rec = FrameRecorder::new(ctx, 4).unwrap();
+    rec.begin().unwrap();
+    let out = taa.record(&mut rec, g, color, frame, jitter).unwrap();
+    rec.submit_and_wait().unwrap();
+    read_image(ctx, out)
+}
+
+/// Still camera on the Cornell box at 64×72: 16 frames of TAA on the raw 1-sample colour against
+/// one raw frame, both against a 256-spp Cartesian reference (random jitter per sample, so
+/// anti-aliased), on the screen (VP after the remap, blur off). TAA must lower the RMSE over the
+/// whole frame, and at geometric edges (texels whose grid 3×3 spans several surfaces, the
+/// complement of `surface_interiors`), where a fixed-jitter 1-sample frame is aliased.
+#[test]
+fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let size = SCREEN;
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
+    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    drop(reference_renderer);
+    for (name, space) in spaces(size) {
+        let vp = space.visual_polar().copied();
+        let again = || -> Box<dyn SamplingSpace> { vp.map_or_else(|| Box::new(Cartesian::new(size)) as Box<dyn SamplingSpace>, |v| Box::new(v)) };
+        let mut raw_renderer = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut raw = Vec::new();
+        raw_renderer.render_frame(&frame(camera, 0)).unwrap();
+        raw_renderer.read_hdr(&mut raw).unwrap();
+        drop(raw_renderer);
+
+        let mut r = Renderer::new(&ctx, &scene, again(), with_taa(DenoiserSettings::None)).unwrap();
+        let mut resolved = Vec::new();
+        for f in 0..16 {
+            r.render_frame(&frame(camera, f)).unwrap();
+        }
+        r.read_hdr(&mut resolved).unwrap();
+        assert_finite_non_negative(name, &resolved);
+        assert!(r.timings().iter().any(|t| t.name == "taa"), "{name}: no taa pass timed");
+        let taa_ms: f64 = r.timings().iter().filter(|t| t.name == "taa").map(|t| t.ms).sum();
+        let interior = surface_interiors(&ctx, &r.gbuffer, r.space());
+        save_preview(&format!("taa_{name}_raw.png"), size.x, size.y, &raw);
+        save_preview(&format!("taa_{name}.png"), size.x, size.y, &resolved);
+        // TAA resolves with Karis's 1/(1 + luma) weights, i.e. it averages in a compressed space:
+        // where a pixel covers part of the light (17× the walls' radiance) that average lies far
+        // below the reference's linear coverage mean, by design (against flicker). Those pixels
+        // (reference luminance > 1) are printed apart; geometric edges elsewhere are asserted.
+        let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        let lit: Vec<bool> = reference.iter().map(|p| luminance(p) > 1.0).collect();
+        let factor = |keep: &dyn Fn(usize) -> bool| {
+            let (a, b) = (rmse_where(&raw, &reference, keep), rmse_where(&resolved, &reference, keep));
+            (a, b, a / b)
+        };
+        let edge_count = (0..interior.len()).filter(|&i| !interior[i] && !lit[i]).count();
+        let (wa, wb, whole) = factor(&|i| !lit[i]);
+        let (ia, ib, inner) = factor(&|i| interior[i] && !lit[i]);
+        let (ea, eb, edges) = factor(&|i| !interior[i] && !lit[i]);
+        let (la, lb, light) = factor(&|i| lit[i]);
+        let (aa, ab, all) = factor(&|_| true);
+        println!(
+            "{name} {}×{}, RMSE 1 raw frame → 16 TAA frames: without the light's pixels {wa:.4} → {wb:.4} ({whole:.2}×), \
+             surface interiors {ia:.4} → {ib:.4} ({inner:.2}×), geometric edges ({edge_count} px) {ea:.4} → {eb:.4} ({edges:.2}×); \
+             light pixels {la:.4} → {lb:.4} ({light:.2}×); everything {aa:.4} → {ab:.4} ({all:.2}×); taa pass {taa_ms:.3} ms",
+            size.x, size.y
+        );
+        assert!(whole >= 2.5, "{name}: RMSE fell only {whole:.2}×");
+        assert!(inner >= 2.5, "{name}: surface-interior RMSE fell only {inner:.2}×");
+        assert!(edges >= 2.0, "{name}: geometric-edge RMSE fell only {edges:.2}×");
+        assert!(edge_count > 100, "{name}: too few edge pixels ({edge_count})");
+    }
+    assert_clean(&ctx);
+}
+
+/// Fireflies (huge, infinite, NaN and negative colour injected into traced Cornell frames) going
+/// into TAA: every output texel stays finite and non-negative.
+#[test]
+fn taa_output_is_finite_and_non_negative_with_fireflies() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    for (name, space) in spaces(SCREEN) {
+        let grid = space.grid_size();
+        let variant = space.shader_variant();
+        let mut r = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut taa = Taa::new(&ctx, grid, variant, TaaSettings::default()).unwrap();
+        let mut previous = None;
+        let mut peak = 0f32;
+        for f in 0..6 {
+            r.render_frame(&frame(camera, f)).unwrap();
+            let mut color: Vec<[f32; 4]> = read_image(&ctx, &r.gbuffer.color);
+            let kept: Vec<usize> = (0..color.len()).filter(|&i| color[i][3] > 0.0).collect();
+            let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
+            color[pick(1)] = [1e30, 1e30, 1e30, 1.0];
+            color[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
+            color[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
+            color[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
+            write_image(&ctx, &r.gbuffer.color, &color);
+            let current = r.space().params();
+            let jitter = TaaSettings::default().jitter(f);
+            let out = resolve(&ctx, &mut taa, &r.gbuffer, &r.gbuffer.color, &DenoiseFrame { current, previous }, jitter);
+            previous = Some(current);
+            assert_finite_non_negative(&format!("{name} frame {f}"), &out);
+            peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+        }
+        println!("{name}: brightest TAA output with fireflies {peak:.1}");
+    }
+    assert_clean(&ctx);
+}
+
+/// The occluder scene of the SVGF disocclusion test through TAA: where the moving occluder
+/// uncovers the background, the output is exactly this frame's sample (history dropped); the
+/// occluder's history follows its motion and the static background keeps its history (blended).
+#[test]
+fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
+    let ctx = gpu();
+    let (background, occluder) = (0.25f32, 4.0f32);
+    for (name, space) in spaces(SCREEN) {
+        let screens = texel_screens(space.as_ref());
+        let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
+        let mut taa = Taa::new(&ctx, space.grid_size(), space.shader_variant(), TaaSettings::default()).unwrap();
+        let params = space.params();
+        let (mut out, mut current) = (Vec::new(), Vec::new());
+        for f in 0..9u32 {
+            let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
+            let samples: Vec<Option<Sample>> = screens
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    let s = (*s)?;
+                    let noise = 0.5 + hash(i as u32 * 31 + f * 7919);
+                    Some(if covered.contains(&s.x) {
+                        Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
+                    } else {
+                        Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
+                    })
+                })
+                .collect();
+            upload_gbuffer(&ctx, &g, &samples);
+            current = samples;
+            // Samples at texel centres: the jitter is the centre.
+            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }, Vec2::splat(0.5));
+        }
+        let (mut uncovered, mut followed, mut stayed, mut blended) = (0, 0, 0, 0);
+        for (i, s) in screens.iter().enumerate() {
+            let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
+            let (got, now) = (out[i][1], current[i].unwrap().radiance);
+            if s.x < 14.0 {
+                uncovered += 1;
+                assert!((got - now).abs() <= 1e-5 * now, "{name}: uncovered texel {i} at {s} shows {got}, this frame's sample is {now}");
+            } else if s.x > 18.0 && s.x < 46.0 {
+                followed += 1;
+                assert!(got > 2.0, "{name}: occluder texel {i} at {s} shows {got}");
+                blended += ((got - now).abs() > 1e-4) as u32;
+            } else if s.x > 50.0 {
+                stayed += 1;
+                assert!(got < 1.0, "{name}: background texel {i} at {s} shows {got}");
+                blended += ((got - now).abs() > 1e-4) as u32;
+            }
+        }
+        println!("{name}: {uncovered} uncovered (reset), {followed} moved-occluder and {stayed} static texels ({blended} blended)");
+        assert!(uncovered > 20 && followed > 5 && stayed > 20, "{name}: too few texels checked");
+        assert!(blended as f32 >= 0.95 * (followed + stayed) as f32, "{name}: only {blended} of {} texels kept a history", followed + stayed);
+    }
+    assert_clean(&ctx);
+}
+
+/// With TAA on, every sample lies at the frame's Halton offset inside its grid texel: on a still
+/// camera the motion output (previous screen position) is the sample's own screen position, which
+/// must be the CPU's mapping of texel + `TaaSettings::jitter(frame)`. With TAA off it must not be.
+#[test]
+fn taa_makes_the_tracer_use_the_frames_halton_offset() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    for (name, space) in spaces(SCREEN) {
+        let vp = space.visual_polar().copied();
+        let again = || -> Box<dyn SamplingSpace> { vp.map_or_else(|| Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>, |v| Box::new(v)) };
+        let grid = space.grid_size();
+        drop(space);
+        for taa_on in [true, false] {
+            let s = if taa_on { with_taa(DenoiserSettings::None) } else { settings(DenoiserSettings::None) };
+            let mut r = Renderer::new(&ctx, &scene, again(), s).unwrap();
+            for f in [0u32, 1, 5, 17] {
+                r.render_frame(&frame(camera, f)).unwrap();
+                let motion: Vec<[f32; 2]> = read_image(&ctx, &r.gbuffer.motion);
+                let jitter = TaaSettings::default().jitter(f);
+                let (mut worst, mut checked, mut off) = (0f32, 0, 0);
+                for y in 0..grid.y {
+                    for x in 0..grid.x {
+                        let m = Vec2::from(motion[(y * grid.x + x) as usize]);
+                        let Some(expected) = r.space().grid_to_screen(Vec2::new(x as f32, y as f32) + jitter) else { continue };
+                        if m == Vec2::splat(-1.0) || !(expected.cmpge(Vec2::ZERO).all() && expected.cmplt(SCREEN.as_vec2()).all()) {
+                            continue;
+                        }
+                        let e = (m - expected).length();
+                        worst = worst.max(e);
+                        checked += 1;
+                        off += (e > 0.05) as u32;
+                    }
+                }
+                assert!(checked > 1000, "{name}: only {checked} texels checked");
+                if taa_on {
+                    assert!(worst < 0.02, "{name} frame {f}: a sample lies {worst} px from the Halton offset {jitter}");
+                } else {
+                    assert!(off as f32 > 0.5 * checked as f32, "{name} frame {f}: random jitter matches Halton at {} of {checked}", checked - off);
+                }
+                if f == 5 {
+                    println!("{name} taa {taa_on}: frame {f} jitter {jitter}, {checked} texels, worst {worst:.5} px, {off} off by > 0.05 px");
+                }
+            }
+        }
+    }
+    assert_clean(&ctx);
+}
+
+/// `fovea render --taa vp` after the denoiser (and on the raw colour): the report names it and
+/// times the pass; `--taa screen` is refused as not implemented yet.
+#[test]
+fn render_command_runs_taa_and_reports_it() {
+    use fovea_tools::commands::render::{run, RenderArgs};
+    let out = fovea_tests::artifacts_dir().join(format!("taa-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let args = |method, denoiser, taa| RenderArgs {
+        scene: "cornell-box",
+        method,
+        width: Some(40),
+        height: Some(36),
+        scale: 0.25,
+        headset: "fove0",
+        gaze: "sim:3",
+        frames: 2,
+        out: &out,
+        exr: false,
+        camera_path: true,
+        seed: 1,
+        max_depth: 3,
+        exposure: 1.0,
+        profile: Default::default(),
+        debug_views: false,
+        denoiser,
+        taa,
+        device: None,
+        validation: true,
+    };
+    for (method, denoiser, taa) in [("cartesian", "none", "vp"), ("vp", "svgf", "vp"), ("vp", "none", "off")] {
+        run(&args(method, denoiser, taa)).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(report["taa"], taa);
+        assert_eq!(report["passes"].get("taa").is_some(), taa == "vp", "{method}/{denoiser}/{taa}");
+    }
+    let err = format!("{:#}", run(&args("vp", "none", "screen")).unwrap_err());
+    assert!(err.contains("not implemented yet"), "{err}");
+}

@@ -5,8 +5,9 @@
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::graph::{FrameRecorder, PassTiming};
-use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_REFERENCE};
+use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
+use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{DenoiseFrame, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
@@ -51,6 +52,9 @@ pub struct RenderSettings {
     pub blur: BlurSettings,
     /// Denoiser between the tracer and the screen (fixed for the renderer's life: it owns state).
     pub denoiser: DenoiserSettings,
+    /// TAA after the denoiser (fixed for the renderer's life, like the denoiser); when on, the
+    /// tracer jitters by its Halton sequence instead of the RNG.
+    pub taa: TaaMode,
 }
 
 impl Default for RenderSettings {
@@ -62,6 +66,7 @@ impl Default for RenderSettings {
             tone_curve: ToneCurve::Aces,
             blur: BlurSettings::default(),
             denoiser: DenoiserSettings::None,
+            taa: TaaMode::Off,
         }
     }
 }
@@ -121,6 +126,8 @@ pub struct Renderer {
     grid_readback: Buffer,
     /// Per-eye denoiser state (`settings.denoiser`).
     denoiser: Option<Denoiser>,
+    /// Per-eye TAA state (`settings.taa`).
+    taa: Option<Taa>,
     recorder: FrameRecorder,
     prev_camera: Option<CameraPose>,
     /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
@@ -151,6 +158,10 @@ impl Renderer {
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let denoiser_passes = denoiser.as_ref().map_or(0, |d| d.max_passes());
+        let taa = match settings.taa.settings() {
+            Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), *s)?),
+            None => None,
+        };
         Ok(Renderer {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], uniform)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform)?,
@@ -173,8 +184,9 @@ impl Renderer {
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_readback: readback("grid_readback", grid.x as u64 * grid.y as u64 * 4)?,
             to_screen,
-            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 24 + denoiser_passes)?,
+            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 25 + denoiser_passes)?,
             denoiser,
+            taa,
             prev_camera: None,
             prev_sampling: None,
             ctx: ctx.clone(),
@@ -202,7 +214,12 @@ impl Renderer {
         self.recorder.timings()
     }
 
-    fn write_frame_data(&self, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32) -> Result<()> {
+    /// The TAA state, when `settings.taa` is on.
+    pub fn taa(&self) -> Option<&Taa> {
+        self.taa.as_ref()
+    }
+
+    fn write_frame_data(&self, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
         let screen = self.space.screen_size().as_vec2();
         let prev = self.prev_camera.unwrap_or(*camera);
         let data = FrameData {
@@ -219,6 +236,7 @@ impl Renderer {
                 self.scene.texture_count,
             ),
             scene_sphere: self.scene.bounding_sphere(),
+            jitter: jitter.extend(0.0).extend(0.0),
         };
         self.frame_data.write(&[data])
     }
@@ -228,7 +246,9 @@ impl Renderer {
         if let Some(gaze) = input.gaze {
             self.space.set_gaze(gaze)?;
         }
-        self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, 0)?;
+        let jitter = self.taa.as_ref().map(|t| t.settings.jitter(input.frame_index));
+        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 };
+        self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let space = self.space.params();
         self.sampling.write(&[space])?;
         self.sampling_table.write(&self.space.sampling_table())?;
@@ -237,9 +257,14 @@ impl Renderer {
         rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
         self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0)?;
         // Denoisers work in the sampling grid (Cartesian samples are the screen).
-        let grid_hdr = match &mut self.denoiser {
-            Some(d) => d.record(rec, &self.gbuffer, &DenoiseFrame { current: space, previous: self.prev_sampling })?,
+        let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
+        let denoised = match &mut self.denoiser {
+            Some(d) => d.record(rec, &self.gbuffer, &denoise_frame)?,
             None => &self.gbuffer.color,
+        };
+        let grid_hdr = match (&mut self.taa, jitter) {
+            (Some(taa), Some(jitter)) => taa.record(rec, &self.gbuffer, denoised, &denoise_frame, jitter)?,
+            _ => denoised,
         };
         let screen_hdr = match (&self.to_screen, self.space.visual_polar()) {
             (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &self.sampling_table, grid_hdr, &self.settings.blur)?,
@@ -305,7 +330,7 @@ impl Renderer {
         // The G-buffer is overwritten and the previous camera forgotten: no history survives.
         self.prev_camera = None;
         self.prev_sampling = None;
-        self.write_frame_data(camera, 0, max_depth, FRAME_FLAG_REFERENCE)?;
+        self.write_frame_data(camera, 0, max_depth, FRAME_FLAG_REFERENCE, Vec2::ZERO)?;
         self.sampling.write(&[self.space.params()])?;
         let mut done = 0;
         while done < spp {

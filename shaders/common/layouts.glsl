@@ -20,6 +20,9 @@ const uint LIGHT_KIND_DIRECTIONAL = 3u;
 
 // FrameData.frame.w flags.
 const uint FRAME_FLAG_REFERENCE = 1u;
+// The tracer jitters every sample by FrameData.jitter (TAA's Halton sequence) instead of its RNG;
+// the RNG stream itself is drawn unchanged, so everything after the jitter stays the same.
+const uint FRAME_FLAG_HALTON_JITTER = 2u;
 
 // Everything the passes need to know about the current (and previous) frame.
 struct FrameData {
@@ -31,6 +34,7 @@ struct FrameData {
     uvec4 frame;                // x frame index, y seed, z max path depth, w FRAME_FLAG_* bits
     uvec4 counts;               // x light entries, y triangles, z materials, w textures
     vec4 scene_sphere;          // xyz centre, w radius of the scene's bounding sphere
+    vec4 jitter;                // xy sub-texel sample offset in [0, 1)² (FRAME_FLAG_HALTON_JITTER), zw unused
 };
 
 // Where samples lie on the screen; each sampling space gives the slots its own meaning.
@@ -183,6 +187,19 @@ struct SvgfAtrousPush {
     vec4 vp_shape1;
     vec4 params;                // x σ luminance, y σ depth, z σ normal, w unused
     uvec4 config;               // x tap spacing (2^iteration texels), yzw unused
+};
+
+// Push constants of TAA in the sampling grid (Karis 2014). Same 128-byte layout as
+// SvgfTemporalPush: this frame's space, then the previous frame's gaze-dependent slots.
+struct TaaPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
+    vec4 prev_shape0;
+    vec4 prev_shape1;
+    vec4 params;                // x current-frame weight, y 1 = drop all history, zw this frame's jitter in the texel
 };
 
 const uint TONEMAP_CLAMP = 0u;

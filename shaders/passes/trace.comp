@@ -66,6 +66,7 @@ void main() {
     uint rng = rng_seed(uvec2(texel), fd.frame.x, fd.frame.y, push.p.config.x);
     vec2 screen;
     vec2 jitter = rng_next2(rng);
+    if ((fd.frame.w & FRAME_FLAG_HALTON_JITTER) != 0u) jitter = fd.jitter.xy;
     if (!sample_screen_position(texel, jitter, screen)) {
         imageStore(out_color, texel, vec4(0.0));
         imageStore(out_radiance, texel, vec4(0.0));

@@ -99,6 +99,10 @@ struct RenderOpts {
     /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017, the paper's parameters).
     #[arg(long, default_value = "none")]
     denoiser: String,
+    /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for
+    /// Cartesian). `screen` (after the remap) is reserved and not implemented yet.
+    #[arg(long, default_value = "off")]
+    taa: String,
 }
 
 impl RenderOpts {
@@ -246,6 +250,7 @@ fn main() -> Result<()> {
             profile: opts.profile()?,
             debug_views: opts.debug_views,
             denoiser: &opts.denoiser,
+            taa: &opts.taa,
             device: device.device.as_deref(),
             validation: device.validation,
         }),

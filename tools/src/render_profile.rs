@@ -1,11 +1,12 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF parameters (used when `--denoiser svgf`).
+//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
+use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
 use serde::Deserialize;
 use std::path::Path;
@@ -15,6 +16,7 @@ pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
+    pub taa: TaaSettings,
 }
 
 #[derive(Deserialize, Default)]
@@ -23,6 +25,14 @@ struct ProfileFile {
     visual_polar: Option<VpSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
+    taa: Option<TaaSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TaaSection {
+    current_weight: Option<f32>,
+    jitter_points: Option<u32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -148,6 +158,12 @@ impl RenderProfile {
             s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
             s.validate().with_context(|| at("svgf"))?;
         }
+        if let Some(f) = file.taa {
+            let s = &mut profile.taa;
+            s.current_weight = f.current_weight.unwrap_or(s.current_weight);
+            s.jitter_points = f.jitter_points.unwrap_or(s.jitter_points);
+            s.validate().with_context(|| at("taa"))?;
+        }
         Ok(profile)
     }
 
@@ -205,6 +221,7 @@ mod tests {
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
+        assert_eq!(p.taa, TaaSettings::default());
     }
 
     #[test]
@@ -219,6 +236,8 @@ mod tests {
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Exact);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(900.0));
         assert_eq!(p.blur.sigma_at_30, 0.0);
+        let p = load_str("taa_ok.toml", "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n").unwrap();
+        assert_eq!(p.taa, TaaSettings { current_weight: 0.05, jitter_points: 8 });
     }
 
     #[test]
@@ -235,6 +254,9 @@ mod tests {
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
+            ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
+            ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
+            ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),
         ];
         for (name, text, key) in cases {
             let err = format!("{:#}", load_str(name, text).unwrap_err());

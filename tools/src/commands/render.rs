@@ -6,6 +6,7 @@ use crate::output::{prepare_output_dir, write_exr, write_png};
 use crate::gaze::GazeDriver;
 use anyhow::{bail, Context, Result};
 use fovea_hal::GazeOrigin;
+use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use crate::render_profile::RenderProfile;
@@ -38,6 +39,8 @@ pub struct RenderArgs<'a> {
     pub debug_views: bool,
     /// `none` or `svgf` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
+    /// `off` or `vp` (`TaaMode::NAMES`; `screen` is refused as not implemented yet).
+    pub taa: &'a str,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
@@ -50,6 +53,8 @@ struct Report {
     method: String,
     /// Denoiser in the sampling grid (`none`, `svgf`).
     denoiser: String,
+    /// TAA: `off`, or `vp` (in the sampling grid).
+    taa: String,
     scene: String,
     headset: String,
     gaze_source: String,
@@ -127,6 +132,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
         other => other,
     };
+    let taa = match TaaMode::parse(args.taa).context("--taa")? {
+        TaaMode::SamplingGrid(_) => TaaMode::SamplingGrid(args.profile.taa),
+        other => other,
+    };
+    // TAA reprojects with the paper's mapping, like SVGF.
+    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
+        bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
+    }
     // SVGF reprojects and filters with the paper's mapping (no per-column arc table yet).
     if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
         bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
@@ -145,6 +158,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         exposure: args.exposure,
         blur: args.profile.blur,
         denoiser,
+        taa,
         ..Default::default()
     };
     let screen = UVec2::new(width, height);
@@ -216,6 +230,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let report = Report {
         method: args.method.to_string(),
         denoiser: denoiser.name().to_string(),
+        taa: taa.name().to_string(),
         scene: scene.source.display().to_string(),
         headset: hmd.id.clone(),
         gaze_source: args.gaze.to_string(),
@@ -246,12 +261,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let path = args.out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     println!(
-        "rendered {} frame(s) of {}×{} ({}, denoiser {}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
+        "rendered {} frame(s) of {}×{} ({}, denoiser {}, taa {}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
         args.frames,
         width,
         height,
         report.method,
         report.denoiser,
+        report.taa,
         grid.x,
         grid.y,
         report.samples_traced,

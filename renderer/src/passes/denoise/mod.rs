@@ -1,12 +1,13 @@
 //! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
 //! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
-//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF now;
-//! A-SVGF, BMFR, TAA fit beside it), one pass = one module + one shader (a variant per sampling
-//! space, `shaders/passes/denoise/`) + one push-constant struct in `layouts.glsl`; the grid
-//! addressing they share is `shaders/denoise/grid.glsl`.
+//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
+//! which runs after the denoiser; A-SVGF, BMFR fit beside them), one pass = one module + one
+//! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
+//! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
 pub mod modulate;
 pub mod svgf;
+pub mod taa;
 
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;

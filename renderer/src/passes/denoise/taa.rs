@@ -1,0 +1,207 @@
+//! TAA (Karis 2014; denoisers.md) in the sampling grid, as the paper does (issue 5): the tracer
+//! jitters each frame by a Halton(2, 3) offset inside the grid texel (Visual-Polar: inside the VP
+//! texel), and one pass reprojects the history through the previous frame's grid, clips it toward
+//! this frame's 3×3 YCoCg neighbourhood and blends it with luma weights. It runs after the
+//! denoiser (or on the raw colour) and before the way to the screen.
+
+use super::DenoiseFrame;
+use crate::error::{Error, Result};
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::TaaPush;
+use crate::passes::push_bytes;
+use crate::passes::trace::GBuffer;
+use crate::vk::{ComputePipeline, Context, Image};
+use ash::vk;
+use glam::{UVec2, Vec2, Vec4};
+use std::sync::Arc;
+
+/// Filter parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TaaSettings {
+    /// Blend weight of the current frame (the history keeps 1 − this), before luma weighting.
+    pub current_weight: f32,
+    /// Length of the Halton(2, 3) jitter cycle.
+    pub jitter_points: u32,
+}
+
+impl Default for TaaSettings {
+    fn default() -> Self {
+        TaaSettings { current_weight: 0.1, jitter_points: 16 }
+    }
+}
+
+/// The jitter cycles accepted: fewer points leave visible aliasing, more gain nothing at a ≈ 0.1
+/// blend weight (the history forgets them before the cycle ends).
+pub const JITTER_POINTS: std::ops::RangeInclusive<u32> = 8..=16;
+
+impl TaaSettings {
+    pub fn validate(&self) -> Result<()> {
+        let w = self.current_weight;
+        if !(w.is_finite() && w > 0.0 && w <= 1.0) {
+            return Err(Error::Invalid(format!("taa: current_weight must be in (0, 1], got {w}")));
+        }
+        if !JITTER_POINTS.contains(&self.jitter_points) {
+            return Err(Error::Invalid(format!(
+                "taa: jitter_points must be in {}..={}, got {}",
+                JITTER_POINTS.start(),
+                JITTER_POINTS.end(),
+                self.jitter_points
+            )));
+        }
+        Ok(())
+    }
+
+    /// This frame's sample position inside the texel, in [0, 1)²: point `frame % jitter_points`
+    /// of Halton(2, 3) (indices from 1), shifted so that the cycle's mean is the texel centre.
+    pub fn jitter(&self, frame_index: u32) -> Vec2 {
+        let n = self.jitter_points;
+        let point = |i: u32| Vec2::new(radical_inverse(i + 1, 2), radical_inverse(i + 1, 3));
+        let mean = (0..n).map(point).sum::<Vec2>() / n as f32;
+        (point(frame_index % n) - mean + 0.5).clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON))
+    }
+}
+
+fn radical_inverse(mut i: u32, base: u32) -> f32 {
+    let (mut f, mut r) = (1.0f32, 0.0f32);
+    while i > 0 {
+        f /= base as f32;
+        r += f * (i % base) as f32;
+        i /= base;
+    }
+    r
+}
+
+/// Where TAA runs (`fovea render --taa`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum TaaMode {
+    #[default]
+    Off,
+    /// In the sampling grid (`vp`; for Cartesian that is the screen).
+    SamplingGrid(TaaSettings),
+}
+
+impl TaaMode {
+    /// The names `parse` accepts; `screen` (after the remap) is reserved.
+    pub const NAMES: &'static [&'static str] = &["off", "vp"];
+
+    pub fn parse(name: &str) -> Result<TaaMode> {
+        match name {
+            "off" => Ok(TaaMode::Off),
+            "vp" => Ok(TaaMode::SamplingGrid(TaaSettings::default())),
+            "screen" => Err(Error::Invalid("taa 'screen' (TAA after the remap) is not implemented yet; use vp or off".into())),
+            other => Err(Error::Invalid(format!("taa '{other}': expected one of {}", Self::NAMES.join(", ")))),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            TaaMode::Off => "off",
+            TaaMode::SamplingGrid(_) => "vp",
+        }
+    }
+
+    pub fn settings(&self) -> Option<&TaaSettings> {
+        match self {
+            TaaMode::Off => None,
+            TaaMode::SamplingGrid(s) => Some(s),
+        }
+    }
+}
+
+/// Per-eye TAA: the pass and its ping-pong history, allocated once.
+pub struct Taa {
+    pub settings: TaaSettings,
+    pipeline: ComputePipeline,
+    /// Resolved colour by frame parity; this frame's half is also the pass's output.
+    history: [Image; 2],
+    /// The packed surface each history texel belongs to (disocclusion test).
+    surface: [Image; 2],
+    frames: u64,
+}
+
+impl Taa {
+    /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
+    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: TaaSettings) -> Result<Taa> {
+        settings.validate()?;
+        let image = |name: &str, format| Image::new(ctx, name, grid.x, grid.y, format);
+        let (rgba, surface) = (vk::Format::R32G32B32A32_SFLOAT, vk::Format::R32G32B32A32_UINT);
+        let shader = format!("passes/denoise/taa.{variant}");
+        Ok(Taa {
+            settings,
+            pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
+            history: [image("taa.history0", rgba)?, image("taa.history1", rgba)?],
+            surface: [image("taa.surface0", surface)?, image("taa.surface1", surface)?],
+            frames: 0,
+        })
+    }
+
+    /// GPU bytes carried between frames.
+    pub fn history_bytes(&self) -> u64 {
+        self.history.iter().chain(&self.surface).map(|i| i.width as u64 * i.height as u64 * i.texel_bytes()).sum()
+    }
+
+    /// Resolves `color` (grid-sized radiance) against the history; `jitter` is the offset the
+    /// tracer used this frame (`TaaSettings::jitter`). History is dropped on the first frame and
+    /// whenever `frame.previous` is `None`. Returns the resolved image (next frame's history).
+    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, color: &Image, frame: &DenoiseFrame, jitter: Vec2) -> Result<&Image> {
+        let cur = (self.frames % 2) as usize;
+        let previous = if self.frames == 0 { None } else { frame.previous };
+        let binds = [
+            read_image("color", color),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            read_image("ids", &g.ids),
+            read_image("motion", &g.motion),
+            read_image("prev_history", &self.history[1 - cur]),
+            read_image("prev_surface", &self.surface[1 - cur]),
+            write_image("history", &self.history[cur]),
+            write_image("surface", &self.surface[cur]),
+        ];
+        let (current, p) = (&frame.current, previous.as_ref().unwrap_or(&frame.current));
+        let reset = if previous.is_none() { 1.0 } else { 0.0 };
+        let push = TaaPush {
+            vp_grid: current.grid,
+            vp_gaze: current.gaze,
+            vp_shape0: current.shape0,
+            vp_shape1: current.shape1,
+            prev_gaze: p.gaze,
+            prev_shape0: p.shape0,
+            prev_shape1: p.shape1,
+            params: Vec4::new(self.settings.current_weight, reset, jitter.x, jitter.y),
+        };
+        let out = &self.history[cur];
+        rec.dispatch("taa", &self.pipeline, &binds, push_bytes(&push), [out.width, out.height, 1])?;
+        self.frames += 1;
+        Ok(&self.history[cur])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halton_jitter_is_centred_inside_the_texel_and_cycles() {
+        for n in JITTER_POINTS {
+            let s = TaaSettings { jitter_points: n, ..Default::default() };
+            let points: Vec<Vec2> = (0..n).map(|f| s.jitter(f)).collect();
+            assert!(points.iter().all(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all()), "{points:?}");
+            let mean = points.iter().sum::<Vec2>() / n as f32;
+            assert!((mean - 0.5).abs().max_element() < 1e-5, "{n} points: mean {mean}");
+            assert_eq!(s.jitter(n + 3), s.jitter(3));
+        }
+        assert!((radical_inverse(3, 2) - 0.75).abs() < 1e-7 && (radical_inverse(4, 3) - 4.0 / 9.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn settings_and_names_are_checked() {
+        assert!(TaaSettings { current_weight: 0.0, ..Default::default() }.validate().is_err());
+        assert!(TaaSettings { current_weight: f32::NAN, ..Default::default() }.validate().is_err());
+        assert!(TaaSettings { jitter_points: 4, ..Default::default() }.validate().is_err());
+        assert!(TaaSettings::default().validate().is_ok());
+        assert_eq!(TaaMode::parse("vp").unwrap().name(), "vp");
+        assert_eq!(TaaMode::parse("off").unwrap(), TaaMode::Off);
+        assert!(TaaMode::parse("screen").unwrap_err().to_string().contains("not implemented yet"));
+        assert!(TaaMode::parse("on").is_err());
+    }
+}
