@@ -63,6 +63,36 @@ bool grid_tap(Grid g, ivec2 t, ivec2 o, out ivec2 tap) {
 #endif
 }
 
+// Filter loops visit taps column by column: the row count of a column (divisions and a floor
+// in Visual-Polar) is then computed once per column instead of once or twice per tap, which is
+// most of a VP tap's cost on lavapipe. A tap found this way is exactly grid_tap's (same
+// expression) and always holds a sample (its row is wrapped into the column).
+struct GridColumn {
+    int col;
+    int rows;        // rows of `col`
+    int rows_here;   // rows of the centre's column
+};
+
+// The column `dx` texels away from t's; false when that leaves the grid.
+bool grid_column(Grid g, ivec2 t, int rows_here, int dx, out GridColumn c) {
+    c.col = t.x + dx;
+    c.rows_here = rows_here;
+    c.rows = (dx == 0 || c.col < 0 || c.col >= g.size.x) ? rows_here : grid_rows(g, c.col);
+    return c.col >= 0 && c.col < g.size.x;
+}
+
+// The tap `dy` rows (of t's column) away from t, in column c; false when it leaves the grid.
+bool grid_column_tap(GridColumn c, ivec2 t, int dy, out ivec2 tap) {
+#if defined(SAMPLING_VISUAL_POLAR)
+    int r = int(floor((float(t.y) + 0.5 + float(dy)) * float(c.rows) / float(c.rows_here)));
+    tap = ivec2(c.col, grid_wrap(r, c.rows));
+    return true;
+#else
+    tap = ivec2(c.col, t.y + dy);
+    return tap.y >= 0 && tap.y < c.rows;
+#endif
+}
+
 // Continuous grid position (texel centres at +½; Visual-Polar y in rows of column floor(x)) of a
 // screen position; false where the grid holds no sample there.
 bool grid_from_screen(Grid g, vec2 screen, out vec2 p) {

@@ -30,12 +30,15 @@ void main() {
     vec4 centre = imageLoad(src, t);
 
     // The luminance edge-stop uses a 3×3 Gaussian of the variance: single-texel estimates are noisy.
+    int rows_here = grid_rows(g, t.x);
     float var = 0.0;
     float var_w = 0.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    for (int dx = -1; dx <= 1; ++dx) {
+        GridColumn col;
+        if (!grid_column(g, t, rows_here, dx, col)) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
             ivec2 q;
-            if (!grid_tap(g, t, ivec2(dx, dy), q) || !grid_holds_sample(g, q)) continue;
+            if (!grid_column_tap(col, t, dy, q)) continue;
             float k = GAUSS3[abs(dx)] * GAUSS3[abs(dy)];
             var += k * imageLoad(src, q).a;
             var_w += k;
@@ -50,10 +53,12 @@ void main() {
     vec3 sum_c = w0 * centre.rgb;
     float sum_v = w0 * w0 * centre.a;
     float sum_w = w0;
-    for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
+    for (int dx = -2; dx <= 2; ++dx) {
+        GridColumn col;
+        if (!grid_column(g, t, rows_here, dx * step, col)) continue;
+        for (int dy = -2; dy <= 2; ++dy) {
             ivec2 q;
-            if ((dx == 0 && dy == 0) || !grid_tap(g, t, ivec2(dx, dy) * step, q) || !grid_holds_sample(g, q)) continue;
+            if ((dx == 0 && dy == 0) || !grid_column_tap(col, t, dy * step, q)) continue;
             vec4 c = imageLoad(src, q);
             SvgfSurface sq = svgf_surface(imageLoad(normal_depth, q), 0.0, uvec2(0u));
             float w = B3[abs(dx)] * B3[abs(dy)] * svgf_edge_weight(s, sq, float(step) * length(vec2(dx, dy)),

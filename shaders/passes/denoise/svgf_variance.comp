@@ -35,10 +35,13 @@ void main() {
     vec3 sum_c = centre.rgb;
     vec2 sum_m = cm.xy;
     float sum_w = 1.0;
-    for (int dy = -3; dy <= 3; ++dy) {
-        for (int dx = -3; dx <= 3; ++dx) {
+    int rows_here = grid_rows(g, t.x);
+    for (int dx = -3; dx <= 3; ++dx) {
+        GridColumn col;
+        if (!grid_column(g, t, rows_here, dx, col)) continue;
+        for (int dy = -3; dy <= 3; ++dy) {
             ivec2 q;
-            if ((dx == 0 && dy == 0) || !grid_tap(g, t, ivec2(dx, dy), q) || !grid_holds_sample(g, q)) continue;
+            if ((dx == 0 && dy == 0) || !grid_column_tap(col, t, dy, q)) continue;
             vec3 c = imageLoad(accum, q).rgb;
             SvgfSurface sq = svgf_surface(imageLoad(normal_depth, q), 0.0, uvec2(0u));
             float w = svgf_edge_weight(s, sq, length(vec2(dx, dy)), push.p.params.y, push.p.params.z,
