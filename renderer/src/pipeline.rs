@@ -173,7 +173,7 @@ impl Renderer {
                 storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )?,
-            trace: TracePass::new(ctx, space.shader_variant())?,
+            trace: TracePass::new(ctx, space.trace_variant())?,
             accumulate: AccumulatePass::new(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
             gbuffer: GBuffer::new(ctx, grid)?,

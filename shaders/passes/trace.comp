@@ -3,7 +3,8 @@
 // hit, BRDF-sampled continuation (real-time: depth 3 = one indirect bounce). Writes the per-sample
 // G-buffer that the denoisers read, sized to the sampling grid.
 //! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variant visual_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
+//! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"

@@ -24,7 +24,12 @@ bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen) {
     screen = vec2(0.0);
     if (!vp_is_valid_texel(P, texel)) return false;
     // rng_next gives [0, 1): texel + jitter stays in the texel, so floor(x) is its column.
+#if defined(VP_LAYOUT_PAPER_ONLY)
+    // The paper-layout kernel: lavapipe would run the clipped mapping too under a branch.
+    screen = vp_vp_to_screen(P, vec2(texel) + jitter);
+#else
     screen = vp_layout_vp_to_screen(P, vec2(texel) + jitter);
+#endif
     return true;
 }
 

@@ -19,6 +19,12 @@ pub trait SamplingSpace {
     fn name(&self) -> &'static str;
     /// Variant suffix of the kernels compiled for this space (e.g. `passes/trace.cartesian`).
     fn shader_variant(&self) -> &'static str;
+    /// Variant of the trace kernel: `shader_variant` unless the space compiles a layout-specific
+    /// mapping (lavapipe pays for both sides of a branch, so the paper's VP layout gets a trace
+    /// kernel without the screen-clipped path).
+    fn trace_variant(&self) -> &'static str {
+        self.shader_variant()
+    }
     /// Size of the sampling grid in texels (the size of every per-sample image).
     fn grid_size(&self) -> UVec2;
     fn screen_size(&self) -> UVec2;

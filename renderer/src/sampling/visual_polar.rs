@@ -515,6 +515,12 @@ impl SamplingSpace for VisualPolar {
     fn shader_variant(&self) -> &'static str {
         "visual_polar"
     }
+    fn trace_variant(&self) -> &'static str {
+        match self.params.layout {
+            VpLayout::Paper => "visual_polar",
+            VpLayout::ScreenClipped => "visual_polar_clipped",
+        }
+    }
     fn grid_size(&self) -> UVec2 {
         self.grid
     }
