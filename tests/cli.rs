@@ -3,7 +3,6 @@
 
 use fovea_tools::commands::reference::{run as reference, ReferenceArgs};
 use fovea_tools::commands::render::{run as render, RenderArgs};
-use fovea_tools::render_profile::RenderProfile;
 use std::path::{Path, PathBuf};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -13,28 +12,7 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
-    RenderArgs {
-        scene,
-        method: "cartesian",
-        width: Some(40),
-        height: Some(36),
-        scale: 0.25,
-        headset: "fove0",
-        gaze: "sim:3",
-        frames: 2,
-        out,
-        exr: true,
-        camera_path: true,
-        seed: 1,
-        max_depth: 3,
-        exposure: 1.0,
-        profile: RenderProfile::default(),
-        debug_views: false,
-        denoiser: "none",
-        taa: "off",
-        device: None,
-        validation: true,
-    }
+    fovea_tests::small_render_args(scene, out)
 }
 
 #[test]

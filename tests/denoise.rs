@@ -222,6 +222,19 @@ fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
     (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
 }
 
+/// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a
+/// NaN and a negative colour.
+fn inject_fireflies(ctx: &Arc<Context>, image: &Image, f: u32) {
+    let mut texels: Vec<[f32; 4]> = read_image(ctx, image);
+    let kept: Vec<usize> = (0..texels.len()).filter(|&i| texels[i][3] > 0.0).collect();
+    let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
+    texels[pick(1)] = [1e30, 1e30, 1e30, 1.0];
+    texels[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
+    texels[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
+    texels[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
+    write_image(ctx, image, &texels);
+}
+
 /// Fireflies (huge, infinite and NaN radiance injected into a traced Cornell frame) and an empty
 /// view: every output texel stays finite and non-negative, the empty view exactly black.
 #[test]
@@ -240,14 +253,7 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
         let mut peak = 0f32;
         for f in 0..6 {
             r.render_frame(&frame(camera, f)).unwrap();
-            let mut radiance: Vec<[f32; 4]> = read_image(&ctx, &r.gbuffer.radiance);
-            let kept: Vec<usize> = (0..radiance.len()).filter(|&i| radiance[i][3] > 0.0).collect();
-            let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
-            radiance[pick(1)] = [1e30, 1e30, 1e30, 1.0];
-            radiance[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
-            radiance[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
-            radiance[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
-            write_image(&ctx, &r.gbuffer.radiance, &radiance);
+            inject_fireflies(&ctx, &r.gbuffer.radiance, f);
             let current = r.space().params();
             let (out, moments) = denoise(&ctx, &mut svgf, &r.gbuffer, &DenoiseFrame { current, previous });
             previous = Some(current);
@@ -404,29 +410,7 @@ fn render_command_runs_svgf_and_reports_it() {
     let out = fovea_tests::artifacts_dir().join(format!("denoise-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     for (method, denoiser) in [("cartesian", "svgf"), ("vp", "svgf"), ("vp", "none")] {
-        run(&RenderArgs {
-            scene: "cornell-box",
-            method,
-            width: Some(40),
-            height: Some(36),
-            scale: 0.25,
-            headset: "fove0",
-            gaze: "sim:3",
-            frames: 2,
-            out: &out,
-            exr: false,
-            camera_path: true,
-            seed: 1,
-            max_depth: 3,
-            exposure: 1.0,
-            profile: Default::default(),
-            debug_views: false,
-            denoiser,
-            taa: "off",
-            device: None,
-            validation: true,
-        })
-        .unwrap();
+        run(&RenderArgs { method, denoiser, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
         assert_eq!(report["denoiser"], denoiser);
         for pass in ["svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_modulate"] {
@@ -531,14 +515,7 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
         let mut peak = 0f32;
         for f in 0..6 {
             r.render_frame(&frame(camera, f)).unwrap();
-            let mut color: Vec<[f32; 4]> = read_image(&ctx, &r.gbuffer.color);
-            let kept: Vec<usize> = (0..color.len()).filter(|&i| color[i][3] > 0.0).collect();
-            let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
-            color[pick(1)] = [1e30, 1e30, 1e30, 1.0];
-            color[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
-            color[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
-            color[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
-            write_image(&ctx, &r.gbuffer.color, &color);
+            inject_fireflies(&ctx, &r.gbuffer.color, f);
             let current = r.space().params();
             let jitter = TaaSettings::default().jitter(f);
             let out = resolve(&ctx, &mut taa, &r.gbuffer, &r.gbuffer.color, &DenoiseFrame { current, previous }, jitter);
@@ -664,28 +641,7 @@ fn render_command_runs_taa_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
     let out = fovea_tests::artifacts_dir().join(format!("taa-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let args = |method, denoiser, taa| RenderArgs {
-        scene: "cornell-box",
-        method,
-        width: Some(40),
-        height: Some(36),
-        scale: 0.25,
-        headset: "fove0",
-        gaze: "sim:3",
-        frames: 2,
-        out: &out,
-        exr: false,
-        camera_path: true,
-        seed: 1,
-        max_depth: 3,
-        exposure: 1.0,
-        profile: Default::default(),
-        debug_views: false,
-        denoiser,
-        taa,
-        device: None,
-        validation: true,
-    };
+    let args = |method, denoiser, taa| RenderArgs { method, denoiser, taa, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) };
     for (method, denoiser, taa) in [("cartesian", "none", "vp"), ("vp", "svgf", "vp"), ("vp", "none", "off")] {
         run(&args(method, denoiser, taa)).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();

@@ -104,3 +104,30 @@ pub fn write_image(ctx: &Arc<Context>, image: &Image, texels: &[[f32; 4]]) {
     rec.copy_buffer_to_image("test_write_image", &buffer, image).unwrap();
     rec.submit_and_wait().unwrap();
 }
+
+/// `fovea render` arguments for a small, quick run (40×36, 2 frames, Cartesian, orbiting camera,
+/// EXR on, validation on) into `out`; tests change the fields they exercise.
+pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_tools::commands::render::RenderArgs<'a> {
+    fovea_tools::commands::render::RenderArgs {
+        scene,
+        method: "cartesian",
+        width: Some(40),
+        height: Some(36),
+        scale: 0.25,
+        headset: "fove0",
+        gaze: "sim:3",
+        frames: 2,
+        out,
+        exr: true,
+        camera_path: true,
+        seed: 1,
+        max_depth: 3,
+        exposure: 1.0,
+        profile: Default::default(),
+        debug_views: false,
+        denoiser: "none",
+        taa: "off",
+        device: None,
+        validation: true,
+    }
+}
