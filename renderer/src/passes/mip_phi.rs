@@ -4,11 +4,11 @@
 //! (`PhiMips::image`), laid out by `shaders/sampling/phi_mips.glsl`, which `rows_at_level` and
 //! `level_offset` mirror.
 
-use super::push_bytes;
+use super::{push_bytes, VpLayoutPipelines};
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{MipPhiPush, SamplingParams, PHI_MIP_LEVELS};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
 use std::sync::Arc;
@@ -50,19 +50,13 @@ impl PhiMips {
 }
 
 pub struct MipPhiPass {
-    /// The paper's layout and the screen-clipped one (`VpLayout`): separate kernels, because
-    /// lavapipe pays for both sides of a branch.
-    paper: ComputePipeline,
-    clipped: ComputePipeline,
+    pipelines: VpLayoutPipelines,
 }
 
 impl MipPhiPass {
     pub fn new(ctx: &Arc<Context>) -> Result<MipPhiPass> {
         let size = std::mem::size_of::<MipPhiPush>() as u32;
-        Ok(MipPhiPass {
-            paper: ComputePipeline::new(ctx, "passes/mip_phi.paper", size)?,
-            clipped: ComputePipeline::new(ctx, "passes/mip_phi.clipped", size)?,
-        })
+        Ok(MipPhiPass { pipelines: VpLayoutPipelines::new(ctx, "passes/mip_phi", size)? })
     }
 
     /// Copies `vp_color` (the VP grid of `vp`) into level 0 of `mips` and builds the levels above
@@ -79,17 +73,8 @@ impl MipPhiPass {
                 config: UVec4::new(src, 0, 0, 0),
             };
             let rows = rows_at_level(vp_color.height, src + 1);
-            rec.dispatch("mip_phi", self.pipeline_for(vp), &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
+            rec.dispatch("mip_phi", self.pipelines.for_space(vp), &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
         }
         Ok(())
-    }
-
-    fn pipeline_for(&self, vp: &SamplingParams) -> &ComputePipeline {
-        // shape1.w: the layout (VisualPolar::sampling_params).
-        if vp.shape1.w != 0.0 {
-            &self.clipped
-        } else {
-            &self.paper
-        }
     }
 }

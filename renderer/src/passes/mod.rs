@@ -10,6 +10,33 @@ pub mod remap;
 pub mod tonemap;
 pub mod trace;
 
+/// One Visual-Polar kernel compiled for each layout (`//! variant paper` / `clipped`): lavapipe
+/// pays for both sides of a branch, so the paper's layout gets a kernel without the
+/// screen-clipped path.
+pub(crate) struct VpLayoutPipelines {
+    paper: crate::vk::ComputePipeline,
+    clipped: crate::vk::ComputePipeline,
+}
+
+impl VpLayoutPipelines {
+    /// `shader` without the variant suffix (e.g. `passes/remap`).
+    pub fn new(ctx: &std::sync::Arc<crate::vk::Context>, shader: &str, push_size: u32) -> crate::error::Result<Self> {
+        Ok(VpLayoutPipelines {
+            paper: crate::vk::ComputePipeline::new(ctx, &format!("{shader}.paper"), push_size)?,
+            clipped: crate::vk::ComputePipeline::new(ctx, &format!("{shader}.clipped"), push_size)?,
+        })
+    }
+
+    /// The kernel for the layout of `vp` (shape1.w, see VisualPolar::sampling_params).
+    pub fn for_space(&self, vp: &crate::layouts::SamplingParams) -> &crate::vk::ComputePipeline {
+        if vp.shape1.w != 0.0 {
+            &self.clipped
+        } else {
+            &self.paper
+        }
+    }
+}
+
 /// Bytes of a push-constant struct, as the recorder takes them.
 pub(crate) fn push_bytes<T: bytemuck::Pod>(p: &T) -> &[u8] {
     bytemuck::bytes_of(p)

@@ -3,28 +3,22 @@
 //! screen-clipped layout).
 
 use super::mip_phi::PhiMips;
-use super::push_bytes;
+use super::{push_bytes, VpLayoutPipelines};
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{RemapPush, SamplingParams};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::vk::{Buffer, Context, Image};
 use glam::UVec4;
 use std::sync::Arc;
 
 pub struct RemapPass {
-    /// The paper's layout and the screen-clipped one (`VpLayout`): separate kernels, because
-    /// lavapipe pays for both sides of a branch.
-    paper: ComputePipeline,
-    clipped: ComputePipeline,
+    pipelines: VpLayoutPipelines,
 }
 
 impl RemapPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RemapPass> {
         let size = std::mem::size_of::<RemapPush>() as u32;
-        Ok(RemapPass {
-            paper: ComputePipeline::new(ctx, "passes/remap.paper", size)?,
-            clipped: ComputePipeline::new(ctx, "passes/remap.clipped", size)?,
-        })
+        Ok(RemapPass { pipelines: VpLayoutPipelines::new(ctx, "passes/remap", size)? })
     }
 
     /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` and `columns` (its
@@ -38,15 +32,6 @@ impl RemapPass {
             vp_shape1: vp.shape1,
             config: UVec4::new(mips.levels, 0, 0, 0),
         };
-        rec.dispatch("remap", self.pipeline_for(vp), &binds, push_bytes(&push), [screen.width, screen.height, 1])
-    }
-
-    fn pipeline_for(&self, vp: &SamplingParams) -> &ComputePipeline {
-        // shape1.w: the layout (VisualPolar::sampling_params).
-        if vp.shape1.w != 0.0 {
-            &self.clipped
-        } else {
-            &self.paper
-        }
+        rec.dispatch("remap", self.pipelines.for_space(vp), &binds, push_bytes(&push), [screen.width, screen.height, 1])
     }
 }
