@@ -162,9 +162,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..Default::default()
     };
     let screen = UVec2::new(width, height);
-    let first_gaze = gaze.frame(0)?.pixel;
+    // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
+    let screen_centre = screen.as_vec2() * 0.5;
     let space: Box<dyn SamplingSpace> = match args.method {
-        "vp" => Box::new(VisualPolar::new(screen, first_gaze, args.profile.visual_polar).context("Visual-Polar space")?),
+        "vp" => Box::new(VisualPolar::new(screen, screen_centre, args.profile.visual_polar).context("Visual-Polar space")?),
         _ => Box::new(Cartesian::new(screen)),
     };
     let grid = space.grid_size();
