@@ -16,17 +16,11 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer}
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::{assert_clean, gpu, owned_scene, read_image, rmse, save_preview, write_image};
+use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, rmse, save_preview, unit_hash, write_image};
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
-
-fn hash(mut v: u32) -> f32 {
-    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
-    ((v >> 22) ^ v) as f32 / u32::MAX as f32
-}
 
 fn spaces(screen: UVec2) -> [(&'static str, Box<dyn SamplingSpace>); 2] {
     let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
@@ -222,19 +216,6 @@ fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
     (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
 }
 
-/// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a
-/// NaN and a negative colour.
-fn inject_fireflies(ctx: &Arc<Context>, image: &Image, f: u32) {
-    let mut texels: Vec<[f32; 4]> = read_image(ctx, image);
-    let kept: Vec<usize> = (0..texels.len()).filter(|&i| texels[i][3] > 0.0).collect();
-    let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
-    texels[pick(1)] = [1e30, 1e30, 1e30, 1.0];
-    texels[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
-    texels[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
-    texels[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
-    write_image(ctx, image, &texels);
-}
-
 /// Fireflies (huge, infinite and NaN radiance injected into a traced Cornell frame) and an empty
 /// view: every output texel stays finite and non-negative, the empty view exactly black.
 #[test]
@@ -299,7 +280,7 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
                 .enumerate()
                 .map(|(i, s)| {
                     let s = (*s)?;
-                    let noise = 0.5 + hash(i as u32 * 31 + f * 7919);
+                    let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
                     Some(if covered.contains(&s.x) {
                         Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
                     } else {
@@ -360,7 +341,7 @@ fn vp_seam_is_filtered_like_any_other_angle() {
             .enumerate()
             .map(|(i, s)| {
                 let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
-                let noise = 0.6 * (hash(i as u32 * 13 + f * 104_729) - 0.5);
+                let noise = 0.6 * (unit_hash(i as u32 * 13 + f * 104_729) - 0.5);
                 s.map(|s| Sample { radiance: truth(x, y) + noise, depth: 5.0, mesh: 1, motion: s })
             })
             .collect();
@@ -548,7 +529,7 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
                 .enumerate()
                 .map(|(i, s)| {
                     let s = (*s)?;
-                    let noise = 0.5 + hash(i as u32 * 31 + f * 7919);
+                    let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
                     Some(if covered.contains(&s.x) {
                         Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
                     } else {
@@ -634,20 +615,30 @@ fn taa_makes_the_tracer_use_the_frames_halton_offset() {
     assert_clean(&ctx);
 }
 
-/// `fovea render --taa vp` after the denoiser (and on the raw colour): the report names it and
-/// times the pass; `--taa screen` is refused as not implemented yet.
+/// `fovea render --taa vp|screen` after the denoiser (and on the raw colour): the report names it
+/// and times the pass (`taa` in the grid, `taa_screen` after the remap; Cartesian's screen is its
+/// grid); an unknown mode is refused.
 #[test]
 fn render_command_runs_taa_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
     let out = fovea_tests::artifacts_dir().join(format!("taa-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let args = |method, denoiser, taa| RenderArgs { method, denoiser, taa, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) };
-    for (method, denoiser, taa) in [("cartesian", "none", "vp"), ("vp", "svgf", "vp"), ("vp", "none", "off")] {
+    let runs = [
+        ("cartesian", "none", "vp", Some("taa")),
+        ("cartesian", "none", "screen", Some("taa")),
+        ("vp", "svgf", "vp", Some("taa")),
+        ("vp", "svgf", "screen", Some("taa_screen")),
+        ("vp", "none", "off", None),
+    ];
+    for (method, denoiser, taa, pass) in runs {
         run(&args(method, denoiser, taa)).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
         assert_eq!(report["taa"], taa);
-        assert_eq!(report["passes"].get("taa").is_some(), taa == "vp", "{method}/{denoiser}/{taa}");
+        for name in ["taa", "taa_screen"] {
+            assert_eq!(report["passes"].get(name).is_some(), pass == Some(name), "{method}/{denoiser}/{taa}: {name}");
+        }
     }
-    let err = format!("{:#}", run(&args("vp", "none", "screen")).unwrap_err());
-    assert!(err.contains("not implemented yet"), "{err}");
+    let err = format!("{:#}", run(&args("vp", "none", "temporal")).unwrap_err());
+    assert!(err.contains("expected one of off, vp, screen"), "{err}");
 }

@@ -15,7 +15,7 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer}
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::{assert_clean, gpu, read_image, save_preview, write_image};
+use fovea_tests::{assert_clean, gpu, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, Vec2};
 use std::sync::Arc;
 
@@ -31,18 +31,22 @@ fn gazes() -> [(&'static str, Vec2); 3] {
     [("centre", SCREEN.as_vec2() * 0.5), ("edge", Vec2::new(6.0, 50.0)), ("corner", Vec2::new(90.5, 103.0))]
 }
 
-fn hash(mut v: u32) -> f32 {
-    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
-    ((v >> 22) ^ v) as f32 / u32::MAX as f32
-}
-
 fn image(ctx: &Arc<Context>, name: &str, size: UVec2) -> Image {
     Image::new(ctx, name, size.x, size.y, vk::Format::R32G32B32A32_SFLOAT).unwrap()
 }
 
 /// Runs mips + remap on a VP image given texel by texel; returns (stacked mips, screen image).
 fn to_screen(ctx: &Arc<Context>, vp: &VisualPolar, texel: impl Fn(u32, u32) -> [f32; 4]) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    to_screen_with_offset(ctx, vp, Vec2::ZERO, texel)
+}
+
+/// `to_screen` for samples that sit `sample_offset` texels beside their texel centres.
+fn to_screen_with_offset(
+    ctx: &Arc<Context>,
+    vp: &VisualPolar,
+    sample_offset: Vec2,
+    texel: impl Fn(u32, u32) -> [f32; 4],
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let g = vp.grid_size();
     let data: Vec<[f32; 4]> = (0..g.y).flat_map(|y| (0..g.x).map(move |x| (x, y))).map(|(x, y)| texel(x, y)).collect();
     let vp_color = image(ctx, "vp_color", g);
@@ -55,7 +59,7 @@ fn to_screen(ctx: &Arc<Context>, vp: &VisualPolar, texel: impl Fn(u32, u32) -> [
     let mut rec = FrameRecorder::new(ctx, 16).unwrap();
     rec.begin().unwrap();
     mip_phi.record(&mut rec, &params, &columns, &vp_color, &mips).unwrap();
-    remap.record(&mut rec, &params, &columns, &mips, &screen).unwrap();
+    remap.record(&mut rec, &params, &columns, &mips, &screen, sample_offset).unwrap();
     rec.submit_and_wait().unwrap();
     (read_image(ctx, &mips.image), read_image(ctx, &screen))
 }
@@ -99,7 +103,7 @@ fn phi_mips_match_a_cpu_reference() {
 fn check_phi_mips(ctx: &Arc<Context>, vp: &VisualPolar) {
     let g = vp.grid_size();
     let texel = |x: u32, y: u32| {
-        let v = hash(x * 7919 + y * 104_729);
+        let v = unit_hash(x * 7919 + y * 104_729);
         [v, 1.0 - v, (x + y) as f32, 1.0]
     };
     let (mips, _) = to_screen(ctx, vp, texel);
@@ -154,6 +158,40 @@ fn remap_keeps_a_constant_image_constant() {
     assert_clean(&ctx);
 }
 
+/// Distance of each remapped screen position from its pixel's centre, against half the extent of
+/// the texel under the pixel (a whole texel for screen-clipped border pixels the outer column's
+/// arcs do not reach): (mean px, worst px, pixels over their bound, such border pixels, error
+/// image in units of the bound).
+fn position_errors(vp: &VisualPolar, gaze: Vec2, screen: &[[f32; 4]]) -> (f64, f32, u32, u32, Vec<[f32; 4]>) {
+    let (mut worst, mut sum, mut over, mut border_pixels) = (0f32, 0f64, 0, 0);
+    let mut error_image = vec![[0f32; 4]; screen.len()];
+    for py in 0..SCREEN.y {
+        for px in 0..SCREEN.x {
+            let centre = Vec2::new(px as f32 + 0.5, py as f32 + 0.5);
+            let i = (py * SCREEN.x + px) as usize;
+            let err = (Vec2::new(screen[i][0], screen[i][1]) - centre).length();
+            // Screen extent of the texel under this pixel (one step along ρ and along φ).
+            let g = vp.screen_to_vp(centre);
+            let step_rho = (vp.vp_to_screen(g + Vec2::X) - vp.vp_to_screen(g)).length();
+            let step_phi = (vp.vp_to_screen(g + Vec2::Y) - vp.vp_to_screen(g)).length();
+            // Where the outer of the two columns the remap blends has left the screen at
+            // this angle (its circle is larger), the inner column answers alone: up to one
+            // texel along ρ off.
+            let outer = ((g.x - 0.5).max(0.0) as u32 + 1).min(vp.grid_size().x - 1);
+            let d = centre - gaze;
+            let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+            let inner_only = vp.column_arcs(outer).arc_of_phi(phi).2 > 0.0;
+            border_pixels += inner_only as u32;
+            let allowed = if inner_only { 1.0 } else { 0.5 } * step_rho.max(step_phi).max(1.0);
+            over += (err > allowed) as u32;
+            worst = worst.max(err);
+            sum += err as f64;
+            error_image[i] = [err / allowed, 0.0, 0.0, 1.0];
+        }
+    }
+    (sum / screen.len() as f64, worst, over, border_pixels, error_image)
+}
+
 /// Each VP texel holds its own screen position; the remapped image must hold (about) every
 /// pixel's centre. Allowed error: half the texel's extent on screen, which is what linear
 /// interpolation of a curved grid and the φ box filter can be off by; in the screen-clipped
@@ -169,33 +207,7 @@ fn remap_reproduces_screen_positions() {
                 let p = vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 [p.x, p.y, 0.0, 1.0]
             });
-            let (mut worst, mut sum, mut over, mut border_pixels) = (0f32, 0f64, 0, 0);
-            let mut error_image = vec![[0f32; 4]; screen.len()];
-            for py in 0..SCREEN.y {
-                for px in 0..SCREEN.x {
-                    let centre = Vec2::new(px as f32 + 0.5, py as f32 + 0.5);
-                    let i = (py * SCREEN.x + px) as usize;
-                    let err = (Vec2::new(screen[i][0], screen[i][1]) - centre).length();
-                    // Screen extent of the texel under this pixel (one step along ρ and along φ).
-                    let g = vp.screen_to_vp(centre);
-                    let step_rho = (vp.vp_to_screen(g + Vec2::X) - vp.vp_to_screen(g)).length();
-                    let step_phi = (vp.vp_to_screen(g + Vec2::Y) - vp.vp_to_screen(g)).length();
-                    // Where the outer of the two columns the remap blends has left the screen at
-                    // this angle (its circle is larger), the inner column answers alone: up to one
-                    // texel along ρ off.
-                    let outer = ((g.x - 0.5).max(0.0) as u32 + 1).min(vp.grid_size().x - 1);
-                    let d = centre - gaze;
-                    let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
-                    let inner_only = vp.column_arcs(outer).arc_of_phi(phi).2 > 0.0;
-                    border_pixels += inner_only as u32;
-                    let allowed = if inner_only { 1.0 } else { 0.5 } * step_rho.max(step_phi).max(1.0);
-                    over += (err > allowed) as u32;
-                    worst = worst.max(err);
-                    sum += err as f64;
-                    error_image[i] = [err / allowed, 0.0, 0.0, 1.0];
-                }
-            }
-            let mean = sum / screen.len() as f64;
+            let (mean, worst, over, border_pixels, error_image) = position_errors(&vp, gaze, &screen);
             println!(
                 "gaze {name} {layout:?}: mean position error {mean:.3} px, worst {worst:.3} px, {over} pixels over their texel \
                  bound ({border_pixels} border pixels outside the outer column's arcs)"
@@ -206,6 +218,37 @@ fn remap_reproduces_screen_positions() {
             assert_eq!(over, 0, "gaze {name} {layout:?}: pixels off by more than half their texel");
             assert!(mean < 0.25, "gaze {name} {layout:?}: mean error {mean} px");
         }
+    }
+    assert_clean(&ctx);
+}
+
+/// Screen-space TAA's jittered samples: each texel holds the screen position of a sample traced
+/// at a Halton offset inside it, and the remap, told that offset, must put every position back
+/// on its pixel as well as for centred samples — while reading the same image as if centred is
+/// off by about the jitter times the texel footprint (the test would fail without the offset).
+/// The paper's layout only: TAA is refused with the screen-clipped one (`fovea render`).
+#[test]
+fn remap_reads_jittered_samples_where_they_were_traced() {
+    let ctx = gpu();
+    let jitter = Vec2::new(0.85, 0.2);
+    for (name, gaze) in gazes() {
+        let layout = VpLayout::Paper;
+        let vp = space(gaze, layout);
+        let texel = |x: u32, y: u32| {
+            let p = vp.vp_to_screen(Vec2::new(x as f32, y as f32) + jitter);
+            [p.x, p.y, 0.0, 1.0]
+        };
+        let (_, placed) = to_screen_with_offset(&ctx, &vp, jitter - 0.5, texel);
+        let (_, centred) = to_screen(&ctx, &vp, texel);
+        let (mean, worst, over, _, _) = position_errors(&vp, gaze, &placed);
+        let (mean_centred, ..) = position_errors(&vp, gaze, &centred);
+        println!(
+            "gaze {name} {layout:?}, jitter {jitter}: mean position error {mean:.3} px (worst {worst:.3}, {over} over \
+             their bound); read as if centred {mean_centred:.3} px"
+        );
+        assert_eq!(over, 0, "gaze {name} {layout:?}: jittered pixels off by more than half their texel");
+        assert!(mean < 0.25, "gaze {name} {layout:?}: mean error {mean} px");
+        assert!(mean_centred > 2.0 * mean, "gaze {name} {layout:?}: the offset changed little ({mean_centred} vs {mean})");
     }
     assert_clean(&ctx);
 }
@@ -229,7 +272,7 @@ fn foveated_blur_spares_the_fovea_and_spreads_by_sigma() {
     let n = (SCREEN.x * SCREEN.y) as usize;
     let at = |i: usize| Vec2::new((i as u32 % SCREEN.x) as f32 + 0.5, (i as u32 / SCREEN.x) as f32 + 0.5);
 
-    let noise: Vec<[f32; 4]> = (0..n).map(|i| [hash(i as u32), hash(i as u32 + 7), 0.5, 1.0]).collect();
+    let noise: Vec<[f32; 4]> = (0..n).map(|i| [unit_hash(i as u32), unit_hash(i as u32 + 7), 0.5, 1.0]).collect();
     let out = blur(&ctx, &shape, &noise);
     let mut blurred_outside = 0;
     for i in 0..n {

@@ -8,6 +8,7 @@ use crate::graph::{FrameRecorder, PassTiming};
 use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
+use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::{DenoiseFrame, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
@@ -152,14 +153,20 @@ impl Renderer {
             Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
         };
         let pixels = screen.x as u64 * screen.y as u64;
+        // Screen-space TAA runs between the remap and the blur; for Cartesian the sampling grid
+        // is the screen, and it is the sampling-grid filter.
+        let (grid_taa, screen_taa) = match (settings.taa, space.visual_polar()) {
+            (TaaMode::Screen(s), Some(_)) => (None, Some(s)),
+            (mode, _) => (mode.settings().copied(), None),
+        };
         let to_screen = match space.visual_polar() {
-            Some(_) => Some(ToScreen::new(ctx, grid, screen)?),
+            Some(_) => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
             None => None,
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let denoiser_passes = denoiser.as_ref().map_or(0, |d| d.max_passes());
-        let taa = match settings.taa.settings() {
-            Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), *s)?),
+        let taa = match grid_taa {
+            Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
             None => None,
         };
         Ok(Renderer {
@@ -214,9 +221,16 @@ impl Renderer {
         self.recorder.timings()
     }
 
-    /// The TAA state, when `settings.taa` is on.
+    /// The sampling-grid TAA state, when `settings.taa` runs in the grid.
     pub fn taa(&self) -> Option<&Taa> {
         self.taa.as_ref()
+    }
+
+    /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
+    pub fn taa_history_bytes(&self) -> u64 {
+        let grid = self.taa.as_ref().map_or(0, |t| t.history_bytes());
+        let screen = self.to_screen.as_ref().and_then(|s| s.taa.as_ref()).map_or(0, |t| t.history_bytes());
+        grid + screen
     }
 
     fn write_frame_data(&self, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
@@ -246,7 +260,7 @@ impl Renderer {
         if let Some(gaze) = input.gaze {
             self.space.set_gaze(gaze)?;
         }
-        let jitter = self.taa.as_ref().map(|t| t.settings.jitter(input.frame_index));
+        let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
         let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 };
         self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let space = self.space.params();
@@ -266,8 +280,15 @@ impl Renderer {
             (Some(taa), Some(jitter)) => taa.record(rec, &self.gbuffer, denoised, &denoise_frame, jitter)?,
             _ => denoised,
         };
-        let screen_hdr = match (&self.to_screen, self.space.visual_polar()) {
-            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &self.sampling_table, grid_hdr, &self.settings.blur)?,
+        let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
+            frame_data: &self.frame_data,
+            gbuffer: &self.gbuffer,
+            space: &denoise_frame.current,
+            has_previous: denoise_frame.previous.is_some(),
+            jitter,
+        });
+        let screen_hdr = match (&mut self.to_screen, self.space.visual_polar()) {
+            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &self.sampling_table, grid_hdr, &self.settings.blur, screen_taa.as_ref())?,
             _ => grid_hdr,
         };
         let (exposure, curve) = (self.settings.exposure, self.settings.tone_curve);

@@ -1,15 +1,18 @@
 //! Back to the screen from a Visual-Polar grid (visual-polar.md §6–7): φ-only mips → remap by
-//! backward mapping → foveated blur. Owns the passes and their screen-sized images.
+//! backward mapping → (screen-space TAA, optional) → foveated blur. Owns the passes and their
+//! screen-sized images.
 
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::passes::blur::{BlurPass, BlurShape};
+use crate::passes::denoise::taa::TaaSettings;
+use crate::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
 use crate::passes::mip_phi::{MipPhiPass, PhiMips};
 use crate::passes::remap::RemapPass;
 use crate::sampling::VisualPolar;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
-use glam::UVec2;
+use glam::{UVec2, Vec2};
 use std::sync::Arc;
 
 /// The paper's blur strength: σ = 6.8 px at 30° on the 1280×1440 FOVE 0 eye.
@@ -55,10 +58,13 @@ pub struct ToScreen {
     scratch: Image,
     /// Final linear radiance on the screen.
     pub blurred: Image,
+    /// TAA between the remap and the blur (`--taa screen`).
+    pub taa: Option<ScreenTaa>,
 }
 
 impl ToScreen {
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2) -> Result<ToScreen> {
+    /// `taa`: resolve in screen space after the remap with these settings.
+    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2, taa: Option<TaaSettings>) -> Result<ToScreen> {
         let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(ToScreen {
             mip_phi: MipPhiPass::new(ctx)?,
@@ -68,26 +74,39 @@ impl ToScreen {
             remapped: image("screen.remapped")?,
             scratch: image("screen.blur_scratch")?,
             blurred: image("screen.blurred")?,
+            taa: taa.map(|t| ScreenTaa::new(ctx, screen, t)).transpose()?,
         })
     }
 
-    /// Records mips, remap and (unless σ is 0) the blur; returns the screen image to show.
-    /// `columns` is a texel buffer holding `vp.column_table()` (the renderer's `sampling_table`).
+    /// Records mips, remap, the screen-space TAA (when this was built with one; `taa` then
+    /// carries the frame's jitter and G-buffer) and (unless σ is 0) the blur; returns the screen
+    /// image to show. `columns` is a texel buffer holding `vp.column_table()` (the renderer's
+    /// `sampling_table`).
     pub fn record(
-        &self,
+        &mut self,
         rec: &mut FrameRecorder,
         vp: &VisualPolar,
         columns: &Buffer,
         vp_color: &Image,
         blur: &BlurSettings,
+        taa: Option<&ScreenTaaFrame>,
     ) -> Result<&Image> {
         let params = vp.sampling_params();
         self.mip_phi.record(rec, &params, columns, vp_color, &self.mips)?;
-        self.remap.record(rec, &params, columns, &self.mips, &self.remapped)?;
+        // Samples jittered for the screen-space TAA are read where they were traced.
+        let sample_offset = match (&self.taa, taa) {
+            (Some(_), Some(frame)) => frame.jitter - Vec2::splat(0.5),
+            _ => Vec2::ZERO,
+        };
+        self.remap.record(rec, &params, columns, &self.mips, &self.remapped, sample_offset)?;
+        let resolved = match (&mut self.taa, taa) {
+            (Some(resolver), Some(frame)) => resolver.record(rec, &self.remapped, frame)?,
+            _ => &self.remapped,
+        };
         if blur.sigma_at_30 <= 0.0 {
-            return Ok(&self.remapped);
+            return Ok(resolved);
         }
-        self.blur.record(rec, &blur.shape(vp), &self.remapped, &self.scratch, &self.blurred)?;
+        self.blur.record(rec, &blur.shape(vp), resolved, &self.scratch, &self.blurred)?;
         Ok(&self.blurred)
     }
 }

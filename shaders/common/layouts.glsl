@@ -135,6 +135,8 @@ struct RemapPush {
     vec4 vp_shape0;
     vec4 vp_shape1;
     uvec4 config;               // x φ mip levels built (≥ 2), yzw unused
+    vec4 sample_offset;         // xy where this frame's samples sit in their VP texel minus ½ (screen-space TAA's
+                                //   Halton jitter; 0 otherwise: samples are read as if centred), zw unused
 };
 
 // Push constants of the foveated blur (one pass per axis).
@@ -200,6 +202,18 @@ struct TaaPush {
     vec4 prev_shape0;
     vec4 prev_shape1;
     vec4 params;                // x current-frame weight, y 1 = drop all history, zw this frame's jitter in the texel
+};
+
+// Push constants of TAA after the remap to screen space (beyond the paper, its future work). The
+// VP samples jitter by a Halton offset inside their VP texel, so on the screen the jitter spans one
+// texel footprint: under a pixel from the fovea, many pixels in the periphery. The pass reads the
+// footprint from the space to size its neighbourhood.
+struct TaaScreenPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 params;                // x current-frame weight, y 1 = drop all history, zw unused
 };
 
 const uint TONEMAP_CLAMP = 0u;

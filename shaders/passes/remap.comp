@@ -9,6 +9,8 @@
 // Near the border a pixel's angle may lie outside the outer column's arcs (that circle leaves the
 // screen sooner): such a clamped column is trusted only within one of its φ texels of the pixel,
 // beyond that the inner column (whose arcs hold the pixel) answers alone.
+// Samples jittered inside their texel (screen-space TAA) are read where they were traced:
+// sample_offset shifts the lookup by the jitter, in texels along ρ and in level-0 rows along φ.
 // Two variants: lavapipe executes both sides of every branch, so the paper's layout gets a kernel
 // with the screen-clipped path compiled out.
 //! variant paper: VP_LAYOUT_PAPER
@@ -80,7 +82,7 @@ vec4 sample_column_clipped(VpParams P, VpArcs arcs, uint col, float phi, float r
     vec3 ai = vp_arc_of_phi(arcs, phi);
     int i = int(ai.y);
     trust = max(1.0 - vp_arc_row(arcs, ai.z, n), 0.0);
-    float y0 = vp_arc_row(arcs, ai.x, n);
+    float y0 = vp_arc_row(arcs, ai.x, n) - push.p.sample_offset.y;
     float lo0 = i == 0 ? -1e30 : vp_arc_row(arcs, vp_arcs_arc_start(arcs, i), n);
     float hi0 = i == vp_arcs_count(arcs) - 1 ? 1e30 : vp_arc_row(arcs, arcs.end[i], n);
     float lod = phi_lod(rows0, vp_arcs_total(arcs), r, levels);
@@ -98,7 +100,7 @@ vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels, out fl
         if (!vp_arcs_wrap(arcs)) return sample_column_clipped(P, arcs, col, phi, r, levels, trust);
     }
     uint rows0 = vp_rows_in_column(P, col);
-    float y0 = phi / VP_TAU * float(rows0);
+    float y0 = phi / VP_TAU * float(rows0) - push.p.sample_offset.y;
     float lod = phi_lod(rows0, VP_TAU, r, levels);
     uint l0 = uint(lod);
     uint l1 = min(l0 + 1u, levels - 1u);
@@ -115,7 +117,8 @@ void main() {
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
-    float x = clamp(vp_u_of_r(P, r) * float(P.grid.x) - 0.5, 0.0, float(P.grid.x - 1u));
+    // Texel centres at integers; a jittered sample sits sample_offset texels beside its centre.
+    float x = clamp(vp_u_of_r(P, r) * float(P.grid.x) - 0.5 - push.p.sample_offset.x, 0.0, float(P.grid.x - 1u));
     uint c0 = uint(x);
     uint c1 = min(c0 + 1u, P.grid.x - 1u);
     uint levels = max(push.p.config.x, 1u);

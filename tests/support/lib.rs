@@ -131,3 +131,23 @@ pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_
         validation: true,
     }
 }
+
+/// A hash of `v` in [0, 1] (PCG output permutation): deterministic picks in tests.
+pub fn unit_hash(mut v: u32) -> f32 {
+    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
+    ((v >> 22) ^ v) as f32 / u32::MAX as f32
+}
+
+/// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a
+/// NaN and a negative colour.
+pub fn inject_fireflies(ctx: &Arc<Context>, image: &Image, f: u32) {
+    let mut texels: Vec<[f32; 4]> = read_image(ctx, image);
+    let kept: Vec<usize> = (0..texels.len()).filter(|&i| texels[i][3] > 0.0).collect();
+    let pick = |k: u32| kept[(unit_hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
+    texels[pick(1)] = [1e30, 1e30, 1e30, 1.0];
+    texels[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
+    texels[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
+    texels[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
+    write_image(ctx, image, &texels);
+}

@@ -100,7 +100,8 @@ struct RenderOpts {
     #[arg(long, default_value = "none")]
     denoiser: String,
     /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for
-    /// Cartesian). `screen` (after the remap) is reserved and not implemented yet.
+    /// Cartesian) | screen (after the remap to the screen, neighbourhood sized by the local VP
+    /// texel footprint; for Cartesian the same as vp).
     #[arg(long, default_value = "off")]
     taa: String,
 }

@@ -1,5 +1,5 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp`).
+//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp` or `--taa screen`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 

@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{RemapPush, SamplingParams};
 use crate::vk::{Buffer, Context, Image};
-use glam::UVec4;
+use glam::{UVec4, Vec2, Vec4};
 use std::sync::Arc;
 
 pub struct RemapPass {
@@ -23,7 +23,17 @@ impl RemapPass {
 
     /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` and `columns` (its
     /// `VisualPolar::column_table`) hold the same space (gaze included) the image was traced with.
-    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, columns: &Buffer, mips: &PhiMips, screen: &Image) -> Result<()> {
+    /// `sample_offset`: where the samples sit in their texel minus ½ (a TAA jitter; zero for
+    /// samples read as if centred).
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        vp: &SamplingParams,
+        columns: &Buffer,
+        mips: &PhiMips,
+        screen: &Image,
+        sample_offset: Vec2,
+    ) -> Result<()> {
         let binds = [read_image("mips", &mips.image), write_image("screen_color", screen), read_texels("vp_columns", columns)];
         let push = RemapPush {
             vp_grid: vp.grid,
@@ -31,6 +41,7 @@ impl RemapPass {
             vp_shape0: vp.shape0,
             vp_shape1: vp.shape1,
             config: UVec4::new(mips.levels, 0, 0, 0),
+            sample_offset: Vec4::new(sample_offset.x, sample_offset.y, 0.0, 0.0),
         };
         rec.dispatch("remap", self.pipelines.for_space(vp), &binds, push_bytes(&push), [screen.width, screen.height, 1])
     }

@@ -11,6 +11,7 @@
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"
+#include "../../denoise/taa.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { TaaPush p; } push;
@@ -26,26 +27,6 @@ layout(set = 0, binding = 8, rgba32ui) uniform writeonly uimage2D surface;
 
 // A bilinear footprint with less of the grid's samples than this has no usable history.
 const float TAA_MIN_HISTORY_WEIGHT = 0.01;
-
-vec3 rgb_to_ycocg(vec3 c) {
-    return vec3(dot(c, vec3(0.25, 0.5, 0.25)), dot(c, vec3(0.5, 0.0, -0.5)), dot(c, vec3(-0.25, 0.5, -0.25)));
-}
-
-vec3 ycocg_to_rgb(vec3 c) {
-    return vec3(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
-}
-
-// The point where the segment from `mean` (inside the box) to `h` leaves the box [lo, hi]: a clip
-// toward the mean keeps the history's hue where a per-axis clamp would not.
-vec3 clip_toward_mean(vec3 lo, vec3 hi, vec3 mean, vec3 h) {
-    vec3 d = h - mean;
-    float t = 1.0;
-    for (int i = 0; i < 3; ++i) {
-        if (d[i] > 1e-7) t = min(t, (hi[i] - mean[i]) / d[i]);
-        else if (d[i] < -1e-7) t = min(t, (lo[i] - mean[i]) / d[i]);
-    }
-    return mean + max(t, 0.0) * d;
-}
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
@@ -117,11 +98,7 @@ void main() {
     vec3 result = c;
     if (hist_weight >= TAA_MIN_HISTORY_WEIGHT) {
         vec3 hy = clip_toward_mean(lo, hi, mean, rgb_to_ycocg(max(hist / hist_weight, vec3(0.0))));
-        float alpha = push.p.params.x;
-        // Karis's luma weights: a bright outlier pulls the blend far less than its share.
-        float wc = alpha / (1.0 + cy.x);
-        float wh = (1.0 - alpha) / (1.0 + max(hy.x, 0.0));
-        result = max(ycocg_to_rgb((wc * cy + wh * hy) / (wc + wh)), vec3(0.0));
+        result = taa_blend(cy, hy, push.p.params.x);
     }
     imageStore(history, t, vec4(result, 1.0));
 }

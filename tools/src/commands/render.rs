@@ -39,7 +39,7 @@ pub struct RenderArgs<'a> {
     pub debug_views: bool,
     /// `none` or `svgf` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
-    /// `off` or `vp` (`TaaMode::NAMES`; `screen` is refused as not implemented yet).
+    /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
     pub taa: &'a str,
     pub device: Option<&'a str>,
     pub validation: bool,
@@ -53,7 +53,8 @@ struct Report {
     method: String,
     /// Denoiser in the sampling grid (`none`, `svgf`).
     denoiser: String,
-    /// TAA: `off`, or `vp` (in the sampling grid).
+    /// TAA: `off`, `vp` (in the sampling grid) or `screen` (after the remap; for Cartesian the
+    /// sampling-grid filter, the grid being the screen).
     taa: String,
     scene: String,
     headset: String,
@@ -132,11 +133,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
         other => other,
     };
-    let taa = match TaaMode::parse(args.taa).context("--taa")? {
-        TaaMode::SamplingGrid(_) => TaaMode::SamplingGrid(args.profile.taa),
-        other => other,
-    };
-    // TAA reprojects with the paper's mapping, like SVGF.
+    let taa = TaaMode::parse(args.taa).context("--taa")?.with_settings(args.profile.taa);
+    // TAA reprojects with the paper's mapping, like SVGF (the screen-space one finds depths in the
+    // VP G-buffer the same way).
     if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
         bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
     }

@@ -8,6 +8,7 @@
 pub mod modulate;
 pub mod svgf;
 pub mod taa;
+pub mod taa_screen;
 
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;

@@ -78,17 +78,20 @@ pub enum TaaMode {
     Off,
     /// In the sampling grid (`vp`; for Cartesian that is the screen).
     SamplingGrid(TaaSettings),
+    /// After the remap, in screen space (`screen`; `taa_screen`). For Cartesian the sampling
+    /// grid is the screen, so this is the sampling-grid filter.
+    Screen(TaaSettings),
 }
 
 impl TaaMode {
-    /// The names `parse` accepts; `screen` (after the remap) is reserved.
-    pub const NAMES: &'static [&'static str] = &["off", "vp"];
+    /// The names `parse` accepts.
+    pub const NAMES: &'static [&'static str] = &["off", "vp", "screen"];
 
     pub fn parse(name: &str) -> Result<TaaMode> {
         match name {
             "off" => Ok(TaaMode::Off),
             "vp" => Ok(TaaMode::SamplingGrid(TaaSettings::default())),
-            "screen" => Err(Error::Invalid("taa 'screen' (TAA after the remap) is not implemented yet; use vp or off".into())),
+            "screen" => Ok(TaaMode::Screen(TaaSettings::default())),
             other => Err(Error::Invalid(format!("taa '{other}': expected one of {}", Self::NAMES.join(", ")))),
         }
     }
@@ -97,13 +100,23 @@ impl TaaMode {
         match self {
             TaaMode::Off => "off",
             TaaMode::SamplingGrid(_) => "vp",
+            TaaMode::Screen(_) => "screen",
         }
     }
 
     pub fn settings(&self) -> Option<&TaaSettings> {
         match self {
             TaaMode::Off => None,
-            TaaMode::SamplingGrid(s) => Some(s),
+            TaaMode::SamplingGrid(s) | TaaMode::Screen(s) => Some(s),
+        }
+    }
+
+    /// The same mode with other filter parameters (a render profile's `[taa]`).
+    pub fn with_settings(self, settings: TaaSettings) -> TaaMode {
+        match self {
+            TaaMode::Off => TaaMode::Off,
+            TaaMode::SamplingGrid(_) => TaaMode::SamplingGrid(settings),
+            TaaMode::Screen(_) => TaaMode::Screen(settings),
         }
     }
 }
@@ -201,7 +214,9 @@ mod tests {
         assert!(TaaSettings::default().validate().is_ok());
         assert_eq!(TaaMode::parse("vp").unwrap().name(), "vp");
         assert_eq!(TaaMode::parse("off").unwrap(), TaaMode::Off);
-        assert!(TaaMode::parse("screen").unwrap_err().to_string().contains("not implemented yet"));
+        assert_eq!(TaaMode::parse("screen").unwrap().name(), "screen");
+        let tuned = TaaSettings { current_weight: 0.2, ..Default::default() };
+        assert_eq!(TaaMode::parse("screen").unwrap().with_settings(tuned).settings(), Some(&tuned));
         assert!(TaaMode::parse("on").is_err());
     }
 }

@@ -1,0 +1,86 @@
+//! TAA after the remap, in screen space (issue 5; beyond the paper, listed there as future
+//! work). The tracer jitters each Visual-Polar sample by the frame's Halton offset inside its VP
+//! texel, the remap reads the samples where they were traced (`RemapPass` sample offset), and
+//! this pass accumulates the screen images: one jitter cycle sweeps each pixel over a whole VP
+//! texel, which in the periphery spans many pixels — so the neighbourhood that clips the history
+//! is spaced by the local texel footprint (see `taa_screen.comp`). Runs between the remap and
+//! the foveated blur; the history is screen-sized and unblurred.
+
+use super::taa::TaaSettings;
+use crate::error::Result;
+use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
+use crate::layouts::{SamplingParams, TaaScreenPush};
+use crate::passes::push_bytes;
+use crate::passes::trace::GBuffer;
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use ash::vk;
+use glam::{UVec2, Vec4};
+use std::sync::Arc;
+
+/// Per-eye screen-space TAA: the pass and its ping-pong history (colour + the depth it was
+/// resolved with), allocated once.
+pub struct ScreenTaa {
+    pub settings: TaaSettings,
+    pipeline: ComputePipeline,
+    history: [Image; 2],
+    frames: u64,
+}
+
+/// What one frame's resolve reads besides the remapped image.
+pub struct ScreenTaaFrame<'a> {
+    /// The renderer's `FrameData` uniform buffer (this and the previous camera).
+    pub frame_data: &'a Buffer,
+    /// The VP G-buffer the remapped image came from (depths for the reprojection).
+    pub gbuffer: &'a GBuffer,
+    /// This frame's space (its gaze).
+    pub space: &'a SamplingParams,
+    /// False when no previous frame may be used (all history dropped).
+    pub has_previous: bool,
+    /// Where the tracer put this frame's samples inside their VP texel (`TaaSettings::jitter`).
+    pub jitter: glam::Vec2,
+}
+
+impl ScreenTaa {
+    pub fn new(ctx: &Arc<Context>, screen: UVec2, settings: TaaSettings) -> Result<ScreenTaa> {
+        settings.validate()?;
+        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
+        Ok(ScreenTaa {
+            settings,
+            pipeline: ComputePipeline::new(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
+            history: [image("taa_screen.history0")?, image("taa_screen.history1")?],
+            frames: 0,
+        })
+    }
+
+    /// GPU bytes carried between frames.
+    pub fn history_bytes(&self) -> u64 {
+        self.history.iter().map(|i| i.width as u64 * i.height as u64 * i.texel_bytes()).sum()
+    }
+
+    /// Resolves the remapped `color` (screen-sized) against the history; returns the resolved
+    /// image (next frame's history).
+    pub fn record(&mut self, rec: &mut FrameRecorder, color: &Image, frame: &ScreenTaaFrame) -> Result<&Image> {
+        let cur = (self.frames % 2) as usize;
+        let reset = self.frames == 0 || !frame.has_previous;
+        let binds = [
+            read_buffer("frame", frame.frame_data),
+            read_image("color", color),
+            read_image("normal_depth", &frame.gbuffer.normal_depth),
+            read_image("position", &frame.gbuffer.position),
+            read_image("prev_history", &self.history[1 - cur]),
+            write_image("history", &self.history[cur]),
+        ];
+        let s = frame.space;
+        let push = TaaScreenPush {
+            vp_grid: s.grid,
+            vp_gaze: s.gaze,
+            vp_shape0: s.shape0,
+            vp_shape1: s.shape1,
+            params: Vec4::new(self.settings.current_weight, if reset { 1.0 } else { 0.0 }, 0.0, 0.0),
+        };
+        let out = &self.history[cur];
+        rec.dispatch("taa_screen", &self.pipeline, &binds, push_bytes(&push), [out.width, out.height, 1])?;
+        self.frames += 1;
+        Ok(&self.history[cur])
+    }
+}
