@@ -1,6 +1,6 @@
 //! `fovea eval` through its library entry point (as `tests/cli.rs` does for the other commands):
 //! eval.json's fields and values on small synthetic EXRs, and bad input named in the error.
-//! No GPU needed.
+//! No GPU needed, except for `fovea quality`, which renders.
 
 use fovea_tools::commands::eval::{run as eval, EvalArgs};
 use fovea_tools::output::write_exr;
@@ -144,4 +144,59 @@ fn bad_inputs_are_named_in_the_error() {
     let err = format!("{:#}", eval(&args(&good, &good, "32,36", &out)).unwrap_err());
     assert!(err.contains("mine.txt"), "{err}");
     assert_eq!(std::fs::read_to_string(out.join("mine.txt")).unwrap(), "mine");
+}
+
+/// `fovea quality` on a tiny sequence: every combination of the asked methods, denoisers, TAA
+/// modes and cameras is rendered and measured against references of its own camera poses; the
+/// folder can be reused; bad names and foreign files are refused.
+#[test]
+fn quality_command_measures_every_combination() {
+    use fovea_tools::commands::quality::{run, QualityArgs};
+    let out = temp_dir("quality");
+    let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (methods, denoisers, taa, cameras) = (strings(&["vp", "cartesian"]), strings(&["none"]), strings(&["off", "screen"]), strings(&["still", "moving"]));
+    let args = |denoisers| QualityArgs {
+        scene: "cornell-box",
+        width: 40,
+        height: 36,
+        headset: "fove0",
+        gaze: "sim:2",
+        frames: 3,
+        eval_frames: 2,
+        methods: &methods,
+        denoisers,
+        taa: &taa,
+        cameras: &cameras,
+        reference_spp: 4,
+        rings: 4,
+        seed: 1,
+        profile: Default::default(),
+        out: &out,
+        device: None,
+        validation: true,
+    };
+    for _ in 0..2 {
+        run(&args(&denoisers)).unwrap();
+    }
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
+    let runs = report["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2 * 2 * 2, "{runs:?}");
+    for r in runs {
+        assert_eq!(r["rings"].as_array().unwrap().len(), 4);
+        assert_eq!(r["frames"], serde_json::json!([1, 2]));
+        let rmse = r["frame_rmse"].as_f64().unwrap();
+        assert!(rmse.is_finite() && rmse > 0.0, "{r}");
+    }
+    // A still camera needs one reference; a moving one a reference per evaluated frame.
+    for name in ["reference_still_0000.exr", "reference_moving_0001.exr", "reference_moving_0002.exr"] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
+    assert!(table.contains("**moving camera**") && table.contains("| vp + none, screen |"), "{table}");
+    let bad = strings(&["nlm"]);
+    let err = format!("{:#}", run(&args(&bad)).unwrap_err());
+    assert!(err.contains("--denoisers nlm"), "{err}");
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let err = format!("{:#}", run(&args(&denoisers)).unwrap_err());
+    assert!(err.contains("notes.txt"), "{err}");
 }

@@ -17,3 +17,12 @@ pub fn orbit(start: &CameraPose, scene_centre: Vec3, frame: u32, frames: u32) ->
     let rotate = Mat4::from_translation(pivot) * Mat4::from_rotation_y(yaw) * Mat4::from_translation(-pivot);
     CameraPose { world_from_view: rotate * start.world_from_view, fov_tan: start.fov_tan }
 }
+
+/// The camera of frame `frame` of `frames`: the start pose, or on the default path when `moving`.
+pub fn pose(start: &CameraPose, scene_centre: Vec3, frame: u32, frames: u32, moving: bool) -> CameraPose {
+    if moving {
+        orbit(start, scene_centre, frame, frames)
+    } else {
+        *start
+    }
+}

@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use fovea_tools::commands;
+use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_tools::render_profile::{ProfileOverrides, RenderProfile};
 use std::path::PathBuf;
 
@@ -206,6 +207,53 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Quality over a gaze sequence for each method × denoiser × TAA, still and moving camera:
+    /// per-ring RMSE/SSIM against converged references → DIR/quality.json + quality.md.
+    Quality {
+        #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+        scene: String,
+        #[arg(long, default_value_t = 160)]
+        width: u32,
+        #[arg(long, default_value_t = 180)]
+        height: u32,
+        #[arg(long, default_value = "fove0")]
+        headset: String,
+        /// Gaze source of every run (as for `render`); rings follow each frame's gaze.
+        #[arg(long, default_value = "sim:1")]
+        gaze: String,
+        #[arg(long, default_value_t = 16)]
+        frames: u32,
+        /// The last this many frames are evaluated and averaged.
+        #[arg(long, default_value_t = 4)]
+        eval_frames: u32,
+        #[arg(long, value_delimiter = ',', default_value = "vp,cartesian")]
+        methods: Vec<String>,
+        /// Denoisers to compare (default: every one built in).
+        #[arg(long, value_delimiter = ',')]
+        denoisers: Vec<String>,
+        #[arg(long, value_delimiter = ',', default_value = "off")]
+        taa: Vec<String>,
+        /// still and/or moving (the scene's default camera path).
+        #[arg(long, value_delimiter = ',', default_value = "still,moving")]
+        cameras: Vec<String>,
+        #[arg(long, default_value_t = 256)]
+        reference_spp: u32,
+        /// Equal-width rings from the gaze out to the farthest corner.
+        #[arg(long, default_value_t = 10)]
+        rings: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// Render profile (TOML) for every run; flags below override it.
+        #[arg(long)]
+        profile: Option<PathBuf>,
+        /// Foveated blur σ at 30° (0 turns it off).
+        #[arg(long)]
+        blur_sigma: Option<f32>,
+        #[arg(long, default_value = "out/quality")]
+        out: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
     Eval {
         /// Reference linear EXR (e.g. from `fovea reference`).
@@ -285,6 +333,53 @@ fn main() -> Result<()> {
         Command::Headsets => commands::headsets::run(),
         Command::Info { device } => commands::info::run(device.device.as_deref()),
         Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
+        Command::Quality {
+            scene,
+            width,
+            height,
+            headset,
+            gaze,
+            frames,
+            eval_frames,
+            methods,
+            denoisers,
+            taa,
+            cameras,
+            reference_spp,
+            rings,
+            seed,
+            profile,
+            blur_sigma,
+            out,
+            device,
+        } => {
+            let base = match &profile {
+                Some(path) => RenderProfile::load(path)?,
+                None => RenderProfile::default(),
+            };
+            let profile = base.override_with(&ProfileOverrides { blur_sigma, ..Default::default() })?;
+            let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();
+            commands::quality::run(&commands::quality::QualityArgs {
+                scene: &scene,
+                width,
+                height,
+                headset: &headset,
+                gaze: &gaze,
+                frames,
+                eval_frames,
+                methods: &methods,
+                denoisers: if denoisers.is_empty() { &all } else { &denoisers },
+                taa: &taa,
+                cameras: &cameras,
+                reference_spp,
+                rings,
+                seed,
+                profile,
+                out: &out,
+                device: device.device.as_deref(),
+                validation: device.validation,
+            })
+        }
         Command::Eval { reference, test, gaze, rings, out } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,

@@ -12,8 +12,13 @@ pub fn prepare_output_dir(dir: &Path) -> Result<()> {
             bail!("output {} exists and is not a folder", dir.display());
         }
         for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-            let name = entry?.file_name().to_string_lossy().into_owned();
-            let ours = matches!(name.as_str(), "report.json" | "eval.json" | "eval.png")
+            let entry = entry?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            // `fovea quality` keeps one `fovea render` folder per run (checked when reused).
+            let run_folder = name.starts_with("run_") && entry.path().is_dir();
+            let ours = matches!(name.as_str(), "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md")
+                || run_folder
+                || (name.starts_with("reference_") && name.ends_with(".exr"))
                 || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
                 || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)));
             if !ours {

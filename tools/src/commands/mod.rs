@@ -5,6 +5,7 @@ pub mod debug_views;
 pub mod gen_scene;
 pub mod headsets;
 pub mod info;
+pub mod quality;
 pub mod reference;
 pub mod render;
 

@@ -190,7 +190,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Held => 1,
             GazeOrigin::Centre => 2,
         }] += 1;
-        let camera = if args.camera_path { camera_path::orbit(&start_pose, centre, frame, args.frames) } else { start_pose };
+        let camera = camera_path::pose(&start_pose, centre, frame, args.frames, args.camera_path);
         let input = FrameInput {
             camera,
             frame_index: frame,

@@ -1,0 +1,286 @@
+//! `fovea quality`: image quality over a gaze sequence for every sampling method × denoiser × TAA
+//! mode, with a still and with a moving camera (issue 5's quality table). Each combination is a
+//! `fovea render` run (same scene, gaze source, seed and profile) into `DIR/run_*`; its last
+//! `--eval-frames` frames are compared with converged Cartesian references of the same camera
+//! poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own gaze, and the
+//! ring metrics are averaged over those frames → `DIR/quality.json` + `DIR/quality.md`.
+
+use super::render::{self, RenderArgs};
+use crate::camera_path;
+use crate::metrics::{evaluate, Evaluation};
+use crate::output::{prepare_output_dir, read_exr, write_exr};
+use crate::render_profile::RenderProfile;
+use anyhow::{bail, Context, Result};
+use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::sampling::Cartesian;
+use glam::{UVec2, Vec2};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+pub struct QualityArgs<'a> {
+    pub scene: &'a str,
+    pub width: u32,
+    pub height: u32,
+    pub headset: &'a str,
+    pub gaze: &'a str,
+    pub frames: u32,
+    /// The last this many frames are evaluated.
+    pub eval_frames: u32,
+    pub methods: &'a [String],
+    pub denoisers: &'a [String],
+    pub taa: &'a [String],
+    /// `still` and/or `moving` (the scene's default camera path).
+    pub cameras: &'a [String],
+    pub reference_spp: u32,
+    pub rings: usize,
+    pub seed: u32,
+    pub profile: RenderProfile,
+    pub out: &'a Path,
+    pub device: Option<&'a str>,
+    pub validation: bool,
+}
+
+pub const CAMERAS: &[&str] = &["still", "moving"];
+
+/// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
+#[derive(Serialize)]
+struct RunQuality {
+    camera: String,
+    method: String,
+    denoiser: String,
+    taa: String,
+    frame_gpu_ms: f64,
+    /// Frames whose metrics are averaged, and their gaze points (render pixels).
+    frames: Vec<u32>,
+    gaze: Vec<[f32; 2]>,
+    rings: Vec<RingMean>,
+    frame_rmse: f64,
+    frame_ssim: f64,
+}
+
+#[derive(Serialize)]
+struct RingMean {
+    /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
+    ecc_inner: f64,
+    ecc_outer: f64,
+    rmse: Option<f64>,
+    ssim: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    scene: &'a str,
+    width: u32,
+    height: u32,
+    headset: &'a str,
+    gaze_source: &'a str,
+    frames: u32,
+    eval_frames: u32,
+    reference_spp: u32,
+    blur_sigma_at_30: f32,
+    runs: &'a [RunQuality],
+}
+
+fn check_names(flag: &str, given: &[String], allowed: &[&str]) -> Result<()> {
+    if given.is_empty() {
+        bail!("{flag} needs at least one of {}", allowed.join(", "));
+    }
+    for g in given {
+        if !allowed.contains(&g.as_str()) {
+            bail!("{flag} {g}: expected one of {}", allowed.join(", "));
+        }
+    }
+    Ok(())
+}
+
+pub fn run(args: &QualityArgs) -> Result<()> {
+    check_names("--methods", args.methods, render::METHODS)?;
+    check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
+    check_names("--taa", args.taa, TaaMode::NAMES)?;
+    check_names("--cameras", args.cameras, CAMERAS)?;
+    if args.eval_frames == 0 || args.eval_frames > args.frames {
+        bail!("--eval-frames {} must be in 1..={} (--frames)", args.eval_frames, args.frames);
+    }
+    if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
+        bail!("--rings, --reference-spp, --width and --height must be at least 1");
+    }
+    prepare_output_dir(args.out)?;
+    let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
+    let mut runs = Vec::new();
+    for camera in args.cameras {
+        let moving = camera == "moving";
+        let references = references(args, moving, &evaluated)?;
+        for method in args.methods {
+            for denoiser in args.denoisers {
+                for taa in args.taa {
+                    let dir = args.out.join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
+                    let render_args = RenderArgs {
+                        scene: args.scene,
+                        method,
+                        width: Some(args.width),
+                        height: Some(args.height),
+                        scale: 1.0,
+                        headset: args.headset,
+                        gaze: args.gaze,
+                        frames: args.frames,
+                        out: &dir,
+                        exr: true,
+                        camera_path: moving,
+                        seed: args.seed,
+                        max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+                        exposure: 1.0,
+                        profile: args.profile,
+                        debug_views: false,
+                        denoiser,
+                        taa,
+                        device: args.device,
+                        validation: args.validation,
+                    };
+                    render::run(&render_args).with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
+                    let mut q = measure(args, &dir, &evaluated, &references)?;
+                    (q.camera, q.method, q.denoiser, q.taa) = (camera.clone(), method.clone(), denoiser.clone(), taa.clone());
+                    runs.push(q);
+                }
+            }
+        }
+    }
+    let report = Report {
+        scene: args.scene,
+        width: args.width,
+        height: args.height,
+        headset: args.headset,
+        gaze_source: args.gaze,
+        frames: args.frames,
+        eval_frames: args.eval_frames,
+        reference_spp: args.reference_spp,
+        blur_sigma_at_30: args.profile.blur.sigma_at_30,
+        runs: &runs,
+    };
+    std::fs::write(args.out.join("quality.json"), serde_json::to_string_pretty(&report)? + "\n")?;
+    let table = markdown(&report);
+    std::fs::write(args.out.join("quality.md"), &table)?;
+    print!("{table}");
+    Ok(())
+}
+
+/// Converged references of the evaluated frames' camera poses (one for a still camera), written
+/// to `DIR/reference_<camera>_NNNN.exr`.
+fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+    let scene = crate::scenes::load(args.scene)?;
+    let Some(camera) = scene.default_camera() else {
+        bail!("{}: the scene has no perspective camera", scene.source.display());
+    };
+    let start = CameraPose::from_scene_camera(camera, args.width, args.height);
+    let centre = scene.bounds().center();
+    let ctx = super::open_device(args.device, args.validation)?;
+    let size = UVec2::new(args.width, args.height);
+    let settings = RenderSettings { seed: args.seed.wrapping_add(0x5eed), ..Default::default() };
+    let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
+    let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
+    let mut out = Vec::new();
+    for &f in &poses {
+        let pose = camera_path::pose(&start, centre, f, args.frames, moving);
+        let reference = renderer.render_reference(&pose, args.reference_spp, fovea_renderer::pipeline::REALTIME_MAX_DEPTH, |_| {})?;
+        let name = format!("reference_{}_{f:04}.exr", if moving { "moving" } else { "still" });
+        write_exr(&args.out.join(name), args.width, args.height, &reference)?;
+        out.push(reference);
+    }
+    super::check_validation(&ctx)?;
+    Ok(if moving { out } else { vec![out.remove(0); evaluated.len()] })
+}
+
+/// The run's evaluated frames against their references, ring metrics averaged over frames.
+fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<[f32; 4]>]) -> Result<RunQuality> {
+    let report_path = dir.join("report.json");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report_path)?)
+        .with_context(|| format!("reading {}", report_path.display()))?;
+    let mut evals: Vec<Evaluation> = Vec::new();
+    let mut gazes = Vec::new();
+    for (&f, reference) in evaluated.iter().zip(references) {
+        let gaze = &report["gaze"][f as usize];
+        let gaze = Vec2::new(gaze[0].as_f64().unwrap_or(0.0) as f32, gaze[1].as_f64().unwrap_or(0.0) as f32);
+        let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
+        let (_, _, test) = read_exr(&path)?;
+        evals.push(evaluate(reference, &test, args.width, args.height, gaze, args.rings));
+        gazes.push(gaze.to_array());
+    }
+    let n = evals.len() as f64;
+    let mean = |v: Vec<Option<f64>>| -> Option<f64> { v.iter().copied().sum::<Option<f64>>().map(|s| s / v.len() as f64) };
+    let rings = (0..args.rings)
+        .map(|i| RingMean {
+            ecc_inner: evals[0].rings[i].ecc_inner,
+            ecc_outer: evals[0].rings[i].ecc_outer,
+            // RMSE averaged as MSE, so frames add like pixels do.
+            rmse: mean(evals.iter().map(|e| e.rings[i].metrics.rmse.map(|r| r * r)).collect()).map(f64::sqrt),
+            ssim: mean(evals.iter().map(|e| e.rings[i].metrics.ssim).collect()),
+        })
+        .collect();
+    Ok(RunQuality {
+        camera: String::new(),
+        method: String::new(),
+        denoiser: String::new(),
+        taa: String::new(),
+        frame_gpu_ms: report["frame_gpu_ms"].as_f64().unwrap_or(0.0),
+        frames: evaluated.to_vec(),
+        gaze: gazes,
+        rings,
+        frame_rmse: (evals.iter().map(|e| e.frame.rmse.unwrap_or(0.0).powi(2)).sum::<f64>() / n).sqrt(),
+        frame_ssim: evals.iter().map(|e| e.frame.ssim.unwrap_or(0.0)).sum::<f64>() / n,
+    })
+}
+
+/// Per camera: one row per combination, RMSE / SSIM per ring and whole frame; then, per filter,
+/// whether VP beats Cartesian in the innermost ring (the paper's claim).
+fn markdown(r: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Quality over a gaze sequence: {} at {}×{}, gaze {}, {} frames, metrics averaged over the last {}, \
+         against {}-spp Cartesian references; rings of the paper's normalised eccentricity around each frame's gaze; \
+         blur σ at 30° {}.\n",
+        r.scene, r.width, r.height, r.gaze_source, r.frames, r.eval_frames, r.reference_spp, r.blur_sigma_at_30
+    );
+    for camera in CAMERAS {
+        let runs: Vec<&RunQuality> = r.runs.iter().filter(|q| q.camera == *camera).collect();
+        let Some(first) = runs.first() else { continue };
+        let _ = write!(s, "**{camera} camera** — RMSE / SSIM\n\n| method + denoiser, TAA |");
+        for ring in &first.rings {
+            let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
+        }
+        let _ = writeln!(s, " frame | GPU ms |");
+        let _ = writeln!(s, "|---|{}---|---|", "---|".repeat(first.rings.len()));
+        for q in &runs {
+            let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+            for ring in &q.rings {
+                match (ring.rmse, ring.ssim) {
+                    (Some(e), Some(m)) => {
+                        let _ = write!(s, " {e:.4} / {m:.3} |");
+                    }
+                    _ => s.push_str(" – |"),
+                }
+            }
+            let _ = writeln!(s, " {:.4} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_gpu_ms);
+        }
+        s.push('\n');
+        for vp in runs.iter().filter(|q| q.method == "vp") {
+            let cartesian = runs.iter().find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
+            if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
+                if let Some(c_rmse) = c.rings[0].rmse {
+                    let verdict = if v_rmse < c_rmse { "VP wins" } else { "Cartesian wins" };
+                    let _ = writeln!(
+                        s,
+                        "- {} + TAA {}, innermost ring: Cartesian / VP RMSE = {:.2}× ({verdict})",
+                        vp.denoiser,
+                        vp.taa,
+                        c_rmse / v_rmse
+                    );
+                }
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
