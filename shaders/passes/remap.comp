@@ -115,7 +115,7 @@ void main() {
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
-    float x = clamp(vp_u_of_r(P, r) * float(P.grid.x) - 0.5, 0.0, float(P.grid.x - 1u));
+    float x = clamp(vp_u_of_r(P, vp_axis_of_offset(P, d, r)) * float(P.grid.x) - 0.5, 0.0, float(P.grid.x - 1u));
     uint c0 = uint(x);
     uint c1 = min(c0 + 1u, P.grid.x - 1u);
     uint levels = max(push.p.config.x, 1u);
