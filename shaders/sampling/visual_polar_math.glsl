@@ -194,6 +194,29 @@ float vp_r_of_u(VpParams P, float u) {
     return e / P.e_norm * P.r_max;
 }
 
+// atan on [0, 1] in plain arithmetic, op for op as Rust's atan_unit (visual_polar_headset.rs):
+// the driver's atan may be ~1e-5 relative off.
+float vp_atan_unit(float z) {
+    float base = 0.0;
+    float w = z;
+    if (z > 0.41421357) {
+        base = 0.7853982;
+        w = (z - 1.0) / (z + 1.0);
+    }
+    float v = w / (1.0 + sqrt(1.0 + w * w));
+    float v2 = v * v;
+    float q = (((((-0.07692308 * v2 + 0.09090909) * v2 - 0.11111111) * v2 + 0.14285715) * v2 - 0.2) * v2
+        + 0.33333334) * v2;
+    return base + 2.0 * (v - v * q);
+}
+
+// atan2(y, x) for y >= 0, in [0, π] (Rust angle_of).
+float vp_angle_of(float y, float x) {
+    float ax = abs(x);
+    float a = y <= ax ? vp_atan_unit(ax > 0.0 ? y / ax : 0.0) : 1.5707964 - vp_atan_unit(ax / y);
+    return x < 0.0 ? 3.1415927 - a : a;
+}
+
 // Headset axis (Rust HeadsetAxis::eccentricity): true eccentricity (degrees) of offset d (pixels)
 // from the gaze, atan2(|Ĝ × T̂|, Ĝ·T̂).
 float vp_headset_eccentricity(VpParams P, vec2 d) {
@@ -204,8 +227,7 @@ float vp_headset_eccentricity(VpParams P, vec2 d) {
     float cz = g.x * t.y - g.y * t.x;
     float cross_len = sqrt(cx * cx + cy * cy + cz * cz);
     float dot_gt = g.x * g.x + g.y * g.y + 1.0 + (g.x * t.x + g.y * t.y);
-    // GLSL atan(y, x) is undefined at the origin; the gaze itself is eccentricity 0.
-    return (cross_len > 0.0 ? atan(cross_len, dot_gt) : 0.0) * VP_DEG_PER_RAD;
+    return vp_angle_of(cross_len, dot_gt) * VP_DEG_PER_RAD;
 }
 
 // Headset axis (Rust HeadsetAxis::distance): pixels from the gaze along unit pixel direction dir

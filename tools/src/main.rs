@@ -90,6 +90,10 @@ struct RenderOpts {
     /// VP layout: paper (default) or screen-clipped (each column's rows on its on-screen arcs).
     #[arg(long)]
     vp_layout: Option<String>,
+    /// VP eccentricity axis: normalized (the paper's, 80 ↦ farthest corner; default) or headset
+    /// (true degrees through the --headset eye's FOV).
+    #[arg(long)]
+    vp_eccentricity: Option<String>,
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
@@ -120,6 +124,7 @@ impl RenderOpts {
             inverse_cdf: self.vp_inverse_cdf.clone(),
             radius: self.vp_radius.clone(),
             layout: self.vp_layout.clone(),
+            eccentricity: self.vp_eccentricity.clone(),
             blur_sigma: self.blur_sigma,
         })
     }

@@ -10,7 +10,7 @@ use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use crate::render_profile::RenderProfile;
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
+use fovea_renderer::sampling::{Cartesian, FovTangents, SamplingSpace, VisualPolar, VpLayout};
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -105,6 +105,8 @@ struct VpReport {
     radius: String,
     /// "paper" or "screen-clipped".
     layout: String,
+    /// The ρ axis: "normalized" (the paper's) or "headset" (true degrees through the eye's FOV).
+    eccentricity: String,
 }
 
 #[derive(Serialize, Default)]
@@ -164,8 +166,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let screen = UVec2::new(width, height);
     // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
     let screen_centre = screen.as_vec2() * 0.5;
+    let f = eye.fov;
+    let fov = FovTangents::from_angles_deg(f.angle_left.to_degrees(), f.angle_right.to_degrees(), f.angle_down.to_degrees(), f.angle_up.to_degrees());
+    let vp_params = args.profile.visual_polar_for(fov).with_context(|| format!("--headset {}", args.headset))?;
     let space: Box<dyn SamplingSpace> = match args.method {
-        "vp" => Box::new(VisualPolar::new(screen, screen_centre, args.profile.visual_polar).context("Visual-Polar space")?),
+        "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
         _ => Box::new(Cartesian::new(screen)),
     };
     let grid = space.grid_size();
@@ -297,5 +302,6 @@ fn vp_report(profile: &RenderProfile) -> VpReport {
             RadiusMode::Fixed(r) => format!("{r}"),
         },
         layout: crate::render_profile::layout_name(p.layout).into(),
+        eccentricity: crate::render_profile::eccentricity_name(profile.eccentricity).into(),
     }
 }
