@@ -227,6 +227,10 @@ enum Command {
         /// Output folder for eval.json and eval.png (must hold only fovea's own outputs).
         #[arg(long, default_value = "out/eval")]
         out: PathBuf,
+        /// Also report rings of true eccentricity (degrees) through this headset's left-eye FOV
+        /// (eval.json `true_eccentricity`).
+        #[arg(long)]
+        headset: Option<String>,
     },
 }
 
@@ -289,12 +293,13 @@ fn main() -> Result<()> {
         Command::Headsets => commands::headsets::run(),
         Command::Info { device } => commands::info::run(device.device.as_deref()),
         Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
-        Command::Eval { reference, test, gaze, rings, out } => commands::eval::run(&commands::eval::EvalArgs {
+        Command::Eval { reference, test, gaze, rings, out, headset } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,
             gaze: &gaze,
             rings,
             out: &out,
+            headset: headset.as_deref(),
         }),
     }
 }

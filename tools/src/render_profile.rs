@@ -232,6 +232,11 @@ impl RenderProfile {
     }
 }
 
+/// An HMD eye's FOV as the plain tangents the renderer takes.
+pub fn fov_tangents(fov: &fovea_hal::Fov) -> FovTangents {
+    FovTangents { left: -fov.angle_left.tan(), right: fov.angle_right.tan(), up: fov.angle_up.tan(), down: -fov.angle_down.tan() }
+}
+
 impl RenderProfile {
     /// The Visual-Polar parameters for an eye with this FOV (the headset axis needs it).
     pub fn visual_polar_for(&self, fov: FovTangents) -> Result<VisualPolarParams> {

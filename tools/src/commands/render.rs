@@ -10,7 +10,7 @@ use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use crate::render_profile::RenderProfile;
-use fovea_renderer::sampling::{Cartesian, FovTangents, SamplingSpace, VisualPolar, VpLayout};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -166,8 +166,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let screen = UVec2::new(width, height);
     // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
     let screen_centre = screen.as_vec2() * 0.5;
-    let f = eye.fov;
-    let fov = FovTangents::from_angles_deg(f.angle_left.to_degrees(), f.angle_right.to_degrees(), f.angle_down.to_degrees(), f.angle_up.to_degrees());
+    let fov = crate::render_profile::fov_tangents(&eye.fov);
     let vp_params = args.profile.visual_polar_for(fov).with_context(|| format!("--headset {}", args.headset))?;
     let space: Box<dyn SamplingSpace> = match args.method {
         "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
