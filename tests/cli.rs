@@ -94,6 +94,8 @@ fn headset_eccentricity_runs_every_vp_pass() {
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
         let name = fovea_tools::render_profile::eccentricity_name(mode);
         assert_eq!(report["visual_polar"]["eccentricity"], name);
+        let inverse = if mode == EccentricityMode::Headset { "exact" } else { "polynomial" };
+        assert_eq!(report["visual_polar"]["inverse_cdf"], inverse);
         for pass in ["trace", "svgf_temporal", "svgf_atrous", "taa", "mip_phi", "remap", "blur_h", "tonemap"] {
             assert!(report["passes"][pass].as_f64().unwrap_or(0.0) > 0.0, "{name}: pass {pass} missing");
         }

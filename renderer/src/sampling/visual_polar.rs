@@ -392,7 +392,7 @@ impl VisualPolar {
             r_corner_px,
         };
         if let Some(axis) = headset {
-            if !(axis.e_max > params.fovea_deg) {
+            if !axis.e_max.is_finite() || axis.e_max <= params.fovea_deg {
                 return Err(invalid(format!(
                     "eccentricity = headset: the farthest screen corner is only {}° from the gaze, not beyond the \
                      fovea ({}°): check the FOV tangents and fovea_deg",

@@ -292,9 +292,10 @@ fn vp_report(profile: &RenderProfile) -> VpReport {
         clip_fraction: p.clip_fraction,
         fovea_deg: p.fovea_deg,
         density_exponent: p.density_exponent,
-        inverse_cdf: match p.inverse_cdf {
-            InverseCdf::Polynomial => "polynomial".into(),
-            InverseCdf::Exact => "exact".into(),
+        // The headset axis always uses the exact inverse (the quartic is a fit for [0, 80]).
+        inverse_cdf: match (p.inverse_cdf, profile.eccentricity) {
+            (_, crate::render_profile::EccentricityMode::Headset) | (InverseCdf::Exact, _) => "exact".into(),
+            (InverseCdf::Polynomial, _) => "polynomial".into(),
         },
         radius: match p.radius_mode {
             RadiusMode::FarthestCorner => "corner".into(),
