@@ -156,7 +156,8 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
     let budget = vp.sample_count() as f64;
     let pixels: Vec<Vec2> =
         (0..screen.y).flat_map(|y| (0..screen.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).collect();
-    let (ring_set, target, to_ecc, e_end, x_label): (Rings, Vec<f64>, Box<dyn Fn(f64) -> f64>, f64, &str) = match vp.headset() {
+    // Per axis: the rings, the target per pixel, degrees per ring unit, the axis end and label.
+    let (ring_set, target, ecc_per_unit, e_end, x_label): (Rings, Vec<f64>, f64, f64, &str) = match vp.headset() {
         None => {
             // Acuity target: density c·V(e(r)) with c chosen so that its integral over the whole
             // r_max disc equals VP's total sample count (VP spends its budget on that disc,
@@ -170,7 +171,7 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
                 (0..steps).map(|i| (i as f64 + 0.5) * dr).map(|r| acuity(e_of(r)) * std::f64::consts::TAU * r * dr).sum();
             let c = budget / integral;
             let target = pixels.iter().map(|&p| c * acuity(e_of((p - vp.gaze()).length() as f64))).collect();
-            (ring_set, target, Box::new(e_of), ECC_MAX, "normalised eccentricity (r / r_max · 80)")
+            (ring_set, target, ECC_MAX / r_max, ECC_MAX, "normalised eccentricity (r / r_max · 80)")
         }
         Some(axis) => {
             // Acuity target per unit of the polar measure e·de·dφ (φ: the pixel angle VP lays its
@@ -186,13 +187,13 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
             let c = budget / integral;
             let target = pixels.iter().zip(&e).map(|(&p, &e)| c * acuity(e) * e * polar_jacobian(&ecc, p - gaze, p)).collect();
             let ring_set = Rings::from_coordinates(screen.x, gaze, &e, e_max, rings);
-            (ring_set, target, Box::new(|e| e), e_max, "true eccentricity (degrees through the headset's FOV)")
+            (ring_set, target, 1.0, e_max, "true eccentricity (degrees through the headset's FOV)")
         }
     };
 
     let mid = |i: usize| {
         let (r0, r1) = ring_set.bounds(i);
-        to_ecc(0.5 * (r0 + r1))
+        0.5 * (r0 + r1) * ecc_per_unit
     };
     let per_ring = |label: &str, map: &[f64]| Series {
         label: label.into(),
