@@ -69,6 +69,42 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     assert_eq!((grid.width(), grid.height()), (vp.grid_size().x, vp.grid_size().y));
 }
 
+/// `--vp-eccentricity headset` through every VP pass (trace, SVGF, TAA, φ-mips, remap, blur)
+/// on the simulated FOVE 0: validation-clean, recorded in report.json, and the frame matches the
+/// paper axis' frame of the same scene and gaze in its mean (both see the whole Cornell box).
+#[test]
+fn headset_eccentricity_runs_every_vp_pass() {
+    use fovea_tools::render_profile::EccentricityMode;
+    let mean_of = |out: &Path| {
+        let img = image::open(out.join("frame_0002.png")).unwrap().to_rgb8();
+        img.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>() / 3.0).sum::<f64>() / img.pixels().len() as f64
+    };
+    let mut means = Vec::new();
+    for mode in [EccentricityMode::Normalized, EccentricityMode::Headset] {
+        let out = temp_dir(&format!("render-vp-{mode:?}"));
+        let mut args = render_args("cornell-box", &out);
+        args.method = "vp";
+        args.gaze = "12,20";
+        args.frames = 3;
+        args.camera_path = false;
+        args.denoiser = "svgf";
+        args.taa = "vp";
+        args.profile.eccentricity = mode;
+        render(&args).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        let name = fovea_tools::render_profile::eccentricity_name(mode);
+        assert_eq!(report["visual_polar"]["eccentricity"], name);
+        let inverse = if mode == EccentricityMode::Headset { "exact" } else { "polynomial" };
+        assert_eq!(report["visual_polar"]["inverse_cdf"], inverse);
+        for pass in ["trace", "svgf_temporal", "svgf_atrous", "taa", "mip_phi", "remap", "blur_h", "tonemap"] {
+            assert!(report["passes"][pass].as_f64().unwrap_or(0.0) > 0.0, "{name}: pass {pass} missing");
+        }
+        means.push(mean_of(&out));
+    }
+    println!("mean 8-bit value: normalized {:.1}, headset {:.1}", means[0], means[1]);
+    assert!(means[1] > 5.0 && (means[1] / means[0] - 1.0).abs() < 0.15, "frame means {means:?}");
+}
+
 #[test]
 fn output_folders_with_user_files_are_refused() {
     let out = temp_dir("userfile");

@@ -28,7 +28,7 @@ fn image(w: u32, h: u32) -> Vec<[f32; 4]> {
 }
 
 fn args<'a>(reference: &'a Path, test: &'a Path, gaze: &'a str, out: &'a Path) -> EvalArgs<'a> {
-    EvalArgs { reference, test, gaze, rings: 10, out }
+    EvalArgs { reference, test, gaze, rings: 10, out, headset: None }
 }
 
 fn read_json(dir: &Path) -> serde_json::Value {
@@ -199,4 +199,51 @@ fn quality_command_measures_every_combination() {
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let err = format!("{:#}", run(&args(&denoisers)).unwrap_err());
     assert!(err.contains("notes.txt"), "{err}");
+}
+
+/// `--headset`: rings of true eccentricity through the FOV, out to the farthest corner's; an
+/// error placed beyond 30° true eccentricity shows only in the rings past 30°.
+#[test]
+fn true_eccentricity_rings_through_a_headset() {
+    use fovea_renderer::sampling::HeadsetAxis;
+    let dir = temp_dir("true-ecc");
+    let reference = dir.join("ref.exr");
+    let clean = image(W, H);
+    write_exr(&reference, W, H, &clean).unwrap();
+    let gaze = glam::Vec2::new(32.0, 36.0);
+    // config/headsets/fove0.toml
+    let fov = fovea_renderer::sampling::FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
+    let axis = HeadsetAxis::new(fov, glam::UVec2::new(W, H), gaze);
+    let noisy: Vec<[f32; 4]> = clean
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let px = glam::Vec2::new((i as u32 % W) as f32 + 0.5, (i as u32 / W) as f32 + 0.5);
+            if axis.eccentricity(px - gaze) > 30.0 { [p[0] + 0.5, p[1], p[2], 1.0] } else { *p }
+        })
+        .collect();
+    let test = dir.join("test.exr");
+    write_exr(&test, W, H, &noisy).unwrap();
+    let out = dir.join("out");
+    eval(&EvalArgs { headset: Some("fove0"), ..args(&reference, &test, "32,36", &out) }).unwrap();
+    let json = read_json(&out);
+    let t = &json["true_eccentricity"];
+    assert_eq!(t["headset"], "fove0");
+    let e_max = t["e_max_deg"].as_f64().unwrap();
+    assert!((e_max - axis.e_max as f64).abs() < 1e-9 && e_max > 50.0, "e_max {e_max}");
+    let rings = t["rings"].as_array().unwrap();
+    assert_eq!(rings.iter().map(|r| r["pixels"].as_u64().unwrap()).sum::<u64>(), (W * H) as u64);
+    for r in rings {
+        let (inner, outer, rmse) = (r["inner"].as_f64().unwrap(), r["outer"].as_f64().unwrap(), r["rmse"].as_f64());
+        if outer <= 30.0 {
+            assert_eq!(rmse, Some(0.0), "ring {inner}–{outer}° should be clean");
+        } else if inner >= 30.0 {
+            assert!(rmse.unwrap() > 0.1, "ring {inner}–{outer}° should show the error");
+        }
+    }
+    // Without --headset the field is absent; a bad headset is named.
+    eval(&args(&reference, &test, "32,36", &out)).unwrap();
+    assert!(read_json(&out).get("true_eccentricity").is_none());
+    let err = format!("{:#}", eval(&EvalArgs { headset: Some("nope"), ..args(&reference, &test, "32,36", &out) }).unwrap_err());
+    assert!(err.contains("--headset nope"), "{err}");
 }

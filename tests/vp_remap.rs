@@ -13,7 +13,7 @@ use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, P
 use fovea_renderer::passes::remap::RemapPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_tests::{assert_clean, gpu, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, Vec2};
@@ -25,6 +25,12 @@ const LAYOUTS: [VpLayout; 2] = [VpLayout::Paper, VpLayout::ScreenClipped];
 
 fn space(gaze: Vec2, layout: VpLayout) -> VisualPolar {
     VisualPolar::new(SCREEN, gaze, VisualPolarParams { layout, ..Default::default() }).unwrap()
+}
+
+/// The headset eccentricity axis through FOVE 0's FOV (paper layout).
+fn headset_space(gaze: Vec2) -> VisualPolar {
+    let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
+    VisualPolar::new(SCREEN, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fov), ..Default::default() }).unwrap()
 }
 
 fn gazes() -> [(&'static str, Vec2); 3] {
@@ -196,27 +202,27 @@ fn position_errors(vp: &VisualPolar, gaze: Vec2, screen: &[[f32; 4]]) -> (f64, f
 /// pixel's centre. Allowed error: half the texel's extent on screen, which is what linear
 /// interpolation of a curved grid and the φ box filter can be off by; in the screen-clipped
 /// layout a whole texel for border pixels the outer column's arcs do not reach (read from the
-/// inner column alone).
+/// inner column alone). Also with the headset eccentricity axis (FOVE 0).
 #[test]
 fn remap_reproduces_screen_positions() {
     let ctx = gpu();
     for (name, gaze) in gazes() {
-        for layout in LAYOUTS {
-            let vp = space(gaze, layout);
+        let headset = ("Headset".to_string(), headset_space(gaze));
+        for (label, vp) in LAYOUTS.map(|layout| (format!("{layout:?}"), space(gaze, layout))).into_iter().chain([headset]) {
             let (_, screen) = to_screen(&ctx, &vp, |x, y| {
                 let p = vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 [p.x, p.y, 0.0, 1.0]
             });
             let (mean, worst, over, border_pixels, error_image) = position_errors(&vp, gaze, &screen);
             println!(
-                "gaze {name} {layout:?}: mean position error {mean:.3} px, worst {worst:.3} px, {over} pixels over their texel \
+                "gaze {name} {label}: mean position error {mean:.3} px, worst {worst:.3} px, {over} pixels over their texel \
                  bound ({border_pixels} border pixels outside the outer column's arcs)"
             );
             if over > 0 || mean > 0.25 {
-                save_preview(&format!("vp_remap_error_{name}_{layout:?}.png"), SCREEN.x, SCREEN.y, &error_image);
+                save_preview(&format!("vp_remap_error_{name}_{label}.png"), SCREEN.x, SCREEN.y, &error_image);
             }
-            assert_eq!(over, 0, "gaze {name} {layout:?}: pixels off by more than half their texel");
-            assert!(mean < 0.25, "gaze {name} {layout:?}: mean error {mean} px");
+            assert_eq!(over, 0, "gaze {name} {label}: pixels off by more than half their texel");
+            assert!(mean < 0.25, "gaze {name} {label}: mean error {mean} px");
         }
     }
     assert_clean(&ctx);

@@ -15,7 +15,7 @@
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
 use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
 use fovea_tests::{assert_clean, gpu, read_image};
@@ -116,14 +116,25 @@ fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (
 /// Renders one VP frame and checks counts and the G-buffer; returns the off-screen share and the
 /// CPU counts.
 fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2, layout: VpLayout) -> (f64, CpuCounts, u64) {
-    let vp = VisualPolar::new(SCREEN, gaze, VisualPolarParams { layout, ..Default::default() }).unwrap();
+    check_vp_frame_with(ctx, scene, gaze_name, gaze, VisualPolarParams { layout, ..Default::default() })
+}
+
+fn check_vp_frame_with(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    gaze_name: &str,
+    gaze: Vec2,
+    params: VisualPolarParams,
+) -> (f64, CpuCounts, u64) {
+    let (layout, eccentricity) = (params.layout, params.eccentricity);
+    let vp = VisualPolar::new(SCREEN, gaze, params).unwrap();
     let (r, stats) = render(ctx, scene, Box::new(vp));
     let g = vp.grid_size();
     let samples = vp.sample_count();
     let cpu = cpu_counts(&vp, r.settings.seed);
     let share = stats.samples_offscreen as f64 / samples as f64;
     println!(
-        "{layout:?} gaze {gaze_name} {gaze}: grid {}x{}, {} samples ({:.1} % of {} screen pixels), traced {}, off-screen {} = {:.1} % \
+        "{layout:?} {eccentricity:?} gaze {gaze_name} {gaze}: grid {}x{}, {} samples ({:.1} % of {} screen pixels), traced {}, off-screen {} = {:.1} % \
          (CPU replay {} ± {}, at texel centres {}, cell bounds [{}, {}])",
         g.x,
         g.y,
@@ -215,6 +226,23 @@ fn screen_clipped_layout_keeps_samples_on_screen() {
         assert_eq!(cpu.cell_all, 0, "gaze {name}: a texel cell wholly off the screen");
         assert!(share < 0.03, "gaze {name}: {:.2} % off the screen", 100.0 * share);
     }
+    assert_clean(&ctx);
+}
+
+/// The headset eccentricity axis (FOVE 0): the trace kernel places the samples where the Rust
+/// mapping does (the off-screen count matches the CPU replay of the kernel's jitter), centre and
+/// corner gaze.
+#[test]
+fn headset_axis_tracing_counts_samples_and_offscreen() {
+    let ctx = gpu();
+    let scene = cornell();
+    let params = VisualPolarParams {
+        eccentricity: Eccentricity::Headset(FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4)),
+        ..Default::default()
+    };
+    let (centre, _, _) = check_vp_frame_with(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5, params);
+    let (corner, _, _) = check_vp_frame_with(&ctx, &scene, "corner", Vec2::new(2.0, 2.0), params);
+    assert!(centre < 0.3 && 0.3 < corner, "off-screen share: centre {centre:.3}, corner {corner:.3}");
     assert_clean(&ctx);
 }
 

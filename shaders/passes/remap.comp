@@ -118,7 +118,7 @@ void main() {
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
     // Texel centres at integers; a jittered sample sits sample_offset texels beside its centre.
-    float x = clamp(vp_u_of_r(P, r) * float(P.grid.x) - 0.5 - push.p.sample_offset.x, 0.0, float(P.grid.x - 1u));
+    float x = clamp(vp_u_of_r(P, vp_axis_of_offset(P, d, r)) * float(P.grid.x) - 0.5 - push.p.sample_offset.x, 0.0, float(P.grid.x - 1u));
     uint c0 = uint(x);
     uint c1 = min(c0 + 1u, P.grid.x - 1u);
     uint levels = max(push.p.config.x, 1u);

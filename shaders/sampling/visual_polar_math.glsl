@@ -8,6 +8,10 @@
 // r = e / e_norm · r_max. Triangular clip: fovea column c keeps n(c) = clamp(floor(H·u_c/u_f + ½),
 // 1, H) rows (u_c = (c + ½)/W), the first n(c); row y of column c sits at φ = 2π·y/n(c).
 //
+// Headset axis (flag 4, Rust visual_polar_headset.rs): the "radius" is the true eccentricity in
+// degrees (r_max = e_norm = 1, r_f = fovea°, derived here), the CDF runs over [0, e_max] with the
+// exact inverse; screen offsets convert through the eye's FOV tangents (vp_headset_*).
+//
 // Self-contained on purpose (no layouts.glsl): the parameters come as the four vectors of the
 // `SamplingParams` slots, packed by `VisualPolar::sampling_params()`, and `vp_unpack` names them.
 #ifndef FOVEA_SAMPLING_VISUAL_POLAR_MATH_GLSL
@@ -18,39 +22,55 @@ const float VP_E_MAX_DEG = 80.0;
 const float VP_PI = 3.14159265358979;
 const float VP_TAU = 6.28318530717959;
 const int VP_NEWTON_STEPS = 12;
+const float VP_E_TOP_HEADSET_DEG = 180.0;
+const float VP_DEG_PER_RAD = 57.29578;
+const float VP_RAD_PER_DEG = 0.017453292;
+const float VP_FAR_PIXELS_PER_SCREEN = 4.0;
 
 struct VpParams {
     uvec2 grid;      // VP grid size in texels
     vec2 screen;     // screen size in pixels
     vec2 gaze;       // gaze in screen pixels
-    float r_max;     // pixels that e_norm maps to
+    float r_max;     // pixels that e_norm maps to (headset: 1, the axis is degrees)
     float k;         // density exponent
     float u_f;       // fovea width in u (2 · clip fraction)
     float p_f;       // CDF fraction at the fovea edge
-    float r_f;       // fovea radius in pixels
-    float e_norm;    // e(1): e_poly(1) for the polynomial, 80 for the exact inverse
-    float cdf_max;   // cdf(80, k)
+    float r_f;       // fovea radius in pixels (headset: fovea°)
+    float e_norm;    // e(1): e_poly(1) for the polynomial, 80 for the exact inverse (headset: 1)
+    float cdf_max;   // cdf(80, k) (headset: cdf(e_max, k))
     bool exact;      // exact inverse CDF instead of the paper's quartic
     bool clipped;    // screen-clipped layout: map with visual_polar_clipped.glsl (vp_layout_*)
+    bool headset;    // true-eccentricity axis through the FOV tangents
+    vec2 gaze_tan;   // headset: the gaze in tangent space
+    vec2 tan_scale;  // headset: tangent units per pixel
+    float far;       // headset: where samples beyond their ray's horizon are parked (pixels)
 };
 
 // Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
-// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
-// shape1 = (cdf_max, exact, fovea°, layout: 0 paper, 1 screen-clipped).
+// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis), and
+// - paper axis: gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
+//   shape1 = (cdf_max, flags, fovea° (unused here), 0);
+// - headset axis: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
+//   shape1 = (cdf_max, flags, scale.x, scale.y); r_max = e_norm = 1 are derived.
 VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     VpParams p;
+    uint flags = uint(shape1.y);
     p.grid = grid.xy;
     p.screen = vec2(grid.zw);
     p.gaze = gaze.xy;
-    p.r_max = gaze.z;
     p.k = gaze.w;
     p.u_f = shape0.x;
     p.p_f = shape0.y;
     p.r_f = shape0.z;
-    p.e_norm = shape0.w;
     p.cdf_max = shape1.x;
-    p.exact = shape1.y != 0.0;
-    p.clipped = shape1.w != 0.0;
+    p.exact = (flags & 1u) != 0u;
+    p.clipped = (flags & 2u) != 0u;
+    p.headset = (flags & 4u) != 0u;
+    p.r_max = p.headset ? 1.0 : gaze.z;
+    p.e_norm = p.headset ? 1.0 : shape0.w;
+    p.gaze_tan = vec2(gaze.z, shape0.w);
+    p.tan_scale = shape1.zw;
+    p.far = VP_FAR_PIXELS_PER_SCREEN * (p.screen.x + p.screen.y);
     return p;
 }
 
@@ -132,10 +152,11 @@ float vp_inverse_cdf_poly_derivative(float p) {
 
 // Exact inverse: safeguarded Newton from the quartic's guess (bisection when a step leaves the
 // bracket), as in Rust.
-float vp_inverse_cdf_exact(float p, float k, float cdf_max) {
+// e_top: the bracket's top, 80 (paper) or 180 (headset axis, normalised at e_max ≤ 180).
+float vp_inverse_cdf_exact(float p, float k, float cdf_max, float e_top) {
     float target = p * cdf_max;
     float lo = 0.0;
-    float hi = p <= 1.0 ? VP_E_MAX_DEG : 4.0 * VP_E_MAX_DEG;
+    float hi = p <= 1.0 ? e_top : 4.0 * e_top;
     float e = clamp(vp_inverse_cdf_poly(p), lo, hi);
     for (int i = 0; i < VP_NEWTON_STEPS; ++i) {
         float f = vp_cdf(e, k) - target;
@@ -168,8 +189,74 @@ bool vp_is_valid_texel(VpParams P, ivec2 t) {
 float vp_r_of_u(VpParams P, float u) {
     if (u < P.u_f) return u / P.u_f * P.r_f;
     float p = P.p_f + (u - P.u_f) / (1.0 - P.u_f) * (1.0 - P.p_f);
-    float e = P.exact ? vp_inverse_cdf_exact(p, P.k, P.cdf_max) : vp_inverse_cdf_poly(p);
+    float e_top = P.headset ? VP_E_TOP_HEADSET_DEG : VP_E_MAX_DEG;
+    float e = P.exact ? vp_inverse_cdf_exact(p, P.k, P.cdf_max, e_top) : vp_inverse_cdf_poly(p);
     return e / P.e_norm * P.r_max;
+}
+
+// atan on [0, 1] in plain arithmetic, op for op as Rust's atan_unit (visual_polar_headset.rs):
+// the driver's atan may be ~1e-5 relative off.
+float vp_atan_unit(float z) {
+    float base = 0.0;
+    float w = z;
+    if (z > 0.41421357) {
+        base = 0.7853982;
+        w = (z - 1.0) / (z + 1.0);
+    }
+    float v = w / (1.0 + sqrt(1.0 + w * w));
+    float v2 = v * v;
+    float q = (((((-0.07692308 * v2 + 0.09090909) * v2 - 0.11111111) * v2 + 0.14285715) * v2 - 0.2) * v2
+        + 0.33333334) * v2;
+    return base + 2.0 * (v - v * q);
+}
+
+// atan2(y, x) for y >= 0, in [0, π] (Rust angle_of).
+float vp_angle_of(float y, float x) {
+    float ax = abs(x);
+    float a = y <= ax ? vp_atan_unit(ax > 0.0 ? y / ax : 0.0) : 1.5707964 - vp_atan_unit(ax / y);
+    return x < 0.0 ? 3.1415927 - a : a;
+}
+
+// Headset axis (Rust HeadsetAxis::eccentricity): true eccentricity (degrees) of offset d (pixels)
+// from the gaze, atan2(|Ĝ × T̂|, Ĝ·T̂).
+float vp_headset_eccentricity(VpParams P, vec2 d) {
+    vec2 g = P.gaze_tan;
+    vec2 t = d * P.tan_scale;
+    float cx = -t.y;
+    float cy = t.x;
+    float cz = g.x * t.y - g.y * t.x;
+    float cross_len = sqrt(cx * cx + cy * cy + cz * cz);
+    float dot_gt = g.x * g.x + g.y * g.y + 1.0 + (g.x * t.x + g.y * t.y);
+    return vp_angle_of(cross_len, dot_gt) * VP_DEG_PER_RAD;
+}
+
+// Headset axis (Rust HeadsetAxis::distance): pixels from the gaze along unit pixel direction dir
+// to true eccentricity e (degrees): t = a·sin e / (h·cos e − b·sin e), parked at P.far beyond
+// the ray's horizon.
+float vp_headset_distance(VpParams P, float e, vec2 dir) {
+    vec2 g = P.gaze_tan;
+    vec2 dd = dir * P.tan_scale;
+    float a = g.x * g.x + g.y * g.y + 1.0;
+    float b = g.x * dd.x + g.y * dd.y;
+    float hz = g.x * dd.y - g.y * dd.x;
+    float h = sqrt(dd.x * dd.x + dd.y * dd.y + hz * hz);
+    float rad = e * VP_RAD_PER_DEG;
+    float s = sin(rad);
+    float c = cos(rad);
+    float den = h * c - b * s;
+    return den > 0.0 ? min(a * s / den, P.far) : P.far;
+}
+
+// The axis value of offset d from the gaze (r = |d|): r, or the true eccentricity (headset).
+float vp_axis_of_offset(VpParams P, vec2 d, float r) {
+    return P.headset ? vp_headset_eccentricity(P, d) : r;
+}
+
+// Normalised ρ and pixel angle φ → screen offset from the gaze (pixels).
+vec2 vp_offset_of(VpParams P, float u, float phi) {
+    vec2 dir = vec2(cos(phi), sin(phi));
+    float a = vp_r_of_u(P, u);
+    return (P.headset ? vp_headset_distance(P, a, dir) : a) * dir;
 }
 
 float vp_u_of_r(VpParams P, float r) {
@@ -191,7 +278,7 @@ vec2 vp_screen_to_vp(VpParams P, vec2 s) {
     // GLSL atan(y, x) is undefined at the origin; the gaze itself maps to φ = 0 like Rust's atan2.
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
-    float x = vp_u_of_r(P, r) * float(P.grid.x);
+    float x = vp_u_of_r(P, vp_axis_of_offset(P, d, r)) * float(P.grid.x);
     float n = float(vp_rows_in_column(P, vp_column_of(P, x)));
     float y = phi / VP_TAU * n;
     return vec2(x, y >= n ? 0.0 : y);
@@ -202,8 +289,7 @@ vec2 vp_screen_to_vp(VpParams P, vec2 s) {
 vec2 vp_vp_to_screen(VpParams P, vec2 g) {
     float n = float(vp_rows_in_column(P, vp_column_of(P, g.x)));
     float phi = g.y / n * VP_TAU;
-    float r = vp_r_of_u(P, g.x / float(P.grid.x));
-    return P.gaze + r * vec2(cos(phi), sin(phi));
+    return P.gaze + vp_offset_of(P, g.x / float(P.grid.x), phi);
 }
 
 #endif

@@ -146,38 +146,60 @@ fn ramp(t: f32) -> [u8; 3] {
     std::array::from_fn(|c| (STOPS[i][c] + (STOPS[i + 1][c] - STOPS[i][c]) * f).round() as u8)
 }
 
-/// Plot of samples per pixel against normalised eccentricity (r / r_max · 80; r_max is the
-/// farthest-corner radius, which is Visual-Polar's own with the default radius mode), per ring:
-/// VP measured, the acuity target, uniform at VP's sample budget and Cartesian 1 spp.
+/// Plot of samples per pixel against eccentricity, per ring: VP measured, the acuity target,
+/// uniform at VP's sample budget and Cartesian 1 spp. The paper's axis: normalised eccentricity
+/// (r / r_max · 80; r_max is the farthest-corner radius, Visual-Polar's own with the default
+/// radius mode). The headset axis: true eccentricity through the headset's FOV.
 pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
     let screen = vp.screen();
-    let ring_set = Rings::new(screen.x, screen.y, vp.gaze(), rings);
     let measured: Vec<f64> = samples_per_pixel(vp).iter().map(|&c| c as f64).collect();
     let budget = vp.sample_count() as f64;
-
-    // Acuity target: density c·V(e(r)) with c chosen so that its integral over the whole r_max
-    // disc equals VP's total sample count (VP spends its budget on that disc, corners off screen
-    // included), i.e. c = budget / ∫₀^r_max V(e(r)) 2πr dr (midpoint rule).
-    let r_max = ring_set.r_max;
-    let e_of = |r: f64| r / r_max * ECC_MAX;
-    let steps = 4096;
-    let dr = r_max / steps as f64;
-    let integral: f64 = (0..steps).map(|i| (i as f64 + 0.5) * dr).map(|r| acuity(e_of(r)) * std::f64::consts::TAU * r * dr).sum();
-    let c = budget / integral;
-    let target: Vec<f64> = (0..screen.y)
-        .flat_map(|y| (0..screen.x).map(move |x| (x, y)))
-        .map(|(x, y)| c * acuity(e_of((Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - vp.gaze()).length() as f64)))
-        .collect();
+    let pixels: Vec<Vec2> =
+        (0..screen.y).flat_map(|y| (0..screen.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).collect();
+    // Per axis: the rings, the target per pixel, degrees per ring unit, the axis end and label.
+    let (ring_set, target, ecc_per_unit, e_end, x_label): (Rings, Vec<f64>, f64, f64, &str) = match vp.headset() {
+        None => {
+            // Acuity target: density c·V(e(r)) with c chosen so that its integral over the whole
+            // r_max disc equals VP's total sample count (VP spends its budget on that disc,
+            // corners off screen included), i.e. c = budget / ∫₀^r_max V(e(r)) 2πr dr (midpoint rule).
+            let ring_set = Rings::new(screen.x, screen.y, vp.gaze(), rings);
+            let r_max = ring_set.r_max;
+            let e_of = move |r: f64| r / r_max * ECC_MAX;
+            let steps = 4096;
+            let dr = r_max / steps as f64;
+            let integral: f64 =
+                (0..steps).map(|i| (i as f64 + 0.5) * dr).map(|r| acuity(e_of(r)) * std::f64::consts::TAU * r * dr).sum();
+            let c = budget / integral;
+            let target = pixels.iter().map(|&p| c * acuity(e_of((p - vp.gaze()).length() as f64))).collect();
+            (ring_set, target, ECC_MAX / r_max, ECC_MAX, "normalised eccentricity (r / r_max · 80)")
+        }
+        Some(axis) => {
+            // Acuity target per unit of the polar measure e·de·dφ (φ: the pixel angle VP lays its
+            // rows on) with VP's budget over [0, e_max]; a pixel holds e·|∂(e, φ)/∂(x, y)| of it.
+            let gaze = vp.gaze();
+            let ecc = |p: Vec2| axis.eccentricity(p - gaze) as f64;
+            let e: Vec<f64> = pixels.iter().map(|&p| ecc(p)).collect();
+            let e_max = axis.e_max as f64;
+            let steps = 4096;
+            let de = e_max / steps as f64;
+            let integral: f64 =
+                (0..steps).map(|i| (i as f64 + 0.5) * de).map(|e| acuity(e) * std::f64::consts::TAU * e * de).sum();
+            let c = budget / integral;
+            let target = pixels.iter().zip(&e).map(|(&p, &e)| c * acuity(e) * e * polar_jacobian(&ecc, p - gaze, p)).collect();
+            let ring_set = Rings::from_coordinates(screen.x, gaze, &e, e_max, rings);
+            (ring_set, target, 1.0, e_max, "true eccentricity (degrees through the headset's FOV)")
+        }
+    };
 
     let mid = |i: usize| {
         let (r0, r1) = ring_set.bounds(i);
-        e_of(0.5 * (r0 + r1))
+        0.5 * (r0 + r1) * ecc_per_unit
     };
     let per_ring = |label: &str, map: &[f64]| Series {
         label: label.into(),
         points: ring_set.mean(map).into_iter().enumerate().filter_map(|(i, m)| Some((mid(i), m?))).collect(),
     };
-    let flat = |label: String, v: f64| Series { label, points: vec![(0.0, v), (ECC_MAX, v)] };
+    let flat = |label: String, v: f64| Series { label, points: vec![(0.0, v), (e_end, v)] };
     let uniform = budget / (screen.x as f64 * screen.y as f64);
     let mut series = vec![
         per_ring("Visual-Polar (measured)", &measured),
@@ -193,7 +215,20 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
         series.push(per_ring("Visual-Polar, paper's layout (measured)", &paper_map));
     }
     let title = format!("Sample density, {}×{}, gaze ({:.0}, {:.0})", screen.x, screen.y, vp.gaze().x, vp.gaze().y);
-    line_plot(path, &title, "normalised eccentricity (r / r_max · 80)", "samples per pixel", &series, true)
+    line_plot(path, &title, x_label, "samples per pixel", &series, true)
+}
+
+/// |∂(e, φ)/∂(x, y)| at pixel `p` (offset `d` from the gaze): degrees × radians per pixel², by
+/// central differences of `ecc` and φ = atan2(d.y, d.x) exactly.
+fn polar_jacobian(ecc: &dyn Fn(Vec2) -> f64, d: Vec2, p: Vec2) -> f64 {
+    let r2 = d.length_squared() as f64;
+    if r2 < 1e-12 {
+        return 0.0;
+    }
+    let h = 0.25f32;
+    let de_dx = (ecc(p + Vec2::X * h) - ecc(p - Vec2::X * h)) / (2.0 * h) as f64;
+    let de_dy = (ecc(p + Vec2::Y * h) - ecc(p - Vec2::Y * h)) / (2.0 * h) as f64;
+    (de_dx * d.x as f64 / r2 + de_dy * d.y as f64 / r2).abs()
 }
 
 #[cfg(test)]
@@ -303,6 +338,11 @@ mod tests {
         // The screen-clipped layout adds the paper's layout as a series.
         let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
         density_plot(&path, &VisualPolar::new(UVec2::new(320, 360), Vec2::new(20.0, 30.0), params).unwrap(), 24).unwrap();
+        assert!(image::open(&path).is_ok());
+        // The headset axis plots against true eccentricity.
+        let fov = fovea_renderer::sampling::FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
+        let params = VisualPolarParams { eccentricity: fovea_renderer::sampling::Eccentricity::Headset(fov), ..Default::default() };
+        density_plot(&path, &VisualPolar::new(UVec2::new(320, 360), Vec2::new(100.0, 150.0), params).unwrap(), 24).unwrap();
         assert!(image::open(&path).is_ok());
         std::fs::remove_file(&path).unwrap();
     }

@@ -91,6 +91,10 @@ struct RenderOpts {
     /// VP layout: paper (default) or screen-clipped (each column's rows on its on-screen arcs).
     #[arg(long)]
     vp_layout: Option<String>,
+    /// VP eccentricity axis: normalized (the paper's, 80 ↦ farthest corner; default) or headset
+    /// (true degrees through the --headset eye's FOV).
+    #[arg(long)]
+    vp_eccentricity: Option<String>,
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
@@ -122,6 +126,7 @@ impl RenderOpts {
             inverse_cdf: self.vp_inverse_cdf.clone(),
             radius: self.vp_radius.clone(),
             layout: self.vp_layout.clone(),
+            eccentricity: self.vp_eccentricity.clone(),
             blur_sigma: self.blur_sigma,
         })
     }
@@ -271,6 +276,10 @@ enum Command {
         /// Output folder for eval.json and eval.png (must hold only fovea's own outputs).
         #[arg(long, default_value = "out/eval")]
         out: PathBuf,
+        /// Also report rings of true eccentricity (degrees) through this headset's left-eye FOV
+        /// (eval.json `true_eccentricity`).
+        #[arg(long)]
+        headset: Option<String>,
     },
 }
 
@@ -380,12 +389,13 @@ fn main() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Eval { reference, test, gaze, rings, out } => commands::eval::run(&commands::eval::EvalArgs {
+        Command::Eval { reference, test, gaze, rings, out, headset } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,
             gaze: &gaze,
             rings,
             out: &out,
+            headset: headset.as_deref(),
         }),
     }
 }

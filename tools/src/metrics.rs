@@ -106,7 +106,8 @@ fn blur_clamped(src: &[f64], width: usize, height: usize, kernel: &[f64]) -> Vec
 
 /// `n` equal-width rings of screen distance from the gaze point out to r_max, the largest
 /// gaze-to-corner distance (as Visual-Polar's radius). Pixel (x, y) is at its centre
-/// (x + 0.5, y + 0.5); y points down.
+/// (x + 0.5, y + 0.5); y points down. `from_coordinates` rings any other per-pixel coordinate
+/// (e.g. the true eccentricity through a headset's FOV); r_max is then that coordinate's top.
 pub struct Rings {
     pub gaze: Vec2,
     pub r_max: f64,
@@ -122,14 +123,20 @@ impl Rings {
         let g = gaze.as_dvec2();
         let screen = glam::DVec2::new(width as f64, height as f64);
         let r_max = g.abs().max((screen - g).abs()).length().max(f64::MIN_POSITIVE);
-        let index = (0..height)
+        let distances: Vec<f64> = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
-            .map(|(x, y)| {
-                let r = (glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5) - g).length();
-                ((r / r_max * count as f64) as usize).min(count - 1) as u32
-            })
+            .map(|(x, y)| (glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5) - g).length())
             .collect();
-        Self { gaze, r_max, count, width, index }
+        Self::from_coordinates(width, gaze, &distances, r_max, count)
+    }
+
+    /// `count` equal-width rings of a per-pixel coordinate (row-major, ≥ 0) over [0, max];
+    /// values past max fall in the last ring.
+    pub fn from_coordinates(width: u32, gaze: Vec2, coordinates: &[f64], max: f64, count: usize) -> Self {
+        assert!(count > 0, "at least one ring");
+        let max = max.max(f64::MIN_POSITIVE);
+        let index = coordinates.iter().map(|&c| ((c / max * count as f64).max(0.0) as usize).min(count - 1) as u32).collect();
+        Self { gaze, r_max: max, count, width, index }
     }
 
     /// Ring of pixel (x, y).
@@ -210,6 +217,28 @@ pub struct Evaluation {
     pub r_max_px: f64,
     pub frame: Metrics,
     pub rings: Vec<RingMetrics>,
+}
+
+/// One ring of `evaluate_rings`: its coordinate bounds and metrics.
+#[derive(Clone, Debug, Serialize)]
+pub struct CoordinateRing {
+    pub ring: usize,
+    pub inner: f64,
+    pub outer: f64,
+    #[serde(flatten)]
+    pub metrics: Metrics,
+}
+
+/// Per-ring RMSE, PSNR and SSIM of `test` against `reference` over any ring set.
+pub fn evaluate_rings(reference: &[[f32; 4]], test: &[[f32; 4]], width: u32, height: u32, rings: &Rings) -> Vec<CoordinateRing> {
+    let maps = PixelMaps::new(reference, test, width, height);
+    let (mse, ssim, counts) = (rings.mean(&maps.squared_error), rings.mean(&maps.ssim), rings.pixel_counts());
+    (0..rings.count)
+        .map(|i| {
+            let (inner, outer) = rings.bounds(i);
+            CoordinateRing { ring: i, inner, outer, metrics: Metrics::from_means(mse[i], ssim[i], counts[i]) }
+        })
+        .collect()
 }
 
 /// Whole-frame and per-ring RMSE, PSNR and SSIM of `test` against `reference`.

@@ -2,9 +2,11 @@
 //! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp` or `--taa screen`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
+//! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
+//! (`RenderProfile::visual_polar_for`).
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
@@ -14,6 +16,9 @@ use std::path::Path;
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
+    /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
+    /// until `visual_polar_for` adds the headset's FOV.
+    pub eccentricity: EccentricityMode,
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
     pub taa: TaaSettings,
@@ -58,6 +63,7 @@ struct VpSection {
     inverse_cdf: Option<String>,
     radius: Option<toml::Value>,
     layout: Option<String>,
+    eccentricity: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -76,7 +82,34 @@ pub struct ProfileOverrides {
     pub inverse_cdf: Option<String>,
     pub radius: Option<String>,
     pub layout: Option<String>,
+    pub eccentricity: Option<String>,
     pub blur_sigma: Option<f32>,
+}
+
+/// What the Visual-Polar ρ axis measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EccentricityMode {
+    /// The paper's normalised screen distance (80 ↦ the farthest corner).
+    #[default]
+    Normalized,
+    /// True degrees from the gaze direction through the headset eye's FOV.
+    Headset,
+}
+
+pub fn parse_eccentricity(s: &str) -> Result<EccentricityMode> {
+    match s {
+        "normalized" => Ok(EccentricityMode::Normalized),
+        "headset" => Ok(EccentricityMode::Headset),
+        other => bail!("'{other}' is not an eccentricity axis (normalized | headset)"),
+    }
+}
+
+/// The name `parse_eccentricity` reads (report.json, messages).
+pub fn eccentricity_name(mode: EccentricityMode) -> &'static str {
+    match mode {
+        EccentricityMode::Normalized => "normalized",
+        EccentricityMode::Headset => "headset",
+    }
 }
 
 pub fn parse_inverse_cdf(s: &str) -> Result<InverseCdf> {
@@ -140,7 +173,12 @@ impl RenderProfile {
             if let Some(layout) = vp.layout {
                 p.layout = parse_layout(&layout).with_context(|| format!("{}.layout", at("visual_polar")))?;
             }
+            if let Some(mode) = vp.eccentricity {
+                profile.eccentricity =
+                    parse_eccentricity(&mode).with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
+            }
             p.validate().with_context(|| at("visual_polar"))?;
+            profile.check_eccentricity().with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
         }
         if let Some(blur) = file.blur {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
@@ -184,9 +222,36 @@ impl RenderProfile {
             p.layout = parse_layout(layout).context("--vp-layout")?;
         }
         p.validate().context("Visual-Polar flags")?;
+        if let Some(mode) = &o.eccentricity {
+            self.eccentricity = parse_eccentricity(mode).context("--vp-eccentricity")?;
+        }
+        self.check_eccentricity().context("--vp-eccentricity")?;
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
         check_blur(&self.blur).context("--blur-sigma")?;
         Ok(self)
+    }
+}
+
+/// An HMD eye's FOV as the plain tangents the renderer takes.
+pub fn fov_tangents(fov: &fovea_hal::Fov) -> FovTangents {
+    FovTangents { left: -fov.angle_left.tan(), right: fov.angle_right.tan(), up: fov.angle_up.tan(), down: -fov.angle_down.tan() }
+}
+
+impl RenderProfile {
+    /// The Visual-Polar parameters for an eye with this FOV (the headset axis needs it).
+    pub fn visual_polar_for(&self, fov: FovTangents) -> Result<VisualPolarParams> {
+        let mut p = self.visual_polar;
+        if self.eccentricity == EccentricityMode::Headset {
+            p.eccentricity = Eccentricity::Headset(fov);
+        }
+        p.validate().context("Visual-Polar parameters")?;
+        Ok(p)
+    }
+
+    /// The combinations the headset axis refuses, checked with a stand-in FOV (the real one is
+    /// only known to the command).
+    fn check_eccentricity(&self) -> Result<()> {
+        self.visual_polar_for(FovTangents { left: 1.0, right: 1.0, up: 1.0, down: 1.0 }).map(|_| ())
     }
 }
 
@@ -219,6 +284,7 @@ mod tests {
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Polynomial);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
+        assert_eq!(p.eccentricity, EccentricityMode::Normalized);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
@@ -238,6 +304,11 @@ mod tests {
         assert_eq!(p.blur.sigma_at_30, 0.0);
         let p = load_str("taa_ok.toml", "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n").unwrap();
         assert_eq!(p.taa, TaaSettings { current_weight: 0.05, jitter_points: 8 });
+        let p = load_str("ecc_ok.toml", "[visual_polar]\neccentricity = \"headset\"\n").unwrap();
+        assert_eq!(p.eccentricity, EccentricityMode::Headset);
+        let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
+        assert_eq!(p.visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Headset(fov));
+        assert_eq!(RenderProfile::default().visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Normalized);
     }
 
     #[test]
@@ -250,6 +321,9 @@ mod tests {
             ("radius.toml", "[visual_polar]\nradius = -3\n", "radius"),
             ("layout.toml", "[visual_polar]\nlayout = \"clipped\"\n", "layout"),
             ("layout_type.toml", "[visual_polar]\nlayout = 1\n", "layout"),
+            ("ecc.toml", "[visual_polar]\neccentricity = \"true\"\n", "eccentricity"),
+            ("ecc_type.toml", "[visual_polar]\neccentricity = 2\n", "eccentricity"),
+            ("ecc_clip.toml", "[visual_polar]\neccentricity = \"headset\"\nlayout = \"screen-clipped\"\n", "eccentricity"),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
@@ -278,6 +352,12 @@ mod tests {
         let bad = ProfileOverrides { layout: Some("full".into()), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-layout"));
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(500.0));
+        let o = ProfileOverrides { eccentricity: Some("headset".into()), ..Default::default() };
+        assert_eq!(RenderProfile::default().override_with(&o).unwrap().eccentricity, EccentricityMode::Headset);
+        let bad = ProfileOverrides { eccentricity: Some("degrees".into()), ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
+        let bad = ProfileOverrides { eccentricity: Some("headset".into()), layout: Some("screen-clipped".into()), ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
         let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));
     }

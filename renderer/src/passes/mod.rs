@@ -27,9 +27,9 @@ impl VpLayoutPipelines {
         })
     }
 
-    /// The kernel for the layout of `vp` (shape1.w, see VisualPolar::sampling_params).
+    /// The kernel for the layout of `vp` (its flag slot, see VisualPolar::sampling_params).
     pub fn for_space(&self, vp: &crate::layouts::SamplingParams) -> &crate::vk::ComputePipeline {
-        if vp.shape1.w != 0.0 {
+        if crate::sampling::params_select_clipped_layout(vp) {
             &self.clipped
         } else {
             &self.paper

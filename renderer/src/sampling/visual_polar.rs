@@ -18,7 +18,15 @@
 //! That is the paper's layout (`VpLayout::Paper`, the default). `VpLayout::ScreenClipped` keeps
 //! the grid and the row counts but lays each column's rows on the on-screen part of its circle
 //! only: `visual_polar_clipped.rs`.
+//!
+//! The ρ axis is the paper's normalised eccentricity by default (`Eccentricity::Normalized`).
+//! `Eccentricity::Headset` makes it the true eccentricity in degrees through the eye's FOV
+//! (`visual_polar_headset.rs`): the "radius" r of the formulas above becomes e itself (r_max =
+//! e_norm = 1, r_f = fovea°), the CDF runs over [0, e_max] (e_max = the largest true eccentricity
+//! of a screen corner for this gaze) and always uses the exact inverse (the quartic is a fit for
+//! [0, 80]); φ stays the angle in pixels, so the rows, the clip and the φ mips are unchanged.
 
+use super::visual_polar_headset::{FovTangents, HeadsetAxis};
 use super::SamplingSpace;
 use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
@@ -32,6 +40,12 @@ pub const E_MAX_DEG: f32 = 80.0;
 /// Steps of the exact inverse: from the polynomial guess 3 suffice for k = 1; the rest cover other
 /// density exponents, where some steps may fall back to bisection.
 const NEWTON_STEPS: u32 = 12;
+/// Bracket top of the exact inverse with the headset axis (true degrees never exceed 180).
+pub const E_TOP_HEADSET_DEG: f32 = 180.0;
+/// Bits of the flag slot (`SamplingParams::shape1.y`).
+const FLAG_EXACT: u32 = 1;
+const FLAG_CLIPPED: u32 = 2;
+const FLAG_HEADSET: u32 = 4;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InverseCdf {
@@ -63,6 +77,15 @@ pub enum VpLayout {
     ScreenClipped,
 }
 
+/// What the ρ axis measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Eccentricity {
+    /// The paper's: a screen distance normalised so that r_max ↦ 80.
+    Normalized,
+    /// True degrees from the gaze direction through this eye's FOV (`visual_polar_headset.rs`).
+    Headset(FovTangents),
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VisualPolarParams {
     /// Per-axis grid scale relative to the screen (2/3: 853×960 for 1280×1440).
@@ -76,6 +99,7 @@ pub struct VisualPolarParams {
     pub inverse_cdf: InverseCdf,
     pub radius_mode: RadiusMode,
     pub layout: VpLayout,
+    pub eccentricity: Eccentricity,
 }
 
 impl Default for VisualPolarParams {
@@ -88,6 +112,7 @@ impl Default for VisualPolarParams {
             inverse_cdf: InverseCdf::Polynomial,
             radius_mode: RadiusMode::FarthestCorner,
             layout: VpLayout::Paper,
+            eccentricity: Eccentricity::Normalized,
         }
     }
 }
@@ -117,6 +142,23 @@ impl VisualPolarParams {
         if let RadiusMode::Fixed(r) = self.radius_mode {
             if !(r.is_finite() && r > 0.0) {
                 return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
+            }
+        }
+        if let Eccentricity::Headset(fov) = self.eccentricity {
+            fov.check().map_err(invalid)?;
+            // The on-screen arcs are computed for circles; the headset's iso-eccentricity curves
+            // are conics.
+            if self.layout != VpLayout::Paper {
+                return Err(invalid(
+                    "eccentricity = headset supports only the paper layout (layout = paper)".to_string(),
+                ));
+            }
+            if self.radius_mode != RadiusMode::FarthestCorner {
+                return Err(invalid(
+                    "eccentricity = headset ends the ρ axis at the farthest corner's true eccentricity: \
+                     radius_mode must be the farthest corner"
+                        .to_string(),
+                ));
             }
         }
         Ok(())
@@ -230,13 +272,15 @@ fn inverse_cdf_poly_derivative(p: f32) -> f32 {
     ((100.36 * p + 0.504) * p + 55.22) * p + 23.87
 }
 
-/// Exact inverse of the normalised CDF: e with cdf(e, k) = p · cdf_max (cdf_max = cdf(80, k)).
-/// Safeguarded Newton from the polynomial guess: the bracket [lo, hi] shrinks every step and a
-/// Newton step leaving it is replaced by bisection (far from k = 1 the quartic guess can be poor
-/// and a plain step from a flat tail overshoots into the fovea). The GLSL twin does the same in f32.
-pub fn inverse_cdf_exact(p: f32, k: f32, cdf_max: f32) -> f32 {
+/// Exact inverse of the normalised CDF: e with cdf(e, k) = p · cdf_max, cdf_max = cdf(e_max, k)
+/// for some e_max ≤ `e_top` (the paper: e_max = e_top = 80; the headset axis: its farthest
+/// corner's true eccentricity, bracketed by 180). Safeguarded Newton from the polynomial guess:
+/// the bracket [lo, hi] shrinks every step and a Newton step leaving it is replaced by bisection
+/// (far from k = 1 the quartic guess can be poor and a plain step from a flat tail overshoots
+/// into the fovea). The GLSL twin does the same in f32.
+pub fn inverse_cdf_exact(p: f32, k: f32, cdf_max: f32, e_top: f32) -> f32 {
     let target = p * cdf_max;
-    let (mut lo, mut hi) = (0.0f32, if p <= 1.0 { E_MAX_DEG } else { 4.0 * E_MAX_DEG });
+    let (mut lo, mut hi) = (0.0f32, if p <= 1.0 { e_top } else { 4.0 * e_top });
     let mut e = inverse_cdf_poly(p).clamp(lo, hi);
     for _ in 0..NEWTON_STEPS {
         let f = cdf(e, k) - target;
@@ -284,6 +328,11 @@ pub struct VisualPolar {
     e_norm: f32,
     cdf_max: f32,
     exact: bool,
+    /// The tangent-space geometry with `Eccentricity::Headset` (then r_max = e_norm = 1 and r_f
+    /// = fovea°: the "radius" axis is the true eccentricity).
+    headset: Option<HeadsetAxis>,
+    /// Largest gaze-to-corner distance in pixels (= r_max on the paper's axis).
+    r_corner_px: f32,
 }
 
 impl VisualPolar {
@@ -302,21 +351,30 @@ impl VisualPolar {
             .as_uvec2()
             .max(UVec2::ONE);
         let k = params.density_exponent;
-        // The quartic is a fit for k = 1 only.
-        let exact = params.inverse_cdf == InverseCdf::Exact || k != 1.0;
-        let cdf_max = cdf(E_MAX_DEG, k);
-        let p_f = fovea_fraction(params.fovea_deg, k);
-        let r_max = match params.radius_mode {
-            RadiusMode::FarthestCorner => {
-                let far = gaze.max(screen.as_vec2() - gaze).abs();
-                far.length()
-            }
-            RadiusMode::Fixed(r) => r,
+        let headset = match params.eccentricity {
+            Eccentricity::Normalized => None,
+            Eccentricity::Headset(fov) => Some(HeadsetAxis::new(fov, screen, gaze)),
         };
-        let (e_f, e_norm) = if exact {
-            (params.fovea_deg, E_MAX_DEG)
-        } else {
-            (inverse_cdf_poly(p_f), inverse_cdf_poly(1.0))
+        // The quartic is a fit for k = 1 on [0, 80] only.
+        let exact = params.inverse_cdf == InverseCdf::Exact || k != 1.0 || headset.is_some();
+        let r_corner_px = {
+            let far = gaze.max(screen.as_vec2() - gaze).abs();
+            far.length()
+        };
+        let (cdf_max, r_max, r_f, e_norm) = match headset {
+            None => {
+                let r_max = match params.radius_mode {
+                    RadiusMode::FarthestCorner => r_corner_px,
+                    RadiusMode::Fixed(r) => r,
+                };
+                let (e_f, e_norm) = if exact {
+                    (params.fovea_deg, E_MAX_DEG)
+                } else {
+                    (inverse_cdf_poly(fovea_fraction(params.fovea_deg, k)), inverse_cdf_poly(1.0))
+                };
+                (cdf(E_MAX_DEG, k), r_max, e_f / e_norm * r_max, e_norm)
+            }
+            Some(axis) => (cdf(axis.e_max, k), 1.0, params.fovea_deg, 1.0),
         };
         let vp = Self {
             screen,
@@ -324,13 +382,24 @@ impl VisualPolar {
             params,
             grid,
             u_f: 2.0 * params.clip_fraction,
-            p_f,
+            p_f: cdf(params.fovea_deg, k) / cdf_max,
             r_max,
-            r_f: e_f / e_norm * r_max,
+            r_f,
             e_norm,
             cdf_max,
             exact,
+            headset,
+            r_corner_px,
         };
+        if let Some(axis) = headset {
+            if !axis.e_max.is_finite() || axis.e_max <= params.fovea_deg {
+                return Err(invalid(format!(
+                    "eccentricity = headset: the farthest screen corner is only {}° from the gaze, not beyond the \
+                     fovea ({}°): check the FOV tangents and fovea_deg",
+                    axis.e_max, params.fovea_deg
+                )));
+            }
+        }
         // Guards against parameter combinations that pass the range checks but break the math
         // (e.g. an extreme density exponent overflowing the CDF).
         if !(vp.r_max > 0.0 && vp.r_f.is_finite() && vp.r_f > 0.0 && vp.cdf_max.is_finite() && vp.cdf_max > 0.0)
@@ -357,12 +426,29 @@ impl VisualPolar {
     pub fn grid_size(&self) -> UVec2 {
         self.grid
     }
+    /// Pixels the ρ axis ends at: r_max on the paper's axis; with the headset axis the largest
+    /// gaze-to-corner distance (where that axis ends too, at e_max).
     pub fn r_max(&self) -> f32 {
-        self.r_max
+        match self.headset {
+            None => self.r_max,
+            Some(_) => self.r_corner_px,
+        }
     }
-    /// Fovea radius on screen in pixels.
+    /// Fovea radius on screen in pixels (headset axis: the mean over directions of the fovea's
+    /// edge, which is not a circle there).
     pub fn r_fovea(&self) -> f32 {
-        self.r_f
+        match &self.headset {
+            None => self.r_f,
+            Some(axis) => axis.mean_distance(self.params.fovea_deg),
+        }
+    }
+    /// The tangent-space geometry, with `Eccentricity::Headset`.
+    pub fn headset(&self) -> Option<&HeadsetAxis> {
+        self.headset.as_ref()
+    }
+    /// True eccentricity (degrees) of a screen position, with `Eccentricity::Headset`.
+    pub fn true_eccentricity(&self, s: Vec2) -> Option<f32> {
+        self.headset.map(|axis| axis.eccentricity(s - self.gaze))
     }
     /// Width of the clip triangle in normalised u: clipped area u_f/2 = clip_fraction.
     pub fn u_fovea(&self) -> f32 {
@@ -372,14 +458,22 @@ impl VisualPolar {
         self.p_f
     }
 
-    /// Screen distance (pixels) of the paper's normalised eccentricity `e` (e_norm ↦ r_max).
+    /// Screen distance (pixels) of eccentricity `e`: the paper's normalised one (e_norm ↦
+    /// r_max), or with the headset axis true degrees (mean distance over directions).
     pub fn radius_of_eccentricity(&self, e: f32) -> f32 {
-        e / self.e_norm * self.r_max
+        match &self.headset {
+            None => e / self.e_norm * self.r_max,
+            Some(axis) => axis.mean_distance(e),
+        }
     }
 
-    /// The paper's normalised eccentricity of a screen distance (pixels).
+    /// The paper's normalised eccentricity of a screen distance (pixels). The headset axis has
+    /// no single answer (use `true_eccentricity`); it gets the paper's scale with r_max().
     pub fn eccentricity_of_radius(&self, r: f32) -> f32 {
-        r / self.r_max * self.e_norm
+        match self.headset {
+            None => r / self.r_max * self.e_norm,
+            Some(_) => r / self.r_corner_px * E_MAX_DEG,
+        }
     }
 
     /// Rows of φ that column `col` keeps (the triangular clip; see the module docs).
@@ -406,21 +500,42 @@ impl VisualPolar {
             .sum()
     }
 
-    /// Normalised ρ coordinate → screen distance (pixels).
+    /// Normalised ρ coordinate → the axis value: screen distance (pixels) on the paper's axis,
+    /// true eccentricity (degrees) on the headset's.
     pub fn r_of_u(&self, u: f32) -> f32 {
         if u < self.u_f {
             return u / self.u_f * self.r_f;
         }
         let p = self.p_f + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - self.p_f);
         let e = if self.exact {
-            inverse_cdf_exact(p, self.params.density_exponent, self.cdf_max)
+            let e_top = if self.headset.is_some() { E_TOP_HEADSET_DEG } else { E_MAX_DEG };
+            inverse_cdf_exact(p, self.params.density_exponent, self.cdf_max, e_top)
         } else {
             inverse_cdf_poly(p)
         };
         e / self.e_norm * self.r_max
     }
 
-    /// Screen distance (pixels) → normalised ρ coordinate (inverse of `r_of_u`).
+    /// The axis value of the screen offset `d` from the gaze, `r = |d|`: r itself, or the true
+    /// eccentricity with the headset axis. GLSL: `vp_axis_of_offset`.
+    pub fn axis_of_offset(&self, d: Vec2, r: f32) -> f32 {
+        match &self.headset {
+            None => r,
+            Some(axis) => axis.eccentricity(d),
+        }
+    }
+
+    /// Normalised ρ and pixel angle φ → screen offset from the gaze. GLSL: `vp_offset_of`.
+    pub fn offset_of(&self, u: f32, phi: f32) -> Vec2 {
+        let dir = Vec2::new(phi.cos(), phi.sin());
+        let a = self.r_of_u(u);
+        match &self.headset {
+            None => a * dir,
+            Some(axis) => axis.distance(a, dir) * dir,
+        }
+    }
+
+    /// Axis value (see `r_of_u`) → normalised ρ coordinate (inverse of `r_of_u`).
     pub fn u_of_r(&self, r: f32) -> f32 {
         if r < self.r_f {
             return r / self.r_f * self.u_f;
@@ -465,7 +580,7 @@ impl VisualPolar {
         if phi < 0.0 {
             phi += TAU;
         }
-        let x = self.u_of_r(r) * self.grid.x as f32;
+        let x = self.u_of_r(self.axis_of_offset(d, r)) * self.grid.x as f32;
         let n = self.rows_in_column(self.column_of(x)) as f32;
         // atan2 may round to exactly 2π after the wrap: keep y inside [0, n).
         let y = phi / TAU * n;
@@ -476,32 +591,45 @@ impl VisualPolar {
     pub fn paper_vp_to_screen(&self, g: Vec2) -> Vec2 {
         let n = self.rows_in_column(self.column_of(g.x)) as f32;
         let phi = g.y / n * TAU;
-        let r = self.r_of_u(g.x / self.grid.x as f32);
-        self.gaze + r * Vec2::new(phi.cos(), phi.sin())
+        self.gaze + self.offset_of(g.x / self.grid.x as f32, phi)
     }
 
     /// The parameters as the GPU gets them (binding `sampling`; unpacked by `vp_unpack` in
-    /// `visual_polar_math.glsl`): grid = (grid w, grid h, screen w, screen h),
-    /// gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
-    /// shape1 = (cdf_max, exact, fovea°, layout: 0 paper, 1 screen-clipped).
+    /// `visual_polar_math.glsl`, which derives r_max = e_norm = 1 for the headset axis):
+    /// grid = (grid w, grid h, screen w, screen h), shape1.y = flags (1 exact inverse CDF,
+    /// 2 screen-clipped layout, 4 headset axis), and by axis
+    /// - paper (normalised): gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
+    ///   shape1 = (cdf_max, flags, fovea° (informative), 0);
+    /// - headset: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
+    ///   shape1 = (cdf_max, flags, scale.x, scale.y) (G: gaze in tangent space, scale: tangent
+    ///   units per pixel; cdf_max = cdf(e_max, k)).
     pub fn sampling_params(&self) -> SamplingParams {
-        SamplingParams {
-            grid: UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y),
-            gaze: Vec4::new(
-                self.gaze.x,
-                self.gaze.y,
-                self.r_max,
-                self.params.density_exponent,
-            ),
-            shape0: Vec4::new(self.u_f, self.p_f, self.r_f, self.e_norm),
-            shape1: Vec4::new(
-                self.cdf_max,
-                self.exact as u32 as f32,
-                self.params.fovea_deg,
-                (self.params.layout == VpLayout::ScreenClipped) as u32 as f32,
-            ),
+        let flags = self.exact as u32 * FLAG_EXACT
+            + (self.params.layout == VpLayout::ScreenClipped) as u32 * FLAG_CLIPPED
+            + self.headset.is_some() as u32 * FLAG_HEADSET;
+        let grid = UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y);
+        let k = self.params.density_exponent;
+        match &self.headset {
+            None => SamplingParams {
+                grid,
+                gaze: Vec4::new(self.gaze.x, self.gaze.y, self.r_max, k),
+                shape0: Vec4::new(self.u_f, self.p_f, self.r_f, self.e_norm),
+                shape1: Vec4::new(self.cdf_max, flags as f32, self.params.fovea_deg, 0.0),
+            },
+            Some(axis) => SamplingParams {
+                grid,
+                gaze: Vec4::new(self.gaze.x, self.gaze.y, axis.gaze_tan.x, k),
+                shape0: Vec4::new(self.u_f, self.p_f, self.r_f, axis.gaze_tan.y),
+                shape1: Vec4::new(self.cdf_max, flags as f32, axis.scale.x, axis.scale.y),
+            },
         }
     }
+}
+
+/// Whether packed parameters (`VisualPolar::sampling_params`) select the screen-clipped layout
+/// (the flag slot; Cartesian parameters are all zero, i.e. no).
+pub fn params_select_clipped_layout(p: &SamplingParams) -> bool {
+    (p.shape1.y as u32) & FLAG_CLIPPED != 0
 }
 
 /// The tracer's view of the space: one sample per kept texel; the GPU twin is

@@ -334,8 +334,8 @@ mod tests {
                 let vp = clipped(w, h, gaze);
                 let paper = VisualPolar::new(vp.screen(), gaze, Default::default()).unwrap();
                 assert_eq!(vp.sample_count(), paper.sample_count());
-                assert_eq!(vp.sampling_params().shape1.w, 1.0);
-                assert_eq!(paper.sampling_params().shape1.w, 0.0);
+                assert!(crate::sampling::params_select_clipped_layout(&vp.sampling_params()));
+                assert!(!crate::sampling::params_select_clipped_layout(&paper.sampling_params()));
                 assert!(paper.column_table().chunks(2).all(|t| t[0] == [0.0; 4] && t[1] == [TAU; 4]));
                 let (grid, mut off, mut full_columns) = (vp.grid_size(), 0, 0);
                 for x in 0..grid.x {

@@ -89,7 +89,7 @@ fn polynomial_matches_exact_inverse() {
         let p = p_f + (1.0 - p_f) * i as f32 / 2000.0;
         let exact = bisect_inverse(p as f64, 1.0);
         worst_poly = worst_poly.max((inverse_cdf_poly(p) as f64 - exact).abs());
-        worst_newton = worst_newton.max((inverse_cdf_exact(p, 1.0, cdf_max) as f64 - exact).abs());
+        worst_newton = worst_newton.max((inverse_cdf_exact(p, 1.0, cdf_max, E_MAX_DEG) as f64 - exact).abs());
         // The quartic's inverse (used by screen → VP) undoes Eq. 3.
         let back = poly_fraction_of(inverse_cdf_poly(p), cdf_max);
         assert!((back - p).abs() < 2e-6, "poly inverse at p {p}: {back}");
@@ -103,7 +103,7 @@ fn polynomial_matches_exact_inverse() {
         let p_f = fovea_fraction(ACUITY_KNEE_DEG, k);
         for i in 0..=200 {
             let p = p_f + (1.0 - p_f) * i as f32 / 200.0;
-            let err = (inverse_cdf_exact(p, k, cdf_max) as f64 - bisect_inverse(p as f64, k)).abs();
+            let err = (inverse_cdf_exact(p, k, cdf_max, E_MAX_DEG) as f64 - bisect_inverse(p as f64, k)).abs();
             assert!(err < 1e-3, "k {k} p {p}: Newton off by {err}°");
         }
     }
@@ -247,25 +247,21 @@ fn derived_numbers() {
     );
 }
 
+/// Ring edges: 4 fovea rings, then `rings_periphery` up to `e_end`.
+fn ring_edges(fovea: f32, e_end: f32, rings_periphery: usize) -> Vec<f32> {
+    (0..=4)
+        .map(|i| fovea * i as f32 / 4.0)
+        .chain((1..=rings_periphery).map(|i| fovea + (e_end - fovea) * i as f32 / rings_periphery as f32))
+        .collect()
+}
+
 /// Screen-space sample density per eccentricity ring (ρ = distance / r_max · 80), on screen only:
 /// samples (4 jitters along ρ per texel, so ring edges do not quantise whole columns) against
 /// the target integrated over the ring's on-screen pixels. Returns (ρ_lo, measured/target, density).
 fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)>, f32) {
-    let (w, h) = (s.screen().x as usize, s.screen().y as usize);
     let k = s.params().density_exponent;
     let f = s.params().fovea_deg;
-    let edges: Vec<f32> = (0..=4)
-        .map(|i| f * i as f32 / 4.0)
-        .chain(
-            (1..=rings_periphery).map(|i| f + (E_MAX_DEG - f) * i as f32 / rings_periphery as f32),
-        )
-        .collect();
-    let ring = |rho: f32| {
-        edges
-            .iter()
-            .rposition(|&e| e <= rho)
-            .filter(|&i| i + 1 < edges.len())
-    };
+    let edges = ring_edges(f, E_MAX_DEG, rings_periphery);
     let grid = s.grid_size();
     // Target densities: uniform fovea; periphery ∝ V^k with the periphery's whole sample budget.
     let n_fovea = grid.x as f32 * grid.y as f32 * s.u_fovea() * 0.5;
@@ -279,14 +275,35 @@ fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)
             n_periph * acuity(rho).powf(k) * scale
         }
     };
+    let rho_of = |p: Vec2| (p - s.gaze()).length() / s.r_max() * E_MAX_DEG;
+    ring_counts(s, &edges, &rho_of, &|p| target(rho_of(p)) as f64)
+}
+
+/// Per ring of `ecc` (a screen position's ring coordinate), on screen only: the grid's samples
+/// (4 jitters along ρ per texel) against `expected` (target samples in the pixel at a position)
+/// summed over the ring's pixels. Returns (ring start, measured/target, samples per pixel) for
+/// rings with ≥ 500 pixels, and the off-screen share of the samples.
+fn ring_counts(
+    s: &VisualPolar,
+    edges: &[f32],
+    ecc: &dyn Fn(Vec2) -> f32,
+    expected_in_pixel: &dyn Fn(Vec2) -> f64,
+) -> (Vec<(f32, f32, f32)>, f32) {
+    let (w, h) = (s.screen().x as usize, s.screen().y as usize);
+    let ring = |rho: f32| {
+        edges
+            .iter()
+            .rposition(|&e| e <= rho)
+            .filter(|&i| i + 1 < edges.len())
+    };
+    let grid = s.grid_size();
     let mut expected = vec![0f64; edges.len()];
     let mut pixels = vec![0u64; edges.len()];
     for y in 0..h {
         for x in 0..w {
-            let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - s.gaze();
-            let rho = d.length() / s.r_max() * E_MAX_DEG;
-            if let Some(i) = ring(rho) {
-                expected[i] += target(rho) as f64;
+            let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            if let Some(i) = ring(ecc(p)) {
+                expected[i] += expected_in_pixel(p);
                 pixels[i] += 1;
             }
         }
@@ -303,7 +320,7 @@ fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)
                 total += 0.25;
                 if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32 {
                     onscreen += 0.25;
-                    if let Some(i) = ring((p - s.gaze()).length() / s.r_max() * E_MAX_DEG) {
+                    if let Some(i) = ring(ecc(p)) {
                         got[i] += 0.25;
                     }
                 }
@@ -444,3 +461,6 @@ fn sampling_space_impl() {
     assert_eq!(SamplingSpace::screen_to_grid(&fixed, Vec2::ZERO), None);
     assert!(SamplingSpace::screen_to_grid(&fixed, Vec2::new(100.0, 90.0)).is_some());
 }
+
+#[path = "visual_polar_headset_tests.rs"]
+mod headset;

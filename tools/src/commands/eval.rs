@@ -1,7 +1,7 @@
 //! `fovea eval`: quality of a rendered frame against a reference, whole-frame and per ring of
 //! eccentricity around the gaze → `DIR/eval.json` + `DIR/eval.png`.
 
-use crate::metrics::{evaluate, Evaluation};
+use crate::metrics::{evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings};
 use crate::output::{prepare_output_dir, read_exr};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
@@ -16,6 +16,18 @@ pub struct EvalArgs<'a> {
     pub gaze: &'a str,
     pub rings: usize,
     pub out: &'a Path,
+    /// Also ring by true eccentricity (degrees) through this headset's left-eye FOV.
+    pub headset: Option<&'a str>,
+}
+
+/// Rings of true eccentricity: equal widths in degrees from the gaze direction out to the
+/// farthest corner's (the images are taken to fill the eye's FOV).
+#[derive(Serialize)]
+struct TrueEccentricity {
+    headset: String,
+    e_max_deg: f64,
+    /// `inner` / `outer` in degrees.
+    rings: Vec<CoordinateRing>,
 }
 
 /// eval.json: the inputs, then the metrics (field order kept as written).
@@ -25,6 +37,8 @@ struct Report<'a> {
     test: String,
     #[serde(flatten)]
     eval: &'a Evaluation,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    true_eccentricity: Option<TrueEccentricity>,
 }
 
 pub fn run(args: &EvalArgs) -> Result<()> {
@@ -41,11 +55,30 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         );
     }
     let gaze = parse_gaze(args.gaze, w, h)?;
+    let hmd = match args.headset {
+        Some(name) => Some(fovea_hal::HmdDescription::resolve(name).with_context(|| format!("--headset {name}"))?),
+        None => None,
+    };
     prepare_output_dir(args.out)?;
     let eval = evaluate(&reference, &test, w, h, gaze, args.rings);
+    let true_eccentricity = hmd.map(|hmd| {
+        let fov = crate::render_profile::fov_tangents(&hmd.eye(fovea_hal::Eye::Left).fov);
+        let axis = fovea_renderer::sampling::HeadsetAxis::new(fov, glam::UVec2::new(w, h), gaze);
+        let degrees: Vec<f64> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))
+            .map(|p| axis.eccentricity(p - gaze) as f64)
+            .collect();
+        let rings = Rings::from_coordinates(w, gaze, &degrees, axis.e_max as f64, args.rings);
+        TrueEccentricity { headset: hmd.id.clone(), e_max_deg: axis.e_max as f64, rings: evaluate_rings(&reference, &test, w, h, &rings) }
+    });
 
     let json_path = args.out.join("eval.json");
-    let report = Report { reference: args.reference.display().to_string(), test: args.test.display().to_string(), eval: &eval };
+    let report = Report {
+        reference: args.reference.display().to_string(),
+        test: args.test.display().to_string(),
+        eval: &eval,
+        true_eccentricity,
+    };
     std::fs::write(&json_path, serde_json::to_string_pretty(&report)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     write_plot(&args.out.join("eval.png"), &eval)?;

@@ -106,6 +106,8 @@ struct VpReport {
     radius: String,
     /// "paper" or "screen-clipped".
     layout: String,
+    /// The ρ axis: "normalized" (the paper's) or "headset" (true degrees through the eye's FOV).
+    eccentricity: String,
 }
 
 #[derive(Serialize, Default)]
@@ -163,8 +165,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let screen = UVec2::new(width, height);
     // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
     let screen_centre = screen.as_vec2() * 0.5;
+    let fov = crate::render_profile::fov_tangents(&eye.fov);
+    let vp_params = args.profile.visual_polar_for(fov).with_context(|| format!("--headset {}", args.headset))?;
     let space: Box<dyn SamplingSpace> = match args.method {
-        "vp" => Box::new(VisualPolar::new(screen, screen_centre, args.profile.visual_polar).context("Visual-Polar space")?),
+        "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
         _ => Box::new(Cartesian::new(screen)),
     };
     let grid = space.grid_size();
@@ -287,14 +291,16 @@ fn vp_report(profile: &RenderProfile) -> VpReport {
         clip_fraction: p.clip_fraction,
         fovea_deg: p.fovea_deg,
         density_exponent: p.density_exponent,
-        inverse_cdf: match p.inverse_cdf {
-            InverseCdf::Polynomial => "polynomial".into(),
-            InverseCdf::Exact => "exact".into(),
+        // The headset axis always uses the exact inverse (the quartic is a fit for [0, 80]).
+        inverse_cdf: match (p.inverse_cdf, profile.eccentricity) {
+            (_, crate::render_profile::EccentricityMode::Headset) | (InverseCdf::Exact, _) => "exact".into(),
+            (InverseCdf::Polynomial, _) => "polynomial".into(),
         },
         radius: match p.radius_mode {
             RadiusMode::FarthestCorner => "corner".into(),
             RadiusMode::Fixed(r) => format!("{r}"),
         },
         layout: crate::render_profile::layout_name(p.layout).into(),
+        eccentricity: crate::render_profile::eccentricity_name(profile.eccentricity).into(),
     }
 }
