@@ -259,7 +259,7 @@ impl Renderer {
         // Denoisers work in the sampling grid (Cartesian samples are the screen).
         let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
         let denoised = match &mut self.denoiser {
-            Some(d) => d.record(rec, &self.gbuffer, &denoise_frame)?,
+            Some(d) => d.record(rec, &self.gbuffer, &denoise_frame, input.camera.world_from_view.w_axis.truncate())?,
             None => &self.gbuffer.color,
         };
         let grid_hdr = match (&mut self.taa, jitter) {

@@ -1,10 +1,12 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp`).
+//! the SVGF and BMFR parameters (used with `--denoiser svgf` / `bmfr`) and the TAA parameters
+//! (used when `--taa vp`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
@@ -16,6 +18,7 @@ pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
+    pub bmfr: BmfrSettings,
     pub taa: TaaSettings,
 }
 
@@ -25,6 +28,7 @@ struct ProfileFile {
     visual_polar: Option<VpSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
+    bmfr: Option<BmfrSection>,
     taa: Option<TaaSection>,
 }
 
@@ -33,6 +37,14 @@ struct ProfileFile {
 struct TaaSection {
     current_weight: Option<f32>,
     jitter_points: Option<u32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct BmfrSection {
+    alpha_noisy: Option<f32>,
+    alpha_filtered: Option<f32>,
+    noise: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -158,6 +170,13 @@ impl RenderProfile {
             s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
             s.validate().with_context(|| at("svgf"))?;
         }
+        if let Some(f) = file.bmfr {
+            let s = &mut profile.bmfr;
+            s.alpha_noisy = f.alpha_noisy.unwrap_or(s.alpha_noisy);
+            s.alpha_filtered = f.alpha_filtered.unwrap_or(s.alpha_filtered);
+            s.noise = f.noise.unwrap_or(s.noise);
+            s.validate().with_context(|| at("bmfr"))?;
+        }
         if let Some(f) = file.taa {
             let s = &mut profile.taa;
             s.current_weight = f.current_weight.unwrap_or(s.current_weight);
@@ -221,6 +240,7 @@ mod tests {
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
+        assert_eq!(p.bmfr, BmfrSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
     }
 
@@ -238,6 +258,8 @@ mod tests {
         assert_eq!(p.blur.sigma_at_30, 0.0);
         let p = load_str("taa_ok.toml", "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n").unwrap();
         assert_eq!(p.taa, TaaSettings { current_weight: 0.05, jitter_points: 8 });
+        let p = load_str("bmfr_ok.toml", "[bmfr]\nalpha_noisy = 0.25\nnoise = 0\n").unwrap();
+        assert_eq!(p.bmfr, BmfrSettings { alpha_noisy: 0.25, noise: 0.0, ..Default::default() });
     }
 
     #[test]
@@ -254,6 +276,9 @@ mod tests {
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
+            ("bmfr.toml", "[bmfr]\nalpha_filtered = 1.0\n", "bmfr"),
+            ("bmfr_noise.toml", "[bmfr]\nnoise = -0.01\n", "bmfr"),
+            ("bmfr_key.toml", "[bmfr]\nblock_size = 16\n", "block_size"),
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),

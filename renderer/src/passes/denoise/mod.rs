@@ -1,20 +1,22 @@
 //! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
 //! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
 //! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
-//! which runs after the denoiser; A-SVGF, BMFR fit beside them), one pass = one module + one
+//! which runs after the denoiser; BMFR; A-SVGF fits beside them), one pass = one module + one
 //! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
 //! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
+pub mod bmfr;
 pub mod modulate;
 pub mod svgf;
 pub mod taa;
 
+use bmfr::{Bmfr, BmfrSettings};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
 use crate::passes::trace::GBuffer;
 use crate::vk::{Context, Image};
-use glam::UVec2;
+use glam::{UVec2, Vec3};
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
 
@@ -25,17 +27,19 @@ pub enum DenoiserSettings {
     #[default]
     None,
     Svgf(SvgfSettings),
+    Bmfr(BmfrSettings),
 }
 
 impl DenoiserSettings {
     /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["none", "svgf"];
+    pub const NAMES: &'static [&'static str] = &["none", "svgf", "bmfr"];
 
     /// A denoiser by name, with its defaults.
     pub fn parse(name: &str) -> Result<DenoiserSettings> {
         match name {
             "none" => Ok(DenoiserSettings::None),
             "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
+            "bmfr" => Ok(DenoiserSettings::Bmfr(BmfrSettings::default())),
             other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
         }
     }
@@ -44,6 +48,7 @@ impl DenoiserSettings {
         match self {
             DenoiserSettings::None => "none",
             DenoiserSettings::Svgf(_) => "svgf",
+            DenoiserSettings::Bmfr(_) => "bmfr",
         }
     }
 }
@@ -59,6 +64,7 @@ pub struct DenoiseFrame {
 /// A denoiser with its per-eye state.
 pub enum Denoiser {
     Svgf(Box<Svgf>),
+    Bmfr(Box<Bmfr>),
 }
 
 impl Denoiser {
@@ -67,6 +73,7 @@ impl Denoiser {
         Ok(match settings {
             DenoiserSettings::None => None,
             DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
+            DenoiserSettings::Bmfr(s) => Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?))),
         })
     }
 
@@ -74,6 +81,7 @@ impl Denoiser {
     pub fn history_bytes(&self) -> u64 {
         match self {
             Denoiser::Svgf(s) => s.history.bytes(),
+            Denoiser::Bmfr(b) => b.history.bytes(),
         }
     }
 
@@ -81,13 +89,17 @@ impl Denoiser {
     pub fn max_passes(&self) -> u32 {
         match self {
             Denoiser::Svgf(s) => s.max_passes(),
+            Denoiser::Bmfr(b) => b.max_passes(),
         }
     }
 
     /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+    /// `camera_origin`: this frame's camera position in world space (the G-buffer's positions are
+    /// relative to it; BMFR accumulates positions across frames).
+    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, camera_origin: Vec3) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
+            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, camera_origin),
         }
     }
 }
