@@ -336,7 +336,8 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
         for (i, s) in screens.iter().enumerate() {
             let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
             // Margins of a few pixels keep bilinear footprints across the edges (and coarse
-            // peripheral VP texels) out of the checked sets.
+            // peripheral VP texels) out of the checked sets. Lengths blend over bilinear taps:
+            // compared to 1e-3.
             let (len, lum) = (lengths[i][3], out[i][1]);
             if s.x > 18.0 && s.x < 27.0 {
                 uncovered += 1;
@@ -344,11 +345,12 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                 assert!(lum < 1.0, "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)");
             } else if s.x > 2.0 && s.x < 14.0 {
                 followed += 1;
-                assert_eq!(len, 9.0, "{name}: the occluder's history at {s} did not follow the camera");
+                assert!((len - 9.0).abs() < 1e-3, "{name}: the occluder's history at {s} did not follow the camera ({len})");
                 assert!(lum > 2.0, "{name}: occluder texel {i} at {s} shows {lum}");
-            } else if s.x > 34.0 {
+            } else if s.x > 34.0 && s.x < 60.0 {
+                // (Beyond 60.8 px the background was off the screen last frame.)
                 stayed += 1;
-                assert_eq!(len, 9.0, "{name}: background at {s} lost its history");
+                assert!((len - 9.0).abs() < 1e-3, "{name}: background at {s} lost its history ({len})");
                 assert!(lum < 1.0, "{name}: background texel {i} at {s} shows {lum}");
             }
         }

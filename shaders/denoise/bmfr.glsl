@@ -23,9 +23,10 @@
 const int BMFR_SIDE = int(BMFR_BLOCK);
 
 // Reprojection accepts a previous sample whose position (moved into this frame's camera-relative
-// space) lies within this many depth gradients (per texel) plus a share of the depth, and whose
-// normal is within ~25°.
-const float BMFR_REPROJECT_GRADIENTS = 3.0;
+// space) lies within this many texel footprints (world distance to the nearer neighbour texel,
+// the larger over the two grid axes: bilinear taps lie up to ~1.4 texels away) plus a share of the
+// depth, and whose normal is within ~25°.
+const float BMFR_REPROJECT_FOOTPRINTS = 2.0;
 const float BMFR_REPROJECT_DEPTH_SLACK = 0.01;
 const float BMFR_REPROJECT_NORMAL_COS = 0.9;
 // A history length cap that keeps the count exact in fp32 (the α floors bound the weights long
@@ -104,7 +105,7 @@ void bmfr_features(vec3 normal, vec3 position, vec3 offset, vec3 scale, out floa
 // surface: previous hit flag equal, and for hits the previous position (moved by `shift` into this
 // frame's camera-relative space) within `tolerance` and the normal within ~25°. Rejected taps
 // weigh 0; false when nothing usable is left. Reads the history images `prev_position`
-// (xyz camera-relative, w 1 = hit) and `prev_normal`, which a kernel that defines
+// (xyz camera-relative, w the texel footprint, 0 = miss) and `prev_normal`, which a kernel that defines
 // BMFR_REPROJECT binds before including this file.
 #if defined(BMFR_REPROJECT)
 bool bmfr_reproject(Grid prev, vec2 prev_screen, vec3 p, vec3 n, bool hit, float tolerance, vec3 shift,
@@ -130,6 +131,10 @@ bool bmfr_reproject(Grid prev, vec2 prev_screen, vec3 p, vec3 n, bool hit, float
         if (!same || any(isnan(pp))) w[i] = 0.0;
     }
     return w.x + w.y + w.z + w.w >= 0.01;
+}
+
+float bmfr_tolerance(float footprint, float depth) {
+    return BMFR_REPROJECT_FOOTPRINTS * footprint + BMFR_REPROJECT_DEPTH_SLACK * depth;
 }
 #endif
 

@@ -11,11 +11,11 @@ layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { BmfrTemporalPush p; } push;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D radiance;       // demodulated
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D normal_depth;
-layout(set = 0, binding = 2, rgba32f) uniform readonly image2D position;       // w: depth gradient per texel
+layout(set = 0, binding = 2, rgba32f) uniform readonly image2D position;       // camera-relative
 layout(set = 0, binding = 3, rg32f) uniform readonly image2D motion;           // previous screen position (−1: none)
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D prev_noisy;     // rgb, history length
 layout(set = 0, binding = 5, rgba16f) uniform readonly image2D prev_normal;
-layout(set = 0, binding = 6, rgba32f) uniform readonly image2D prev_position;  // xyz, w 1 = hit
+layout(set = 0, binding = 6, rgba32f) uniform readonly image2D prev_position;  // xyz, w footprint (0: miss)
 layout(set = 0, binding = 7, rgba32f) uniform writeonly image2D noisy;
 layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D normal;
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D features_position;
@@ -23,6 +23,22 @@ layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D features_positio
 #define BMFR_REPROJECT
 #include "../../denoise/bmfr.glsl"
 #include "../../denoise/svgf.glsl"
+
+// World size of texel t: distance to the nearer neighbour along each grid axis (the other
+// side may be another surface), the larger of the two axes; 0 without neighbours.
+float footprint(Grid g, ivec2 t, vec3 p) {
+    float size = 0.0;
+    for (int axis = 0; axis < 2; ++axis) {
+        float nearest = 3.0e38;
+        for (int side = -1; side <= 1; side += 2) {
+            ivec2 q;
+            ivec2 o = axis == 0 ? ivec2(side, 0) : ivec2(0, side);
+            if (grid_tap(g, t, o, q) && grid_holds_sample(g, q)) nearest = min(nearest, distance(imageLoad(position, q).xyz, p));
+        }
+        size = nearest < 3.0e38 ? max(size, nearest) : size;
+    }
+    return size;
+}
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
@@ -52,7 +68,9 @@ void main() {
     Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
     ivec2 taps[4];
     vec4 w;
-    float tolerance = BMFR_REPROJECT_GRADIENTS * pw.w + BMFR_REPROJECT_DEPTH_SLACK * nd.w;
+    // Stored with the position (w; > 0 marks a hit) so that the pass after the fit accepts the same taps.
+    float size = hit ? max(footprint(g, t, p), 1e-6 * nd.w + 1e-30) : 0.0;
+    float tolerance = bmfr_tolerance(size, nd.w);
     if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, p, n, hit, tolerance, shift, taps, w)) {
         for (int i = 0; i < 4; ++i) {
             if (w[i] == 0.0) continue;
@@ -74,5 +92,5 @@ void main() {
     }
     imageStore(noisy, t, vec4(c, len));
     imageStore(normal, t, vec4(n, 0.0));
-    imageStore(features_position, t, vec4(p, hit ? 1.0 : 0.0));
+    imageStore(features_position, t, vec4(p, size));
 }

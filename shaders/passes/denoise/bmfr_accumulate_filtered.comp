@@ -11,15 +11,16 @@ layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { BmfrTemporalPush p; } push;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D fitted;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D normal_depth;
-layout(set = 0, binding = 2, rgba32f) uniform readonly image2D position;       // w: depth gradient per texel
+layout(set = 0, binding = 2, rgba32f) uniform readonly image2D position;       // camera-relative
 layout(set = 0, binding = 3, rg32f) uniform readonly image2D motion;           // previous screen position (−1: none)
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D noisy;          // w: history length
 layout(set = 0, binding = 5, rgba16f) uniform readonly image2D prev_normal;
-layout(set = 0, binding = 6, rgba32f) uniform readonly image2D prev_position;  // xyz, w 1 = hit
+layout(set = 0, binding = 6, rgba32f) uniform readonly image2D prev_position;  // xyz, w footprint (0: miss)
 layout(set = 0, binding = 7, rgba32f) uniform readonly image2D prev_filtered;
 layout(set = 0, binding = 8, rgba16f) uniform readonly image2D albedo;
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D filtered;     // history
 layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D dst;
+layout(set = 0, binding = 11, rgba32f) uniform readonly image2D features_position; // this frame's: w footprint
 
 #define BMFR_REPROJECT
 #include "../../denoise/bmfr.glsl"
@@ -42,7 +43,7 @@ void main() {
     Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
     ivec2 taps[4];
     vec4 w;
-    float tolerance = BMFR_REPROJECT_GRADIENTS * pw.w + BMFR_REPROJECT_DEPTH_SLACK * nd.w;
+    float tolerance = bmfr_tolerance(imageLoad(features_position, t).w, nd.w);
     if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, hit ? pw.xyz : vec3(0.0), nd.xyz, hit,
                                             tolerance, push.p.params.xyz, taps, w)) {
         vec3 h = vec3(0.0);

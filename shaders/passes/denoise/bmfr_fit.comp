@@ -18,7 +18,7 @@ layout(local_size_x = BMFR_FIT_LANES) in;
 layout(push_constant) uniform Push { BmfrBlockPush p; } push;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D noisy;               // accumulated rgb
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D normal;              // accumulated
-layout(set = 0, binding = 2, rgba32f) uniform readonly image2D features_position;   // xyz, w 1 = hit
+layout(set = 0, binding = 2, rgba32f) uniform readonly image2D features_position;   // xyz, w footprint (0: miss)
 layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D weights;
 
 const int LANES = int(BMFR_FIT_LANES);

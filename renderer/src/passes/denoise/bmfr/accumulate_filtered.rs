@@ -48,6 +48,7 @@ impl AccumulateFilteredPass {
             read_image("albedo", &g.albedo),
             write_image("filtered", &h.filtered[cur]),
             write_image("dst", dst),
+            read_image("features_position", &h.position[cur]),
         ];
         let push = temporal_push(current, r, alpha_floor);
         rec.dispatch("bmfr_accumulate_filtered", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])

@@ -93,7 +93,7 @@ pub struct BmfrHistory {
     pub noisy: [Image; 2],
     /// Accumulated normal.
     pub normal: [Image; 2],
-    /// Accumulated camera-relative position (xyz; w 1 = a hit).
+    /// Accumulated camera-relative position (xyz; w the texel's world footprint, 0 = a miss).
     pub position: [Image; 2],
     /// Accumulated fitted colour (demodulated).
     pub filtered: [Image; 2],
