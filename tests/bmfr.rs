@@ -5,14 +5,15 @@
 //! other angle; the `--denoiser bmfr` flag end to end.
 
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::layouts::BMFR_BLOCK;
+use ash::vk;
+use fovea_renderer::layouts::{MaterialGpu, BMFR_BLOCK};
 use fovea_renderer::passes::denoise::bmfr::{Bmfr, BmfrSettings, BLOCK_OFFSETS};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
+use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, DenoiserSettings};
 use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::vk::Context;
+use fovea_renderer::vk::{Buffer, Context};
 use fovea_tests::denoise::{
     assert_finite_non_negative, hash, rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,
 };
@@ -47,11 +48,16 @@ fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
     FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
 }
 
+/// One material, not emissive (what the synthetic G-buffers' material index 0 reads).
+fn plain_materials(ctx: &Arc<Context>) -> Buffer {
+    Buffer::with_data(ctx, "materials", &[MaterialGpu::default()], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap()
+}
+
 /// Runs one BMFR frame; returns its output (re-modulated).
-fn denoise(ctx: &Arc<Context>, bmfr: &mut Bmfr, g: &GBuffer, frame: &DenoiseFrame, origin: Vec3) -> Vec<[f32; 4]> {
+fn denoise(ctx: &Arc<Context>, bmfr: &mut Bmfr, g: &GBuffer, frame: &DenoiseFrame, origin: Vec3, materials: &Buffer) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 8).unwrap();
     rec.begin().unwrap();
-    bmfr.record(&mut rec, g, frame, origin).unwrap();
+    bmfr.record(&mut rec, g, frame, &DenoiseScene { camera_origin: origin, materials }).unwrap();
     rec.submit_and_wait().unwrap();
     read_image(ctx, &bmfr.output)
 }
@@ -119,7 +125,7 @@ fn fit_matches_a_cpu_least_squares_solve() {
     let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
     let offset = BLOCK_OFFSETS[0];
     assert_eq!(bmfr.next_block_offset().to_array(), offset);
-    denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO);
+    denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO, &plain_materials(&ctx));
     let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
     // Blocks start at b·32 − (16 − offset) per axis.
@@ -274,7 +280,7 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             r.render_frame(&frame(camera, f)).unwrap();
             inject_fireflies(&ctx, &r.gbuffer.radiance, f);
             let current = r.space().params();
-            let out = denoise(&ctx, &mut bmfr, &r.gbuffer, &DenoiseFrame { current, previous }, origin);
+            let out = denoise(&ctx, &mut bmfr, &r.gbuffer, &DenoiseFrame { current, previous }, origin, &r.scene.materials);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} history"), &read_image(&ctx, bmfr.noisy()));
@@ -309,6 +315,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
         let mut bmfr = Bmfr::new(&ctx, space.grid_size(), space.shader_variant(), BmfrSettings::default()).unwrap();
         let params = space.params();
+        let materials = plain_materials(&ctx);
         let mut out = Vec::new();
         for f in 0..9u32 {
             let (camera_x, prev_camera_x) = if f < 8 { (0.0, 0.0) } else { (1.0, 0.0) };
@@ -329,7 +336,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                 .collect();
             upload_gbuffer(&ctx, &g, &texels);
             let previous = (f > 0).then_some(params);
-            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous }, Vec3::new(camera_x, 0.0, 0.0));
+            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous }, Vec3::new(camera_x, 0.0, 0.0), &materials);
         }
         let lengths: Vec<[f32; 4]> = read_image(&ctx, bmfr.noisy());
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
@@ -376,6 +383,7 @@ fn vp_seam_is_fitted_like_any_other_angle() {
     let params = vp.sampling_params();
     let screens = texel_screens(&vp);
     let centre = screen.as_vec2() * 0.5;
+    let materials = plain_materials(&ctx);
     let mut out = Vec::new();
     for f in 0..8u32 {
         let texels: Vec<Option<Texel>> = screens
@@ -391,7 +399,7 @@ fn vp_seam_is_fitted_like_any_other_angle() {
             })
             .collect();
         upload_gbuffer(&ctx, &g, &texels);
-        out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }, Vec3::ZERO);
+        out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }, Vec3::ZERO, &materials);
     }
     assert_finite_non_negative("seam", &out);
     const BINS: usize = 16;

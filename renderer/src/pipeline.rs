@@ -8,7 +8,7 @@ use crate::graph::{FrameRecorder, PassTiming};
 use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
-use crate::passes::denoise::{DenoiseFrame, Denoiser, DenoiserSettings};
+use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::sampling::SamplingSpace;
@@ -259,7 +259,10 @@ impl Renderer {
         // Denoisers work in the sampling grid (Cartesian samples are the screen).
         let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
         let denoised = match &mut self.denoiser {
-            Some(d) => d.record(rec, &self.gbuffer, &denoise_frame, input.camera.world_from_view.w_axis.truncate())?,
+            Some(d) => {
+                let scene = DenoiseScene { camera_origin: input.camera.world_from_view.w_axis.truncate(), materials: &self.scene.materials };
+                d.record(rec, &self.gbuffer, &denoise_frame, &scene)?
+            }
             None => &self.gbuffer.color,
         };
         let grid_hdr = match (&mut self.taa, jitter) {

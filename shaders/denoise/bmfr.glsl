@@ -102,13 +102,14 @@ void bmfr_features(vec3 normal, vec3 position, vec3 offset, vec3 scale, out floa
 }
 
 // Bilinear taps of the previous frame (through the previous frame's space) that show this
-// surface: previous hit flag equal, and for hits the previous position (moved by `shift` into this
+// surface: the same kind (`kind` and the history's position w: > 0 surface, < 0 emitter, 0 miss),
+// and for hits the previous position (moved by `shift` into this
 // frame's camera-relative space) within `tolerance` and the normal within ~25°. Rejected taps
 // weigh 0; false when nothing usable is left. Reads the history images `prev_position`
-// (xyz camera-relative, w the texel footprint, 0 = miss) and `prev_normal`, which a kernel that defines
+// (xyz camera-relative, w the kind) and `prev_normal`, which a kernel that defines
 // BMFR_REPROJECT binds before including this file.
 #if defined(BMFR_REPROJECT)
-bool bmfr_reproject(Grid prev, vec2 prev_screen, vec3 p, vec3 n, bool hit, float tolerance, vec3 shift,
+bool bmfr_reproject(Grid prev, vec2 prev_screen, vec3 p, vec3 n, float kind, float tolerance, vec3 shift,
                     out ivec2 taps[4], out vec4 w) {
     w = vec4(0.0);
     for (int i = 0; i < 4; ++i) taps[i] = ivec2(0);
@@ -122,9 +123,8 @@ bool bmfr_reproject(Grid prev, vec2 prev_screen, vec3 p, vec3 n, bool hit, float
         }
         vec4 pp = imageLoad(prev_position, taps[i]);
         vec3 pn = imageLoad(prev_normal, taps[i]).xyz;
-        bool prev_hit = pp.w > 0.0;
-        bool same = prev_hit == hit;
-        if (hit && same) {
+        bool same = sign(pp.w) == sign(kind);
+        if (kind != 0.0 && same) {
             float len = length(pn);
             same = distance(p, pp.xyz + shift) <= tolerance && len > 0.0 && dot(n, pn) >= BMFR_REPROJECT_NORMAL_COS * len;
         }

@@ -18,7 +18,9 @@ layout(set = 0, binding = 5, rgba16f) uniform readonly image2D prev_normal;
 layout(set = 0, binding = 6, rgba32f) uniform readonly image2D prev_position;  // xyz, w footprint (0: miss)
 layout(set = 0, binding = 7, rgba32f) uniform writeonly image2D noisy;
 layout(set = 0, binding = 8, rgba16f) uniform writeonly image2D normal;
-layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D features_position;
+layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D features_position; // w footprint, < 0 emitter, 0 miss
+layout(set = 0, binding = 10, rg32ui) uniform readonly uimage2D ids;           // y: material | mesh << 16
+layout(std430, set = 0, binding = 11) readonly buffer MaterialBuffer { MaterialGpu data[]; } materials;
 
 #define BMFR_REPROJECT
 #include "../../denoise/bmfr.glsl"
@@ -68,10 +70,13 @@ void main() {
     Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
     ivec2 taps[4];
     vec4 w;
-    // Stored with the position (w; > 0 marks a hit) so that the pass after the fit accepts the same taps.
+    // Stored with the position (w) so that the pass after the fit accepts the same taps; its sign
+    // tells emitters (kept out of the fits) from other surfaces, 0 misses.
+    bool emitter = hit && any(greaterThan(materials.data[imageLoad(ids, t).y & 0xffffu].emissive.rgb, vec3(0.0)));
     float size = hit ? max(footprint(g, t, p), 1e-6 * nd.w + 1e-30) : 0.0;
+    float kind = emitter ? -size : size;
     float tolerance = bmfr_tolerance(size, nd.w);
-    if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, p, n, hit, tolerance, shift, taps, w)) {
+    if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, p, n, kind, tolerance, shift, taps, w)) {
         for (int i = 0; i < 4; ++i) {
             if (w[i] == 0.0) continue;
             vec4 hc = imageLoad(prev_noisy, taps[i]);
@@ -92,5 +97,5 @@ void main() {
     }
     imageStore(noisy, t, vec4(c, len));
     imageStore(normal, t, vec4(n, 0.0));
-    imageStore(features_position, t, vec4(p, size));
+    imageStore(features_position, t, vec4(p, kind));
 }

@@ -20,7 +20,7 @@ layout(set = 0, binding = 7, rgba32f) uniform readonly image2D prev_filtered;
 layout(set = 0, binding = 8, rgba16f) uniform readonly image2D albedo;
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D filtered;     // history
 layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D dst;
-layout(set = 0, binding = 11, rgba32f) uniform readonly image2D features_position; // this frame's: w footprint
+layout(set = 0, binding = 11, rgba32f) uniform readonly image2D features_position; // this frame's: w footprint, < 0 emitter, 0 miss
 
 #define BMFR_REPROJECT
 #include "../../denoise/bmfr.glsl"
@@ -43,8 +43,9 @@ void main() {
     Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
     ivec2 taps[4];
     vec4 w;
-    float tolerance = bmfr_tolerance(imageLoad(features_position, t).w, nd.w);
-    if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, hit ? pw.xyz : vec3(0.0), nd.xyz, hit,
+    float kind = imageLoad(features_position, t).w;
+    float tolerance = bmfr_tolerance(abs(kind), nd.w);
+    if (alpha_floor < 1.0 && bmfr_reproject(prev, imageLoad(motion, t).xy, hit ? pw.xyz : vec3(0.0), nd.xyz, kind,
                                             tolerance, push.p.params.xyz, taps, w)) {
         vec3 h = vec3(0.0);
         for (int i = 0; i < 4; ++i) {

@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
 use crate::passes::trace::GBuffer;
-use crate::vk::{Context, Image};
+use crate::vk::{Buffer, Context, Image};
 use glam::{UVec2, Vec3};
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
@@ -61,6 +61,16 @@ pub struct DenoiseFrame {
     pub previous: Option<SamplingParams>,
 }
 
+/// What a denoiser may need from the scene besides the G-buffer.
+#[derive(Clone, Copy)]
+pub struct DenoiseScene<'a> {
+    /// This frame's camera position in world space (the G-buffer's positions are relative to it;
+    /// BMFR accumulates positions across frames).
+    pub camera_origin: Vec3,
+    /// The scene's materials (`MaterialGpu`; BMFR keeps emitters out of its fits).
+    pub materials: &'a Buffer,
+}
+
 /// A denoiser with its per-eye state.
 pub enum Denoiser {
     Svgf(Box<Svgf>),
@@ -94,12 +104,10 @@ impl Denoiser {
     }
 
     /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    /// `camera_origin`: this frame's camera position in world space (the G-buffer's positions are
-    /// relative to it; BMFR accumulates positions across frames).
-    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, camera_origin: Vec3) -> Result<&Image> {
+    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
-            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, camera_origin),
+            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, scene),
         }
     }
 }

@@ -3,11 +3,11 @@
 
 use super::{BmfrHistory, Reprojection};
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context};
+use crate::vk::{Buffer, ComputePipeline, Context};
 use std::sync::Arc;
 
 pub struct AccumulatePass {
@@ -43,6 +43,7 @@ impl AccumulatePass {
         &self,
         rec: &mut FrameRecorder,
         g: &GBuffer,
+        materials: &Buffer,
         h: &BmfrHistory,
         prev: usize,
         cur: usize,
@@ -55,6 +56,8 @@ impl AccumulatePass {
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
             read_image("motion", &g.motion),
+            read_image("ids", &g.ids),
+            read_buffer("materials", materials),
             read_image("prev_noisy", &h.noisy[prev]),
             read_image("prev_normal", &h.normal[prev]),
             read_image("prev_position", &h.position[prev]),

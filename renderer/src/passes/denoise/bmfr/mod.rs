@@ -3,6 +3,8 @@
 //! camera-relative position) → per 32×32 block a least-squares fit of the radiance as a linear
 //! combination of 10 features (1, normal, position, position²; Householder QR) → each texel
 //! evaluates its block's fit → accumulation of the fitted colour, re-modulated by albedo.
+//! Emitters seen directly (and misses) stay out of the fits and keep their accumulated input: a
+//! light in a ceiling has the ceiling's features, and one fit for both smears it over the ceiling.
 //! The block grid shifts every frame (16 fixed offsets) so that block seams move and the
 //! accumulation after the fit hides them.
 //!
@@ -18,7 +20,7 @@ mod accumulate_filtered;
 mod fit;
 mod weighted_sum;
 
-use super::DenoiseFrame;
+use super::{DenoiseFrame, DenoiseScene};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::{SamplingParams, BMFR_BLOCK, BMFR_WEIGHT_TEXELS};
@@ -93,7 +95,8 @@ pub struct BmfrHistory {
     pub noisy: [Image; 2],
     /// Accumulated normal.
     pub normal: [Image; 2],
-    /// Accumulated camera-relative position (xyz; w the texel's world footprint, 0 = a miss).
+    /// Accumulated camera-relative position (xyz; w the texel's world footprint, negative for an
+    /// emitter, 0 = a miss).
     pub position: [Image; 2],
     /// Accumulated fitted colour (demodulated).
     pub filtered: [Image; 2],
@@ -190,17 +193,17 @@ impl Bmfr {
     }
 
     /// Records one frame: accumulate → fit → weighted sum → accumulate the fit and re-modulate;
-    /// returns `output`. `camera_origin`: this frame's camera position in world space (the
-    /// G-buffer's positions are relative to it). History is dropped on the first frame and
-    /// whenever `frame.previous` is `None`.
-    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, camera_origin: Vec3) -> Result<&Image> {
+    /// returns `output`. History is dropped on the first frame and whenever `frame.previous` is
+    /// `None`.
+    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
+        let camera_origin = scene.camera_origin;
         let s = self.settings;
         let offset = self.next_block_offset();
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous.as_ref() };
         let reprojection = Reprojection { previous, camera_shift: h.origin - camera_origin };
-        self.accumulate.record(rec, g, h, prev, cur, &frame.current, &reprojection, s.alpha_noisy)?;
+        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, &reprojection, s.alpha_noisy)?;
         let seed = h.frames as u32;
         self.fit.record(rec, h, cur, &self.weights, &frame.current, offset, seed, s.noise)?;
         self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, offset)?;
