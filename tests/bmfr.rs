@@ -77,10 +77,11 @@ fn cpu_least_squares(rows: &[([f64; 10], f64)]) -> [f64; 10] {
     for k in 0..10 {
         let p = (k..10).max_by(|&x, &y| a[x][k].abs().total_cmp(&a[y][k].abs())).unwrap();
         a.swap(k, p);
-        for r in k + 1..10 {
-            let m = a[r][k] / a[k][k];
-            for j in k..11 {
-                a[r][j] -= m * a[k][j];
+        let pivot_row = a[k];
+        for row in a.iter_mut().skip(k + 1) {
+            let m = row[k] / pivot_row[k];
+            for (x, p) in row.iter_mut().zip(pivot_row).skip(k) {
+                *x -= m * p;
             }
         }
     }
@@ -150,6 +151,7 @@ fn fit_matches_a_cpu_least_squares_solve() {
         let wide = |a: usize| hi[a] - lo[a] > 1.0;
         let offset = [0, 1, 2].map(|a| if wide(a) { lo[a] } else { 0.0 });
         let scale = [0, 1, 2].map(|a| if wide(a) { 1.0 / (hi[a] - lo[a]) } else { 1.0 });
+        #[allow(clippy::needless_range_loop)]
         for c in 0..3 {
             let rows: Vec<([f64; 10], f64)> =
                 members.iter().map(|&i| (features(texels[i].normal, texels[i].position, offset, scale), texels[i].radiance[c] as f64)).collect();
