@@ -208,8 +208,9 @@ struct TaaPush {
 const uint BMFR_BLOCK = 32u;
 // Features per row: 1, normal xyz, position xyz, position² xyz.
 const uint BMFR_FEATURES = 10u;
-// Lanes of one fit workgroup (one workgroup per block; each lane owns 1024 / lanes rows).
-const uint BMFR_FIT_LANES = 256u;
+// Lanes of one fit workgroup (one workgroup per block; each lane owns 1024 / lanes rows). 64 beats
+// 256 on lavapipe by ~4× (every barrier is a pass over all lanes there).
+const uint BMFR_FIT_LANES = 64u;
 // Texels per block in the weights image: 10 weight texels (rgb per feature), then the position
 // scaling (min xyz, 1/range xyz).
 const uint BMFR_WEIGHT_TEXELS = 12u;

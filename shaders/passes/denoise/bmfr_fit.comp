@@ -3,7 +3,9 @@
 // least-squares problem [10 features | RGB] (1024 × 13, one row per texel) by Householder QR and
 // back-substitution, giving 10 weights per colour channel. Rows of texels without a sample or
 // without a hit are zero. Each lane keeps its own BMFR_BLOCK² / BMFR_FIT_LANES rows in registers;
-// the column sums a reflection needs are reduced in shared memory.
+// the column sums a reflection needs are reduced in shared memory, one lane per column (two
+// barriers per reduction: lavapipe pays for every barrier with a pass over all lanes, so a
+// log-depth tree of barriers costs it more than 13 lanes summing a column each).
 // Positions are min/max-scaled per block where their range exceeds 1; features except the
 // constant get uniform noise of ±params.x (stochastic regularisation: no exactly collinear
 // columns). A column left with a near-zero norm is skipped (weight 0): rank-deficient blocks.
@@ -29,22 +31,22 @@ const int COLUMNS = int(BMFR_FEATURES) + 3;
 const float BMFR_MIN_NORM2 = 1e-8;
 
 shared float sums[COLUMNS][LANES];
+shared float totals[COLUMNS];
 shared float pivot_values[COLUMNS];
 shared float r_rows[BMFR_FEATURES][COLUMNS];
 shared int pivots[BMFR_FEATURES];
 shared vec3 solved[BMFR_FEATURES];
 
-// Sums sums[j][·] over the lanes into sums[j][0] (min or max for the scaling pass).
+// Sums sums[j][·] over the lanes into totals[j] (min or max for the scaling pass).
 void reduce(int lane, int op) {
-    for (int stride = LANES / 2; stride > 0; stride >>= 1) {
-        barrier();
-        if (lane < stride) {
-            for (int j = 0; j < COLUMNS; ++j) {
-                float a = sums[j][lane];
-                float b = sums[j][lane + stride];
-                sums[j][lane] = op == 0 ? a + b : (op == 1 ? min(a, b) : max(a, b));
-            }
+    barrier();
+    if (lane < COLUMNS) {
+        float acc = sums[lane][0];
+        for (int l = 1; l < LANES; ++l) {
+            float b = sums[lane][l];
+            acc = op == 0 ? acc + b : (op == 1 ? min(acc, b) : max(acc, b));
         }
+        totals[lane] = acc;
     }
     barrier();
 }
@@ -76,14 +78,14 @@ void main() {
         for (int a = 0; a < 3; ++a) sums[a][lane] = min(sums[a][lane], valid[i] ? pos[i][a] : 3.0e38);
     }
     reduce(lane, 1);
-    vec3 lo = vec3(sums[0][0], sums[1][0], sums[2][0]);
+    vec3 lo = vec3(totals[0], totals[1], totals[2]);
     barrier();
     for (int j = 0; j < COLUMNS; ++j) sums[j][lane] = -3.0e38;
     for (int i = 0; i < ROWS; ++i) {
         for (int a = 0; a < 3; ++a) sums[a][lane] = max(sums[a][lane], valid[i] ? pos[i][a] : -3.0e38);
     }
     reduce(lane, 2);
-    vec3 range = vec3(sums[0][0], sums[1][0], sums[2][0]) - lo;
+    vec3 range = vec3(totals[0], totals[1], totals[2]) - lo;
     bvec3 wide = greaterThan(range, vec3(1.0));
     vec3 offset = mix(vec3(0.0), lo, wide);
     vec3 scale = mix(vec3(1.0), 1.0 / max(range, vec3(1.0)), wide);
@@ -107,14 +109,18 @@ void main() {
     int pivot = 0;
     for (int k = 0; k < int(BMFR_FEATURES); ++k) {
         barrier();
-        // Dot products of column k (rows ≥ pivot) with every column; the pivot row broadcast.
+        // Column k below the pivot (selected with constant indices: private arrays indexed by a
+        // loop variable turn into scratch memory), its dot products with every column, and the
+        // pivot row broadcast.
+        float x[ROWS];
+        for (int i = 0; i < ROWS; ++i) {
+            float xk = 0.0;
+            for (int c = 0; c < COLUMNS; ++c) xk = c == k ? m[i][c] : xk;
+            x[i] = i * LANES + lane >= pivot ? xk : 0.0;
+        }
         for (int j = 0; j < COLUMNS; ++j) {
             float s = 0.0;
-            for (int i = 0; i < ROWS; ++i) {
-                float xk = 0.0;
-                for (int c = 0; c < COLUMNS; ++c) xk = c == k ? m[i][c] : xk;
-                s += i * LANES + lane >= pivot ? xk * m[i][j] : 0.0;
-            }
+            for (int i = 0; i < ROWS; ++i) s += x[i] * m[i][j];
             sums[j][lane] = s;
         }
         // Rows < LANES are lane-major in slot i = 0: the pivot row (< 10) is lane `pivot`'s.
@@ -122,7 +128,7 @@ void main() {
             for (int j = 0; j < COLUMNS; ++j) pivot_values[j] = m[0][j];
         }
         reduce(lane, 0);
-        float norm2 = sums[k][0];
+        float norm2 = totals[k];
         if (norm2 <= BMFR_MIN_NORM2) {
             if (lane == 0) pivots[k] = -1;
             continue;
@@ -132,12 +138,10 @@ void main() {
         // vᵀv / 2 with v = x − α e_pivot.
         float half_vv = norm2 - alpha * xp;
         float tau[COLUMNS];
-        for (int j = 0; j < COLUMNS; ++j) tau[j] = j > k ? (sums[j][0] - alpha * pivot_values[j]) / half_vv : 0.0;
+        for (int j = 0; j < COLUMNS; ++j) tau[j] = j > k ? (totals[j] - alpha * pivot_values[j]) / half_vv : 0.0;
         for (int i = 0; i < ROWS; ++i) {
             int r = i * LANES + lane;
-            float vk = 0.0;
-            for (int c = 0; c < COLUMNS; ++c) vk = c == k ? m[i][c] : vk;
-            vk = r == pivot ? vk - alpha : (r > pivot ? vk : 0.0);
+            float vk = r == pivot ? x[i] - alpha : x[i];
             for (int j = 0; j < COLUMNS; ++j) {
                 m[i][j] -= vk * tau[j];
                 if (j == k && r >= pivot) m[i][j] = r == pivot ? alpha : 0.0;
