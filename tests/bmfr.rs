@@ -92,85 +92,133 @@ fn cpu_least_squares(rows: &[([f64; 10], f64)]) -> [f64; 10] {
     w
 }
 
-/// The fit of every 32×32 block of a 64×72 Cartesian grid (first frame: no history, the block
-/// offset is `BLOCK_OFFSETS[0]`, regularisation noise off) against a CPU solve in f64 of the same
-/// blocks: each texel's fitted colour (before the accumulation after the fit) must match.
+/// The block of each grid texel (`None`: no sample), derived here from the rule in
+/// `shaders/denoise/bmfr.glsl`, independently of the GPU's enumeration of a block's texels:
+/// blocks start at b·32 − (16 − offset) on x (and on y in Cartesian space); Visual-Polar rows are
+/// placed at their angle on the block column's tallest height N and counted from the shift,
+/// wrapping at N.
+fn cpu_blocks(space: &dyn SamplingSpace, offset: [i32; 2]) -> Vec<Option<(i32, i32)>> {
+    let grid = space.grid_size();
+    let side = BMFR_BLOCK as i32;
+    let shift = [16 - offset[0], 16 - offset[1]];
+    let rows = |c: i32| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(c as u32)) as i32;
+    (0..grid.x * grid.y)
+        .map(|i| {
+            let (x, y) = ((i % grid.x) as i32, (i / grid.x) as i32);
+            if y >= rows(x) {
+                return None;
+            }
+            let bx = (x + shift[0]) / side;
+            if space.visual_polar().is_none() {
+                return Some((bx, (y + shift[1]) / side));
+            }
+            let big_n = rows((bx * side - shift[0] + side - 1).clamp(0, grid.x as i32 - 1));
+            let v = (2 * y + 1) * big_n / (2 * rows(x));
+            Some((bx, (v + shift[1]).rem_euclid(big_n) / side))
+        })
+        .collect()
+}
+
+/// The fit of every block (first frame: no history, block offset `BLOCK_OFFSETS[0]`,
+/// regularisation noise off) against a CPU solve in f64 over the CPU's own partition of the grid
+/// (`cpu_blocks`): each texel's fitted colour (before the accumulation after the fit) must match,
+/// in Cartesian space (64×72) and in Visual-Polar space (screen 128×144, blocks crossing the φ
+/// seam, clipped fovea columns). A texel the GPU fitted in another block than the one it reads
+/// its weights from, or left out, shows an error of the added noise's size.
 /// Features are generic (normals on a 1/256 lattice, exact in the fp16 history; x spans 4 units,
 /// so it is min/max-scaled; y and z span < 1 and are not), colours a known linear combination
-/// plus noise, so every block is a real least-squares problem of full rank.
+/// plus noise, so every block of ≥ 40 texels is a least-squares problem of full rank.
 #[test]
 fn fit_matches_a_cpu_least_squares_solve() {
     let ctx = gpu();
-    let space = Cartesian::new(SCREEN);
-    let grid = space.grid_size();
+    let vp = VisualPolar::new(UVec2::new(128, 144), Vec2::new(64.0, 72.0), VisualPolarParams::default()).unwrap();
+    let spaces: [(&str, Box<dyn SamplingSpace>); 2] = [("cartesian", Box::new(Cartesian::new(SCREEN))), ("vp", Box::new(vp))];
     let lattice = |v: f32| (v * 256.0).round() / 256.0;
     let truth = [[2.0, 0.3, -0.2, 0.1, 0.4, 0.2, 0.05, -0.1, 0.3, 0.02], [1.5, -0.1, 0.2, 0.3, -0.3, 0.1, 0.02, 0.2, -0.2, 0.01], [2.5, 0.2, 0.1, -0.3, 0.1, -0.2, 0.04, 0.1, 0.1, 0.03]];
-    let texels: Vec<Texel> = (0..grid.x * grid.y)
-        .map(|i| {
-            let h = |k: u32| hash(i * 11 + k);
-            let normal = [lattice(2.0 * h(1) - 1.0), lattice(2.0 * h(2) - 1.0), lattice(h(3))];
-            let position = [4.0 * h(4) - 2.0, 0.8 * h(5) - 0.4, -5.0 + 0.9 * h(6)];
-            let mut radiance = [0f32; 3];
-            for (c, r) in radiance.iter_mut().enumerate() {
-                // Features before the per-block scaling; any linear combination of them is one of
-                // the scaled features too.
-                let f = features(normal, position, [0.0; 3], [1.0; 3]);
-                *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>() + 0.1 * (hash(i * 11 + 7 + c as u32) - 0.5);
-                assert!(*r > 0.0, "test colours must be positive (the output is clamped)");
-            }
-            Texel { radiance, normal, position, mesh: 1, motion: Vec2::splat(-1.0) }
-        })
-        .collect();
-    let g = GBuffer::new(&ctx, grid).unwrap();
-    upload_gbuffer(&ctx, &g, &texels.iter().map(|t| Some(*t)).collect::<Vec<_>>());
-    let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
-    let offset = BLOCK_OFFSETS[0];
-    assert_eq!(bmfr.next_block_offset().to_array(), offset);
-    denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO, &plain_materials(&ctx));
-    let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
+    for (name, space) in spaces {
+        let grid = space.grid_size();
+        let offset = BLOCK_OFFSETS[0];
+        let blocks_of = cpu_blocks(space.as_ref(), offset);
+        let texels: Vec<Option<Texel>> = (0..grid.x * grid.y)
+            .map(|i| {
+                blocks_of[i as usize]?;
+                let h = |k: u32| hash(i * 11 + k);
+                let normal = [lattice(2.0 * h(1) - 1.0), lattice(2.0 * h(2) - 1.0), lattice(h(3))];
+                let position = [4.0 * h(4) - 2.0, 0.8 * h(5) - 0.4, -5.0 + 0.9 * h(6)];
+                let mut radiance = [0f32; 3];
+                for (c, r) in radiance.iter_mut().enumerate() {
+                    // Features before the per-block scaling; any linear combination of them is one
+                    // of the scaled features too.
+                    let f = features(normal, position, [0.0; 3], [1.0; 3]);
+                    *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>() + 0.1 * (hash(i * 11 + 7 + c as u32) - 0.5);
+                    assert!(*r > 0.0, "test colours must be positive (the output is clamped)");
+                }
+                Some(Texel { radiance, normal, position, mesh: 1, motion: Vec2::splat(-1.0) })
+            })
+            .collect();
+        let g = GBuffer::new(&ctx, grid).unwrap();
+        upload_gbuffer(&ctx, &g, &texels);
+        let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
+        assert_eq!(bmfr.next_block_offset().to_array(), offset);
+        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO, &plain_materials(&ctx));
+        let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
-    // Blocks start at b·32 − (16 − offset) per axis.
-    let shift = [16 - offset[0], 16 - offset[1]];
-    let block_of = |i: usize| {
-        let (x, y) = ((i as u32 % grid.x) as i32, (i as u32 / grid.x) as i32);
-        ((x + shift[0]) / BMFR_BLOCK as i32, (y + shift[1]) / BMFR_BLOCK as i32)
-    };
-    let mut blocks: Vec<(i32, i32)> = (0..texels.len()).map(block_of).collect();
-    blocks.sort();
-    blocks.dedup();
-    let (mut worst, mut worst_rel) = (0f64, 0f64);
-    for block in &blocks {
-        let members: Vec<usize> = (0..texels.len()).filter(|&i| block_of(i) == *block).collect();
-        let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
-        for &i in &members {
-            for a in 0..3 {
-                lo[a] = lo[a].min(texels[i].position[a]);
-                hi[a] = hi[a].max(texels[i].position[a]);
+        let mut blocks: Vec<(i32, i32)> = blocks_of.iter().flatten().copied().collect();
+        blocks.sort();
+        blocks.dedup();
+        let (mut worst, mut worst_rel, mut checked, mut seam_blocks) = (0f64, 0f64, 0usize, 0);
+        for block in &blocks {
+            let members: Vec<usize> = (0..texels.len()).filter(|&i| blocks_of[i] == Some(*block)).collect();
+            if members.len() < 40 {
+                continue;
+            }
+            let rows_of = |i: usize| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(i as u32 % grid.x));
+            let row = |i: usize| i as u32 / grid.x;
+            if members.iter().any(|&i| row(i) == 0) && members.iter().any(|&i| row(i) + 1 == rows_of(i)) {
+                seam_blocks += 1;
+            }
+            checked += members.len();
+            let member_texels: Vec<Texel> = members.iter().map(|&i| texels[i].unwrap()).collect();
+            let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+            for t in &member_texels {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(t.position[a]);
+                    hi[a] = hi[a].max(t.position[a]);
+                }
+            }
+            let wide = |a: usize| hi[a] - lo[a] > 1.0;
+            let offset = [0, 1, 2].map(|a| if wide(a) { lo[a] } else { 0.0 });
+            let scale = [0, 1, 2].map(|a| if wide(a) { 1.0 / (hi[a] - lo[a]) } else { 1.0 });
+            #[allow(clippy::needless_range_loop)]
+            for c in 0..3 {
+                let rows: Vec<([f64; 10], f64)> =
+                    member_texels.iter().map(|t| (features(t.normal, t.position, offset, scale), t.radiance[c] as f64)).collect();
+                let w = cpu_least_squares(&rows);
+                for (&i, (f, _)) in members.iter().zip(&rows) {
+                    let expected: f64 = (0..10).map(|k| w[k] * f[k]).sum();
+                    let e = (fitted[i][c] as f64 - expected).abs();
+                    worst = worst.max(e);
+                    worst_rel = worst_rel.max(e / expected.abs());
+                }
             }
         }
-        let wide = |a: usize| hi[a] - lo[a] > 1.0;
-        let offset = [0, 1, 2].map(|a| if wide(a) { lo[a] } else { 0.0 });
-        let scale = [0, 1, 2].map(|a| if wide(a) { 1.0 / (hi[a] - lo[a]) } else { 1.0 });
-        #[allow(clippy::needless_range_loop)]
-        for c in 0..3 {
-            let rows: Vec<([f64; 10], f64)> =
-                members.iter().map(|&i| (features(texels[i].normal, texels[i].position, offset, scale), texels[i].radiance[c] as f64)).collect();
-            let w = cpu_least_squares(&rows);
-            for (&i, (f, _)) in members.iter().zip(&rows) {
-                let expected: f64 = (0..10).map(|k| w[k] * f[k]).sum();
-                let e = (fitted[i][c] as f64 - expected).abs();
-                worst = worst.max(e);
-                worst_rel = worst_rel.max(e / expected.abs());
-            }
+        let valid = blocks_of.iter().flatten().count();
+        println!(
+            "{name}: {} blocks, {checked} of {valid} texels checked ({seam_blocks} blocks across the φ seam): worst fitted-colour \
+             difference GPU (fp32 QR) vs CPU (f64) {worst:.2e} ({worst_rel:.2e} relative)",
+            blocks.len()
+        );
+        // fp32 Householder QR is backward stable: the fitted values (not the individual weights,
+        // which the near-collinear 1, z, z² columns make ill-conditioned) carry errors of a few ulps
+        // of the colour (~2.5, ulp 2.4e-7) times a small factor; 3e-6 is measured, 1e-4 leaves
+        // ~30×, while a wrong block, wrong scaling, a missing row or a dropped feature shows errors
+        // of the added noise's size (±0.05).
+        assert!(worst < 1e-4, "{name}: fitted colours differ by up to {worst}");
+        assert!(checked as f64 >= 0.9 * valid as f64, "{name}: only {checked} of {valid} texels in blocks of ≥ 40");
+        if name == "vp" {
+            assert!(seam_blocks > 0, "no block crosses the φ seam");
         }
     }
-    println!("{} blocks: worst fitted-colour difference GPU (fp32 QR) vs CPU (f64) {worst:.2e} ({worst_rel:.2e} relative)", blocks.len());
-    // fp32 Householder QR is backward stable: the fitted values (not the individual weights, which
-    // the near-collinear 1, z, z² columns make ill-conditioned) carry errors of a few ulps of the
-    // colour (~2.5, ulp 2.4e-7) times a small factor; 3e-6 is measured, 1e-4 leaves ~30×, while a
-    // wrong block, wrong scaling, a missing row or a dropped feature shows errors of the added
-    // noise's size (±0.05).
-    assert!(worst < 1e-4, "fitted colours differ by up to {worst}");
     assert_clean(&ctx);
 }
 
