@@ -26,9 +26,11 @@ layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D weights;
 const int LANES = int(BMFR_FIT_LANES);
 const int ROWS = BMFR_SIDE * BMFR_SIDE / LANES;
 const int COLUMNS = int(BMFR_FEATURES) + 3;
-// A column whose remaining norm² is below this is numerically zero (features are O(1) after the
-// scaling; the regularisation noise alone leaves ~10 in a full block).
-const float BMFR_MIN_NORM2 = 1e-8;
+// A column whose remaining norm² (below the rows of R built so far) is below this share of its
+// initial norm² lies in the span of the columns before it (≈ 3e-4 relative norm: fp32 round-off
+// leaves ~1e-6, the ±1e-2 regularisation noise ~1e-2 on O(1) features); an all-zero column too.
+const float BMFR_MIN_RELATIVE_NORM2 = 1e-7;
+const float BMFR_MIN_NORM2 = 1e-20;
 
 shared float sums[COLUMNS][LANES];
 shared float totals[COLUMNS];
@@ -105,6 +107,16 @@ void main() {
         for (int c = 0; c < 3; ++c) m[i][10 + c] = rgb[i][c];
     }
 
+    // Initial column norms², the scale the rank test compares with.
+    for (int j = 0; j < COLUMNS; ++j) {
+        float s = 0.0;
+        for (int i = 0; i < ROWS; ++i) s += m[i][j] * m[i][j];
+        sums[j][lane] = s;
+    }
+    reduce(lane, 0);
+    float initial_norm2[10];
+    for (int k = 0; k < 10; ++k) initial_norm2[k] = totals[k];
+
     // Householder QR, column by column; `pivot` is the next row of R (skipped columns take none).
     int pivot = 0;
     for (int k = 0; k < int(BMFR_FEATURES); ++k) {
@@ -129,7 +141,9 @@ void main() {
         }
         reduce(lane, 0);
         float norm2 = totals[k];
-        if (norm2 <= BMFR_MIN_NORM2) {
+        float start2 = 0.0;
+        for (int c = 0; c < 10; ++c) start2 = c == k ? initial_norm2[c] : start2;
+        if (norm2 <= max(BMFR_MIN_RELATIVE_NORM2 * start2, BMFR_MIN_NORM2)) {
             if (lane == 0) pivots[k] = -1;
             continue;
         }
