@@ -398,7 +398,7 @@ fn render_command_runs_svgf_and_reports_it() {
             assert_eq!(report["passes"].get(pass).is_some(), denoiser == "svgf", "{method}/{denoiser}: pass {pass}");
         }
     }
-    assert!(DenoiserSettings::parse("bmfr").is_err());
+    assert!(DenoiserSettings::parse("nlm").is_err());
 }
 
 

@@ -9,7 +9,7 @@ use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_HALTON_JITTER, FRAME_
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
-use crate::passes::denoise::{DenoiseFrame, Denoiser, DenoiserSettings};
+use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{TonemapPass, ToneCurve};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::sampling::SamplingSpace;
@@ -273,7 +273,10 @@ impl Renderer {
         // Denoisers work in the sampling grid (Cartesian samples are the screen).
         let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
         let denoised = match &mut self.denoiser {
-            Some(d) => d.record(rec, &self.gbuffer, &denoise_frame)?,
+            Some(d) => {
+                let scene = DenoiseScene { camera_origin: input.camera.world_from_view.w_axis.truncate(), materials: &self.scene.materials };
+                d.record(rec, &self.gbuffer, &denoise_frame, &scene)?
+            }
             None => &self.gbuffer.color,
         };
         let grid_hdr = match (&mut self.taa, jitter) {

@@ -221,6 +221,43 @@ struct TaaScreenPush {
     vec4 params;                // x current-frame weight, y 1 = drop all history, zw unused
 };
 
+// ---- BMFR (Koskela et al. 2019, TOG): blockwise multi-order feature regression.
+
+// Side of a fit block in texels: a block is BMFR_BLOCK² = 1024 rows of the least-squares matrix.
+const uint BMFR_BLOCK = 32u;
+// Features per row: 1, normal xyz, position xyz, position² xyz.
+const uint BMFR_FEATURES = 10u;
+// Lanes of one fit workgroup (one workgroup per block; each lane owns 1024 / lanes rows). 64 beats
+// 256 on lavapipe by ~4× (every barrier is a pass over all lanes there).
+const uint BMFR_FIT_LANES = 64u;
+// Texels per block in the weights image: 10 weight texels (rgb per feature), then the position
+// scaling (min xyz, 1/range xyz).
+const uint BMFR_WEIGHT_TEXELS = 12u;
+
+// Push constants of BMFR's two temporal passes (accumulation of the noisy input and features
+// before the fit, of the fitted colour after it). The previous frame's space differs only in its
+// gaze-dependent slots, like SvgfTemporalPush; that keeps the block at 128 bytes.
+struct BmfrTemporalPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
+    vec4 prev_shape0;
+    vec4 prev_shape1;
+    vec4 params;                // xyz previous camera origin − this one (positions are camera-relative), w α floor (1: drop all history)
+};
+
+// Push constants of BMFR's per-block fit and of its per-texel weighted sum.
+struct BmfrBlockPush {
+    uvec4 vp_grid;              // the space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    ivec4 config;               // xy block-grid offset (texels, in [−16, 14]), z noise seed (frame), w unused
+    vec4 params;                // x stochastic regularisation amplitude, yzw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 

@@ -2,6 +2,7 @@
 //! image statistics. Every test opens its own context with validation on and ends with
 //! `assert_clean`, so any validation warning or error fails the test that caused it.
 
+pub mod denoise;
 pub mod scenes;
 
 use ash::vk;

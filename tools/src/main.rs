@@ -101,7 +101,8 @@ struct RenderOpts {
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
-    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017, the paper's parameters).
+    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017) | bmfr (Koskela et al.
+    /// 2019); parameters from the profile's [svgf] / [bmfr] sections.
     #[arg(long, default_value = "none")]
     denoiser: String,
     /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for

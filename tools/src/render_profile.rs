@@ -1,5 +1,6 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp` or `--taa screen`).
+//! the SVGF and BMFR parameters (used with `--denoiser svgf` / `bmfr`) and the TAA parameters
+//! (used with `--taa vp` or `--taa screen`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 //! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
@@ -7,6 +8,7 @@
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
@@ -21,6 +23,7 @@ pub struct RenderProfile {
     pub eccentricity: EccentricityMode,
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
+    pub bmfr: BmfrSettings,
     pub taa: TaaSettings,
 }
 
@@ -30,6 +33,7 @@ struct ProfileFile {
     visual_polar: Option<VpSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
+    bmfr: Option<BmfrSection>,
     taa: Option<TaaSection>,
 }
 
@@ -38,6 +42,14 @@ struct ProfileFile {
 struct TaaSection {
     current_weight: Option<f32>,
     jitter_points: Option<u32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct BmfrSection {
+    alpha_noisy: Option<f32>,
+    alpha_filtered: Option<f32>,
+    noise: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -196,6 +208,13 @@ impl RenderProfile {
             s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
             s.validate().with_context(|| at("svgf"))?;
         }
+        if let Some(f) = file.bmfr {
+            let s = &mut profile.bmfr;
+            s.alpha_noisy = f.alpha_noisy.unwrap_or(s.alpha_noisy);
+            s.alpha_filtered = f.alpha_filtered.unwrap_or(s.alpha_filtered);
+            s.noise = f.noise.unwrap_or(s.noise);
+            s.validate().with_context(|| at("bmfr"))?;
+        }
         if let Some(f) = file.taa {
             let s = &mut profile.taa;
             s.current_weight = f.current_weight.unwrap_or(s.current_weight);
@@ -287,6 +306,7 @@ mod tests {
         assert_eq!(p.eccentricity, EccentricityMode::Normalized);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
+        assert_eq!(p.bmfr, BmfrSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
     }
 
@@ -309,6 +329,8 @@ mod tests {
         let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
         assert_eq!(p.visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Headset(fov));
         assert_eq!(RenderProfile::default().visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Normalized);
+        let p = load_str("bmfr_ok.toml", "[bmfr]\nalpha_noisy = 0.25\nnoise = 0\n").unwrap();
+        assert_eq!(p.bmfr, BmfrSettings { alpha_noisy: 0.25, noise: 0.0, ..Default::default() });
     }
 
     #[test]
@@ -328,6 +350,9 @@ mod tests {
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
+            ("bmfr.toml", "[bmfr]\nalpha_filtered = 1.0\n", "bmfr"),
+            ("bmfr_noise.toml", "[bmfr]\nnoise = -0.01\n", "bmfr"),
+            ("bmfr_key.toml", "[bmfr]\nblock_size = 16\n", "block_size"),
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),

@@ -6,7 +6,6 @@
 use anyhow::Result;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
-use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
@@ -38,17 +37,31 @@ pub struct VpFrameReport {
     pub trace_ratio: f64,
     /// (φ-mips + remap + blur) / VP frame (issue target ≤ 0.10 on lavapipe).
     pub to_screen_share: f64,
-    /// SVGF (all its passes) at the same sizes: ms per frame (median), VP / Cartesian, and the
-    /// bytes of history each space carries between frames.
-    pub svgf_cartesian_ms: f64,
-    pub svgf_vp_ms: f64,
-    pub svgf_ratio: f64,
-    pub svgf_cartesian_history_bytes: u64,
-    pub svgf_vp_history_bytes: u64,
+    /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
+    pub denoisers: Vec<DenoiserCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
     pub shuffled_mrays_per_s: f64,
     pub coherence_gain: f64,
+}
+
+/// The denoisers measured, each with its defaults; a denoiser's passes are named `<name>_*`.
+fn denoisers() -> Vec<DenoiserSettings> {
+    DenoiserSettings::NAMES.iter().filter(|n| **n != "none").map(|n| DenoiserSettings::parse(n).expect("a listed denoiser")).collect()
+}
+
+/// One denoiser in VP vs Cartesian space: its passes' median ms per frame, their sum, VP /
+/// Cartesian, and the bytes of history each space carries between frames.
+#[derive(Serialize)]
+pub struct DenoiserCost {
+    pub name: String,
+    pub cartesian_passes_ms: BTreeMap<String, f64>,
+    pub vp_passes_ms: BTreeMap<String, f64>,
+    pub cartesian_ms: f64,
+    pub vp_ms: f64,
+    pub ratio: f64,
+    pub cartesian_history_bytes: u64,
+    pub vp_history_bytes: u64,
 }
 
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
@@ -101,13 +114,28 @@ pub fn measure(
     let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), RenderSettings::default())?;
     let vp_passes_ms = pass_medians(&mut vpr, pose, Some(gaze), frames)?;
     drop(vpr);
-    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), svgf)?;
-    let (svgf_cartesian_ms, svgf_cartesian_history_bytes) = svgf_cost(&mut cart, pose, None, frames)?;
-    drop(cart);
-    let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), svgf)?;
-    let (svgf_vp_ms, svgf_vp_history_bytes) = svgf_cost(&mut vpr, pose, Some(gaze), frames)?;
-    drop(vpr);
+    let mut costs = Vec::new();
+    for denoiser in denoisers() {
+        let settings = RenderSettings { denoiser, ..Default::default() };
+        let prefix = format!("{}_", denoiser.name());
+        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
+        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&mut cart, &prefix, pose, None, frames)?;
+        drop(cart);
+        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
+        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&mut vpr, &prefix, pose, Some(gaze), frames)?;
+        drop(vpr);
+        let (cartesian_ms, vp_ms) = (cartesian_passes_ms.values().sum::<f64>(), vp_passes_ms.values().sum::<f64>());
+        costs.push(DenoiserCost {
+            name: denoiser.name().to_string(),
+            cartesian_passes_ms,
+            vp_passes_ms,
+            cartesian_ms,
+            vp_ms,
+            ratio: vp_ms / cartesian_ms,
+            cartesian_history_bytes,
+            vp_history_bytes,
+        });
+    }
     let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cartesian_passes_ms), frame_ms(&vp_passes_ms));
     let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
 
@@ -133,19 +161,14 @@ pub fn measure(
         vp_passes_ms,
         cartesian_frame_ms,
         vp_frame_ms,
-        svgf_cartesian_ms,
-        svgf_vp_ms,
-        svgf_ratio: svgf_vp_ms / svgf_cartesian_ms,
-        svgf_cartesian_history_bytes,
-        svgf_vp_history_bytes,
+        denoisers: costs,
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
         coherence_gain: shuffled_ms / ordered_ms,
     };
     println!(
         "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); mips+remap+blur {:.1} % of the VP frame; \
-         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×); SVGF {:.1} ms VP vs {:.1} ms Cartesian = {:.3}, \
-         history {:.1} vs {:.1} MiB",
+         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×)",
         grid.x,
         grid.y,
         report.vp_frame_ms,
@@ -156,21 +179,34 @@ pub fn measure(
         report.vp_order_mrays_per_s,
         report.shuffled_mrays_per_s,
         report.coherence_gain,
-        report.svgf_vp_ms,
-        report.svgf_cartesian_ms,
-        report.svgf_ratio,
-        report.svgf_vp_history_bytes as f64 / (1 << 20) as f64,
-        report.svgf_cartesian_history_bytes as f64 / (1 << 20) as f64
     );
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    for d in &report.denoisers {
+        let passes: Vec<String> = d
+            .vp_passes_ms
+            .iter()
+            .map(|(pass, vp_ms)| format!("{pass} {vp_ms:.2} vs {:.2}", d.cartesian_passes_ms.get(pass).copied().unwrap_or(f64::NAN)))
+            .collect();
+        println!(
+            "  {}: {:.1} ms VP vs {:.1} ms Cartesian = {:.3} ({}), history {:.1} vs {:.1} MiB",
+            d.name,
+            d.vp_ms,
+            d.cartesian_ms,
+            d.ratio,
+            passes.join(", "),
+            mib(d.vp_history_bytes),
+            mib(d.cartesian_history_bytes)
+        );
+    }
     Ok(report)
 }
 
-/// Median ms of the denoiser's passes per frame, and its history bytes.
-fn svgf_cost(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(f64, u64)> {
+/// Median ms per frame of each of the denoiser's passes (named `prefix*`), and its history bytes.
+fn denoiser_cost(renderer: &mut Renderer, prefix: &str, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(BTreeMap<String, f64>, u64)> {
     let passes = pass_medians(renderer, camera, gaze, frames)?;
-    let ms = passes.iter().filter(|(k, _)| k.starts_with("svgf_")).map(|(_, v)| v).sum();
+    let own = passes.into_iter().filter(|(k, _)| k.starts_with(prefix)).collect();
     let bytes = renderer.denoiser().map_or(0, |d| d.history_bytes());
-    Ok((ms, bytes))
+    Ok((own, bytes))
 }
 
 /// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's

@@ -37,7 +37,7 @@ pub struct RenderArgs<'a> {
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
-    /// `none` or `svgf` (`DenoiserSettings::NAMES`).
+    /// `none`, `svgf` or `bmfr` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
     /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
     pub taa: &'a str,
@@ -51,7 +51,7 @@ pub const METHODS: &[&str] = &["vp", "cartesian"];
 #[derive(Serialize)]
 struct Report {
     method: String,
-    /// Denoiser in the sampling grid (`none`, `svgf`).
+    /// Denoiser in the sampling grid (`none`, `svgf`, `bmfr`).
     denoiser: String,
     /// TAA: `off`, `vp` (in the sampling grid) or `screen` (after the remap; for Cartesian the
     /// sampling-grid filter, the grid being the screen).
@@ -133,6 +133,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
+        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(args.profile.bmfr),
         other => other,
     };
     let taa = TaaMode::parse(args.taa).context("--taa")?.with_settings(args.profile.taa);
@@ -141,7 +142,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
         bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
     }
-    // SVGF reprojects and filters with the paper's mapping (no per-column arc table yet).
+    // SVGF and BMFR reproject and filter with the paper's mapping (no per-column arc table yet).
     if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
         bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
     }

@@ -1,21 +1,23 @@
 //! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
 //! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
 //! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
-//! which runs after the denoiser; A-SVGF, BMFR fit beside them), one pass = one module + one
+//! which runs after the denoiser; BMFR; A-SVGF fits beside them), one pass = one module + one
 //! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
 //! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
+pub mod bmfr;
 pub mod modulate;
 pub mod svgf;
 pub mod taa;
 pub mod taa_screen;
 
+use bmfr::{Bmfr, BmfrSettings};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
 use crate::passes::trace::GBuffer;
-use crate::vk::{Context, Image};
-use glam::UVec2;
+use crate::vk::{Buffer, Context, Image};
+use glam::{UVec2, Vec3};
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
 
@@ -26,17 +28,19 @@ pub enum DenoiserSettings {
     #[default]
     None,
     Svgf(SvgfSettings),
+    Bmfr(BmfrSettings),
 }
 
 impl DenoiserSettings {
     /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["none", "svgf"];
+    pub const NAMES: &'static [&'static str] = &["none", "svgf", "bmfr"];
 
     /// A denoiser by name, with its defaults.
     pub fn parse(name: &str) -> Result<DenoiserSettings> {
         match name {
             "none" => Ok(DenoiserSettings::None),
             "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
+            "bmfr" => Ok(DenoiserSettings::Bmfr(BmfrSettings::default())),
             other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
         }
     }
@@ -45,6 +49,7 @@ impl DenoiserSettings {
         match self {
             DenoiserSettings::None => "none",
             DenoiserSettings::Svgf(_) => "svgf",
+            DenoiserSettings::Bmfr(_) => "bmfr",
         }
     }
 }
@@ -57,9 +62,20 @@ pub struct DenoiseFrame {
     pub previous: Option<SamplingParams>,
 }
 
+/// What a denoiser may need from the scene besides the G-buffer.
+#[derive(Clone, Copy)]
+pub struct DenoiseScene<'a> {
+    /// This frame's camera position in world space (the G-buffer's positions are relative to it;
+    /// BMFR accumulates positions across frames).
+    pub camera_origin: Vec3,
+    /// The scene's materials (`MaterialGpu`; BMFR keeps emitters out of its fits).
+    pub materials: &'a Buffer,
+}
+
 /// A denoiser with its per-eye state.
 pub enum Denoiser {
     Svgf(Box<Svgf>),
+    Bmfr(Box<Bmfr>),
 }
 
 impl Denoiser {
@@ -68,6 +84,7 @@ impl Denoiser {
         Ok(match settings {
             DenoiserSettings::None => None,
             DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
+            DenoiserSettings::Bmfr(s) => Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?))),
         })
     }
 
@@ -75,6 +92,7 @@ impl Denoiser {
     pub fn history_bytes(&self) -> u64 {
         match self {
             Denoiser::Svgf(s) => s.history.bytes(),
+            Denoiser::Bmfr(b) => b.history.bytes(),
         }
     }
 
@@ -82,13 +100,15 @@ impl Denoiser {
     pub fn max_passes(&self) -> u32 {
         match self {
             Denoiser::Svgf(s) => s.max_passes(),
+            Denoiser::Bmfr(b) => b.max_passes(),
         }
     }
 
     /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
+            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, scene),
         }
     }
 }

@@ -1,0 +1,59 @@
+//! BMFR per-block fit: one workgroup per 32×32 block builds the 1024 × 13 least-squares matrix
+//! (10 features with stochastic regularisation | RGB) and solves it by Householder QR into 10
+//! weights per channel.
+
+use super::{block_count, BmfrHistory};
+use crate::error::Result;
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{BmfrBlockPush, SamplingParams, BMFR_FIT_LANES};
+use crate::passes::push_bytes;
+use crate::vk::{ComputePipeline, Context, Image};
+use glam::{IVec2, IVec4, UVec2, Vec4};
+use std::sync::Arc;
+
+pub struct FitPass {
+    pipeline: ComputePipeline,
+}
+
+/// The push block of the fit and the weighted sum: the space and the block-grid offset.
+pub(super) fn block_push(space: &SamplingParams, offset: IVec2, seed: u32, noise: f32) -> BmfrBlockPush {
+    BmfrBlockPush {
+        vp_grid: space.grid,
+        vp_gaze: space.gaze,
+        vp_shape0: space.shape0,
+        vp_shape1: space.shape1,
+        config: IVec4::new(offset.x, offset.y, seed as i32, 0),
+        params: Vec4::new(noise, 0.0, 0.0, 0.0),
+    }
+}
+
+impl FitPass {
+    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<FitPass> {
+        let shader = format!("passes/denoise/bmfr_fit.{variant}");
+        Ok(FitPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+    }
+
+    /// Features and noisy colour from history half `cur` → `weights`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        h: &BmfrHistory,
+        cur: usize,
+        weights: &Image,
+        space: &SamplingParams,
+        offset: IVec2,
+        seed: u32,
+        noise: f32,
+    ) -> Result<()> {
+        let binds = [
+            read_image("noisy", &h.noisy[cur]),
+            read_image("normal", &h.normal[cur]),
+            read_image("features_position", &h.position[cur]),
+            write_image("weights", weights),
+        ];
+        let push = block_push(space, offset, seed, noise);
+        let blocks = block_count(UVec2::new(space.grid.x, space.grid.y));
+        rec.dispatch("bmfr_fit", &self.pipeline, &binds, push_bytes(&push), [blocks.x * BMFR_FIT_LANES, blocks.y, 1])
+    }
+}

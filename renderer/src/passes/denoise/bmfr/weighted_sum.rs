@@ -1,0 +1,45 @@
+//! BMFR weighted sum: each texel evaluates its block's fit on its own features, clamped ≥ 0.
+
+use super::fit::block_push;
+use super::BmfrHistory;
+use crate::error::Result;
+use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::layouts::{BmfrBlockPush, SamplingParams};
+use crate::passes::push_bytes;
+use crate::vk::{ComputePipeline, Context, Image};
+use glam::IVec2;
+use std::sync::Arc;
+
+pub struct WeightedSumPass {
+    pipeline: ComputePipeline,
+}
+
+impl WeightedSumPass {
+    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<WeightedSumPass> {
+        let shader = format!("passes/denoise/bmfr_weighted_sum.{variant}");
+        Ok(WeightedSumPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+    }
+
+    /// Features of history half `cur` and the blocks' `weights` → `fitted`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        h: &BmfrHistory,
+        cur: usize,
+        weights: &Image,
+        fitted: &Image,
+        space: &SamplingParams,
+        offset: IVec2,
+    ) -> Result<()> {
+        let binds = [
+            read_image("noisy", &h.noisy[cur]),
+            read_image("normal", &h.normal[cur]),
+            read_image("features_position", &h.position[cur]),
+            read_image("weights", weights),
+            write_image("fitted", fitted),
+        ];
+        let push = block_push(space, offset, 0, 0.0);
+        rec.dispatch("bmfr_weighted_sum", &self.pipeline, &binds, push_bytes(&push), [fitted.width, fitted.height, 1])
+    }
+}

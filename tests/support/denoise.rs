@@ -1,0 +1,115 @@
+//! Helpers for denoiser tests (BMFR's; the SVGF/TAA tests in `denoise.rs` keep their own copies
+//! and may move to these): hashing, uploads of synthetic G-buffer data, masks and metrics.
+
+use ash::vk;
+use fovea_renderer::graph::FrameRecorder;
+use fovea_renderer::passes::trace::GBuffer;
+use fovea_renderer::sampling::SamplingSpace;
+use fovea_renderer::vk::{Buffer, Context, Image};
+use glam::Vec2;
+use std::sync::Arc;
+
+/// A deterministic value in [0, 1] from an index (PCG hash).
+pub fn hash(mut v: u32) -> f32 {
+    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
+    ((v >> 22) ^ v) as f32 / u32::MAX as f32
+}
+
+/// Any plain-old-data texels into an image of the matching format.
+pub fn upload<T: bytemuck::Pod>(ctx: &Arc<Context>, image: &Image, texels: &[T]) {
+    assert_eq!(texels.len(), image.width as usize * image.height as usize);
+    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    rec.copy_buffer_to_image("test_upload", &buffer, image).unwrap();
+    rec.submit_and_wait().unwrap();
+}
+
+/// One texel of a synthetic G-buffer.
+#[derive(Clone, Copy, Debug)]
+pub struct Texel {
+    pub radiance: [f32; 3],
+    /// Shading normal (need not be unit length: BMFR uses it as a feature).
+    pub normal: [f32; 3],
+    /// Camera-relative position; its depth is −z.
+    pub position: [f32; 3],
+    pub mesh: u32,
+    /// Previous screen position (−1: none).
+    pub motion: Vec2,
+}
+
+const HALF_ONE: u16 = 0x3c00;
+
+/// Fills the G-buffer like the tracer would (albedo 1): `None` = a texel without a sample.
+pub fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, texels: &[Option<Texel>]) {
+    let colour: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.radiance[0], t.radiance[1], t.radiance[2], 1.0])).collect();
+    upload(ctx, &g.color, &colour);
+    upload(ctx, &g.radiance, &colour);
+    upload(ctx, &g.albedo, &texels.iter().map(|t| if t.is_some() { [HALF_ONE; 4] } else { [0u16; 4] }).collect::<Vec<_>>());
+    let nd: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.normal[0], t.normal[1], t.normal[2], -t.position[2]])).collect();
+    upload(ctx, &g.normal_depth, &nd);
+    // w: depth gradient per texel, 0.2 % of the depth.
+    let pos: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.position[0], t.position[1], t.position[2], -0.002 * t.position[2]])).collect();
+    upload(ctx, &g.position, &pos);
+    upload(ctx, &g.ids, &texels.iter().map(|t| t.map_or([0u32; 2], |t| [1, t.mesh << 16])).collect::<Vec<_>>());
+    upload(ctx, &g.motion, &texels.iter().map(|t| t.map_or([-1.0f32; 2], |t| t.motion.to_array())).collect::<Vec<_>>());
+}
+
+/// Screen position of each grid texel's centre (`None`: no sample there).
+pub fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
+    let g = space.grid_size();
+    (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
+}
+
+pub fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
+    for (i, p) in pixels.iter().enumerate() {
+        assert!(p.iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: texel {i} = {p:?}");
+    }
+}
+
+/// RMSE over RGB of the pixels `keep` selects.
+pub fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: impl Fn(usize) -> bool) -> f64 {
+    let (a, b): (Vec<[f32; 4]>, Vec<[f32; 4]>) = a.iter().zip(b).enumerate().filter(|(i, _)| keep(*i)).map(|(_, (x, y))| (*x, *y)).unzip();
+    crate::rmse(&a, &b)
+}
+
+/// Screen pixels whose 3×3 neighbourhood in the sampling grid (around the texel the pixel falls
+/// in; Visual-Polar neighbours at the same angle, φ wrapping) is one surface: same material, depth
+/// within 5 %, normals within ~25°, from the space's traced G-buffer. Edge texels show one surface
+/// per frame where a reference averages several: aliasing at the grid's resolution, not noise.
+pub fn surface_interiors(ctx: &Arc<Context>, g: &GBuffer, space: &dyn SamplingSpace) -> Vec<bool> {
+    let ids: Vec<[u32; 2]> = crate::read_image(ctx, &g.ids);
+    let nd: Vec<[f32; 4]> = crate::read_image(ctx, &g.normal_depth);
+    let (grid, screen) = (space.grid_size(), space.screen_size());
+    let rows = |c: u32| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(c));
+    let index = |x: u32, y: u32| (y * grid.x + x) as usize;
+    let same = |i: usize, q: usize| {
+        let cos = (0..3).map(|c| nd[i][c] * nd[q][c]).sum::<f32>();
+        ids[q][0] != 0 && ids[q][1] & 0xffff == ids[i][1] & 0xffff && (nd[q][3] - nd[i][3]).abs() < 0.05 * nd[i][3] && cos > 0.9
+    };
+    let cartesian = space.visual_polar().is_none();
+    (0..screen.x * screen.y)
+        .map(|p| {
+            let centre = Vec2::new((p % screen.x) as f32 + 0.5, (p / screen.x) as f32 + 0.5);
+            let Some(gp) = space.screen_to_grid(centre) else { return false };
+            let (tx, ty) = (gp.x as u32, gp.y as u32);
+            let (n, i) = (rows(tx), index(tx, ty));
+            (-1..=1i32).all(|dx| {
+                let c = tx as i32 + dx;
+                if c < 0 || c >= grid.x as i32 {
+                    return true;
+                }
+                let nc = rows(c as u32) as i32;
+                let row = ((ty as f32 + 0.5) * nc as f32 / n as f32) as i32;
+                (-1..=1i32).all(|dy| {
+                    let r = row + dy;
+                    if cartesian && (r < 0 || r >= nc) {
+                        return true;
+                    }
+                    same(i, index(c as u32, r.rem_euclid(nc) as u32))
+                })
+            })
+        })
+        .collect()
+}
