@@ -5,6 +5,7 @@
 //! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
 //! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
+pub mod asvgf;
 pub mod modulate;
 pub mod svgf;
 pub mod taa;
@@ -13,7 +14,8 @@ use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
 use crate::passes::trace::GBuffer;
-use crate::vk::{Context, Image};
+use crate::vk::{Buffer, Context, Image};
+use asvgf::{Asvgf, AsvgfSettings};
 use glam::UVec2;
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
@@ -25,17 +27,19 @@ pub enum DenoiserSettings {
     #[default]
     None,
     Svgf(SvgfSettings),
+    Asvgf(AsvgfSettings),
 }
 
 impl DenoiserSettings {
     /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["none", "svgf"];
+    pub const NAMES: &'static [&'static str] = &["none", "svgf", "asvgf"];
 
     /// A denoiser by name, with its defaults.
     pub fn parse(name: &str) -> Result<DenoiserSettings> {
         match name {
             "none" => Ok(DenoiserSettings::None),
             "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
+            "asvgf" => Ok(DenoiserSettings::Asvgf(AsvgfSettings::default())),
             other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
         }
     }
@@ -44,7 +48,14 @@ impl DenoiserSettings {
         match self {
             DenoiserSettings::None => "none",
             DenoiserSettings::Svgf(_) => "svgf",
+            DenoiserSettings::Asvgf(_) => "asvgf",
         }
+    }
+
+    /// Whether the tracer must re-shade gradient samples (its `*_gradients` variant) and keep
+    /// the visibility they are projected from.
+    pub fn needs_gradients(&self) -> bool {
+        matches!(self, DenoiserSettings::Asvgf(_))
     }
 }
 
@@ -59,6 +70,7 @@ pub struct DenoiseFrame {
 /// A denoiser with its per-eye state.
 pub enum Denoiser {
     Svgf(Box<Svgf>),
+    Asvgf(Box<Asvgf>),
 }
 
 impl Denoiser {
@@ -67,6 +79,7 @@ impl Denoiser {
         Ok(match settings {
             DenoiserSettings::None => None,
             DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
+            DenoiserSettings::Asvgf(s) => Some(Denoiser::Asvgf(Box::new(Asvgf::new(ctx, grid, variant, *s)?))),
         })
     }
 
@@ -74,6 +87,7 @@ impl Denoiser {
     pub fn history_bytes(&self) -> u64 {
         match self {
             Denoiser::Svgf(s) => s.history.bytes(),
+            Denoiser::Asvgf(a) => a.history_bytes(),
         }
     }
 
@@ -81,6 +95,24 @@ impl Denoiser {
     pub fn max_passes(&self) -> u32 {
         match self {
             Denoiser::Svgf(s) => s.max_passes(),
+            Denoiser::Asvgf(a) => a.max_passes(),
+        }
+    }
+
+    /// Records what must run before the tracer, while `gbuffer` still holds last frame (A-SVGF's
+    /// forward projection). `frame_data`: the frame's uniform buffer (both cameras).
+    pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
+        match self {
+            Denoiser::Svgf(_) => Ok(()),
+            Denoiser::Asvgf(a) => a.record_before_trace(rec, gbuffer, frame, frame_data),
+        }
+    }
+
+    /// The samples the tracer's gradient variant re-shades (A-SVGF only).
+    pub fn gradient_samples(&self) -> Option<&Buffer> {
+        match self {
+            Denoiser::Svgf(_) => None,
+            Denoiser::Asvgf(a) => Some(&a.samples),
         }
     }
 
@@ -88,6 +120,7 @@ impl Denoiser {
     pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
+            Denoiser::Asvgf(a) => a.record(rec, gbuffer, frame),
         }
     }
 }
