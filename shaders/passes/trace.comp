@@ -39,7 +39,7 @@ layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;      
 // [3] traced samples whose screen position is off the screen.
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
 #if defined(TRACE_GRADIENTS)
-layout(set = 0, binding = 18, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter
+layout(set = 0, binding = 18, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
 layout(std430, set = 0, binding = 19) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
 #endif
 
@@ -150,7 +150,7 @@ void main() {
     imageStore(out_ids, texel, uvec4(ids, 0u, 0u));
     imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
 #if defined(TRACE_GRADIENTS)
-    imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, 0u));
+    imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, gradient ? 1u : 0u));
     if (gradient) gradient_samples.data[stratum].shading.w = floatBitsToUint(svgf_luminance(svgf_sanitize(color / albedo)));
 #endif
 }

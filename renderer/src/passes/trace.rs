@@ -30,7 +30,8 @@ pub struct GBuffer {
     pub motion: Image,
     /// Only for A-SVGF (`GBuffer::with_visibility`; written by the gradient kernel variants):
     /// x, y barycentrics of the hit (float bits), z the RNG state after the jitter draw — what
-    /// re-shading exactly this sample's path next frame needs besides `ids`.
+    /// re-shading exactly this sample's path next frame needs besides `ids` — and w 1 where the
+    /// sample was itself a gradient sample (not projected again).
     pub visibility: Option<Image>,
 }
 

@@ -1,6 +1,8 @@
 #version 460
 // A-SVGF forward projection (Schied et al. 2018, §4.1): per stratum of last frame's grid, the
-// brightest sample that hit a surface (brightest: a moving penumbra shows up there first) is
+// brightest sample that hit a surface (brightest: a moving penumbra shows up there first) and was
+// not itself a gradient sample (a path repeated again and again — the brightest at that — would
+// stay in the image as a fixed bright sample) is
 // carried to this frame — world position → this frame's screen → this frame's grid — and claims
 // the stratum it lands in (the first claim wins). The tracer's gradient variant then re-shades that
 // surface with that sample's random state in the texel it landed in. Runs before the tracer, so
@@ -18,7 +20,7 @@ layout(std140, set = 0, binding = 0) uniform FrameBuffer { FrameData data; } fra
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D radiance;      // last frame's, demodulated
 layout(set = 0, binding = 2, rg32ui) uniform readonly uimage2D ids;           // x triangle + 1 (0: miss)
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;      // camera-relative (last camera)
-layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state
+layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state, 1: gradient sample
 layout(std430, set = 0, binding = 5) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
 
 // The camera position of a rigid view-from-world transform.
@@ -37,7 +39,7 @@ void main() {
     for (int j = 0; j < STRATUM; ++j) {
         for (int i = 0; i < STRATUM; ++i) {
             ivec2 t = STRATUM * s + ivec2(i, j);
-            if (!grid_holds_sample(g, t) || imageLoad(ids, t).x == 0u) continue;
+            if (!grid_holds_sample(g, t) || imageLoad(ids, t).x == 0u || imageLoad(visibility, t).w != 0u) continue;
             float l = svgf_luminance(svgf_sanitize(imageLoad(radiance, t).rgb));
             if (l > brightest) {
                 brightest = l;
