@@ -96,7 +96,8 @@ struct RenderOpts {
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
-    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017, the paper's parameters).
+    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017, the paper's parameters) |
+    /// asvgf (Schied et al. 2018: SVGF with temporal gradients; VP needs the paper's layout).
     #[arg(long, default_value = "none")]
     denoiser: String,
     /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for

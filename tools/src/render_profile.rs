@@ -1,10 +1,12 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF parameters (used when `--denoiser svgf`) and the TAA parameters (used when `--taa vp`).
+//! the SVGF parameters (used when `--denoiser svgf`, and by A-SVGF's SVGF stages), the A-SVGF
+//! gradient parameters (`--denoiser asvgf`) and the TAA parameters (used when `--taa vp`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
@@ -16,6 +18,8 @@ pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
+    /// Its `svgf` is always the `[svgf]` section's.
+    pub asvgf: AsvgfSettings,
     pub taa: TaaSettings,
 }
 
@@ -25,7 +29,16 @@ struct ProfileFile {
     visual_polar: Option<VpSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
+    asvgf: Option<AsvgfSection>,
     taa: Option<TaaSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct AsvgfSection {
+    gradient_iterations: Option<u32>,
+    gradient_sigma_depth: Option<f32>,
+    gradient_sigma_normal: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -158,6 +171,14 @@ impl RenderProfile {
             s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
             s.validate().with_context(|| at("svgf"))?;
         }
+        profile.asvgf.svgf = profile.svgf;
+        if let Some(f) = file.asvgf {
+            let s = &mut profile.asvgf;
+            s.gradient_iterations = f.gradient_iterations.unwrap_or(s.gradient_iterations);
+            s.gradient_sigma_depth = f.gradient_sigma_depth.unwrap_or(s.gradient_sigma_depth);
+            s.gradient_sigma_normal = f.gradient_sigma_normal.unwrap_or(s.gradient_sigma_normal);
+            s.validate().with_context(|| at("asvgf"))?;
+        }
         if let Some(f) = file.taa {
             let s = &mut profile.taa;
             s.current_weight = f.current_weight.unwrap_or(s.current_weight);
@@ -221,6 +242,7 @@ mod tests {
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
+        assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
     }
 
@@ -238,6 +260,15 @@ mod tests {
         assert_eq!(p.blur.sigma_at_30, 0.0);
         let p = load_str("taa_ok.toml", "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n").unwrap();
         assert_eq!(p.taa, TaaSettings { current_weight: 0.05, jitter_points: 8 });
+        let p = load_str("asvgf_ok.toml", "[svgf]
+alpha_color = 0.1
+[asvgf]
+gradient_iterations = 2
+gradient_sigma_normal = 64
+").unwrap();
+        assert_eq!(p.asvgf.gradient_iterations, 2);
+        assert_eq!(p.asvgf.gradient_sigma_normal, 64.0);
+        assert_eq!(p.asvgf.svgf.alpha_color, 0.1, "A-SVGF's SVGF stages take the [svgf] section");
     }
 
     #[test]
@@ -254,6 +285,10 @@ mod tests {
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
+            ("asvgf.toml", "[asvgf]\ngradient_iterations = 0\n", "asvgf"),
+            ("asvgf_sigma.toml", "[asvgf]\ngradient_sigma_depth = -1\n", "asvgf"),
+            ("asvgf_key.toml", "[asvgf]\nalpha = 0.5\n", "alpha"),
+            ("asvgf_svgf.toml", "[svgf]\nalpha_color = 0\n[asvgf]\n", "svgf"),
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),

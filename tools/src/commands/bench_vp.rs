@@ -1,11 +1,13 @@
 //! The Visual-Polar part of `fovea bench` (issue 4): whole frames in VP vs Cartesian at full
 //! resolution on the same scene, gaze and device, per pass; the share of the way back to the
 //! screen (φ-mips + remap + blur); and primary-ray coherence: the VP samples traced in VP order
-//! vs the same rays shuffled.
+//! vs the same rays shuffled. Denoisers beside SVGF (A-SVGF) get the same cost lines through
+//! `denoiser_cost`.
 
 use anyhow::Result;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
+use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
@@ -45,10 +47,74 @@ pub struct VpFrameReport {
     pub svgf_ratio: f64,
     pub svgf_cartesian_history_bytes: u64,
     pub svgf_vp_history_bytes: u64,
+    /// Further denoisers (A-SVGF), the same figures per denoiser.
+    pub denoisers: Vec<DenoiserCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
     pub shuffled_mrays_per_s: f64,
     pub coherence_gain: f64,
+}
+
+/// One denoiser at the bench's sizes: median ms of its passes per frame in each space, VP /
+/// Cartesian, and the history bytes each space carries between frames.
+#[derive(Serialize)]
+pub struct DenoiserCost {
+    pub name: String,
+    /// Its passes (and the trace, which a denoiser may change: A-SVGF's re-shades gradient samples).
+    pub cartesian_passes_ms: BTreeMap<String, f64>,
+    pub vp_passes_ms: BTreeMap<String, f64>,
+    /// Its passes without the trace.
+    pub cartesian_ms: f64,
+    pub vp_ms: f64,
+    pub ratio: f64,
+    pub cartesian_history_bytes: u64,
+    pub vp_history_bytes: u64,
+}
+
+/// Measures `denoiser`, whose passes are named with one of `prefixes`, in both spaces.
+#[allow(clippy::too_many_arguments)]
+fn denoiser_cost(
+    ctx: &std::sync::Arc<fovea_renderer::vk::Context>,
+    make_scene: &dyn Fn() -> Result<GpuScene>,
+    denoiser: DenoiserSettings,
+    prefixes: &[&str],
+    vp: &VisualPolar,
+    pose: CameraPose,
+    frames: u32,
+) -> Result<DenoiserCost> {
+    let settings = RenderSettings { denoiser, ..Default::default() };
+    let ours = |k: &str| prefixes.iter().any(|p| k.starts_with(p));
+    let run = |space: Box<dyn fovea_renderer::sampling::SamplingSpace>, gaze| -> Result<(BTreeMap<String, f64>, f64, u64)> {
+        let mut r = Renderer::with_gpu_scene(ctx, make_scene()?, space, settings)?;
+        let passes: BTreeMap<String, f64> = pass_medians(&mut r, pose, gaze, frames)?.into_iter().filter(|(k, _)| ours(k) || k == "trace").collect();
+        let ms = passes.iter().filter(|(k, _)| ours(k)).map(|(_, v)| v).sum();
+        Ok((passes, ms, r.denoiser().map_or(0, |d| d.history_bytes())))
+    };
+    let (cartesian_passes_ms, cartesian_ms, cartesian_history_bytes) = run(Box::new(Cartesian::new(vp.screen())), None)?;
+    let (vp_passes_ms, vp_ms, vp_history_bytes) = run(Box::new(*vp), Some(vp.gaze()))?;
+    let cost = DenoiserCost {
+        name: denoiser.name().to_string(),
+        cartesian_passes_ms,
+        vp_passes_ms,
+        cartesian_ms,
+        vp_ms,
+        ratio: vp_ms / cartesian_ms,
+        cartesian_history_bytes,
+        vp_history_bytes,
+    };
+    let per_pass = |m: &BTreeMap<String, f64>| m.iter().map(|(k, v)| format!("{k} {v:.2}")).collect::<Vec<_>>().join(", ");
+    println!(
+        "  {}: {:.1} ms VP vs {:.1} ms Cartesian = {:.3}, history {:.1} vs {:.1} MiB; VP passes ms: {}; Cartesian: {}",
+        cost.name,
+        cost.vp_ms,
+        cost.cartesian_ms,
+        cost.ratio,
+        cost.vp_history_bytes as f64 / (1 << 20) as f64,
+        cost.cartesian_history_bytes as f64 / (1 << 20) as f64,
+        per_pass(&cost.vp_passes_ms),
+        per_pass(&cost.cartesian_passes_ms)
+    );
+    Ok(cost)
 }
 
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
@@ -118,7 +184,7 @@ pub fn measure(
     let (_, shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffled, false)?;
     let rate = |ms: f64| rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let grid = vp.grid_size();
-    let report = VpFrameReport {
+    let mut report = VpFrameReport {
         scene: scene_name.to_string(),
         width: w,
         height: h,
@@ -138,6 +204,7 @@ pub fn measure(
         svgf_ratio: svgf_vp_ms / svgf_cartesian_ms,
         svgf_cartesian_history_bytes,
         svgf_vp_history_bytes,
+        denoisers: Vec::new(),
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
         coherence_gain: shuffled_ms / ordered_ms,
@@ -162,6 +229,8 @@ pub fn measure(
         report.svgf_vp_history_bytes as f64 / (1 << 20) as f64,
         report.svgf_cartesian_history_bytes as f64 / (1 << 20) as f64
     );
+    let asvgf = DenoiserSettings::Asvgf(AsvgfSettings::default());
+    report.denoisers.push(denoiser_cost(ctx, make_scene, asvgf, &["asvgf_", "svgf_"], &vp, pose, frames)?);
     Ok(report)
 }
 

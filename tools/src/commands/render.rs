@@ -37,7 +37,7 @@ pub struct RenderArgs<'a> {
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
-    /// `none` or `svgf` (`DenoiserSettings::NAMES`).
+    /// `none`, `svgf` or `asvgf` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
     /// `off` or `vp` (`TaaMode::NAMES`; `screen` is refused as not implemented yet).
     pub taa: &'a str,
@@ -51,7 +51,7 @@ pub const METHODS: &[&str] = &["vp", "cartesian"];
 #[derive(Serialize)]
 struct Report {
     method: String,
-    /// Denoiser in the sampling grid (`none`, `svgf`).
+    /// Denoiser in the sampling grid (`none`, `svgf`, `asvgf`).
     denoiser: String,
     /// TAA: `off`, or `vp` (in the sampling grid).
     taa: String,
@@ -130,6 +130,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
+        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(args.profile.asvgf),
         other => other,
     };
     let taa = match TaaMode::parse(args.taa).context("--taa")? {
