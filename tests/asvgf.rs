@@ -74,7 +74,7 @@ fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
 /// Still camera: a gradient sample shades last frame's surface with last frame's random state, so
 /// an unchanged scene gives the same path and δ = 0; the light at half its emission gives exactly
 /// half the radiance (δ < 0), and back at full twice that (δ > 0) — all light in the box is the
-/// ceiling light's, and every path is the same one.
+/// ceiling light's, and every path is the same one. Then the same with the camera moving.
 #[test]
 fn gradient_samples_reshade_last_frames_path() {
     let ctx = gpu();
@@ -114,6 +114,15 @@ fn gradient_samples_reshade_last_frames_path() {
         r.set_emission_scale(&scene, light, 1.0).unwrap();
         r.render_frame(&frame(camera, 3)).unwrap();
         check_ratio(&r, 3, 2.0);
+
+        // A moving camera: the samples land elsewhere in the grid, and the box's walls are
+        // Lambertian, so the same path (seen from a slightly different direction) still gives the
+        // same radiance.
+        for f in 4..7 {
+            let shift = Mat4::from_translation(glam::Vec3::new(0.01 * (f - 3) as f32, 0.005 * (f - 3) as f32, 0.0));
+            r.render_frame(&frame(CameraPose { world_from_view: shift * camera.world_from_view, ..camera }, f)).unwrap();
+        }
+        check_ratio(&r, 6, 1.0);
         assert_clean(&ctx);
     }
 }
@@ -316,4 +325,25 @@ fn asvgf_refuses_the_screen_clipped_layout() {
     let err = Renderer::new(&ctx, &scene, Box::new(vp), settings(asvgf())).err().expect("screen-clipped A-SVGF refused").to_string();
     assert!(err.contains("asvgf") && err.contains("screen-clipped"), "{err}");
     assert_clean(&ctx);
+}
+
+/// `fovea render --denoiser asvgf` (moving camera, simulated gaze): the report names the
+/// denoiser and times its passes in both spaces; the screen-clipped layout is a clear error.
+#[test]
+fn render_command_runs_asvgf_and_reports_it() {
+    use fovea_tools::commands::render::{run, RenderArgs};
+    let out = fovea_tests::artifacts_dir().join(format!("asvgf-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    for method in ["cartesian", "vp"] {
+        run(&RenderArgs { method, denoiser: "asvgf", frames: 3, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(report["denoiser"], "asvgf");
+        for pass in ["asvgf_clear", "asvgf_forward", "asvgf_gradient", "svgf_temporal", "svgf_atrous", "svgf_modulate"] {
+            assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
+        }
+    }
+    let mut args = RenderArgs { method: "vp", denoiser: "asvgf", ..fovea_tests::small_render_args("cornell-box", &out) };
+    args.profile.visual_polar.layout = VpLayout::ScreenClipped;
+    let err = format!("{:#}", run(&args).unwrap_err());
+    assert!(err.contains("asvgf") && err.contains("layout"), "{err}");
 }
