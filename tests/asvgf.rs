@@ -12,7 +12,7 @@ use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene, rmse, save_preview};
+use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene, read_image, rmse, save_preview};
 use glam::{Mat4, UVec2};
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
@@ -74,7 +74,8 @@ fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
 /// Still camera: a gradient sample shades last frame's surface with last frame's random state, so
 /// an unchanged scene gives the same path and δ = 0; the light at half its emission gives exactly
 /// half the radiance (δ < 0), and back at full twice that (δ > 0) — all light in the box is the
-/// ceiling light's, and every path is the same one. Then the same with the camera moving.
+/// ceiling light's, and every path is the same one; the reconstructed λ = |δ̂| / max f̂ follows (0,
+/// ½, ½). Then the same with the camera moving.
 #[test]
 fn gradient_samples_reshade_last_frames_path() {
     let ctx = gpu();
@@ -105,6 +106,14 @@ fn gradient_samples_reshade_last_frames_path() {
             assert!(off * 100 <= lit.len(), "{name} frame {f}: {off} of {} gradient samples off the ratio {expected}", lit.len());
             let sign = lit.iter().filter(|(prev, cur)| (cur - prev).signum() == (expected - 1.0).signum() || expected == 1.0).count();
             assert!(sign * 100 >= lit.len() * 99, "{name} frame {f}: δ has the wrong sign in {} samples", lit.len() - sign);
+            // The reconstruction averages δ and max f alike: λ = |δ̂| / max f̂ is the ratio's.
+            let Some(Denoiser::Asvgf(a)) = r.denoiser() else { panic!() };
+            let gradient: Vec<[f32; 4]> = read_image(&ctx, a.gradient());
+            let lambda = (expected - 1.0).abs() / expected.max(1.0);
+            let confident: Vec<f32> = gradient.iter().filter(|g| g[2] > 0.0 && g[1] > 1e-3).map(|g| g[0].abs() / g[1]).collect();
+            let off = confident.iter().filter(|l| (*l - lambda).abs() > 1e-3).count();
+            println!("{name} frame {f}: λ = {lambda} expected, {off} of {} reconstructed strata off by > 1e-3", confident.len());
+            assert!(confident.len() * 2 > (strata.x * strata.y) as usize && off * 100 <= confident.len(), "{name} frame {f}: λ off in {off} strata");
         };
         r.render_frame(&frame(camera, 1)).unwrap();
         check_ratio(&r, 1, 1.0);

@@ -281,9 +281,9 @@ impl Renderer {
         if let Some(d) = &mut self.denoiser {
             d.record_before_trace(rec, &self.gbuffer, &denoise_frame, &self.frame_data)?;
         }
-        let gradient_samples = self.denoiser.as_ref().and_then(|d| d.gradient_samples());
+        let gradients = self.denoiser.as_ref().and_then(|d| d.gradient_targets());
         let trace = self.trace_gradients.as_ref().unwrap_or(&self.trace);
-        trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0, gradient_samples)?;
+        trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0, gradients)?;
         let denoised = match &mut self.denoiser {
             Some(d) => d.record(rec, &self.gbuffer, &denoise_frame)?,
             None => &self.gbuffer.color,

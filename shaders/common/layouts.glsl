@@ -221,6 +221,7 @@ struct AsvgfForwardPush {
     vec4 vp_gaze;
     vec4 vp_shape0;
     vec4 vp_shape1;
+    uvec4 config;               // x 1: project last frame's samples, 0: only clear the gradient image (no usable last frame); yzw unused
 };
 
 // Push constants of one iteration of A-SVGF's gradient reconstruction (à-trous on the strata).

@@ -41,6 +41,7 @@ layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_co
 #if defined(TRACE_GRADIENTS)
 layout(set = 0, binding = 18, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
 layout(std430, set = 0, binding = 19) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
+layout(set = 0, binding = 20, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
 #endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
@@ -151,6 +152,11 @@ void main() {
     imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
 #if defined(TRACE_GRADIENTS)
     imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, gradient ? 1u : 0u));
-    if (gradient) gradient_samples.data[stratum].shading.w = floatBitsToUint(svgf_luminance(svgf_sanitize(color / albedo)));
+    if (gradient) {
+        float current = svgf_luminance(svgf_sanitize(color / albedo));
+        float previous = uintBitsToFloat(gs.shading.z);
+        gradient_samples.data[stratum].shading.w = floatBitsToUint(current);
+        imageStore(out_gradient, texel / int(ASVGF_STRATUM), vec4(current - previous, max(current, previous), 1.0, 0.0));
+    }
 #endif
 }

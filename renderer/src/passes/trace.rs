@@ -59,6 +59,17 @@ impl GBuffer {
     }
 }
 
+/// What the `*_gradients` kernel variants read and write besides the G-buffer (A-SVGF).
+#[derive(Clone, Copy)]
+pub struct GradientTargets<'a> {
+    /// The forward-projected samples (`AsvgfGradientSample` per 3×3 stratum); the tracer adds
+    /// this frame's luminance.
+    pub samples: &'a Buffer,
+    /// Per stratum: δ, max f, 1 where a sample was re-shaded (zeros elsewhere: the forward
+    /// projection clears it).
+    pub gradient: &'a Image,
+}
+
 pub struct TracePass {
     pipeline: ComputePipeline,
 }
@@ -75,9 +86,8 @@ impl TracePass {
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
     /// frame (reference accumulation); real-time frames use 0. `sampling_table` holds the space's
-    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs). `gradient_samples`:
-    /// A-SVGF's forward-projected samples, for the `*_gradients` variants (which also write
-    /// `out.visibility`).
+    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs). `gradients`: A-SVGF's,
+    /// for the `*_gradients` variants (which also write `out.visibility`).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -89,7 +99,7 @@ impl TracePass {
         ray_counters: &Buffer,
         out: &GBuffer,
         sample_index: u32,
-        gradient_samples: Option<&Buffer>,
+        gradients: Option<GradientTargets>,
     ) -> Result<()> {
         let s = scene.binds();
         let mut binds = vec![
@@ -106,8 +116,9 @@ impl TracePass {
             write_image("out_ids", &out.ids),
             write_image("out_motion", &out.motion),
         ];
-        if let (Some(samples), Some(visibility)) = (gradient_samples, &out.visibility) {
-            binds.push(write_buffer("gradient_samples", samples));
+        if let (Some(g), Some(visibility)) = (gradients, &out.visibility) {
+            binds.push(write_buffer("gradient_samples", g.samples));
+            binds.push(write_image("out_gradient", g.gradient));
             binds.push(write_image("out_visibility", visibility));
         }
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };

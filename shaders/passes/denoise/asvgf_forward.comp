@@ -6,7 +6,9 @@
 // carried to this frame — world position → this frame's screen → this frame's grid — and claims
 // the stratum it lands in (the first claim wins). The tracer's gradient variant then re-shades that
 // surface with that sample's random state in the texel it landed in. Runs before the tracer, so
-// the G-buffer still holds last frame. Strata in the Visual-Polar grid: shaders/denoise/strata.glsl.
+// the G-buffer still holds last frame. Each invocation also clears its stratum of the gradient
+// image, where the tracer writes the strata that got a gradient sample (the strata grids of both
+// frames are one). Strata in the Visual-Polar grid: shaders/denoise/strata.glsl.
 //! variant cartesian: SAMPLING_CARTESIAN
 //! variant visual_polar: SAMPLING_VISUAL_POLAR
 #include "../../common/layouts.glsl"
@@ -22,6 +24,7 @@ layout(set = 0, binding = 2, rg32ui) uniform readonly uimage2D ids;           //
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;      // camera-relative (last camera)
 layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state, 1: gradient sample
 layout(std430, set = 0, binding = 5) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
+layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D gradient;   // per stratum: δ, max f, 1 (written by the tracer)
 
 // The camera position of a rigid view-from-world transform.
 vec3 camera_origin(mat4 view_from_world) {
@@ -32,7 +35,9 @@ void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
     // The grid's rows per column do not depend on the gaze: this frame's grid addresses last frame's.
     Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
-    if (!stratum_holds_samples(g, s)) return;
+    if (any(greaterThanEqual(s, strata_size(g)))) return;
+    imageStore(gradient, s, vec4(0.0));
+    if (push.p.config.x == 0u || !stratum_holds_samples(g, s)) return;
 
     float brightest = -1.0;
     ivec2 picked = ivec2(0);

@@ -5,40 +5,22 @@
 // luminance term: the gradient itself is what is being estimated). It filters the temporal
 // difference δ = f_i − f_{i−1} and the normaliser max(f_i, f_{i−1}) of the strata that have a
 // re-shaded gradient sample; z carries the fraction of the kernel's weight that had one, which is
-// the next iteration's confidence. The *_samples variants read the raw samples (first iteration).
+// the next iteration's confidence. The first iteration reads what the tracer wrote (δ, max f, 1
+// where a stratum has a gradient sample, zeros elsewhere).
 //! variant cartesian: SAMPLING_CARTESIAN
 //! variant visual_polar: SAMPLING_VISUAL_POLAR
-//! variant cartesian_samples: SAMPLING_CARTESIAN GRADIENT_FROM_SAMPLES
-//! variant visual_polar_samples: SAMPLING_VISUAL_POLAR GRADIENT_FROM_SAMPLES
 #include "../../common/layouts.glsl"
 #include "../../denoise/strata.glsl"
 #include "../../denoise/svgf.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { AsvgfGradientPush p; } push;
-#if defined(GRADIENT_FROM_SAMPLES)
-layout(std430, set = 0, binding = 0) readonly buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
-#else
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D src;    // δ, max f, confidence
-#endif
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D normal_depth;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D position;  // w: depth gradient per texel
 layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D dst;      // δ, max f, confidence
 
 const float B3[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
-
-// δ, max(f_i, f_{i−1}) and confidence of stratum s.
-vec3 load_gradient(Grid g, ivec2 s) {
-#if defined(GRADIENT_FROM_SAMPLES)
-    AsvgfGradientSample gs = gradient_samples.data[s.y * strata_size(g).x + s.x];
-    if (gs.surface.x == 0u || gs.shading.w == ASVGF_NO_LUMINANCE) return vec3(0.0);
-    float previous = uintBitsToFloat(gs.shading.z);
-    float current = uintBitsToFloat(gs.shading.w);
-    return vec3(current - previous, max(current, previous), 1.0);
-#else
-    return imageLoad(src, s).xyz;
-#endif
-}
 
 void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
@@ -62,7 +44,7 @@ void main() {
             SvgfSurface sq = svgf_surface(imageLoad(normal_depth, tq), 0.0, uvec2(0u));
             float distance = float(STRATUM * step) * length(vec2(dx, dy));
             float w = B3[abs(dx)] * B3[abs(dy)] * svgf_edge_weight(c, sq, distance, push.p.params.x, push.p.params.y, 0.0, 1.0);
-            vec3 v = load_gradient(g, q);
+            vec3 v = imageLoad(src, q).xyz;
             sum += w * v.z * v.xy;
             sum_confident += w * v.z;
             sum_w += w;

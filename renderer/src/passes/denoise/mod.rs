@@ -13,7 +13,7 @@ pub mod taa;
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, GradientTargets};
 use crate::vk::{Buffer, Context, Image};
 use asvgf::{Asvgf, AsvgfSettings};
 use glam::UVec2;
@@ -108,11 +108,11 @@ impl Denoiser {
         }
     }
 
-    /// The samples the tracer's gradient variant re-shades (A-SVGF only).
-    pub fn gradient_samples(&self) -> Option<&Buffer> {
+    /// What the tracer's gradient variant re-shades and writes (A-SVGF only).
+    pub fn gradient_targets(&self) -> Option<GradientTargets<'_>> {
         match self {
             Denoiser::Svgf(_) => None,
-            Denoiser::Asvgf(a) => Some(&a.samples),
+            Denoiser::Asvgf(a) => Some(a.gradient_targets()),
         }
     }
 

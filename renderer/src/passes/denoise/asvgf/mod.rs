@@ -18,13 +18,13 @@ use super::DenoiseFrame;
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, GradientTargets};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use forward::ForwardPass;
 use glam::UVec2;
 use gpu_allocator::MemoryLocation;
-use gradient::{GradientPass, GradientSource};
+use gradient::GradientPass;
 use std::sync::Arc;
 
 /// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α.
@@ -70,9 +70,10 @@ pub struct Asvgf {
     gradient: GradientPass,
     /// One `AsvgfGradientSample` per stratum, cleared every frame (host-visible for inspection).
     pub samples: Buffer,
+    /// Per stratum: δ, max f, 1 where the tracer re-shaded a sample (zeros elsewhere).
+    raw: Image,
     /// Reconstruction ping-pong (strata-sized: δ̂, max f, confidence).
     ping: [Image; 2],
-    strata: UVec2,
     /// Bytes of the G-buffer's visibility image, which carries last frame's samples to this one.
     visibility_bytes: u64,
     frames: u64,
@@ -93,8 +94,8 @@ impl Asvgf {
             forward: ForwardPass::new(ctx, variant)?,
             gradient: GradientPass::new(ctx, variant)?,
             samples: Buffer::new(ctx, "asvgf.gradient_samples", count * sample_bytes, usage, MemoryLocation::GpuToCpu)?,
+            raw: image("asvgf.gradient_samples")?,
             ping: [image("asvgf.gradient0")?, image("asvgf.gradient1")?],
-            strata,
             visibility_bytes: grid.x as u64 * grid.y as u64 * 16,
             frames: 0,
         })
@@ -114,20 +115,23 @@ impl Asvgf {
     /// the first frame or without a previous frame). `frame_data` holds both cameras.
     pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
         rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
-        if self.frames > 0 && frame.previous.is_some() {
-            self.forward.record(rec, g, frame_data, &self.samples, self.strata, &frame.current)?;
-        }
-        Ok(())
+        let project = self.frames > 0 && frame.previous.is_some();
+        self.forward.record(rec, g, frame_data, &self.samples, &self.raw, &frame.current, project)
+    }
+
+    /// The tracer's gradient-variant inputs and outputs.
+    pub fn gradient_targets(&self) -> GradientTargets<'_> {
+        GradientTargets { samples: &self.samples, gradient: &self.raw }
     }
 
     /// After the tracer: reconstructs the gradients, then SVGF with the adaptive α.
     pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
         let s = self.settings;
-        let mut src = GradientSource::Samples(&self.samples);
+        let mut src = &self.raw;
         for i in 0..s.gradient_iterations {
             let dst = &self.ping[(i % 2) as usize];
             self.gradient.record(rec, g, src, dst, 1 << i, &frame.current, &s)?;
-            src = GradientSource::Image(dst);
+            src = dst;
         }
         let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];
         self.frames += 1;
@@ -136,7 +140,8 @@ impl Asvgf {
 
     /// The gradient samples of the last recorded frame.
     pub fn read_samples(&self) -> Result<Vec<AsvgfGradientSample>> {
-        let mut out = vec![AsvgfGradientSample::default(); (self.strata.x * self.strata.y) as usize];
+        let strata = self.strata();
+        let mut out = vec![AsvgfGradientSample::default(); (strata.x * strata.y) as usize];
         self.samples.read_into(&mut out)?;
         Ok(out)
     }
@@ -148,6 +153,6 @@ impl Asvgf {
 
     /// Size of the strata grid.
     pub fn strata(&self) -> UVec2 {
-        self.strata
+        UVec2::new(self.raw.width, self.raw.height)
     }
 }
