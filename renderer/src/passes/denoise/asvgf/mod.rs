@@ -94,7 +94,7 @@ impl Asvgf {
             forward: ForwardPass::new(ctx, variant)?,
             gradient: GradientPass::new(ctx, variant)?,
             samples: Buffer::new(ctx, "asvgf.gradient_samples", count * sample_bytes, usage, MemoryLocation::GpuToCpu)?,
-            raw: image("asvgf.gradient_samples")?,
+            raw: image("asvgf.gradient_raw")?,
             ping: [image("asvgf.gradient0")?, image("asvgf.gradient1")?],
             visibility_bytes: grid.x as u64 * grid.y as u64 * 16,
             frames: 0,
