@@ -8,7 +8,7 @@ use crate::layouts::{
     LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
 use crate::scene::bvh::Bvh;
-use crate::scene::lights::{build_light_table, LightKind};
+use crate::scene::lights::{build_light_table_scaled, LightKind};
 use crate::scene::{Aabb, PunctualLight, Scene};
 use crate::vk::{Buffer, Context};
 use ash::vk;
@@ -34,6 +34,8 @@ pub struct GpuScene {
     pub bounds: Aabb,
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
+    /// Per-material emission factor set at run time (`set_emission_scale`; 1 = as loaded).
+    emission_scale: Vec<f32>,
 }
 
 impl GpuScene {
@@ -68,9 +70,10 @@ impl GpuScene {
             }
             triangles.push(TriangleGpu { vertices: UVec4::new(t.indices[0], t.indices[1], t.indices[2], t.material | (t.mesh << 16)) });
         }
-        let materials: Vec<MaterialGpu> = scene.materials.iter().map(material_gpu).collect();
+        let emission_scale = vec![1.0; scene.materials.len()];
+        let materials: Vec<MaterialGpu> = scene.materials.iter().map(|m| material_gpu(m, 1.0)).collect();
         let (textures, texels) = pack_textures(scene);
-        let lights = light_entries(scene);
+        let lights = light_entries(scene, &emission_scale);
 
         Ok(GpuScene {
             bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &bvh.node_texels())?,
@@ -88,7 +91,37 @@ impl GpuScene {
             bounds: scene.bounds(),
             bvh_depth: depth,
             bvh_bytes: bvh.memory_bytes(),
+            emission_scale,
         })
+    }
+
+    /// Scales material `material`'s emission by `scale` (relative to `scene`, the scene this was
+    /// uploaded from; 0 switches its lights off) and rebuilds the light-sampling table so that
+    /// next-event estimation picks lights by their new power. For lights switched during a
+    /// sequence (tests, scripted sequences); takes effect from the next frame recorded.
+    pub fn set_emission_scale(&mut self, ctx: &Arc<Context>, scene: &Scene, material: usize, scale: f32) -> Result<()> {
+        if material >= self.emission_scale.len() || scene.materials.len() != self.emission_scale.len() {
+            return Err(Error::Invalid(format!(
+                "emission scale: material {material} does not exist ({} materials uploaded, {} in the scene given)",
+                self.emission_scale.len(),
+                scene.materials.len()
+            )));
+        }
+        if !scale.is_finite() || scale < 0.0 {
+            return Err(Error::Invalid(format!("emission scale of material {material} must be finite and ≥ 0, got {scale}")));
+        }
+        self.emission_scale[material] = scale;
+        let materials: Vec<MaterialGpu> =
+            scene.materials.iter().zip(&self.emission_scale).map(|(m, s)| material_gpu(m, *s)).collect();
+        self.materials.write(&materials)?;
+        let lights = light_entries(scene, &self.emission_scale);
+        if std::mem::size_of_val(lights.as_slice()) as u64 > self.lights.size {
+            self.lights = Buffer::with_data(ctx, "lights", &lights, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        } else {
+            self.lights.write(&lights)?;
+        }
+        self.light_count = lights.len() as u32;
+        Ok(())
     }
 
     /// The scene bindings of `shaders/common/scene.glsl` (all read-only).
@@ -116,10 +149,10 @@ fn texture_index(t: Option<u32>) -> u32 {
     t.unwrap_or(NO_TEXTURE)
 }
 
-fn material_gpu(m: &crate::scene::Material) -> MaterialGpu {
+fn material_gpu(m: &crate::scene::Material, emission_scale: f32) -> MaterialGpu {
     MaterialGpu {
         base_color: m.base_color,
-        emissive: m.emissive.extend(0.0),
+        emissive: (m.emissive * emission_scale).extend(0.0),
         specular: m.specular_color.extend(m.specular_factor),
         surface: Vec4::new(m.metallic, m.roughness, m.ior, m.normal_scale),
         textures: UVec4::new(
@@ -149,8 +182,8 @@ fn pack_textures(scene: &Scene) -> (Vec<TextureGpu>, Vec<u32>) {
     (infos, texels)
 }
 
-fn light_entries(scene: &Scene) -> Vec<LightGpu> {
-    let table = build_light_table(scene);
+fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {
+    let table = build_light_table_scaled(scene, emission_scale);
     table
         .entries
         .iter()

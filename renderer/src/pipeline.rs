@@ -114,6 +114,9 @@ pub struct Renderer {
     sampling_table: Buffer,
     ray_counters: Buffer,
     trace: TracePass,
+    /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
+    /// (references keep `trace`).
+    trace_gradients: Option<TracePass>,
     accumulate: AccumulatePass,
     tonemap: TonemapPass,
     pub gbuffer: GBuffer,
@@ -164,6 +167,17 @@ impl Renderer {
             None => None,
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
+        let gradients = settings.denoiser.needs_gradients();
+        let trace_gradients = match (gradients, space.trace_variant()) {
+            (false, _) => None,
+            (true, "visual_polar_clipped") => {
+                return Err(Error::Invalid(format!(
+                    "denoiser '{}' does not support the screen-clipped Visual-Polar layout (use layout = \"paper\")",
+                    settings.denoiser.name()
+                )))
+            }
+            (true, variant) => Some(TracePass::new(ctx, &format!("{variant}_gradients"))?),
+        };
         let denoiser_passes = denoiser.as_ref().map_or(0, |d| d.max_passes());
         let taa = match grid_taa {
             Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
@@ -181,9 +195,10 @@ impl Renderer {
                 MemoryLocation::GpuToCpu,
             )?,
             trace: TracePass::new(ctx, space.trace_variant())?,
+            trace_gradients,
             accumulate: AccumulatePass::new(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
-            gbuffer: GBuffer::new(ctx, grid)?,
+            gbuffer: if gradients { GBuffer::with_visibility(ctx, grid)? } else { GBuffer::new(ctx, grid)? },
             accum: Image::new(ctx, "accum", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?,
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             ldr_readback: readback("ldr_readback", pixels * 4)?,
@@ -209,6 +224,12 @@ impl Renderer {
 
     pub fn context(&self) -> &Arc<Context> {
         &self.ctx
+    }
+
+    /// Scales a material's emission at run time (`GpuScene::set_emission_scale`; `scene` is the
+    /// scene this renderer was built from): a light switched off, dimmed or back on.
+    pub fn set_emission_scale(&mut self, scene: &Scene, material: usize, scale: f32) -> Result<()> {
+        self.scene.set_emission_scale(&self.ctx, scene, material, scale)
     }
 
     /// The denoiser and its state, when `settings.denoiser` names one.
@@ -269,9 +290,14 @@ impl Renderer {
         let rec = &mut self.recorder;
         rec.begin()?;
         rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
-        self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0)?;
         // Denoisers work in the sampling grid (Cartesian samples are the screen).
         let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
+        if let Some(d) = &mut self.denoiser {
+            d.record_before_trace(rec, &self.gbuffer, &denoise_frame, &self.frame_data)?;
+        }
+        let gradients = self.denoiser.as_ref().and_then(|d| d.gradient_targets());
+        let trace = self.trace_gradients.as_ref().unwrap_or(&self.trace);
+        trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0, gradients)?;
         let denoised = match &mut self.denoiser {
             Some(d) => {
                 let scene = DenoiseScene { camera_origin: input.camera.world_from_view.w_axis.truncate(), materials: &self.scene.materials };
@@ -362,7 +388,7 @@ impl Renderer {
             let rec = &mut self.recorder;
             rec.begin()?;
             for s in done..done + batch {
-                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, s)?;
+                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, s, None)?;
                 self.accumulate.record(rec, &self.gbuffer.color, &self.accum, s)?;
             }
             if done + batch == spp {

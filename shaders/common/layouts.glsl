@@ -258,6 +258,38 @@ struct BmfrBlockPush {
     vec4 params;                // x stochastic regularisation amplitude, yzw unused
 };
 
+// ---- A-SVGF (Schied et al. 2018): gradient samples, one per ASVGF_STRATUM × ASVGF_STRATUM
+// stratum of the sampling grid, reconstructed at that 1/3 resolution into the temporal α of SVGF.
+const uint ASVGF_STRATUM = 3u;
+// AsvgfGradientSample.shading.w until the tracer has re-shaded the sample.
+const uint ASVGF_NO_LUMINANCE = 0xffffffffu;
+
+// One stratum's gradient sample: last frame's surface and random state, forward-projected into
+// this frame's grid (asvgf_forward.comp), and the luminance of both shadings (demodulated).
+struct AsvgfGradientSample {
+    uvec4 surface;              // x 1 + last frame's texel index (0: none claimed this stratum), y triangle + 1, zw barycentrics (float bits)
+    uvec4 shading;              // x this frame's texel (x | y << 16), y RNG state after the jitter draw, z last luminance, w this frame's (float bits; ASVGF_NO_LUMINANCE: not re-shaded)
+};
+
+// Push constants of A-SVGF's forward projection (one invocation per stratum of last frame).
+struct AsvgfForwardPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    uvec4 config;               // x 1: project last frame's samples, 0: only clear the gradient image (no usable last frame); yzw unused
+};
+
+// Push constants of one iteration of A-SVGF's gradient reconstruction (à-trous on the strata).
+struct AsvgfGradientPush {
+    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
+    vec4 vp_gaze;
+    vec4 vp_shape0;
+    vec4 vp_shape1;
+    vec4 params;                // x σ depth, y σ normal, zw unused
+    uvec4 config;               // x tap spacing in strata (2^iteration), yzw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 

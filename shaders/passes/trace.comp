@@ -2,9 +2,15 @@
 // Path tracer, one sample per sampling-grid texel: primary ray, next-event estimation at every
 // hit, BRDF-sampled continuation (real-time: depth 3 = one indirect bounce). Writes the per-sample
 // G-buffer that the denoisers read, sized to the sampling grid.
+// The *_gradients variants serve A-SVGF (Schied et al. 2018): a texel that the forward projection
+// of last frame's samples chose (asvgf_forward.comp) re-shades that frame's surface with that
+// frame's random state, and every texel writes the visibility (barycentrics, random state) the
+// next projection reads. Plain rendering keeps the variants without them and pays nothing.
 //! variant cartesian: SAMPLING_CARTESIAN
 //! variant visual_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
 //! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
+//! variant cartesian_gradients: SAMPLING_CARTESIAN TRACE_GRADIENTS
+//! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -12,6 +18,11 @@
 #include "../common/lights.glsl"
 #include "../common/camera.glsl"
 #include "../sampling/space.glsl"
+#include "../common/path.glsl"
+#if defined(TRACE_GRADIENTS)
+#include "../denoise/strata.glsl"
+#include "../denoise/svgf.glsl"
+#endif
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 
@@ -27,23 +38,11 @@ layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;      
 // Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays,
 // [3] traced samples whose screen position is off the screen.
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
-
-uint shadow_rays = 0u;
-uint continuation_rays = 0u;
-
-bool visible(vec3 p, vec3 n, LightSample ls) {
-    Hit h;
-    shadow_rays++;
-    return !bvh_trace(offset_ray(p, n), ls.direction, 0.0, ls.distance * (1.0 - 1e-4), true, h);
-}
-
-vec3 direct_light(Surface s, vec3 v, inout uint rng) {
-    LightSample ls;
-    if (!sample_light(s.position, rng, ls)) return vec3(0.0);
-    vec3 f = brdf_eval_cos(s, v, ls.direction);
-    if (all(equal(f, vec3(0.0))) || !visible(s.position, s.geometric_normal, ls)) return vec3(0.0);
-    return f * ls.radiance_over_pdf;
-}
+#if defined(TRACE_GRADIENTS)
+layout(set = 0, binding = 18, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
+layout(std430, set = 0, binding = 19) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
+layout(set = 0, binding = 20, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
+#endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
 // two grid axes; 1 in Cartesian space): the denoisers compare depths per grid texel. Visual-Polar
@@ -76,6 +75,9 @@ void main() {
         imageStore(out_position, texel, vec4(0.0));
         imageStore(out_ids, texel, uvec4(0u));
         imageStore(out_motion, texel, vec4(-1.0));
+#if defined(TRACE_GRADIENTS)
+        imageStore(out_visibility, texel, uvec4(0u));
+#endif
         return;
     }
     if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, fd.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
@@ -83,6 +85,22 @@ void main() {
     vec3 view_dir = view_direction(screen, fd.fov_tan, fd.screen.xy);
     vec3 dir = normalize(mat3(fd.world_from_view) * view_dir);
     uint max_depth = fd.frame.z;
+#if defined(TRACE_GRADIENTS)
+    // A gradient sample: this texel looks at the surface the forward projection put here instead
+    // of along its jitter (the surface lies inside the texel) and, if it is still visible, shades
+    // it with last frame's random state.
+    uint stratum = asvgf_stratum_index(texel, int(sampling.data.grid.x));
+    AsvgfGradientSample gs = gradient_samples.data[stratum];
+    bool gradient = gs.surface.x != 0u && gs.shading.x == (uint(texel.x) | (uint(texel.y) << 16u));
+    vec2 gradient_bary = uintBitsToFloat(gs.surface.zw);
+    if (gradient) {
+        TriangleGpu tri = triangles.data[gs.surface.y - 1u];
+        vec3 p = (1.0 - gradient_bary.x - gradient_bary.y) * vertices.data[tri.vertices.x].position_u.xyz
+               + gradient_bary.x * vertices.data[tri.vertices.y].position_u.xyz
+               + gradient_bary.y * vertices.data[tri.vertices.z].position_u.xyz;
+        dir = normalize(p - org);
+    }
+#endif
 
     Hit hit;
     vec3 color = vec3(0.0);
@@ -91,7 +109,17 @@ void main() {
     vec4 position = vec4(0.0);
     uvec2 ids = uvec2(0u);
     vec2 prev_screen = vec2(-1.0);
-    if (!bvh_trace(org, dir, 0.0, 1e30, false, hit)) {
+    bool found = bvh_trace(org, dir, 0.0, 1e30, false, hit);
+#if defined(TRACE_GRADIENTS)
+    gradient = gradient && found && hit.triangle == gs.surface.y - 1u;
+    if (gradient) {
+        hit.u = gradient_bary.x;
+        hit.v = gradient_bary.y;
+        rng = gs.shading.y;
+    }
+    uint path_rng = rng;
+#endif
+    if (!found) {
         // Nothing hit: no environment light; the previous position is the same direction.
         vec3 prev_view = mat3(fd.prev_view_from_world) * dir;
         project_view(prev_view, fd.prev_fov_tan, fd.screen.xy, prev_screen);
@@ -108,26 +136,7 @@ void main() {
         position = vec4(p_rel, depth_gradient);
         ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
         project_view((fd.prev_view_from_world * vec4(s.position, 1.0)).xyz, fd.prev_fov_tan, fd.screen.xy, prev_screen);
-
-        if (max_depth >= 1u) color += s.emission;
-        vec3 throughput = vec3(1.0);
-        vec3 v = -dir;
-        for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
-            color += throughput * direct_light(s, v, rng);
-            if (depth_i + 1u >= max_depth) break;
-            vec3 l, weight;
-            bool delta;
-            vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
-            if (!brdf_sample(s, v, u3, l, weight, delta)) break;
-            throughput *= weight;
-            vec3 o = offset_ray(s.position, s.geometric_normal);
-            continuation_rays++;
-            if (!bvh_trace(o, l, 0.0, 1e30, false, hit)) break;
-            s = fetch_surface(hit, l);
-            // A mirror bounce cannot be found by next-event estimation: count what it sees.
-            if (delta) color += throughput * s.emission;
-            v = -l;
-        }
+        color = shade_path(s, dir, max_depth, rng);
     }
     atomicAdd(ray_counters.data[0], 1u);
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);
@@ -141,4 +150,13 @@ void main() {
     imageStore(out_position, texel, position);
     imageStore(out_ids, texel, uvec4(ids, 0u, 0u));
     imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
+#if defined(TRACE_GRADIENTS)
+    imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, gradient ? 1u : 0u));
+    if (gradient) {
+        float current = svgf_luminance(svgf_sanitize(color / albedo));
+        float previous = uintBitsToFloat(gs.shading.z);
+        gradient_samples.data[stratum].shading.w = floatBitsToUint(current);
+        imageStore(out_gradient, texel / int(ASVGF_STRATUM), vec4(current - previous, max(current, previous), 1.0, 0.0));
+    }
+#endif
 }

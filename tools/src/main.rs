@@ -101,8 +101,9 @@ struct RenderOpts {
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
-    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017) | bmfr (Koskela et al.
-    /// 2019); parameters from the profile's [svgf] / [bmfr] sections.
+    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017) | asvgf (Schied et al. 2018:
+    /// SVGF with temporal gradients) | bmfr (Koskela et al. 2019); parameters from the profile's
+    /// [svgf] / [asvgf] / [bmfr] sections (VP needs the paper's layout).
     #[arg(long, default_value = "none")]
     denoiser: String,
     /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for

@@ -1,6 +1,6 @@
 //! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF and BMFR parameters (used with `--denoiser svgf` / `bmfr`) and the TAA parameters
-//! (used with `--taa vp` or `--taa screen`).
+//! the SVGF, A-SVGF and BMFR parameters (used with `--denoiser svgf` / `asvgf` / `bmfr`; A-SVGF's
+//! SVGF stages take `[svgf]`) and the TAA parameters (used with `--taa vp` or `--taa screen`).
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 //! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
@@ -9,6 +9,7 @@
 use anyhow::{bail, Context, Result};
 use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
+use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
@@ -24,6 +25,8 @@ pub struct RenderProfile {
     pub blur: BlurSettings,
     pub svgf: SvgfSettings,
     pub bmfr: BmfrSettings,
+    /// Its `svgf` is always the `[svgf]` section's.
+    pub asvgf: AsvgfSettings,
     pub taa: TaaSettings,
 }
 
@@ -34,7 +37,16 @@ struct ProfileFile {
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
     bmfr: Option<BmfrSection>,
+    asvgf: Option<AsvgfSection>,
     taa: Option<TaaSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct AsvgfSection {
+    gradient_iterations: Option<u32>,
+    gradient_sigma_depth: Option<f32>,
+    gradient_sigma_normal: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -215,6 +227,14 @@ impl RenderProfile {
             s.noise = f.noise.unwrap_or(s.noise);
             s.validate().with_context(|| at("bmfr"))?;
         }
+        profile.asvgf.svgf = profile.svgf;
+        if let Some(f) = file.asvgf {
+            let s = &mut profile.asvgf;
+            s.gradient_iterations = f.gradient_iterations.unwrap_or(s.gradient_iterations);
+            s.gradient_sigma_depth = f.gradient_sigma_depth.unwrap_or(s.gradient_sigma_depth);
+            s.gradient_sigma_normal = f.gradient_sigma_normal.unwrap_or(s.gradient_sigma_normal);
+            s.validate().with_context(|| at("asvgf"))?;
+        }
         if let Some(f) = file.taa {
             let s = &mut profile.taa;
             s.current_weight = f.current_weight.unwrap_or(s.current_weight);
@@ -307,6 +327,7 @@ mod tests {
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.svgf, SvgfSettings::default());
         assert_eq!(p.bmfr, BmfrSettings::default());
+        assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
     }
 
@@ -331,6 +352,15 @@ mod tests {
         assert_eq!(RenderProfile::default().visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Normalized);
         let p = load_str("bmfr_ok.toml", "[bmfr]\nalpha_noisy = 0.25\nnoise = 0\n").unwrap();
         assert_eq!(p.bmfr, BmfrSettings { alpha_noisy: 0.25, noise: 0.0, ..Default::default() });
+        let p = load_str("asvgf_ok.toml", "[svgf]
+alpha_color = 0.1
+[asvgf]
+gradient_iterations = 2
+gradient_sigma_normal = 64
+").unwrap();
+        assert_eq!(p.asvgf.gradient_iterations, 2);
+        assert_eq!(p.asvgf.gradient_sigma_normal, 64.0);
+        assert_eq!(p.asvgf.svgf.alpha_color, 0.1, "A-SVGF's SVGF stages take the [svgf] section");
     }
 
     #[test]
@@ -353,6 +383,10 @@ mod tests {
             ("bmfr.toml", "[bmfr]\nalpha_filtered = 1.0\n", "bmfr"),
             ("bmfr_noise.toml", "[bmfr]\nnoise = -0.01\n", "bmfr"),
             ("bmfr_key.toml", "[bmfr]\nblock_size = 16\n", "block_size"),
+            ("asvgf.toml", "[asvgf]\ngradient_iterations = 0\n", "asvgf"),
+            ("asvgf_sigma.toml", "[asvgf]\ngradient_sigma_depth = -1\n", "asvgf"),
+            ("asvgf_key.toml", "[asvgf]\nalpha = 0.5\n", "alpha"),
+            ("asvgf_svgf.toml", "[svgf]\nalpha_color = 0\n[asvgf]\n", "svgf"),
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 pub use bvh::{Bvh, BvhNode};
 pub use intersect::{Hit, Ray};
-pub use lights::{build_light_table, AliasSlot, LightEntry, LightKind, LightTable};
+pub use lights::{build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable};
 
 /// A loaded scene, flattened to world space.
 #[derive(Clone, Debug, Default)]

@@ -71,18 +71,25 @@ fn mean_linear_colour(texture: &Texture) -> Vec3 {
 }
 
 pub fn build_light_table(scene: &Scene) -> LightTable {
+    build_light_table_scaled(scene, &[])
+}
+
+/// The light table with material i's emission scaled by `emission_scale[i]` (1 beyond the slice;
+/// 0 drops its triangles): lights switched or dimmed at run time.
+pub fn build_light_table_scaled(scene: &Scene, emission_scale: &[f32]) -> LightTable {
     let mut entries = Vec::new();
     // Mean texture colours are computed once per texture that some emissive material uses.
     let mut texture_means: Vec<Option<Vec3>> = vec![None; scene.textures.len()];
     let material_emission: Vec<Vec3> = scene
         .materials
         .iter()
-        .map(|m| {
+        .enumerate()
+        .map(|(i, m)| {
             let texture_mean = m.emissive_texture.and_then(|t| {
                 let texture = scene.textures.get(t as usize)?;
                 Some(*texture_means[t as usize].get_or_insert_with(|| mean_linear_colour(texture)))
             });
-            m.emissive * texture_mean.unwrap_or(Vec3::ONE)
+            m.emissive * texture_mean.unwrap_or(Vec3::ONE) * emission_scale.get(i).copied().unwrap_or(1.0)
         })
         .collect();
     for (i, tri) in scene.triangles.iter().enumerate() {

@@ -100,3 +100,23 @@ fn emissive_texture_mean_scales_triangle_power() {
     let table = build_light_table(&scene);
     assert!((table.entries[0].power - 0.5 * 0.5 * PI).abs() < 1e-5);
 }
+
+#[test]
+fn emission_scale_dims_or_drops_a_materials_triangles() {
+    let v = |p: Vec3| Vertex { position: p, normal: Vec3::Z, uv: Vec2::ZERO, tangent: Vec4::X };
+    let scene = Scene {
+        vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
+        triangles: vec![Triangle { indices: [0, 1, 2], material: 0, mesh: 0 }, Triangle { indices: [0, 1, 2], material: 1, mesh: 1 }],
+        materials: vec![Material { emissive: Vec3::ONE, ..Material::default() }, Material { emissive: Vec3::ONE, ..Material::default() }],
+        ..Scene::default()
+    };
+    let full = build_light_table(&scene);
+    let dimmed = build_light_table_scaled(&scene, &[0.25]);
+    assert_eq!(dimmed.entries.len(), 2);
+    assert!((dimmed.entries[0].power - 0.25 * full.entries[0].power).abs() < 1e-6);
+    assert_eq!(dimmed.entries[1].power, full.entries[1].power, "materials beyond the slice keep their emission");
+    assert!((dimmed.alias[0].pdf - 0.2).abs() < 1e-6, "pdfs follow the new powers");
+    let off = build_light_table_scaled(&scene, &[1.0, 0.0]);
+    assert_eq!(off.entries.iter().map(|e| e.index).collect::<Vec<_>>(), vec![0]);
+    assert!(build_light_table_scaled(&scene, &[0.0, 0.0]).entries.is_empty());
+}

@@ -1,4 +1,5 @@
 //! The path-tracing pass: one sample per sampling-grid texel, writing the per-sample G-buffer.
+//! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf).
 
 use super::push_bytes;
 use crate::error::Result;
@@ -27,6 +28,11 @@ pub struct GBuffer {
     pub ids: Image,
     /// Previous frame's screen position of the surface (−1: none).
     pub motion: Image,
+    /// Only for A-SVGF (`GBuffer::with_visibility`; written by the gradient kernel variants):
+    /// x, y barycentrics of the hit (float bits), z the RNG state after the jitter draw — what
+    /// re-shading exactly this sample's path next frame needs besides `ids` — and w 1 where the
+    /// sample was itself a gradient sample (not projected again).
+    pub visibility: Option<Image>,
 }
 
 impl GBuffer {
@@ -41,8 +47,27 @@ impl GBuffer {
             position: image("gbuffer.position", vk::Format::R32G32B32A32_SFLOAT)?,
             ids: image("gbuffer.ids", vk::Format::R32G32_UINT)?,
             motion: image("gbuffer.motion", vk::Format::R32G32_SFLOAT)?,
+            visibility: None,
         })
     }
+
+    /// A G-buffer with the visibility image the A-SVGF gradient samples are projected from.
+    pub fn with_visibility(ctx: &Arc<Context>, size: UVec2) -> Result<GBuffer> {
+        let mut g = GBuffer::new(ctx, size)?;
+        g.visibility = Some(Image::new(ctx, "gbuffer.visibility", size.x, size.y, vk::Format::R32G32B32A32_UINT)?);
+        Ok(g)
+    }
+}
+
+/// What the `*_gradients` kernel variants read and write besides the G-buffer (A-SVGF).
+#[derive(Clone, Copy)]
+pub struct GradientTargets<'a> {
+    /// The forward-projected samples (`AsvgfGradientSample` per 3×3 stratum); the tracer adds
+    /// this frame's luminance.
+    pub samples: &'a Buffer,
+    /// Per stratum: δ, max f, 1 where a sample was re-shaded (zeros elsewhere: the forward
+    /// projection clears it).
+    pub gradient: &'a Image,
 }
 
 pub struct TracePass {
@@ -61,7 +86,8 @@ impl TracePass {
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
     /// frame (reference accumulation); real-time frames use 0. `sampling_table` holds the space's
-    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs).
+    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs). `gradients`: A-SVGF's,
+    /// for the `*_gradients` variants (which also write `out.visibility`).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -73,9 +99,10 @@ impl TracePass {
         ray_counters: &Buffer,
         out: &GBuffer,
         sample_index: u32,
+        gradients: Option<GradientTargets>,
     ) -> Result<()> {
         let s = scene.binds();
-        let binds = [
+        let mut binds = vec![
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
@@ -89,6 +116,11 @@ impl TracePass {
             write_image("out_ids", &out.ids),
             write_image("out_motion", &out.motion),
         ];
+        if let (Some(g), Some(visibility)) = (gradients, &out.visibility) {
+            binds.push(write_buffer("gradient_samples", g.samples));
+            binds.push(write_image("out_gradient", g.gradient));
+            binds.push(write_image("out_visibility", visibility));
+        }
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
         rec.dispatch("trace", &self.pipeline, &binds, push_bytes(&push), [out.size.x, out.size.y, 1])
     }

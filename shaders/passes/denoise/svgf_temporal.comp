@@ -5,8 +5,13 @@
 // 3×3 around it), and blends colour and luminance moments with α = max(α_min, 1/history).
 // Writes: accumulated colour + temporal variance, moments + history length, and this frame's
 // surface for the next frame's test. Texels without a sample get zeros.
+// The *_adaptive variants are A-SVGF's (Schied et al. 2018, §4.3): the reconstructed temporal
+// gradient of the texel's stratum gives λ = |δ̂| / max(f_i, f_{i−1}), which raises both alphas to
+// (1 − λ)·α + λ and shortens the history length by the same factor (a changed light restarts it).
 //! variant cartesian: SAMPLING_CARTESIAN
 //! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variant cartesian_adaptive: SAMPLING_CARTESIAN SVGF_ADAPTIVE_ALPHA
+//! variant visual_polar_adaptive: SAMPLING_VISUAL_POLAR SVGF_ADAPTIVE_ALPHA
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"
@@ -24,6 +29,9 @@ layout(set = 0, binding = 7, rgba32ui) uniform readonly uimage2D prev_surface;
 layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D accum;         // colour, variance
 layout(set = 0, binding = 9, rgba32f) uniform writeonly image2D moments;       // m1, m2, history length
 layout(set = 0, binding = 10, rgba32ui) uniform writeonly uimage2D surface;
+#if defined(SVGF_ADAPTIVE_ALPHA)
+layout(set = 0, binding = 11, rgba32f) uniform readonly image2D gradient;      // per stratum: δ̂, max f, confidence
+#endif
 
 vec3 hist_color;
 vec3 hist_moments; // m1, m2, length
@@ -86,9 +94,17 @@ void main() {
     if (hist_weight > 0.0) {
         vec3 h = hist_color / hist_weight;
         vec3 hm = hist_moments / hist_weight;
+#if defined(SVGF_ADAPTIVE_ALPHA)
+        vec3 gr = imageLoad(gradient, t / int(ASVGF_STRATUM)).xyz;
+        float lambda = gr.z > 0.0 ? clamp(abs(gr.x) / max(gr.y, 1e-6), 0.0, 1.0) : 0.0;
+        len = min((1.0 - lambda) * hm.z + 1.0, push.p.params.z);
+        color = mix(h, c, mix(max(push.p.params.x, 1.0 / len), 1.0, lambda));
+        m = mix(hm.xy, m, mix(max(push.p.params.y, 1.0 / len), 1.0, lambda));
+#else
         len = min(hm.z + 1.0, push.p.params.z);
         color = mix(h, c, max(push.p.params.x, 1.0 / len));
         m = mix(hm.xy, m, max(push.p.params.y, 1.0 / len));
+#endif
     }
     imageStore(accum, t, vec4(color, max(m.y - m.x * m.x, 0.0)));
     imageStore(moments, t, vec4(m, len, 0.0));

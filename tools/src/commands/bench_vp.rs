@@ -50,13 +50,25 @@ fn denoisers() -> Vec<DenoiserSettings> {
     DenoiserSettings::NAMES.iter().filter(|n| **n != "none").map(|n| DenoiserSettings::parse(n).expect("a listed denoiser")).collect()
 }
 
+/// Name prefixes of a denoiser's passes: its own, and for A-SVGF the SVGF stages it reuses.
+fn pass_prefixes(denoiser: &DenoiserSettings) -> Vec<String> {
+    let own = format!("{}_", denoiser.name());
+    if denoiser.needs_gradients() {
+        vec![own, "svgf_".to_string()]
+    } else {
+        vec![own]
+    }
+}
+
 /// One denoiser in VP vs Cartesian space: its passes' median ms per frame, their sum, VP /
 /// Cartesian, and the bytes of history each space carries between frames.
 #[derive(Serialize)]
 pub struct DenoiserCost {
     pub name: String,
+    /// Its passes, and the trace (listed, not summed: A-SVGF's tracer re-shades gradient samples).
     pub cartesian_passes_ms: BTreeMap<String, f64>,
     pub vp_passes_ms: BTreeMap<String, f64>,
+    /// Its passes without the trace.
     pub cartesian_ms: f64,
     pub vp_ms: f64,
     pub ratio: f64,
@@ -117,14 +129,15 @@ pub fn measure(
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let settings = RenderSettings { denoiser, ..Default::default() };
-        let prefix = format!("{}_", denoiser.name());
+        let prefixes = pass_prefixes(&denoiser);
         let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
-        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&mut cart, &prefix, pose, None, frames)?;
+        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&mut cart, &prefixes, pose, None, frames)?;
         drop(cart);
         let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
-        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&mut vpr, &prefix, pose, Some(gaze), frames)?;
+        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&mut vpr, &prefixes, pose, Some(gaze), frames)?;
         drop(vpr);
-        let (cartesian_ms, vp_ms) = (cartesian_passes_ms.values().sum::<f64>(), vp_passes_ms.values().sum::<f64>());
+        let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
+        let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
         costs.push(DenoiserCost {
             name: denoiser.name().to_string(),
             cartesian_passes_ms,
@@ -201,10 +214,11 @@ pub fn measure(
     Ok(report)
 }
 
-/// Median ms per frame of each of the denoiser's passes (named `prefix*`), and its history bytes.
-fn denoiser_cost(renderer: &mut Renderer, prefix: &str, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(BTreeMap<String, f64>, u64)> {
+/// Median ms per frame of each of the denoiser's passes (named `prefix*` for one of `prefixes`)
+/// and of the trace, and the denoiser's history bytes.
+fn denoiser_cost(renderer: &mut Renderer, prefixes: &[String], camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(BTreeMap<String, f64>, u64)> {
     let passes = pass_medians(renderer, camera, gaze, frames)?;
-    let own = passes.into_iter().filter(|(k, _)| k.starts_with(prefix)).collect();
+    let own = passes.into_iter().filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str()))).collect();
     let bytes = renderer.denoiser().map_or(0, |d| d.history_bytes());
     Ok((own, bytes))
 }

@@ -37,7 +37,7 @@ pub struct RenderArgs<'a> {
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
-    /// `none`, `svgf` or `bmfr` (`DenoiserSettings::NAMES`).
+    /// `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
     /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
     pub taa: &'a str,
@@ -51,7 +51,7 @@ pub const METHODS: &[&str] = &["vp", "cartesian"];
 #[derive(Serialize)]
 struct Report {
     method: String,
-    /// Denoiser in the sampling grid (`none`, `svgf`, `bmfr`).
+    /// Denoiser in the sampling grid (`none`, `svgf`, `asvgf`, `bmfr`).
     denoiser: String,
     /// TAA: `off`, `vp` (in the sampling grid) or `screen` (after the remap; for Cartesian the
     /// sampling-grid filter, the grid being the screen).
@@ -133,6 +133,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
+        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(args.profile.asvgf),
         DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(args.profile.bmfr),
         other => other,
     };

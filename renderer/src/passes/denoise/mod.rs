@@ -5,6 +5,7 @@
 //! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
 //! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
+pub mod asvgf;
 pub mod bmfr;
 pub mod modulate;
 pub mod svgf;
@@ -15,8 +16,9 @@ use bmfr::{Bmfr, BmfrSettings};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, GradientTargets};
 use crate::vk::{Buffer, Context, Image};
+use asvgf::{Asvgf, AsvgfSettings};
 use glam::{UVec2, Vec3};
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
@@ -28,18 +30,20 @@ pub enum DenoiserSettings {
     #[default]
     None,
     Svgf(SvgfSettings),
+    Asvgf(AsvgfSettings),
     Bmfr(BmfrSettings),
 }
 
 impl DenoiserSettings {
     /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["none", "svgf", "bmfr"];
+    pub const NAMES: &'static [&'static str] = &["none", "svgf", "asvgf", "bmfr"];
 
     /// A denoiser by name, with its defaults.
     pub fn parse(name: &str) -> Result<DenoiserSettings> {
         match name {
             "none" => Ok(DenoiserSettings::None),
             "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
+            "asvgf" => Ok(DenoiserSettings::Asvgf(AsvgfSettings::default())),
             "bmfr" => Ok(DenoiserSettings::Bmfr(BmfrSettings::default())),
             other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
         }
@@ -49,8 +53,15 @@ impl DenoiserSettings {
         match self {
             DenoiserSettings::None => "none",
             DenoiserSettings::Svgf(_) => "svgf",
+            DenoiserSettings::Asvgf(_) => "asvgf",
             DenoiserSettings::Bmfr(_) => "bmfr",
         }
+    }
+
+    /// Whether the tracer must re-shade gradient samples (its `*_gradients` variant) and keep
+    /// the visibility they are projected from.
+    pub fn needs_gradients(&self) -> bool {
+        matches!(self, DenoiserSettings::Asvgf(_))
     }
 }
 
@@ -75,6 +86,7 @@ pub struct DenoiseScene<'a> {
 /// A denoiser with its per-eye state.
 pub enum Denoiser {
     Svgf(Box<Svgf>),
+    Asvgf(Box<Asvgf>),
     Bmfr(Box<Bmfr>),
 }
 
@@ -84,6 +96,7 @@ impl Denoiser {
         Ok(match settings {
             DenoiserSettings::None => None,
             DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
+            DenoiserSettings::Asvgf(s) => Some(Denoiser::Asvgf(Box::new(Asvgf::new(ctx, grid, variant, *s)?))),
             DenoiserSettings::Bmfr(s) => Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?))),
         })
     }
@@ -92,6 +105,7 @@ impl Denoiser {
     pub fn history_bytes(&self) -> u64 {
         match self {
             Denoiser::Svgf(s) => s.history.bytes(),
+            Denoiser::Asvgf(a) => a.history_bytes(),
             Denoiser::Bmfr(b) => b.history.bytes(),
         }
     }
@@ -100,7 +114,25 @@ impl Denoiser {
     pub fn max_passes(&self) -> u32 {
         match self {
             Denoiser::Svgf(s) => s.max_passes(),
+            Denoiser::Asvgf(a) => a.max_passes(),
             Denoiser::Bmfr(b) => b.max_passes(),
+        }
+    }
+
+    /// Records what must run before the tracer, while `gbuffer` still holds last frame (A-SVGF's
+    /// forward projection). `frame_data`: the frame's uniform buffer (both cameras).
+    pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
+        match self {
+            Denoiser::Svgf(_) | Denoiser::Bmfr(_) => Ok(()),
+            Denoiser::Asvgf(a) => a.record_before_trace(rec, gbuffer, frame, frame_data),
+        }
+    }
+
+    /// What the tracer's gradient variant re-shades and writes (A-SVGF only).
+    pub fn gradient_targets(&self) -> Option<GradientTargets<'_>> {
+        match self {
+            Denoiser::Svgf(_) | Denoiser::Bmfr(_) => None,
+            Denoiser::Asvgf(a) => Some(a.gradient_targets()),
         }
     }
 
@@ -108,6 +140,7 @@ impl Denoiser {
     pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
+            Denoiser::Asvgf(a) => a.record(rec, gbuffer, frame),
             Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, scene),
         }
     }

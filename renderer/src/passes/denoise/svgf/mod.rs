@@ -143,11 +143,20 @@ pub struct Svgf {
 impl Svgf {
     /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
     pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: SvgfSettings) -> Result<Svgf> {
+        Svgf::build(ctx, grid, variant, variant, settings)
+    }
+
+    /// SVGF whose temporal accumulation takes A-SVGF's reconstructed gradient (`record_adaptive`).
+    pub(crate) fn adaptive(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: SvgfSettings) -> Result<Svgf> {
+        Svgf::build(ctx, grid, variant, &format!("{variant}_adaptive"), settings)
+    }
+
+    fn build(ctx: &Arc<Context>, grid: UVec2, variant: &str, temporal_variant: &str, settings: SvgfSettings) -> Result<Svgf> {
         settings.validate()?;
         let image = |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(Svgf {
             settings,
-            temporal: TemporalPass::new(ctx, variant)?,
+            temporal: TemporalPass::new(ctx, temporal_variant)?,
             variance: VariancePass::new(ctx, variant)?,
             atrous: AtrousPass::new(ctx, variant)?,
             modulate: ModulatePass::new(ctx)?,
@@ -170,11 +179,21 @@ impl Svgf {
     /// Records one frame: temporal → variance → à-trous iterations → modulate; returns `output`.
     /// History is dropped on the first frame and whenever `frame.previous` is `None`.
     pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+        self.record_with(rec, g, frame, None)
+    }
+
+    /// `record` for SVGF built by `adaptive`: `gradient` (per 3×3 stratum: δ̂, max f, confidence)
+    /// sets each texel's temporal α.
+    pub(crate) fn record_adaptive(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, gradient: &Image) -> Result<&Image> {
+        self.record_with(rec, g, frame, Some(gradient))
+    }
+
+    fn record_with(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, gradient: Option<&Image>) -> Result<&Image> {
         let s = self.settings;
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous };
-        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, previous.as_ref(), &s)?;
+        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, previous.as_ref(), &s, gradient)?;
         self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, &s)?;
         // Iteration 0 writes the colour history; then the two ping images alternate.
         let mut src = &self.ping[0];

@@ -22,7 +22,8 @@ impl TemporalPass {
     }
 
     /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance). `previous`:
-    /// the previous frame's space, `None` to start every history afresh.
+    /// the previous frame's space, `None` to start every history afresh. `gradient`: A-SVGF's
+    /// reconstructed gradient per stratum, for the `*_adaptive` kernel variants.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -35,8 +36,9 @@ impl TemporalPass {
         current: &SamplingParams,
         previous: Option<&SamplingParams>,
         s: &SvgfSettings,
+        gradient: Option<&Image>,
     ) -> Result<()> {
-        let binds = [
+        let mut binds = vec![
             read_image("radiance", &g.radiance),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
@@ -49,6 +51,9 @@ impl TemporalPass {
             write_image("moments", &h.moments[cur]),
             write_image("surface", &h.surface[cur]),
         ];
+        if let Some(gradient) = gradient {
+            binds.push(read_image("gradient", gradient));
+        }
         // The grid and screen never change for one renderer: only the gaze-dependent slots travel.
         let p = previous.unwrap_or(current);
         let reset = if previous.is_none() { 1.0 } else { 0.0 };

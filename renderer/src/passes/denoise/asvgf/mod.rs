@@ -1,0 +1,158 @@
+//! A-SVGF — SVGF with temporal gradients (Schied, Peters, Dachsbacher 2018; denoisers.md) on the
+//! sampling grid. Per 3×3 stratum one sample of last frame (the brightest) is forward-projected
+//! into this frame's grid (`forward`), where the tracer's gradient variant re-shades that surface
+//! with that sample's random state: δ = f_i − f_{i−1} is then the change of the lighting alone.
+//! The gradients are reconstructed at 1/3 resolution by joint-bilateral à-trous iterations
+//! (`gradient`), and SVGF's temporal accumulation uses α_i = (1 − λ)·α + λ with
+//! λ = |δ̂| / max(f_i, f_{i−1}) (its `*_adaptive` kernel variant); the rest is SVGF's.
+//!
+//! Visual-Polar: strata wrap on φ and end at the grid on ρ (`shaders/denoise/strata.glsl`); the
+//! projection goes world → this frame's screen → this frame's grid (this frame's gaze). Only the
+//! paper's layout: the tracer has no gradient variant of the screen-clipped one.
+
+mod forward;
+mod gradient;
+
+use super::svgf::{Svgf, SvgfSettings};
+use super::DenoiseFrame;
+use crate::error::{Error, Result};
+use crate::graph::FrameRecorder;
+use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
+use crate::passes::trace::{GBuffer, GradientTargets};
+use crate::vk::{Buffer, Context, Image};
+use ash::vk;
+use forward::ForwardPass;
+use glam::UVec2;
+use gpu_allocator::MemoryLocation;
+use gradient::GradientPass;
+use std::sync::Arc;
+
+/// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AsvgfSettings {
+    pub svgf: SvgfSettings,
+    /// À-trous iterations of the gradient reconstruction (5×5 taps, spacing 2^i strata).
+    pub gradient_iterations: u32,
+    /// Depth edge-stop σ_z of the reconstruction (as SVGF's).
+    pub gradient_sigma_depth: f32,
+    /// Normal edge-stop exponent σ_n of the reconstruction.
+    pub gradient_sigma_normal: f32,
+}
+
+impl Default for AsvgfSettings {
+    fn default() -> Self {
+        AsvgfSettings { svgf: SvgfSettings::default(), gradient_iterations: 4, gradient_sigma_depth: 1.0, gradient_sigma_normal: 128.0 }
+    }
+}
+
+/// Most reconstruction iterations accepted: 2^7 strata apart spans any grid.
+pub const MAX_GRADIENT_ITERATIONS: u32 = 8;
+
+impl AsvgfSettings {
+    pub fn validate(&self) -> Result<()> {
+        self.svgf.validate()?;
+        let bad = |what: String| Err(Error::Invalid(format!("asvgf: {what}")));
+        if !(1..=MAX_GRADIENT_ITERATIONS).contains(&self.gradient_iterations) {
+            return bad(format!("gradient_iterations must be in 1..={MAX_GRADIENT_ITERATIONS}, got {}", self.gradient_iterations));
+        }
+        let sigmas = [self.gradient_sigma_depth, self.gradient_sigma_normal];
+        if !sigmas.iter().all(|s| s.is_finite() && *s > 0.0) {
+            return bad(format!("gradient σ_z, σ_n must be finite and > 0, got {sigmas:?}"));
+        }
+        Ok(())
+    }
+}
+
+pub struct Asvgf {
+    pub settings: AsvgfSettings,
+    pub svgf: Svgf,
+    forward: ForwardPass,
+    gradient: GradientPass,
+    /// One `AsvgfGradientSample` per stratum, cleared every frame (host-visible for inspection).
+    pub samples: Buffer,
+    /// Per stratum: δ, max f, 1 where the tracer re-shaded a sample (zeros elsewhere).
+    raw: Image,
+    /// Reconstruction ping-pong (strata-sized: δ̂, max f, confidence).
+    ping: [Image; 2],
+    /// Bytes of the G-buffer's visibility image, which carries last frame's samples to this one.
+    visibility_bytes: u64,
+    frames: u64,
+}
+
+impl Asvgf {
+    /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
+    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: AsvgfSettings) -> Result<Asvgf> {
+        settings.validate()?;
+        let strata = (grid + (ASVGF_STRATUM - 1)) / ASVGF_STRATUM;
+        let count = strata.x as u64 * strata.y as u64;
+        let image = |name: &str| Image::new(ctx, name, strata.x, strata.y, vk::Format::R32G32B32A32_SFLOAT);
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let sample_bytes = std::mem::size_of::<AsvgfGradientSample>() as u64;
+        Ok(Asvgf {
+            settings,
+            svgf: Svgf::adaptive(ctx, grid, variant, settings.svgf)?,
+            forward: ForwardPass::new(ctx, variant)?,
+            gradient: GradientPass::new(ctx, variant)?,
+            samples: Buffer::new(ctx, "asvgf.gradient_samples", count * sample_bytes, usage, MemoryLocation::GpuToCpu)?,
+            raw: image("asvgf.gradient_raw")?,
+            ping: [image("asvgf.gradient0")?, image("asvgf.gradient1")?],
+            visibility_bytes: grid.x as u64 * grid.y as u64 * 16,
+            frames: 0,
+        })
+    }
+
+    /// Dispatches (and fills) one frame records at most.
+    pub fn max_passes(&self) -> u32 {
+        self.svgf.max_passes() + self.settings.gradient_iterations + 2
+    }
+
+    /// GPU bytes carried between frames: SVGF's history and the visibility the projection reads.
+    pub fn history_bytes(&self) -> u64 {
+        self.svgf.history.bytes() + self.visibility_bytes
+    }
+
+    /// Before the tracer: clears the gradient samples and projects last frame's into them (none on
+    /// the first frame or without a previous frame). `frame_data` holds both cameras.
+    pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
+        rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
+        let project = self.frames > 0 && frame.previous.is_some();
+        self.forward.record(rec, g, frame_data, &self.samples, &self.raw, &frame.current, project)
+    }
+
+    /// The tracer's gradient-variant inputs and outputs.
+    pub fn gradient_targets(&self) -> GradientTargets<'_> {
+        GradientTargets { samples: &self.samples, gradient: &self.raw }
+    }
+
+    /// After the tracer: reconstructs the gradients, then SVGF with the adaptive α.
+    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+        let s = self.settings;
+        let mut src = &self.raw;
+        for i in 0..s.gradient_iterations {
+            let dst = &self.ping[(i % 2) as usize];
+            self.gradient.record(rec, g, src, dst, 1 << i, &frame.current, &s)?;
+            src = dst;
+        }
+        let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];
+        self.frames += 1;
+        self.svgf.record_adaptive(rec, g, frame, gradient)
+    }
+
+    /// The gradient samples of the last recorded frame.
+    pub fn read_samples(&self) -> Result<Vec<AsvgfGradientSample>> {
+        let strata = self.strata();
+        let mut out = vec![AsvgfGradientSample::default(); (strata.x * strata.y) as usize];
+        self.samples.read_into(&mut out)?;
+        Ok(out)
+    }
+
+    /// The reconstructed gradient of the last recorded frame (δ̂, max f, confidence per stratum).
+    pub fn gradient(&self) -> &Image {
+        &self.ping[((self.settings.gradient_iterations - 1) % 2) as usize]
+    }
+
+    /// Size of the strata grid.
+    pub fn strata(&self) -> UVec2 {
+        UVec2::new(self.raw.width, self.raw.height)
+    }
+}

@@ -1,0 +1,56 @@
+// A-SVGF's 3×3 strata of the sampling grid (Schied et al. 2018): one gradient sample each, and the
+// 1/3-resolution grid the gradient is reconstructed on. Stratum (sx, sy) holds the texels
+// 3·(sx, sy) + [0, 3)². Visual-Polar (visual-polar.md §5): a stratum column has as many strata as
+// its tallest column needs; strata wrap on φ (keeping the angle across columns of different
+// height, like grid_column_tap), end at the grid on ρ, and a stratum whose texels are all clipped
+// holds nothing.
+#ifndef FOVEA_DENOISE_STRATA_GLSL
+#define FOVEA_DENOISE_STRATA_GLSL
+
+#include "grid.glsl"
+
+const int STRATUM = int(ASVGF_STRATUM);
+
+// Index of the stratum holding `texel` in the sample buffer (row-major over the strata grid).
+uint asvgf_stratum_index(ivec2 texel, int grid_width) {
+    int width = (grid_width + STRATUM - 1) / STRATUM;
+    return uint((texel.y / STRATUM) * width + texel.x / STRATUM);
+}
+
+ivec2 strata_size(Grid g) {
+    return (g.size + STRATUM - 1) / STRATUM;
+}
+
+// Strata in stratum column sx (Visual-Polar rows grow with ρ: the last column is the tallest).
+int strata_rows(Grid g, int sx) {
+    int col = min(STRATUM * sx + STRATUM - 1, g.size.x - 1);
+    return (grid_rows(g, col) + STRATUM - 1) / STRATUM;
+}
+
+bool stratum_holds_samples(Grid g, ivec2 s) {
+    return s.x >= 0 && s.y >= 0 && s.x < strata_size(g).x && s.y < strata_rows(g, s.x);
+}
+
+// A texel of stratum s holding a sample, near its centre: where the edge-stopping functions read
+// the stratum's surface.
+ivec2 stratum_centre_texel(Grid g, ivec2 s) {
+    int col = min(STRATUM * s.x + 1, g.size.x - 1);
+    return ivec2(col, clamp(STRATUM * s.y + 1, 0, grid_rows(g, col) - 1));
+}
+
+// The stratum `o` strata away from s (o.y in strata of s's column); false when it leaves the
+// strata grid (Cartesian: any side; Visual-Polar: ρ only, φ wraps).
+bool strata_tap(Grid g, ivec2 s, ivec2 o, out ivec2 tap) {
+    tap = s + o;
+    if (tap.x < 0 || tap.x >= strata_size(g).x) return false;
+#if defined(SAMPLING_VISUAL_POLAR)
+    int n0 = strata_rows(g, s.x);
+    int n1 = o.x == 0 ? n0 : strata_rows(g, tap.x);
+    tap.y = grid_wrap(int(floor((float(s.y) + 0.5 + float(o.y)) * float(n1) / float(n0))), n1);
+    return true;
+#else
+    return tap.y >= 0 && tap.y < strata_size(g).y;
+#endif
+}
+
+#endif

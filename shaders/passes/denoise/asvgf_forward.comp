@@ -1,0 +1,72 @@
+#version 460
+// A-SVGF forward projection (Schied et al. 2018, §4.1): per stratum of last frame's grid, the
+// brightest sample that hit a surface (brightest: a moving penumbra shows up there first) and was
+// not itself a gradient sample (a path repeated again and again — the brightest at that — would
+// stay in the image as a fixed bright sample) is
+// carried to this frame — world position → this frame's screen → this frame's grid — and claims
+// the stratum it lands in (the first claim wins). The tracer's gradient variant then re-shades that
+// surface with that sample's random state in the texel it landed in. Runs before the tracer, so
+// the G-buffer still holds last frame. Each invocation also clears its stratum of the gradient
+// image, where the tracer writes the strata that got a gradient sample (the strata grids of both
+// frames are one). Strata in the Visual-Polar grid: shaders/denoise/strata.glsl.
+//! variant cartesian: SAMPLING_CARTESIAN
+//! variant visual_polar: SAMPLING_VISUAL_POLAR
+#include "../../common/layouts.glsl"
+#include "../../common/camera.glsl"
+#include "../../denoise/strata.glsl"
+#include "../../denoise/svgf.glsl"
+
+layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
+layout(push_constant) uniform Push { AsvgfForwardPush p; } push;
+layout(std140, set = 0, binding = 0) uniform FrameBuffer { FrameData data; } frame;
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D radiance;      // last frame's, demodulated
+layout(set = 0, binding = 2, rg32ui) uniform readonly uimage2D ids;           // x triangle + 1 (0: miss)
+layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;      // camera-relative (last camera)
+layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state, 1: gradient sample
+layout(std430, set = 0, binding = 5) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
+layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D gradient;   // per stratum: δ, max f, 1 (written by the tracer)
+
+// The camera position of a rigid view-from-world transform.
+vec3 camera_origin(mat4 view_from_world) {
+    return -(transpose(mat3(view_from_world)) * view_from_world[3].xyz);
+}
+
+void main() {
+    ivec2 s = ivec2(gl_GlobalInvocationID.xy);
+    // The grid's rows per column do not depend on the gaze: this frame's grid addresses last frame's.
+    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    if (any(greaterThanEqual(s, strata_size(g)))) return;
+    imageStore(gradient, s, vec4(0.0));
+    if (push.p.config.x == 0u || !stratum_holds_samples(g, s)) return;
+
+    float brightest = -1.0;
+    ivec2 picked = ivec2(0);
+    for (int j = 0; j < STRATUM; ++j) {
+        for (int i = 0; i < STRATUM; ++i) {
+            ivec2 t = STRATUM * s + ivec2(i, j);
+            if (!grid_holds_sample(g, t) || imageLoad(ids, t).x == 0u || imageLoad(visibility, t).w != 0u) continue;
+            float l = svgf_luminance(svgf_sanitize(imageLoad(radiance, t).rgb));
+            if (l > brightest) {
+                brightest = l;
+                picked = t;
+            }
+        }
+    }
+    if (brightest < 0.0) return;
+
+    FrameData fd = frame.data;
+    vec3 world = imageLoad(position, picked).xyz + camera_origin(fd.prev_view_from_world);
+    vec3 view = transpose(mat3(fd.world_from_view)) * (world - fd.world_from_view[3].xyz);
+    vec2 screen;
+    vec2 p;
+    if (!project_view(view, fd.fov_tan, fd.screen.xy, screen) || !grid_from_screen(g, screen, p)) return;
+    ivec2 target = grid_nearest(g, p);
+    if (!grid_holds_sample(g, target)) return;
+
+    uint index = asvgf_stratum_index(target, g.size.x);
+    uint claim = uint(picked.y * g.size.x + picked.x) + 1u;
+    if (atomicCompSwap(gradient_samples.data[index].surface.x, 0u, claim) != 0u) return;
+    uvec4 vis = imageLoad(visibility, picked);
+    gradient_samples.data[index].surface.yzw = uvec3(imageLoad(ids, picked).x, vis.xy);
+    gradient_samples.data[index].shading = uvec4(uint(target.x) | (uint(target.y) << 16u), vis.z, floatBitsToUint(brightest), ASVGF_NO_LUMINANCE);
+}
