@@ -39,9 +39,10 @@ layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;      
 // [3] traced samples whose screen position is off the screen.
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
 #if defined(TRACE_GRADIENTS)
-layout(set = 0, binding = 18, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
-layout(std430, set = 0, binding = 19) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
-layout(set = 0, binding = 20, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
+// From 21: binding 18 is the VP sampling table (sampling/visual_polar.glsl).
+layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
+layout(std430, set = 0, binding = 22) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
+layout(set = 0, binding = 23, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
 #endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
