@@ -6,9 +6,10 @@
 // Screen-clipped layout (visual_polar_clipped.glsl): a column whose rows cover only its on-screen
 // arcs neither wraps (an odd last row keeps its own value) nor averages across the gap between two
 // arcs (a pair split by a gap keeps the row on the output row's side).
-// Two variants: lavapipe executes both sides of every branch, so the paper's layout gets a kernel
-// with the screen-clipped path compiled out.
-//! variant paper: VP_LAYOUT_PAPER
+// Two variants: lavapipe executes both sides of every branch, so the paper's layout with the
+// normalised ρ axis gets a kernel with the screen-clipped path and the headset axis compiled out;
+// `clipped` is the general kernel (either layout, either axis).
+//! variant paper: VP_LAYOUT_PAPER VP_NORMALIZED_AXIS_ONLY
 //! variant clipped: VP_LAYOUT_CLIPPED
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_clipped.glsl"

@@ -11,9 +11,10 @@
 // beyond that the inner column (whose arcs hold the pixel) answers alone.
 // Samples jittered inside their texel (screen-space TAA) are read where they were traced:
 // sample_offset shifts the lookup by the jitter, in texels along ρ and in level-0 rows along φ.
-// Two variants: lavapipe executes both sides of every branch, so the paper's layout gets a kernel
-// with the screen-clipped path compiled out.
-//! variant paper: VP_LAYOUT_PAPER
+// Two variants: lavapipe executes both sides of every branch, so the paper's layout with the
+// normalised ρ axis gets a kernel with the screen-clipped path and the headset axis compiled out;
+// `clipped` is the general kernel (either layout, either axis).
+//! variant paper: VP_LAYOUT_PAPER VP_NORMALIZED_AXIS_ONLY
 //! variant clipped: VP_LAYOUT_CLIPPED
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_clipped.glsl"

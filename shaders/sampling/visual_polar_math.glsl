@@ -27,6 +27,15 @@ const float VP_DEG_PER_RAD = 57.29578;
 const float VP_RAD_PER_DEG = 0.017453292;
 const float VP_FAR_PIXELS_PER_SCREEN = 4.0;
 
+// Kernels specialised for the paper's normalised axis define VP_NORMALIZED_AXIS_ONLY: lavapipe
+// executes both sides of every branch, so the headset axis's arithmetic (atan, sin, cos, sqrt)
+// would otherwise cost every default frame. Everywhere else P.headset decides at run time.
+#if defined(VP_NORMALIZED_AXIS_ONLY)
+const bool VP_MAY_USE_HEADSET_AXIS = false;
+#else
+const bool VP_MAY_USE_HEADSET_AXIS = true;
+#endif
+
 struct VpParams {
     uvec2 grid;      // VP grid size in texels
     vec2 screen;     // screen size in pixels
@@ -65,7 +74,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.cdf_max = shape1.x;
     p.exact = (flags & 1u) != 0u;
     p.clipped = (flags & 2u) != 0u;
-    p.headset = (flags & 4u) != 0u;
+    p.headset = VP_MAY_USE_HEADSET_AXIS && (flags & 4u) != 0u;
     p.r_max = p.headset ? 1.0 : gaze.z;
     p.e_norm = p.headset ? 1.0 : shape0.w;
     p.gaze_tan = vec2(gaze.z, shape0.w);

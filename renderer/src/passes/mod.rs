@@ -27,9 +27,10 @@ impl VpLayoutPipelines {
         })
     }
 
-    /// The kernel for the layout of `vp` (its flag slot, see VisualPolar::sampling_params).
+    /// The kernel for the space of `vp` (its flag slot, see VisualPolar::sampling_params): the
+    /// `clipped` kernel is the general one (either layout, either ρ axis).
     pub fn for_space(&self, vp: &crate::layouts::SamplingParams) -> &crate::vk::ComputePipeline {
-        if crate::sampling::params_select_clipped_layout(vp) {
+        if crate::sampling::params_need_general_kernel(vp) {
             &self.clipped
         } else {
             &self.paper

@@ -8,7 +8,7 @@ mod visual_polar_clipped;
 mod visual_polar_headset;
 
 pub use cartesian::Cartesian;
-pub use visual_polar::{params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadiusMode, VpLayout};
+pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadiusMode, VpLayout};
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
 

@@ -632,6 +632,13 @@ pub fn params_select_clipped_layout(p: &SamplingParams) -> bool {
     (p.shape1.y as u32) & FLAG_CLIPPED != 0
 }
 
+/// Whether packed parameters need a general VP kernel rather than the one specialised for the
+/// paper's layout and normalised axis (lavapipe runs both sides of a branch, so the default pays
+/// for neither the screen-clipped mapping nor the headset axis).
+pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
+    (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET) != 0
+}
+
 /// The tracer's view of the space: one sample per kept texel; the GPU twin is
 /// `shaders/sampling/visual_polar.glsl` (kernel variant `visual_polar`). With the paper's layout
 /// samples may land off the screen (the r_max circle covers the corners); they are traced, as in
@@ -643,10 +650,12 @@ impl SamplingSpace for VisualPolar {
     fn shader_variant(&self) -> &'static str {
         "visual_polar"
     }
+    /// `visual_polar`: specialised for the paper's layout and normalised axis; otherwise the
+    /// general kernel (`visual_polar_clipped`: either layout, either axis).
     fn trace_variant(&self) -> &'static str {
-        match self.params.layout {
-            VpLayout::Paper => "visual_polar",
-            VpLayout::ScreenClipped => "visual_polar_clipped",
+        match (self.params.layout, self.headset.is_some()) {
+            (VpLayout::Paper, false) => "visual_polar",
+            _ => "visual_polar_clipped",
         }
     }
     fn grid_size(&self) -> UVec2 {

@@ -33,20 +33,18 @@ layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D history;       /
 const float TAA_SCREEN_DEPTH_SLACK = 0.02;
 const float TAA_SCREEN_DEPTH_GRADIENTS = 2.0;
 
-// Screen pixels between neighbouring VP samples around screen distance r (the larger of the ρ and
-// φ steps of one texel): the distance this frame's jitter can move the remapped image.
-float texel_footprint(VpParams P, float r) {
-    float du = 0.5 / float(P.grid.x);
-    float u = vp_u_of_r(P, r);
-    float step_rho = vp_r_of_u(P, min(u + du, 1.0)) - vp_r_of_u(P, max(u - du, 0.0));
-    uint col = vp_column_of(P, u * float(P.grid.x));
-    float step_phi = VP_TAU * r / float(vp_rows_in_column(P, col));
+// Screen pixels between neighbouring VP samples at continuous grid position g (the larger of the
+// ρ and φ steps of one texel, through the space's own mapping, so either ρ axis): the distance
+// this frame's jitter can move the remapped image.
+float texel_footprint(VpParams P, vec2 g) {
+    float x = clamp(g.x, 0.5, float(P.grid.x) - 0.5);
+    float step_rho = length(vp_vp_to_screen(P, vec2(x + 0.5, g.y)) - vp_vp_to_screen(P, vec2(x - 0.5, g.y)));
+    float step_phi = length(vp_vp_to_screen(P, vec2(x, g.y + 0.5)) - vp_vp_to_screen(P, vec2(x, g.y - 0.5)));
     return max(max(step_rho, step_phi), 1.0);
 }
 
-// The VP texel holding the sample nearest to screen position s.
-ivec2 nearest_texel(VpParams P, vec2 s) {
-    vec2 g = vp_screen_to_vp(P, s);
+// The VP texel holding the sample nearest to continuous grid position g.
+ivec2 nearest_texel(VpParams P, vec2 g) {
     uint col = vp_column_of(P, g.x);
     uint rows = vp_rows_in_column(P, col);
     return ivec2(col, min(uint(max(g.y, 0.0)), rows - 1u));
@@ -60,10 +58,11 @@ void main() {
     VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
     vec2 s = vec2(t) + 0.5;
     vec3 c = svgf_sanitize(imageLoad(color, t).rgb);
-    ivec2 texel = nearest_texel(P, s);
+    vec2 g = vp_screen_to_vp(P, s);
+    ivec2 texel = nearest_texel(P, g);
     float depth = imageLoad(normal_depth, texel).w;
     float depth_step = imageLoad(position, texel).w;
-    int spacing = int(round(texel_footprint(P, length(s - P.gaze))));
+    int spacing = int(round(texel_footprint(P, g)));
 
     // Neighbourhood statistics in YCoCg over 3×3 taps one footprint apart (clamped to the screen).
     vec3 cy = rgb_to_ycocg(c);
