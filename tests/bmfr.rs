@@ -14,10 +14,8 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer}
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
-use fovea_tests::denoise::{
-    assert_finite_non_negative, hash, rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,
-};
-use fovea_tests::{assert_clean, gpu, owned_scene, read_image, save_preview, write_image};
+use fovea_tests::denoise::{assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel};
+use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -142,7 +140,7 @@ fn fit_matches_a_cpu_least_squares_solve() {
         let texels: Vec<Option<Texel>> = (0..grid.x * grid.y)
             .map(|i| {
                 blocks_of[i as usize]?;
-                let h = |k: u32| hash(i * 11 + k);
+                let h = |k: u32| unit_hash(i * 11 + k);
                 let normal = [lattice(2.0 * h(1) - 1.0), lattice(2.0 * h(2) - 1.0), lattice(h(3))];
                 let position = [4.0 * h(4) - 2.0, 0.8 * h(5) - 0.4, -5.0 + 0.9 * h(6)];
                 let mut radiance = [0f32; 3];
@@ -150,7 +148,7 @@ fn fit_matches_a_cpu_least_squares_solve() {
                     // Features before the per-block scaling; any linear combination of them is one
                     // of the scaled features too.
                     let f = features(normal, position, [0.0; 3], [1.0; 3]);
-                    *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>() + 0.1 * (hash(i * 11 + 7 + c as u32) - 0.5);
+                    *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>() + 0.1 * (unit_hash(i * 11 + 7 + c as u32) - 0.5);
                     assert!(*r > 0.0, "test colours must be positive (the output is clamped)");
                 }
                 Some(Texel { radiance, normal, position, mesh: 1, motion: Vec2::splat(-1.0) })
@@ -236,7 +234,7 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
     let texels: Vec<Option<Texel>> = (0..grid.x * grid.y)
         .map(|i| {
             let (x, y) = ((i % grid.x) as f32 / 64.0, (i / grid.x) as f32 / 64.0);
-            let v = 0.5 + 0.3 * x - 0.2 * y + 0.4 * x * x + 0.1 * y * y + 0.05 * (hash(i) - 0.5);
+            let v = 0.5 + 0.3 * x - 0.2 * y + 0.4 * x * x + 0.1 * y * y + 0.05 * (unit_hash(i) - 0.5);
             Some(Texel { radiance: [v, 2.0 * v, 0.5 * v], normal: [0.0, 0.0, 1.0], position: [x, y, -5.0], mesh: 1, motion: Vec2::splat(-1.0) })
         })
         .collect();
@@ -357,19 +355,6 @@ fn bmfr_reduces_noise_in_both_spaces() {
     assert_clean(&ctx);
 }
 
-/// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a
-/// NaN and a negative colour.
-fn inject_fireflies(ctx: &Arc<Context>, image: &fovea_renderer::vk::Image, f: u32) {
-    let mut texels: Vec<[f32; 4]> = read_image(ctx, image);
-    let kept: Vec<usize> = (0..texels.len()).filter(|&i| texels[i][3] > 0.0).collect();
-    let pick = |k: u32| kept[(hash(k + 97 * f) * (kept.len() - 1) as f32) as usize];
-    texels[pick(1)] = [1e30, 1e30, 1e30, 1.0];
-    texels[pick(2)] = [f32::INFINITY, 0.0, 1.0, 1.0];
-    texels[pick(3)] = [f32::NAN, 1.0, 1.0, 1.0];
-    texels[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
-    write_image(ctx, image, &texels);
-}
-
 /// Fireflies (huge, infinite, NaN and negative radiance injected into traced Cornell frames) and
 /// an empty view: every output texel stays finite and non-negative, the empty view exactly black.
 #[test]
@@ -441,7 +426,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                     let rel = Vec3::new((s.x - centre.x) / focal * depth, (s.y - centre.y) / focal * depth, -depth);
                     let world_x = camera_x + rel.x;
                     let motion = Vec2::new(centre.x + focal * (world_x - prev_camera_x) / depth, s.y);
-                    let v = level * (0.5 + hash(i as u32 * 31 + f * 7919));
+                    let v = level * (0.5 + unit_hash(i as u32 * 31 + f * 7919));
                     Some(Texel { radiance: [v; 3], normal: [0.0, 0.0, 1.0], position: rel.to_array(), mesh, motion })
                 })
                 .collect();
@@ -502,7 +487,7 @@ fn vp_seam_is_fitted_like_any_other_angle() {
             .enumerate()
             .map(|(i, s)| {
                 let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
-                let noise = 0.6 * (hash(i as u32 * 13 + f * 104_729) - 0.5);
+                let noise = 0.6 * (unit_hash(i as u32 * 13 + f * 104_729) - 0.5);
                 s.map(|s| {
                     let p = (s - centre) / 64.0 * 5.0;
                     Texel { radiance: [truth(x, y) + noise; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }

@@ -6,7 +6,6 @@
 //! TAA in the sampling grid (Karis 2014): noise and edge aliasing reduced against the reference,
 //! fireflies, disocclusion resets, the tracer's Halton jitter, the `--taa` flag.
 
-use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
 use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
@@ -15,8 +14,9 @@ use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, rmse, save_preview, unit_hash, write_image};
+use fovea_renderer::vk::{Context, Image};
+use fovea_tests::denoise::{assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload};
+use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
 
@@ -38,59 +38,6 @@ fn with_svgf() -> DenoiserSettings {
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
     FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
-}
-
-fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
-    for (i, p) in pixels.iter().enumerate() {
-        assert!(p.iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: texel {i} = {p:?}");
-    }
-}
-
-/// RMSE over the pixels `keep` selects.
-fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: impl Fn(usize) -> bool) -> f64 {
-    let (a, b): (Vec<[f32; 4]>, Vec<[f32; 4]>) = a.iter().zip(b).enumerate().filter(|(i, _)| keep(*i)).map(|(_, (x, y))| (*x, *y)).unzip();
-    rmse(&a, &b)
-}
-
-/// Screen pixels whose 3×3 neighbourhood *in the sampling grid* (around the texel the pixel falls
-/// in; Visual-Polar neighbours at the same angle, φ wrapping) is one surface: same material, depth
-/// within 5 %, normals within ~25°, from the space's traced G-buffer. Without TAA (not part of
-/// SVGF) an edge texel shows one surface per frame where the reference averages several: aliasing
-/// at the grid's resolution, not noise.
-fn surface_interiors(ctx: &Arc<Context>, g: &GBuffer, space: &dyn SamplingSpace) -> Vec<bool> {
-    let ids: Vec<[u32; 2]> = read_image(ctx, &g.ids);
-    let nd: Vec<[f32; 4]> = read_image(ctx, &g.normal_depth);
-    let (grid, screen) = (space.grid_size(), space.screen_size());
-    let rows = |c: u32| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(c));
-    let at = |x: u32, y: u32| (y * grid.x + x) as usize;
-    let same = |i: usize, q: usize| {
-        let dot = (0..3).map(|c| nd[i][c] * nd[q][c]).sum::<f32>();
-        ids[q][0] != 0 && ids[q][1] & 0xffff == ids[i][1] & 0xffff && (nd[q][3] - nd[i][3]).abs() < 0.05 * nd[i][3] && dot > 0.9
-    };
-    let cartesian = space.visual_polar().is_none();
-    (0..screen.x * screen.y)
-        .map(|p| {
-            let centre = Vec2::new((p % screen.x) as f32 + 0.5, (p / screen.x) as f32 + 0.5);
-            let Some(gp) = space.screen_to_grid(centre) else { return false };
-            let (tx, ty) = (gp.x as u32, gp.y as u32);
-            let (n, i) = (rows(tx), at(tx, ty));
-            (-1..=1i32).all(|dx| {
-                let c = tx as i32 + dx;
-                if c < 0 || c >= grid.x as i32 {
-                    return true;
-                }
-                let nc = rows(c as u32) as i32;
-                let row = ((ty as f32 + 0.5) * nc as f32 / n as f32) as i32;
-                (-1..=1i32).all(|dy| {
-                    let r = row + dy;
-                    if cartesian && (r < 0 || r >= nc) {
-                        return true;
-                    }
-                    same(i, at(c as u32, r.rem_euclid(nc) as u32))
-                })
-            })
-        })
-        .collect()
 }
 
 /// Still camera on the Cornell box at 128×144 (5 à-trous iterations span ±62 px; at much smaller
@@ -168,14 +115,6 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
 }
 
 /// Any plain-old-data texels into an image of the matching format.
-fn upload<T: bytemuck::Pod>(ctx: &Arc<Context>, image: &Image, texels: &[T]) {
-    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
-    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
-    rec.begin().unwrap();
-    rec.copy_buffer_to_image("test_upload", &buffer, image).unwrap();
-    rec.submit_and_wait().unwrap();
-}
-
 /// One sample of a synthetic G-buffer: a grey radiance on a face-on surface.
 #[derive(Clone, Copy)]
 struct Sample {
@@ -208,12 +147,6 @@ fn denoise(ctx: &Arc<Context>, svgf: &mut Svgf, g: &GBuffer, frame: &DenoiseFram
     svgf.record(&mut rec, g, frame).unwrap();
     rec.submit_and_wait().unwrap();
     (read_image(ctx, &svgf.output), read_image(ctx, svgf.moments()))
-}
-
-/// Screen position of each grid texel's centre (`None`: no sample there).
-fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
-    let g = space.grid_size();
-    (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
 }
 
 /// Fireflies (huge, infinite and NaN radiance injected into a traced Cornell frame) and an empty

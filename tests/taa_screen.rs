@@ -12,6 +12,7 @@ use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
 use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
@@ -33,21 +34,6 @@ fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
 
 fn luminance(p: &[f32; 4]) -> f32 {
     0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-}
-
-fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: impl Fn(usize) -> bool) -> f64 {
-    let (mut sum, mut n) = (0f64, 0usize);
-    for i in (0..a.len()).filter(|&i| keep(i)) {
-        sum += (0..3).map(|c| (a[i][c] as f64 - b[i][c] as f64).powi(2)).sum::<f64>() / 3.0;
-        n += 1;
-    }
-    (sum / n.max(1) as f64).sqrt()
-}
-
-fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
-    for (i, p) in pixels.iter().enumerate() {
-        assert!(p[..3].iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: pixel {i} = {p:?}");
-    }
 }
 
 /// 16 frames of VP with TAA after the remap vs one raw frame, against 256 spp, beside TAA in the

@@ -1,5 +1,5 @@
-//! Helpers for denoiser tests (BMFR's; the SVGF/TAA tests in `denoise.rs` keep their own copies
-//! and may move to these): hashing, uploads of synthetic G-buffer data, masks and metrics.
+//! Helpers for the denoiser tests (SVGF/TAA, BMFR, screen-space TAA): uploads of synthetic
+//! G-buffer data, masks and metrics.
 
 use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
@@ -8,13 +8,6 @@ use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::vk::{Buffer, Context, Image};
 use glam::Vec2;
 use std::sync::Arc;
-
-/// A deterministic value in [0, 1] from an index (PCG hash).
-pub fn hash(mut v: u32) -> f32 {
-    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
-    ((v >> 22) ^ v) as f32 / u32::MAX as f32
-}
 
 /// Any plain-old-data texels into an image of the matching format.
 pub fn upload<T: bytemuck::Pod>(ctx: &Arc<Context>, image: &Image, texels: &[T]) {
