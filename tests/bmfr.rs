@@ -14,7 +14,10 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer}
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
-use fovea_tests::denoise::{assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel};
+use fovea_tests::denoise::{
+    assert_finite_non_negative, assert_seam_like_elsewhere, rmse_where, seam_noise, seam_truth, surface_interiors, texel_screens, upload_gbuffer,
+    Texel,
+};
 use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
@@ -473,7 +476,6 @@ fn vp_seam_is_fitted_like_any_other_angle() {
     let screen = UVec2::new(128, 144);
     let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
     let grid = vp.grid_size();
-    let truth = |x: u32, y: u32| 0.5 + 0.3 * (std::f32::consts::TAU * (y as f32 + 0.5) / vp.rows_in_column(x) as f32).sin();
     let g = GBuffer::new(&ctx, grid).unwrap();
     let mut bmfr = Bmfr::new(&ctx, grid, vp.shader_variant(), BmfrSettings::default()).unwrap();
     let params = vp.sampling_params();
@@ -487,10 +489,10 @@ fn vp_seam_is_fitted_like_any_other_angle() {
             .enumerate()
             .map(|(i, s)| {
                 let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
-                let noise = 0.6 * (unit_hash(i as u32 * 13 + f * 104_729) - 0.5);
+                let noise = seam_noise(i as u32, f);
                 s.map(|s| {
                     let p = (s - centre) / 64.0 * 5.0;
-                    Texel { radiance: [truth(x, y) + noise; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }
+                    Texel { radiance: [seam_truth(&vp, x, y) + noise; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }
                 })
             })
             .collect();
@@ -498,36 +500,7 @@ fn vp_seam_is_fitted_like_any_other_angle() {
         out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }, Vec3::ZERO, &materials);
     }
     assert_finite_non_negative("seam", &out);
-    const BINS: usize = 16;
-    let (mut sum, mut count) = ([0f64; BINS], [0u32; BINS]);
-    let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
-    for x in 0..grid.x {
-        let n = vp.rows_in_column(x);
-        if n < 32 {
-            continue;
-        }
-        for y in 0..n {
-            let e = (out[(y * grid.x + x) as usize][1] - truth(x, y)) as f64;
-            let bin = (y as usize * BINS) / n as usize;
-            sum[bin] += e * e;
-            count[bin] += 1;
-            if y < 2 || y + 2 >= n {
-                seam += e * e;
-                seam_n += 1;
-            } else if y + 2 >= n / 2 && y < n / 2 + 2 {
-                opposite += e * e;
-                opposite_n += 1;
-            }
-        }
-    }
-    let rms: Vec<f64> = (0..BINS).map(|b| (sum[b] / count[b] as f64).sqrt()).collect();
-    let mut sorted = rms.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[BINS / 2];
-    let (seam, opposite) = ((seam / seam_n as f64).sqrt(), (opposite / opposite_n as f64).sqrt());
-    println!("seam rows RMSE {seam:.4}, rows at φ ≈ π {opposite:.4}, median row bin {median:.4}; per bin {rms:.4?}");
-    assert!(seam <= 1.25 * opposite, "seam error {seam} vs {opposite} at φ ≈ π");
-    assert!(seam <= 1.25 * median, "seam error {seam} vs median {median}");
+    assert_seam_like_elsewhere(&vp, &out);
     assert_clean(&ctx);
 }
 

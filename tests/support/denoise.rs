@@ -4,7 +4,7 @@
 use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::sampling::SamplingSpace;
+use fovea_renderer::sampling::{SamplingSpace, VisualPolar};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use glam::Vec2;
 use std::sync::Arc;
@@ -105,4 +105,52 @@ pub fn surface_interiors(ctx: &Arc<Context>, g: &GBuffer, space: &dyn SamplingSp
             })
         })
         .collect()
+}
+
+/// The φ-seam tests' signal: a sine once around every column (row y of column x), so a filter that
+/// did not wrap on φ would see a jump where the rows end.
+pub fn seam_truth(vp: &VisualPolar, x: u32, y: u32) -> f32 {
+    0.5 + 0.3 * (std::f32::consts::TAU * (y as f32 + 0.5) / vp.rows_in_column(x) as f32).sin()
+}
+
+/// The seam tests' noise on texel `i` in frame `f`.
+pub fn seam_noise(i: u32, f: u32) -> f32 {
+    0.6 * (crate::unit_hash(i * 13 + f * 104_729) - 0.5)
+}
+
+/// A filtered VP grid (`out`, green channel) against `seam_truth`: the squared error of the rows
+/// next to the φ = 0/2π seam must be no larger (×1.25) than at φ ≈ π and than the median of 16 row
+/// bins, over columns with at least 32 rows.
+pub fn assert_seam_like_elsewhere(vp: &VisualPolar, out: &[[f32; 4]]) {
+    const BINS: usize = 16;
+    let grid = vp.grid_size();
+    let (mut sum, mut count) = ([0f64; BINS], [0u32; BINS]);
+    let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
+    for x in 0..grid.x {
+        let n = vp.rows_in_column(x);
+        if n < 32 {
+            continue;
+        }
+        for y in 0..n {
+            let e = (out[(y * grid.x + x) as usize][1] - seam_truth(vp, x, y)) as f64;
+            let bin = (y as usize * BINS) / n as usize;
+            sum[bin] += e * e;
+            count[bin] += 1;
+            if y < 2 || y + 2 >= n {
+                seam += e * e;
+                seam_n += 1;
+            } else if y + 2 >= n / 2 && y < n / 2 + 2 {
+                opposite += e * e;
+                opposite_n += 1;
+            }
+        }
+    }
+    let rms: Vec<f64> = (0..BINS).map(|b| (sum[b] / count[b] as f64).sqrt()).collect();
+    let mut sorted = rms.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[BINS / 2];
+    let (seam, opposite) = ((seam / seam_n as f64).sqrt(), (opposite / opposite_n as f64).sqrt());
+    println!("seam rows RMSE {seam:.4}, rows at φ ≈ π {opposite:.4}, median row bin {median:.4}; per bin {rms:.4?}");
+    assert!(seam <= 1.25 * opposite, "seam error {seam} vs {opposite} at φ ≈ π");
+    assert!(seam <= 1.25 * median, "seam error {seam} vs median {median}");
 }
