@@ -142,6 +142,26 @@ fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, samples: &[Option<Sample>]) {
     upload(ctx, &g.motion, &samples.iter().map(|s| s.map_or([-1.0f32; 2], |s| s.motion.to_array())).collect::<Vec<_>>());
 }
 
+/// Frame `f` of the moving-occluder scene: frames 0–7 the occluder (mesh 2, depth 2) covers
+/// x < 32 (VP samples beyond the screen too); frame 8 it covers x in [16, 48), moved by 16 px,
+/// over the static background (mesh 1, depth 10). Radiance with per-frame noise.
+fn occluder_scene(screens: &[Option<Vec2>], f: u32, background: f32, occluder: f32) -> Vec<Option<Sample>> {
+    let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
+    screens
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let s = (*s)?;
+            let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
+            Some(if covered.contains(&s.x) {
+                Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
+            } else {
+                Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
+            })
+        })
+        .collect()
+}
+
 /// Runs one SVGF frame; returns its output (re-modulated) and moments (z = history length).
 fn denoise(ctx: &Arc<Context>, svgf: &mut Svgf, g: &GBuffer, frame: &DenoiseFrame) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut rec = FrameRecorder::new(ctx, 16).unwrap();
@@ -207,22 +227,7 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let params = space.params();
         let mut last = (Vec::new(), Vec::new());
         for f in 0..9u32 {
-            // Frames 0–7: the occluder covers x < 32 (VP samples beyond the screen too); frame 8: x in
-            // [16, 48), moved by 16 px.
-            let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
-            let samples: Vec<Option<Sample>> = screens
-                .iter()
-                .enumerate()
-                .map(|(i, s)| {
-                    let s = (*s)?;
-                    let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
-                    Some(if covered.contains(&s.x) {
-                        Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
-                    } else {
-                        Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
-                    })
-                })
-                .collect();
+            let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             let previous = (f > 0).then_some(params);
             last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous });
@@ -426,20 +431,7 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let params = space.params();
         let (mut out, mut current) = (Vec::new(), Vec::new());
         for f in 0..9u32 {
-            let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
-            let samples: Vec<Option<Sample>> = screens
-                .iter()
-                .enumerate()
-                .map(|(i, s)| {
-                    let s = (*s)?;
-                    let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
-                    Some(if covered.contains(&s.x) {
-                        Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
-                    } else {
-                        Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
-                    })
-                })
-                .collect();
+            let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             current = samples;
             // Samples at texel centres: the jitter is the centre.
