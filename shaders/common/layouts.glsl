@@ -42,7 +42,7 @@ struct FrameData {
 // (1 exact inverse CDF, 2 screen-clipped layout, 4 headset eccentricity axis); paper axis: gaze.zw
 // = (r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, flags, fovea°, 0); headset
 // axis: gaze.zw = (gaze tangent x, k), shape0 = (u_f, p_f, fovea°, gaze tangent y), shape1 =
-// (cdf(e_max), flags, tangent per pixel x, y). Cartesian: zero.
+// (e_max, flags, tangent per pixel x, y). Cartesian: zero.
 struct SamplingParams {
     uvec4 grid;                 // xy sampling-grid size in texels, zw screen size in pixels
     vec4 gaze;                  // xy gaze in screen pixels, zw space-specific (see above)

@@ -46,7 +46,8 @@ struct VpParams {
     float p_f;       // CDF fraction at the fovea edge
     float r_f;       // fovea radius in pixels (headset: fovea°)
     float e_norm;    // e(1): e_poly(1) for the polynomial, 80 for the exact inverse (headset: 1)
-    float cdf_max;   // cdf(80, k) (headset: cdf(e_max, k))
+    float e_max;     // where the CDF is normalised: 80 (headset: the farthest corner's true eccentricity)
+    float cdf_max;   // cdf(e_max, k)
     bool exact;      // exact inverse CDF instead of the paper's quartic
     bool clipped;    // screen-clipped layout: map with visual_polar_clipped.glsl (vp_layout_*)
     bool headset;    // true-eccentricity axis through the FOV tangents
@@ -54,34 +55,6 @@ struct VpParams {
     vec2 tan_scale;  // headset: tangent units per pixel
     float far;       // headset: where samples beyond their ray's horizon are parked (pixels)
 };
-
-// Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
-// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis), and
-// - paper axis: gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
-//   shape1 = (cdf_max, flags, fovea° (unused here), 0);
-// - headset axis: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
-//   shape1 = (cdf_max, flags, scale.x, scale.y); r_max = e_norm = 1 are derived.
-VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
-    VpParams p;
-    uint flags = uint(shape1.y);
-    p.grid = grid.xy;
-    p.screen = vec2(grid.zw);
-    p.gaze = gaze.xy;
-    p.k = gaze.w;
-    p.u_f = shape0.x;
-    p.p_f = shape0.y;
-    p.r_f = shape0.z;
-    p.cdf_max = shape1.x;
-    p.exact = (flags & 1u) != 0u;
-    p.clipped = (flags & 2u) != 0u;
-    p.headset = VP_MAY_USE_HEADSET_AXIS && (flags & 4u) != 0u;
-    p.r_max = p.headset ? 1.0 : gaze.z;
-    p.e_norm = p.headset ? 1.0 : shape0.w;
-    p.gaze_tan = vec2(gaze.z, shape0.w);
-    p.tan_scale = shape1.zw;
-    p.far = VP_FAR_PIXELS_PER_SCREEN * (p.screen.x + p.screen.y);
-    return p;
-}
 
 // Reddy's acuity V(e), cycles per degree.
 float vp_acuity(float e) {
@@ -150,6 +123,36 @@ float vp_cdf_derivative(float d, float k) {
     return VP_PI / 30.0 * pow(vp_acuity(d), k) * d;
 }
 
+// Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
+// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis), and
+// - paper axis: gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
+//   shape1 = (cdf_max, flags, fovea° (unused here), 0);
+// - headset axis: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
+//   shape1 = (e_max, flags, scale.x, scale.y); r_max = e_norm = 1 and cdf_max = cdf(e_max, k)
+//   are derived (as VisualPolar::new computes them).
+VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
+    VpParams p;
+    uint flags = uint(shape1.y);
+    p.grid = grid.xy;
+    p.screen = vec2(grid.zw);
+    p.gaze = gaze.xy;
+    p.k = gaze.w;
+    p.u_f = shape0.x;
+    p.p_f = shape0.y;
+    p.r_f = shape0.z;
+    p.exact = (flags & 1u) != 0u;
+    p.clipped = (flags & 2u) != 0u;
+    p.headset = VP_MAY_USE_HEADSET_AXIS && (flags & 4u) != 0u;
+    p.r_max = p.headset ? 1.0 : gaze.z;
+    p.e_norm = p.headset ? 1.0 : shape0.w;
+    p.e_max = p.headset ? shape1.x : VP_E_MAX_DEG;
+    p.cdf_max = p.headset ? vp_cdf(shape1.x, p.k) : shape1.x;
+    p.gaze_tan = vec2(gaze.z, shape0.w);
+    p.tan_scale = shape1.zw;
+    p.far = VP_FAR_PIXELS_PER_SCREEN * (p.screen.x + p.screen.y);
+    return p;
+}
+
 // Eq. 3, the paper's quartic (p = CDF(e)/CDF(80), meant for p >= p_f).
 float vp_inverse_cdf_poly(float p) {
     return (((25.09 * p + 0.1680) * p + 27.61) * p + 23.87) * p + 3.232;
@@ -159,16 +162,37 @@ float vp_inverse_cdf_poly_derivative(float p) {
     return ((100.36 * p + 0.504) * p + 55.22) * p + 23.87;
 }
 
-// Exact inverse: safeguarded Newton from the quartic's guess (bisection when a step leaves the
-// bracket), as in Rust.
+// ln(1 + x), op for op as Rust's log1p_f32: 2·atanh(x/(2 + x)) for small |x| (accurate relative
+// to the result), vp_ln(1 + x) otherwise.
+float vp_log1p(float x) {
+    if (abs(x) >= 0.5) return vp_ln(1.0 + x);
+    float s = x / (2.0 + x);
+    float s2 = s * s;
+    float q = (((0.11111111 * s2 + 0.14285715) * s2 + 0.2) * s2 + 0.33333334) * s2;
+    return 2.0 * s + 2.0 * s * q;
+}
+
+// cdf(e_max, k) − cdf(e, k) (Rust cdf_tail): for k = 1 past the knee A·(ln(1 + x) − x/t_max),
+// x = 0.3(e_max − e)/t, accurate relative to itself where the CDF is flat (near e_max).
+float vp_cdf_tail(float e, float k, float e_max, float cdf_max) {
+    if (k != 1.0 || e < VP_ACUITY_KNEE_DEG) return cdf_max - vp_cdf(e, k);
+    const float A = 166.4 * VP_PI;
+    float t = 0.3 * e + 1.0;
+    float t_max = 0.3 * e_max + 1.0;
+    float x = 0.3 * (e_max - e) / t;
+    return A * (vp_log1p(x) - x / t_max);
+}
+
+// Exact inverse from the tail fraction q = 1 − p: safeguarded Newton from the quartic's guess
+// (bisection when a step leaves the bracket), as in Rust's inverse_cdf_exact.
 // e_top: the bracket's top, 80 (paper) or 180 (headset axis, normalised at e_max ≤ 180).
-float vp_inverse_cdf_exact(float p, float k, float cdf_max, float e_top) {
-    float target = p * cdf_max;
+float vp_inverse_cdf_exact(float q, float k, float cdf_max, float e_max, float e_top) {
+    float target = q * cdf_max;
     float lo = 0.0;
-    float hi = p <= 1.0 ? e_top : 4.0 * e_top;
-    float e = clamp(vp_inverse_cdf_poly(p), lo, hi);
+    float hi = q >= 0.0 ? e_top : 4.0 * e_top;
+    float e = clamp(vp_inverse_cdf_poly(1.0 - q), lo, hi);
     for (int i = 0; i < VP_NEWTON_STEPS; ++i) {
-        float f = vp_cdf(e, k) - target;
+        float f = target - vp_cdf_tail(e, k, e_max, cdf_max);
         if (f < 0.0) lo = e; else hi = e;
         float next = e - f / max(vp_cdf_derivative(e, k), 1e-6);
         e = (next >= lo && next <= hi) ? next : 0.5 * (lo + hi);
@@ -197,9 +221,10 @@ bool vp_is_valid_texel(VpParams P, ivec2 t) {
 
 float vp_r_of_u(VpParams P, float u) {
     if (u < P.u_f) return u / P.u_f * P.r_f;
-    float p = P.p_f + (u - P.u_f) / (1.0 - P.u_f) * (1.0 - P.p_f);
     float e_top = P.headset ? VP_E_TOP_HEADSET_DEG : VP_E_MAX_DEG;
-    float e = P.exact ? vp_inverse_cdf_exact(p, P.k, P.cdf_max, e_top) : vp_inverse_cdf_poly(p);
+    float e = P.exact
+        ? vp_inverse_cdf_exact((1.0 - u) / (1.0 - P.u_f) * (1.0 - P.p_f), P.k, P.cdf_max, P.e_max, e_top)
+        : vp_inverse_cdf_poly(P.p_f + (u - P.u_f) / (1.0 - P.u_f) * (1.0 - P.p_f));
     return e / P.e_norm * P.r_max;
 }
 
@@ -271,7 +296,8 @@ vec2 vp_offset_of(VpParams P, float u, float phi) {
 float vp_u_of_r(VpParams P, float r) {
     if (r < P.r_f) return r / P.r_f * P.u_f;
     float e = r / P.r_max * P.e_norm;
-    float p = P.exact ? vp_cdf(e, P.k) / P.cdf_max : vp_poly_fraction_of(e, P.cdf_max);
+    if (P.exact) return 1.0 - vp_cdf_tail(e, P.k, P.e_max, P.cdf_max) / P.cdf_max / (1.0 - P.p_f) * (1.0 - P.u_f);
+    float p = vp_poly_fraction_of(e, P.cdf_max);
     return P.u_f + (p - P.p_f) / (1.0 - P.p_f) * (1.0 - P.u_f);
 }
 

@@ -272,18 +272,54 @@ fn inverse_cdf_poly_derivative(p: f32) -> f32 {
     ((100.36 * p + 0.504) * p + 55.22) * p + 23.87
 }
 
-/// Exact inverse of the normalised CDF: e with cdf(e, k) = p · cdf_max, cdf_max = cdf(e_max, k)
-/// for some e_max ≤ `e_top` (the paper: e_max = e_top = 80; the headset axis: its farthest
-/// corner's true eccentricity, bracketed by 180). Safeguarded Newton from the polynomial guess:
-/// the bracket [lo, hi] shrinks every step and a Newton step leaving it is replaced by bisection
-/// (far from k = 1 the quartic guess can be poor and a plain step from a flat tail overshoots
-/// into the fovea). The GLSL twin does the same in f32.
-pub fn inverse_cdf_exact(p: f32, k: f32, cdf_max: f32, e_top: f32) -> f32 {
-    let target = p * cdf_max;
-    let (mut lo, mut hi) = (0.0f32, if p <= 1.0 { e_top } else { 4.0 * e_top });
-    let mut e = inverse_cdf_poly(p).clamp(lo, hi);
+/// ln(1 + x) (x > −½ … ∞) in plain f32 arithmetic, op for op as `vp_log1p` in the GLSL: for
+/// small |x| through s = x/(2 + x), ln(1 + x) = 2 atanh s (accurate relative to the result, which
+/// `ln_f32(1 + x)` is not: 1 + x rounds away x's low bits), otherwise `ln_f32(1 + x)`.
+// The coefficients are 1/9, 1/7, 1/5, 1/3 spelled as the GLSL twin spells them.
+#[allow(clippy::excessive_precision)]
+pub fn log1p_f32(x: f32) -> f32 {
+    if x.abs() >= 0.5 {
+        return ln_f32(1.0 + x);
+    }
+    // |s| ≤ 0.2: the series' truncation is < 1e-8 relative.
+    let s = x / (2.0 + x);
+    let s2 = s * s;
+    let q = (((0.111_111_11 * s2 + 0.142_857_15) * s2 + 0.2) * s2 + 0.333_333_34) * s2;
+    2.0 * s + 2.0 * s * q
+}
+
+/// The CDF's tail cdf(e_max, k) − cdf(e, k), the mass beyond e; `cdf_max` = cdf(e_max, k).
+/// For k = 1 past the knee it is computed without the difference of two large numbers:
+/// with t = 0.3e + 1 and x = 0.3(e_max − e)/t, Eq. 2 gives A·(ln(1 + x) − x/t_max). Near e_max
+/// the CDF is flat (one f32 ulp of cdf(80) ≈ 1091 is 2e-5°), so the plain difference would make
+/// the exact inverse's result depend on rounding at the ~1e-3 px level; the tail is accurate
+/// relative to itself, which is what lets Rust and GLSL agree there.
+pub fn cdf_tail(e: f32, k: f32, e_max: f32, cdf_max: f32) -> f32 {
+    if k != 1.0 || e < ACUITY_KNEE_DEG {
+        return cdf_max - cdf(e, k);
+    }
+    const A: f32 = 166.4 * std::f32::consts::PI;
+    let t = 0.3 * e + 1.0;
+    let t_max = 0.3 * e_max + 1.0;
+    let x = 0.3 * (e_max - e) / t;
+    A * (log1p_f32(x) - x / t_max)
+}
+
+/// Exact inverse of the normalised CDF, given the tail fraction q = 1 − p: e with
+/// cdf_tail(e) = q · cdf_max, cdf_max = cdf(e_max, k), e_max ≤ `e_top` (the paper: e_max = e_top
+/// = 80; the headset axis: its farthest corner's true eccentricity, bracketed by 180). Working on
+/// the tail keeps the far end, where the CDF is flat, well conditioned (see `cdf_tail`); callers
+/// form q from u directly, not as 1 − p. Safeguarded Newton from the polynomial guess: the bracket
+/// [lo, hi] shrinks every step and a Newton step leaving it is replaced by bisection (far from
+/// k = 1 the quartic guess can be poor and a plain step from a flat tail overshoots into the
+/// fovea). The GLSL twin does the same in f32.
+pub fn inverse_cdf_exact(q: f32, k: f32, cdf_max: f32, e_max: f32, e_top: f32) -> f32 {
+    let target = q * cdf_max;
+    let (mut lo, mut hi) = (0.0f32, if q >= 0.0 { e_top } else { 4.0 * e_top });
+    let mut e = inverse_cdf_poly(1.0 - q).clamp(lo, hi);
     for _ in 0..NEWTON_STEPS {
-        let f = cdf(e, k) - target;
+        // Increasing in e, zero at the root.
+        let f = target - cdf_tail(e, k, e_max, cdf_max);
         if f < 0.0 {
             lo = e;
         } else {
@@ -506,12 +542,13 @@ impl VisualPolar {
         if u < self.u_f {
             return u / self.u_f * self.r_f;
         }
-        let p = self.p_f + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - self.p_f);
         let e = if self.exact {
+            // The tail fraction 1 − p straight from u (see `inverse_cdf_exact`).
+            let q = (1.0 - u) / (1.0 - self.u_f) * (1.0 - self.p_f);
             let e_top = if self.headset.is_some() { E_TOP_HEADSET_DEG } else { E_MAX_DEG };
-            inverse_cdf_exact(p, self.params.density_exponent, self.cdf_max, e_top)
+            inverse_cdf_exact(q, self.params.density_exponent, self.cdf_max, self.e_max(), e_top)
         } else {
-            inverse_cdf_poly(p)
+            inverse_cdf_poly(self.p_f + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - self.p_f))
         };
         e / self.e_norm * self.r_max
     }
@@ -541,12 +578,19 @@ impl VisualPolar {
             return r / self.r_f * self.u_f;
         }
         let e = r / self.r_max * self.e_norm;
-        let p = if self.exact {
-            cdf(e, self.params.density_exponent) / self.cdf_max
-        } else {
-            poly_fraction_of(e, self.cdf_max)
-        };
+        if self.exact {
+            // Through the tail, like r_of_u, so both directions stay well conditioned at e_max.
+            let q = cdf_tail(e, self.params.density_exponent, self.e_max(), self.cdf_max) / self.cdf_max;
+            return 1.0 - q / (1.0 - self.p_f) * (1.0 - self.u_f);
+        }
+        let p = poly_fraction_of(e, self.cdf_max);
         self.u_f + (p - self.p_f) / (1.0 - self.p_f) * (1.0 - self.u_f)
+    }
+
+    /// The eccentricity the CDF is normalised at: 80 on the paper's axis, the farthest corner's
+    /// true eccentricity on the headset's.
+    fn e_max(&self) -> f32 {
+        self.headset.map_or(E_MAX_DEG, |axis| axis.e_max)
     }
 
     /// The column a continuous grid x belongs to (clamped, so u = 1 stays in the last column).
@@ -601,8 +645,8 @@ impl VisualPolar {
     /// - paper (normalised): gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
     ///   shape1 = (cdf_max, flags, fovea° (informative), 0);
     /// - headset: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
-    ///   shape1 = (cdf_max, flags, scale.x, scale.y) (G: gaze in tangent space, scale: tangent
-    ///   units per pixel; cdf_max = cdf(e_max, k)).
+    ///   shape1 = (e_max, flags, scale.x, scale.y) (G: gaze in tangent space, scale: tangent
+    ///   units per pixel; the GPU derives cdf_max = cdf(e_max, k) as `new` does).
     pub fn sampling_params(&self) -> SamplingParams {
         let flags = self.exact as u32 * FLAG_EXACT
             + (self.params.layout == VpLayout::ScreenClipped) as u32 * FLAG_CLIPPED
@@ -620,7 +664,7 @@ impl VisualPolar {
                 grid,
                 gaze: Vec4::new(self.gaze.x, self.gaze.y, axis.gaze_tan.x, k),
                 shape0: Vec4::new(self.u_f, self.p_f, self.r_f, axis.gaze_tan.y),
-                shape1: Vec4::new(self.cdf_max, flags as f32, axis.scale.x, axis.scale.y),
+                shape1: Vec4::new(axis.e_max, flags as f32, axis.scale.x, axis.scale.y),
             },
         }
     }

@@ -184,7 +184,7 @@ fn headset_packing() {
     assert_eq!(q.shape1.y, 5.0, "flags: exact + headset");
     assert_eq!((q.gaze.z, q.shape0.w), (axis.gaze_tan.x, axis.gaze_tan.y));
     assert_eq!((q.shape1.z, q.shape1.w), (axis.scale.x, axis.scale.y));
-    assert_eq!((q.shape0.z, q.shape1.x), (s.params().fovea_deg, cdf(axis.e_max, 1.0)));
+    assert_eq!((q.shape0.z, q.shape1.x), (s.params().fovea_deg, axis.e_max));
     assert_eq!(axis.far, FAR_PIXELS_PER_SCREEN * (640.0 + 720.0));
     // The whole ρ axis: u = 1 is the farthest corner's true eccentricity.
     assert!((s.r_of_u(1.0) - axis.e_max).abs() < 1e-3);

@@ -89,7 +89,7 @@ fn polynomial_matches_exact_inverse() {
         let p = p_f + (1.0 - p_f) * i as f32 / 2000.0;
         let exact = bisect_inverse(p as f64, 1.0);
         worst_poly = worst_poly.max((inverse_cdf_poly(p) as f64 - exact).abs());
-        worst_newton = worst_newton.max((inverse_cdf_exact(p, 1.0, cdf_max, E_MAX_DEG) as f64 - exact).abs());
+        worst_newton = worst_newton.max((inverse_cdf_exact(1.0 - p, 1.0, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64 - exact).abs());
         // The quartic's inverse (used by screen → VP) undoes Eq. 3.
         let back = poly_fraction_of(inverse_cdf_poly(p), cdf_max);
         assert!((back - p).abs() < 2e-6, "poly inverse at p {p}: {back}");
@@ -103,7 +103,7 @@ fn polynomial_matches_exact_inverse() {
         let p_f = fovea_fraction(ACUITY_KNEE_DEG, k);
         for i in 0..=200 {
             let p = p_f + (1.0 - p_f) * i as f32 / 200.0;
-            let err = (inverse_cdf_exact(p, k, cdf_max, E_MAX_DEG) as f64 - bisect_inverse(p as f64, k)).abs();
+            let err = (inverse_cdf_exact(1.0 - p, k, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64 - bisect_inverse(p as f64, k)).abs();
             assert!(err < 1e-3, "k {k} p {p}: Newton off by {err}°");
         }
     }
