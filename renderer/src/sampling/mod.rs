@@ -2,6 +2,7 @@
 //! gives CPU forward/inverse mappings (tests and tools) and names the trace-kernel variant whose
 //! GLSL include (`shaders/sampling/`) implements the same mapping on the GPU.
 
+mod acuity;
 mod cartesian;
 mod visual_polar;
 mod visual_polar_clipped;
