@@ -112,6 +112,8 @@ pub struct Renderer {
     /// The space's per-frame table (`SamplingSpace::sampling_table`), read by the trace and the
     /// Visual-Polar passes back to the screen.
     sampling_table: Buffer,
+    /// Host staging of `sampling_table`, reused every frame (no per-frame allocation).
+    sampling_table_rows: Vec<[f32; 4]>,
     ray_counters: Buffer,
     trace: TracePass,
     /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
@@ -187,6 +189,7 @@ impl Renderer {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], uniform)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform)?,
             sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table())?,
+            sampling_table_rows: Vec::new(),
             ray_counters: Buffer::new(
                 ctx,
                 "ray_counters",
@@ -286,7 +289,8 @@ impl Renderer {
         self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let space = self.space.params();
         self.sampling.write(&[space])?;
-        self.sampling_table.write(&self.space.sampling_table())?;
+        self.space.write_sampling_table(&mut self.sampling_table_rows);
+        self.sampling_table.write(&self.sampling_table_rows)?;
         let rec = &mut self.recorder;
         rec.begin()?;
         rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;

@@ -102,7 +102,15 @@ impl TracePass {
         gradients: Option<GradientTargets>,
     ) -> Result<()> {
         let s = scene.binds();
-        let mut binds = vec![
+        // A fixed array sliced to what this kernel binds: no host allocation per frame.
+        let gradient_binds = match (gradients, &out.visibility) {
+            (Some(g), Some(visibility)) => {
+                Some([write_buffer("gradient_samples", g.samples), write_image("out_gradient", g.gradient), write_image("out_visibility", visibility)])
+            }
+            _ => None,
+        };
+        let extra = gradient_binds.unwrap_or([s[0]; 3]);
+        let binds = [
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
@@ -115,13 +123,10 @@ impl TracePass {
             write_image("out_position", &out.position),
             write_image("out_ids", &out.ids),
             write_image("out_motion", &out.motion),
+            extra[0], extra[1], extra[2],
         ];
-        if let (Some(g), Some(visibility)) = (gradients, &out.visibility) {
-            binds.push(write_buffer("gradient_samples", g.samples));
-            binds.push(write_image("out_gradient", g.gradient));
-            binds.push(write_image("out_visibility", visibility));
-        }
+        let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
-        rec.dispatch("trace", &self.pipeline, &binds, push_bytes(&push), [out.size.x, out.size.y, 1])
+        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [out.size.x, out.size.y, 1])
     }
 }

@@ -39,7 +39,14 @@ pub trait SamplingSpace {
     /// `sampling_table`; Visual-Polar: the per-column on-screen arcs). Empty when the space needs
     /// none; its length never changes for one space.
     fn sampling_table(&self) -> Vec<[f32; 4]> {
-        Vec::new()
+        let mut table = Vec::new();
+        self.write_sampling_table(&mut table);
+        table
+    }
+    /// `sampling_table` into a caller-owned vector (cleared first), so the render loop reuses
+    /// its capacity instead of allocating every frame.
+    fn write_sampling_table(&self, out: &mut Vec<[f32; 4]>) {
+        out.clear();
     }
     /// Screen position (pixels, y down) of a grid position (texel units, texel centre = +0.5).
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2>;

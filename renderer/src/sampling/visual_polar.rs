@@ -536,8 +536,8 @@ impl SamplingSpace for VisualPolar {
         self.sampling_params()
     }
     /// The per-column arcs (`column_table`): full circles in the paper's layout.
-    fn sampling_table(&self) -> Vec<[f32; 4]> {
-        self.column_table()
+    fn write_sampling_table(&self, out: &mut Vec<[f32; 4]>) {
+        self.write_column_table(out);
     }
     /// `None` outside the grid and in clipped texels (the texel is `floor(grid)`).
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {

@@ -127,8 +127,10 @@ pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
     if r.is_nan() || r <= 0.0 || !g.is_finite() {
         return ColumnArcs::FULL;
     }
-    // Cut arcs as [lo, hi) within [0, 2π), split where they cross φ = 0.
-    let mut cuts: Vec<(f64, f64)> = Vec::with_capacity(8);
+    // Cut arcs as [lo, hi) within [0, 2π), split where they cross φ = 0. Fixed arrays, not
+    // vectors: the renderer rebuilds every column's arcs each frame and must not allocate.
+    let mut cuts = [(0.0f64, 0.0f64); 8];
+    let mut n_cuts = 0;
     let edges = [(0.0, s.x - g.x), (FRAC_PI_2, s.y - g.y), (PI, g.x), (3.0 * FRAC_PI_2, g.y)];
     for (normal, d) in edges {
         if d >= r {
@@ -141,37 +143,52 @@ pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
         let lo = (normal - half).rem_euclid(TAU64);
         let hi = lo + 2.0 * half;
         if hi > TAU64 {
-            cuts.push((lo, TAU64));
-            cuts.push((0.0, hi - TAU64));
+            cuts[n_cuts] = (lo, TAU64);
+            cuts[n_cuts + 1] = (0.0, hi - TAU64);
+            n_cuts += 2;
         } else {
-            cuts.push((lo, hi));
+            cuts[n_cuts] = (lo, hi);
+            n_cuts += 1;
         }
     }
-    if cuts.is_empty() {
+    if n_cuts == 0 {
         return ColumnArcs::FULL;
     }
-    cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    // The complement of the merged cuts, walking 0 → 2π.
-    let mut on: Vec<(f64, f64)> = Vec::with_capacity(5); // (start, length)
+    let cuts = &mut cuts[..n_cuts];
+    cuts.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    // The complement of the merged cuts, walking 0 → 2π: (start, length), at most 5.
+    let mut on = [(0.0f64, 0.0f64); 5];
+    let mut n_on = 0;
     let mut at = 0.0;
-    for (lo, hi) in cuts {
+    for &(lo, hi) in cuts.iter() {
         if lo > at {
-            on.push((at, lo - at));
+            on[n_on] = (at, lo - at);
+            n_on += 1;
         }
         at = at.max(hi);
     }
     if at < TAU64 {
-        on.push((at, TAU64 - at));
+        on[n_on] = (at, TAU64 - at);
+        n_on += 1;
     }
+    let mut on = &mut on[..n_on];
     // An interval ending at 2π continues the one starting at 0.
     if on.len() >= 2 && on[0].0 == 0.0 {
         let last = on.len() - 1;
         if on[last].0 + on[last].1 >= TAU64 {
             on[last].1 += on[0].1;
-            on.remove(0);
+            on = &mut on[1..];
         }
     }
-    on.retain(|&(_, len)| len >= MIN_ARC);
+    // Drop slivers (keeping the order).
+    let mut kept = 0;
+    for i in 0..on.len() {
+        if on[i].1 >= MIN_ARC {
+            on[kept] = on[i];
+            kept += 1;
+        }
+    }
+    let on = &on[..kept];
     let total: f64 = on.iter().map(|&(_, len)| len).sum();
     if on.is_empty() || total > TAU64 - MIN_ARC {
         return ColumnArcs::FULL;
@@ -213,7 +230,15 @@ impl VisualPolar {
     /// The per-column table the GPU reads, two RGBA32F texels per column (`ColumnArcs::texels`);
     /// GLSL looks it up through `vp_column_arcs`. Recomputed whenever the gaze moves.
     pub fn column_table(&self) -> Vec<[f32; 4]> {
-        (0..self.grid_size().x).flat_map(|c| self.column_arcs(c).texels()).collect()
+        let mut table = Vec::new();
+        self.write_column_table(&mut table);
+        table
+    }
+
+    /// `column_table` into a caller-owned vector (cleared first; the render loop reuses it).
+    pub fn write_column_table(&self, out: &mut Vec<[f32; 4]>) {
+        out.clear();
+        out.extend((0..self.grid_size().x).flat_map(|c| self.column_arcs(c).texels()));
     }
 
     /// Grid → screen in the screen-clipped layout (GLSL `vp_clipped_vp_to_screen`): row y of a

@@ -38,7 +38,8 @@ impl TemporalPass {
         s: &SvgfSettings,
         gradient: Option<&Image>,
     ) -> Result<()> {
-        let mut binds = vec![
+        // A fixed array sliced to what this kernel binds: no host allocation per frame.
+        let binds = [
             read_image("radiance", &g.radiance),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
@@ -50,10 +51,9 @@ impl TemporalPass {
             write_image("accum", accum),
             write_image("moments", &h.moments[cur]),
             write_image("surface", &h.surface[cur]),
+            read_image("gradient", gradient.unwrap_or(&g.radiance)),
         ];
-        if let Some(gradient) = gradient {
-            binds.push(read_image("gradient", gradient));
-        }
+        let binds = &binds[..if gradient.is_some() { binds.len() } else { binds.len() - 1 }];
         // The grid and screen never change for one renderer: only the gaze-dependent slots travel.
         let p = previous.unwrap_or(current);
         let reset = if previous.is_none() { 1.0 } else { 0.0 };
@@ -67,6 +67,6 @@ impl TemporalPass {
             prev_shape1: p.shape1,
             params: Vec4::new(s.alpha_color, s.alpha_moments, s.max_history as f32, reset),
         };
-        rec.dispatch("svgf_temporal", &self.pipeline, &binds, push_bytes(&push), [accum.width, accum.height, 1])
+        rec.dispatch("svgf_temporal", &self.pipeline, binds, push_bytes(&push), [accum.width, accum.height, 1])
     }
 }
