@@ -2,15 +2,51 @@
 //! and generates the matching Rust `#[repr(C)]` structs plus a probe shader per struct that a
 //! device test uses to prove every field's std430 offset.
 //!
-//! Only 4-byte scalars, 2- and 4-component vectors and mat4 are allowed: vec3 and implicit
-//! padding are rejected so that `#[repr(C)]` and std430 cannot disagree silently.
+//! Only 4-byte scalars, 2- and 4-component vectors, mat4 and structs declared earlier in the
+//! header are allowed: vec3 and implicit padding are rejected so that `#[repr(C)]` and std430
+//! cannot disagree silently (a nested struct has its members' largest alignment in both).
 
 use std::fmt::Write;
 use std::path::Path;
 
 pub struct Field {
-    pub ty: &'static FieldType,
     pub name: String,
+    rust: String,
+    /// Size in 32-bit words.
+    words: usize,
+    /// std430 base alignment in bytes.
+    align: usize,
+    /// Each 32-bit word in memory order: the GLSL accessor appended to the field access, and how
+    /// the probe shader turns it into a uint ("f" float, "u" uint, "i" int).
+    word_access: Vec<(String, char)>,
+}
+
+impl Field {
+    fn basic(ty: &FieldType, name: &str) -> Field {
+        Field {
+            name: name.to_string(),
+            rust: ty.rust.to_string(),
+            words: ty.words,
+            align: ty.align,
+            word_access: ty.components.iter().map(|c| (c.to_string(), ty.scalar)).collect(),
+        }
+    }
+
+    /// A field whose type is an earlier struct: its words are the struct's, in order.
+    fn nested(inner: &Struct, name: &str) -> Field {
+        let word_access = inner
+            .fields
+            .iter()
+            .flat_map(|f| f.word_access.iter().map(move |(access, scalar)| (format!(".{}{access}", f.name), *scalar)))
+            .collect::<Vec<_>>();
+        Field {
+            name: name.to_string(),
+            rust: inner.name.clone(),
+            words: word_access.len(),
+            align: inner.fields.iter().map(|f| f.align).max().unwrap_or(4),
+            word_access,
+        }
+    }
 }
 
 pub struct Struct {
@@ -29,16 +65,14 @@ pub struct Header {
     pub constants: Vec<Constant>,
 }
 
+/// A basic GLSL type: its Rust twin, size in words, std430 alignment in bytes, scalar kind and
+/// the accessors of its words.
 pub struct FieldType {
     glsl: &'static str,
     rust: &'static str,
-    /// Number of 32-bit words.
     words: usize,
-    /// std430 base alignment in bytes.
     align: usize,
-    /// How one word is turned into a uint in the probe shader ("f" float, "u" uint, "i" int).
     scalar: char,
-    /// GLSL expressions selecting each word, appended to the field access.
     components: &'static [&'static str],
 }
 
@@ -95,10 +129,18 @@ pub fn parse(path: &Path) -> Result<Header, String> {
             let decl = line.trim_end_matches(';');
             let mut parts = decl.split_whitespace();
             let (ty, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
-            let ty = TYPES.iter().find(|t| t.glsl == ty).ok_or_else(|| {
-                format!("{}: field type '{ty}' not allowed (use 4-byte scalars, vec2/vec4 kinds or mat4; vec3 breaks std430/repr(C) agreement)", at())
-            })?;
-            s.fields.push(Field { ty, name: name.to_string() });
+            let field = if let Some(basic) = TYPES.iter().find(|t| t.glsl == ty) {
+                Field::basic(basic, name)
+            } else if let Some(inner) = structs.iter().find(|st: &&Struct| st.name == ty) {
+                Field::nested(inner, name)
+            } else {
+                return Err(format!(
+                    "{}: field type '{ty}' not allowed (use 4-byte scalars, vec2/vec4 kinds, mat4 or a struct declared above; \
+                     vec3 breaks std430/repr(C) agreement)",
+                    at()
+                ));
+            };
+            s.fields.push(field);
         } else {
             return Err(format!("{}: unexpected line '{line}'", at()));
         }
@@ -110,14 +152,14 @@ fn check_layout(s: &Struct) -> Result<(), String> {
     let mut offset = 0;
     let mut align = 4;
     for f in &s.fields {
-        if offset % f.ty.align != 0 {
+        if offset % f.align != 0 {
             return Err(format!(
                 "field {} at byte {offset} needs {}-byte alignment: reorder or pad explicitly",
-                f.name, f.ty.align
+                f.name, f.align
             ));
         }
-        offset += f.ty.words * 4;
-        align = align.max(f.ty.align);
+        offset += f.words * 4;
+        align = align.max(f.align);
     }
     if offset % align != 0 {
         return Err(format!("size {offset} is not a multiple of its alignment {align}: pad explicitly"));
@@ -134,7 +176,7 @@ pub fn rust_source(header: &Header) -> String {
         writeln!(out, "\n#[repr(C)]\n#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]").unwrap();
         writeln!(out, "pub struct {} {{", s.name).unwrap();
         for f in &s.fields {
-            writeln!(out, "    pub {}: {},", f.name, f.ty.rust).unwrap();
+            writeln!(out, "    pub {}: {},", f.name, f.rust).unwrap();
         }
         writeln!(out, "}}").unwrap();
     }
@@ -146,7 +188,7 @@ pub fn rust_source(header: &Header) -> String {
             writeln!(
                 out,
                 "        FieldLayout {{ name: \"{}\", offset: core::mem::offset_of!({}, {}), words: {} }},",
-                f.name, s.name, f.name, f.ty.words
+                f.name, s.name, f.name, f.words
             )
             .unwrap();
         }
@@ -166,9 +208,9 @@ pub fn probe_shaders(header: &Header) -> Vec<(String, String)> {
             let mut body = String::new();
             let mut k = 0;
             for f in &s.fields {
-                for c in f.ty.components {
+                for (c, scalar) in &f.word_access {
                     let access = format!("src.data.{}{}", f.name, c);
-                    let word = match f.ty.scalar {
+                    let word = match scalar {
                         'f' => format!("floatBitsToUint({access})"),
                         'i' => format!("uint({access})"),
                         _ => access,

@@ -19,3 +19,10 @@ pub struct StructLayout {
 }
 
 include!(concat!(env!("OUT_DIR"), "/layouts.rs"));
+
+impl SamplingParams {
+    /// The gaze-dependent slots, what a pass gets of the previous frame's space.
+    pub fn frame(&self) -> SamplingFrame {
+        SamplingFrame { gaze: self.gaze, shape0: self.shape0, shape1: self.shape1 }
+    }
+}

@@ -50,6 +50,15 @@ struct SamplingParams {
     vec4 shape1;
 };
 
+// The gaze-dependent slots of a frame's SamplingParams: what a pass needs of the previous frame's
+// space (the grid and screen never change for one renderer), so this frame's space and the
+// previous frame's fit in Vulkan's guaranteed 128 push-constant bytes.
+struct SamplingFrame {
+    vec4 gaze;
+    vec4 shape0;
+    vec4 shape1;
+};
+
 struct MaterialGpu {
     vec4 base_color;            // linear RGBA factor
     vec4 emissive;              // rgb = emissiveFactor × emissive strength, w unused
@@ -156,56 +165,37 @@ struct VpProbePush {
 };
 
 // ---- Denoisers (issue 5): they run in the sampling grid (texel = sample). Every pass gets the
-// space as flattened SamplingParams push constants (see MipPhiPush for why not the buffer);
-// Cartesian kernel variants ignore the vp_* fields.
+// space as SamplingParams push constants (see MipPhiPush for why not the buffer); Cartesian
+// kernel variants ignore it.
 
 // Luminance ceiling of a sample entering SVGF's history: a firefly may not make the squared
 // moment overflow (demodulated light sources stay far below it).
 const float SVGF_MAX_LUMINANCE = 65504.0;
 
-// Push constants of SVGF's temporal accumulation. The previous frame's space differs from this
-// one only in its gaze-dependent slots (the grid and screen never change for one renderer), so
-// prev_* carry its gaze, shape0 and shape1; that keeps the block at Vulkan's guaranteed 128 bytes.
+// Push constants of SVGF's temporal accumulation (128 bytes: see SamplingFrame).
 struct SvgfTemporalPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
-    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
-    vec4 prev_shape0;
-    vec4 prev_shape1;
+    SamplingParams space;       // this frame's space
+    SamplingFrame prev;         // the previous frame's (its grid = space.grid)
     vec4 params;                // x α colour, y α moments, z history cap (frames), w 1 = drop all history
 };
 
 // Push constants of SVGF's variance estimate (spatial 7×7 while the history is short).
 struct SvgfVariancePush {
-    uvec4 vp_grid;              // the space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;
     vec4 params;                // x σ luminance, y σ depth, z σ normal, w history (frames) below which it is spatial
 };
 
 // Push constants of one SVGF à-trous iteration.
 struct SvgfAtrousPush {
-    uvec4 vp_grid;              // the space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;
     vec4 params;                // x σ luminance, y σ depth, z σ normal, w unused
     uvec4 config;               // x tap spacing (2^iteration texels), yzw unused
 };
 
-// Push constants of TAA in the sampling grid (Karis 2014). Same 128-byte layout as
-// SvgfTemporalPush: this frame's space, then the previous frame's gaze-dependent slots.
+// Push constants of TAA in the sampling grid (Karis 2014), 128 bytes like SvgfTemporalPush.
 struct TaaPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
-    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
-    vec4 prev_shape0;
-    vec4 prev_shape1;
+    SamplingParams space;       // this frame's space
+    SamplingFrame prev;         // the previous frame's (its grid = space.grid)
     vec4 params;                // x current-frame weight, y 1 = drop all history, zw this frame's jitter in the texel
 };
 
@@ -214,10 +204,7 @@ struct TaaPush {
 // texel footprint: under a pixel from the fovea, many pixels in the periphery. The pass reads the
 // footprint from the space to size its neighbourhood.
 struct TaaScreenPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;       // this frame's space
     vec4 params;                // x current-frame weight, y 1 = drop all history, zw unused
 };
 
@@ -235,25 +222,16 @@ const uint BMFR_FIT_LANES = 64u;
 const uint BMFR_WEIGHT_TEXELS = 12u;
 
 // Push constants of BMFR's two temporal passes (accumulation of the noisy input and features
-// before the fit, of the fitted colour after it). The previous frame's space differs only in its
-// gaze-dependent slots, like SvgfTemporalPush; that keeps the block at 128 bytes.
+// before the fit, of the fitted colour after it), 128 bytes like SvgfTemporalPush.
 struct BmfrTemporalPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
-    vec4 prev_gaze;             // the previous frame's gaze, shape0, shape1 (its grid = vp_grid)
-    vec4 prev_shape0;
-    vec4 prev_shape1;
+    SamplingParams space;       // this frame's space
+    SamplingFrame prev;         // the previous frame's (its grid = space.grid)
     vec4 params;                // xyz previous camera origin − this one (positions are camera-relative), w α floor (1: drop all history)
 };
 
 // Push constants of BMFR's per-block fit and of its per-texel weighted sum.
 struct BmfrBlockPush {
-    uvec4 vp_grid;              // the space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;
     ivec4 config;               // xy block-grid offset (texels, in [−16, 14]), z noise seed (frame), w unused
     vec4 params;                // x stochastic regularisation amplitude, yzw unused
 };
@@ -273,19 +251,13 @@ struct AsvgfGradientSample {
 
 // Push constants of A-SVGF's forward projection (one invocation per stratum of last frame).
 struct AsvgfForwardPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;       // this frame's space
     uvec4 config;               // x 1: project last frame's samples, 0: only clear the gradient image (no usable last frame); yzw unused
 };
 
 // Push constants of one iteration of A-SVGF's gradient reconstruction (à-trous on the strata).
 struct AsvgfGradientPush {
-    uvec4 vp_grid;              // this frame's space: SamplingParams field by field
-    vec4 vp_gaze;
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;       // this frame's space
     vec4 params;                // x σ depth, y σ normal, zw unused
     uvec4 config;               // x tap spacing in strata (2^iteration), yzw unused
 };

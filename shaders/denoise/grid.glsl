@@ -26,6 +26,16 @@ Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     return g;
 }
 
+// This frame's grid.
+Grid grid_make(SamplingParams space) {
+    return grid_make(space.grid, space.gaze, space.shape0, space.shape1);
+}
+
+// The previous frame's grid: its gaze-dependent slots on this frame's (unchanging) grid.
+Grid grid_make(SamplingParams space, SamplingFrame previous) {
+    return grid_make(space.grid, previous.gaze, previous.shape0, previous.shape1);
+}
+
 // Rows of column `col` that hold samples.
 int grid_rows(Grid g, int col) {
 #if defined(SAMPLING_VISUAL_POLAR)

@@ -34,7 +34,7 @@ vec3 camera_origin(mat4 view_from_world) {
 void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
     // The grid's rows per column do not depend on the gaze: this frame's grid addresses last frame's.
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(s, strata_size(g)))) return;
     imageStore(gradient, s, vec4(0.0));
     if (push.p.config.x == 0u || !stratum_holds_samples(g, s)) return;

@@ -24,7 +24,7 @@ const float B3[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 
 void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(s, strata_size(g)))) return;
     if (!stratum_holds_samples(g, s)) {
         imageStore(dst, s, vec4(0.0));

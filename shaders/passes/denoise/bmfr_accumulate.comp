@@ -44,7 +44,7 @@ float footprint(Grid g, ivec2 t, vec3 p) {
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {
         imageStore(noisy, t, vec4(0.0));
@@ -67,7 +67,7 @@ void main() {
     vec3 h_position = vec3(0.0);
     float h_length = 0.0;
     float h_weight = 0.0;
-    Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
+    Grid prev = grid_make(push.p.space, push.p.prev);
     ivec2 taps[4];
     vec4 w;
     // Stored with the position (w) so that the pass after the fit accepts the same taps; its sign

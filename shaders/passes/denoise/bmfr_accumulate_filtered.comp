@@ -27,7 +27,7 @@ layout(set = 0, binding = 11, rgba32f) uniform readonly image2D features_positio
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     vec4 a = imageLoad(albedo, t);
     if (!grid_holds_sample(g, t)) {
@@ -40,7 +40,7 @@ void main() {
     vec4 pw = imageLoad(position, t);
     bool hit = nd.w > 0.0;
     float alpha_floor = push.p.params.w;
-    Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
+    Grid prev = grid_make(push.p.space, push.p.prev);
     ivec2 taps[4];
     vec4 w;
     float kind = imageLoad(features_position, t).w;

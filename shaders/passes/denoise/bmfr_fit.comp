@@ -56,7 +56,7 @@ void reduce(int lane, int op) {
 void main() {
     int lane = int(gl_LocalInvocationID.x);
     ivec2 block = ivec2(gl_WorkGroupID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     ivec2 shift = 16 - push.p.config.xy;
 
     bool valid[ROWS];

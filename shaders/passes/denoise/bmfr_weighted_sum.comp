@@ -17,7 +17,7 @@ layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D fitted;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {
         imageStore(fitted, t, vec4(0.0));

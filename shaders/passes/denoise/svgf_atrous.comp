@@ -21,7 +21,7 @@ const float GAUSS3[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {
         imageStore(dst, t, vec4(0.0));

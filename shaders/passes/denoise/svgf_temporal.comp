@@ -50,7 +50,7 @@ void take(Grid prev, SvgfSurface s, ivec2 tap, float w) {
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {
         imageStore(accum, t, vec4(0.0));
@@ -65,7 +65,7 @@ void main() {
     hist_color = vec3(0.0);
     hist_moments = vec3(0.0);
     hist_weight = 0.0;
-    Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
+    Grid prev = grid_make(push.p.space, push.p.prev);
     vec2 p;
     if (push.p.params.w == 0.0 && prev_screen != vec2(-1.0) && grid_from_screen(prev, prev_screen, p)) {
         ivec2 taps[4];

@@ -30,7 +30,7 @@ const float TAA_MIN_HISTORY_WEIGHT = 0.01;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    Grid g = grid_make(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {
         imageStore(history, t, vec4(0.0));
@@ -61,7 +61,7 @@ void main() {
     vec3 hist = vec3(0.0);
     float hist_weight = 0.0;
     vec2 prev_screen = imageLoad(motion, t).xy;
-    Grid prev = grid_make(push.p.vp_grid, push.p.prev_gaze, push.p.prev_shape0, push.p.prev_shape1);
+    Grid prev = grid_make(push.p.space, push.p.prev);
     vec2 p;
     if (push.p.params.y == 0.0 && prev_screen != vec2(-1.0) && grid_from_screen(prev, prev_screen, p)) {
         // The motion belongs to the jittered sample; the history is kept at texel centres, so step

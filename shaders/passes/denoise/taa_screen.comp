@@ -55,7 +55,7 @@ void main() {
     ivec2 size = imageSize(color);
     if (any(greaterThanEqual(t, size))) return;
     FrameData fd = frame.data;
-    VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
     vec2 s = vec2(t) + 0.5;
     vec3 c = svgf_sanitize(imageLoad(color, t).rgb);
     vec2 g = vp_screen_to_vp(P, s);

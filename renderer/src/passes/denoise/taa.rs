@@ -173,13 +173,8 @@ impl Taa {
         let (current, p) = (&frame.current, previous.as_ref().unwrap_or(&frame.current));
         let reset = if previous.is_none() { 1.0 } else { 0.0 };
         let push = TaaPush {
-            vp_grid: current.grid,
-            vp_gaze: current.gaze,
-            vp_shape0: current.shape0,
-            vp_shape1: current.shape1,
-            prev_gaze: p.gaze,
-            prev_shape0: p.shape0,
-            prev_shape1: p.shape1,
+            space: *current,
+            prev: p.frame(),
             params: Vec4::new(self.settings.current_weight, reset, jitter.x, jitter.y),
         };
         let out = &self.history[cur];

@@ -70,12 +70,8 @@ impl ScreenTaa {
             read_image("prev_history", &self.history[1 - cur]),
             write_image("history", &self.history[cur]),
         ];
-        let s = frame.space;
         let push = TaaScreenPush {
-            vp_grid: s.grid,
-            vp_gaze: s.gaze,
-            vp_shape0: s.shape0,
-            vp_shape1: s.shape1,
+            space: *frame.space,
             params: Vec4::new(self.settings.current_weight, if reset { 1.0 } else { 0.0 }, 0.0, 0.0),
         };
         let out = &self.history[cur];

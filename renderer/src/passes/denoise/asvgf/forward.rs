@@ -46,10 +46,7 @@ impl ForwardPass {
             write_image("gradient", gradient),
         ];
         let push = AsvgfForwardPush {
-            vp_grid: space.grid,
-            vp_gaze: space.gaze,
-            vp_shape0: space.shape0,
-            vp_shape1: space.shape1,
+            space: *space,
             config: UVec4::new(project as u32, 0, 0, 0),
         };
         rec.dispatch("asvgf_forward", &self.pipeline, &binds, push_bytes(&push), [gradient.width, gradient.height, 1])

@@ -35,10 +35,7 @@ impl GradientPass {
     ) -> Result<()> {
         let binds = [read_image("src", src), read_image("normal_depth", &g.normal_depth), read_image("position", &g.position), write_image("dst", dst)];
         let push = AsvgfGradientPush {
-            vp_grid: space.grid,
-            vp_gaze: space.gaze,
-            vp_shape0: space.shape0,
-            vp_shape1: space.shape1,
+            space: *space,
             params: Vec4::new(s.gradient_sigma_depth, s.gradient_sigma_normal, 0.0, 0.0),
             config: UVec4::new(step, 0, 0, 0),
         };

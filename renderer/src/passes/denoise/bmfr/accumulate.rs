@@ -20,13 +20,8 @@ pub(super) fn temporal_push(current: &SamplingParams, r: &Reprojection, alpha_fl
     let p = r.previous.unwrap_or(current);
     let alpha = if r.previous.is_none() { 1.0 } else { alpha_floor };
     BmfrTemporalPush {
-        vp_grid: current.grid,
-        vp_gaze: current.gaze,
-        vp_shape0: current.shape0,
-        vp_shape1: current.shape1,
-        prev_gaze: p.gaze,
-        prev_shape0: p.shape0,
-        prev_shape1: p.shape1,
+        space: *current,
+        prev: p.frame(),
         params: r.camera_shift.extend(alpha),
     }
 }

@@ -18,10 +18,7 @@ pub struct FitPass {
 /// The push block of the fit and the weighted sum: the space and the block-grid offset.
 pub(super) fn block_push(space: &SamplingParams, offset: IVec2, seed: u32, noise: f32) -> BmfrBlockPush {
     BmfrBlockPush {
-        vp_grid: space.grid,
-        vp_gaze: space.gaze,
-        vp_shape0: space.shape0,
-        vp_shape1: space.shape1,
+        space: *space,
         config: IVec4::new(offset.x, offset.y, seed as i32, 0),
         params: Vec4::new(noise, 0.0, 0.0, 0.0),
     }

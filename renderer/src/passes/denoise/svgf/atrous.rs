@@ -40,10 +40,7 @@ impl AtrousPass {
             write_image("dst", dst),
         ];
         let push = SvgfAtrousPush {
-            vp_grid: space.grid,
-            vp_gaze: space.gaze,
-            vp_shape0: space.shape0,
-            vp_shape1: space.shape1,
+            space: *space,
             params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, 0.0),
             config: UVec4::new(step, 0, 0, 0),
         };

@@ -58,13 +58,8 @@ impl TemporalPass {
         let p = previous.unwrap_or(current);
         let reset = if previous.is_none() { 1.0 } else { 0.0 };
         let push = SvgfTemporalPush {
-            vp_grid: current.grid,
-            vp_gaze: current.gaze,
-            vp_shape0: current.shape0,
-            vp_shape1: current.shape1,
-            prev_gaze: p.gaze,
-            prev_shape0: p.shape0,
-            prev_shape1: p.shape1,
+            space: *current,
+            prev: p.frame(),
             params: Vec4::new(s.alpha_color, s.alpha_moments, s.max_history as f32, reset),
         };
         rec.dispatch("svgf_temporal", &self.pipeline, binds, push_bytes(&push), [accum.width, accum.height, 1])

@@ -41,10 +41,7 @@ impl VariancePass {
             write_image("dst", dst),
         ];
         let push = SvgfVariancePush {
-            vp_grid: space.grid,
-            vp_gaze: space.gaze,
-            vp_shape0: space.shape0,
-            vp_shape1: space.shape1,
+            space: *space,
             params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, s.variance_history as f32),
         };
         rec.dispatch("svgf_variance", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
