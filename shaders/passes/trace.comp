@@ -7,12 +7,10 @@
 // frame's random state, and every texel writes the visibility (barycentrics, random state) the
 // next projection reads. Plain rendering keeps the variants without them and pays nothing.
 //! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY VP_POLYNOMIAL_CDF_ONLY
-//! variant visual_polar_exact: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
+//! variant visual_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
 //! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
 //! variant cartesian_gradients: SAMPLING_CARTESIAN TRACE_GRADIENTS
-//! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY VP_POLYNOMIAL_CDF_ONLY TRACE_GRADIENTS
-//! variant visual_polar_exact_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
+//! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"

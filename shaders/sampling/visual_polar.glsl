@@ -19,13 +19,7 @@ VpArcs vp_column_arcs(uint col) {
 
 VpParams sampling_vp_params() {
     SamplingParams s = sampling.data;
-    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
-#if defined(VP_POLYNOMIAL_CDF_ONLY)
-    // Kernels for the paper's quartic inverse CDF (the default): lavapipe would run the exact
-    // inverse's Newton iterations under a mask in every mapping.
-    P.exact = false;
-#endif
-    return P;
+    return vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
 }
 
 // Whether `texel` holds a sample (not clipped, inside the grid).

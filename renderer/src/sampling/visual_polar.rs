@@ -635,7 +635,7 @@ pub fn params_select_clipped_layout(p: &SamplingParams) -> bool {
 /// Whether packed parameters need a general VP kernel rather than the one specialised for the
 /// paper's layout, normalised axis and quartic inverse CDF (lavapipe runs both sides of a branch,
 /// so the default pays for neither the screen-clipped mapping, the headset axis nor the exact
-/// inverse CDF's Newton iterations).
+/// CDF that the remap's screen → VP mapping evaluates).
 pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
     (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET | FLAG_EXACT) != 0
 }
@@ -651,13 +651,11 @@ impl SamplingSpace for VisualPolar {
     fn shader_variant(&self) -> &'static str {
         "visual_polar"
     }
-    /// `visual_polar`: specialised for the paper's layout, normalised axis and quartic inverse
-    /// CDF; `visual_polar_exact`: the same with the exact inverse CDF; otherwise the general
-    /// kernel (`visual_polar_clipped`: either layout, either axis).
+    /// `visual_polar`: specialised for the paper's layout and normalised axis; otherwise the
+    /// general kernel (`visual_polar_clipped`: either layout, either axis).
     fn trace_variant(&self) -> &'static str {
-        match (self.params.layout, self.headset.is_some(), self.exact) {
-            (VpLayout::Paper, false, false) => "visual_polar",
-            (VpLayout::Paper, false, true) => "visual_polar_exact",
+        match (self.params.layout, self.headset.is_some()) {
+            (VpLayout::Paper, false) => "visual_polar",
             _ => "visual_polar_clipped",
         }
     }
