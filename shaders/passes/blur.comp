@@ -16,10 +16,10 @@ void main() {
     vec4 shape = push.p.shape;
     float sigma = shape.w * max(length(vec2(t) + 0.5 - shape.xy) - shape.z, 0.0);
     // Wide kernels only occur in the periphery, where the image is a magnified, already smooth
-    // VP image: taps about σ/2 apart out to 2.5σ (5 or 6 per side from σ ≈ 9 px, at most 8) keep the
-    // cost flat; the sampled Gaussian's first alias sits at 2/σ cycles per pixel, where the
-    // continuous one has fallen to e^(−8π²), and the tails beyond 2.5σ hold 1.2 % of its weight.
-    // Float arithmetic: an integer division runs lane by lane on lavapipe.
+    // VP image: taps about σ/2 apart out to 2.5σ (5 or 6 per side from σ ≈ 9 px, at most 8)
+    // keep the cost flat; the sampled Gaussian's first alias sits at 2/σ cycles per pixel, where
+    // the continuous one has fallen to e^(−8π²), and the tails beyond 2.5σ hold 1.2 % of its
+    // weight. Float arithmetic: an integer division runs lane by lane on lavapipe.
     float spacing_px = max(1.0, floor(sigma * 0.5 + 0.5));
     int spacing = int(spacing_px);
     int taps = int(min(ceil(2.5 * sigma / spacing_px), floor(float(push.p.config.y) / spacing_px)));
