@@ -13,7 +13,7 @@ use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, P
 use fovea_renderer::passes::remap::RemapPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, InverseCdf, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_tests::{assert_clean, gpu, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, Vec2};
@@ -31,6 +31,12 @@ fn space(gaze: Vec2, layout: VpLayout) -> VisualPolar {
 fn headset_space(gaze: Vec2) -> VisualPolar {
     let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
     VisualPolar::new(SCREEN, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fov), ..Default::default() }).unwrap()
+}
+
+/// The exact inverse CDF (paper layout): the remap's paper kernel compiles it out, so this space
+/// takes the general kernel.
+fn exact_cdf_space(gaze: Vec2) -> VisualPolar {
+    VisualPolar::new(SCREEN, gaze, VisualPolarParams { inverse_cdf: InverseCdf::Exact, ..Default::default() }).unwrap()
 }
 
 fn gazes() -> [(&'static str, Vec2); 3] {
@@ -202,13 +208,13 @@ fn position_errors(vp: &VisualPolar, gaze: Vec2, screen: &[[f32; 4]]) -> (f64, f
 /// pixel's centre. Allowed error: half the texel's extent on screen, which is what linear
 /// interpolation of a curved grid and the φ box filter can be off by; in the screen-clipped
 /// layout a whole texel for border pixels the outer column's arcs do not reach (read from the
-/// inner column alone). Also with the headset eccentricity axis (FOVE 0).
+/// inner column alone). Also with the headset eccentricity axis (FOVE 0) and the exact inverse CDF.
 #[test]
 fn remap_reproduces_screen_positions() {
     let ctx = gpu();
     for (name, gaze) in gazes() {
-        let headset = ("Headset".to_string(), headset_space(gaze));
-        for (label, vp) in LAYOUTS.map(|layout| (format!("{layout:?}"), space(gaze, layout))).into_iter().chain([headset]) {
+        let others = [("Headset".to_string(), headset_space(gaze)), ("ExactCdf".to_string(), exact_cdf_space(gaze))];
+        for (label, vp) in LAYOUTS.map(|layout| (format!("{layout:?}"), space(gaze, layout))).into_iter().chain(others) {
             let (_, screen) = to_screen(&ctx, &vp, |x, y| {
                 let p = vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 [p.x, p.y, 0.0, 1.0]

@@ -41,7 +41,7 @@ void main() {
     // Rows past the column's count are never read by the remap.
     if (uint(t.y) >= phi_mip_rows(rows0, src + 1u)) return;
     uint a = 2u * uint(t.y);
-    uint b = (a + 1u) % src_rows;
+    uint b = a + 1u == src_rows ? 0u : a + 1u; // a < src_rows: wraps without a per-lane division
     vec4 va, vb;
     if (src == 0u) {
         va = imageLoad(vp_color, ivec2(t.x, a));

@@ -12,9 +12,9 @@
 // Samples jittered inside their texel (screen-space TAA) are read where they were traced:
 // sample_offset shifts the lookup by the jitter, in texels along ρ and in level-0 rows along φ.
 // Two variants: lavapipe executes both sides of every branch, so the paper's layout with the
-// normalised ρ axis gets a kernel with the screen-clipped path and the headset axis compiled out;
-// `clipped` is the general kernel (either layout, either axis).
-//! variant paper: VP_LAYOUT_PAPER VP_NORMALIZED_AXIS_ONLY
+// normalised ρ axis and the quartic inverse CDF gets a kernel with the screen-clipped path, the
+// headset axis and the exact CDF compiled out; `clipped` is the general kernel.
+//! variant paper: VP_LAYOUT_PAPER VP_NORMALIZED_AXIS_ONLY VP_POLYNOMIAL_CDF_ONLY
 //! variant clipped: VP_LAYOUT_CLIPPED
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_clipped.glsl"
@@ -42,13 +42,15 @@ vec4 fetch(uint level, uint height, uint col, uint row) {
 
 // Linear along φ at one level; y0 = continuous row coordinate at level 0 (texel centres at +½).
 vec4 sample_phi(uint col, uint rows0, float y0, uint level, uint height) {
-    uint m = phi_mip_rows(rows0, level);
+    int m = int(phi_mip_rows(rows0, level));
     float y = y0 / float(1u << level) - 0.5;
     float f = floor(y);
-    int a = int(f) % int(m);
-    if (a < 0) a += int(m);
-    uint b = (uint(a) + 1u) % m;
-    return mix(fetch(level, height, col, uint(a)), fetch(level, height, col, b), y - f);
+    // y0 stays within half a row of [0, rows0), so both rows are at most one period off: adding
+    // or subtracting m wraps them (an integer % becomes a per-lane scalar division on lavapipe).
+    int a = int(f);
+    a += a < 0 ? m : (a >= m ? -m : 0);
+    int b = a + 1 == m ? 0 : a + 1;
+    return mix(fetch(level, height, col, uint(a)), fetch(level, height, col, uint(b)), y - f);
 }
 
 // Linear along φ at one level, clamped to the rows whose centres lie in [lo0, hi0) (level-0 rows:
@@ -104,16 +106,24 @@ vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels, out fl
     float y0 = phi / VP_TAU * float(rows0) - push.p.sample_offset.y;
     float lod = phi_lod(rows0, VP_TAU, r, levels);
     uint l0 = uint(lod);
-    uint l1 = min(l0 + 1u, levels - 1u);
-    vec4 v0 = sample_phi(col, rows0, y0, l0, P.grid.y);
-    vec4 v1 = sample_phi(col, rows0, y0, l1, P.grid.y);
-    return mix(v0, v1, lod - float(l0));
+    float t = lod - float(l0);
+    // The coarser level only where the footprint lies between two levels. A loop rather than a
+    // second call: lavapipe leaves a loop once no lane of its batch needs another pass, and away
+    // from the gaze (most of the screen) one pixel spans at most one row, so it reads level 0 only.
+    uint last = t > 0.0 ? l0 + 1u : l0;
+    vec4 v = vec4(0.0);
+    for (uint l = l0; l <= last; ++l)
+        v += (l == l0 ? 1.0 - t : t) * sample_phi(col, rows0, y0, l, P.grid.y);
+    return v;
 }
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, imageSize(screen_color)))) return;
     VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+#if defined(VP_POLYNOMIAL_CDF_ONLY)
+    P.exact = false; // the exact CDF would cost every pixel of the default frame under a mask
+#endif
     vec2 d = vec2(t) + 0.5 - P.gaze;
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;

@@ -52,10 +52,11 @@ float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
     float size = 0.0;
     for (int axis = 0; axis < 2; ++axis) {
         ivec2 step = axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
+        // The last column/row (or a clipped neighbour) has its neighbour on the other side. Picked
+        // before mapping: lavapipe would map both candidates (a VP mapping each) under masks.
+        ivec2 neighbour = sample_exists(texel + step) ? texel + step : texel - step;
         vec2 next;
-        // The last column/row (or a clipped neighbour) has its neighbour on the other side.
-        if (sample_screen_position(texel + step, jitter, next) || sample_screen_position(texel - step, jitter, next))
-            size = max(size, length(next - screen));
+        if (sample_screen_position(neighbour, jitter, next)) size = max(size, length(next - screen));
     }
     return size > 0.0 ? size : 1.0;
 }

@@ -1,5 +1,6 @@
 // Selects the sampling space a kernel variant is compiled for. Every space provides
-// `bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen)`.
+// `bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen)` and
+// `bool sample_exists(ivec2 texel)` (whether the former returns true, without mapping).
 #ifndef FOVEA_SAMPLING_SPACE_GLSL
 #define FOVEA_SAMPLING_SPACE_GLSL
 

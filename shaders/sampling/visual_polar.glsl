@@ -17,10 +17,19 @@ VpArcs vp_column_arcs(uint col) {
     return VpArcs(texelFetch(sampling_table, int(2u * col)), texelFetch(sampling_table, int(2u * col + 1u)));
 }
 
+VpParams sampling_vp_params() {
+    SamplingParams s = sampling.data;
+    return vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+}
+
+// Whether `texel` holds a sample (not clipped, inside the grid).
+bool sample_exists(ivec2 texel) {
+    return vp_is_valid_texel(sampling_vp_params(), texel);
+}
+
 // Screen position (pixels, y down) of the sample held by `texel`; false when the texel holds none.
 bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen) {
-    SamplingParams s = sampling.data;
-    VpParams P = vp_unpack(s.grid, s.gaze, s.shape0, s.shape1);
+    VpParams P = sampling_vp_params();
     screen = vec2(0.0);
     if (!vp_is_valid_texel(P, texel)) return false;
     // rng_next gives [0, 1): texel + jitter stays in the texel, so floor(x) is its column.

@@ -498,10 +498,11 @@ pub fn params_select_clipped_layout(p: &SamplingParams) -> bool {
 }
 
 /// Whether packed parameters need a general VP kernel rather than the one specialised for the
-/// paper's layout and normalised axis (lavapipe runs both sides of a branch, so the default pays
-/// for neither the screen-clipped mapping nor the headset axis).
+/// paper's layout, normalised axis and quartic inverse CDF (lavapipe runs both sides of a branch,
+/// so the default pays for neither the screen-clipped mapping, the headset axis nor the exact
+/// CDF that the remap's screen → VP mapping evaluates).
 pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
-    (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET) != 0
+    (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET | FLAG_EXACT) != 0
 }
 
 /// The tracer's view of the space: one sample per kept texel; the GPU twin is
