@@ -135,19 +135,13 @@ const uint BLUR_MAX_RADIUS = 64u;
 // turns per-lane storage-buffer reads into scalar loads, which cost these light passes more than
 // their arithmetic.
 struct MipPhiPush {
-    uvec4 vp_grid;              // the space: SamplingParams (VisualPolar::sampling_params)
-    vec4 vp_gaze;               //   field by field
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;       // VisualPolar::sampling_params
     uvec4 config;               // x source level (0 = the VP image), yzw unused
 };
 
 // Push constants of the remap-to-screen pass.
 struct RemapPush {
-    uvec4 vp_grid;              // the space: SamplingParams (VisualPolar::sampling_params)
-    vec4 vp_gaze;               //   field by field
-    vec4 vp_shape0;
-    vec4 vp_shape1;
+    SamplingParams space;       // VisualPolar::sampling_params
     uvec4 config;               // x φ mip levels built (≥ 2), yzw unused
     vec4 sample_offset;         // xy where this frame's samples sit in their VP texel minus ½ (screen-space TAA's
                                 //   Halton jitter; 0 otherwise: samples are read as if centred), zw unused

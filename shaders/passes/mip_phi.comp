@@ -32,7 +32,7 @@ VpArcs vp_column_arcs(uint col) {
 }
 
 void main() {
-    VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (uint(t.x) >= P.grid.x) return;
     uint src = push.p.config.x;

@@ -120,7 +120,7 @@ vec4 sample_column(VpParams P, uint col, float phi, float r, uint levels, out fl
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, imageSize(screen_color)))) return;
-    VpParams P = vp_unpack(push.p.vp_grid, push.p.vp_gaze, push.p.vp_shape0, push.p.vp_shape1);
+    VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
 #if defined(VP_POLYNOMIAL_CDF_ONLY)
     P.exact = false; // the exact CDF would cost every pixel of the default frame under a mask
 #endif

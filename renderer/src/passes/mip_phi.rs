@@ -66,10 +66,7 @@ impl MipPhiPass {
         for src in 0..mips.levels - 1 {
             let binds = [read_image("vp_color", vp_color), write_image("mips", &mips.image), read_texels("vp_columns", columns)];
             let push = MipPhiPush {
-                vp_grid: vp.grid,
-                vp_gaze: vp.gaze,
-                vp_shape0: vp.shape0,
-                vp_shape1: vp.shape1,
+                space: *vp,
                 config: UVec4::new(src, 0, 0, 0),
             };
             let rows = rows_at_level(vp_color.height, src + 1);

@@ -36,10 +36,7 @@ impl RemapPass {
     ) -> Result<()> {
         let binds = [read_image("mips", &mips.image), write_image("screen_color", screen), read_texels("vp_columns", columns)];
         let push = RemapPush {
-            vp_grid: vp.grid,
-            vp_gaze: vp.gaze,
-            vp_shape0: vp.shape0,
-            vp_shape1: vp.shape1,
+            space: *vp,
             config: UVec4::new(mips.levels, 0, 0, 0),
             sample_offset: Vec4::new(sample_offset.x, sample_offset.y, 0.0, 0.0),
         };
