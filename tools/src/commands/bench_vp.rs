@@ -78,25 +78,42 @@ pub struct DenoiserCost {
 
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
 pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<BTreeMap<String, f64>> {
-    let input = |frame_index| FrameInput { camera, frame_index, gaze, read_hdr: false, read_grid: false };
-    renderer.render_frame(&input(0))?;
-    let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut medians = interleaved_pass_medians(&mut [(renderer, gaze)], camera, frames)?;
+    Ok(medians.remove(0))
+}
+
+/// `pass_medians` of several renderers (each with its gaze) whose frames alternate: a drift of
+/// the machine's speed during the run (up to ±25 % within an hour on these CPU machines) then
+/// hits every side alike, and the ratios between them stay fair.
+pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: CameraPose, frames: u32) -> Result<Vec<BTreeMap<String, f64>>> {
+    let input = |frame_index, gaze| FrameInput { camera, frame_index, gaze, read_hdr: false, read_grid: false };
+    for (renderer, gaze) in renderers.iter_mut() {
+        renderer.render_frame(&input(0, *gaze))?;
+    }
+    let mut samples: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); renderers.len()];
     for frame in 0..frames.max(1) {
-        renderer.render_frame(&input(frame + 1))?;
-        // A pass recorded several times in one frame (one mip level each) counts as one.
-        let mut frame_sums: BTreeMap<&str, f64> = BTreeMap::new();
-        for t in renderer.timings() {
-            *frame_sums.entry(t.name).or_default() += t.ms;
-        }
-        for (name, ms) in frame_sums {
-            samples.entry(name.to_string()).or_default().push(ms);
+        for ((renderer, gaze), samples) in renderers.iter_mut().zip(&mut samples) {
+            renderer.render_frame(&input(frame + 1, *gaze))?;
+            // A pass recorded several times in one frame (one mip level each) counts as one.
+            let mut frame_sums: BTreeMap<&str, f64> = BTreeMap::new();
+            for t in renderer.timings() {
+                *frame_sums.entry(t.name).or_default() += t.ms;
+            }
+            for (name, ms) in frame_sums {
+                samples.entry(name.to_string()).or_default().push(ms);
+            }
         }
     }
     Ok(samples
         .into_iter()
-        .map(|(name, mut v)| {
-            v.sort_by(f64::total_cmp);
-            (name, v[v.len() / 2])
+        .map(|passes| {
+            passes
+                .into_iter()
+                .map(|(name, mut v)| {
+                    v.sort_by(f64::total_cmp);
+                    (name, v[v.len() / 2])
+                })
+                .collect()
         })
         .collect())
 }
@@ -119,23 +136,26 @@ pub fn measure(
     let screen = UVec2::new(w, h);
     let gaze = screen.as_vec2() * 0.5;
     let pose = CameraPose::from_scene_camera(camera, w, h);
-    let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), RenderSettings::default())?;
-    let cartesian_passes_ms = pass_medians(&mut cart, pose, None, frames)?;
-    drop(cart);
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
-    let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), RenderSettings::default())?;
-    let vp_passes_ms = pass_medians(&mut vpr, pose, Some(gaze), frames)?;
-    drop(vpr);
+    let pair = |settings: RenderSettings| -> Result<(Renderer, Renderer)> {
+        Ok((
+            Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?,
+            Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?,
+        ))
+    };
+    let (mut cart, mut vpr) = pair(RenderSettings::default())?;
+    let [cartesian_passes_ms, vp_passes_ms]: [BTreeMap<String, f64>; 2] =
+        interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.try_into().expect("two renderers");
+    drop((cart, vpr));
     let mut costs = Vec::new();
     for denoiser in denoisers() {
-        let settings = RenderSettings { denoiser, ..Default::default() };
         let prefixes = pass_prefixes(&denoiser);
-        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
-        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&mut cart, &prefixes, pose, None, frames)?;
-        drop(cart);
-        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
-        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&mut vpr, &prefixes, pose, Some(gaze), frames)?;
-        drop(vpr);
+        let (mut cart, mut vpr) = pair(RenderSettings { denoiser, ..Default::default() })?;
+        let [cart_all, vp_all]: [BTreeMap<String, f64>; 2] =
+            interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.try_into().expect("two renderers");
+        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&cart, cart_all, &prefixes);
+        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&vpr, vp_all, &prefixes);
+        drop((cart, vpr));
         let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
         costs.push(DenoiserCost {
@@ -214,13 +234,12 @@ pub fn measure(
     Ok(report)
 }
 
-/// Median ms per frame of each of the denoiser's passes (named `prefix*` for one of `prefixes`)
-/// and of the trace, and the denoiser's history bytes.
-fn denoiser_cost(renderer: &mut Renderer, prefixes: &[String], camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<(BTreeMap<String, f64>, u64)> {
-    let passes = pass_medians(renderer, camera, gaze, frames)?;
+/// Of a renderer's pass medians: the denoiser's passes (named `prefix*` for one of `prefixes`)
+/// and the trace, and the denoiser's history bytes.
+fn denoiser_cost(renderer: &Renderer, passes: BTreeMap<String, f64>, prefixes: &[String]) -> (BTreeMap<String, f64>, u64) {
     let own = passes.into_iter().filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str()))).collect();
     let bytes = renderer.denoiser().map_or(0, |d| d.history_bytes());
-    Ok((own, bytes))
+    (own, bytes)
 }
 
 /// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's
