@@ -143,16 +143,20 @@ pub fn measure(
             Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?,
         ))
     };
+    // Cartesian first, VP second, frames interleaved.
+    let medians = |cart: &mut Renderer, vpr: &mut Renderer| -> Result<(BTreeMap<String, f64>, BTreeMap<String, f64>)> {
+        let mut m = interleaved_pass_medians(&mut [(cart, None), (vpr, Some(gaze))], pose, frames)?;
+        let vp = m.pop().expect("two renderers in, two medians out");
+        Ok((m.pop().expect("two renderers in, two medians out"), vp))
+    };
     let (mut cart, mut vpr) = pair(RenderSettings::default())?;
-    let [cartesian_passes_ms, vp_passes_ms]: [BTreeMap<String, f64>; 2] =
-        interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.try_into().expect("two renderers");
+    let (cartesian_passes_ms, vp_passes_ms) = medians(&mut cart, &mut vpr)?;
     drop((cart, vpr));
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
         let (mut cart, mut vpr) = pair(RenderSettings { denoiser, ..Default::default() })?;
-        let [cart_all, vp_all]: [BTreeMap<String, f64>; 2] =
-            interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.try_into().expect("two renderers");
+        let (cart_all, vp_all) = medians(&mut cart, &mut vpr)?;
         let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&cart, cart_all, &prefixes);
         let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&vpr, vp_all, &prefixes);
         drop((cart, vpr));
