@@ -137,29 +137,23 @@ pub fn measure(
     let gaze = screen.as_vec2() * 0.5;
     let pose = CameraPose::from_scene_camera(camera, w, h);
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
-    let pair = |settings: RenderSettings| -> Result<(Renderer, Renderer)> {
-        Ok((
-            Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?,
-            Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?,
-        ))
+    // A Cartesian and a VP renderer with these settings, their frames interleaved: each one's
+    // pass medians and denoiser history bytes (the renderers are dropped before the next pair).
+    let measure_pair = |settings: RenderSettings| -> Result<[(BTreeMap<String, f64>, u64); 2]> {
+        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
+        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
+        let history = |r: &Renderer| r.denoiser().map_or(0, |d| d.history_bytes());
+        let (cart_history, vp_history) = (history(&cart), history(&vpr));
+        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.into_iter();
+        let mut next = |bytes| medians.next().map(|m| (m, bytes)).expect("one median map per renderer");
+        Ok([next(cart_history), next(vp_history)])
     };
-    // Cartesian first, VP second, frames interleaved.
-    let medians = |cart: &mut Renderer, vpr: &mut Renderer| -> Result<(BTreeMap<String, f64>, BTreeMap<String, f64>)> {
-        let mut m = interleaved_pass_medians(&mut [(cart, None), (vpr, Some(gaze))], pose, frames)?;
-        let vp = m.pop().expect("two renderers in, two medians out");
-        Ok((m.pop().expect("two renderers in, two medians out"), vp))
-    };
-    let (mut cart, mut vpr) = pair(RenderSettings::default())?;
-    let (cartesian_passes_ms, vp_passes_ms) = medians(&mut cart, &mut vpr)?;
-    drop((cart, vpr));
+    let [(cartesian_passes_ms, _), (vp_passes_ms, _)] = measure_pair(RenderSettings::default())?;
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
-        let (mut cart, mut vpr) = pair(RenderSettings { denoiser, ..Default::default() })?;
-        let (cart_all, vp_all) = medians(&mut cart, &mut vpr)?;
-        let (cartesian_passes_ms, cartesian_history_bytes) = denoiser_cost(&cart, cart_all, &prefixes);
-        let (vp_passes_ms, vp_history_bytes) = denoiser_cost(&vpr, vp_all, &prefixes);
-        drop((cart, vpr));
+        let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)] = measure_pair(RenderSettings { denoiser, ..Default::default() })?;
+        let (cartesian_passes_ms, vp_passes_ms) = (denoiser_passes(cart_all, &prefixes), denoiser_passes(vp_all, &prefixes));
         let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
         costs.push(DenoiserCost {
@@ -239,11 +233,9 @@ pub fn measure(
 }
 
 /// Of a renderer's pass medians: the denoiser's passes (named `prefix*` for one of `prefixes`)
-/// and the trace, and the denoiser's history bytes.
-fn denoiser_cost(renderer: &Renderer, passes: BTreeMap<String, f64>, prefixes: &[String]) -> (BTreeMap<String, f64>, u64) {
-    let own = passes.into_iter().filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str()))).collect();
-    let bytes = renderer.denoiser().map_or(0, |d| d.history_bytes());
-    (own, bytes)
+/// and the trace.
+fn denoiser_passes(passes: BTreeMap<String, f64>, prefixes: &[String]) -> BTreeMap<String, f64> {
+    passes.into_iter().filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str()))).collect()
 }
 
 /// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's
