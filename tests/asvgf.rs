@@ -40,7 +40,7 @@ fn svgf() -> DenoiserSettings {
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
-    FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
+    FrameInput::mono(camera, frame_index, None).with_hdr(true)
 }
 
 /// The Cornell box's only emissive material (its ceiling light).

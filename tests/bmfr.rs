@@ -46,7 +46,7 @@ fn with_bmfr() -> DenoiserSettings {
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
-    FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
+    FrameInput::mono(camera, frame_index, None).with_hdr(true)
 }
 
 /// One material, not emissive (what the synthetic G-buffers' material index 0 reads).
@@ -323,7 +323,7 @@ fn bmfr_reduces_noise_in_both_spaces() {
         }
         r.read_hdr(&mut denoised).unwrap();
         assert_finite_non_negative(name, &denoised);
-        let interior = surface_interiors(&ctx, &r.gbuffer, r.space());
+        let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         save_preview(&format!("bmfr_{name}_raw.png"), size.x, size.y, &raw);
         save_preview(&format!("bmfr_{name}.png"), size.x, size.y, &denoised);
 
@@ -377,9 +377,9 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
         let mut peak = 0f32;
         for f in 0..6 {
             r.render_frame(&frame(camera, f)).unwrap();
-            inject_fireflies(&ctx, &r.gbuffer.radiance, f);
+            inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let out = denoise(&ctx, &mut bmfr, &r.gbuffer, &DenoiseFrame { current, previous }, origin, &r.scene.materials);
+            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous }, origin, &r.scene.materials);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} history"), &read_image(&ctx, bmfr.noisy()));

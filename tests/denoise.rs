@@ -39,7 +39,7 @@ fn with_svgf() -> DenoiserSettings {
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
-    FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
+    FrameInput::mono(camera, frame_index, None).with_hdr(true)
 }
 
 /// Still camera on the Cornell box at 128×144 (5 à-trous iterations span ±62 px; at much smaller
@@ -83,7 +83,7 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
         }
         r.read_hdr(&mut denoised).unwrap();
         assert_finite_non_negative(name, &denoised);
-        let interior = surface_interiors(&ctx, &r.gbuffer, r.space());
+        let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         save_preview(&format!("denoise_{name}_raw.png"), size.x, size.y, &raw);
         save_preview(&format!("denoise_{name}_svgf.png"), size.x, size.y, &denoised);
 
@@ -189,9 +189,9 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
         let mut peak = 0f32;
         for f in 0..6 {
             r.render_frame(&frame(camera, f)).unwrap();
-            inject_fireflies(&ctx, &r.gbuffer.radiance, f);
+            inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let (out, moments) = denoise(&ctx, &mut svgf, &r.gbuffer, &DenoiseFrame { current, previous });
+            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous });
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} moments"), &moments);
@@ -355,7 +355,7 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
         assert_finite_non_negative(name, &resolved);
         assert!(r.timings().iter().any(|t| t.name == "taa"), "{name}: no taa pass timed");
         let taa_ms: f64 = r.timings().iter().filter(|t| t.name == "taa").map(|t| t.ms).sum();
-        let interior = surface_interiors(&ctx, &r.gbuffer, r.space());
+        let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         save_preview(&format!("taa_{name}_raw.png"), size.x, size.y, &raw);
         save_preview(&format!("taa_{name}.png"), size.x, size.y, &resolved);
         // TAA resolves with Karis's 1/(1 + luma) weights, i.e. it averages in a compressed space:
@@ -404,10 +404,10 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
         let mut peak = 0f32;
         for f in 0..6 {
             r.render_frame(&frame(camera, f)).unwrap();
-            inject_fireflies(&ctx, &r.gbuffer.color, f);
+            inject_fireflies(&ctx, &r.view(0).gbuffer.color, f);
             let current = r.space().params();
             let jitter = TaaSettings::default().jitter(f);
-            let out = resolve(&ctx, &mut taa, &r.gbuffer, &r.gbuffer.color, &DenoiseFrame { current, previous }, jitter);
+            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous }, jitter);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f}"), &out);
             peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
@@ -479,7 +479,7 @@ fn taa_makes_the_tracer_use_the_frames_halton_offset() {
             let mut r = Renderer::new(&ctx, &scene, again(), s).unwrap();
             for f in [0u32, 1, 5, 17] {
                 r.render_frame(&frame(camera, f)).unwrap();
-                let motion: Vec<[f32; 2]> = read_image(&ctx, &r.gbuffer.motion);
+                let motion: Vec<[f32; 2]> = read_image(&ctx, &r.view(0).gbuffer.motion);
                 let jitter = TaaSettings::default().jitter(f);
                 let (mut worst, mut checked, mut off) = (0f32, 0, 0);
                 for y in 0..grid.y {

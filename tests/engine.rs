@@ -82,7 +82,7 @@ fn binding_mistakes_name_the_pass_and_the_binding() {
 #[test]
 fn pipeline_creation_checks_the_params_struct_size_and_shader_name() {
     let ctx = gpu();
-    let err = ComputePipeline::new(&ctx, "passes/tonemap", 4).err().expect("size mismatch").to_string();
+    let err = ComputePipeline::new(&ctx, "passes/tonemap.own", 4).err().expect("size mismatch").to_string();
     assert!(err.contains("32") && err.contains("4"), "{err}");
     let err = ComputePipeline::new(&ctx, "passes/no_such_pass", 0).err().expect("unknown shader").to_string();
     assert!(err.contains("no_such_pass"), "{err}");

@@ -97,7 +97,7 @@ fn render_loop_makes_no_host_allocations() {
         for frame in 0..WARM_UP_FRAMES + COUNTED_FRAMES {
             // The gaze moves every frame, as it does on a headset.
             let gaze = SCREEN.as_vec2() * Vec2::new(0.3 + 0.1 * frame as f32, 0.6 - 0.05 * frame as f32);
-            let input = FrameInput { camera, frame_index: frame, gaze: Some(gaze), read_hdr: false, read_grid: false };
+            let input = FrameInput::mono(camera, frame, Some(gaze));
             let n = allocations_during(|| {
                 renderer.render_frame(&input).unwrap();
                 renderer.read_ldr(&mut ldr).unwrap();

@@ -151,7 +151,7 @@ fn same_seed_gives_identical_frames_and_new_frames_give_new_noise() {
     let size = 32;
     let camera = pose(&scene, size);
     let frame = |r: &mut Renderer, index: u32| {
-        r.render_frame(&FrameInput { camera, frame_index: index, gaze: None, read_hdr: true, read_grid: false }).unwrap();
+        r.render_frame(&FrameInput::mono(camera, index, None).with_hdr(true)).unwrap();
         let mut hdr = Vec::new();
         r.read_hdr(&mut hdr).unwrap();
         hdr
@@ -175,7 +175,7 @@ fn realtime_frames_report_exact_ray_counts_and_finite_output() {
     let scene = fovea_tests::owned_scene("stress");
     let size = 48;
     let mut r = renderer(&ctx, &scene, size, 1);
-    let stats = r.render_frame(&FrameInput { camera: pose(&scene, size), frame_index: 0, gaze: None, read_hdr: true, read_grid: false }).unwrap();
+    let stats = r.render_frame(&FrameInput::mono(pose(&scene, size), 0, None).with_hdr(true)).unwrap();
     assert_eq!(stats.samples_traced, (size * size) as u64);
     assert_eq!(stats.primary_rays, (size * size) as u64);
     // At most one shadow ray per hit vertex (two vertices) and one continuation per sample.

@@ -29,7 +29,7 @@ fn settings(taa: TaaMode) -> RenderSettings {
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
-    FrameInput { camera, frame_index, gaze: None, read_hdr: true, read_grid: false }
+    FrameInput::mono(camera, frame_index, None).with_hdr(true)
 }
 
 fn luminance(p: &[f32; 4]) -> f32 {
@@ -123,7 +123,7 @@ fn screen_taa_output_is_finite_and_non_negative_with_fireflies() {
         write_image(&ctx, &color, &hdr);
         inject_fireflies(&ctx, &color, f);
         let space = r.space().params();
-        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &r.gbuffer, space: &space, has_previous: f > 0, jitter: Vec2::splat(0.5) };
+        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &r.view(0).gbuffer, space: &space, has_previous: f > 0, jitter: Vec2::splat(0.5) };
         let out = resolve(&ctx, &mut taa, &color, &input);
         assert_finite_non_negative(&format!("frame {f}"), &out);
         peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));

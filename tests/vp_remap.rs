@@ -332,7 +332,7 @@ fn frame_means(ctx: &Arc<Context>, space: Box<dyn SamplingSpace>, gaze: Option<V
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     let (mut sum, mut hdr, mut offscreen) = ([0f64; 3], Vec::new(), 0);
     for frame in 0..frames {
-        let stats = r.render_frame(&FrameInput { camera, frame_index: frame, gaze, read_hdr: true, read_grid: true }).unwrap();
+        let stats = r.render_frame(&FrameInput::mono(camera, frame, gaze).with_hdr(true).with_grid(true)).unwrap();
         assert_eq!(stats.samples_traced, r.space().sample_count());
         offscreen += stats.samples_offscreen;
         r.read_hdr(&mut hdr).unwrap();

@@ -109,7 +109,7 @@ fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (
     let settings = RenderSettings::default();
     let mut r = Renderer::new(ctx, scene, space, settings).unwrap();
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let stats = r.render_frame(&FrameInput { camera, frame_index: FRAME_INDEX, gaze: None, read_hdr: false, read_grid: false }).unwrap();
+    let stats = r.render_frame(&FrameInput::mono(camera, FRAME_INDEX, None)).unwrap();
     (r, stats)
 }
 
@@ -169,10 +169,10 @@ fn check_vp_frame_with(
 
     // G-buffer: clipped texels are written as "nothing" (zeros, motion −1); kept on-screen
     // texels of the closed Cornell box hit geometry.
-    let color: Vec<[f32; 4]> = read_image(ctx, &r.gbuffer.color);
-    let normal_depth: Vec<[f32; 4]> = read_image(ctx, &r.gbuffer.normal_depth);
-    let ids: Vec<[u32; 2]> = read_image(ctx, &r.gbuffer.ids);
-    let motion: Vec<[f32; 2]> = read_image(ctx, &r.gbuffer.motion);
+    let color: Vec<[f32; 4]> = read_image(ctx, &r.view(0).gbuffer.color);
+    let normal_depth: Vec<[f32; 4]> = read_image(ctx, &r.view(0).gbuffer.normal_depth);
+    let ids: Vec<[u32; 2]> = read_image(ctx, &r.view(0).gbuffer.ids);
+    let motion: Vec<[f32; 2]> = read_image(ctx, &r.view(0).gbuffer.motion);
     let (mut clipped, mut kept_on_screen, mut hits_on_screen) = (0u64, 0u64, 0u64);
     for y in 0..g.y {
         for x in 0..g.x {

@@ -4,7 +4,13 @@
 //!
 //! All passes are compute (plus copies), all images stay in GENERAL layout, so a hazard needs only
 //! a global memory barrier: read-after-write, write-after-write and write-after-read are detected
-//! per resource since the last barrier.
+//! per resource since the last barrier. Images the engine does not own (a swapchain's) are
+//! `External`: their layout transitions in and out are declared with `acquire_external` and
+//! `release_external`.
+//!
+//! A recorder is one frame slot: `submit` returns at once, `wait` blocks on the slot's fence and
+//! reads its timestamps. A frame's command buffer starts with a barrier against everything
+//! submitted before it, so frames in flight that share history images are ordered on the GPU.
 
 use crate::error::{Error, Result};
 use crate::vk::{Buffer, ComputePipeline, Context, Image, ResourceId};
@@ -18,6 +24,7 @@ pub enum Resource<'a> {
     Buffer(&'a Buffer),
     Texels(&'a Buffer),
     Image(&'a Image),
+    External(&'a ExternalImage),
 }
 
 impl Resource<'_> {
@@ -25,7 +32,32 @@ impl Resource<'_> {
         match self {
             Resource::Buffer(b) | Resource::Texels(b) => b.id,
             Resource::Image(i) => i.id,
+            Resource::External(e) => e.id,
         }
+    }
+}
+
+/// An image the engine writes but does not own (a swapchain image): its handle, a view with
+/// STORAGE usage, and the layouts it arrives in and must leave in.
+#[derive(Clone, Copy, Debug)]
+pub struct ExternalImage {
+    pub raw: vk::Image,
+    pub view: vk::ImageView,
+    pub width: u32,
+    pub height: u32,
+    pub format: vk::Format,
+    /// UNDEFINED for a freshly acquired swapchain image (its contents are overwritten).
+    pub layout_before: vk::ImageLayout,
+    /// PRESENT_SRC_KHR for a swapchain image.
+    pub layout_after: vk::ImageLayout,
+    pub id: ResourceId,
+}
+
+impl ExternalImage {
+    /// Bytes of a tightly packed copy of the image (screenshots). `id` must be one per image,
+    /// from `crate::vk::next_resource_id`.
+    pub fn bytes(&self) -> u64 {
+        self.width as u64 * self.height as u64 * crate::vk::format_bytes(self.format)
     }
 }
 
@@ -52,12 +84,24 @@ pub fn read_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
 pub fn write_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
     Bind { name, resource: Resource::Image(i), write: true }
 }
+pub fn write_external<'a>(name: &'static str, e: &'a ExternalImage) -> Bind<'a> {
+    Bind { name, resource: Resource::External(e), write: true }
+}
 
-/// GPU time of one pass in the last submitted frame.
+/// GPU time of one pass of a completed frame.
 #[derive(Clone, Copy, Debug)]
 pub struct PassTiming {
     pub name: &'static str,
+    /// The view (eye) the pass rendered; passes shared by all views count as view 0.
+    pub view: u32,
     pub ms: f64,
+}
+
+/// Semaphores one submission waits on and signals (a swapchain's acquire and present).
+#[derive(Clone, Copy, Default)]
+pub struct SubmitSync<'a> {
+    pub wait: &'a [(vk::Semaphore, vk::PipelineStageFlags)],
+    pub signal: &'a [vk::Semaphore],
 }
 
 pub struct FrameRecorder {
@@ -66,11 +110,14 @@ pub struct FrameRecorder {
     fence: vk::Fence,
     queries: vk::QueryPool,
     max_passes: u32,
-    passes: Vec<&'static str>,
+    passes: Vec<(&'static str, u32)>,
+    view: u32,
     read_since_barrier: Vec<ResourceId>,
     written_since_barrier: Vec<ResourceId>,
     timings: Vec<PassTiming>,
     recording: bool,
+    /// Submitted and not yet waited for.
+    in_flight: bool,
 }
 
 impl FrameRecorder {
@@ -93,25 +140,94 @@ impl FrameRecorder {
             queries,
             max_passes,
             passes: Vec::with_capacity(max_passes as usize),
+            view: 0,
             read_since_barrier: Vec::with_capacity(64),
             written_since_barrier: Vec::with_capacity(64),
             timings: Vec::with_capacity(max_passes as usize),
             recording: false,
+            in_flight: false,
         })
     }
 
+    /// Starts recording; waits first if this slot's previous frame is still in flight.
     pub fn begin(&mut self) -> Result<()> {
+        self.wait()?;
         let device = &self.ctx.device;
         unsafe {
             device.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
             let info = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             device.begin_command_buffer(self.cmd, &info)?;
             device.cmd_reset_query_pool(self.cmd, self.queries, 0, self.max_passes * 2);
+            // Orders this frame after every earlier submission (frames in flight share history
+            // images; a barrier's first scope covers all commands before it in submission order).
+            let all = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE;
+            let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+            let barrier = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(all);
+            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
         }
         self.passes.clear();
+        self.view = 0;
         self.read_since_barrier.clear();
         self.written_since_barrier.clear();
         self.recording = true;
+        Ok(())
+    }
+
+    /// The view the following passes render (their timings carry it).
+    pub fn set_view(&mut self, view: u32) {
+        self.view = view;
+    }
+
+    /// Whether a submitted frame has not been waited for yet.
+    pub fn in_flight(&self) -> bool {
+        self.in_flight
+    }
+
+    /// Moves an external image from its arrival layout to GENERAL before the passes write it.
+    pub fn acquire_external(&mut self, image: &ExternalImage) {
+        self.barrier_for([(image.id, true)].into_iter());
+        let barrier = external_transition(image, image.layout_before, vk::ImageLayout::GENERAL, vk::AccessFlags::empty(), vk::AccessFlags::SHADER_WRITE);
+        let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
+        unsafe {
+            self.ctx.device.cmd_pipeline_barrier(self.cmd, stages, vk::PipelineStageFlags::COMPUTE_SHADER, vk::DependencyFlags::empty(), &[], &[], &[barrier]);
+        }
+        self.written_since_barrier.push(image.id);
+    }
+
+    /// Moves an external image to the layout it must leave in (PRESENT_SRC_KHR), after copying
+    /// it into `copy_to` when given (a screenshot of exactly what is presented).
+    pub fn release_external(&mut self, image: &ExternalImage, copy_to: Option<&Buffer>) -> Result<()> {
+        let ctx = self.ctx.clone();
+        let device = &ctx.device;
+        let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
+        let transfer = vk::PipelineStageFlags::TRANSFER;
+        let mut from = vk::ImageLayout::GENERAL;
+        let mut src_access = vk::AccessFlags::SHADER_WRITE;
+        let mut src_stage = compute;
+        if let Some(buffer) = copy_to {
+            if buffer.size < image.bytes() {
+                return Err(Error::Binding { pass: "screenshot".into(), reason: format!("buffer '{}' too small for the external image", buffer.name) });
+            }
+            self.barrier_for([(buffer.id, true)].into_iter());
+            let index = self.open_pass("screenshot")?;
+            let to_src = external_transition(image, from, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, src_access, vk::AccessFlags::TRANSFER_READ);
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
+            unsafe {
+                device.cmd_pipeline_barrier(self.cmd, compute, transfer, vk::DependencyFlags::empty(), &[], &[], &[to_src]);
+                device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &[region]);
+            }
+            self.close_pass(index);
+            from = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+            src_access = vk::AccessFlags::TRANSFER_READ;
+            src_stage = transfer;
+        }
+        // Presentation waits on a semaphore, which makes these writes visible: no dst access.
+        let to_final = external_transition(image, from, image.layout_after, src_access, vk::AccessFlags::empty());
+        unsafe {
+            device.cmd_pipeline_barrier(self.cmd, src_stage, vk::PipelineStageFlags::BOTTOM_OF_PIPE, vk::DependencyFlags::empty(), &[], &[], &[to_final]);
+        }
         Ok(())
     }
 
@@ -146,6 +262,13 @@ impl FrameRecorder {
                         image_layout: vk::ImageLayout::GENERAL,
                     }
                 }
+                Resource::External(ext) => {
+                    image_infos[i] = vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: ext.view,
+                        image_layout: vk::ImageLayout::GENERAL,
+                    }
+                }
             }
         }
         let mut writes = [vk::WriteDescriptorSet::default(); MAX_BINDINGS];
@@ -156,7 +279,7 @@ impl FrameRecorder {
             writes[count] = match b.resource {
                 Resource::Buffer(_) => w.buffer_info(std::slice::from_ref(&buffer_infos[i])),
                 Resource::Texels(_) => w.texel_buffer_view(std::slice::from_ref(&views[i])),
-                Resource::Image(_) => w.image_info(std::slice::from_ref(&image_infos[i])),
+                Resource::Image(_) | Resource::External(_) => w.image_info(std::slice::from_ref(&image_infos[i])),
             };
             count += 1;
         }
@@ -248,6 +371,13 @@ impl FrameRecorder {
 
     /// Submits the frame, waits for it and reads the pass timings back.
     pub fn submit_and_wait(&mut self) -> Result<&[PassTiming]> {
+        self.submit(SubmitSync::default())?;
+        self.wait()?;
+        Ok(&self.timings)
+    }
+
+    /// Ends and submits the frame without waiting (`wait` or the next `begin` collects it).
+    pub fn submit(&mut self, sync: SubmitSync) -> Result<()> {
         let device = &self.ctx.device;
         let all = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
         let to_host = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(vk::AccessFlags::HOST_READ);
@@ -264,24 +394,39 @@ impl FrameRecorder {
             device.end_command_buffer(self.cmd)?;
         }
         self.recording = false;
-        let last_pass = || self.passes.last().copied().unwrap_or("<none>").to_string();
-        let lost = |e: vk::Result| match e {
-            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { last_pass: last_pass() },
-            other => Error::Vulkan(other),
-        };
         let cmds = [self.cmd];
-        let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-        unsafe {
-            let _guard = self.ctx.queue_lock.lock().expect("queue lock");
-            device.queue_submit(self.ctx.queue, &[submit], self.fence).map_err(lost)?;
+        let mut wait_semaphores = [vk::Semaphore::null(); 4];
+        let mut wait_stages = [vk::PipelineStageFlags::empty(); 4];
+        let waits = sync.wait.len().min(4);
+        for (i, &(semaphore, stage)) in sync.wait.iter().take(waits).enumerate() {
+            wait_semaphores[i] = semaphore;
+            wait_stages[i] = stage;
         }
+        let submit = vk::SubmitInfo::default()
+            .command_buffers(&cmds)
+            .wait_semaphores(&wait_semaphores[..waits])
+            .wait_dst_stage_mask(&wait_stages[..waits])
+            .signal_semaphores(sync.signal);
+        self.ctx.submit(&[submit], self.fence).map_err(|e| self.lost(e))?;
+        self.in_flight = true;
+        Ok(())
+    }
+
+    /// Waits for this slot's submitted frame (if any) and reads its pass timings.
+    pub fn wait(&mut self) -> Result<()> {
+        if !self.in_flight {
+            return Ok(());
+        }
+        let device = &self.ctx.device;
+        self.ctx.counters.fence_waits.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         unsafe {
-            device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(lost)?;
+            device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(|e| self.lost(e))?;
             device.reset_fences(&[self.fence])?;
         }
+        self.in_flight = false;
         self.timings.clear();
         if !self.passes.is_empty() {
-            let mut stamps = [0u64; 256];
+            let mut stamps = [0u64; 512];
             let count = (self.passes.len() * 2).min(stamps.len());
             unsafe {
                 device.get_query_pool_results(
@@ -292,12 +437,19 @@ impl FrameRecorder {
                 )?
             };
             let period_ms = self.ctx.info.timestamp_period_ns as f64 * 1e-6;
-            for (i, name) in self.passes.iter().enumerate() {
+            for (i, &(name, view)) in self.passes.iter().enumerate().take(count / 2) {
                 let ticks = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
-                self.timings.push(PassTiming { name, ms: ticks as f64 * period_ms });
+                self.timings.push(PassTiming { name, view, ms: ticks as f64 * period_ms });
             }
         }
-        Ok(&self.timings)
+        Ok(())
+    }
+
+    fn lost(&self, e: vk::Result) -> Error {
+        match e {
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { last_pass: self.passes.last().map_or("<none>", |p| p.0).to_string() },
+            other => Error::Vulkan(other),
+        }
     }
 
     pub fn timings(&self) -> &[PassTiming] {
@@ -323,7 +475,7 @@ impl FrameRecorder {
                 (b.resource, info.ty),
                 (Resource::Buffer(_), vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER)
                     | (Resource::Texels(_), vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
-                    | (Resource::Image(_), vk::DescriptorType::STORAGE_IMAGE)
+                    | (Resource::Image(_) | Resource::External(_), vk::DescriptorType::STORAGE_IMAGE)
             );
             if !ok {
                 return fail(format!("binding '{}' is a {:?} in the shader", b.name, info.ty));
@@ -368,7 +520,7 @@ impl FrameRecorder {
         if index >= self.max_passes {
             return Err(Error::Binding { pass: pass.into(), reason: format!("more than {} passes in one frame", self.max_passes) });
         }
-        self.passes.push(pass);
+        self.passes.push((pass, self.view));
         unsafe {
             if let Some(du) = &self.ctx.debug_utils {
                 let mut name = [0u8; 64];
@@ -393,10 +545,29 @@ impl FrameRecorder {
     }
 }
 
+fn external_transition(
+    image: &ExternalImage,
+    from: vk::ImageLayout,
+    to: vk::ImageLayout,
+    src: vk::AccessFlags,
+    dst: vk::AccessFlags,
+) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier::default()
+        .image(image.raw)
+        .old_layout(from)
+        .new_layout(to)
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .subresource_range(crate::vk::color_range())
+}
+
 impl Drop for FrameRecorder {
     fn drop(&mut self) {
         unsafe {
-            let _ = self.ctx.device.device_wait_idle();
+            // Only this slot's frame can still use the command buffer and queries.
+            if self.in_flight {
+                let _ = self.ctx.device.wait_for_fences(&[self.fence], true, u64::MAX);
+            }
             self.ctx.device.destroy_query_pool(self.queries, None);
             self.ctx.device.destroy_fence(self.fence, None);
             if let Ok(pool) = self.ctx.pool.lock() {

@@ -2,10 +2,12 @@
 //! foveated samples. Read the modules in pipeline order:
 //! `scene` (what is traced, CPU side, crate `fovea_scene`) → `gpu_scene` (its upload) →
 //! `sampling` (where samples go) → `passes` (trace; mip_phi, remap, blur; tonemap; accumulate) →
-//! `to_screen` (VP grid → screen) → `pipeline` (one frame).
+//! `to_screen` (VP grid → screen) → `view` (one eye's state) → `pipeline` (the engine: views,
+//! one submit per frame) → `frames` (frames in flight).
 //! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
 
 pub mod error;
+pub mod frames;
 pub mod gpu_scene;
 pub mod graph;
 pub mod layouts;
@@ -14,6 +16,7 @@ pub mod pipeline;
 pub mod sampling;
 pub mod shaders;
 pub mod to_screen;
+pub mod view;
 pub mod vk;
 
 pub use error::{Error, Result};

@@ -4,21 +4,21 @@
 
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
-use crate::graph::{FrameRecorder, PassTiming};
-use crate::layouts::{FrameData, SamplingParams, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
+use crate::frames::FrameRing;
+use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
+use crate::layouts::{FrameData, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use crate::passes::tonemap::{TonemapPass, ToneCurve};
-use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::passes::tonemap::{LdrTarget, TonemapPass, ToneCurve};
 use crate::sampling::SamplingSpace;
-use crate::to_screen::{BlurSettings, ToScreen};
+use crate::to_screen::BlurSettings;
+use crate::view::View;
 use crate::scene::{Camera, Scene};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
-use glam::{Mat4, UVec4, Vec2, Vec4};
-use gpu_allocator::MemoryLocation;
+use glam::{Mat4, UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
 
 /// The real-time path: primary ray, one indirect bounce, next-event estimation at both hits.
@@ -56,6 +56,8 @@ pub struct RenderSettings {
     /// TAA after the denoiser (fixed for the renderer's life, like the denoiser); when on, the
     /// tracer jitters by its Halton sequence instead of the RNG.
     pub taa: TaaMode,
+    /// How the views' (eyes') random sequences relate.
+    pub stereo_noise: StereoNoise,
 }
 
 impl Default for RenderSettings {
@@ -68,20 +70,85 @@ impl Default for RenderSettings {
             blur: BlurSettings::default(),
             denoiser: DenoiserSettings::None,
             taa: TaaMode::Off,
+            stereo_noise: StereoNoise::default(),
         }
     }
 }
 
+/// How the two eyes' 1-spp noise relates (`RenderSettings::stereo_noise`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StereoNoise {
+    /// Each view gets its own random sequence (the view index salts the seed).
+    #[default]
+    Independent,
+    /// Every view uses the same seed: texel (x, y) of both eyes draws the same random numbers.
+    Shared,
+}
+
+/// The most views one frame renders (two eyes).
+pub const MAX_VIEWS: usize = 2;
+
+/// One view's input: its camera (pose and asymmetric FOV tangents) and gaze.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewInput {
+    pub camera: CameraPose,
+    /// Gaze point in the view's screen pixels; `None` keeps the space's current gaze.
+    pub gaze: Option<Vec2>,
+}
+
+/// One frame of every view (fixed capacity: building it allocates nothing).
 #[derive(Clone, Copy, Debug)]
 pub struct FrameInput {
-    pub camera: CameraPose,
+    views: [ViewInput; MAX_VIEWS],
+    view_count: usize,
     pub frame_index: u32,
-    /// Gaze point in screen pixels; `None` keeps the space's current gaze.
-    pub gaze: Option<Vec2>,
     /// Also copy the linear screen image back (EXR output).
     pub read_hdr: bool,
     /// Also tonemap the sampling-grid image and copy it back (`read_grid_ldr`; debug views).
     pub read_grid: bool,
+}
+
+impl FrameInput {
+    /// A frame of one view.
+    pub fn mono(camera: CameraPose, frame_index: u32, gaze: Option<Vec2>) -> FrameInput {
+        FrameInput::views(&[ViewInput { camera, gaze }], frame_index).expect("one view fits")
+    }
+
+    /// A frame of `views.len()` ≤ MAX_VIEWS views, in the renderer's view order.
+    pub fn views(views: &[ViewInput], frame_index: u32) -> Result<FrameInput> {
+        if views.is_empty() || views.len() > MAX_VIEWS {
+            return Err(Error::Invalid(format!("a frame has 1 to {MAX_VIEWS} views, not {}", views.len())));
+        }
+        let mut all = [views[0]; MAX_VIEWS];
+        all[..views.len()].copy_from_slice(views);
+        Ok(FrameInput { views: all, view_count: views.len(), frame_index, read_hdr: false, read_grid: false })
+    }
+
+    pub fn with_hdr(mut self, read_hdr: bool) -> FrameInput {
+        self.read_hdr = read_hdr;
+        self
+    }
+
+    pub fn with_grid(mut self, read_grid: bool) -> FrameInput {
+        self.read_grid = read_grid;
+        self
+    }
+
+    pub fn view_inputs(&self) -> &[ViewInput] {
+        &self.views[..self.view_count]
+    }
+}
+
+/// An image the engine does not own that the frame's final pass writes (a swapchain image), with
+/// the semaphores the submission waits on and signals.
+#[derive(Clone, Copy)]
+pub struct FrameTarget<'a> {
+    pub image: &'a ExternalImage,
+    /// Top-left pixel of each view in the image (stereo side by side).
+    pub offsets: [UVec2; MAX_VIEWS],
+    pub sync: SubmitSync<'a>,
+    /// Copy the finished image here before it is released (screenshots).
+    pub copy_to: Option<&'a Buffer>,
 }
 
 /// Exact counts for one frame (from the GPU's own counters).
@@ -102,171 +169,166 @@ impl FrameStats {
     }
 }
 
+/// The real-time engine: one scene upload and one set of pipelines shared by every view, each
+/// view with its own space and history, all views of a frame recorded into one command buffer
+/// and submitted once, frames kept in flight on a ring of slots (`frames`).
 pub struct Renderer {
     ctx: Arc<Context>,
     pub scene: GpuScene,
-    space: Box<dyn SamplingSpace>,
     pub settings: RenderSettings,
-    frame_data: Buffer,
-    sampling: Buffer,
-    /// The space's per-frame table (`SamplingSpace::sampling_table`), read by the trace and the
-    /// Visual-Polar passes back to the screen.
-    sampling_table: Buffer,
-    /// Host staging of `sampling_table`, reused every frame (no per-frame allocation).
-    sampling_table_rows: Vec<[f32; 4]>,
-    ray_counters: Buffer,
-    trace: TracePass,
-    /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
-    /// (references keep `trace`).
-    trace_gradients: Option<TracePass>,
+    views: Vec<View>,
+    ring: FrameRing,
     accumulate: AccumulatePass,
     tonemap: TonemapPass,
-    pub gbuffer: GBuffer,
-    accum: Image,
-    /// Visual-Polar spaces only: the way back to the screen.
-    to_screen: Option<ToScreen>,
-    ldr: Image,
-    ldr_readback: Buffer,
-    hdr_readback: Buffer,
-    grid_ldr: Image,
-    grid_readback: Buffer,
-    /// Per-eye denoiser state (`settings.denoiser`).
-    denoiser: Option<Denoiser>,
-    /// Per-eye TAA state (`settings.taa`).
-    taa: Option<Taa>,
-    recorder: FrameRecorder,
-    prev_camera: Option<CameraPose>,
-    /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
-    prev_sampling: Option<SamplingParams>,
+    /// The newest frame whose results were collected (`render_frame`, `wait_frame`).
+    last_waited: Option<u64>,
 }
 
 impl Renderer {
+    /// A one-view renderer with one frame slot (each `render_frame` waits for its frame).
     pub fn new(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
         let gpu_scene = GpuScene::upload(ctx, scene)?;
         Renderer::with_gpu_scene(ctx, gpu_scene, space, settings)
     }
 
     pub fn with_gpu_scene(ctx: &Arc<Context>, scene: GpuScene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
+        Renderer::with_views(ctx, scene, vec![space], settings, 1)
+    }
+
+    /// A renderer of several views (`spaces`, one per eye) over one uploaded scene, keeping up
+    /// to `frames_in_flight` frames on the GPU at once.
+    pub fn with_views(
+        ctx: &Arc<Context>,
+        scene: GpuScene,
+        spaces: Vec<Box<dyn SamplingSpace>>,
+        settings: RenderSettings,
+        frames_in_flight: usize,
+    ) -> Result<Renderer> {
         if settings.max_depth == 0 {
             return Err(Error::Invalid("max depth must be at least 1 (1 = emission seen directly)".into()));
         }
-        let grid = space.grid_size();
-        let screen = space.screen_size();
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let readback = |name: &str, bytes: u64| {
-            Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
-        };
-        let pixels = screen.x as u64 * screen.y as u64;
-        // Screen-space TAA runs between the remap and the blur; for Cartesian the sampling grid
-        // is the screen, and it is the sampling-grid filter.
-        let (grid_taa, screen_taa) = match (settings.taa, space.visual_polar()) {
-            (TaaMode::Screen(s), Some(_)) => (None, Some(s)),
-            (mode, _) => (mode.settings().copied(), None),
-        };
-        let to_screen = match space.visual_polar() {
-            Some(_) => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
-            None => None,
-        };
-        let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
-        let gradients = settings.denoiser.needs_gradients();
-        let trace_gradients = match (gradients, space.trace_variant()) {
-            (false, _) => None,
-            (true, "visual_polar_clipped") => {
-                return Err(Error::Invalid(format!(
-                    "denoiser '{}' does not support the screen-clipped Visual-Polar layout (use layout = \"paper\")",
-                    settings.denoiser.name()
-                )))
-            }
-            (true, variant) => Some(TracePass::new(ctx, &format!("{variant}_gradients"))?),
-        };
-        let denoiser_passes = denoiser.as_ref().map_or(0, |d| d.max_passes());
-        let taa = match grid_taa {
-            Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
-            None => None,
-        };
+        if spaces.is_empty() || spaces.len() > MAX_VIEWS {
+            return Err(Error::Invalid(format!("a renderer has 1 to {MAX_VIEWS} views, not {}", spaces.len())));
+        }
+        if frames_in_flight == 0 {
+            return Err(Error::Invalid("frames in flight must be at least 1".into()));
+        }
+        let views = build_views(ctx, spaces, &settings, frames_in_flight)?;
+        let ring = FrameRing::new(ctx, frames_in_flight, max_passes(&views))?;
         Ok(Renderer {
-            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], uniform)?,
-            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform)?,
-            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table())?,
-            sampling_table_rows: Vec::new(),
-            ray_counters: Buffer::new(
-                ctx,
-                "ray_counters",
-                (RAY_COUNTERS * 4) as u64,
-                storage | vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )?,
-            trace: TracePass::new(ctx, space.trace_variant())?,
-            trace_gradients,
             accumulate: AccumulatePass::new(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
-            gbuffer: if gradients { GBuffer::with_visibility(ctx, grid)? } else { GBuffer::new(ctx, grid)? },
-            accum: Image::new(ctx, "accum", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?,
-            ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
-            ldr_readback: readback("ldr_readback", pixels * 4)?,
-            hdr_readback: readback("hdr_readback", pixels * 16)?,
-            grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
-            grid_readback: readback("grid_readback", grid.x as u64 * grid.y as u64 * 4)?,
-            to_screen,
-            recorder: FrameRecorder::new(ctx, 2 * REFERENCE_SAMPLES_PER_SUBMIT + 25 + denoiser_passes)?,
-            denoiser,
-            taa,
-            prev_camera: None,
-            prev_sampling: None,
             ctx: ctx.clone(),
             scene,
-            space,
             settings,
+            views,
+            ring,
+            last_waited: None,
         })
     }
 
+    /// Replaces every view (new spaces, a new denoiser or TAA, a resize) while frames are in
+    /// flight: the old views are released once the frames that used them have completed.
+    pub fn replace_views(&mut self, spaces: Vec<Box<dyn SamplingSpace>>, settings: RenderSettings) -> Result<()> {
+        if spaces.is_empty() || spaces.len() > MAX_VIEWS {
+            return Err(Error::Invalid(format!("a renderer has 1 to {MAX_VIEWS} views, not {}", spaces.len())));
+        }
+        let views = build_views(&self.ctx, spaces, &settings, self.ring.slots())?;
+        if max_passes(&views) > max_passes(&self.views) {
+            // Timestamp pools are sized for the old views: a new ring, the old one drained.
+            self.ring.finish()?;
+            self.ring = FrameRing::new(&self.ctx, self.ring.slots(), max_passes(&views))?;
+            self.last_waited = None;
+        }
+        let old = std::mem::replace(&mut self.views, views);
+        self.ring.defer_release(Box::new(old));
+        self.settings = settings;
+        Ok(())
+    }
+
+    pub fn views(&self) -> &[View] {
+        &self.views
+    }
+
+    pub fn view(&self, index: usize) -> &View {
+        &self.views[index]
+    }
+
+    /// The first view's space (the only one of a mono renderer).
     pub fn space(&self) -> &dyn SamplingSpace {
-        self.space.as_ref()
+        self.views[0].space.as_ref()
     }
 
     pub fn context(&self) -> &Arc<Context> {
         &self.ctx
     }
 
+    pub fn frames_in_flight(&self) -> usize {
+        self.ring.slots()
+    }
+
+    /// The frame ring (slot waits, drains, deferred releases) for tests and the bench.
+    pub fn ring(&self) -> &FrameRing {
+        &self.ring
+    }
+
+    /// Keeps `resource` alive until every frame submitted so far has completed.
+    pub fn defer_release(&mut self, resource: Box<dyn std::any::Any>) {
+        self.ring.defer_release(resource);
+    }
+
     /// Scales a material's emission at run time (`GpuScene::set_emission_scale`; `scene` is the
-    /// scene this renderer was built from): a light switched off, dimmed or back on.
+    /// scene this renderer was built from): a light switched off, dimmed or back on. The
+    /// material table is host-visible and read by frames in flight, so this first waits for them:
+    /// an edit, not a per-frame call.
     pub fn set_emission_scale(&mut self, scene: &Scene, material: usize, scale: f32) -> Result<()> {
+        self.ring.finish()?;
         self.scene.set_emission_scale(&self.ctx, scene, material, scale)
     }
 
-    /// The denoiser and its state, when `settings.denoiser` names one.
+    /// The first view's denoiser and its state, when `settings.denoiser` names one.
     pub fn denoiser(&self) -> Option<&Denoiser> {
-        self.denoiser.as_ref()
+        self.views[0].denoiser()
     }
 
-    /// GPU time of each pass of the last submission.
+    /// GPU time of each pass of the newest collected frame (every view's passes, tagged).
     pub fn timings(&self) -> &[PassTiming] {
-        self.recorder.timings()
+        match self.last_waited.and_then(|f| self.ring.slot_of(f)) {
+            Some(slot) => self.ring.recorder(slot).timings(),
+            None => &[],
+        }
     }
 
-    /// The sampling-grid TAA state, when `settings.taa` runs in the grid.
+    /// GPU time of each pass of `frame`, once it has completed and while its slot holds it.
+    pub fn frame_timings(&self, frame: u64) -> Result<&[PassTiming]> {
+        Ok(self.ring.recorder(self.readable_slot(frame)?).timings())
+    }
+
+    /// The first view's sampling-grid TAA state, when `settings.taa` runs in the grid.
     pub fn taa(&self) -> Option<&Taa> {
-        self.taa.as_ref()
+        self.views[0].taa()
     }
 
-    /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
+    /// GPU bytes of TAA history carried between frames (first view; 0 when off).
     pub fn taa_history_bytes(&self) -> u64 {
-        let grid = self.taa.as_ref().map_or(0, |t| t.history_bytes());
-        let screen = self.to_screen.as_ref().and_then(|s| s.taa.as_ref()).map_or(0, |t| t.history_bytes());
-        grid + screen
+        self.views[0].taa_history_bytes()
     }
 
-    fn write_frame_data(&self, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
-        let screen = self.space.screen_size().as_vec2();
-        let prev = self.prev_camera.unwrap_or(*camera);
+    fn write_frame_data(&self, view: usize, slot: usize, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
+        let v = &self.views[view];
+        let screen = v.space.screen_size().as_vec2();
+        let prev = v.prev_camera.unwrap_or(*camera);
+        let seed = match self.settings.stereo_noise {
+            StereoNoise::Independent => self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9),
+            StereoNoise::Shared => self.settings.seed,
+        };
         let data = FrameData {
             world_from_view: camera.world_from_view,
             prev_view_from_world: prev.world_from_view.inverse(),
             fov_tan: camera.fov_tan,
             prev_fov_tan: prev.fov_tan,
             screen: Vec4::new(screen.x, screen.y, 1.0 / screen.x, 1.0 / screen.y),
-            frame: UVec4::new(frame_index, self.settings.seed, max_depth, flags),
+            frame: UVec4::new(frame_index, seed, max_depth, flags),
             counts: UVec4::new(
                 self.scene.light_count,
                 self.scene.triangle_count,
@@ -276,98 +338,153 @@ impl Renderer {
             scene_sphere: self.scene.bounding_sphere(),
             jitter: jitter.extend(0.0).extend(0.0),
         };
-        self.frame_data.write(&[data])
+        v.slots[slot].frame_data.write(&[data])
     }
 
-    /// Renders one real-time frame into the screen image and reads the tonemapped result back.
+    /// Renders one real-time frame of every view and waits for it (the offline path: tests,
+    /// `fovea render` with one slot). Returns the first view's counts.
     pub fn render_frame(&mut self, input: &FrameInput) -> Result<FrameStats> {
-        if let Some(gaze) = input.gaze {
-            self.space.set_gaze(gaze)?;
+        let frame = self.submit(input, None)?;
+        self.wait_frame(frame)?;
+        self.frame_stats(frame, 0)
+    }
+
+    /// Frees the slot the next frame will use: waits for the frame in it (submitted
+    /// `frames_in_flight` frames ago) and returns it. Its results stay readable until the next
+    /// `submit`: a loop that writes every frame reads the returned frame here.
+    pub fn retire_next(&mut self) -> Result<Option<u64>> {
+        let retired = self.ring.retire_next()?;
+        if retired.is_some() {
+            self.last_waited = retired.max(self.last_waited);
+        }
+        Ok(retired)
+    }
+
+    /// Waits for `frame` (a drain when it is the newest).
+    pub fn wait_frame(&mut self, frame: u64) -> Result<()> {
+        self.ring.wait_for(frame)?;
+        self.last_waited = Some(frame).max(self.last_waited);
+        Ok(())
+    }
+
+    /// Waits for every frame in flight (before reading the last ones, or shutting down).
+    pub fn finish(&mut self) -> Result<()> {
+        self.ring.finish()?;
+        if self.ring.next_frame() > 0 {
+            self.last_waited = Some(self.ring.next_frame() - 1);
+        }
+        Ok(())
+    }
+
+    /// Records every view of one frame into one command buffer and submits it without waiting
+    /// for it (only for the frame that used the same slot before, if still running). The last
+    /// pass writes each view's own LDR image, or `target` when given. Returns the frame's id.
+    pub fn submit(&mut self, input: &FrameInput, target: Option<&FrameTarget>) -> Result<u64> {
+        let inputs = input.view_inputs();
+        if inputs.len() != self.views.len() {
+            return Err(Error::Invalid(format!("the frame has {} views, the renderer {}", inputs.len(), self.views.len())));
+        }
+        let retired = self.ring.retire_next()?;
+        self.last_waited = retired.max(self.last_waited);
+        let slot = self.ring.next_slot();
+        for (v, view_input) in inputs.iter().enumerate() {
+            self.prepare_view(v, slot, view_input, input)?;
+        }
+        let (_, rec) = self.ring.begin_next()?;
+        if let Some(t) = target {
+            rec.acquire_external(t.image);
+        }
+        for (v, view_input) in inputs.iter().enumerate() {
+            rec.set_view(v as u32);
+            let external = target.map(|t| (t.image, t.offsets[v]));
+            record_view(rec, &mut self.views[v], slot, &self.scene, &self.tonemap, &self.settings, view_input, input, external)?;
+        }
+        let sync = match target {
+            Some(t) => {
+                rec.release_external(t.image, t.copy_to)?;
+                t.sync
+            }
+            None => SubmitSync::default(),
+        };
+        rec.submit(sync)?;
+        for (view, view_input) in self.views.iter_mut().zip(inputs) {
+            view.prev_camera = Some(view_input.camera);
+            view.prev_sampling = Some(view.space.params());
+        }
+        Ok(self.ring.submitted())
+    }
+
+    /// Host-side work of one view before recording: gaze, this slot's uniforms and table.
+    fn prepare_view(&mut self, v: usize, slot: usize, view_input: &ViewInput, input: &FrameInput) -> Result<()> {
+        if let Some(gaze) = view_input.gaze {
+            self.views[v].space.set_gaze(gaze)?;
         }
         let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
         let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 };
-        self.write_frame_data(&input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
-        let space = self.space.params();
-        self.sampling.write(&[space])?;
-        self.space.write_sampling_table(&mut self.sampling_table_rows);
-        self.sampling_table.write(&self.sampling_table_rows)?;
-        let rec = &mut self.recorder;
-        rec.begin()?;
-        rec.fill_buffer("clear_counters", &self.ray_counters, 0)?;
-        // Denoisers work in the sampling grid (Cartesian samples are the screen).
-        let denoise_frame = DenoiseFrame { current: space, previous: self.prev_sampling };
-        if let Some(d) = &mut self.denoiser {
-            d.record_before_trace(rec, &self.gbuffer, &denoise_frame, &self.frame_data)?;
-        }
-        let gradients = self.denoiser.as_ref().and_then(|d| d.gradient_targets());
-        let trace = self.trace_gradients.as_ref().unwrap_or(&self.trace);
-        trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, 0, gradients)?;
-        let denoised = match &mut self.denoiser {
-            Some(d) => {
-                let scene = DenoiseScene { camera_origin: input.camera.world_from_view.w_axis.truncate(), materials: &self.scene.materials };
-                d.record(rec, &self.gbuffer, &denoise_frame, &scene)?
-            }
-            None => &self.gbuffer.color,
-        };
-        let grid_hdr = match (&mut self.taa, jitter) {
-            (Some(taa), Some(jitter)) => taa.record(rec, &self.gbuffer, denoised, &denoise_frame, jitter)?,
-            _ => denoised,
-        };
-        let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
-            frame_data: &self.frame_data,
-            gbuffer: &self.gbuffer,
-            space: &denoise_frame.current,
-            has_previous: denoise_frame.previous.is_some(),
-            jitter,
-        });
-        let screen_hdr = match (&mut self.to_screen, self.space.visual_polar()) {
-            (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &self.sampling_table, grid_hdr, &self.settings.blur, screen_taa.as_ref())?,
-            _ => grid_hdr,
-        };
-        let (exposure, curve) = (self.settings.exposure, self.settings.tone_curve);
-        self.tonemap.record(rec, "tonemap", screen_hdr, &self.ldr, exposure, curve)?;
-        rec.copy_image_to_buffer("readback", &self.ldr, &self.ldr_readback)?;
-        if input.read_hdr {
-            rec.copy_image_to_buffer("readback_hdr", screen_hdr, &self.hdr_readback)?;
-        }
-        if input.read_grid {
-            self.tonemap.record(rec, "tonemap_grid", grid_hdr, &self.grid_ldr, exposure, curve)?;
-            rec.copy_image_to_buffer("readback_grid", &self.grid_ldr, &self.grid_readback)?;
-        }
-        rec.submit_and_wait()?;
-        self.prev_camera = Some(input.camera);
-        self.prev_sampling = Some(space);
-        let mut counters = [0u32; RAY_COUNTERS];
-        self.ray_counters.read_into(&mut counters)?;
-        Ok(FrameStats {
-            samples_traced: counters[0] as u64,
-            primary_rays: counters[0] as u64,
-            shadow_rays: counters[1] as u64,
-            continuation_rays: counters[2] as u64,
-            samples_offscreen: counters[3] as u64,
-        })
+        self.write_frame_data(v, slot, &view_input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
+        let view = &mut self.views[v];
+        view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;
+        let s = &view.slots[slot];
+        s.sampling.write(&[view.space.params()])?;
+        view.space.write_sampling_table(&mut view.table_rows);
+        s.sampling_table.write(&view.table_rows)
     }
 
-    /// The last frame's tonemapped pixels, RGBA8, rows top to bottom.
+    fn readable_slot(&self, frame: u64) -> Result<usize> {
+        match self.ring.slot_of(frame) {
+            Some(slot) if self.ring.is_readable(frame) => Ok(slot),
+            Some(_) => Err(Error::Invalid(format!("frame {frame} is still in flight (wait for it first)"))),
+            None => Err(Error::Invalid(format!("frame {frame} is no longer held: its slot was reused"))),
+        }
+    }
+
+    fn last_slot(&self) -> Result<usize> {
+        let frame = self.last_waited.ok_or_else(|| Error::Invalid("no frame has completed yet".into()))?;
+        self.readable_slot(frame)
+    }
+
+    /// Exact counts of one view of a completed frame (from the GPU's own counters).
+    pub fn frame_stats(&self, frame: u64, view: usize) -> Result<FrameStats> {
+        self.views[view].slots[self.readable_slot(frame)?].stats()
+    }
+
+    /// Tonemapped pixels of one view of a completed frame, RGBA8, rows top to bottom.
+    pub fn read_view_ldr(&self, frame: u64, view: usize, out: &mut Vec<u8>) -> Result<()> {
+        let b = &self.views[view].slots[self.readable_slot(frame)?].ldr_readback;
+        out.resize(b.size as usize, 0);
+        b.read_into(out)
+    }
+
+    /// Linear screen image of one view of a completed frame (`FrameInput::read_hdr`), RGBA32F.
+    pub fn read_view_hdr(&self, frame: u64, view: usize, out: &mut Vec<[f32; 4]>) -> Result<()> {
+        read_optional(&self.views[view].slots[self.readable_slot(frame)?].hdr_readback, "read_hdr", out)
+    }
+
+    /// Tonemapped sampling-grid image of one view of a completed frame (`read_grid`), RGBA8.
+    pub fn read_view_grid_ldr(&self, frame: u64, view: usize, out: &mut Vec<u8>) -> Result<()> {
+        read_optional(&self.views[view].slots[self.readable_slot(frame)?].grid_readback, "read_grid", out)
+    }
+
+    /// The newest collected frame's tonemapped pixels (first view), RGBA8, rows top to bottom.
     pub fn read_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
-        out.resize(self.ldr_readback.size as usize, 0);
-        self.ldr_readback.read_into(out)
+        let b = &self.views[0].slots[self.last_slot()?].ldr_readback;
+        out.resize(b.size as usize, 0);
+        b.read_into(out)
     }
 
-    /// The last frame's tonemapped sampling-grid image (`FrameInput::read_grid`), RGBA8.
+    /// The newest collected frame's tonemapped sampling-grid image (first view), RGBA8.
     pub fn read_grid_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
-        out.resize(self.grid_readback.size as usize, 0);
-        self.grid_readback.read_into(out)
+        read_optional(&self.views[0].slots[self.last_slot()?].grid_readback, "read_grid", out)
     }
 
-    /// The last frame's (or reference's) linear screen image, RGBA32F.
+    /// The newest collected frame's (or reference's) linear screen image (first view), RGBA32F.
     pub fn read_hdr(&self, out: &mut Vec<[f32; 4]>) -> Result<()> {
-        out.resize(self.hdr_readback.size as usize / 16, [0.0; 4]);
-        self.hdr_readback.read_into(out)
+        read_optional(&self.views[0].slots[self.last_slot()?].hdr_readback, "read_hdr", out)
     }
 
-    /// Converged linear radiance: the mean of `spp` samples per pixel with paths of up to
-    /// `max_depth` vertices. `progress` gets the number of samples done after each submission.
+    /// Converged linear radiance of the first view: the mean of `spp` samples per pixel with
+    /// paths of up to `max_depth` vertices. `progress` gets the number of samples done after
+    /// each submission.
     pub fn render_reference(
         &mut self,
         camera: &CameraPose,
@@ -378,27 +495,42 @@ impl Renderer {
         if spp == 0 || max_depth == 0 {
             return Err(Error::Invalid("reference needs spp ≥ 1 and max depth ≥ 1".into()));
         }
-        if self.space.grid_size() != self.space.screen_size() {
+        if self.space().grid_size() != self.space().screen_size() {
             return Err(Error::Invalid("references are rendered in Cartesian space".into()));
         }
-        // The G-buffer is overwritten and the previous camera forgotten: no history survives.
-        self.prev_camera = None;
-        self.prev_sampling = None;
-        self.write_frame_data(camera, 0, max_depth, FRAME_FLAG_REFERENCE, Vec2::ZERO)?;
-        self.sampling.write(&[self.space.params()])?;
+        self.finish()?;
+        let screen = self.space().screen_size();
+        {
+            let view = &mut self.views[0];
+            // The G-buffer is overwritten and the previous camera forgotten: no history survives.
+            view.prev_camera = None;
+            view.prev_sampling = None;
+            if view.accum.is_none() {
+                view.accum = Some(Image::new(&self.ctx, "accum", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?);
+            }
+        }
         let mut done = 0;
         while done < spp {
             let batch = (spp - done).min(REFERENCE_SAMPLES_PER_SUBMIT);
-            let rec = &mut self.recorder;
-            rec.begin()?;
-            for s in done..done + batch {
-                self.trace.record(rec, &self.scene, &self.frame_data, &self.sampling, &self.sampling_table, &self.ray_counters, &self.gbuffer, s, None)?;
-                self.accumulate.record(rec, &self.gbuffer.color, &self.accum, s)?;
+            let slot = self.ring.next_slot();
+            self.views[0].ensure_readbacks(&self.ctx, slot, true, false)?;
+            self.write_frame_data(0, slot, camera, 0, max_depth, FRAME_FLAG_REFERENCE, Vec2::ZERO)?;
+            self.views[0].slots[slot].sampling.write(&[self.views[0].space.params()])?;
+            let (_, rec) = self.ring.begin_next()?;
+            let view = &self.views[0];
+            let (s, accum) = (&view.slots[slot], view.accum.as_ref().expect("made above"));
+            for i in done..done + batch {
+                view.trace.record(rec, &self.scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, i, None)?;
+                self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {
-                rec.copy_image_to_buffer("readback_hdr", &self.accum, &self.hdr_readback)?;
+                rec.copy_image_to_buffer("readback_hdr", accum, s.hdr_readback.as_ref().expect("made above"))?;
             }
-            rec.submit_and_wait()?;
+            rec.submit(SubmitSync::default())?;
+            let frame = self.ring.submitted();
+            // One batch at a time: the accumulation image carries the sum between batches
+            // (ordered on the GPU anyway), and waiting keeps the progress bar honest.
+            self.wait_frame(frame)?;
             done += batch;
             progress(done);
         }
@@ -406,4 +538,93 @@ impl Renderer {
         self.read_hdr(&mut out)?;
         Ok(out)
     }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // Views and the scene go before the ring: nothing in flight may still use them.
+        let _ = self.ring.finish();
+    }
+}
+
+fn build_views(ctx: &Arc<Context>, spaces: Vec<Box<dyn SamplingSpace>>, settings: &RenderSettings, slots: usize) -> Result<Vec<View>> {
+    spaces.into_iter().map(|space| View::new(ctx, space, settings, slots)).collect()
+}
+
+/// Timestamped passes one frame may hold: every view's passes, or a reference submission.
+fn max_passes(views: &[View]) -> u32 {
+    let frame: u32 = views.iter().map(View::max_passes).sum();
+    frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 1) + 2
+}
+
+fn read_optional<T: bytemuck::Pod>(buffer: &Option<Buffer>, flag: &str, out: &mut Vec<T>) -> Result<()> {
+    let b = buffer.as_ref().ok_or_else(|| Error::Invalid(format!("no frame asked for this read-back (FrameInput::{flag})")))?;
+    out.resize(b.size as usize / std::mem::size_of::<T>(), T::zeroed());
+    b.read_into(out)
+}
+
+/// Records one view's frame: trace → denoiser → TAA → the way back to the screen → tonemap into
+/// the view's own LDR image (read back into the slot) or into `external` at its offset.
+#[allow(clippy::too_many_arguments)]
+fn record_view(
+    rec: &mut FrameRecorder,
+    view: &mut View,
+    slot: usize,
+    scene: &GpuScene,
+    tonemap: &TonemapPass,
+    settings: &RenderSettings,
+    view_input: &ViewInput,
+    input: &FrameInput,
+    external: Option<(&ExternalImage, UVec2)>,
+) -> Result<()> {
+    let space = view.space.params();
+    let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
+    let s = &view.slots[slot];
+    rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
+    // Denoisers work in the sampling grid (Cartesian samples are the screen).
+    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling };
+    if let Some(d) = &mut view.denoiser {
+        d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
+    }
+    let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
+    let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
+    trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, 0, gradients)?;
+    let denoised = match &mut view.denoiser {
+        Some(d) => {
+            let scene = DenoiseScene { camera_origin: view_input.camera.world_from_view.w_axis.truncate(), materials: &scene.materials };
+            d.record(rec, &view.gbuffer, &denoise_frame, &scene)?
+        }
+        None => &view.gbuffer.color,
+    };
+    let grid_hdr = match (&mut view.taa, jitter) {
+        (Some(taa), Some(jitter)) => taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?,
+        _ => denoised,
+    };
+    let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
+        frame_data: &s.frame_data,
+        gbuffer: &view.gbuffer,
+        space: &denoise_frame.current,
+        has_previous: denoise_frame.previous.is_some(),
+        jitter,
+    });
+    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar()) {
+        (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+        _ => grid_hdr,
+    };
+    let (exposure, curve) = (settings.exposure, settings.tone_curve);
+    match external {
+        Some((image, offset)) => tonemap.record(rec, "tonemap", screen_hdr, LdrTarget::External { image, offset }, exposure, curve)?,
+        None => {
+            tonemap.record(rec, "tonemap", screen_hdr, LdrTarget::Own(&view.ldr), exposure, curve)?;
+            rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
+        }
+    }
+    if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {
+        rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+    }
+    if let (true, Some(b)) = (input.read_grid, &s.grid_readback) {
+        tonemap.record(rec, "tonemap_grid", grid_hdr, LdrTarget::Own(&view.grid_ldr), exposure, curve)?;
+        rec.copy_image_to_buffer("readback_grid", &view.grid_ldr, b)?;
+    }
+    Ok(())
 }

@@ -103,7 +103,7 @@ struct AccumulatePush {
 // Push constants of the tonemap pass.
 struct TonemapPush {
     vec4 params;                // x exposure multiplier, yzw unused
-    uvec4 config;               // x operator (0 clamp, 1 ACES fitted), yzw unused
+    uvec4 config;               // x operator (0 clamp, 1 ACES fitted), yz target offset (px), w unused
 };
 
 // Push constants of the raycast pass (BVH tests and ray-throughput benchmarks).

@@ -9,13 +9,13 @@ use glam::UVec4;
 use std::sync::Arc;
 
 pub struct AccumulatePass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl AccumulatePass {
     pub fn new(ctx: &Arc<Context>) -> Result<AccumulatePass> {
         Ok(AccumulatePass {
-            pipeline: ComputePipeline::new(ctx, "passes/accumulate", std::mem::size_of::<AccumulatePush>() as u32)?,
+            pipeline: ComputePipeline::shared(ctx, "passes/accumulate", std::mem::size_of::<AccumulatePush>() as u32)?,
         })
     }
 

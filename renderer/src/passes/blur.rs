@@ -27,12 +27,12 @@ impl BlurShape {
 }
 
 pub struct BlurPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl BlurPass {
     pub fn new(ctx: &Arc<Context>) -> Result<BlurPass> {
-        Ok(BlurPass { pipeline: ComputePipeline::new(ctx, "passes/blur", std::mem::size_of::<BlurPush>() as u32)? })
+        Ok(BlurPass { pipeline: ComputePipeline::shared(ctx, "passes/blur", std::mem::size_of::<BlurPush>() as u32)? })
     }
 
     /// `src` → (horizontal) → `scratch` → (vertical) → `dst`; all three screen-sized.

@@ -14,16 +14,16 @@ pub mod trace;
 /// pays for both sides of a branch, so the paper's layout gets a kernel without the
 /// screen-clipped path.
 pub(crate) struct VpLayoutPipelines {
-    paper: crate::vk::ComputePipeline,
-    clipped: crate::vk::ComputePipeline,
+    paper: std::sync::Arc<crate::vk::ComputePipeline>,
+    clipped: std::sync::Arc<crate::vk::ComputePipeline>,
 }
 
 impl VpLayoutPipelines {
     /// `shader` without the variant suffix (e.g. `passes/remap`).
     pub fn new(ctx: &std::sync::Arc<crate::vk::Context>, shader: &str, push_size: u32) -> crate::error::Result<Self> {
         Ok(VpLayoutPipelines {
-            paper: crate::vk::ComputePipeline::new(ctx, &format!("{shader}.paper"), push_size)?,
-            clipped: crate::vk::ComputePipeline::new(ctx, &format!("{shader}.clipped"), push_size)?,
+            paper: crate::vk::ComputePipeline::shared(ctx, &format!("{shader}.paper"), push_size)?,
+            clipped: crate::vk::ComputePipeline::shared(ctx, &format!("{shader}.clipped"), push_size)?,
         })
     }
 

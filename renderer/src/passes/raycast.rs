@@ -10,12 +10,12 @@ use glam::UVec4;
 use std::sync::Arc;
 
 pub struct RaycastPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl RaycastPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RaycastPass> {
-        Ok(RaycastPass { pipeline: ComputePipeline::new(ctx, "passes/raycast", std::mem::size_of::<RaycastPush>() as u32)? })
+        Ok(RaycastPass { pipeline: ComputePipeline::shared(ctx, "passes/raycast", std::mem::size_of::<RaycastPush>() as u32)? })
     }
 
     /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::host_texels`: texel

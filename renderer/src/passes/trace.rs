@@ -71,7 +71,7 @@ pub struct GradientTargets<'a> {
 }
 
 pub struct TracePass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 /// Counters the trace kernel fills (one u32 each): primary, shadow and continuation rays, and
@@ -81,7 +81,7 @@ pub const RAY_COUNTERS: usize = 4;
 impl TracePass {
     pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {
         let shader = format!("passes/trace.{sampling_variant}");
-        Ok(TracePass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<TracePush>() as u32)? })
+        Ok(TracePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TracePush>() as u32)? })
     }
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one

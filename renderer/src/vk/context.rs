@@ -5,8 +5,8 @@ use super::validation::{debug_callback, ValidationCounter};
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use std::ffi::{c_char, CStr};
-use std::sync::atomic::{AtomicI64, Ordering};
+use std::ffi::{c_char, CStr, CString};
+use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -35,7 +35,33 @@ impl std::str::FromStr for DeviceSelector {
 pub struct ContextOptions {
     /// Turn on VK_LAYER_KHRONOS_validation and count its messages.
     pub validation: bool,
+    /// Also turn on the layer's synchronisation validation (hazards between commands and
+    /// between frames in flight); only with `validation`.
+    pub sync_validation: bool,
     pub device: DeviceSelector,
+    /// Extra instance extensions the caller needs (a window surface's, say).
+    pub instance_extensions: Vec<CString>,
+    /// Extra device extensions the caller needs (`VK_KHR_swapchain`).
+    pub device_extensions: Vec<CString>,
+    /// Refuse devices that cannot write storage images without a format qualifier (what the
+    /// external-target tonemap needs to write a swapchain image of any UNORM format).
+    pub require_storage_write_without_format: bool,
+}
+
+/// Waits and submissions since the context was made: the real-time loop's tests prove with these
+/// that the steady state never drains the queue or the device.
+#[derive(Default, Debug)]
+pub struct EngineCounters {
+    pub submits: AtomicU64,
+    pub queue_idle_waits: AtomicU64,
+    pub device_idle_waits: AtomicU64,
+    pub fence_waits: AtomicU64,
+}
+
+impl EngineCounters {
+    pub fn get(counter: &AtomicU64) -> u64 {
+        counter.load(Ordering::SeqCst)
+    }
 }
 
 /// What `fovea info` prints about each device.
@@ -69,6 +95,14 @@ pub struct Context {
     pub validation: Arc<ValidationCounter>,
     allocator: Mutex<Option<Allocator>>,
     live_allocations: AtomicI64,
+    allocated_bytes: AtomicI64,
+    pub counters: EngineCounters,
+    /// Storage images may be written without a format qualifier (the external-target tonemap:
+    /// swapchain formats differ from the engine's own RGBA8).
+    pub storage_write_without_format: bool,
+    /// Compute pipelines by shader name, shared by every view and pass that uses the kernel.
+    /// Weak: a pipeline lives as long as a pass holds it (no cycle through the context).
+    pub(crate) pipelines: Mutex<std::collections::HashMap<String, std::sync::Weak<super::ComputePipeline>>>,
     /// Serialises queue submissions (vkQueueSubmit needs external synchronisation).
     pub(crate) queue_lock: Mutex<()>,
     pub(crate) pool: Mutex<vk::CommandPool>,
@@ -78,7 +112,7 @@ impl Context {
     pub fn new(options: &ContextOptions) -> Result<Arc<Context>> {
         let entry = unsafe { ash::Entry::load()? };
         let validation = Arc::new(ValidationCounter::default());
-        let (instance, debug_enabled) = create_instance(&entry, options.validation)?;
+        let (instance, debug_enabled) = create_instance(&entry, options)?;
         let debug_instance = if debug_enabled {
             let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -110,10 +144,18 @@ impl Context {
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let extensions = [ash::khr::push_descriptor::NAME.as_ptr()];
+        let mut extensions = vec![ash::khr::push_descriptor::NAME.as_ptr()];
+        extensions.extend(options.device_extensions.iter().map(|e| e.as_ptr()));
+        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let without_format = supported.shader_storage_image_write_without_format == vk::TRUE;
+        if options.require_storage_write_without_format && !without_format {
+            return Err(Error::NoSuitableDevice(format!("{}: no shaderStorageImageWriteWithoutFormat (needed for external targets)", chosen.name)));
+        }
+        let features = vk::PhysicalDeviceFeatures::default().shader_storage_image_write_without_format(without_format);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
-            .enabled_extension_names(&extensions);
+            .enabled_extension_names(&extensions)
+            .enabled_features(&features);
         let device = unsafe { instance.create_device(physical, &device_info, None)? };
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
 
@@ -144,6 +186,10 @@ impl Context {
             validation,
             allocator: Mutex::new(Some(allocator)),
             live_allocations: AtomicI64::new(0),
+            allocated_bytes: AtomicI64::new(0),
+            counters: EngineCounters::default(),
+            storage_write_without_format: without_format,
+            pipelines: Mutex::new(Default::default()),
             queue_lock: Mutex::new(()),
             pool: Mutex::new(pool),
             device,
@@ -154,7 +200,7 @@ impl Context {
     /// All devices the loader reports, for `fovea info`.
     pub fn enumerate() -> Result<Vec<DeviceInfo>> {
         let entry = unsafe { ash::Entry::load()? };
-        let (instance, _) = create_instance(&entry, false)?;
+        let (instance, _) = create_instance(&entry, &ContextOptions::default())?;
         let devices = list_devices(&instance);
         unsafe { instance.destroy_instance(None) };
         devices
@@ -167,12 +213,14 @@ impl Context {
         let mut guard = self.allocator.lock().expect("allocator lock poisoned");
         let allocation = guard.as_mut().expect("allocator alive while the context is").allocate(desc)?;
         self.live_allocations.fetch_add(1, Ordering::SeqCst);
+        self.allocated_bytes.fetch_add(allocation.size() as i64, Ordering::SeqCst);
         Ok(allocation)
     }
 
     pub(crate) fn free(&self, allocation: gpu_allocator::vulkan::Allocation) {
         let mut guard = self.allocator.lock().expect("allocator lock poisoned");
         if let Some(a) = guard.as_mut() {
+            self.allocated_bytes.fetch_sub(allocation.size() as i64, Ordering::SeqCst);
             // Freeing can only fail for a foreign allocation, which would be a bug here.
             a.free(allocation).expect("free of an allocation from this allocator");
             self.live_allocations.fetch_sub(1, Ordering::SeqCst);
@@ -182,6 +230,33 @@ impl Context {
     /// Allocations not yet freed (tests check this is zero once resources are dropped).
     pub fn live_allocations(&self) -> i64 {
         self.live_allocations.load(Ordering::SeqCst)
+    }
+
+    /// GPU memory bytes held by live allocations (stereo's one shared scene upload is measured
+    /// with this).
+    pub fn allocated_bytes(&self) -> i64 {
+        self.allocated_bytes.load(Ordering::SeqCst)
+    }
+
+    /// Waits until the device is idle (shutdown and resource rebuilds, never the frame loop);
+    /// counted in `counters.device_idle_waits`.
+    pub fn wait_idle(&self) -> Result<()> {
+        self.counters.device_idle_waits.fetch_add(1, Ordering::SeqCst);
+        let _guard = self.queue_lock.lock().expect("queue lock");
+        unsafe { self.device.device_wait_idle()? };
+        Ok(())
+    }
+
+    /// Submits under the queue lock, counted in `counters.submits`.
+    pub(crate) fn submit(&self, submits: &[vk::SubmitInfo], fence: vk::Fence) -> std::result::Result<(), vk::Result> {
+        self.counters.submits.fetch_add(1, Ordering::SeqCst);
+        let _guard = self.queue_lock.lock().expect("queue lock");
+        unsafe { self.device.queue_submit(self.queue, submits, fence) }
+    }
+
+    /// Whether the compute queue family can present to `surface` (a window's).
+    pub fn queue_supports_surface(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> Result<bool> {
+        Ok(unsafe { surface_loader.get_physical_device_surface_support(self.physical, self.queue_family, surface)? })
     }
 
     /// Records and runs a short command buffer now and waits for it (set-up work, not frames).
@@ -199,8 +274,9 @@ impl Context {
             self.device.end_command_buffer(cmd)?;
             let cmds = [cmd];
             let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+            self.submit(&[submit], vk::Fence::null())?;
+            self.counters.queue_idle_waits.fetch_add(1, Ordering::SeqCst);
             let _guard = self.queue_lock.lock().expect("queue lock");
-            self.device.queue_submit(self.queue, &[submit], vk::Fence::null())?;
             self.device.queue_wait_idle(self.queue)
         })();
         unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
@@ -241,7 +317,8 @@ impl Drop for Context {
     }
 }
 
-fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instance, bool)> {
+fn create_instance(entry: &ash::Entry, options: &ContextOptions) -> Result<(ash::Instance, bool)> {
+    let validation = options.validation;
     let available_layers = unsafe { entry.enumerate_instance_layer_properties()? };
     let has_layer = available_layers
         .iter()
@@ -262,12 +339,22 @@ fn create_instance(entry: &ash::Entry, validation: bool) -> Result<(ash::Instanc
         .engine_name(c"fovea")
         .api_version(vk::API_VERSION_1_2);
     let layers: Vec<*const c_char> = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-    let extensions: Vec<*const c_char> =
+    let mut extensions: Vec<*const c_char> =
         if debug_enabled { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
-    let info = vk::InstanceCreateInfo::default()
+    extensions.extend(options.instance_extensions.iter().map(|e| e.as_ptr()));
+    let sync_validation = validation && options.sync_validation;
+    if sync_validation {
+        extensions.push(ash::ext::validation_features::NAME.as_ptr());
+    }
+    let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+    let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
+    if sync_validation {
+        info = info.push_next(&mut features);
+    }
     let instance = unsafe { entry.create_instance(&info, None)? };
     Ok((instance, debug_enabled))
 }

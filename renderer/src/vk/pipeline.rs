@@ -100,6 +100,22 @@ impl ComputePipeline {
         })
     }
 
+    /// The one pipeline of `shader` on this context, built on first use and shared by every pass
+    /// and view that runs the kernel (stereo views share their pipelines).
+    pub fn shared(ctx: &Arc<Context>, shader: &str, push_size: u32) -> Result<Arc<ComputePipeline>> {
+        let mut cache = ctx.pipelines.lock().expect("pipeline cache lock");
+        if let Some(p) = cache.get(shader).and_then(|w| w.upgrade()) {
+            if p.push_size != push_size {
+                return Err(Error::Shader { shader: shader.into(), reason: format!("push-constant block is {} bytes, the Rust params struct {push_size}", p.push_size) });
+            }
+            return Ok(p);
+        }
+        let pipeline = Arc::new(ComputePipeline::new(ctx, shader, push_size)?);
+        cache.retain(|_, w| w.strong_count() > 0);
+        cache.insert(shader.to_string(), Arc::downgrade(&pipeline));
+        Ok(pipeline)
+    }
+
     /// Workgroups needed to cover `threads` invocations along each axis.
     pub fn groups_for(&self, threads: [u32; 3]) -> [u32; 3] {
         [0, 1, 2].map(|i| threads[i].div_ceil(self.local_size[i]))

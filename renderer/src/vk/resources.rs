@@ -11,6 +11,11 @@ use std::sync::Arc;
 /// Identity of a resource for barrier tracking in the frame graph.
 pub type ResourceId = u64;
 
+/// A fresh resource identity (also for images the engine does not own, `graph::ExternalImage`).
+pub fn next_resource_id() -> ResourceId {
+    next_id()
+}
+
 fn next_id() -> ResourceId {
     static NEXT: AtomicU64 = AtomicU64::new(1);
     NEXT.fetch_add(1, Ordering::Relaxed)

@@ -104,7 +104,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             // One untimed frame first: the first dispatch of a pipeline pays one-off costs
             // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
             let sums = super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
-            let input = FrameInput { camera: pose, frame_index: 0, gaze: None, read_hdr: false, read_grid: false };
+            let input = FrameInput::mono(pose, 0, None);
             let frame_rays = renderer.render_frame(&input)?.rays_traced();
             let r = RayReport {
                 scene: name.clone(),

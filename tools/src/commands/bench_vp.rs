@@ -86,7 +86,7 @@ pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Ve
 /// the machine's speed during the run (up to ±25 % within an hour on these CPU machines) then
 /// hits every side alike, and the ratios between them stay fair.
 pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: CameraPose, frames: u32) -> Result<Vec<BTreeMap<String, f64>>> {
-    let input = |frame_index, gaze| FrameInput { camera, frame_index, gaze, read_hdr: false, read_grid: false };
+    let input = |frame_index, gaze| FrameInput::mono(camera, frame_index, gaze);
     for (renderer, gaze) in renderers.iter_mut() {
         renderer.render_frame(&input(0, *gaze))?;
     }

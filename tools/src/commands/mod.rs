@@ -15,11 +15,16 @@ use std::sync::Arc;
 
 /// Opens the Vulkan device. Validation is on in debug builds and with `--validation`.
 pub fn open_device(device: Option<&str>, validation: bool) -> Result<Arc<Context>> {
-    let options = ContextOptions {
+    Context::new(&device_options(device, validation)).context("opening the Vulkan device")
+}
+
+/// The device options every command starts from (the viewer adds its window's extensions).
+pub fn device_options(device: Option<&str>, validation: bool) -> ContextOptions {
+    ContextOptions {
         validation: validation || cfg!(debug_assertions),
         device: device.map(|d| d.parse::<DeviceSelector>().expect("infallible")).unwrap_or_default(),
-    };
-    Context::new(&options).context("opening the Vulkan device")
+        ..Default::default()
+    }
 }
 
 /// Fails the run if the validation layer reported any warning or error.

@@ -197,13 +197,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Centre => 2,
         }] += 1;
         let camera = camera_path::pose(&start_pose, centre, frame, args.frames, args.camera_path);
-        let input = FrameInput {
-            camera,
-            frame_index: frame,
-            gaze: Some(frame_gaze.pixel),
-            read_hdr: args.exr,
-            read_grid: debug.is_some(),
-        };
+        let input = FrameInput::mono(camera, frame, Some(frame_gaze.pixel)).with_hdr(args.exr).with_grid(debug.is_some());
         let stats = renderer.render_frame(&input)?;
         samples += stats.samples_traced;
         offscreen += stats.samples_offscreen;

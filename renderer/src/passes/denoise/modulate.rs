@@ -7,12 +7,12 @@ use crate::vk::{ComputePipeline, Context, Image};
 use std::sync::Arc;
 
 pub struct ModulatePass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl ModulatePass {
     pub fn new(ctx: &Arc<Context>) -> Result<ModulatePass> {
-        Ok(ModulatePass { pipeline: ComputePipeline::new(ctx, "passes/denoise/modulate", 0)? })
+        Ok(ModulatePass { pipeline: ComputePipeline::shared(ctx, "passes/denoise/modulate", 0)? })
     }
 
     /// `pass` names the dispatch in the timing report (e.g. "svgf_modulate").

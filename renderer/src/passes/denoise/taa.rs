@@ -124,7 +124,7 @@ impl TaaMode {
 /// Per-eye TAA: the pass and its ping-pong history, allocated once.
 pub struct Taa {
     pub settings: TaaSettings,
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
     /// Resolved colour by frame parity; this frame's half is also the pass's output.
     history: [Image; 2],
     /// The packed surface each history texel belongs to (disocclusion test).
@@ -141,7 +141,7 @@ impl Taa {
         let shader = format!("passes/denoise/taa.{variant}");
         Ok(Taa {
             settings,
-            pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
+            pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
             history: [image("taa.history0", rgba)?, image("taa.history1", rgba)?],
             surface: [image("taa.surface0", surface)?, image("taa.surface1", surface)?],
             frames: 0,

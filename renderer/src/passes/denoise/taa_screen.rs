@@ -21,7 +21,7 @@ use std::sync::Arc;
 /// resolved with), allocated once.
 pub struct ScreenTaa {
     pub settings: TaaSettings,
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
     history: [Image; 2],
     frames: u64,
 }
@@ -46,7 +46,7 @@ impl ScreenTaa {
         let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(ScreenTaa {
             settings,
-            pipeline: ComputePipeline::new(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
+            pipeline: ComputePipeline::shared(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
             history: [image("taa_screen.history0")?, image("taa_screen.history1")?],
             frames: 0,
         })

@@ -12,13 +12,13 @@ use glam::UVec4;
 use std::sync::Arc;
 
 pub struct ForwardPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl ForwardPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<ForwardPass> {
         let shader = format!("passes/denoise/asvgf_forward.{variant}");
-        Ok(ForwardPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<AsvgfForwardPush>() as u32)? })
+        Ok(ForwardPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<AsvgfForwardPush>() as u32)? })
     }
 
     /// Reads last frame's samples from `g` (before the tracer overwrites it) and the cameras from

@@ -12,13 +12,13 @@ use glam::{UVec4, Vec4};
 use std::sync::Arc;
 
 pub struct GradientPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl GradientPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<GradientPass> {
         let shader = format!("passes/denoise/asvgf_gradient.{variant}");
-        Ok(GradientPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<AsvgfGradientPush>() as u32)? })
+        Ok(GradientPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<AsvgfGradientPush>() as u32)? })
     }
 
     /// `src` → `dst` (strata-sized: δ, max f, confidence), taps `step` strata apart.

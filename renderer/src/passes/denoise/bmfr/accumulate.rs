@@ -11,7 +11,7 @@ use crate::vk::{Buffer, ComputePipeline, Context};
 use std::sync::Arc;
 
 pub struct AccumulatePass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 /// The push block both temporal passes share: this frame's space, the previous frame's
@@ -29,7 +29,7 @@ pub(super) fn temporal_push(current: &SamplingParams, r: &Reprojection, alpha_fl
 impl AccumulatePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulatePass> {
         let shader = format!("passes/denoise/bmfr_accumulate.{variant}");
-        Ok(AccumulatePass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
+        Ok(AccumulatePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
     }
 
     /// Reads history half `prev`, writes half `cur` (noisy, normal, position).

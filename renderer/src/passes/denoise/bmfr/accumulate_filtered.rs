@@ -12,13 +12,13 @@ use crate::vk::{ComputePipeline, Context, Image};
 use std::sync::Arc;
 
 pub struct AccumulateFilteredPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl AccumulateFilteredPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulateFilteredPass> {
         let shader = format!("passes/denoise/bmfr_accumulate_filtered.{variant}");
-        Ok(AccumulateFilteredPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
+        Ok(AccumulateFilteredPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
     }
 
     /// `fitted` + history half `prev` → history half `cur` and `dst` (re-modulated).

@@ -12,7 +12,7 @@ use glam::{IVec2, IVec4, UVec2, Vec4};
 use std::sync::Arc;
 
 pub struct FitPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 /// The push block of the fit and the weighted sum: the space and the block-grid offset.
@@ -27,7 +27,7 @@ pub(super) fn block_push(space: &SamplingParams, offset: IVec2, seed: u32, noise
 impl FitPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<FitPass> {
         let shader = format!("passes/denoise/bmfr_fit.{variant}");
-        Ok(FitPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+        Ok(FitPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
     }
 
     /// Features and noisy colour from history half `cur` → `weights`.

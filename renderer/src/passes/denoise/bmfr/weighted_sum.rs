@@ -11,13 +11,13 @@ use glam::IVec2;
 use std::sync::Arc;
 
 pub struct WeightedSumPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl WeightedSumPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<WeightedSumPass> {
         let shader = format!("passes/denoise/bmfr_weighted_sum.{variant}");
-        Ok(WeightedSumPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+        Ok(WeightedSumPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
     }
 
     /// Features of history half `cur` and the blocks' `weights` → `fitted`.

@@ -12,13 +12,13 @@ use glam::{UVec4, Vec4};
 use std::sync::Arc;
 
 pub struct AtrousPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl AtrousPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AtrousPass> {
         let shader = format!("passes/denoise/svgf_atrous.{variant}");
-        Ok(AtrousPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfAtrousPush>() as u32)? })
+        Ok(AtrousPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfAtrousPush>() as u32)? })
     }
 
     /// `src` → `dst` (both colour, variance), taps `step` texels apart.

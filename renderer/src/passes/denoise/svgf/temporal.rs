@@ -12,13 +12,13 @@ use glam::Vec4;
 use std::sync::Arc;
 
 pub struct TemporalPass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl TemporalPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<TemporalPass> {
         let shader = format!("passes/denoise/svgf_temporal.{variant}");
-        Ok(TemporalPass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfTemporalPush>() as u32)? })
+        Ok(TemporalPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfTemporalPush>() as u32)? })
     }
 
     /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance). `previous`:

@@ -12,13 +12,13 @@ use glam::Vec4;
 use std::sync::Arc;
 
 pub struct VariancePass {
-    pipeline: ComputePipeline,
+    pipeline: std::sync::Arc<ComputePipeline>,
 }
 
 impl VariancePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<VariancePass> {
         let shader = format!("passes/denoise/svgf_variance.{variant}");
-        Ok(VariancePass { pipeline: ComputePipeline::new(ctx, &shader, std::mem::size_of::<SvgfVariancePush>() as u32)? })
+        Ok(VariancePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfVariancePush>() as u32)? })
     }
 
     /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance).

@@ -1,0 +1,176 @@
+//! One view (an eye): its sampling space and everything that follows the space or carries
+//! history between its frames — G-buffer, denoiser and TAA state, the way back to the screen,
+//! the previous camera and gaze — plus, per frame slot, the small buffers the host writes or
+//! reads (uniforms, counters, read-backs). The scene and the pipelines are shared by all views.
+
+use crate::error::{Error, Result};
+use crate::layouts::{FrameData, SamplingParams};
+use crate::passes::denoise::taa::{Taa, TaaMode};
+use crate::passes::denoise::Denoiser;
+use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
+use crate::sampling::SamplingSpace;
+use crate::to_screen::ToScreen;
+use crate::vk::{Buffer, Context, Image};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// What one view's frame in one slot owns on the host side: written before the submit, read
+/// after the slot's fence.
+pub(crate) struct ViewSlot {
+    pub frame_data: Buffer,
+    pub sampling: Buffer,
+    /// The space's per-frame table (`SamplingSpace::sampling_table`).
+    pub sampling_table: Buffer,
+    pub ray_counters: Buffer,
+    pub ldr_readback: Buffer,
+    /// Made on the first frame that asks for it (`FrameInput::read_hdr` / `read_grid`): a viewer
+    /// never pays for screen-sized HDR copies.
+    pub hdr_readback: Option<Buffer>,
+    pub grid_readback: Option<Buffer>,
+}
+
+impl ViewSlot {
+    fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace) -> Result<ViewSlot> {
+        let screen = space.screen_size();
+        Ok(ViewSlot {
+            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
+            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
+            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table())?,
+            ray_counters: Buffer::new(
+                ctx,
+                "ray_counters",
+                (RAY_COUNTERS * 4) as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?,
+            ldr_readback: readback(ctx, "ldr_readback", screen.x as u64 * screen.y as u64 * 4)?,
+            hdr_readback: None,
+            grid_readback: None,
+        })
+    }
+
+    pub fn stats(&self) -> Result<FrameStats> {
+        let mut counters = [0u32; RAY_COUNTERS];
+        self.ray_counters.read_into(&mut counters)?;
+        Ok(FrameStats {
+            samples_traced: counters[0] as u64,
+            primary_rays: counters[0] as u64,
+            shadow_rays: counters[1] as u64,
+            continuation_rays: counters[2] as u64,
+            samples_offscreen: counters[3] as u64,
+        })
+    }
+}
+
+pub(crate) fn readback(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Buffer> {
+    Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
+}
+
+pub struct View {
+    pub space: Box<dyn SamplingSpace>,
+    pub gbuffer: GBuffer,
+    pub(crate) trace: TracePass,
+    /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
+    /// (references keep `trace`).
+    pub(crate) trace_gradients: Option<TracePass>,
+    /// Visual-Polar spaces only: the way back to the screen.
+    pub(crate) to_screen: Option<ToScreen>,
+    pub(crate) ldr: Image,
+    pub(crate) grid_ldr: Image,
+    /// Reference accumulation target, made by the first `render_reference`.
+    pub(crate) accum: Option<Image>,
+    pub(crate) denoiser: Option<Denoiser>,
+    pub(crate) taa: Option<Taa>,
+    pub(crate) prev_camera: Option<CameraPose>,
+    /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
+    pub(crate) prev_sampling: Option<SamplingParams>,
+    pub(crate) slots: Vec<ViewSlot>,
+    /// Host staging of the sampling table, reused every frame (no per-frame allocation).
+    pub(crate) table_rows: Vec<[f32; 4]>,
+}
+
+impl View {
+    pub(crate) fn new(ctx: &Arc<Context>, space: Box<dyn SamplingSpace>, settings: &RenderSettings, slots: usize) -> Result<View> {
+        let grid = space.grid_size();
+        let screen = space.screen_size();
+        // Screen-space TAA runs between the remap and the blur; for Cartesian the sampling grid
+        // is the screen, and it is the sampling-grid filter.
+        let (grid_taa, screen_taa) = match (settings.taa, space.visual_polar()) {
+            (TaaMode::Screen(s), Some(_)) => (None, Some(s)),
+            (mode, _) => (mode.settings().copied(), None),
+        };
+        let to_screen = match space.visual_polar() {
+            Some(_) => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
+            None => None,
+        };
+        let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
+        let gradients = settings.denoiser.needs_gradients();
+        let trace_gradients = match (gradients, space.trace_variant()) {
+            (false, _) => None,
+            (true, "visual_polar_clipped") => {
+                return Err(Error::Invalid(format!(
+                    "denoiser '{}' does not support the screen-clipped Visual-Polar layout (use layout = \"paper\")",
+                    settings.denoiser.name()
+                )))
+            }
+            (true, variant) => Some(TracePass::new(ctx, &format!("{variant}_gradients"))?),
+        };
+        let taa = match grid_taa {
+            Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
+            None => None,
+        };
+        let slots = (0..slots).map(|_| ViewSlot::new(ctx, space.as_ref())).collect::<Result<Vec<_>>>()?;
+        Ok(View {
+            trace: TracePass::new(ctx, space.trace_variant())?,
+            trace_gradients,
+            gbuffer: if gradients { GBuffer::with_visibility(ctx, grid)? } else { GBuffer::new(ctx, grid)? },
+            ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
+            grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
+            accum: None,
+            to_screen,
+            denoiser,
+            taa,
+            prev_camera: None,
+            prev_sampling: None,
+            slots,
+            table_rows: Vec::new(),
+            space,
+        })
+    }
+
+    /// Passes one frame of this view records at most (sizes the timestamp pool).
+    pub(crate) fn max_passes(&self) -> u32 {
+        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
+    }
+
+    /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
+    pub fn taa_history_bytes(&self) -> u64 {
+        let grid = self.taa.as_ref().map_or(0, |t| t.history_bytes());
+        let screen = self.to_screen.as_ref().and_then(|s| s.taa.as_ref()).map_or(0, |t| t.history_bytes());
+        grid + screen
+    }
+
+    pub fn denoiser(&self) -> Option<&Denoiser> {
+        self.denoiser.as_ref()
+    }
+
+    pub fn taa(&self) -> Option<&Taa> {
+        self.taa.as_ref()
+    }
+
+    /// The read-back buffers a frame in `slot` needs, made on first use.
+    pub(crate) fn ensure_readbacks(&mut self, ctx: &Arc<Context>, slot: usize, hdr: bool, grid: bool) -> Result<()> {
+        let screen = self.space.screen_size();
+        let size = self.space.grid_size();
+        let s = &mut self.slots[slot];
+        if hdr && s.hdr_readback.is_none() {
+            s.hdr_readback = Some(readback(ctx, "hdr_readback", screen.x as u64 * screen.y as u64 * 16)?);
+        }
+        if grid && s.grid_readback.is_none() {
+            s.grid_readback = Some(readback(ctx, "grid_readback", size.x as u64 * size.y as u64 * 4)?);
+        }
+        Ok(())
+    }
+}
