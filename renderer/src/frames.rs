@@ -68,10 +68,14 @@ impl FrameRing {
         Ok(Some(frame))
     }
 
-    /// Waits for `frame` if it is still in flight (a drain when it is the newest).
+    /// Waits for `frame` and every earlier frame still in flight, oldest first (a drain when
+    /// `frame` is the newest).
     pub fn wait_for(&mut self, frame: u64) -> Result<()> {
-        if let Some(slot) = self.slot_of(frame) {
-            self.wait_slot(slot, frame)?;
+        let first = frame.saturating_sub(self.slots() as u64 - 1);
+        for f in first..=frame {
+            if let Some(slot) = self.slot_of(f) {
+                self.wait_slot(slot, f)?;
+            }
         }
         Ok(())
     }

@@ -1,6 +1,6 @@
 //! Per-frame gaze for the renderer: a hal gaze source (simulated FOVE 0, trace playback, fixed)
 //! sampled at each frame's display time, run through the invalid-gaze policy and turned into a
-//! pixel of the rendered (possibly scaled) left-eye image. This is the only place that glues hal
+//! pixel of each eye's rendered (possibly scaled) image. This is the only place that glues hal
 //! backends to rendering.
 
 use anyhow::{Context, Result};
@@ -19,8 +19,10 @@ pub struct GazeDriver {
 /// The gaze used for one frame.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameGaze {
-    /// Gaze point in render pixels (x right, y down).
+    /// Gaze point in the left eye's render pixels (x right, y down).
     pub pixel: Vec2,
+    /// The same gaze direction in each eye's render pixels (indexed by `Eye::index`).
+    pub pixels: [Vec2; 2],
     pub origin: GazeOrigin,
     pub time_ns: XrTime,
 }
@@ -54,9 +56,11 @@ impl GazeDriver {
         self.source.begin_frame(t)?;
         let sample = self.source.sample_at(t);
         let resolved = self.policy.resolve(&sample, t);
-        let eye = self.hmd.eye(Eye::Left);
-        let centre = Vec2::new(eye.recommended_width as f32, eye.recommended_height as f32) * 0.5;
-        let headset_px = self.hmd.direction_to_pixel(Eye::Left, resolved.direction).unwrap_or(centre);
-        Ok(FrameGaze { pixel: headset_px * self.scale, origin: resolved.source, time_ns: t })
+        let pixels = [Eye::Left, Eye::Right].map(|eye| {
+            let view = self.hmd.eye(eye);
+            let centre = Vec2::new(view.recommended_width as f32, view.recommended_height as f32) * 0.5;
+            self.hmd.direction_to_pixel(eye, resolved.direction).unwrap_or(centre) * self.scale
+        });
+        Ok(FrameGaze { pixel: pixels[0], pixels, origin: resolved.source, time_ns: t })
     }
 }

@@ -48,8 +48,16 @@ struct RenderOpts {
     /// (0.25 keeps the default run near a minute on lavapipe; 1 is the full 1280×1440 FOVE eye).
     #[arg(long, default_value_t = 0.25)]
     scale: f32,
-    #[arg(long, default_value_t = 24)]
-    frames: u32,
+    /// Frames to render (render: default 24; view: default until the window is closed).
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Eyes: left (default; files frame_NNNN.png), right, or both (one scene upload, both eyes
+    /// in one submit per frame; files frame_NNNN_left.png and frame_NNNN_right.png).
+    #[arg(long, default_value = "left")]
+    eyes: String,
+    /// Frames kept on the GPU at once (1 waits for every frame).
+    #[arg(long, default_value_t = 2)]
+    frames_in_flight: usize,
     /// Output folder (created; must hold only fovea's own outputs if it exists).
     #[arg(long, default_value = "out/render")]
     out: PathBuf,
@@ -285,6 +293,37 @@ enum Command {
     },
 }
 
+/// `fovea render`'s length without `--frames`.
+const DEFAULT_RENDER_FRAMES: u32 = 24;
+
+/// The flags `fovea render` and `fovea view` share, checked.
+fn render_args<'a>(opts: &'a RenderOpts, device: &'a DeviceArgs, profile: &RenderProfile, default_frames: u32) -> Result<commands::render::RenderArgs<'a>> {
+    Ok(commands::render::RenderArgs {
+        scene: &opts.scene,
+        method: &opts.method,
+        width: opts.width,
+        height: opts.height,
+        scale: opts.scale,
+        headset: &opts.headset,
+        gaze: &opts.gaze,
+        frames: opts.frames.unwrap_or(default_frames),
+        out: &opts.out,
+        exr: opts.exr,
+        camera_path: opts.camera_path,
+        seed: opts.seed,
+        max_depth: opts.max_depth,
+        exposure: opts.exposure,
+        profile: profile.clone(),
+        debug_views: opts.debug_views,
+        denoiser: &opts.denoiser,
+        taa: &opts.taa,
+        device: device.device.as_deref(),
+        validation: device.validation,
+        eyes: commands::setup::Eyes::parse(&opts.eyes)?,
+        frames_in_flight: opts.frames_in_flight,
+    })
+}
+
 fn main() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
@@ -292,28 +331,10 @@ fn main() -> Result<()> {
         device: DeviceArgs { device: None, validation: false },
     });
     match command {
-        Command::Render { opts, device } => commands::render::run(&commands::render::RenderArgs {
-            scene: &opts.scene,
-            method: &opts.method,
-            width: opts.width,
-            height: opts.height,
-            scale: opts.scale,
-            headset: &opts.headset,
-            gaze: &opts.gaze,
-            frames: opts.frames,
-            out: &opts.out,
-            exr: opts.exr,
-            camera_path: opts.camera_path,
-            seed: opts.seed,
-            max_depth: opts.max_depth,
-            exposure: opts.exposure,
-            profile: opts.profile()?,
-            debug_views: opts.debug_views,
-            denoiser: &opts.denoiser,
-            taa: &opts.taa,
-            device: device.device.as_deref(),
-            validation: device.validation,
-        }),
+        Command::Render { opts, device } => {
+            let profile = opts.profile()?;
+            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES)?)
+        }
         Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {
             commands::reference::run(&commands::reference::ReferenceArgs {
                 scene: &scene,

@@ -8,6 +8,7 @@ pub mod info;
 pub mod quality;
 pub mod reference;
 pub mod render;
+pub mod setup;
 
 use anyhow::{Context as _, Result};
 use fovea_renderer::vk::{Context, ContextOptions, DeviceSelector};

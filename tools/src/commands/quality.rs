@@ -138,6 +138,8 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         taa,
                         device: args.device,
                         validation: args.validation,
+                        eyes: super::setup::Eyes::Left,
+                        frames_in_flight: 2,
                     };
                     render::run(&render_args).with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
                     let mut q = measure(args, &dir, &evaluated, &references)?;

@@ -1,17 +1,13 @@
 //! `fovea render`: N frames of the scene, written as PNG (and linear EXR), plus report.json with
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
-use crate::camera_path;
+use super::setup::{Eyes, Setup};
 use crate::output::{prepare_output_dir, write_exr, write_png};
-use crate::gaze::GazeDriver;
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use fovea_hal::GazeOrigin;
-use fovea_renderer::passes::denoise::taa::TaaMode;
-use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::gpu_scene::GpuScene;
+use fovea_renderer::pipeline::{FrameStats, Renderer};
 use crate::render_profile::RenderProfile;
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
-use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -43,10 +39,13 @@ pub struct RenderArgs<'a> {
     pub taa: &'a str,
     pub device: Option<&'a str>,
     pub validation: bool,
+    /// `--eyes`: left (the default, plain frame names), right, or both (one submit per frame).
+    pub eyes: Eyes,
+    /// Frames kept on the GPU at once (a frame's images are written while later ones render).
+    pub frames_in_flight: usize,
 }
 
-/// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian"];
+pub use super::setup::METHODS;
 
 #[derive(Serialize)]
 struct Report {
@@ -58,8 +57,11 @@ struct Report {
     taa: String,
     scene: String,
     headset: String,
+    /// "left", "right" or "both".
+    eyes: String,
+    frames_in_flight: usize,
     gaze_source: String,
-    /// Gaze point per frame in render pixels (the Cartesian method traces uniformly and only
+    /// Gaze point per frame in the left eye's render pixels (the Cartesian method traces uniformly and only
     /// records it; foveated methods centre their sampling on it).
     gaze: Vec<[f32; 2]>,
     /// Frames whose gaze was live / held after a lost sample / the view centre.
@@ -73,12 +75,12 @@ struct Report {
     vp_width: u32,
     vp_height: u32,
     frames: u32,
-    /// Samples traced in one frame.
+    /// Samples traced in one frame of one eye (mean).
     samples_traced: u64,
     /// Traced samples per frame (mean) whose screen position is off the screen.
     samples_offscreen: u64,
     screen_pixels: u64,
-    /// Rays traced in one frame (mean over frames): primary + shadow + continuation.
+    /// Rays traced in one frame of one eye (mean): primary + shadow + continuation.
     rays_traced: u64,
     rays: RayReport,
     max_depth: u32,
@@ -88,7 +90,7 @@ struct Report {
     visual_polar: Option<VpReport>,
     /// Foveated blur σ at 30° for a 1280×1440 eye (vp only; 0 = off).
     blur_sigma_at_30: Option<f32>,
-    /// Pass name → mean GPU milliseconds per frame.
+    /// Pass name → mean GPU milliseconds per frame (both eyes' passes summed in a stereo run).
     passes: BTreeMap<String, f64>,
     /// Sum of the pass means.
     frame_gpu_ms: f64,
@@ -118,121 +120,76 @@ struct RayReport {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
-    if !(args.scale > 0.0 && args.scale <= 4.0) {
-        bail!("--scale {} must be in (0, 4]", args.scale);
-    }
-    let eye = hmd.eye(fovea_hal::Eye::Left);
-    let width = args.width.unwrap_or(((eye.recommended_width as f32 * args.scale).round() as u32).max(1));
-    let height = args.height.unwrap_or(((eye.recommended_height as f32 * args.scale).round() as u32).max(1));
-    if width == 0 || height == 0 || args.frames == 0 {
-        bail!("--width, --height and --frames must be at least 1");
-    }
-    if !METHODS.contains(&args.method) {
-        bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
-    }
-    let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
-        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
-        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(args.profile.asvgf),
-        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(args.profile.bmfr),
-        other => other,
-    };
-    let taa = TaaMode::parse(args.taa).context("--taa")?.with_settings(args.profile.taa);
-    // TAA reprojects with the paper's mapping, like SVGF (the screen-space one finds depths in the
-    // VP G-buffer the same way).
-    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
-        bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
-    }
-    // SVGF and BMFR reproject and filter with the paper's mapping (no per-column arc table yet).
-    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
-        bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
-    }
-    let mut gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
-    let scene = crate::scenes::load(args.scene)?;
-    let Some(camera) = scene.default_camera() else {
-        bail!("{}: the scene has no perspective camera", scene.source.display());
-    };
+    let frames = args.frames;
+    let mut setup = Setup::new(args, frames)?;
+    let (width, height, eyes) = (setup.width, setup.height, setup.eyes);
     prepare_output_dir(args.out)?;
-    let start_pose = CameraPose::from_scene_camera(camera, width, height);
     let ctx = super::open_device(args.device, args.validation)?;
-    let settings = RenderSettings {
-        max_depth: args.max_depth,
-        seed: args.seed,
-        exposure: args.exposure,
-        blur: args.profile.blur,
-        denoiser,
-        taa,
-        ..Default::default()
-    };
-    let screen = UVec2::new(width, height);
-    // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
-    let screen_centre = screen.as_vec2() * 0.5;
-    let fov = crate::render_profile::fov_tangents(&eye.fov);
-    let vp_params = args.profile.visual_polar_for(fov).with_context(|| format!("--headset {}", args.headset))?;
-    let space: Box<dyn SamplingSpace> = match args.method {
-        "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
-        _ => Box::new(Cartesian::new(screen)),
-    };
-    let grid = space.grid_size();
+    let spaces = setup.spaces(args.method, &args.profile)?;
+    let grid = spaces[0].grid_size();
+    let screen = setup.screen();
     let screen_pixels = screen.x as u64 * screen.y as u64;
-    let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
-    let mut debug = args.debug_views.then(|| super::debug_views::DebugViews::new(args.out, screen, grid));
-    let centre = scene.bounds().center();
+    // Debug views read the space's gaze after each frame: they need each frame waited for.
+    let in_flight = if args.debug_views { 1 } else { args.frames_in_flight.max(1) };
+    let scene = GpuScene::upload(&ctx, &setup.scene)?;
+    let mut renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, in_flight)?;
+    let mut out = FrameWriter {
+        args,
+        eyes,
+        width,
+        height,
+        debug: args.debug_views.then(|| super::debug_views::DebugViews::new(args.out, screen, grid)),
+        pass_sums: BTreeMap::new(),
+        totals: FrameStats::default(),
+        ldr: Vec::new(),
+        hdr: Vec::new(),
+    };
 
-    let bar = ProgressBar::new(args.frames as u64);
+    let bar = ProgressBar::new(frames as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} frame {pos}/{len}  {elapsed} (eta {eta})")?);
     let started = std::time::Instant::now();
-    let mut pass_sums: BTreeMap<String, f64> = BTreeMap::new();
-    let (mut samples, mut offscreen, mut rays) = (0u64, 0u64, RayReport::default());
-    let mut gaze_points = Vec::with_capacity(args.frames as usize);
+    let mut gaze_points = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
-    let mut ldr = Vec::new();
-    let mut hdr = Vec::new();
-    for frame in 0..args.frames {
-        let frame_gaze = gaze.frame(frame)?;
+    for frame in 0..frames {
+        let (input, frame_gaze) = setup.frame_input(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
         origins[match frame_gaze.origin {
             GazeOrigin::Live => 0,
             GazeOrigin::Held => 1,
             GazeOrigin::Centre => 2,
         }] += 1;
-        let camera = camera_path::pose(&start_pose, centre, frame, args.frames, args.camera_path);
-        let input = FrameInput::mono(camera, frame, Some(frame_gaze.pixel)).with_hdr(args.exr).with_grid(debug.is_some());
-        let stats = renderer.render_frame(&input)?;
-        samples += stats.samples_traced;
-        offscreen += stats.samples_offscreen;
-        rays.primary += stats.primary_rays;
-        rays.shadow += stats.shadow_rays;
-        rays.continuation += stats.continuation_rays;
-        for t in renderer.timings() {
-            *pass_sums.entry(t.name.to_string()).or_default() += t.ms;
+        let input = input.with_hdr(args.exr).with_grid(args.debug_views);
+        // The slot this frame takes held frame − in_flight: write that one out first.
+        if let Some(done) = renderer.retire_next()? {
+            out.write(&renderer, done)?;
+            bar.inc(1);
         }
-        renderer.read_ldr(&mut ldr)?;
-        write_png(&args.out.join(format!("frame_{frame:04}.png")), width, height, &ldr)?;
-        if args.exr {
-            renderer.read_hdr(&mut hdr)?;
-            write_exr(&args.out.join(format!("frame_{frame:04}.exr")), width, height, &hdr)?;
-        }
-        if let Some(debug) = &mut debug {
-            debug.frame(frame, &renderer)?;
-        }
+        renderer.submit(&input, None)?;
+    }
+    renderer.finish()?;
+    for done in frames.saturating_sub(in_flight as u32) as u64..frames as u64 {
+        out.write(&renderer, done)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
-    if let Some(debug) = &debug {
+    if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
     }
     super::check_validation(&ctx)?;
 
-    let n = args.frames as u64;
-    let passes: BTreeMap<String, f64> = pass_sums.into_iter().map(|(k, v)| (k, v / args.frames as f64)).collect();
-    let rays = RayReport { primary: rays.primary / n, shadow: rays.shadow / n, continuation: rays.continuation / n };
+    let views = eyes.list().len() as u64;
+    let n = frames as u64 * views;
+    let totals = out.totals;
+    let passes: BTreeMap<String, f64> = out.pass_sums.into_iter().map(|(k, v)| (k, v / frames as f64)).collect();
+    let rays = RayReport { primary: totals.primary_rays / n, shadow: totals.shadow_rays / n, continuation: totals.continuation_rays / n };
     let report = Report {
         method: args.method.to_string(),
-        denoiser: denoiser.name().to_string(),
-        taa: taa.name().to_string(),
-        scene: scene.source.display().to_string(),
-        headset: hmd.id.clone(),
+        denoiser: setup.denoiser.name().to_string(),
+        taa: setup.taa.name().to_string(),
+        scene: setup.scene.source.display().to_string(),
+        headset: setup.hmd.id.clone(),
+        eyes: eyes.name().to_string(),
+        frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),
         gaze: gaze_points,
         gaze_live: origins[0],
@@ -243,9 +200,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         height,
         vp_width: grid.x,
         vp_height: grid.y,
-        frames: args.frames,
-        samples_traced: samples / n,
-        samples_offscreen: offscreen / n,
+        frames,
+        samples_traced: totals.samples_traced / n,
+        samples_offscreen: totals.samples_offscreen / n,
         screen_pixels,
         rays_traced: rays.primary + rays.shadow + rays.continuation,
         rays,
@@ -261,10 +218,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let path = args.out.join("report.json");
     std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
     println!(
-        "rendered {} frame(s) of {}×{} ({}, denoiser {}, taa {}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
-        args.frames,
+        "rendered {} frame(s) of {}×{} ({} eye(s), {}, denoiser {}, taa {}, grid {}×{}, {} samples per eye) on {}: {:.1} ms GPU per frame, {} rays per eye and frame → {}",
+        frames,
         width,
         height,
+        eyes.name(),
         report.method,
         report.denoiser,
         report.taa,
@@ -277,6 +235,50 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Writes each completed frame's images and adds its counts and timings up.
+struct FrameWriter<'a> {
+    args: &'a RenderArgs<'a>,
+    eyes: Eyes,
+    width: u32,
+    height: u32,
+    debug: Option<super::debug_views::DebugViews>,
+    pass_sums: BTreeMap<String, f64>,
+    totals: FrameStats,
+    ldr: Vec<u8>,
+    hdr: Vec<[f32; 4]>,
+}
+
+impl FrameWriter<'_> {
+    fn write(&mut self, renderer: &Renderer, frame: u64) -> Result<()> {
+        for t in renderer.frame_timings(frame)? {
+            *self.pass_sums.entry(t.name.to_string()).or_default() += t.ms;
+        }
+        for (view, eye) in self.eyes.list().iter().enumerate() {
+            let stats = renderer.frame_stats(frame, view)?;
+            self.totals.samples_traced += stats.samples_traced;
+            self.totals.samples_offscreen += stats.samples_offscreen;
+            self.totals.primary_rays += stats.primary_rays;
+            self.totals.shadow_rays += stats.shadow_rays;
+            self.totals.continuation_rays += stats.continuation_rays;
+            // A one-eye run keeps the plain names (frame_NNNN.png); stereo names each eye.
+            let suffix = match self.eyes {
+                Eyes::Both => format!("_{}", super::setup::eye_name(*eye)),
+                _ => String::new(),
+            };
+            renderer.read_view_ldr(frame, view, &mut self.ldr)?;
+            write_png(&self.args.out.join(format!("frame_{frame:04}{suffix}.png")), self.width, self.height, &self.ldr)?;
+            if self.args.exr {
+                renderer.read_view_hdr(frame, view, &mut self.hdr)?;
+                write_exr(&self.args.out.join(format!("frame_{frame:04}{suffix}.exr")), self.width, self.height, &self.hdr)?;
+            }
+        }
+        if let Some(debug) = &mut self.debug {
+            debug.frame(frame as u32, renderer)?;
+        }
+        Ok(())
+    }
 }
 
 fn vp_report(profile: &RenderProfile) -> VpReport {

@@ -1,0 +1,197 @@
+//! What `fovea render` and `fovea view` share: the flags checked and turned into render
+//! settings, one sampling space per rendered eye, the scene, each eye's camera and the gaze per
+//! frame. Both commands build frame `k` with `Setup::frame_input`, so the viewer's frames equal
+//! the offline render's (same seeds, cameras and gaze).
+
+use super::render::RenderArgs;
+use crate::camera_path;
+use crate::gaze::{FrameGaze, GazeDriver};
+use crate::render_profile::RenderProfile;
+use anyhow::{bail, Context, Result};
+use fovea_hal::{Eye, HmdDescription};
+use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
+use fovea_renderer::scene::Scene;
+use glam::{Mat4, UVec2, Vec3};
+
+/// The sampling methods `--method` accepts.
+pub const METHODS: &[&str] = &["vp", "cartesian"];
+
+/// Which eyes a run renders (`--eyes`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Eyes {
+    Left,
+    Right,
+    Both,
+}
+
+impl Eyes {
+    pub const NAMES: &'static [&'static str] = &["left", "right", "both"];
+
+    pub fn parse(name: &str) -> Result<Eyes> {
+        Ok(match name {
+            "left" => Eyes::Left,
+            "right" => Eyes::Right,
+            "both" => Eyes::Both,
+            _ => bail!("--eyes {name}: expected one of {}", Eyes::NAMES.join(", ")),
+        })
+    }
+
+    pub fn list(self) -> &'static [Eye] {
+        match self {
+            Eyes::Left => &[Eye::Left],
+            Eyes::Right => &[Eye::Right],
+            Eyes::Both => &[Eye::Left, Eye::Right],
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Eyes::Left => "left",
+            Eyes::Right => "right",
+            Eyes::Both => "both",
+        }
+    }
+}
+
+pub struct Setup {
+    pub hmd: HmdDescription,
+    pub width: u32,
+    pub height: u32,
+    pub eyes: Eyes,
+    pub settings: RenderSettings,
+    pub denoiser: DenoiserSettings,
+    pub taa: TaaMode,
+    pub scene: Scene,
+    pub gaze: GazeDriver,
+    /// The scene camera fitted to the render size (the head; each eye is offset from it).
+    pub start_pose: CameraPose,
+    scene_centre: Vec3,
+    frames: u32,
+    camera_path: bool,
+}
+
+impl Setup {
+    /// Checks the flags and loads what the run needs. `frames`: the run's length (the camera
+    /// path's period).
+    pub fn new(args: &RenderArgs, frames: u32) -> Result<Setup> {
+        let hmd = HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+        if !(args.scale > 0.0 && args.scale <= 4.0) {
+            bail!("--scale {} must be in (0, 4]", args.scale);
+        }
+        let eye = hmd.eye(Eye::Left);
+        let width = args.width.unwrap_or(((eye.recommended_width as f32 * args.scale).round() as u32).max(1));
+        let height = args.height.unwrap_or(((eye.recommended_height as f32 * args.scale).round() as u32).max(1));
+        if width == 0 || height == 0 || frames == 0 {
+            bail!("--width, --height and --frames must be at least 1");
+        }
+        if !METHODS.contains(&args.method) {
+            bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
+        }
+        let (denoiser, taa) = filters(args)?;
+        let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
+        let scene = crate::scenes::load(args.scene)?;
+        let Some(camera) = scene.default_camera() else {
+            bail!("{}: the scene has no perspective camera", scene.source.display());
+        };
+        let start_pose = CameraPose::from_scene_camera(camera, width, height);
+        let settings = RenderSettings {
+            max_depth: args.max_depth,
+            seed: args.seed,
+            exposure: args.exposure,
+            blur: args.profile.blur,
+            denoiser,
+            taa,
+            ..Default::default()
+        };
+        Ok(Setup {
+            scene_centre: scene.bounds().center(),
+            eyes: args.eyes,
+            hmd,
+            width,
+            height,
+            settings,
+            denoiser,
+            taa,
+            scene,
+            gaze,
+            start_pose,
+            frames,
+            camera_path: args.camera_path,
+        })
+    }
+
+    pub fn screen(&self) -> UVec2 {
+        UVec2::new(self.width, self.height)
+    }
+
+    /// One sampling space per rendered eye, centred on the screen until the first gaze.
+    pub fn spaces(&self, method: &str, profile: &RenderProfile) -> Result<Vec<Box<dyn SamplingSpace>>> {
+        self.eyes.list().iter().map(|&eye| space_for(method, profile, &self.hmd, eye, self.screen())).collect()
+    }
+
+    /// Frame `frame`'s input: each eye's camera (the head pose on the camera path, offset by the
+    /// eye's position) and gaze (the combined gaze direction projected into that eye).
+    pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
+        let gaze = self.gaze.frame(frame)?;
+        let head = camera_path::pose(&self.start_pose, self.scene_centre, frame, self.frames, self.camera_path);
+        let mut views = [ViewInput { camera: head, gaze: None }; 2];
+        let eyes = self.eyes.list();
+        for (view, &eye) in views.iter_mut().zip(eyes) {
+            *view = ViewInput { camera: eye_pose(&head, &self.hmd, eye, self.eyes), gaze: Some(gaze.pixels[eye.index()]) };
+        }
+        Ok((FrameInput::views(&views[..eyes.len()], frame)?, gaze))
+    }
+}
+
+/// The head pose for one eye: a mono run keeps the head pose (the scene camera, as before
+/// stereo); a stereo run offsets each eye by its position in the headset (metres = glTF units).
+fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: Eyes) -> CameraPose {
+    match eyes {
+        Eyes::Both => CameraPose { world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset), fov_tan: head.fov_tan },
+        _ => *head,
+    }
+}
+
+fn filters(args: &RenderArgs) -> Result<(DenoiserSettings, TaaMode)> {
+    let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
+        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
+        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(args.profile.asvgf),
+        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(args.profile.bmfr),
+        other => other,
+    };
+    let taa = TaaMode::parse(args.taa).context("--taa")?.with_settings(args.profile.taa);
+    // TAA reprojects with the paper's mapping, like SVGF (the screen-space one finds depths in the
+    // VP G-buffer the same way).
+    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
+        bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
+    }
+    // SVGF and BMFR reproject and filter with the paper's mapping (no per-column arc table yet).
+    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
+        bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
+    }
+    Ok((denoiser, taa))
+}
+
+/// The sampling space of `method` for one eye of `hmd` (its FOV drives the headset ρ axis).
+pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, eye: Eye, screen: UVec2) -> Result<Box<dyn SamplingSpace>> {
+    // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
+    let screen_centre = screen.as_vec2() * 0.5;
+    let fov = crate::render_profile::fov_tangents(&hmd.eye(eye).fov);
+    let vp_params = profile.visual_polar_for(fov).with_context(|| format!("--headset {}", hmd.id))?;
+    Ok(match method {
+        "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
+        "cartesian" => Box::new(Cartesian::new(screen)),
+        other => bail!("--method {other}: expected one of {}", METHODS.join(", ")),
+    })
+}
+
+/// The eye's name in file names and reports.
+pub fn eye_name(eye: Eye) -> &'static str {
+    match eye {
+        Eye::Left => "left",
+        Eye::Right => "right",
+    }
+}
