@@ -11,3 +11,4 @@ pub mod plot;
 pub mod render_profile;
 pub mod scenegen;
 pub mod scenes;
+pub mod viewer;

@@ -35,9 +35,10 @@ struct RenderOpts {
     /// Headset profile: a name from `fovea headsets` or a TOML path.
     #[arg(long, default_value = "fove0")]
     headset: String,
-    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file.
-    #[arg(long, default_value = "sim:1")]
-    gaze: String,
+    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file
+    /// (render: default sim:1; view: default the mouse).
+    #[arg(long)]
+    gaze: Option<String>,
     /// Render width (default: the headset's per-eye width × --scale).
     #[arg(long)]
     width: Option<u32>,
@@ -156,6 +157,20 @@ enum Command {
         // Boxed: the render options dwarf every other command's.
         #[command(flatten)]
         opts: Box<RenderOpts>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Real-time rendering in a window: one eye or both side by side, gaze from the mouse (or
+    /// --gaze), keys m / d / t cycle method, denoiser and TAA, f freezes the gaze, q or Esc quits.
+    View {
+        #[command(flatten)]
+        opts: Box<RenderOpts>,
+        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
+        #[arg(long, default_value = "fifo")]
+        present_mode: String,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -297,7 +312,13 @@ enum Command {
 const DEFAULT_RENDER_FRAMES: u32 = 24;
 
 /// The flags `fovea render` and `fovea view` share, checked.
-fn render_args<'a>(opts: &'a RenderOpts, device: &'a DeviceArgs, profile: &RenderProfile, default_frames: u32) -> Result<commands::render::RenderArgs<'a>> {
+fn render_args<'a>(
+    opts: &'a RenderOpts,
+    device: &'a DeviceArgs,
+    profile: &RenderProfile,
+    default_frames: u32,
+    default_gaze: &'a str,
+) -> Result<commands::render::RenderArgs<'a>> {
     Ok(commands::render::RenderArgs {
         scene: &opts.scene,
         method: &opts.method,
@@ -305,7 +326,7 @@ fn render_args<'a>(opts: &'a RenderOpts, device: &'a DeviceArgs, profile: &Rende
         height: opts.height,
         scale: opts.scale,
         headset: &opts.headset,
-        gaze: &opts.gaze,
+        gaze: opts.gaze.as_deref().unwrap_or(default_gaze),
         frames: opts.frames.unwrap_or(default_frames),
         out: &opts.out,
         exr: opts.exr,
@@ -333,7 +354,19 @@ fn main() -> Result<()> {
     match command {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;
-            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES)?)
+            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1")?)
+        }
+        Command::View { opts, screenshot, present_mode, device } => {
+            let profile = opts.profile()?;
+            // Without --frames the run has no length: the camera path's period is a long one.
+            let render = render_args(&opts, &device, &profile, u32::MAX, "center")?;
+            commands::view::run(&commands::view::ViewArgs {
+                frames: opts.frames,
+                screenshot: screenshot.as_deref(),
+                present_mode: &present_mode,
+                mouse_gaze: opts.gaze.is_none(),
+                render,
+            })
         }
         Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {
             commands::reference::run(&commands::reference::ReferenceArgs {

@@ -254,6 +254,11 @@ impl Context {
         unsafe { self.device.queue_submit(self.queue, submits, fence) }
     }
 
+    /// Holds the queue for a call outside the engine that needs it (vkQueuePresentKHR).
+    pub fn queue_guard(&self) -> std::sync::MutexGuard<'_, ()> {
+        self.queue_lock.lock().expect("queue lock")
+    }
+
     /// Whether the compute queue family can present to `surface` (a window's).
     pub fn queue_supports_surface(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> Result<bool> {
         Ok(unsafe { surface_loader.get_physical_device_surface_support(self.physical, self.queue_family, surface)? })

@@ -274,6 +274,8 @@ pub fn format_bytes(format: vk::Format) -> u64 {
         vk::Format::R32G32B32A32_SFLOAT | vk::Format::R32G32B32A32_UINT => 16,
         vk::Format::R16G16B16A16_SFLOAT | vk::Format::R32G32_SFLOAT | vk::Format::R32G32_UINT => 8,
         vk::Format::R8G8B8A8_UNORM | vk::Format::R32_SFLOAT | vk::Format::R32_UINT => 4,
+        // Swapchain formats the viewer accepts (external targets).
+        vk::Format::B8G8R8A8_UNORM => 4,
         other => panic!("format {other:?} not used by this engine"),
     }
 }

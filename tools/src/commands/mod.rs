@@ -9,6 +9,7 @@ pub mod quality;
 pub mod reference;
 pub mod render;
 pub mod setup;
+pub mod view;
 
 use anyhow::{Context as _, Result};
 use fovea_renderer::vk::{Context, ContextOptions, DeviceSelector};

@@ -1,0 +1,394 @@
+//! `fovea view`: the real-time engine in a desktop window (winit + VK_KHR_swapchain). One eye or
+//! both side by side, written by the engine's last pass straight into the swapchain image; gaze
+//! from the mouse (or any `--gaze` source); keys switch method, denoiser and TAA live and freeze
+//! the gaze; fps and per-pass GPU ms in the title. `--frames N --screenshot FILE` renders frames
+//! 0…N−1 exactly as `fovea render` does and saves the last presented image.
+
+use super::render::RenderArgs;
+use super::setup::{space_for, Setup, METHODS};
+use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
+use anyhow::{anyhow, bail, Context as _, Result};
+use ash::vk;
+use fovea_renderer::gpu_scene::GpuScene;
+use fovea_renderer::graph::SubmitSync;
+use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::{FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS};
+use fovea_renderer::vk::{Buffer, Context};
+use glam::{UVec2, Vec2};
+use gpu_allocator::MemoryLocation;
+use std::ffi::CString;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::window::{Window, WindowId};
+
+pub struct ViewArgs<'a> {
+    pub render: RenderArgs<'a>,
+    /// `None`: run until the window closes.
+    pub frames: Option<u32>,
+    pub screenshot: Option<&'a Path>,
+    pub present_mode: &'a str,
+    /// Gaze from the mouse (no `--gaze` given).
+    pub mouse_gaze: bool,
+}
+
+const DENOISERS: &[&str] = &["none", "svgf", "asvgf", "bmfr"];
+const TAAS: &[&str] = &["off", "vp", "screen"];
+
+pub fn run(args: &ViewArgs) -> Result<()> {
+    let present_mode = PRESENT_MODES
+        .iter()
+        .find(|(name, _)| *name == args.present_mode)
+        .map(|p| p.1)
+        .ok_or_else(|| anyhow!("--present-mode {}: expected one of fifo, mailbox, immediate", args.present_mode))?;
+    if args.screenshot.is_some() && args.frames.is_none() {
+        bail!("--screenshot needs --frames N (the screenshot is of frame N − 1)");
+    }
+    let setup = Setup::new(&args.render, args.frames.unwrap_or(u32::MAX))?;
+    let event_loop = EventLoop::new().context("opening the display (X11 or Wayland; is DISPLAY or WAYLAND_DISPLAY set?)")?;
+    let display = event_loop.display_handle()?.as_raw();
+    let mut options = super::device_options(args.render.device, args.render.validation);
+    options.instance_extensions = ash_window::enumerate_required_extensions(display)?
+        .iter()
+        .map(|&p| unsafe { std::ffi::CStr::from_ptr(p) }.to_owned())
+        .collect();
+    options.device_extensions = vec![CString::from(ash::khr::swapchain::NAME)];
+    options.require_storage_write_without_format = true;
+    let ctx = Context::new(&options).context("opening the Vulkan device")?;
+    let scene = GpuScene::upload(&ctx, &setup.scene)?;
+    let spaces = setup.spaces(args.render.method, &args.render.profile)?;
+    let renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, args.render.frames_in_flight.max(1))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = Viewer {
+        args,
+        ctx: ctx.clone(),
+        setup,
+        renderer,
+        present_mode,
+        window: None,
+        error: None,
+        frame: 0,
+        mouse: None,
+        frozen: false,
+        method: args.render.method.to_string(),
+        denoiser: args.render.denoiser.to_string(),
+        taa: args.render.taa.to_string(),
+        title_at: Instant::now(),
+        frames_since_title: 0,
+    };
+    event_loop.run_app(&mut app)?;
+    if let Some(e) = app.error.take() {
+        return Err(e);
+    }
+    super::check_validation(&ctx)
+}
+
+/// What exists once the window does.
+struct WindowState {
+    window: Arc<Window>,
+    surface_loader: ash::khr::surface::Instance,
+    surface: vk::SurfaceKHR,
+    swapchain: Option<Swapchain>,
+    /// One per frame slot: signalled when the slot's image is acquired.
+    acquired: Vec<vk::Semaphore>,
+    screenshot: Option<Buffer>,
+}
+
+struct Viewer<'a> {
+    args: &'a ViewArgs<'a>,
+    ctx: Arc<Context>,
+    setup: Setup,
+    renderer: Renderer,
+    present_mode: vk::PresentModeKHR,
+    window: Option<WindowState>,
+    error: Option<anyhow::Error>,
+    frame: u32,
+    /// Last cursor position over an eye, in that eye's pixels.
+    mouse: Option<Vec2>,
+    frozen: bool,
+    method: String,
+    denoiser: String,
+    taa: String,
+    title_at: Instant,
+    frames_since_title: u32,
+}
+
+impl ApplicationHandler for Viewer<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        if let Err(e) = self.open_window(event_loop) {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(_) => self.rebuild_swapchain(),
+            WindowEvent::CursorMoved { position, .. } => {
+                let eye_width = self.setup.width as f32;
+                let p = Vec2::new(position.x as f32, position.y as f32);
+                if !self.frozen {
+                    self.mouse = Some(Vec2::new(p.x % eye_width, p.y));
+                }
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => self.key(event_loop, &event.logical_key),
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(w) = &self.window {
+            w.window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // Nothing in flight may use the swapchain or the semaphores once they go.
+        let _ = self.renderer.finish();
+        if let Some(w) = self.window.take() {
+            drop(w.swapchain);
+            unsafe {
+                for s in &w.acquired {
+                    self.ctx.device.destroy_semaphore(*s, None);
+                }
+                w.surface_loader.destroy_surface(w.surface, None);
+            }
+        }
+    }
+}
+
+impl Viewer<'_> {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        self.error.get_or_insert(e);
+        event_loop.exit();
+    }
+
+    fn open_window(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let eyes = self.setup.eyes.list().len() as u32;
+        let size = winit::dpi::PhysicalSize::new(self.setup.width * eyes, self.setup.height);
+        let attrs = Window::default_attributes().with_title("fovea").with_inner_size(size).with_resizable(true);
+        let window = Arc::new(event_loop.create_window(attrs)?);
+        let surface = unsafe {
+            ash_window::create_surface(&self.ctx.entry, &self.ctx.instance, window.display_handle()?.as_raw(), window.window_handle()?.as_raw(), None)?
+        };
+        let surface_loader = ash::khr::surface::Instance::new(&self.ctx.entry, &self.ctx.instance);
+        if !self.ctx.queue_supports_surface(&surface_loader, surface)? {
+            bail!("the compute queue of {} cannot present to this window", self.ctx.info.name);
+        }
+        let acquired = (0..self.renderer.frames_in_flight())
+            .map(|_| unsafe { self.ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) })
+            .collect::<std::result::Result<Vec<_>, _>>()?;
+        self.window = Some(WindowState { window, surface_loader, surface, swapchain: None, acquired, screenshot: None });
+        self.rebuild_swapchain()
+    }
+
+    /// A new swapchain at the window's size, and views resized to it (each eye half the width).
+    fn rebuild_swapchain(&mut self) -> Result<()> {
+        let Some(mut w) = self.window.take() else { return Ok(()) };
+        let result = self.rebuild_swapchain_of(&mut w);
+        self.window = Some(w);
+        result
+    }
+
+    fn rebuild_swapchain_of(&mut self, w: &mut WindowState) -> Result<()> {
+        let size = w.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(()); // minimised: keep the old one until it comes back
+        }
+        // A resize is not the steady state: drain the frames that use the old images.
+        self.renderer.finish()?;
+        let old = w.swapchain.take();
+        let swapchain = Swapchain::new(&self.ctx, &w.surface_loader, w.surface, (size.width, size.height), self.present_mode, old.as_ref().map_or(vk::SwapchainKHR::null(), |s| s.raw))?;
+        drop(old);
+        if w.swapchain.is_none() && self.frame == 0 {
+            eprintln!(
+                "view: swapchain {:?} {}×{}, {:?}; sRGB encoded by the tonemap shader (sRGB formats lack STORAGE)",
+                swapchain.format, swapchain.extent.width, swapchain.extent.height, swapchain.present_mode
+            );
+        }
+        let eyes = self.setup.eyes.list().len() as u32;
+        let eye = UVec2::new(swapchain.extent.width / eyes, swapchain.extent.height);
+        // `--frames` runs keep the render's size (the screenshot must match `fovea render`).
+        if self.args.frames.is_none() && eye != self.setup.screen() && eye.x > 0 {
+            self.setup.width = eye.x;
+            self.setup.height = eye.y;
+            self.setup.start_pose = fovea_renderer::pipeline::CameraPose { fov_tan: scaled_fov(self.setup.start_pose.fov_tan, eye), ..self.setup.start_pose };
+            self.rebuild_views()?;
+        }
+        if self.args.screenshot.is_some() {
+            if !swapchain.can_copy(&w.surface_loader, w.surface) {
+                bail!("this surface does not allow copying its images (TRANSFER_SRC): no --screenshot");
+            }
+            let bytes = swapchain.extent.width as u64 * swapchain.extent.height as u64 * 4;
+            w.screenshot = Some(Buffer::new(&self.ctx, "screenshot", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+        }
+        w.swapchain = Some(swapchain);
+        Ok(())
+    }
+
+    fn rebuild_views(&mut self) -> Result<()> {
+        let profile = &self.args.render.profile;
+        let spaces = self.setup.eyes.list().iter().map(|&eye| space_for(&self.method, profile, &self.setup.hmd, eye, self.setup.screen())).collect::<Result<Vec<_>>>()?;
+        let settings = RenderSettings {
+            denoiser: match DenoiserSettings::parse(&self.denoiser)? {
+                DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
+                DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
+                DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
+                other => other,
+            },
+            taa: TaaMode::parse(&self.taa)?.with_settings(profile.taa),
+            ..self.renderer.settings
+        };
+        self.renderer.replace_views(spaces, settings)?;
+        Ok(())
+    }
+
+    fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) -> Result<()> {
+        let next = |list: &[&str], current: &str| list[(list.iter().position(|m| *m == current).unwrap_or(0) + 1) % list.len()].to_string();
+        match key.as_ref() {
+            Key::Named(NamedKey::Escape) | Key::Character("q") => {
+                event_loop.exit();
+                return Ok(());
+            }
+            Key::Character("m") => self.method = next(METHODS, &self.method),
+            Key::Character("d") => self.denoiser = next(DENOISERS, &self.denoiser),
+            Key::Character("t") => self.taa = next(TAAS, &self.taa),
+            Key::Character("f") => {
+                self.frozen = !self.frozen;
+                return Ok(());
+            }
+            _ => return Ok(()),
+        }
+        if let Err(e) = self.rebuild_views() {
+            // An unsupported combination is reported, not fatal: the old views stay.
+            eprintln!("view: {e:#}");
+        }
+        Ok(())
+    }
+
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        if self.args.frames.is_some_and(|n| self.frame >= n) {
+            self.save_screenshot()?;
+            event_loop.exit();
+            return Ok(());
+        }
+        // The slot's previous frame must be done before its acquire semaphore is reused.
+        self.renderer.retire_next()?;
+        let slot = self.renderer.ring().next_slot();
+        let Some(w) = &self.window else { return Ok(()) };
+        let Some(swapchain) = &w.swapchain else { return Ok(()) };
+        let acquired = w.acquired[slot];
+        let (index, _) = match unsafe { swapchain.loader.acquire_next_image(swapchain.raw, u64::MAX, acquired, vk::Fence::null()) } {
+            Ok(r) => r,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return self.rebuild_swapchain(),
+            Err(e) => return Err(e.into()),
+        };
+        let input = self.frame_input()?;
+        let last = self.args.frames.is_some_and(|n| self.frame + 1 == n);
+        let w = self.window.as_ref().expect("window");
+        let swapchain = w.swapchain.as_ref().expect("swapchain");
+        let image = &swapchain.images[index as usize];
+        let rendered = [swapchain.rendered[index as usize]];
+        let waits = [(acquired, vk::PipelineStageFlags::COMPUTE_SHADER)];
+        let mut offsets = [UVec2::ZERO; MAX_VIEWS];
+        for (v, offset) in offsets.iter_mut().enumerate() {
+            *offset = UVec2::new(v as u32 * self.setup.width, 0);
+        }
+        let target = FrameTarget {
+            image,
+            offsets,
+            sync: SubmitSync { wait: &waits, signal: &rendered },
+            copy_to: if last { w.screenshot.as_ref() } else { None },
+        };
+        self.renderer.submit(&input, Some(&target))?;
+        let swapchains = [swapchain.raw];
+        let indices = [index];
+        let present = vk::PresentInfoKHR::default().wait_semaphores(&rendered).swapchains(&swapchains).image_indices(&indices);
+        let result = {
+            let _queue = self.ctx.queue_guard();
+            unsafe { swapchain.loader.queue_present(self.ctx.queue, &present) }
+        };
+        self.frame += 1;
+        self.frames_since_title += 1;
+        match result {
+            Ok(false) => {}
+            Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.rebuild_swapchain()?,
+            Err(e) => return Err(e.into()),
+        }
+        self.update_title();
+        Ok(())
+    }
+
+    /// Frame k's input: exactly `fovea render`'s for `--frames` runs and gaze sources; the
+    /// mouse (or the frozen gaze) otherwise.
+    fn frame_input(&mut self) -> Result<FrameInput> {
+        let (input, _) = self.setup.frame_input(self.frame)?;
+        if !self.args.mouse_gaze || self.args.frames.is_some() {
+            return Ok(input);
+        }
+        let mut views = [ViewInput { camera: input.view_inputs()[0].camera, gaze: None }; MAX_VIEWS];
+        let count = input.view_inputs().len();
+        for (view, given) in views.iter_mut().zip(input.view_inputs()) {
+            // None keeps the space's gaze: frozen, or no cursor yet.
+            *view = ViewInput { camera: given.camera, gaze: if self.frozen { None } else { self.mouse.or(given.gaze) } };
+        }
+        Ok(FrameInput::views(&views[..count], self.frame)?)
+    }
+
+    fn update_title(&mut self) {
+        let elapsed = self.title_at.elapsed().as_secs_f64();
+        if elapsed < 0.5 {
+            return;
+        }
+        let fps = self.frames_since_title as f64 / elapsed;
+        let total: f64 = self.renderer.timings().iter().map(|t| t.ms).sum();
+        let trace: f64 = self.renderer.timings().iter().filter(|t| t.name == "trace").map(|t| t.ms).sum();
+        let title = format!(
+            "fovea — {} · {} · taa {} · {:.1} fps · GPU {:.1} ms (trace {:.1}) · {}[m d t f: method denoiser taa freeze]",
+            self.method, self.denoiser, self.taa, fps, total, trace, if self.frozen { "gaze frozen · " } else { "" }
+        );
+        if let Some(w) = &self.window {
+            w.window.set_title(&title);
+        }
+        self.title_at = Instant::now();
+        self.frames_since_title = 0;
+    }
+
+    fn save_screenshot(&mut self) -> Result<()> {
+        let (Some(path), Some(w)) = (self.args.screenshot, &self.window) else { return Ok(()) };
+        self.renderer.finish()?;
+        let (Some(buffer), Some(swapchain)) = (&w.screenshot, &w.swapchain) else { return Ok(()) };
+        let mut pixels = vec![0u8; buffer.size as usize];
+        buffer.read_into(&mut pixels)?;
+        if swapchain.format == vk::Format::B8G8R8A8_UNORM {
+            pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
+        crate::output::write_png(path, swapchain.extent.width, swapchain.extent.height, &pixels)
+            .with_context(|| format!("--screenshot {}", path.display()))
+    }
+}
+
+/// The FOV tangents for a new eye size: the vertical extent kept, the horizontal following the
+/// aspect ratio (pixels stay square), like `CameraPose::from_scene_camera`.
+fn scaled_fov(fov: glam::Vec4, eye: UVec2) -> glam::Vec4 {
+    let ty = fov.w;
+    let tx = ty * eye.x as f32 / eye.y as f32;
+    glam::Vec4::new(-tx, tx, fov.z, fov.w)
+}

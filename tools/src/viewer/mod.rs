@@ -1,0 +1,2 @@
+//! `fovea view`'s window plumbing.
+pub mod swapchain;

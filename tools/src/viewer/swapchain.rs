@@ -1,0 +1,135 @@
+//! The window's swapchain: images the engine's last pass writes as external targets.
+//! sRGB swapchain formats rarely allow STORAGE, so a UNORM format with STORAGE is chosen and
+//! the tonemap shader encodes sRGB itself.
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+use fovea_renderer::graph::ExternalImage;
+use fovea_renderer::vk::{next_resource_id, Context};
+use std::sync::Arc;
+
+/// Present modes by `--present-mode` name.
+pub const PRESENT_MODES: &[(&str, vk::PresentModeKHR)] = &[
+    ("fifo", vk::PresentModeKHR::FIFO),
+    ("mailbox", vk::PresentModeKHR::MAILBOX),
+    ("immediate", vk::PresentModeKHR::IMMEDIATE),
+];
+
+pub struct Swapchain {
+    ctx: Arc<Context>,
+    pub loader: ash::khr::swapchain::Device,
+    pub raw: vk::SwapchainKHR,
+    pub images: Vec<ExternalImage>,
+    /// Signalled by each image's frame, waited on by its presentation (one per image: an image
+    /// is only re-acquired after its presentation).
+    pub rendered: Vec<vk::Semaphore>,
+    pub extent: vk::Extent2D,
+    pub format: vk::Format,
+    pub present_mode: vk::PresentModeKHR,
+}
+
+impl Swapchain {
+    pub fn new(
+        ctx: &Arc<Context>,
+        surface_loader: &ash::khr::surface::Instance,
+        surface: vk::SurfaceKHR,
+        size: (u32, u32),
+        wanted_mode: vk::PresentModeKHR,
+        old: vk::SwapchainKHR,
+    ) -> Result<Swapchain> {
+        let caps = unsafe { surface_loader.get_physical_device_surface_capabilities(ctx.physical, surface)? };
+        if !caps.supported_usage_flags.contains(vk::ImageUsageFlags::STORAGE) {
+            bail!("the window surface does not allow STORAGE images (the engine writes the swapchain from a compute shader)");
+        }
+        let format = pick_format(ctx, surface_loader, surface)?;
+        let modes = unsafe { surface_loader.get_physical_device_surface_present_modes(ctx.physical, surface)? };
+        let present_mode = if modes.contains(&wanted_mode) { wanted_mode } else { vk::PresentModeKHR::FIFO };
+        let extent = match caps.current_extent.width {
+            u32::MAX => vk::Extent2D {
+                width: size.0.clamp(caps.min_image_extent.width, caps.max_image_extent.width),
+                height: size.1.clamp(caps.min_image_extent.height, caps.max_image_extent.height),
+            },
+            _ => caps.current_extent,
+        };
+        let mut count = caps.min_image_count + 1;
+        if caps.max_image_count > 0 {
+            count = count.min(caps.max_image_count);
+        }
+        // Screenshots copy the presented image: TRANSFER_SRC where the surface allows it.
+        let usage = vk::ImageUsageFlags::STORAGE | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
+        let info = vk::SwapchainCreateInfoKHR::default()
+            .surface(surface)
+            .min_image_count(count)
+            .image_format(format)
+            .image_color_space(vk::ColorSpaceKHR::SRGB_NONLINEAR)
+            .image_extent(extent)
+            .image_array_layers(1)
+            .image_usage(usage)
+            .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .pre_transform(caps.current_transform)
+            .composite_alpha(vk::CompositeAlphaFlagsKHR::OPAQUE)
+            .present_mode(present_mode)
+            .clipped(true)
+            .old_swapchain(old);
+        let loader = ash::khr::swapchain::Device::new(&ctx.instance, &ctx.device);
+        let raw = unsafe { loader.create_swapchain(&info, None).context("creating the swapchain")? };
+        let raw_images = unsafe { loader.get_swapchain_images(raw)? };
+        let mut images = Vec::with_capacity(raw_images.len());
+        let mut rendered = Vec::with_capacity(raw_images.len());
+        for image in raw_images {
+            let view_info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(format)
+                .subresource_range(fovea_renderer::vk::color_range());
+            let view = unsafe { ctx.device.create_image_view(&view_info, None)? };
+            images.push(ExternalImage {
+                raw: image,
+                view,
+                width: extent.width,
+                height: extent.height,
+                format,
+                layout_before: vk::ImageLayout::UNDEFINED,
+                layout_after: vk::ImageLayout::PRESENT_SRC_KHR,
+                id: next_resource_id(),
+            });
+            rendered.push(unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None)? });
+        }
+        Ok(Swapchain { ctx: ctx.clone(), loader, raw, images, rendered, extent, format, present_mode })
+    }
+
+    pub fn can_copy(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> bool {
+        unsafe { surface_loader.get_physical_device_surface_capabilities(self.ctx.physical, surface) }
+            .is_ok_and(|c| c.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_SRC))
+    }
+}
+
+impl Drop for Swapchain {
+    fn drop(&mut self) {
+        // The caller has drained the frames that used these images.
+        unsafe {
+            for (image, semaphore) in self.images.iter().zip(&self.rendered) {
+                self.ctx.device.destroy_image_view(image.view, None);
+                self.ctx.device.destroy_semaphore(*semaphore, None);
+            }
+            self.loader.destroy_swapchain(self.raw, None);
+        }
+    }
+}
+
+/// The first UNORM 8-bit format the surface offers whose images the device can write from a
+/// compute shader without a format qualifier.
+fn pick_format(ctx: &Context, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> Result<vk::Format> {
+    let formats = unsafe { surface_loader.get_physical_device_surface_formats(ctx.physical, surface)? };
+    let candidates = [vk::Format::B8G8R8A8_UNORM, vk::Format::R8G8B8A8_UNORM];
+    for wanted in candidates {
+        if !formats.iter().any(|f| f.format == wanted && f.color_space == vk::ColorSpaceKHR::SRGB_NONLINEAR) {
+            continue;
+        }
+        let props = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, wanted) };
+        if props.optimal_tiling_features.contains(vk::FormatFeatureFlags::STORAGE_IMAGE) {
+            return Ok(wanted);
+        }
+    }
+    bail!("the window surface offers no UNORM format with STORAGE support (offered: {:?})", formats.iter().map(|f| f.format).collect::<Vec<_>>())
+}
