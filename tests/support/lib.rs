@@ -130,6 +130,8 @@ pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_
         taa: "off",
         device: None,
         validation: true,
+        eyes: fovea_tools::commands::setup::Eyes::Left,
+        frames_in_flight: 2,
     }
 }
 

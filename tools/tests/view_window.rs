@@ -1,0 +1,96 @@
+//! `fovea view` in a real window: an Xvfb display (installed by scripts/setup), lavapipe,
+//! validation on (the binary fails on any message). Its `--frames N --screenshot` image, copied
+//! from the presented swapchain image, must equal `fovea render`'s frame N − 1 of the same
+//! camera, gaze and settings (threshold: every channel within 1 of 255, documented in the README;
+//! on lavapipe the images are byte-identical).
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        // A display number no other server (or parallel test run) holds.
+        let number = (90..190).find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()).expect("a free X display number");
+        let child = Command::new("Xvfb")
+            .args([&format!(":{number}"), "-screen", "0", "800x600x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb (scripts/setup installs it: apt-get install xvfb)");
+        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
+        let start = Instant::now();
+        while !socket.exists() {
+            assert!(start.elapsed() < Duration::from_secs(20), "Xvfb :{number} did not start");
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Xvfb { child, display: format!(":{number}") }
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn fovea(args: &[&str], display: Option<&str>) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_fovea"));
+    cmd.args(args).arg("--validation");
+    match display {
+        Some(d) => cmd.env("DISPLAY", d).env_remove("WAYLAND_DISPLAY"),
+        None => cmd.env_remove("DISPLAY"),
+    };
+    let out = cmd.output().expect("running fovea");
+    assert!(out.status.success(), "fovea {args:?} failed:\n{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+}
+
+fn rgba(path: &Path) -> image::RgbaImage {
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+}
+
+fn check_screenshot_matches_render(name: &str, extra: &[&str]) {
+    let x = Xvfb::start();
+    let dir = std::env::temp_dir().join(format!("fovea-view-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let shot = dir.join("shot.png");
+    let render_out = dir.join("render");
+    let common = ["--width", "80", "--height", "90", "--frames", "30", "--gaze", "sim:2", "--seed", "3"];
+    let view_args: Vec<&str> = ["view"].iter().chain(&common).chain(extra).copied().chain(["--screenshot", shot.to_str().unwrap()]).collect();
+    fovea(&view_args, Some(&x.display));
+    let render_args: Vec<&str> = ["render"].iter().chain(&common).chain(extra).copied().chain(["--out", render_out.to_str().unwrap()]).collect();
+    fovea(&render_args, None);
+    let shot = rgba(&shot);
+    let stereo = extra.contains(&"both");
+    let eyes: Vec<String> = if stereo { vec!["frame_0029_left.png".into(), "frame_0029_right.png".into()] } else { vec!["frame_0029.png".into()] };
+    assert_eq!(shot.dimensions(), (80 * eyes.len() as u32, 90));
+    for (i, file) in eyes.iter().enumerate() {
+        let expected = rgba(&render_out.join(file));
+        let mut worst = 0u8;
+        for (x, y, p) in expected.enumerate_pixels() {
+            let q = shot.get_pixel(x + 80 * i as u32, y);
+            for c in 0..3 {
+                worst = worst.max(p[c].abs_diff(q[c]));
+            }
+        }
+        assert!(worst <= 1, "{name}: the window's {file} differs from fovea render's by up to {worst}/255");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn view_screenshot_matches_the_offline_render() {
+    check_screenshot_matches_render("mono", &["--denoiser", "svgf"]);
+}
+
+#[test]
+fn view_screenshot_of_both_eyes_matches_the_offline_stereo_render() {
+    check_screenshot_matches_render("stereo", &["--eyes", "both", "--taa", "screen"]);
+}
