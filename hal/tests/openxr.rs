@@ -31,18 +31,21 @@ fn expected(s: i64) -> (Vec3, bool, bool) {
     (dir, !blink, !blink && !degraded)
 }
 
-/// Start of the current 5-s cycle on the monotonic clock, plus `offset_ms` (a tick time).
+/// Start of the next 5-s cycle on the monotonic clock, plus `offset_ms` (a tick time). The next
+/// one, because the current one may have begun before the instance (negative XrTime).
 fn cycle_time(rt: &OpenXrRuntime, offset_ms: i64) -> i64 {
     let now = rt.time_to_monotonic(rt.now().unwrap()).unwrap();
-    now - now % CYCLE + offset_ms * MS
+    now - now % CYCLE + CYCLE + offset_ms * MS
 }
 
 fn xr_time(rt: &OpenXrRuntime, monotonic: i64) -> XrTime {
     rt.monotonic_to_time(monotonic).unwrap()
 }
 
+/// atan2(|a×b|, a·b) in f64: acos of an f32 dot product cannot resolve angles below ~0.02°.
 fn angle_deg(a: Vec3, b: Vec3) -> f32 {
-    a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos().to_degrees()
+    let (a, b) = (a.as_dvec3(), b.as_dvec3());
+    a.cross(b).length().atan2(a.dot(b)).to_degrees() as f32
 }
 
 /// The lock, with Monado's test settings, when a runtime is configured; `None` (after saying
@@ -67,6 +70,9 @@ fn runtime_env() -> Option<MutexGuard<'static, ()>> {
     std::env::set_var("XRT_COMPOSITOR_NULL", "1");
     std::env::set_var("SIMULATED_ENABLE", "1");
     std::env::set_var("SIMULATED_EYE_TRACKER", "on");
+    if std::env::var_os("XRT_LOG").is_none() {
+        std::env::set_var("XRT_LOG", "warning"); // Monado's info log is pages per instance
+    }
     Some(guard)
 }
 

@@ -154,7 +154,7 @@ impl OpenXrGaze {
 
     /// Display time 0 (headless sessions have no frame loop) means "now" on the runtime clock.
     fn usable_time(&self, t: XrTime) -> XrTime {
-        if t > 0 || !self.has_timespec {
+        if t != 0 || !self.has_timespec {
             return t;
         }
         self.instance.now().map(|n| n.as_nanos()).unwrap_or(t)
@@ -326,7 +326,7 @@ impl GazeSource for OpenXrGaze {
         }
         self.sync()?;
         let t = self.usable_time(predicted_display_time);
-        if t > 0 {
+        if t != 0 {
             self.update_views(t);
             let s = self.locate_gaze(t);
             self.remember(s);

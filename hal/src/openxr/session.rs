@@ -200,7 +200,11 @@ impl<G: xr::Graphics> SessionOwner<G> {
     /// Attach every action set of the session at once: OpenXR allows one
     /// `xrAttachSessionActionSets` per session, so the renderer's sets and the gaze set
     /// ([`super::GazeActions::action_set`]) go in together.
+    /// An empty list attaches nothing (OpenXR refuses a count of 0), so a later call still can.
     pub fn attach_action_sets(&mut self, sets: &[&xr::ActionSet]) -> Result<(), HalError> {
+        if sets.is_empty() {
+            return Ok(());
+        }
         if self.attached.is_some() {
             return Err(fail("action sets are already attached to this session (OpenXR allows one attach per session): pass all of them in one call"));
         }
