@@ -5,7 +5,7 @@
 //! the requested time through a raw `xrLocateSpace`, because the crate's `Space::locate` cannot
 //! chain `XrEyeGazeSampleTimeEXT` (the real sample time).
 
-use super::session::apply_views;
+use super::session::{apply_views, sync_sets};
 use super::{call, fail, OpenXrRuntime, RuntimeFigures, SessionOwner, SessionStateHandle};
 use crate::error::HalError;
 use crate::hmd::HmdDescription;
@@ -50,9 +50,9 @@ impl GazeActions {
     }
 }
 
-/// Located gaze: spaces and the action set to sync.
+/// Located gaze: its space, and every set of the session's one attach (synced together).
 struct Tracker {
-    set: xr::ActionSet,
+    attached: Vec<xr::ActionSet>,
     gaze_space: xr::Space,
 }
 
@@ -72,7 +72,9 @@ pub struct OpenXrGaze {
     own: Option<SessionOwner<xr::Headless>>,
     numbers: Sequencer,
     last: GazeSample,
-    /// xrSyncActions calls (diagnostics; a borrowed session must still get synced).
+    /// The owner's sync count at the last `begin_frame`.
+    owner_syncs: u64,
+    /// `xrSyncActions` calls this source made itself (frames where the owner did not sync).
     pub syncs: u64,
 }
 
@@ -96,7 +98,7 @@ impl OpenXrGaze {
                     ));
                 }
                 let gaze_space = call("xrCreateActionSpace(gaze)", action.create_space(&session, xr::Path::NULL, xr::Posef::IDENTITY))?;
-                Some(Tracker { set, gaze_space })
+                Some(Tracker { attached: owner.attached_sets().to_vec(), gaze_space })
             }
             None => None,
         };
@@ -115,6 +117,7 @@ impl OpenXrGaze {
             own: None,
             numbers: Sequencer::default(),
             last: GazeSample::no_gaze(0, 0),
+            owner_syncs: 0,
             syncs: 0,
         })
     }
@@ -228,11 +231,13 @@ impl OpenXrGaze {
         }
     }
 
+    /// Sync all attached sets unless the owner already did since the last frame.
     fn sync(&mut self) -> Result<(), HalError> {
         let status = self.state.get();
-        let Some(tracker) = self.tracker.as_ref().filter(|_| status.running) else { return Ok(()) };
-        // Not focused is a success code (SESSION_NOT_FOCUSED): actions stay inactive.
-        call("xrSyncActions(gaze)", self.session.sync_actions(&[xr::ActiveActionSet::new(&tracker.set)]))?;
+        let owner_synced = status.syncs != self.owner_syncs;
+        self.owner_syncs = status.syncs;
+        let Some(tracker) = self.tracker.as_ref().filter(|_| status.running && !owner_synced) else { return Ok(()) };
+        sync_sets(&self.session, &tracker.attached)?;
         self.syncs += 1;
         Ok(())
     }

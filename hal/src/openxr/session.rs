@@ -34,11 +34,14 @@ pub struct SessionStatus {
     /// How often the owner called `xrBeginSession` / `xrEndSession` (once each per run).
     pub begins: u32,
     pub ends: u32,
+    /// How often [`SessionOwner::sync_actions`] ran (the gaze source syncs only in frames where
+    /// it did not).
+    pub syncs: u64,
 }
 
 impl SessionStatus {
     const INITIAL: SessionStatus =
-        SessionStatus { state: xr::SessionState::UNKNOWN, running: false, end: None, begins: 0, ends: 0 };
+        SessionStatus { state: xr::SessionState::UNKNOWN, running: false, end: None, begins: 0, ends: 0, syncs: 0 };
 
     /// Actions (gaze) are only delivered while focused.
     pub fn focused(&self) -> bool {
@@ -117,7 +120,7 @@ pub struct SessionOwner<G: xr::Graphics> {
     shared: SessionStateHandle,
     exit: ExitHandle,
     exit_sent: bool,
-    attached: Option<Vec<xr::sys::ActionSet>>,
+    attached: Option<Vec<xr::ActionSet>>,
 }
 
 impl SessionOwner<xr::Headless> {
@@ -209,13 +212,32 @@ impl<G: xr::Graphics> SessionOwner<G> {
             return Err(fail("action sets are already attached to this session (OpenXR allows one attach per session): pass all of them in one call"));
         }
         call("xrAttachSessionActionSets", self.session.attach_action_sets(sets))?;
-        self.attached = Some(sets.iter().map(|s| s.as_raw()).collect());
+        self.attached = Some(sets.iter().map(|&s| s.clone()).collect());
         Ok(())
     }
 
     /// Whether `set` went into this session's one attach.
     pub fn is_attached(&self, set: &xr::ActionSet) -> bool {
-        self.attached.as_ref().is_some_and(|sets| sets.contains(&set.as_raw()))
+        self.attached_sets().iter().any(|s| s.as_raw() == set.as_raw())
+    }
+
+    /// Every set of the one attach (empty before it).
+    pub fn attached_sets(&self) -> &[xr::ActionSet] {
+        self.attached.as_deref().unwrap_or(&[])
+    }
+
+    /// One `xrSyncActions` for every attached set. Sets left out of a sync become inactive, so
+    /// the renderer and the gaze source must not sync separately: the renderer calls this once
+    /// per frame when it reads its own actions (before the gaze source's `begin_frame`), else the
+    /// gaze source makes the same full sync itself.
+    pub fn sync_actions(&mut self) -> Result<(), HalError> {
+        if !self.status.running {
+            return Ok(());
+        }
+        sync_sets(&self.session, self.attached_sets())?;
+        self.status.syncs += 1;
+        self.shared.set(self.status);
+        Ok(())
     }
 
     /// Drain the event queue and act on session state *changes*: READY → `xrBeginSession`,
@@ -372,6 +394,16 @@ impl<G: xr::Graphics> SessionOwner<G> {
         }
         self.session.get_display_refresh_rate().ok().filter(|hz| hz.is_finite() && *hz > 0.0 && *hz <= 1000.0)
     }
+}
+
+/// `xrSyncActions` over `sets` (all of a session's attached sets). Not focused is a success code
+/// (`XR_SESSION_NOT_FOCUSED`): actions stay inactive.
+pub(crate) fn sync_sets<G>(session: &xr::Session<G>, sets: &[xr::ActionSet]) -> Result<(), HalError> {
+    if sets.is_empty() {
+        return Ok(());
+    }
+    let active: Vec<xr::ActiveActionSet<'_>> = sets.iter().map(xr::ActiveActionSet::new).collect();
+    call("xrSyncActions", session.sync_actions(&active))
 }
 
 /// Per-eye FOV (and offsets when the position is valid) from located views; false when the
