@@ -7,7 +7,7 @@
 //! holds `LOCK` (Monado runs in-process, and some tests switch environment variables).
 #![cfg(feature = "openxr")]
 
-use fovea_hal::openxr::{xr, GazeActions, OpenXrGaze, OpenXrRuntime, SessionEnd, SessionOwner, VulkanBinding};
+use fovea_hal::openxr::{xr, GazeActions, OpenXrGaze, OpenXrRuntime, SessionEnd, SessionOwner, VulkanBinding, STORAGE_FORMATS};
 use fovea_hal::{GazeOrigin, GazeSource, HmdDescription, InvalidGazePolicy, SampleTimeKind, XrTime};
 use glam::Vec3;
 use std::io::Write;
@@ -252,6 +252,10 @@ fn vulkan_session_through_the_runtime() {
     owner.attach_action_sets(&actions.action_set().into_iter().collect::<Vec<_>>()).unwrap();
     let mut gaze = OpenXrGaze::new(&rt, &owner, actions, &HmdDescription::fove0()).unwrap();
     let stage = owner.create_reference_space(xr::ReferenceSpaceType::LOCAL).unwrap();
+    let format = *owner.swapchain_formats().unwrap().iter().find(|f| STORAGE_FORMATS.contains(f)).expect("a UNORM storage format");
+    let size = gaze.describe().eyes.map(|e| (e.recommended_width, e.recommended_height));
+    let mut swapchains: Vec<_> = size.iter().map(|&(w, h)| owner.create_storage_swapchain(format, w, h).unwrap()).collect();
+    assert!(swapchains.iter().all(|s| !s.enumerate_images().unwrap().is_empty()));
     let mut last_time = 0;
     let mut frames = 0;
     let mut valid = 0;
@@ -271,12 +275,28 @@ fn vulkan_session_through_the_runtime() {
         valid += gaze.latest().valid as usize;
         let (flags, views) = owner.locate_views(t, &stage).unwrap();
         assert!(flags.contains(xr::ViewStateFlags::ORIENTATION_VALID) && views.len() == 2);
-        owner.end_frame(t, &[]).unwrap();
+        // Per swapchain: acquire → wait → (render) → release; one projection view per located view.
+        for sc in &mut swapchains {
+            sc.acquire_image().unwrap();
+            sc.wait_image(xr::Duration::INFINITE).unwrap();
+            sc.release_image().unwrap();
+        }
+        let projection: Vec<_> = views
+            .iter()
+            .zip(&swapchains)
+            .zip(size)
+            .map(|((v, sc), (w, h))| {
+                let rect = xr::Rect2Di { offset: xr::Offset2Di { x: 0, y: 0 }, extent: xr::Extent2Di { width: w as i32, height: h as i32 } };
+                xr::CompositionLayerProjectionView::new().pose(v.pose).fov(v.fov).sub_image(xr::SwapchainSubImage::new().swapchain(sc).image_rect(rect))
+            })
+            .collect();
+        let layer = xr::CompositionLayerProjection::new().space(&stage).views(&projection);
+        owner.end_frame(t, &[&layer]).unwrap();
         frames += 1;
     }
     assert_eq!(frames, 8, "the Vulkan session did not run 8 frames in 10 s: {:?}", owner.status());
     assert!(valid >= 6, "gaze valid in only {valid} of 8 Vulkan frames");
-    drop((gaze, stage, owner));
+    drop((gaze, swapchains, stage, owner));
     vk.destroy();
 }
 

@@ -17,7 +17,7 @@ mod vulkan;
 
 pub use gaze::{GazeActions, OpenXrGaze};
 pub use runtime::OpenXrRuntime;
-pub use session::{ExitHandle, RuntimeFigures, SessionEnd, SessionOwner, SessionStateHandle, SessionStatus, VulkanBinding};
+pub use session::{ExitHandle, RuntimeFigures, SessionEnd, SessionOwner, SessionStateHandle, SessionStatus, VulkanBinding, STORAGE_FORMATS};
 /// The `openxr` crate this backend is built on, so callers name the same types.
 pub use openxr as xr;
 

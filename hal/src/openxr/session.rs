@@ -160,6 +160,41 @@ impl SessionOwner<xr::Vulkan> {
     }
 }
 
+/// `VK_FORMAT_R8G8B8A8_UNORM` / `B8G8R8A8_UNORM`: sRGB formats rarely allow storage writes,
+/// so compute writes UNORM and encodes sRGB itself.
+pub const STORAGE_FORMATS: [u32; 2] = [37, 44];
+
+impl SessionOwner<xr::Vulkan> {
+    /// The runtime's swapchain formats (`VkFormat` values), its preferred first.
+    pub fn swapchain_formats(&self) -> Result<Vec<u32>, HalError> {
+        call("xrEnumerateSwapchainFormats", self.session.enumerate_swapchain_formats())
+    }
+
+    /// A single-sample colour swapchain that compute shaders can write (`UNORDERED_ACCESS`, i.e.
+    /// `VK_IMAGE_USAGE_STORAGE_BIT`), plus colour-attachment and transfer-destination usage.
+    /// `format` must be one of [`Self::swapchain_formats`] (see [`STORAGE_FORMATS`]).
+    pub fn create_storage_swapchain(&self, format: u32, width: u32, height: u32) -> Result<xr::Swapchain<xr::Vulkan>, HalError> {
+        let offered = self.swapchain_formats()?;
+        if !offered.contains(&format) {
+            return Err(fail(format!("swapchain format {format} is not offered by the runtime (offered: {offered:?})")));
+        }
+        let info = xr::SwapchainCreateInfo::<xr::Vulkan> {
+            create_flags: xr::SwapchainCreateFlags::EMPTY,
+            usage_flags: xr::SwapchainUsageFlags::UNORDERED_ACCESS
+                | xr::SwapchainUsageFlags::COLOR_ATTACHMENT
+                | xr::SwapchainUsageFlags::TRANSFER_DST,
+            format,
+            sample_count: 1,
+            width,
+            height,
+            face_count: 1,
+            array_size: 1,
+            mip_count: 1,
+        };
+        call("xrCreateSwapchain", self.session.create_swapchain(&info))
+    }
+}
+
 impl<G: xr::Graphics> SessionOwner<G> {
     fn from_parts(rt: &OpenXrRuntime, (session, waiter, stream): (xr::Session<G>, xr::FrameWaiter, xr::FrameStream<G>)) -> Self {
         SessionOwner {
