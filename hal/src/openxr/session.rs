@@ -113,6 +113,8 @@ pub struct SessionOwner<G: xr::Graphics> {
     system: xr::SystemId,
     has_timespec: bool,
     has_refresh_rate: bool,
+    /// No display (and Monado leaves the refresh rate unwritten for such sessions).
+    headless: bool,
     session: xr::Session<G>,
     waiter: xr::FrameWaiter,
     stream: xr::FrameStream<G>,
@@ -133,7 +135,7 @@ impl SessionOwner<xr::Headless> {
         let parts = call("xrCreateSession(headless)", unsafe {
             rt.instance.create_session::<xr::Headless>(rt.system, &xr::headless::SessionCreateInfo {})
         })?;
-        Ok(Self::from_parts(rt, parts))
+        Ok(Self::from_parts(rt, parts, true))
     }
 }
 
@@ -156,7 +158,7 @@ impl SessionOwner<xr::Vulkan> {
         };
         // SAFETY: the caller vouches for the handles.
         let parts = call("xrCreateSession(Vulkan)", unsafe { rt.instance.create_session::<xr::Vulkan>(rt.system, &info) })?;
-        Ok(Self::from_parts(rt, parts))
+        Ok(Self::from_parts(rt, parts, false))
     }
 }
 
@@ -196,12 +198,17 @@ impl SessionOwner<xr::Vulkan> {
 }
 
 impl<G: xr::Graphics> SessionOwner<G> {
-    fn from_parts(rt: &OpenXrRuntime, (session, waiter, stream): (xr::Session<G>, xr::FrameWaiter, xr::FrameStream<G>)) -> Self {
+    fn from_parts(
+        rt: &OpenXrRuntime,
+        (session, waiter, stream): (xr::Session<G>, xr::FrameWaiter, xr::FrameStream<G>),
+        headless: bool,
+    ) -> Self {
         SessionOwner {
             instance: rt.instance.clone(),
             system: rt.system,
             has_timespec: rt.has_timespec,
             has_refresh_rate: rt.has_refresh_rate,
+            headless,
             session,
             waiter,
             stream,
@@ -423,11 +430,13 @@ impl<G: xr::Graphics> SessionOwner<G> {
         Ok(())
     }
 
+    /// The display's refresh rate; `None` for headless sessions (no display) and for values no
+    /// display has (a runtime that leaves the output unwritten).
     fn refresh_rate(&self) -> Option<f32> {
-        if !self.has_refresh_rate {
+        if !self.has_refresh_rate || self.headless {
             return None;
         }
-        self.session.get_display_refresh_rate().ok().filter(|hz| hz.is_finite() && *hz > 0.0 && *hz <= 1000.0)
+        self.session.get_display_refresh_rate().ok().filter(|hz| (1.0..=1000.0).contains(hz))
     }
 }
 
