@@ -75,7 +75,7 @@ pub struct OpenXrGaze {
     /// The owner's sync count at the last `begin_frame`.
     owner_syncs: u64,
     /// `xrSyncActions` calls this source made itself (frames where the owner did not sync).
-    pub syncs: u64,
+    syncs: u64,
 }
 
 impl OpenXrGaze {
@@ -148,6 +148,11 @@ impl OpenXrGaze {
     /// Which figures of `describe()` the runtime reported.
     pub fn runtime_figures(&self) -> RuntimeFigures {
         self.figures
+    }
+
+    /// How often this source called `xrSyncActions` itself (frames where the owner did not).
+    pub fn own_syncs(&self) -> u64 {
+        self.syncs
     }
 
     /// The owner of a headless source's own session (for its status and exit handle).

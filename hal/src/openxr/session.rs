@@ -365,6 +365,10 @@ impl<G: xr::Graphics> SessionOwner<G> {
     /// `xrWaitFrame`: blocks until the runtime wants the next frame; its
     /// `predicted_display_time` is what `begin_frame` of the gaze source and `locate_views` take.
     pub fn wait_frame(&mut self) -> Result<xr::FrameState, HalError> {
+        if self.headless {
+            // Monado answers shouldRender = false without a usable time, and xrBeginFrame fails.
+            return Err(fail("a headless session has no frame loop: take display times from now()"));
+        }
         call("xrWaitFrame", self.waiter.wait())
     }
 
