@@ -152,7 +152,7 @@ fn stereo_noise_independent_vs_shared() {
     let mean = |noise| (0..4).map(|f| pair(noise, HALF_IPD, f)).sum::<f64>() / 4.0;
     let (independent, shared) = (mean(StereoNoise::Independent), mean(StereoNoise::Shared));
     // The converged pair: the parallax part of the difference.
-    let mut reference = |dx| {
+    let reference = |dx| {
         let mut r = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(SCREEN)), RenderSettings::default()).unwrap();
         let hdr = r.render_reference(&eye(&head, dx), 64, 3, |_| {}).unwrap();
         fovea_tools::output::tonemap_preview(&hdr, 1.0)
