@@ -186,7 +186,7 @@ impl FrameRecorder {
     /// Moves an external image from its arrival layout to GENERAL before the passes write it.
     pub fn acquire_external(&mut self, image: &ExternalImage) {
         self.barrier_for([(image.id, true)].into_iter());
-        let barrier = external_transition(image, image.layout_before, vk::ImageLayout::GENERAL, vk::AccessFlags::empty(), vk::AccessFlags::SHADER_WRITE);
+        let barrier = image_transition(image.raw, image.layout_before, vk::ImageLayout::GENERAL, vk::AccessFlags::empty(), vk::AccessFlags::SHADER_WRITE);
         let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
         unsafe {
             self.ctx.device.cmd_pipeline_barrier(self.cmd, stages, vk::PipelineStageFlags::COMPUTE_SHADER, vk::DependencyFlags::empty(), &[], &[], &[barrier]);
@@ -210,7 +210,7 @@ impl FrameRecorder {
             }
             self.barrier_for([(buffer.id, true)].into_iter());
             let index = self.open_pass("screenshot")?;
-            let to_src = external_transition(image, from, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, src_access, vk::AccessFlags::TRANSFER_READ);
+            let to_src = image_transition(image.raw, from, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, src_access, vk::AccessFlags::TRANSFER_READ);
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
                 .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
@@ -224,7 +224,7 @@ impl FrameRecorder {
             src_stage = transfer;
         }
         // Presentation waits on a semaphore, which makes these writes visible: no dst access.
-        let to_final = external_transition(image, from, image.layout_after, src_access, vk::AccessFlags::empty());
+        let to_final = image_transition(image.raw, from, image.layout_after, src_access, vk::AccessFlags::empty());
         unsafe {
             device.cmd_pipeline_barrier(self.cmd, src_stage, vk::PipelineStageFlags::BOTTOM_OF_PIPE, vk::DependencyFlags::empty(), &[], &[], &[to_final]);
         }
@@ -342,15 +342,7 @@ impl FrameRecorder {
         } else {
             (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::AccessFlags::TRANSFER_READ)
         };
-        let transition = |from, to, src, dst| {
-            vk::ImageMemoryBarrier::default()
-                .image(image.raw)
-                .old_layout(from)
-                .new_layout(to)
-                .src_access_mask(src)
-                .dst_access_mask(dst)
-                .subresource_range(crate::vk::color_range())
-        };
+        let transition = |from, to, src, dst| image_transition(image.raw, from, to, src, dst);
         let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
         let any = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
         let device = &self.ctx.device;
@@ -545,15 +537,15 @@ impl FrameRecorder {
     }
 }
 
-fn external_transition(
-    image: &ExternalImage,
+fn image_transition(
+    image: vk::Image,
     from: vk::ImageLayout,
     to: vk::ImageLayout,
     src: vk::AccessFlags,
     dst: vk::AccessFlags,
 ) -> vk::ImageMemoryBarrier<'static> {
     vk::ImageMemoryBarrier::default()
-        .image(image.raw)
+        .image(image)
         .old_layout(from)
         .new_layout(to)
         .src_access_mask(src)

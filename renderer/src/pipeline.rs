@@ -314,6 +314,7 @@ impl Renderer {
         self.views[0].taa_history_bytes()
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn write_frame_data(&self, view: usize, slot: usize, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
         let v = &self.views[view];
         let screen = v.space.screen_size().as_vec2();

@@ -334,7 +334,7 @@ fn render_args<'a>(
         seed: opts.seed,
         max_depth: opts.max_depth,
         exposure: opts.exposure,
-        profile: profile.clone(),
+        profile: *profile,
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
         taa: &opts.taa,
