@@ -38,7 +38,7 @@ impl Default for LoadLimits {
 }
 
 impl Budget {
-    fn from_env(&self) -> Result<u64, String> {
+    fn read_env(&self) -> Result<u64, String> {
         match std::env::var(self.env) {
             Err(std::env::VarError::NotPresent) => Ok(self.default),
             Err(std::env::VarError::NotUnicode(_)) => Err(format!("{} is not valid UTF-8", self.env)),
@@ -56,7 +56,7 @@ impl Budget {
 impl LoadLimits {
     /// The defaults, each overridden by its environment variable when set.
     pub fn from_env() -> Result<LoadLimits, String> {
-        Ok(LoadLimits { max_triangles: TRIANGLES.from_env()?, max_texels: TEXELS.from_env()?, max_bytes: BYTES.from_env()? })
+        Ok(LoadLimits { max_triangles: TRIANGLES.read_env()?, max_texels: TEXELS.read_env()?, max_bytes: BYTES.read_env()? })
     }
 }
 
@@ -79,10 +79,6 @@ impl ByteBudget {
         ByteBudget { limit, used: 0 }
     }
 
-    pub(crate) fn remaining(&self) -> u64 {
-        self.limit - self.used
-    }
-
     /// Reserves `n` bytes, or says what would exceed the budget.
     pub(crate) fn take(&mut self, n: u64, what: &str) -> Result<(), String> {
         match self.used.checked_add(n).filter(|&total| total <= self.limit) {
@@ -103,24 +99,23 @@ mod tests {
     fn byte_budget_refuses_what_does_not_fit_and_names_the_variable() {
         let mut b = ByteBudget::new(10);
         b.take(6, "a").unwrap();
-        assert_eq!(b.remaining(), 4);
         let err = b.take(5, "buffers[1]").unwrap_err();
         assert!(err.contains("buffers[1]") && err.contains("FOVEA_MAX_SCENE_BYTES") && err.contains("budget of 10"), "{err}");
         assert!(b.take(u64::MAX, "huge").is_err(), "no overflow");
-        assert_eq!(b.remaining(), 4, "a refused take reserves nothing");
+        b.take(4, "the rest").expect("a refused take reserves nothing");
     }
 
     #[test]
     fn budget_values_parse_with_separators_and_refuse_junk() {
         // Uses a variable no other test sets, so the process environment stays race-free.
         let b = Budget { name: "test", env: "FOVEA_TEST_ONLY_LIMIT", default: 7 };
-        assert_eq!(b.from_env(), Ok(7));
+        assert_eq!(b.read_env(), Ok(7));
         std::env::set_var(b.env, "1_000");
-        assert_eq!(b.from_env(), Ok(1000));
+        assert_eq!(b.read_env(), Ok(1000));
         std::env::set_var(b.env, "lots");
-        assert!(b.from_env().unwrap_err().contains("FOVEA_TEST_ONLY_LIMIT='lots'"));
+        assert!(b.read_env().unwrap_err().contains("FOVEA_TEST_ONLY_LIMIT='lots'"));
         std::env::set_var(b.env, "0");
-        assert!(b.from_env().is_err(), "a zero budget would refuse every scene");
+        assert!(b.read_env().is_err(), "a zero budget would refuse every scene");
         std::env::remove_var(b.env);
     }
 }

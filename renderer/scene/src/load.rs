@@ -189,7 +189,7 @@ fn check_geometry_budget(document: &gltf::Document, placed: &[Placed], limits: &
     let sizes: Vec<(u64, u64)> = json
         .meshes
         .iter()
-        .map(|m| m.primitives.iter().map(|p| primitive_size(json, p)).fold((0, 0), |a, b| (a.0.saturating_add(b.0), a.1.saturating_add(b.1))))
+        .map(|m| m.primitives.iter().map(|p| primitive_size(json, p)).fold((0u64, 0u64), |a, b| (a.0.saturating_add(b.0), a.1.saturating_add(b.1))))
         .collect();
     let mut instances = vec![0u64; sizes.len()];
     placed.iter().filter_map(|p| p.node.mesh()).for_each(|m| instances[m.index()] += 1);

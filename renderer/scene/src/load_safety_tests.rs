@@ -391,6 +391,36 @@ mod fuzz {
         vec![cornell, textured_doc(json!([{"uri": png}]), json!([{"source": 0}]))]
     }
 
+    /// The triangle as a binary glTF (JSON chunk + BIN chunk): mutations hit the container's
+    /// headers and chunk lengths.
+    fn glb_triangle() -> Vec<u8> {
+        let mut doc = embedded_triangle_doc();
+        doc["buffers"] = json!([{"byteLength": 42}]);
+        let mut json_chunk = doc.to_string().into_bytes();
+        json_chunk.resize(json_chunk.len().next_multiple_of(4), b' ');
+        let mut bin = triangle_bytes();
+        bin.resize(bin.len().next_multiple_of(4), 0);
+        let total = 12 + 8 + json_chunk.len() + 8 + bin.len();
+        let mut glb = b"glTF".to_vec();
+        for v in [2, total as u32, json_chunk.len() as u32] {
+            glb.extend(v.to_le_bytes());
+        }
+        glb.extend(b"JSON");
+        glb.extend(&json_chunk);
+        glb.extend((bin.len() as u32).to_le_bytes());
+        glb.extend(b"BIN\0");
+        glb.extend(&bin);
+        glb
+    }
+
+    #[test]
+    fn the_glb_seed_loads_unmutated() {
+        let dir = temp_dir("fuzz_glb_seed");
+        let path = dir.join("scene.glb");
+        std::fs::write(&path, glb_triangle()).unwrap();
+        assert_eq!(load(&path).unwrap().triangles.len(), 1);
+    }
+
     /// Paths to every number, string and array element in the document (where values live).
     fn leaves(v: &Value, path: &mut Vec<Value>, out: &mut Vec<Vec<Value>>) {
         match v {
@@ -470,9 +500,12 @@ mod fuzz {
         }
 
         #[test]
-        fn mutated_bytes_never_panic(seed in 0usize..2, edits in proptest::collection::vec((any::<usize>(), any::<u8>()), 1..8), cut in proptest::option::of(any::<usize>())) {
+        fn mutated_bytes_never_panic(seed in 0usize..3, edits in proptest::collection::vec((any::<usize>(), any::<u8>()), 1..8), cut in proptest::option::of(any::<usize>())) {
             let dir = temp_dir("fuzz_bytes");
-            let mut bytes = seeds().swap_remove(seed).to_string().into_bytes();
+            let mut bytes = match seed {
+                2 => glb_triangle(),
+                _ => seeds().swap_remove(seed).to_string().into_bytes(),
+            };
             for (at, byte) in edits {
                 let i = at % bytes.len();
                 bytes[i] = byte;
@@ -480,9 +513,29 @@ mod fuzz {
             if let Some(cut) = cut {
                 bytes.truncate(cut % (bytes.len() + 1));
             }
-            let path = dir.join("scene.gltf");
+            let path = dir.join(if seed == 2 { "scene.glb" } else { "scene.gltf" });
             std::fs::write(&path, &bytes).unwrap();
             let _ = load(&path);
         }
+    }
+}
+
+/// The shared real scenes (when this checkout has `../shared/`) load within the default budgets,
+/// with no warnings, exactly as their README describes them.
+#[test]
+fn shared_real_scenes_load_within_the_default_budgets() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/scenes");
+    for (file, triangles, cameras) in
+        [("sponza/Sponza.gltf", 262_087, 4), ("breakfast-room/BreakfastRoom.gltf", 262_687, 3), ("flight-helmet/FlightHelmet.gltf", 94_722, 0)]
+    {
+        let path = root.join(file);
+        if !path.exists() {
+            println!("note: {} not found; skipping", path.display());
+            continue;
+        }
+        let scene = load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((scene.triangles.len(), scene.cameras.len()), (triangles, cameras), "{file}");
+        assert!(!scene.textures.is_empty(), "{file}");
+        assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
     }
 }
