@@ -193,6 +193,7 @@ fn identity(meta: &std::fs::Metadata) -> (u64, i64, i64) {
 
 /// An output folder held by this run: locked until dropped, with the fovea files an earlier run
 /// left in it.
+#[derive(Debug)]
 #[must_use = "the output folder is locked only while this value lives"]
 pub struct OutputDir {
     path: PathBuf,

@@ -2,7 +2,7 @@
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
 use crate::camera_path;
-use crate::output::{prepare_output_dir, write_exr, write_png};
+use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::gaze::GazeDriver;
 use anyhow::{bail, Context, Result};
 use fovea_hal::GazeOrigin;
@@ -94,6 +94,8 @@ struct Report {
     frame_gpu_ms: f64,
     /// Wall-clock seconds for all frames, including read-back and file writing.
     wall_seconds: f64,
+    /// SIGINT/SIGTERM stopped the run after `frames` frames (of the requested ones).
+    interrupted: bool,
 }
 
 #[derive(Serialize)]
@@ -152,7 +154,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let Some(camera) = scene.default_camera() else {
         bail!("{}: the scene has no perspective camera", scene.source.display());
     };
-    prepare_output_dir(args.out)?;
+    let out_dir = prepare_output_dir(args.out)?;
     let start_pose = CameraPose::from_scene_camera(camera, width, height);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings {
@@ -188,6 +190,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut origins = [0u32; 3];
     let mut ldr = Vec::new();
     let mut hdr = Vec::new();
+    let mut frames_done = 0;
     for frame in 0..args.frames {
         let frame_gaze = gaze.frame(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
@@ -223,15 +226,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             debug.frame(frame, &renderer)?;
         }
         bar.inc(1);
+        frames_done = frame + 1;
+        if crate::interrupt::requested().is_some() {
+            break; // the frame in flight is complete; report what was rendered
+        }
     }
     bar.finish_and_clear();
+    let interrupted = crate::interrupt::requested();
     if let Some(debug) = &debug {
         debug.finish(&renderer)?;
     }
     super::check_validation(&ctx)?;
 
-    let n = args.frames as u64;
-    let passes: BTreeMap<String, f64> = pass_sums.into_iter().map(|(k, v)| (k, v / args.frames as f64)).collect();
+    let n = frames_done as u64;
+    let passes: BTreeMap<String, f64> = pass_sums.into_iter().map(|(k, v)| (k, v / frames_done as f64)).collect();
     let rays = RayReport { primary: rays.primary / n, shadow: rays.shadow / n, continuation: rays.continuation / n };
     let report = Report {
         method: args.method.to_string(),
@@ -249,7 +257,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         height,
         vp_width: grid.x,
         vp_height: grid.y,
-        frames: args.frames,
+        frames: frames_done,
         samples_traced: samples / n,
         samples_offscreen: offscreen / n,
         screen_pixels,
@@ -263,12 +271,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
+        interrupted: interrupted.is_some(),
     };
-    let path = args.out.join("report.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
+    write_json(&args.out.join("report.json"), &report)?;
+    out_dir.remove_stale()?;
+    if let Some(interrupted) = interrupted {
+        return Err(interrupted.into());
+    }
     println!(
         "rendered {} frame(s) of {}×{} ({}, denoiser {}, taa {}, grid {}×{}, {} samples) on {}: {:.1} ms GPU per frame, {} rays per frame → {}",
-        args.frames,
+        frames_done,
         width,
         height,
         report.method,
