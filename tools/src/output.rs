@@ -240,7 +240,12 @@ fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, (u64, i64, i64))>> {
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let entry = entry?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        let meta = std::fs::symlink_metadata(entry.path()).with_context(|| format!("inspecting {}", entry.path().display()))?;
+        let meta = match std::fs::symlink_metadata(entry.path()) {
+            Ok(meta) => meta,
+            // Renamed or removed since read_dir listed it (a run's temporary moving into place).
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+            Err(e) => return Err(e).with_context(|| format!("inspecting {}", entry.path().display())),
+        };
         if meta.file_type().is_symlink() {
             bail!(
                 "output folder {} holds a symbolic link '{name}'; fovea does not write through links (remove it or choose another folder)",
