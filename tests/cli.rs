@@ -174,6 +174,17 @@ fn bad_headset_and_gaze_arguments_are_named() {
     args.method = "magic";
     let err = format!("{:#}", render(&args).unwrap_err());
     assert!(err.contains("magic"), "{err}");
+    // Not a file name and not a silent fallback to the centre.
+    for (gaze, needle) in [("NaN,5", "finite pixel coordinates"), ("1e30,5", "(1e30, 5.0) lies outside the 40×36 render image"), ("41,5", "outside")] {
+        let mut args = render_args("cornell-box", &out);
+        args.gaze = gaze;
+        let err = format!("{:#}", render(&args).unwrap_err());
+        assert!(err.contains(gaze) && err.contains(needle) && !err.contains("cannot read"), "{err}");
+    }
+    let mut args = render_args("cornell-box", &out);
+    args.gaze = "/dev/zero";
+    let err = format!("{:#}", render(&args).unwrap_err());
+    assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
 }
 
 /// Runs `f` on a thread; fails the test when it takes longer than `seconds` (a write that opened a
