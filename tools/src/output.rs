@@ -179,14 +179,16 @@ fn is_fovea_temp(name: &str) -> bool {
 }
 
 /// Identity of a file version: a rename over it makes a new inode with a new change time.
+type Version = (u64, i64, i64);
+
 #[cfg(unix)]
-fn identity(meta: &std::fs::Metadata) -> (u64, i64, i64) {
+fn identity(meta: &std::fs::Metadata) -> Version {
     use std::os::unix::fs::MetadataExt;
     (meta.ino(), meta.ctime(), meta.ctime_nsec())
 }
 
 #[cfg(not(unix))]
-fn identity(meta: &std::fs::Metadata) -> (u64, i64, i64) {
+fn identity(meta: &std::fs::Metadata) -> Version {
     let t = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok()).unwrap_or_default();
     (meta.len(), t.as_secs() as i64, t.subsec_nanos() as i64)
 }
@@ -198,7 +200,7 @@ fn identity(meta: &std::fs::Metadata) -> (u64, i64, i64) {
 pub struct OutputDir {
     path: PathBuf,
     _lock: File,
-    previous: Vec<(OsString, (u64, i64, i64))>,
+    previous: Vec<(OsString, Version)>,
 }
 
 /// Creates `dir` or accepts an existing one holding only files fovea writes (frames, reports,
@@ -235,7 +237,7 @@ fn lock_folder(dir: &Path) -> Result<File> {
 
 /// Checks every entry; returns the fovea files found (name and version). With `clean`, removes
 /// leftover temporaries.
-fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, (u64, i64, i64))>> {
+fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, Version)>> {
     let mut found = Vec::new();
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let entry = entry?;
