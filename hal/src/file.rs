@@ -18,7 +18,8 @@ fn refuse(path: &Path, reason: String) -> HalError {
 }
 
 /// Reads `path` as UTF-8 text of at most `limit` bytes; `what` names it in the size error.
-pub(crate) fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, HalError> {
+/// Public so the tools read their own TOML profiles the same way.
+pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, HalError> {
     let file = open_nonblocking(path).map_err(|e| HalError::io(path, e))?;
     let meta = file.metadata().map_err(|e| HalError::io(path, e))?;
     if !meta.is_file() {

@@ -99,3 +99,12 @@ fn stale_outputs_of_an_earlier_run_are_removed_and_leftover_temporaries_cleaned(
     assert_eq!(names(&d), vec![LOCK_FILE, "frame_0000.png", "frame_0001.png", "report.json"]);
     assert_eq!(std::fs::read_to_string(d.join("report.json")).unwrap(), "{}");
 }
+
+#[test]
+fn exr_inputs_must_be_regular_files() {
+    let d = dir("exr_inputs");
+    mkfifo(&d.join("ref.exr"));
+    let err = read_exr(&d.join("ref.exr")).unwrap_err();
+    assert!(err.to_string().contains("a FIFO (named pipe), not a regular file"), "{err}");
+    assert!(read_exr(Path::new("/dev/zero")).unwrap_err().to_string().contains("a device"));
+}
