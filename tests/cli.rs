@@ -174,4 +174,120 @@ fn bad_headset_and_gaze_arguments_are_named() {
     args.method = "magic";
     let err = format!("{:#}", render(&args).unwrap_err());
     assert!(err.contains("magic"), "{err}");
+    // Not a file name and not a silent fallback to the centre.
+    for (gaze, needle) in [("NaN,5", "finite pixel coordinates"), ("1e30,5", "(1e30, 5.0) lies outside the 40×36 render image"), ("41,5", "outside")] {
+        let mut args = render_args("cornell-box", &out);
+        args.gaze = gaze;
+        let err = format!("{:#}", render(&args).unwrap_err());
+        assert!(err.contains(gaze) && err.contains(needle) && !err.contains("cannot read"), "{err}");
+    }
+    let mut args = render_args("cornell-box", &out);
+    args.gaze = "/dev/zero";
+    let err = format!("{:#}", render(&args).unwrap_err());
+    assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
+}
+
+/// Runs `f` on a thread; fails the test when it takes longer than `seconds` (a write that opened a
+/// FIFO would block forever).
+fn within_seconds<T: Send + 'static>(seconds: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(seconds)).expect("the command blocked")
+}
+
+#[test]
+fn a_symbolic_link_in_the_output_folder_is_refused() {
+    let dir = temp_dir("symlink");
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(dir.join("victim.txt"), "keep me").unwrap();
+    std::os::unix::fs::symlink(dir.join("victim.txt"), out.join("frame_0000.png")).unwrap();
+    let err = format!("{:#}", render(&render_args("cornell-box", &out)).unwrap_err());
+    assert!(err.contains("symbolic link 'frame_0000.png'"), "{err}");
+    assert_eq!(std::fs::read_to_string(dir.join("victim.txt")).unwrap(), "keep me");
+    assert!(std::fs::symlink_metadata(out.join("frame_0000.png")).unwrap().file_type().is_symlink(), "the link is left alone");
+}
+
+/// Two renders started together into one folder: the lock lets exactly one write there; the
+/// other is refused before it touches anything. Held explicitly, the lock refuses a run too.
+#[test]
+fn two_concurrent_renders_into_one_folder_are_refused() {
+    let out = temp_dir("concurrent");
+    let barrier = std::sync::Arc::new(std::sync::Barrier::new(2));
+    let runs: Vec<_> = (0..2)
+        .map(|_| {
+            let (out, barrier) = (out.clone(), barrier.clone());
+            std::thread::spawn(move || {
+                let mut args = render_args("cornell-box", &out);
+                args.frames = 8;
+                barrier.wait();
+                render(&args).map_err(|e| format!("{e:#}"))
+            })
+        })
+        .collect();
+    let results: Vec<Result<(), String>> = runs.into_iter().map(|t| t.join().unwrap()).collect();
+    let refused: Vec<&String> = results.iter().filter_map(|r| r.as_ref().err()).collect();
+    assert_eq!(refused.len(), 1, "exactly one run may write into the folder: {results:?}");
+    assert!(refused[0].contains("in use by another fovea run"), "{}", refused[0]);
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["frames"], 8);
+
+    let held = fovea_tools::output::prepare_output_dir(&out).unwrap();
+    let err = format!("{:#}", render(&render_args("cornell-box", &out)).unwrap_err());
+    assert!(err.contains("in use by another fovea run"), "{err}");
+    drop(held);
+    render(&render_args("cornell-box", &out)).unwrap();
+}
+
+/// A rerun with fewer frames and without EXR leaves exactly its own outputs.
+#[test]
+fn a_rerun_removes_the_earlier_runs_stale_frames() {
+    let out = temp_dir("stale");
+    let mut args = render_args("cornell-box", &out);
+    args.frames = 3;
+    render(&args).unwrap();
+    assert!(out.join("frame_0002.png").exists() && out.join("frame_0002.exr").exists());
+    let mut args = render_args("cornell-box", &out);
+    args.exr = false;
+    render(&args).unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, vec![".fovea.lock", "frame_0000.png", "frame_0001.png", "report.json"]);
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!((report["frames"].as_u64(), report["interrupted"].as_bool()), (Some(2), Some(false)));
+}
+
+/// `fovea reference --force` replaces only regular files: a FIFO or a link as `--out` is refused
+/// before rendering (writing would block or write through the link), and the target is untouched.
+#[test]
+fn reference_force_refuses_non_regular_targets() {
+    let dir = temp_dir("force");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("pipe.exr");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    std::fs::write(dir.join("victim.exr"), "old").unwrap();
+    let link = dir.join("link.exr");
+    std::os::unix::fs::symlink(dir.join("victim.exr"), &link).unwrap();
+    for (target, kind) in [(fifo, "a FIFO"), (link, "a symbolic link")] {
+        let err = within_seconds(60, move || {
+            let args = ReferenceArgs {
+                scene: "cornell-box",
+                width: 8,
+                height: 8,
+                spp: 1,
+                max_depth: 3,
+                seed: 1,
+                out: &target,
+                force: true,
+                preview: false,
+                device: None,
+                validation: true,
+            };
+            format!("{:#}", reference(&args).unwrap_err())
+        });
+        assert!(err.contains(kind) && err.contains("only writes or replaces regular files"), "{err}");
+    }
+    assert_eq!(std::fs::read_to_string(dir.join("victim.exr")).unwrap(), "old");
 }

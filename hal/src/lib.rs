@@ -10,6 +10,7 @@
 //! - `openxr` (cargo feature `openxr`): a real runtime through `XR_EXT_eye_gaze_interaction`.
 
 pub mod error;
+pub mod file;
 pub mod hmd;
 pub mod sample;
 pub mod sim;

@@ -39,13 +39,15 @@ impl FromStr for GazeSpec {
             let seed = seed.parse().map_err(|_| err("the seed after `sim:` must be a non-negative integer"))?;
             return Ok(GazeSpec::Simulated { seed });
         }
-        // Something that starts like a number and has a comma is meant as pixel coordinates.
-        let numeric_start = t.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+' || c == '.');
+        // Something that starts like a number, or two things that parse as numbers (`NaN,5`,
+        // `inf,0`), with a comma, is meant as pixel coordinates, never as a trace file name.
         if let Some((x, y)) = t.split_once(',') {
-            if numeric_start {
-                let parse = |v: &str| v.trim().parse::<f32>().ok().filter(|v| v.is_finite());
-                return match (parse(x), parse(y)) {
-                    (Some(x), Some(y)) => Ok(GazeSpec::Fixed { x, y }),
+            let number = |v: &str| v.trim().parse::<f32>().ok();
+            let numeric_start = t.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+' || c == '.');
+            if numeric_start || (number(x).is_some() && number(y).is_some()) {
+                return match (number(x), number(y)) {
+                    (Some(x), Some(y)) if x.is_finite() && y.is_finite() => Ok(GazeSpec::Fixed { x, y }),
+                    (Some(x), Some(y)) => Err(err(&format!("X,Y must be finite pixel coordinates; got {x} and {y}"))),
                     _ => Err(err("expected X,Y as two finite pixel coordinates, e.g. 640,720")),
                 };
             }
@@ -60,6 +62,17 @@ impl GazeSpec {
         Ok(match self {
             GazeSpec::Center => Box::new(FixedGaze::new(hmd, Vec3::NEG_Z)),
             GazeSpec::Fixed { x, y } => {
+                // Off the image the pixel → direction mapping has no meaning (1e30 would come back
+                // as a silent fallback to the centre).
+                let eye = hmd.eye(Eye::Left);
+                let (w, h) = (eye.recommended_width as f32, eye.recommended_height as f32);
+                // One pixel of slack: callers that scale render pixels to headset pixels round.
+                if !((-1.0..=w + 1.0).contains(x) && (-1.0..=h + 1.0).contains(y)) {
+                    return Err(HalError::GazeSpec {
+                        input: format!("{x:?},{y:?}"),
+                        reason: format!("outside the {w}×{h} left-eye image of headset `{}`", hmd.id),
+                    });
+                }
                 let dir = hmd.pixel_to_direction(Eye::Left, Vec2::new(*x, *y));
                 Box::new(FixedGaze::new(hmd, dir))
             }

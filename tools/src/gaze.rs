@@ -28,7 +28,7 @@ pub struct FrameGaze {
 }
 
 impl GazeDriver {
-    /// `spec`: center | X,Y (render pixels) | sim[:seed] | trace path.
+    /// `spec`: center | X,Y (render pixels, inside the render image) | sim[:seed] | trace path.
     pub fn open(spec: &str, hmd: &HmdDescription, render_width: u32, render_height: u32) -> Result<GazeDriver> {
         let eye = hmd.eye(Eye::Left);
         let scale = Vec2::new(
@@ -37,6 +37,10 @@ impl GazeDriver {
         );
         let mut parsed: GazeSpec = spec.parse().with_context(|| format!("--gaze {spec}"))?;
         if let GazeSpec::Fixed { x, y } = &mut parsed {
+            // Checked here in render pixels, the units the user wrote.
+            if !((0.0..=render_width as f32).contains(x) && (0.0..=render_height as f32).contains(y)) {
+                anyhow::bail!("--gaze {spec}: ({x:?}, {y:?}) lies outside the {render_width}×{render_height} render image");
+            }
             *x /= scale.x;
             *y /= scale.y;
         }

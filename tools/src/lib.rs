@@ -5,6 +5,7 @@ pub mod camera_path;
 pub mod commands;
 pub mod density;
 pub mod gaze;
+pub mod interrupt;
 pub mod metrics;
 pub mod output;
 pub mod plot;

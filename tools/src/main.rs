@@ -345,12 +345,30 @@ fn render_args<'a>(
     })
 }
 
-fn main() -> Result<()> {
+/// Exit status 1 for errors, 128 + the signal for a run stopped by SIGINT/SIGTERM.
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("Error: {e:?}");
+            match e.downcast_ref::<fovea_tools::interrupt::Interrupted>() {
+                Some(interrupted) => std::process::ExitCode::from(interrupted.exit_code()),
+                None => std::process::ExitCode::FAILURE,
+            }
+        }
+    }
+}
+
+fn run() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
         opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
         device: DeviceArgs { device: None, validation: false },
     });
+    if matches!(command, Command::Render { .. }) {
+        // Only `render` checks for it; other commands keep the default (stop at once).
+        fovea_tools::interrupt::install()?;
+    }
     match command {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;

@@ -1,66 +1,148 @@
-//! Writes what a run produces: PNG and linear EXR images, and the JSON report. Output folders
-//! are checked first so files the user wrote are never overwritten.
+//! Writes what a run produces: PNG and linear EXR images, JSON and text reports — every one
+//! through [`write_atomic`]: the bytes go to a temporary file in the target's folder, are synced,
+//! and the temporary is renamed over the target, so a failed or killed write leaves the old file
+//! (or none) and never a half-written one. Only regular files are replaced: a symbolic link,
+//! device or FIFO at the target is refused.
+//!
+//! Output folders ([`prepare_output_dir`]) must hold only files fovea writes, no symbolic links,
+//! and are locked (`.fovea.lock`, an advisory `flock`) while a run writes into them, so two runs
+//! cannot interleave their frames.
 
-use anyhow::{bail, Context, Result};
-use std::path::Path;
+use anyhow::{anyhow, bail, Context, Result};
+use std::ffi::OsString;
+use std::fs::{File, OpenOptions};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Creates `dir` or accepts an existing one holding only files fovea writes (frames, reports,
-/// debug views); anything else in it means the user chose the wrong folder.
-pub fn prepare_output_dir(dir: &Path) -> Result<()> {
-    if dir.exists() {
-        if !dir.is_dir() {
-            bail!("output {} exists and is not a folder", dir.display());
+/// Name of the lock file inside an output folder.
+pub const LOCK_FILE: &str = ".fovea.lock";
+/// Temporary files are `.<name>.<pid>.<n>.tmp` next to their target.
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// What kind of thing a path is, for messages ("a symbolic link", "a FIFO", ...).
+fn kind_of(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
         }
-        for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-            let entry = entry?;
-            let name = entry.file_name().to_string_lossy().into_owned();
-            // `fovea quality` keeps one `fovea render` folder per run (checked when reused).
-            let run_folder = name.starts_with("run_") && entry.path().is_dir();
-            let ours = matches!(name.as_str(), "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md")
-                || run_folder
-                || (name.starts_with("reference_") && name.ends_with(".exr"))
-                || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
-                || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)));
-            if !ours {
-                bail!(
-                    "output folder {} holds '{name}', which fovea did not write; choose an empty or new folder",
-                    dir.display()
-                );
-            }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
         }
     }
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))
+    if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_dir() {
+        "a folder"
+    } else if t.is_file() {
+        "a regular file"
+    } else {
+        "not a regular file"
+    }
 }
 
-/// Refuses to replace an existing file unless `force` is set.
-pub fn check_new_file(path: &Path, force: bool) -> Result<()> {
-    if path.exists() && !force {
-        bail!("{} already exists; pass --force to replace it", path.display());
+/// Refuses a target that exists and is not a regular file (a link could redirect the write, a
+/// device or FIFO is not an output).
+fn check_replaceable(path: &Path) -> Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if !meta.file_type().is_file() => {
+            bail!("{} is {}; fovea only writes or replaces regular files", path.display(), kind_of(&meta))
+        }
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e).with_context(|| format!("inspecting {}", path.display())),
     }
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+}
+
+/// A temporary file removed on drop unless it was renamed into place.
+struct TempFile {
+    path: PathBuf,
+    committed: bool,
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.path);
+        }
     }
+}
+
+fn temp_path_for(path: &Path) -> Result<PathBuf> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path.file_name().ok_or_else(|| anyhow!("{} has no file name", path.display()))?.to_string_lossy();
+    // A bounded prefix keeps the temporary's name legal even for a target name near NAME_MAX.
+    let short: String = name.chars().take(64).collect();
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    Ok(path.with_file_name(format!(".{short}.{}.{n}{TEMP_SUFFIX}", std::process::id())))
+}
+
+/// Writes `path` atomically with `write` filling a buffered writer. On any error (or a panic in
+/// `write`) the temporary file is removed and an existing `path` is left exactly as it was.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<()> {
+    check_replaceable(path)?;
+    let mut temp = TempFile { path: temp_path_for(path)?, committed: false };
+    // create_new: never opens something already there (a planted link at the temporary's name).
+    let file = OpenOptions::new().write(true).create_new(true).open(&temp.path).with_context(|| format!("writing {}", path.display()))?;
+    let mut writer = BufWriter::new(file);
+    write(&mut writer).with_context(|| format!("writing {}", path.display()))?;
+    let file = writer.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", path.display()))?;
+    // On disk before the rename, so a crash leaves the old file or the complete new one.
+    file.sync_data().with_context(|| format!("writing {}", path.display()))?;
+    drop(file);
+    check_replaceable(path)?; // a link planted while we wrote is refused, not followed
+    std::fs::rename(&temp.path, path).with_context(|| format!("moving the new {} into place", path.display()))?;
+    temp.committed = true;
     Ok(())
 }
 
-pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba8, width, height, image::ExtendedColorType::Rgba8)
-        .with_context(|| format!("writing {}", path.display()))
+/// Text (reports, tables) written atomically.
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    write_atomic(path, |w| Ok(w.write_all(text.as_bytes())?))
 }
 
-/// Linear float RGB(A) EXR.
+/// Pretty JSON with a trailing newline, written atomically.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    write_text(path, &(serde_json::to_string_pretty(value)? + "\n"))
+}
+
+/// An 8-bit image (`color`: Rgb8 or Rgba8) as PNG, written atomically.
+pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[u8], color: image::ExtendedColorType) -> Result<()> {
+    write_atomic(path, |w| Ok(image::write_buffer_with_format(w, pixels, width, height, color, image::ImageFormat::Png)?))
+}
+
+pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
+    write_image(path, width, height, rgba8, image::ExtendedColorType::Rgba8)
+}
+
+/// Linear float RGB(A) EXR, written atomically.
 pub fn write_exr(path: &Path, width: u32, height: u32, texels: &[[f32; 4]]) -> Result<()> {
+    use exr::prelude::*;
     let w = width as usize;
-    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+    if texels.len() != w * height as usize {
+        bail!("{}: {} texels do not make a {width}×{height} image", path.display(), texels.len());
+    }
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let t = texels[y * w + x];
         (t[0], t[1], t[2], 1.0f32)
-    })
-    .with_context(|| format!("writing {}", path.display()))
+    });
+    write_atomic(path, |out| Ok(Image::from_channels((w, height as usize), channels).write().to_buffered(out)?))
 }
 
 /// Reads a linear EXR's RGB channels (references for `fovea eval` and tests).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     use exr::prelude::*;
+    // A FIFO would block the reader and a device never ends; references are regular files.
+    let meta = std::fs::metadata(path).with_context(|| format!("reading {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("reading {}: it is {}, not a regular file", path.display(), kind_of(&meta));
+    }
     let image = read_first_rgba_layer_from_file(
         path,
         |resolution, _| {
@@ -72,6 +154,156 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     .with_context(|| format!("reading {}", path.display()))?;
     let size = image.layer_data.size;
     Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
+}
+
+/// Refuses to replace an existing file unless `force` is set, and refuses any target that is not a
+/// regular file even with `force`. Nothing is deleted here: the new file replaces the old one
+/// only once it is complete ([`write_atomic`]).
+pub fn check_new_file(path: &Path, force: bool) -> Result<()> {
+    check_replaceable(path)?;
+    if path.exists() && !force {
+        bail!("{} already exists; pass --force to replace it", path.display());
+    }
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+    }
+    Ok(())
+}
+
+/// Names fovea writes into an output folder.
+fn is_fovea_file(name: &str) -> bool {
+    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md")
+        || (name.starts_with("reference_") && name.ends_with(".exr"))
+        || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
+        || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))
+}
+
+/// A temporary of [`write_atomic`] (left behind only by a killed process).
+fn is_fovea_temp(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(TEMP_SUFFIX)
+}
+
+/// Identity of a file version: a rename over it makes a new inode with a new change time.
+type Version = (u64, i64, i64);
+
+#[cfg(unix)]
+fn identity(meta: &std::fs::Metadata) -> Version {
+    use std::os::unix::fs::MetadataExt;
+    (meta.ino(), meta.ctime(), meta.ctime_nsec())
+}
+
+#[cfg(not(unix))]
+fn identity(meta: &std::fs::Metadata) -> Version {
+    let t = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok()).unwrap_or_default();
+    (meta.len(), t.as_secs() as i64, t.subsec_nanos() as i64)
+}
+
+/// An output folder held by this run: locked until dropped, with the fovea files an earlier run
+/// left in it.
+#[derive(Debug)]
+#[must_use = "the output folder is locked only while this value lives"]
+pub struct OutputDir {
+    path: PathBuf,
+    _lock: File,
+    previous: Vec<(OsString, Version)>,
+}
+
+/// Creates `dir` or accepts an existing one holding only files fovea writes (frames, reports,
+/// debug views, `fovea quality`'s `run_*` folders); anything else in it, a symbolic link
+/// included, means the user chose the wrong folder and nothing is touched. Then locks it against
+/// a second concurrent run.
+pub fn prepare_output_dir(dir: &Path) -> Result<OutputDir> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("output {} exists and is not a folder", dir.display());
+    }
+    if dir.exists() {
+        scan(dir, false)?; // refuse before creating the lock file in a user's folder
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let lock = lock_folder(dir)?;
+    // Under the lock no other run writes here, so leftover temporaries are a dead run's.
+    let previous = scan(dir, true)?;
+    Ok(OutputDir { path: dir.to_path_buf(), _lock: lock, previous })
+}
+
+fn lock_folder(dir: &Path) -> Result<File> {
+    let path = dir.join(LOCK_FILE);
+    check_replaceable(&path)?;
+    let file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("opening {}", path.display()))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => bail!(
+            "output folder {} is in use by another fovea run (it holds {LOCK_FILE}); wait for it to finish or choose another folder",
+            dir.display()
+        ),
+        Err(std::fs::TryLockError::Error(e)) => Err(e).with_context(|| format!("locking {}", path.display())),
+    }
+}
+
+/// Checks every entry; returns the fovea files found (name and version). With `clean`, removes
+/// leftover temporaries.
+fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, Version)>> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let meta = match std::fs::symlink_metadata(entry.path()) {
+            Ok(meta) => meta,
+            // Renamed or removed since read_dir listed it (a run's temporary moving into place).
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+            Err(e) => return Err(e).with_context(|| format!("inspecting {}", entry.path().display())),
+        };
+        if meta.file_type().is_symlink() {
+            bail!(
+                "output folder {} holds a symbolic link '{name}'; fovea does not write through links (remove it or choose another folder)",
+                dir.display()
+            );
+        }
+        let regular = meta.file_type().is_file();
+        if name == LOCK_FILE && regular {
+            continue;
+        }
+        // `fovea quality` keeps one `fovea render` folder per run (checked when reused).
+        if name.starts_with("run_") && meta.is_dir() {
+            continue;
+        }
+        if is_fovea_temp(&name) && regular {
+            if clean {
+                let _ = std::fs::remove_file(entry.path());
+            }
+            continue;
+        }
+        if !is_fovea_file(&name) {
+            bail!("output folder {} holds '{name}', which fovea did not write; choose an empty or new folder", dir.display());
+        }
+        if !regular {
+            bail!("output folder {} holds '{name}', which is {}; fovea writes only regular files", dir.display(), kind_of(&meta));
+        }
+        found.push((entry.file_name(), identity(&meta)));
+    }
+    Ok(found)
+}
+
+impl OutputDir {
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Removes the fovea files an earlier run left that this run did not rewrite (frames beyond
+    /// this run's count, EXR or debug files it did not produce), so the folder holds exactly this
+    /// run's outputs. Returns how many were removed.
+    pub fn remove_stale(&self) -> Result<usize> {
+        let mut removed = 0;
+        for (name, version) in &self.previous {
+            let path = self.path.join(name);
+            let unchanged = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_file() && identity(&m) == *version);
+            if unchanged {
+                std::fs::remove_file(&path).with_context(|| format!("removing the stale {}", path.display()))?;
+                removed += 1;
+            }
+        }
+        Ok(removed)
+    }
 }
 
 /// Linear radiance → sRGB RGBA8 with the same fitted ACES curve as the tonemap pass (previews).
@@ -86,3 +318,7 @@ pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32) -> Vec<u8> {
         })
         .collect()
 }
+
+#[cfg(test)]
+#[path = "output_tests.rs"]
+mod tests;

@@ -1,7 +1,7 @@
 //! Small PNG line plots (eval and density views) on `plotters`. Text is drawn with ab_glyph from
 //! DejaVu Sans loaded at run time, so no fontconfig/freetype is needed and no font is vendored.
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use std::path::Path;
@@ -65,8 +65,7 @@ pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series:
         draw(&mut rgb, labels, x, y0..y1, series, &kept)
     };
     drawn.map_err(|e| anyhow!("drawing plot {}: {e}", path.display()))?;
-    image::save_buffer(path, &rgb, SIZE.0, SIZE.1, image::ExtendedColorType::Rgb8)
-        .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_image(path, SIZE.0, SIZE.1, &rgb, image::ExtendedColorType::Rgb8)
 }
 
 /// The drawing, generic over the y axis (plotters gives linear and log axes different types).

@@ -172,7 +172,8 @@ pub fn parse_radius(s: &str) -> Result<RadiusMode> {
 
 impl RenderProfile {
     pub fn load(path: &Path) -> Result<RenderProfile> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading render profile {}", path.display()))?;
+        let text = fovea_hal::file::read_text(path, fovea_hal::file::MAX_PROFILE_BYTES, "a render profile")
+            .with_context(|| format!("reading render profile {}", path.display()))?;
         let file: ProfileFile = toml::from_str(&text).with_context(|| format!("{}: invalid render profile", path.display()))?;
         let mut profile = RenderProfile::default();
         let at = |key: &str| format!("{}: [{}]", path.display(), key);

@@ -51,7 +51,13 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     Ok(file)
 }
 
+/// Loads a scene within the budgets of `FOVEA_MAX_TRIANGLES`, `FOVEA_MAX_TEXELS` and
+/// `FOVEA_MAX_SCENE_BYTES` (see `fovea_scene::limits`); what the loader ignored is printed once.
 pub fn load(name_or_path: &str) -> Result<Scene> {
     let path = resolve(name_or_path)?;
-    Ok(Scene::load(&path)?)
+    let scene = Scene::load(&path)?;
+    for warning in &scene.warnings {
+        eprintln!("warning: {}: {warning}", path.display());
+    }
+    Ok(scene)
 }

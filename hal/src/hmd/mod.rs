@@ -143,7 +143,7 @@ const MAX_RESOLUTION: u32 = 16384;
 impl HmdDescription {
     /// Load and validate a headset TOML file.
     pub fn load(path: &Path) -> Result<HmdDescription, HalError> {
-        let text = std::fs::read_to_string(path).map_err(|e| HalError::io(path, e))?;
+        let text = crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a headset profile")?;
         Self::parse(&text, path)
     }
 

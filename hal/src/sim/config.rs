@@ -111,7 +111,7 @@ impl SimConfig {
     }
 
     pub fn load(path: &Path) -> Result<SimConfig, HalError> {
-        let text = std::fs::read_to_string(path).map_err(|e| HalError::io(path, e))?;
+        let text = crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a simulator profile")?;
         Self::parse(&text, path)
     }
 

@@ -65,6 +65,7 @@ struct Csv<'a> {
 
 impl<'a> Csv<'a> {
     fn parse(text: &'a str, file: &'a Path) -> Result<Csv<'a>, HalError> {
+        let text = crate::file::strip_bom(text);
         let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).filter(|(_, l)| !l.trim().is_empty());
         let (_, header) = lines.next().ok_or_else(|| HalError::trace(file, 1, "empty file; expected a header row"))?;
         let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
@@ -121,7 +122,7 @@ fn degrees_direction(x: f64, y: f64, y_down: bool) -> Option<Vec3> {
 }
 
 pub fn import_gazebase(path: &Path, opts: &DegreesImport) -> Result<Trace, HalError> {
-    let text = std::fs::read_to_string(path).map_err(|e| HalError::io(path, e))?;
+    let text = crate::file::read_text(path, crate::file::MAX_TRACE_BYTES, "a dataset CSV")?;
     import_gazebase_text(&text, path, opts)
 }
 
@@ -162,7 +163,7 @@ pub fn import_gazebase_text(text: &str, file: &Path, opts: &DegreesImport) -> Re
 }
 
 pub fn import_normalized(path: &Path, opts: &NormalizedImport) -> Result<Trace, HalError> {
-    let text = std::fs::read_to_string(path).map_err(|e| HalError::io(path, e))?;
+    let text = crate::file::read_text(path, crate::file::MAX_TRACE_BYTES, "a dataset CSV")?;
     import_normalized_text(&text, path, opts)
 }
 

@@ -115,11 +115,11 @@ pub struct Trace {
 
 impl Trace {
     pub fn load(path: &Path) -> Result<Trace, HalError> {
-        let text = std::fs::read_to_string(path).map_err(|e| HalError::io(path, e))?;
+        let text = crate::file::read_text(path, crate::file::MAX_TRACE_BYTES, "a gaze trace")?;
         Trace::parse(&text, path)
     }
 
-    /// Parse trace text; `file` labels errors.
+    /// Parse trace text (a leading UTF-8 byte-order mark is skipped); `file` labels errors.
     pub fn parse(text: &str, file: &Path) -> Result<Trace, HalError> {
         parse::parse_trace(text, file)
     }

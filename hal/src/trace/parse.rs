@@ -10,6 +10,7 @@ use std::path::Path;
 type Res<T> = Result<T, String>;
 
 pub(super) fn parse_trace(text: &str, file: &Path) -> Result<Trace, HalError> {
+    let text = crate::file::strip_bom(text);
     let err = |line: usize, reason: String| HalError::trace(file, line, reason);
     let mut lines = text.split('\n').enumerate().map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)));
     let (_, first) = lines.next().unwrap_or((1, ""));

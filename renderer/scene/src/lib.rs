@@ -7,10 +7,14 @@
 
 pub mod bvh;
 mod geometry;
+mod images;
 pub mod intersect;
 pub mod lights;
+pub mod limits;
 mod load;
 mod load_material;
+mod source;
+mod validate;
 
 #[cfg(test)]
 mod test_util;
@@ -21,6 +25,8 @@ use std::path::{Path, PathBuf};
 pub use bvh::{Bvh, BvhNode};
 pub use intersect::{Hit, Ray};
 pub use lights::{build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable};
+pub use limits::LoadLimits;
+pub use validate::MAX_EMISSIVE_STRENGTH;
 
 /// A loaded scene, flattened to world space.
 #[derive(Clone, Debug, Default)]
@@ -28,10 +34,13 @@ pub struct Scene {
     pub vertices: Vec<Vertex>,
     pub triangles: Vec<Triangle>,
     /// glTF materials in document order; when some primitive has no material, one default material
-    /// (all glTF defaults) is appended at the end.
+    /// (all glTF defaults) is appended at the end. A material that no rendered primitive uses is
+    /// kept (so indices stay glTF's) but without textures: its images are never decoded.
     pub materials: Vec<Material>,
-    /// One entry per glTF *image* (materials refer to images, so two glTF textures that share an
-    /// image share the texels).
+    /// One entry per glTF *image* that a rendered material samples, in glTF image order
+    /// (materials refer to images, so two glTF textures that share an image share the texels).
+    /// Images nothing renders (an unused material's, a DDS alternative only an extension names)
+    /// are neither read nor decoded.
     pub textures: Vec<Texture>,
     pub punctual_lights: Vec<PunctualLight>,
     /// Perspective cameras in scene-traversal order; `cameras[0]` is the default camera.
@@ -39,6 +48,9 @@ pub struct Scene {
     /// Indexed by [`Triangle::mesh`]: the glTF mesh name, or `mesh<i>` when unnamed.
     pub mesh_names: Vec<String>,
     pub source: PathBuf,
+    /// What the loader ignored and the user may want to know (each said once), e.g. extensions
+    /// the renderer does not understand. Callers print them.
+    pub warnings: Vec<String>,
 }
 
 /// A world-space vertex. `tangent.w` is the bitangent sign: `bitangent = cross(normal, tangent.xyz) * w`.
@@ -196,14 +208,31 @@ pub enum SceneError {
     Data { file: PathBuf, detail: String },
     #[error("{}: mesh '{mesh}' primitive {primitive}: {problem}", file.display())]
     BadPrimitive { file: PathBuf, mesh: String, primitive: usize, problem: String },
+    /// A buffer that cannot be read: `item` is e.g. `buffers[2]`; `uri` is shown without data-URI
+    /// payloads.
+    #[error("{}: {item} (uri \"{uri}\"): {reason}", file.display())]
+    Reference { file: PathBuf, item: String, uri: String, reason: String },
+    /// An image that cannot be read or decoded; `location` is its URI or bufferView.
+    #[error("{}: images[{index}] ({location}, mime type {mime}) cannot be loaded: {reason}", file.display())]
+    Image { file: PathBuf, index: usize, location: String, mime: String, reason: String },
+    /// A [`LoadLimits`] budget would be exceeded; `detail` names the budget and how to raise it.
+    #[error("{}: {detail}", file.display())]
+    Budget { file: PathBuf, detail: String },
 }
 
 impl Scene {
-    /// Loads a `.gltf` (with embedded or external buffers/images) or `.glb` file.
+    /// Loads a `.gltf` (with embedded or external buffers/images) or `.glb` file within the
+    /// budgets of [`LoadLimits::from_env`] (the defaults unless `FOVEA_MAX_*` variables are set).
     /// Orthographic cameras are ignored (the tracer only has a perspective model); a scene without
     /// a perspective camera loads with `cameras` empty and the caller chooses a fallback.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        load::load(path)
+        let limits = LoadLimits::from_env().map_err(|detail| SceneError::Budget { file: path.to_path_buf(), detail })?;
+        load::load(path, &limits)
+    }
+
+    /// [`Scene::load`] with explicit budgets.
+    pub fn load_with_limits(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
+        load::load(path, limits)
     }
 
     /// World-space bounds of all triangles (empty box for an empty scene).
@@ -233,3 +262,5 @@ impl Scene {
 
 #[cfg(test)]
 mod load_tests;
+#[cfg(test)]
+mod load_safety_tests;

@@ -1,9 +1,17 @@
 //! glTF 2.0 → [`Scene`]: walks the node hierarchy and flattens every mesh primitive, camera and
-//! punctual light into world space. Materials and images are converted in `load_material`,
-//! per-primitive vertex work (missing normals/tangents, transforms) in `geometry`.
+//! punctual light into world space. Order matters for safety: the document is validated
+//! (`validate`) and the geometry budget checked from accessor counts before any buffer is read;
+//! buffers and images are read through `source` (inside the scene's folder, regular files,
+//! bounded), images decoded in `images` (only those rendered materials sample), materials
+//! converted in `load_material`, per-primitive vertex work (missing normals/tangents,
+//! transforms) done in `geometry`.
 
 use crate::geometry::{self, PrimitiveData};
-use crate::load_material::{convert_images, convert_material};
+use crate::images::{decode_images, ImageInputs};
+use crate::limits::{over_budget, ByteBudget, LoadLimits, TRIANGLES};
+use crate::load_material::{convert_material, images_used};
+use crate::source::{self, ReadError, Uri};
+use crate::validate;
 use crate::{Camera, Material, PunctualLight, Scene, SceneError, Triangle};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind as LightKindGltf;
@@ -20,92 +28,246 @@ pub(crate) const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
 ];
 
+/// Extensions the loader reads when present (beyond the required-capable ones above). Others in
+/// `extensionsUsed` are listed once in [`Scene::warnings`].
+const UNDERSTOOD_EXTENSIONS: &[&str] = SUPPORTED_REQUIRED_EXTENSIONS;
+
 struct Loader<'a> {
     file: PathBuf,
-    buffers: &'a [gltf::buffer::Data],
+    buffers: &'a [Vec<u8>],
     scene: Scene,
     /// Index of the appended default material, created the first time a primitive needs it.
     default_material: Option<u32>,
 }
 
-pub(crate) fn load(path: &Path) -> Result<Scene, SceneError> {
-    // The checks below cover every panicking path of the gltf crate we know of; this is the
-    // backstop for ones we don't, so malformed input can never take the renderer down.
-    std::panic::catch_unwind(|| load_unguarded(path)).unwrap_or_else(|panic| {
+/// A node placed in the world: every mesh, camera and light the scene renders hangs off one.
+struct Placed<'a> {
+    node: gltf::Node<'a>,
+    world: Mat4,
+}
+
+pub(crate) fn load(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
+    // The checks in `validate` cover every panicking path of the gltf crate we know of; this is
+    // the backstop for ones we don't, so malformed input can never take the renderer down.
+    std::panic::catch_unwind(|| load_unguarded(path, limits)).unwrap_or_else(|panic| {
         let what = panic.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| panic.downcast_ref::<String>().cloned());
         Err(SceneError::Invalid { file: path.to_path_buf(), detail: format!("the glTF parser failed: {}", what.unwrap_or_default()) })
     })
 }
 
-fn load_unguarded(path: &Path) -> Result<Scene, SceneError> {
+/// The whole load without the panic backstop (the fuzz test calls this, so a panic fails it).
+pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
     let file = path.to_path_buf();
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { file: file.clone(), source })?;
+    let mut budget = ByteBudget::new(limits.max_bytes);
+    let bytes = read_scene_file(path, &mut budget)?;
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| SceneError::Malformed { file: file.clone(), detail: e.to_string() })?;
+    drop(bytes);
 
+    let mut warnings = Vec::new();
+    let document = vetted_document(document, &file, &mut warnings)?;
+    let placed = place_nodes(&document, &file)?;
+    check_geometry_budget(&document, &placed, limits, &file)?;
+
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let buffers = load_buffers(document.as_json(), folder, blob, &mut budget, &file)?;
+    let used_materials = materials_used(&placed);
+    let used_images = images_of(&document, &used_materials);
+    let inputs = ImageInputs { file: &file, folder, buffers: &buffers, budget: &mut budget, max_texels: limits.max_texels };
+    let textures = decode_images(document.as_json(), &used_images, inputs)?;
+
+    let mut loader = Loader { file: file.clone(), buffers: &buffers, scene: Scene::default(), default_material: None };
+    loader.scene.source = file.clone();
+    loader.scene.warnings = warnings;
+    loader.scene.textures = textures;
+    let map = |image: usize| used_images.binary_search(&image).ok().map(|i| i as u32);
+    let no_images = |_: usize| None;
+    loader.scene.materials = document
+        .materials()
+        .map(|m| convert_material(&m, if m.index().is_some_and(|i| used_materials.contains(&i)) { &map } else { &no_images }))
+        .collect();
+    loader.scene.mesh_names =
+        document.meshes().map(|m| m.name().map(str::to_owned).unwrap_or_else(|| format!("mesh{}", m.index()))).collect();
+    for p in &placed {
+        loader.append_node(&p.node, p.world)?;
+    }
+    Ok(loader.scene)
+}
+
+/// The scene file itself: a regular file, read whole within the byte budget.
+fn read_scene_file(path: &Path, budget: &mut ByteBudget) -> Result<Vec<u8>, SceneError> {
+    let file = path.to_path_buf();
+    source::read_bounded(path, None, budget, "the scene file").map_err(|e| match e {
+        ReadError::Budget(detail) => SceneError::Budget { file, detail },
+        ReadError::Open(source) | ReadError::Read(source) => SceneError::Io { file, source },
+        other => SceneError::Io { file, source: std::io::Error::other(other.to_string()) },
+    })
+}
+
+/// Extension policy and every check that must run before the gltf crate's accessors; returns
+/// the validated document.
+fn vetted_document(document: gltf::Document, file: &Path, warnings: &mut Vec<String>) -> Result<gltf::Document, SceneError> {
     // Check required extensions before the crate's validator: it knows only the extensions compiled
     // into it (not KHR_materials_specular) and reports others as a bare "Unsupported" path.
     for ext in document.extensions_required() {
         if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&ext) {
             return Err(SceneError::Unsupported {
-                file,
+                file: file.to_path_buf(),
                 feature: format!("required extension {ext} (supported: {})", SUPPORTED_REQUIRED_EXTENSIONS.join(", ")),
             });
         }
     }
+    let ignored: Vec<&str> = document.extensions_used().filter(|e| !UNDERSTOOD_EXTENSIONS.contains(e)).collect();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "ignoring extensions the renderer does not understand: {} (optional: the scene renders without them)",
+            ignored.join(", ")
+        ));
+    }
     let mut json = document.into_json();
     json.extensions_required.clear(); // vetted above
-    check_images_have_sources(&json, &file)?;
-    check_position_accessors_exist(&json, &file)?;
-    let document = gltf::Document::from_json(json).map_err(|e| SceneError::Invalid { file: file.clone(), detail: describe(e) })?;
-
-    let base = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
-    let data_err = |e: gltf::Error| SceneError::Data { file: file.clone(), detail: e.to_string() };
-    let buffers = gltf::import_buffers(&document, base, blob).map_err(data_err)?;
-    let images = gltf::import_images(&document, base, &buffers).map_err(data_err)?;
-
-    let mut loader = Loader { file: file.clone(), buffers: &buffers, scene: Scene::default(), default_material: None };
-    loader.scene.source = file.clone();
-    loader.scene.textures = convert_images(images, &file)?;
-    loader.scene.materials = document.materials().map(|m| convert_material(&m)).collect();
-    loader.scene.mesh_names =
-        document.meshes().map(|m| m.name().map(str::to_owned).unwrap_or_else(|| format!("mesh{}", m.index()))).collect();
-    loader.walk_nodes(&document)?;
-    Ok(loader.scene)
+    validate::check_json(&json, file)?;
+    let document = gltf::Document::from_json(json).map_err(|e| SceneError::Invalid { file: file.to_path_buf(), detail: describe(e) })?;
+    validate::check_document(&document, file)?;
+    Ok(document)
 }
 
-/// `gltf::image::Image::source` unwraps a missing uri / mimeType; refuse such files first.
-fn check_images_have_sources(json: &gltf::json::Root, file: &Path) -> Result<(), SceneError> {
-    for (i, image) in json.images.iter().enumerate() {
-        let ok = image.uri.is_some() || (image.buffer_view.is_some() && image.mime_type.is_some());
-        if !ok {
-            return Err(SceneError::Invalid {
-                file: file.to_path_buf(),
-                detail: format!("images[{i}] needs a uri, or a bufferView with a mimeType"),
-            });
+/// Every node reachable from the scene's roots with its world transform, depth first in document
+/// order. Refuses a hierarchy that is not a tree and transforms that are not finite.
+fn place_nodes<'a>(document: &'a gltf::Document, file: &Path) -> Result<Vec<Placed<'a>>, SceneError> {
+    let invalid = |detail: String| SceneError::Invalid { file: file.to_path_buf(), detail };
+    let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            // No scene: every node that is nobody's child is a root.
+            let mut is_child = vec![false; document.nodes().len()];
+            document.nodes().flat_map(|n| n.children()).for_each(|c| is_child[c.index()] = true);
+            document.nodes().filter(|n| !is_child[n.index()]).collect()
         }
+    };
+    // Depth-first with an explicit stack; `visited` turns a cyclic or shared hierarchy (invalid
+    // glTF that the crate does not detect) into an error instead of an endless loop.
+    let mut visited = vec![false; document.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
+    let mut placed = Vec::new();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(invalid(format!("node {} is reached twice: the node hierarchy is not a tree", node.index())));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(invalid(format!("nodes[{}]: its transform (or a parent's) is not finite", node.index())));
+        }
+        let children: Vec<_> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
+        placed.push(Placed { node, world });
+    }
+    Ok(placed)
+}
+
+/// Triangles and vertices one primitive will produce, from its accessor counts alone (no data
+/// read), mirroring what `append_primitive` and `geometry` build.
+fn primitive_size(json: &gltf::json::Root, prim: &gltf::json::mesh::Primitive) -> (u64, u64) {
+    use gltf::json::validation::Checked;
+    let count = |index: usize| json.accessors.get(index).map_or(0, |a| a.count.0);
+    let positions = prim.attributes.get(&Checked::Valid(gltf::Semantic::Positions)).map_or(0, |i| count(i.value()));
+    let corners = prim.indices.map_or(positions, |i| count(i.value()));
+    let triangles = match prim.mode {
+        Checked::Valid(Mode::Triangles) => corners / 3,
+        Checked::Valid(Mode::TriangleStrip | Mode::TriangleFan) => corners.saturating_sub(2),
+        _ => 0,
+    };
+    // Without normals every corner becomes its own vertex (flat shading).
+    let has_normals = prim.attributes.contains_key(&Checked::Valid(gltf::Semantic::Normals));
+    (triangles, if has_normals { positions } else { triangles.saturating_mul(3) })
+}
+
+/// Refuses, before any geometry is read or copied, a scene whose triangles (or vertices) after
+/// instancing exceed the budget: each node gets its own world-space copy of its mesh.
+fn check_geometry_budget(document: &gltf::Document, placed: &[Placed], limits: &LoadLimits, file: &Path) -> Result<(), SceneError> {
+    let json = document.as_json();
+    let sizes: Vec<(u64, u64)> = json
+        .meshes
+        .iter()
+        .map(|m| m.primitives.iter().map(|p| primitive_size(json, p)).fold((0u64, 0u64), |a, b| (a.0.saturating_add(b.0), a.1.saturating_add(b.1))))
+        .collect();
+    let mut instances = vec![0u64; sizes.len()];
+    placed.iter().filter_map(|p| p.node.mesh()).for_each(|m| instances[m.index()] += 1);
+    let total = |pick: fn(&(u64, u64)) -> u64| {
+        sizes.iter().zip(&instances).fold(0u64, |sum, (s, &n)| sum.saturating_add(pick(s).saturating_mul(n)))
+    };
+    let (triangles, vertices) = (total(|s| s.0), total(|s| s.1));
+    let budget_error = |what: String| SceneError::Budget { file: file.to_path_buf(), detail: over_budget(&TRIANGLES, limits.max_triangles, what) };
+    if triangles > limits.max_triangles {
+        let largest = (0..sizes.len()).max_by_key(|&m| sizes[m].0.saturating_mul(instances[m])).unwrap_or(0);
+        let name = document.meshes().nth(largest).and_then(|m| m.name().map(str::to_owned)).unwrap_or_else(|| format!("mesh{largest}"));
+        return Err(budget_error(format!(
+            "{triangles} triangles after instancing (the largest share: mesh '{name}', {} triangles × {} nodes; every node gets its own copy, there is no GPU instancing)",
+            sizes[largest].0, instances[largest]
+        )));
+    }
+    if vertices > limits.max_triangles.saturating_mul(3) {
+        return Err(budget_error(format!("{vertices} vertices after instancing (3 per budgeted triangle at most)")));
     }
     Ok(())
 }
 
-/// gltf-json 1.4.1's validator indexes `accessors[POSITION]` unchecked (mesh.rs:151).
-fn check_position_accessors_exist(json: &gltf::json::Root, file: &Path) -> Result<(), SceneError> {
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, prim) in mesh.primitives.iter().enumerate() {
-            let position = prim.attributes.get(&gltf::json::validation::Checked::Valid(gltf::Semantic::Positions));
-            if let Some(index) = position.filter(|i| i.value() >= json.accessors.len()) {
-                return Err(SceneError::Invalid {
-                    file: file.to_path_buf(),
-                    detail: format!(
-                        "meshes[{m}].primitives[{p}].attributes.POSITION = {}: index out of range (there are {} accessors)",
-                        index.value(),
-                        json.accessors.len()
-                    ),
-                });
+/// Buffer data, each exactly its declared `byteLength` (a shorter source is an error; a longer one
+/// is read only that far).
+fn load_buffers(json: &gltf::json::Root, folder: &Path, mut blob: Option<Vec<u8>>, budget: &mut ByteBudget, file: &Path) -> Result<Vec<Vec<u8>>, SceneError> {
+    let mut out = Vec::with_capacity(json.buffers.len());
+    for (i, buffer) in json.buffers.iter().enumerate() {
+        let item = format!("buffers[{i}]");
+        let declared = buffer.byte_length.0;
+        let fail = |uri: &str, reason: String| SceneError::Reference { file: file.to_path_buf(), item: item.clone(), uri: source::display_uri(uri), reason };
+        let data = match &buffer.uri {
+            // GLB: the first buffer without a uri is the binary chunk (already read with the file).
+            None => {
+                let mut bin = blob.take().ok_or_else(|| fail("", "no uri, and there is no (further) GLB binary chunk".into()))?;
+                if (bin.len() as u64) < declared {
+                    return Err(fail("", format!("the GLB binary chunk has {} bytes but byteLength declares {declared}", bin.len())));
+                }
+                bin.truncate(declared as usize);
+                bin
             }
-        }
+            Some(uri) => match source::parse_uri(uri).map_err(|reason| fail(uri, reason))? {
+                Uri::Data { payload, .. } => {
+                    let mut data = source::decode_data_uri(payload, budget, &item).map_err(|reason| fail(uri, reason))?;
+                    if (data.len() as u64) < declared {
+                        return Err(fail(uri, format!("the data URI holds {} bytes but byteLength declares {declared}", data.len())));
+                    }
+                    data.truncate(declared as usize);
+                    data
+                }
+                Uri::Relative(relative) => {
+                    let path = source::resolve_inside(folder, &relative).map_err(|reason| fail(uri, reason))?;
+                    source::read_bounded(&path, Some(declared), budget, &item).map_err(|e| match e {
+                        ReadError::Budget(detail) => SceneError::Budget { file: file.to_path_buf(), detail },
+                        other => fail(uri, other.to_string()),
+                    })?
+                }
+            },
+        };
+        out.push(data);
     }
-    Ok(())
+    Ok(out)
+}
+
+/// Materials some placed mesh primitive uses, sorted.
+fn materials_used(placed: &[Placed]) -> Vec<usize> {
+    let mut used: Vec<usize> =
+        placed.iter().filter_map(|p| p.node.mesh()).flat_map(|m| m.primitives().filter_map(|p| p.material().index()).collect::<Vec<_>>()).collect();
+    used.sort_unstable();
+    used.dedup();
+    used
+}
+
+/// Images the used materials sample, sorted and unique (their order in [`Scene::textures`]).
+fn images_of(document: &gltf::Document, materials: &[usize]) -> Vec<usize> {
+    let mut images: Vec<usize> = document.materials().filter(|m| m.index().is_some_and(|i| materials.contains(&i))).flat_map(|m| images_used(&m)).collect();
+    images.sort_unstable();
+    images.dedup();
+    images
 }
 
 fn describe(e: gltf::Error) -> String {
@@ -118,41 +280,17 @@ fn describe(e: gltf::Error) -> String {
 }
 
 impl Loader<'_> {
-    fn walk_nodes(&mut self, document: &gltf::Document) -> Result<(), SceneError> {
-        let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
-            Some(scene) => scene.nodes().collect(),
-            None => {
-                // No scene: every node that is nobody's child is a root.
-                let mut is_child = vec![false; document.nodes().len()];
-                document.nodes().flat_map(|n| n.children()).for_each(|c| is_child[c.index()] = true);
-                document.nodes().filter(|n| !is_child[n.index()]).collect()
+    fn append_node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), SceneError> {
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                self.append_primitive(&mesh, &primitive, world)?;
             }
-        };
-        // Depth-first with an explicit stack; `visited` turns a cyclic or shared hierarchy (invalid
-        // glTF that the crate does not detect) into an error instead of an endless loop.
-        let mut visited = vec![false; document.nodes().len()];
-        let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
-        while let Some((node, parent)) = stack.pop() {
-            if std::mem::replace(&mut visited[node.index()], true) {
-                return Err(SceneError::Invalid {
-                    file: self.file.clone(),
-                    detail: format!("node {} is reached twice: the node hierarchy is not a tree", node.index()),
-                });
-            }
-            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-            if let Some(mesh) = node.mesh() {
-                for primitive in mesh.primitives() {
-                    self.append_primitive(&mesh, &primitive, world)?;
-                }
-            }
-            if let Some(camera) = node.camera() {
-                self.append_camera(&camera, world);
-            }
-            if let Some(light) = node.light() {
-                self.append_light(&light, world);
-            }
-            let children: Vec<_> = node.children().collect();
-            stack.extend(children.into_iter().rev().map(|c| (c, world)));
+        }
+        if let Some(camera) = node.camera() {
+            self.append_camera(&camera, world);
+        }
+        if let Some(light) = node.light() {
+            self.append_light(&light, world);
         }
         Ok(())
     }
@@ -175,11 +313,14 @@ impl Loader<'_> {
             });
         }
         let buffers = self.buffers;
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d[..]));
         let positions: Vec<Vec3> = match reader.read_positions() {
             Some(it) => it.map(Vec3::from).collect(),
             None => return Err(self.bad(mesh, pi, "POSITION is missing or its data is out of the buffer's range".into())),
         };
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(self.bad(mesh, pi, format!("POSITION element {k} is {}: positions must be finite", positions[k])));
+        }
         let n = positions.len();
         let expect_len = |what: &str, len: usize| -> Result<(), SceneError> {
             if len == n { Ok(()) } else { Err(self.bad(mesh, pi, format!("{what} has {len} elements but POSITION has {n}"))) }
@@ -190,6 +331,13 @@ impl Loader<'_> {
         for (what, len) in [("NORMAL", normals.as_ref().map(Vec::len)), ("TEXCOORD_0", uvs.as_ref().map(Vec::len)), ("TANGENT", tangents.as_ref().map(Vec::len))] {
             if let Some(len) = len {
                 expect_len(what, len)?;
+            }
+        }
+        let bad_uv = uvs.as_ref().and_then(|v| v.iter().position(|u| !u.is_finite()));
+        let bad_tangent = tangents.as_ref().and_then(|v| v.iter().position(|t| !t.is_finite()));
+        for (what, k) in [("TEXCOORD_0", bad_uv), ("TANGENT", bad_tangent)] {
+            if let Some(k) = k {
+                return Err(self.bad(mesh, pi, format!("{what} element {k} is not finite")));
             }
         }
         // Attributes that are declared but unreadable would otherwise be silently regenerated.
@@ -225,6 +373,9 @@ impl Loader<'_> {
         let needs_tangents = self.scene.materials[material as usize].normal_texture.is_some();
         let data = PrimitiveData { positions, normals, uvs, tangents, triangles };
         let (vertices, tris) = geometry::build_world_vertices(data, needs_tangents, world);
+        if vertices.iter().any(|v| !v.position.is_finite()) {
+            return Err(self.bad(mesh, pi, "world-space positions overflow f32 (the node transforms scale them too far)".into()));
+        }
         let base = self.scene.vertices.len() as u32;
         self.scene.vertices.extend(vertices);
         let mesh_id = mesh.index() as u32;

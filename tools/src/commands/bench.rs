@@ -60,7 +60,7 @@ struct BenchReport {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    crate::output::prepare_output_dir(args.out)?;
+    let _out_dir = crate::output::prepare_output_dir(args.out)?;
     let ctx = super::open_device(args.device, false)?;
     let mut report = BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new() };
     for name in args.scenes {
@@ -129,7 +129,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     super::check_validation(&ctx)?;
     let path = args.out.join("report.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
+    crate::output::write_json(&path, &report)?;
     println!("wrote {}", path.display());
     Ok(())
 }

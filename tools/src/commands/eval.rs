@@ -2,7 +2,7 @@
 //! eccentricity around the gaze → `DIR/eval.json` + `DIR/eval.png`.
 
 use crate::metrics::{evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings};
-use crate::output::{prepare_output_dir, read_exr};
+use crate::output::{prepare_output_dir, read_exr, write_json};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
 use glam::Vec2;
@@ -59,7 +59,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         Some(name) => Some(fovea_hal::HmdDescription::resolve(name).with_context(|| format!("--headset {name}"))?),
         None => None,
     };
-    prepare_output_dir(args.out)?;
+    let _out_dir = prepare_output_dir(args.out)?;
     let eval = evaluate(&reference, &test, w, h, gaze, args.rings);
     let true_eccentricity = hmd.map(|hmd| {
         let fov = crate::render_profile::fov_tangents(&hmd.eye(fovea_hal::Eye::Left).fov);
@@ -79,8 +79,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         eval: &eval,
         true_eccentricity,
     };
-    std::fs::write(&json_path, serde_json::to_string_pretty(&report)? + "\n")
-        .with_context(|| format!("writing {}", json_path.display()))?;
+    write_json(&json_path, &report)?;
     write_plot(&args.out.join("eval.png"), &eval)?;
 
     let f = &eval.frame;

@@ -8,7 +8,7 @@
 use super::render::{self, RenderArgs};
 use crate::camera_path;
 use crate::metrics::{evaluate, Evaluation};
-use crate::output::{prepare_output_dir, read_exr, write_exr};
+use crate::output::{prepare_output_dir, read_exr, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::denoise::taa::TaaMode;
@@ -107,7 +107,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
     }
-    prepare_output_dir(args.out)?;
+    let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let mut runs = Vec::new();
     for camera in args.cameras {
@@ -161,9 +161,9 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
         runs: &runs,
     };
-    std::fs::write(args.out.join("quality.json"), serde_json::to_string_pretty(&report)? + "\n")?;
+    write_json(&args.out.join("quality.json"), &report)?;
     let table = markdown(&report);
-    std::fs::write(args.out.join("quality.md"), &table)?;
+    write_text(&args.out.join("quality.md"), &table)?;
     print!("{table}");
     Ok(())
 }

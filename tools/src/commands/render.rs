@@ -2,7 +2,7 @@
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
 use super::setup::{Eyes, Setup};
-use crate::output::{prepare_output_dir, write_exr, write_png};
+use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use anyhow::Result;
 use fovea_hal::GazeOrigin;
 use fovea_renderer::gpu_scene::GpuScene;
@@ -96,6 +96,8 @@ struct Report {
     frame_gpu_ms: f64,
     /// Wall-clock seconds for all frames, including read-back and file writing.
     wall_seconds: f64,
+    /// SIGINT/SIGTERM stopped the run after `frames` frames (of the requested ones).
+    interrupted: bool,
 }
 
 #[derive(Serialize)]
@@ -123,7 +125,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let frames = args.frames;
     let mut setup = Setup::new(args, frames)?;
     let (width, height, eyes) = (setup.width, setup.height, setup.eyes);
-    prepare_output_dir(args.out)?;
+    let out_dir = prepare_output_dir(args.out)?;
     let ctx = super::open_device(args.device, args.validation)?;
     let spaces = setup.spaces(args.method, &args.profile)?;
     let grid = spaces[0].grid_size();
@@ -150,7 +152,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
+    let mut submitted = 0u32;
     for frame in 0..frames {
+        if crate::interrupt::requested().is_some() {
+            break; // finish the frames in flight below; report what was rendered
+        }
         let (input, frame_gaze) = setup.frame_input(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
         origins[match frame_gaze.origin {
@@ -165,13 +171,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             bar.inc(1);
         }
         renderer.submit(&input, None)?;
+        submitted = frame + 1;
     }
     renderer.finish()?;
-    for done in frames.saturating_sub(in_flight as u32) as u64..frames as u64 {
+    for done in submitted.saturating_sub(in_flight as u32) as u64..submitted as u64 {
         out.write(&renderer, done)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
+    let interrupted = crate::interrupt::requested();
+    let frames = submitted;
+    if frames == 0 {
+        // Stopped before the first frame: nothing to report.
+        return Err(interrupted.map(anyhow::Error::from).unwrap_or_else(|| anyhow::anyhow!("no frame rendered")));
+    }
     if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
     }
@@ -214,9 +227,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
+        interrupted: interrupted.is_some(),
     };
-    let path = args.out.join("report.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&report)? + "\n")?;
+    write_json(&args.out.join("report.json"), &report)?;
+    out_dir.remove_stale()?;
+    if let Some(interrupted) = interrupted {
+        return Err(interrupted.into());
+    }
     println!(
         "rendered {} frame(s) of {}×{} ({} eye(s), {}, denoiser {}, taa {}, grid {}×{}, {} samples per eye) on {}: {:.1} ms GPU per frame, {} rays per eye and frame → {}",
         frames,
