@@ -90,7 +90,7 @@ impl Setup {
         if !METHODS.contains(&args.method) {
             bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
         }
-        let (denoiser, taa) = filters(args)?;
+        let (denoiser, taa) = filters(args.method, args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
         let scene = crate::scenes::load(args.scene)?;
         let Some(camera) = scene.default_camera() else {
@@ -155,24 +155,26 @@ fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: Eyes) -> Ca
     }
 }
 
-fn filters(args: &RenderArgs) -> Result<(DenoiserSettings, TaaMode)> {
-    let denoiser = match DenoiserSettings::parse(args.denoiser).context("--denoiser")? {
-        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(args.profile.svgf),
-        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(args.profile.asvgf),
-        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(args.profile.bmfr),
+/// `--denoiser` and `--taa` with their parameters from the profile, checked against the method
+/// (`fovea render`, `fovea view`'s live switching and `fovea xr` share it).
+pub fn filters(method: &str, denoiser: &str, taa: &str, profile: &RenderProfile) -> Result<(DenoiserSettings, TaaMode)> {
+    let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
+        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
+        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
+        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
         other => other,
     };
-    let taa = TaaMode::parse(args.taa).context("--taa")?.with_settings(args.profile.taa);
+    let taa_mode = TaaMode::parse(taa).context("--taa")?.with_settings(profile.taa);
     // TAA reprojects with the paper's mapping, like SVGF (the screen-space one finds depths in the
     // VP G-buffer the same way).
-    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && taa != TaaMode::Off {
-        bail!("--taa {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.taa);
+    if method == "vp" && profile.visual_polar.layout != VpLayout::Paper && taa_mode != TaaMode::Off {
+        bail!("--taa {taa} supports only the paper's Visual-Polar layout (--vp-layout paper)");
     }
     // SVGF and BMFR reproject and filter with the paper's mapping (no per-column arc table yet).
-    if args.method == "vp" && args.profile.visual_polar.layout != VpLayout::Paper && denoiser != DenoiserSettings::None {
-        bail!("--denoiser {} supports only the paper's Visual-Polar layout (--vp-layout paper)", args.denoiser);
+    if method == "vp" && profile.visual_polar.layout != VpLayout::Paper && denoiser_settings != DenoiserSettings::None {
+        bail!("--denoiser {denoiser} supports only the paper's Visual-Polar layout (--vp-layout paper)");
     }
-    Ok((denoiser, taa))
+    Ok((denoiser_settings, taa_mode))
 }
 
 /// The sampling space of `method` for one eye of `hmd` (its FOV drives the headset ρ axis).

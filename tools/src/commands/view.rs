@@ -11,8 +11,6 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::passes::denoise::taa::TaaMode;
-use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS};
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{UVec2, Vec2};
@@ -246,16 +244,8 @@ impl Viewer<'_> {
     fn rebuild_views(&mut self) -> Result<()> {
         let profile = &self.args.render.profile;
         let spaces = self.setup.eyes.list().iter().map(|&eye| space_for(&self.method, profile, &self.setup.hmd, eye, self.setup.screen())).collect::<Result<Vec<_>>>()?;
-        let settings = RenderSettings {
-            denoiser: match DenoiserSettings::parse(&self.denoiser)? {
-                DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
-                DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
-                DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
-                other => other,
-            },
-            taa: TaaMode::parse(&self.taa)?.with_settings(profile.taa),
-            ..self.renderer.settings
-        };
+        let (denoiser, taa) = super::setup::filters(&self.method, &self.denoiser, &self.taa, profile)?;
+        let settings = RenderSettings { denoiser, taa, ..self.renderer.settings };
         self.renderer.replace_views(spaces, settings)?;
         Ok(())
     }
