@@ -27,4 +27,4 @@ pub use sample::{Eye, EyeState, GazeRay, GazeSample, SampleTimeKind, XrTime};
 pub use sim::{SimConfig, SimulatedFove};
 pub use source::{FixedGaze, GazeOrigin, GazeSource, InvalidGazePolicy, ResolvedGaze};
 pub use spec::GazeSpec;
-pub use trace::{Playback, Recorder, Trace, TraceHeader};
+pub use trace::{Playback, Recorder, Trace, TraceHeader, TraceWriter};

@@ -4,7 +4,7 @@
 //! backends to rendering.
 
 use anyhow::{Context, Result};
-use fovea_hal::{Eye, GazeOrigin, GazeSource, GazeSpec, HmdDescription, InvalidGazePolicy, XrTime};
+use fovea_hal::{Eye, GazeOrigin, GazeSample, GazeSource, GazeSpec, HmdDescription, InvalidGazePolicy, ResolvedGaze, XrTime};
 use glam::Vec2;
 
 pub struct GazeDriver {
@@ -27,14 +27,16 @@ pub struct FrameGaze {
     pub time_ns: XrTime,
 }
 
+/// Render pixels per headset pixel (the left eye's; both eyes share one render size).
+fn render_scale(hmd: &HmdDescription, render_width: u32, render_height: u32) -> Vec2 {
+    let eye = hmd.eye(Eye::Left);
+    Vec2::new(render_width as f32 / eye.recommended_width as f32, render_height as f32 / eye.recommended_height as f32)
+}
+
 impl GazeDriver {
     /// `spec`: center | X,Y (render pixels, inside the render image) | sim[:seed] | trace path.
     pub fn open(spec: &str, hmd: &HmdDescription, render_width: u32, render_height: u32) -> Result<GazeDriver> {
-        let eye = hmd.eye(Eye::Left);
-        let scale = Vec2::new(
-            render_width as f32 / eye.recommended_width as f32,
-            render_height as f32 / eye.recommended_height as f32,
-        );
+        let scale = render_scale(hmd, render_width, render_height);
         let mut parsed: GazeSpec = spec.parse().with_context(|| format!("--gaze {spec}"))?;
         if let GazeSpec::Fixed { x, y } = &mut parsed {
             // Checked here in render pixels, the units the user wrote.
@@ -45,21 +47,39 @@ impl GazeDriver {
             *y /= scale.y;
         }
         let source = parsed.open(hmd.clone()).with_context(|| format!("opening gaze source '{spec}'"))?;
-        Ok(GazeDriver {
+        Ok(GazeDriver::from_source(source, hmd, render_width, render_height))
+    }
+
+    /// A driver over a source opened elsewhere (`fovea xr`'s OpenXR eye tracker).
+    pub fn from_source(source: Box<dyn GazeSource>, hmd: &HmdDescription, render_width: u32, render_height: u32) -> GazeDriver {
+        let scale = render_scale(hmd, render_width, render_height);
+        GazeDriver {
             source,
             policy: InvalidGazePolicy::default(),
             hmd: hmd.clone(),
             scale,
             frame_period_ns: 1e9 / hmd.refresh_hz as f64,
-        })
+        }
+    }
+
+    /// The display time of frame `index` in the timebase of simulated and recorded sources:
+    /// `index` refresh periods after the start (`fovea xr --record` writes traces in it).
+    pub fn frame_time(&self, index: u32) -> XrTime {
+        (index as f64 * self.frame_period_ns) as XrTime
+    }
+
+    /// The source's sample for display time `t` and the invalid-gaze policy's decision on it.
+    pub fn resolve_at(&mut self, t: XrTime) -> Result<(GazeSample, ResolvedGaze)> {
+        self.source.begin_frame(t)?;
+        let sample = self.source.sample_at(t);
+        let resolved = self.policy.resolve(&sample, t);
+        Ok((sample, resolved))
     }
 
     /// Gaze for frame `index`, displayed at `index` refresh periods after the start.
     pub fn frame(&mut self, index: u32) -> Result<FrameGaze> {
-        let t = (index as f64 * self.frame_period_ns) as XrTime;
-        self.source.begin_frame(t)?;
-        let sample = self.source.sample_at(t);
-        let resolved = self.policy.resolve(&sample, t);
+        let t = self.frame_time(index);
+        let (_, resolved) = self.resolve_at(t)?;
         let pixels = [Eye::Left, Eye::Right].map(|eye| {
             let view = self.hmd.eye(eye);
             let centre = Vec2::new(view.recommended_width as f32, view.recommended_height as f32) * 0.5;

@@ -13,3 +13,4 @@ pub mod render_profile;
 pub mod scenegen;
 pub mod scenes;
 pub mod viewer;
+pub mod xr;

@@ -59,9 +59,10 @@ struct RenderOpts {
     /// Frames kept on the GPU at once (1 waits for every frame).
     #[arg(long, default_value_t = 2)]
     frames_in_flight: usize,
-    /// Output folder (created; must hold only fovea's own outputs if it exists).
-    #[arg(long, default_value = "out/render")]
-    out: PathBuf,
+    /// Output folder (created; must hold only fovea's own outputs if it exists; default
+    /// out/render, for fovea xr out/xr).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Also write linear EXR frames.
     #[arg(long)]
     exr: bool,
@@ -171,6 +172,21 @@ enum Command {
         /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
         #[arg(long, default_value = "fifo")]
         present_mode: String,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Both eyes on a headset through an OpenXR runtime (Vulkan): views and gaze at each frame's
+    /// predicted display time; writes DIR/frames.jsonl (one row per frame) and DIR/report.json.
+    Xr {
+        #[command(flatten)]
+        opts: Box<RenderOpts>,
+        /// Write the gaze that drove the session as a trace (a new file), replayable with
+        /// `fovea render --headset <same> --gaze TRACE.csv`.
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs --frames.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -318,6 +334,7 @@ fn render_args<'a>(
     profile: &RenderProfile,
     default_frames: u32,
     default_gaze: &'a str,
+    default_out: &'static str,
 ) -> Result<commands::render::RenderArgs<'a>> {
     Ok(commands::render::RenderArgs {
         scene: &opts.scene,
@@ -328,7 +345,7 @@ fn render_args<'a>(
         headset: &opts.headset,
         gaze: opts.gaze.as_deref().unwrap_or(default_gaze),
         frames: opts.frames.unwrap_or(default_frames),
-        out: &opts.out,
+        out: opts.out.as_deref().unwrap_or(std::path::Path::new(default_out)),
         exr: opts.exr,
         camera_path: opts.camera_path,
         seed: opts.seed,
@@ -365,25 +382,40 @@ fn run() -> Result<()> {
         opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
         device: DeviceArgs { device: None, validation: false },
     });
-    if matches!(command, Command::Render { .. }) {
-        // Only `render` checks for it; other commands keep the default (stop at once).
+    if matches!(command, Command::Render { .. } | Command::Xr { .. }) {
+        // Only `render` and `xr` check for it (a clean end); other commands stop at once.
         fovea_tools::interrupt::install()?;
     }
     match command {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;
-            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1")?)
+            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1", "out/render")?)
         }
         Command::View { opts, screenshot, present_mode, device } => {
             let profile = opts.profile()?;
             // Without --frames the run has no length: the camera path's period is a long one.
-            let render = render_args(&opts, &device, &profile, u32::MAX, "center")?;
+            let render = render_args(&opts, &device, &profile, u32::MAX, "center", "out/render")?;
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
                 present_mode: &present_mode,
                 mouse_gaze: opts.gaze.is_none(),
                 render,
+            })
+        }
+        Command::Xr { opts, record, screenshot, device } => {
+            let profile = opts.profile()?;
+            // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
+            let render = render_args(&opts, &device, &profile, u32::MAX, "center", "out/xr")?;
+            if opts.eyes != "left" && opts.eyes != "both" {
+                anyhow::bail!("fovea xr renders both eyes; --eyes {} does not apply", opts.eyes);
+            }
+            commands::xr::run(&commands::xr::XrArgs {
+                render,
+                frames: opts.frames,
+                gaze: opts.gaze.as_deref(),
+                record: record.as_deref(),
+                screenshot: screenshot.as_deref(),
             })
         }
         Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {

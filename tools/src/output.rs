@@ -83,23 +83,52 @@ fn temp_path_for(path: &Path) -> Result<PathBuf> {
     Ok(path.with_file_name(format!(".{short}.{}.{n}{TEMP_SUFFIX}", std::process::id())))
 }
 
+/// A file written over time (a per-frame log) that appears under its name only when
+/// [`AtomicWriter::commit`] renames it into place; dropped uncommitted, the temporary is removed
+/// and an existing file at the path stays as it was.
+pub struct AtomicWriter {
+    path: PathBuf,
+    temp: TempFile,
+    writer: BufWriter<File>,
+}
+
+impl AtomicWriter {
+    pub fn create(path: &Path) -> Result<AtomicWriter> {
+        check_replaceable(path)?;
+        let temp = TempFile { path: temp_path_for(path)?, committed: false };
+        // create_new: never opens something already there (a planted link at the temporary's name).
+        let file = OpenOptions::new().write(true).create_new(true).open(&temp.path).with_context(|| format!("writing {}", path.display()))?;
+        Ok(AtomicWriter { path: path.to_path_buf(), temp, writer: BufWriter::new(file) })
+    }
+
+    pub fn writer(&mut self) -> &mut BufWriter<File> {
+        &mut self.writer
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Syncs the temporary and renames it over the target.
+    pub fn commit(self) -> Result<()> {
+        let AtomicWriter { path, mut temp, writer } = self;
+        let file = writer.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", path.display()))?;
+        // On disk before the rename, so a crash leaves the old file or the complete new one.
+        file.sync_data().with_context(|| format!("writing {}", path.display()))?;
+        drop(file);
+        check_replaceable(&path)?; // a link planted while we wrote is refused, not followed
+        std::fs::rename(&temp.path, &path).with_context(|| format!("moving the new {} into place", path.display()))?;
+        temp.committed = true;
+        Ok(())
+    }
+}
+
 /// Writes `path` atomically with `write` filling a buffered writer. On any error (or a panic in
 /// `write`) the temporary file is removed and an existing `path` is left exactly as it was.
 pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<()> {
-    check_replaceable(path)?;
-    let mut temp = TempFile { path: temp_path_for(path)?, committed: false };
-    // create_new: never opens something already there (a planted link at the temporary's name).
-    let file = OpenOptions::new().write(true).create_new(true).open(&temp.path).with_context(|| format!("writing {}", path.display()))?;
-    let mut writer = BufWriter::new(file);
-    write(&mut writer).with_context(|| format!("writing {}", path.display()))?;
-    let file = writer.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", path.display()))?;
-    // On disk before the rename, so a crash leaves the old file or the complete new one.
-    file.sync_data().with_context(|| format!("writing {}", path.display()))?;
-    drop(file);
-    check_replaceable(path)?; // a link planted while we wrote is refused, not followed
-    std::fs::rename(&temp.path, path).with_context(|| format!("moving the new {} into place", path.display()))?;
-    temp.committed = true;
-    Ok(())
+    let mut out = AtomicWriter::create(path)?;
+    write(out.writer()).with_context(|| format!("writing {}", path.display()))?;
+    out.commit()
 }
 
 /// Text (reports, tables) written atomically.
@@ -172,7 +201,7 @@ pub fn check_new_file(path: &Path, force: bool) -> Result<()> {
 
 /// Names fovea writes into an output folder.
 fn is_fovea_file(name: &str) -> bool {
-    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md")
+    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md" | "frames.jsonl" | "xr_view.png")
         || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))

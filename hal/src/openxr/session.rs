@@ -173,7 +173,8 @@ impl SessionOwner<xr::Vulkan> {
     }
 
     /// A single-sample colour swapchain that compute shaders can write (`UNORDERED_ACCESS`, i.e.
-    /// `VK_IMAGE_USAGE_STORAGE_BIT`), plus colour-attachment and transfer-destination usage.
+    /// `VK_IMAGE_USAGE_STORAGE_BIT`), plus colour-attachment and transfer usage (transfer-source:
+    /// screenshots of what was submitted).
     /// `format` must be one of [`Self::swapchain_formats`] (see [`STORAGE_FORMATS`]).
     pub fn create_storage_swapchain(&self, format: u32, width: u32, height: u32) -> Result<xr::Swapchain<xr::Vulkan>, HalError> {
         let offered = self.swapchain_formats()?;
@@ -184,7 +185,8 @@ impl SessionOwner<xr::Vulkan> {
             create_flags: xr::SwapchainCreateFlags::EMPTY,
             usage_flags: xr::SwapchainUsageFlags::UNORDERED_ACCESS
                 | xr::SwapchainUsageFlags::COLOR_ATTACHMENT
-                | xr::SwapchainUsageFlags::TRANSFER_DST,
+                | xr::SwapchainUsageFlags::TRANSFER_DST
+                | xr::SwapchainUsageFlags::TRANSFER_SRC,
             format,
             sample_count: 1,
             width,

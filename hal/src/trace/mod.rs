@@ -7,7 +7,7 @@ mod playback;
 mod recorder;
 
 pub use playback::Playback;
-pub use recorder::Recorder;
+pub use recorder::{Recorder, TraceWriter};
 
 use crate::error::HalError;
 use crate::sample::{GazeRay, GazeSample};

@@ -65,49 +65,34 @@ impl Drop for AtomicFile {
     }
 }
 
-/// Wraps a source and writes every distinct sample the application obtains from it (those with a
-/// time later than the last one written) while passing it through unchanged. Call
-/// [`Recorder::finish`] to publish the file; dropping the recorder discards it.
-pub struct Recorder<S: GazeSource> {
-    source: S,
+/// Writes gaze samples to a trace file, crash-safely: rows go to a temporary file that
+/// [`TraceWriter::finish`] moves into place. Samples must come in increasing time; one at or
+/// before the last written time is skipped (a source asked twice for one measurement).
+pub struct TraceWriter {
     file: Option<AtomicFile>,
     last_time: Option<XrTime>,
     written: usize,
     /// A write failed: stop writing (the file is incomplete) and refuse to publish it.
-    failed: bool,
     error: Option<HalError>,
+    failed: bool,
 }
 
-impl<S: GazeSource> Recorder<S> {
-    pub fn create(source: S, path: &Path, overwrite: bool) -> Result<Self, HalError> {
+impl TraceWriter {
+    /// A trace for `hmd` (its id, FOV and tracker rate go into the header) at `path`; with
+    /// `overwrite` false an existing file is an error, also if it appears before `finish`.
+    pub fn create(hmd: &HmdDescription, path: &Path, overwrite: bool) -> Result<Self, HalError> {
         let mut file = AtomicFile::create(path, overwrite)?;
-        header_for(source.describe()).write(file.writer()).map_err(|e| HalError::io(file.temp_path(), e))?;
-        Ok(Recorder { source, file: Some(file), last_time: None, written: 0, failed: false, error: None })
+        header_for(hmd).write(file.writer()).map_err(|e| HalError::io(file.temp_path(), e))?;
+        Ok(TraceWriter { file: Some(file), last_time: None, written: 0, error: None, failed: false })
     }
 
     pub fn samples_written(&self) -> usize {
         self.written
     }
 
-    pub fn source(&self) -> &S {
-        &self.source
-    }
-
-    /// Flush, sync and move the trace into place. Returns the wrapped source.
-    pub fn finish(mut self) -> Result<S, HalError> {
-        if let Some(e) = self.error.take() {
-            return Err(e);
-        }
-        if self.failed {
-            let file = self.file.as_ref().map(|f| f.temp_path().to_path_buf()).unwrap_or_default();
-            let reason = "an earlier write failed; the recording is incomplete and was not published";
-            return Err(HalError::io(file, std::io::Error::other(reason)));
-        }
-        self.file.take().map_or(Ok(()), AtomicFile::commit)?;
-        Ok(self.source)
-    }
-
-    fn record(&mut self, s: &GazeSample) {
+    /// Writes `s` unless its time is not after the last one written. A failure is kept and
+    /// reported by [`Self::flush`] / [`Self::finish`] (callers that cannot return errors).
+    pub fn write(&mut self, s: &GazeSample) {
         if self.failed || self.last_time.is_some_and(|t| s.time <= t) {
             return;
         }
@@ -123,6 +108,59 @@ impl<S: GazeSource> Recorder<S> {
                 }
             }
         }
+    }
+
+    /// Pushes buffered rows to the temporary file; reports an earlier write failure once.
+    pub fn flush(&mut self) -> Result<(), HalError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if let Some(file) = self.file.as_mut() {
+            file.writer().flush().map_err(|e| HalError::io(file.temp_path(), e))?;
+        }
+        Ok(())
+    }
+
+    /// Flush, sync and move the trace into place.
+    pub fn finish(mut self) -> Result<(), HalError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.failed {
+            let file = self.file.as_ref().map(|f| f.temp_path().to_path_buf()).unwrap_or_default();
+            let reason = "an earlier write failed; the recording is incomplete and was not published";
+            return Err(HalError::io(file, std::io::Error::other(reason)));
+        }
+        self.file.take().map_or(Ok(()), AtomicFile::commit)
+    }
+}
+
+/// Wraps a source and writes every distinct sample the application obtains from it (those with a
+/// time later than the last one written) while passing it through unchanged. Call
+/// [`Recorder::finish`] to publish the file; dropping the recorder discards it.
+pub struct Recorder<S: GazeSource> {
+    source: S,
+    writer: TraceWriter,
+}
+
+impl<S: GazeSource> Recorder<S> {
+    pub fn create(source: S, path: &Path, overwrite: bool) -> Result<Self, HalError> {
+        let writer = TraceWriter::create(source.describe(), path, overwrite)?;
+        Ok(Recorder { source, writer })
+    }
+
+    pub fn samples_written(&self) -> usize {
+        self.writer.samples_written()
+    }
+
+    pub fn source(&self) -> &S {
+        &self.source
+    }
+
+    /// Flush, sync and move the trace into place. Returns the wrapped source.
+    pub fn finish(self) -> Result<S, HalError> {
+        self.writer.finish()?;
+        Ok(self.source)
     }
 }
 
@@ -143,19 +181,13 @@ impl<S: GazeSource> GazeSource for Recorder<S> {
 
     /// Also reports a write failure from an earlier `sample_at` (which cannot return errors).
     fn begin_frame(&mut self, t: XrTime) -> Result<(), HalError> {
-        if let Some(e) = self.error.take() {
-            return Err(e);
-        }
-        self.source.begin_frame(t)?;
-        if let Some(file) = self.file.as_mut() {
-            file.writer().flush().map_err(|e| HalError::io(file.temp_path(), e))?;
-        }
-        Ok(())
+        self.writer.flush()?;
+        self.source.begin_frame(t)
     }
 
     fn sample_at(&mut self, t: XrTime) -> GazeSample {
         let s = self.source.sample_at(t);
-        self.record(&s);
+        self.writer.write(&s);
         s
     }
 

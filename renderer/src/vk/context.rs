@@ -31,7 +31,27 @@ impl std::str::FromStr for DeviceSelector {
     }
 }
 
-#[derive(Clone, Debug, Default)]
+/// Creates the Vulkan instance and device on the engine's behalf from the engine's own
+/// create-infos: an OpenXR runtime (`XR_KHR_vulkan_enable2`) adds the extensions its compositor
+/// needs and chooses the physical device wired to the headset.
+pub trait DeviceCreator: Send + Sync {
+    /// # Safety
+    /// `info` and everything it points to are valid for the call.
+    unsafe fn create_instance(&self, entry: &ash::Entry, info: &vk::InstanceCreateInfo) -> std::result::Result<vk::Instance, String>;
+    /// # Safety
+    /// `instance` came from [`Self::create_instance`] and is alive.
+    unsafe fn physical_device(&self, instance: vk::Instance) -> std::result::Result<vk::PhysicalDevice, String>;
+    /// # Safety
+    /// `physical` came from [`Self::physical_device`]; `info` is valid for the call.
+    unsafe fn create_device(
+        &self,
+        entry: &ash::Entry,
+        physical: vk::PhysicalDevice,
+        info: &vk::DeviceCreateInfo,
+    ) -> std::result::Result<vk::Device, String>;
+}
+
+#[derive(Clone, Default)]
 pub struct ContextOptions {
     /// Turn on VK_LAYER_KHRONOS_validation and count its messages.
     pub validation: bool,
@@ -46,6 +66,23 @@ pub struct ContextOptions {
     /// Refuse devices that cannot write storage images without a format qualifier (what the
     /// external-target tonemap needs to write a swapchain image of any UNORM format).
     pub require_storage_write_without_format: bool,
+    /// Who creates the instance and device (and picks the physical device); `None`: the engine,
+    /// by `device`.
+    pub creator: Option<Arc<dyn DeviceCreator>>,
+}
+
+impl std::fmt::Debug for ContextOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ContextOptions")
+            .field("validation", &self.validation)
+            .field("sync_validation", &self.sync_validation)
+            .field("device", &self.device)
+            .field("instance_extensions", &self.instance_extensions)
+            .field("device_extensions", &self.device_extensions)
+            .field("require_storage_write_without_format", &self.require_storage_write_without_format)
+            .field("creator", &self.creator.as_ref().map(|_| "external"))
+            .finish()
+    }
 }
 
 /// Waits and submissions since the context was made: the real-time loop's tests prove with these
@@ -135,8 +172,20 @@ impl Context {
         };
 
         let devices = list_devices(&instance)?;
-        let chosen = choose_device(&devices, &options.device)?;
-        let physical = unsafe { instance.enumerate_physical_devices()? }[chosen.index];
+        let physicals = unsafe { instance.enumerate_physical_devices()? };
+        let chosen = match &options.creator {
+            Some(creator) => {
+                let physical = unsafe { creator.physical_device(instance.handle()) }.map_err(Error::Invalid)?;
+                let index = physicals.iter().position(|&p| p == physical).ok_or_else(|| Error::Invalid("the device creator chose a physical device the instance does not list".into()))?;
+                let chosen = &devices[index];
+                if let Err(why) = &chosen.suitable {
+                    return Err(Error::NoSuitableDevice(format!("{} (chosen by the OpenXR runtime): {why}", chosen.name)));
+                }
+                chosen
+            }
+            None => choose_device(&devices, &options.device)?,
+        };
+        let physical = physicals[chosen.index];
         let queue_family = compute_queue_family(&instance, physical)
             .ok_or_else(|| Error::NoSuitableDevice(format!("{} has no compute queue", chosen.name)))?;
 
@@ -156,7 +205,13 @@ impl Context {
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions)
             .enabled_features(&features);
-        let device = unsafe { instance.create_device(physical, &device_info, None)? };
+        let device = match &options.creator {
+            Some(creator) => {
+                let raw = unsafe { creator.create_device(&entry, physical, &device_info) }.map_err(Error::Invalid)?;
+                unsafe { ash::Device::load(instance.fp_v1_0(), raw) }
+            }
+            None => unsafe { instance.create_device(physical, &device_info, None)? },
+        };
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
 
         let mut debug_settings = gpu_allocator::AllocatorDebugSettings::default();
@@ -360,7 +415,13 @@ fn create_instance(entry: &ash::Entry, options: &ContextOptions) -> Result<(ash:
     if sync_validation {
         info = info.push_next(&mut features);
     }
-    let instance = unsafe { entry.create_instance(&info, None)? };
+    let instance = match &options.creator {
+        Some(creator) => {
+            let raw = unsafe { creator.create_instance(entry, &info) }.map_err(Error::Invalid)?;
+            unsafe { ash::Instance::load(entry.static_fn(), raw) }
+        }
+        None => unsafe { entry.create_instance(&info, None)? },
+    };
     Ok((instance, debug_enabled))
 }
 

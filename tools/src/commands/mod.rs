@@ -10,6 +10,8 @@ pub mod reference;
 pub mod render;
 pub mod setup;
 pub mod view;
+pub mod xr;
+mod xr_report;
 
 use anyhow::{Context as _, Result};
 use fovea_renderer::vk::{Context, ContextOptions, DeviceSelector};

@@ -1,0 +1,433 @@
+//! `fovea xr`: both eyes on a headset through any OpenXR runtime with Vulkan. Per frame:
+//! xrWaitFrame → the predicted display time → xrLocateViews (each eye's pose and FOV) → the gaze
+//! at that time → both eyes rendered by the real-time engine, in one submit, into the acquired
+//! swapchain image (side by side) → xrEndFrame with one projection layer. Writes
+//! `DIR/frames.jsonl` (one row per frame) and `DIR/report.json`.
+
+use super::render::RenderArgs;
+use super::setup::{filters, space_for, METHODS};
+use crate::gaze::GazeDriver;
+use crate::output::{prepare_output_dir, write_json};
+use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
+use crate::xr::gaze::{Timebase, XrFrameGaze, XrGaze};
+use crate::xr::vulkan::{binding, open_context, XrSwapchain};
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+use fovea_hal::openxr::{xr, GazeActions, OpenXrGaze, OpenXrRuntime, RuntimeFigures, SessionEnd, SessionOwner};
+use fovea_hal::{Eye, GazeOrigin, HmdDescription};
+use fovea_renderer::gpu_scene::GpuScene;
+use fovea_renderer::graph::SubmitSync;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS};
+use fovea_renderer::vk::{Buffer, Context};
+use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+pub struct XrArgs<'a> {
+    /// Scene, method, filters, headset TOML (figures the runtime does not report), scale, seed,
+    /// profile, frames in flight, output folder, validation.
+    pub render: RenderArgs<'a>,
+    /// Rendered frames before a clean session end; `None`: until the runtime or a signal ends it.
+    pub frames: Option<u32>,
+    /// `None`: the runtime's eye tracker when it has one, else the view centre.
+    pub gaze: Option<&'a str>,
+    pub record: Option<&'a Path>,
+    pub screenshot: Option<&'a Path>,
+}
+
+/// The session, the engine on the runtime's device, and what one frame needs.
+struct XrRun<'a> {
+    args: &'a XrArgs<'a>,
+    ctx: Arc<Context>,
+    owner: SessionOwner<xr::Vulkan>,
+    local: xr::Space,
+    view_space: xr::Space,
+    swapchain: XrSwapchain,
+    renderer: Renderer,
+    gaze: XrGaze,
+    /// World from the runtime's LOCAL space: the scene camera is where the head starts.
+    world_from_local: Mat4,
+    eye_size: (u32, u32),
+    log: FrameLog,
+    screenshot: Option<Buffer>,
+    tally: Tally,
+}
+
+/// Sums over the run for report.json.
+#[derive(Default)]
+struct Tally {
+    frames: u64,
+    rendered: u32,
+    origins: [u32; 3],
+    live_ages_ns: Vec<i64>,
+    pass_sums: BTreeMap<String, f64>,
+    stats: FrameStats,
+    cpu_ms: f64,
+    /// Rendered frames whose GPU times were read (all, once the ring is drained).
+    timed: u32,
+}
+
+pub fn run(args: &XrArgs) -> Result<()> {
+    let r = &args.render;
+    if r.width.is_some() || r.height.is_some() {
+        bail!("fovea xr: the size is the runtime's recommended one × --scale; --width/--height do not apply");
+    }
+    if r.camera_path || r.exr || r.debug_views {
+        bail!("fovea xr: --camera-path, --exr and --debug-views do not apply (the headset moves the camera; frames go to the runtime)");
+    }
+    if args.screenshot.is_some() && args.frames.is_none() {
+        bail!("--screenshot needs --frames N (the screenshot is of the last rendered frame)");
+    }
+    if args.frames == Some(0) {
+        bail!("--frames must be at least 1");
+    }
+    if !(r.scale > 0.0 && r.scale <= 4.0) {
+        bail!("--scale {} must be in (0, 4]", r.scale);
+    }
+    if !METHODS.contains(&r.method) {
+        bail!("--method {}: expected one of {}", r.method, METHODS.join(", "));
+    }
+    let (denoiser, taa) = filters(r.method, r.denoiser, r.taa, &r.profile)?;
+    let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
+    let scene = crate::scenes::load(r.scene)?;
+    let Some(camera) = scene.default_camera() else {
+        bail!("{}: the scene has no perspective camera", scene.source.display());
+    };
+    let out_dir = prepare_output_dir(r.out)?;
+    let rt = Arc::new(OpenXrRuntime::create("fovea").context("fovea xr needs an OpenXR runtime (see README: On a headset)")?);
+    let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;
+    let settings = RenderSettings {
+        max_depth: r.max_depth,
+        seed: r.seed,
+        exposure: r.exposure,
+        blur: r.profile.blur,
+        denoiser,
+        taa,
+        ..Default::default()
+    };
+    let started = Instant::now();
+    let (mut run, session) = XrRun::start(args, &rt, ctx, &base, &scene, camera.world_from_view, settings)?;
+    let end = run.frame_loop()?;
+    run.finish(&rt, &base, &session, end, started)?;
+    out_dir.remove_stale()?;
+    match crate::interrupt::requested() {
+        Some(interrupted) => Err(interrupted.into()),
+        None => Ok(()),
+    }
+}
+
+/// What report.json says about the session beside the run's figures.
+struct SessionFacts {
+    hmd: HmdDescription,
+    figures: RuntimeFigures,
+    gaze_source: String,
+    notice: Option<String>,
+}
+
+impl<'a> XrRun<'a> {
+    fn start(
+        args: &'a XrArgs<'a>,
+        rt: &Arc<OpenXrRuntime>,
+        ctx: Arc<Context>,
+        base: &HmdDescription,
+        scene: &fovea_renderer::scene::Scene,
+        world_from_local: Mat4,
+        settings: RenderSettings,
+    ) -> Result<(XrRun<'a>, SessionFacts)> {
+        let r = &args.render;
+        // SAFETY: the handles are the context's, which outlives the session (dropped after it).
+        let mut owner = unsafe { SessionOwner::vulkan(rt, binding(&ctx)) }?;
+        let use_tracker = match args.gaze {
+            Some("openxr") => {
+                if let Some(why) = rt.missing_eye_tracker() {
+                    bail!("--gaze openxr: {why}");
+                }
+                true
+            }
+            Some(_) => false,
+            None => rt.missing_eye_tracker().is_none(),
+        };
+        let mut notice = None;
+        let (hmd, figures, source) = if use_tracker {
+            let actions = GazeActions::new(rt)?;
+            owner.attach_action_sets(&actions.action_set().into_iter().collect::<Vec<_>>())?;
+            let gaze = OpenXrGaze::new(rt, &owner, actions, base)?;
+            let (hmd, figures) = (fovea_hal::GazeSource::describe(&gaze).clone(), gaze.runtime_figures());
+            (hmd, figures, Some(gaze))
+        } else {
+            if args.gaze.is_none() {
+                let why = rt.missing_eye_tracker().unwrap_or_default();
+                let line = format!("fovea xr: no eye tracker ({why}); foveating at the view centre");
+                eprintln!("{line}");
+                notice = Some(line);
+            }
+            let (hmd, figures) = owner.describe(base, false)?;
+            (hmd, figures, None)
+        };
+        let eye = hmd.eye(Eye::Left);
+        let eye_size = (((eye.recommended_width as f32 * r.scale).round() as u32).max(1), ((eye.recommended_height as f32 * r.scale).round() as u32).max(1));
+        let (driver, timebase, gaze_source) = match source {
+            Some(gaze) => (GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1), Timebase::Runtime, "openxr".to_string()),
+            None => {
+                let spec = args.gaze.unwrap_or("center");
+                (GazeDriver::open(spec, &hmd, eye_size.0, eye_size.1)?, Timebase::FromFirstFrame, spec.to_string())
+            }
+        };
+        let gaze = XrGaze::new(driver, timebase, base, args.record)?;
+        let local = owner.create_reference_space(xr::ReferenceSpaceType::LOCAL)?;
+        let view_space = owner.create_reference_space(xr::ReferenceSpaceType::VIEW)?;
+        let swapchain = XrSwapchain::new(&ctx, &owner, eye_size.0, eye_size.1)?;
+        eprintln!(
+            "fovea xr: {} — 2 × {}×{} in one {:?} swapchain, {} Hz",
+            hmd.display_name, eye_size.0, eye_size.1, swapchain.format, hmd.refresh_hz
+        );
+        let screen = UVec2::new(eye_size.0, eye_size.1);
+        let spaces = [Eye::Left, Eye::Right].iter().map(|&e| space_for(r.method, &r.profile, &hmd, e, screen)).collect::<Result<Vec<_>>>()?;
+        let renderer = Renderer::with_views(&ctx, GpuScene::upload(&ctx, scene)?, spaces, settings, r.frames_in_flight.max(1))?;
+        let screenshot = match args.screenshot {
+            Some(_) => Some(Buffer::new(&ctx, "xr screenshot", swapchain.images[0].bytes(), vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?),
+            None => None,
+        };
+        let log = FrameLog::create(&r.out.join("frames.jsonl"))?;
+        let run = XrRun { args, ctx, owner, local, view_space, swapchain, renderer, gaze, world_from_local, eye_size, log, screenshot, tally: Tally::default() };
+        Ok((run, SessionFacts { hmd, figures, gaze_source, notice }))
+    }
+
+    /// Runs frames until the session ends; returns why it ended.
+    fn frame_loop(&mut self) -> Result<SessionEnd> {
+        let exit = self.owner.exit_handle();
+        loop {
+            let done = self.args.frames.is_some_and(|n| self.tally.rendered >= n);
+            if done || crate::interrupt::requested().is_some() {
+                exit.request(); // the owner sends xrRequestExitSession once and ends on STOPPING
+            }
+            let status = self.owner.poll_events()?;
+            if let Some(end) = status.end {
+                return Ok(end);
+            }
+            if !status.running {
+                std::thread::sleep(Duration::from_millis(5));
+                continue;
+            }
+            let state = self.owner.wait_frame()?;
+            let host = Instant::now();
+            self.owner.begin_frame()?;
+            let t = state.predicted_display_time.as_nanos();
+            let render = state.should_render && !exit.requested();
+            let rendered = if render { self.render_frame(t)? } else { None };
+            let (mut row, engine_frame) = match rendered {
+                Some((row, frame)) => (row, Some(frame)),
+                None => {
+                    self.owner.end_frame(t, &[])?;
+                    (FrameRow::not_rendered(t, state.should_render), None)
+                }
+            };
+            row.frame = self.tally.frames;
+            row.cpu_ms = host.elapsed().as_secs_f64() * 1e3;
+            self.tally.frames += 1;
+            if engine_frame.is_some() {
+                self.tally.cpu_ms += row.cpu_ms;
+            }
+            self.log.push(row, engine_frame)?;
+        }
+    }
+
+    /// One rendered frame: views, gaze, both eyes into the acquired image, the projection layer.
+    /// `None` when the runtime has no valid views for this time (ended without layers).
+    fn render_frame(&mut self, t: i64) -> Result<Option<(FrameRow, u64)>> {
+        let (flags, views) = self.owner.locate_views(t, &self.local)?;
+        let (head_flags, eyes_in_head) = self.owner.locate_views(t, &self.view_space)?;
+        let valid = |f: xr::ViewStateFlags| f.contains(xr::ViewStateFlags::ORIENTATION_VALID);
+        if !valid(flags) || !valid(head_flags) || views.len() != 2 || eyes_in_head.len() != 2 {
+            return Ok(None); // no pose to render with: ended without layers by the caller
+        }
+        // One xrSyncActions per frame for every attached set, before the gaze source reads.
+        self.owner.sync_actions()?;
+        let gaze = self.gaze.frame(t, self.tally.rendered, &eyes_in_head, self.eye_size)?;
+        self.count_gaze(&gaze);
+        let mut inputs = [ViewInput { camera: self.camera(&views[0]), gaze: None }; MAX_VIEWS];
+        for (i, view) in views.iter().enumerate() {
+            inputs[i] = ViewInput { camera: self.camera(view), gaze: Some(gaze.pixels[i]) };
+        }
+        let input = FrameInput::views(&inputs, self.tally.rendered)?;
+        let index = self.swapchain.handle.acquire_image().context("xrAcquireSwapchainImage")? as usize;
+        self.swapchain.handle.wait_image(xr::Duration::INFINITE).context("xrWaitSwapchainImage")?;
+        // The slot this frame takes held frame − frames in flight: read its GPU times first.
+        if let Some(done) = self.renderer.retire_next()? {
+            self.read_finished(done)?;
+        }
+        let last = self.args.frames.is_some_and(|n| self.tally.rendered + 1 == n);
+        let mut offsets = [UVec2::ZERO; MAX_VIEWS];
+        offsets[1] = UVec2::new(self.swapchain.eye_width, 0);
+        let target = FrameTarget {
+            image: &self.swapchain.images[index],
+            offsets,
+            sync: SubmitSync::default(),
+            copy_to: if last { self.screenshot.as_ref() } else { None },
+        };
+        // Submitted before the release: the runtime waits for the queue's work on the image.
+        let engine_frame = self.renderer.submit(&input, Some(&target))?;
+        self.swapchain.handle.release_image().context("xrReleaseSwapchainImage")?;
+        self.end_with_layer(t, &views)?;
+        self.tally.rendered += 1;
+        let row = FrameRow {
+            frame: 0,
+            predicted_display_time_ns: t,
+            should_render: true,
+            rendered: true,
+            views: vec![ViewRow::new("left", &views[0]), ViewRow::new("right", &views[1])],
+            gaze: Some(gaze_row(&gaze)),
+            gpu_ms: None,
+            cpu_ms: 0.0,
+        };
+        Ok(Some((row, engine_frame)))
+    }
+
+    fn end_with_layer(&mut self, t: i64, views: &[xr::View]) -> Result<()> {
+        let (w, h) = (self.swapchain.eye_width as i32, self.swapchain.height as i32);
+        let projection: Vec<_> = views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let rect = xr::Rect2Di { offset: xr::Offset2Di { x: i as i32 * w, y: 0 }, extent: xr::Extent2Di { width: w, height: h } };
+                xr::CompositionLayerProjectionView::new()
+                    .pose(v.pose)
+                    .fov(v.fov)
+                    .sub_image(xr::SwapchainSubImage::new().swapchain(&self.swapchain.handle).image_rect(rect))
+            })
+            .collect();
+        let layer = xr::CompositionLayerProjection::new().space(&self.local).views(&projection);
+        self.owner.end_frame(t, &[&layer])?;
+        Ok(())
+    }
+
+    /// An eye's camera: its located pose (LOCAL space) placed at the scene camera, its FOV.
+    fn camera(&self, view: &xr::View) -> CameraPose {
+        let (p, o, f) = (view.pose.position, view.pose.orientation, view.fov);
+        let local_from_eye = Mat4::from_rotation_translation(Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize(), Vec3::new(p.x, p.y, p.z));
+        CameraPose {
+            world_from_view: self.world_from_local * local_from_eye,
+            fov_tan: Vec4::new(f.angle_left.tan(), f.angle_right.tan(), f.angle_down.tan(), f.angle_up.tan()),
+        }
+    }
+
+    fn count_gaze(&mut self, gaze: &XrFrameGaze) {
+        self.tally.origins[origin_index(gaze.origin)] += 1;
+        if gaze.origin == GazeOrigin::Live {
+            self.tally.live_ages_ns.push(gaze.age_ns);
+        }
+    }
+
+    /// GPU times and counts of a completed engine frame into the log and the tally.
+    fn read_finished(&mut self, frame: u64) -> Result<()> {
+        let mut per_eye = [0.0; 2];
+        for t in self.renderer.frame_timings(frame)? {
+            per_eye[(t.view as usize).min(1)] += t.ms;
+            *self.tally.pass_sums.entry(t.name.to_string()).or_default() += t.ms;
+        }
+        for view in 0..2 {
+            let s = self.renderer.frame_stats(frame, view)?;
+            let total = &mut self.tally.stats;
+            total.samples_traced += s.samples_traced;
+            total.samples_offscreen += s.samples_offscreen;
+            total.primary_rays += s.primary_rays;
+            total.shadow_rays += s.shadow_rays;
+            total.continuation_rays += s.continuation_rays;
+        }
+        self.tally.timed += 1;
+        self.log.complete(frame, per_eye)
+    }
+
+    /// Drains the ring, writes the log, the screenshot, the recording and report.json.
+    fn finish(mut self, rt: &OpenXrRuntime, base: &HmdDescription, facts: &SessionFacts, end: SessionEnd, started: Instant) -> Result<()> {
+        self.renderer.finish()?;
+        let submitted = self.renderer.ring().next_frame();
+        let in_flight = self.renderer.frames_in_flight() as u64;
+        for frame in submitted.saturating_sub(in_flight)..submitted {
+            self.read_finished(frame)?;
+        }
+        self.save_screenshot()?;
+        super::check_validation(&self.ctx)?;
+        let XrRun { args, log, gaze, tally, swapchain, ctx, .. } = self;
+        let logged = log.commit()?;
+        let recorded = gaze.finish()?;
+        let report = super::xr_report::build(&super::xr_report::Inputs {
+            args,
+            rt,
+            base,
+            hmd: &facts.hmd,
+            figures: facts.figures,
+            gaze_source: &facts.gaze_source,
+            notice: facts.notice.as_deref(),
+            device: &ctx.info.name,
+            swapchain_format: swapchain.format,
+            end,
+            tally: &super::xr_report::Tally {
+                frames: tally.frames,
+                rendered: tally.rendered,
+                timed: tally.timed,
+                origins: tally.origins,
+                live_ages_ns: &tally.live_ages_ns,
+                pass_sums: &tally.pass_sums,
+                stats: tally.stats,
+                cpu_ms: tally.cpu_ms,
+            },
+            logged,
+            recorded,
+            wall_seconds: started.elapsed().as_secs_f64(),
+            frames_in_flight: in_flight as usize,
+        })?;
+        write_json(&args.render.out.join("report.json"), &report)?;
+        println!(
+            "fovea xr: {} frame(s), {} rendered (2 × {}×{}) on {} via {}: {:.1} ms GPU per frame, gaze {} → {}",
+            tally.frames,
+            tally.rendered,
+            swapchain.eye_width,
+            swapchain.height,
+            ctx.info.name,
+            report.runtime.name,
+            report.frame_gpu_ms,
+            facts.gaze_source,
+            args.render.out.display()
+        );
+        drop(swapchain);
+        Ok(())
+    }
+
+    fn save_screenshot(&self) -> Result<()> {
+        let (Some(path), Some(buffer)) = (self.args.screenshot, &self.screenshot) else { return Ok(()) };
+        let mut pixels = vec![0u8; buffer.size as usize];
+        buffer.read_into(&mut pixels)?;
+        if self.swapchain.format == vk::Format::B8G8R8A8_UNORM {
+            pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
+        let (w, h) = (self.swapchain.eye_width * 2, self.swapchain.height);
+        crate::output::write_png(path, w, h, &pixels).with_context(|| format!("--screenshot {}", path.display()))
+    }
+}
+
+fn origin_index(origin: GazeOrigin) -> usize {
+    match origin {
+        GazeOrigin::Live => 0,
+        GazeOrigin::Held => 1,
+        GazeOrigin::Centre => 2,
+    }
+}
+
+fn gaze_row(g: &XrFrameGaze) -> GazeRow {
+    GazeRow {
+        sample_time_ns: g.sample_time_ns,
+        direction: g.direction.to_array(),
+        origin: match g.origin {
+            GazeOrigin::Live => "live",
+            GazeOrigin::Held => "held",
+            GazeOrigin::Centre => "centre",
+        },
+        age_ns: g.age_ns,
+        pixels: [g.pixels[0].to_array(), g.pixels[1].to_array()],
+        reason: g.reason,
+    }
+}

@@ -1,0 +1,134 @@
+//! The gaze of each `fovea xr` frame: taken at the frame's predicted display time from the
+//! runtime's eye tracker (`--gaze openxr`), or from any other `--gaze` source on a timebase that
+//! starts at the first rendered frame; run through the invalid-gaze policy; projected into each
+//! eye with that frame's located views; optionally recorded (`--record`) so `fovea render --gaze
+//! TRACE.csv` replays the session.
+
+use crate::gaze::GazeDriver;
+use anyhow::{Context, Result};
+use fovea_hal::openxr::xr;
+use fovea_hal::{EyeView, Fov, GazeOrigin, GazeSample, HmdDescription, SampleTimeKind, TraceWriter, XrTime};
+use glam::{Quat, Vec2, Vec3};
+use std::path::Path;
+
+/// Where display times come from for the source.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Timebase {
+    /// The runtime's clock (the OpenXR eye tracker).
+    Runtime,
+    /// Nanoseconds since the first rendered frame's display time (simulated, trace, fixed).
+    FromFirstFrame,
+}
+
+/// The gaze used for one frame, as the per-frame log reports it.
+#[derive(Clone, Copy, Debug)]
+pub struct XrFrameGaze {
+    /// Unit vector in VIEW space (the head): +X right, +Y up, −Z forward.
+    pub direction: Vec3,
+    pub origin: GazeOrigin,
+    /// When the sample used was measured, in the source's timebase; `None` when unknown or for
+    /// the centre fallback.
+    pub sample_time_ns: Option<XrTime>,
+    /// Display time − sample time (0 for the centre fallback).
+    pub age_ns: i64,
+    /// Per eye (left, right): the gaze pixel in that eye's render image.
+    pub pixels: [Vec2; 2],
+    /// Why the centre is used although a gaze was available (behind or outside an eye's view).
+    pub reason: Option<&'static str>,
+}
+
+pub struct XrGaze {
+    driver: GazeDriver,
+    timebase: Timebase,
+    first_display_time: Option<XrTime>,
+    recorder: Option<TraceWriter>,
+}
+
+impl XrGaze {
+    /// `record`: a new trace file (an existing one is refused) written in `base`'s frame timebase
+    /// (`index × 1 / base.refresh_hz`), which is what `fovea render --headset <the same> --gaze
+    /// TRACE.csv` samples.
+    pub fn new(driver: GazeDriver, timebase: Timebase, base: &HmdDescription, record: Option<&Path>) -> Result<XrGaze> {
+        let recorder = match record {
+            Some(path) => Some(TraceWriter::create(base, path, false).with_context(|| format!("--record {}", path.display()))?),
+            None => None,
+        };
+        Ok(XrGaze { driver, timebase, first_display_time: None, recorder })
+    }
+
+    /// The gaze for the rendered frame `render_index` displayed at `display_time`; `eyes_in_head`:
+    /// the two views located in VIEW space; `size`: one eye's render size.
+    pub fn frame(&mut self, display_time: XrTime, render_index: u32, eyes_in_head: &[xr::View], size: (u32, u32)) -> Result<XrFrameGaze> {
+        let first = *self.first_display_time.get_or_insert(display_time);
+        let t = match self.timebase {
+            Timebase::Runtime => display_time,
+            Timebase::FromFirstFrame => display_time - first,
+        };
+        let (sample, resolved) = self.driver.resolve_at(t)?;
+        let mut gaze = XrFrameGaze {
+            direction: resolved.direction,
+            origin: resolved.source,
+            sample_time_ns: None,
+            age_ns: resolved.age_ns,
+            pixels: [Vec2::new(size.0 as f32, size.1 as f32) * 0.5; 2],
+            reason: None,
+        };
+        gaze.sample_time_ns = match resolved.source {
+            GazeOrigin::Live if sample.time_kind == SampleTimeKind::Unknown => None,
+            GazeOrigin::Live | GazeOrigin::Held => Some(t - resolved.age_ns),
+            GazeOrigin::Centre => None,
+        };
+        for (pixel, view) in gaze.pixels.iter_mut().zip(eyes_in_head) {
+            match project(resolved.direction, view, size) {
+                Some(p) => *pixel = p,
+                None if resolved.source != GazeOrigin::Centre => {
+                    gaze.reason = Some("the gaze lies behind or outside an eye's view");
+                }
+                None => {}
+            }
+        }
+        if gaze.reason.is_some() {
+            gaze = XrFrameGaze { origin: GazeOrigin::Centre, age_ns: 0, sample_time_ns: None, pixels: [Vec2::new(size.0 as f32, size.1 as f32) * 0.5; 2], ..gaze };
+        }
+        self.record(render_index, &gaze)?;
+        Ok(gaze)
+    }
+
+    fn record(&mut self, render_index: u32, gaze: &XrFrameGaze) -> Result<()> {
+        let Some(recorder) = self.recorder.as_mut() else { return Ok(()) };
+        let t = self.driver.frame_time(render_index);
+        let sample = match gaze.origin {
+            GazeOrigin::Centre => GazeSample::no_gaze(t, render_index as u64),
+            // Held gaze is written as the direction it held, so the replay shows the same pixels.
+            _ => GazeSample::looking(t, render_index as u64, gaze.direction),
+        };
+        recorder.write(&sample);
+        recorder.flush().context("--record")?;
+        Ok(())
+    }
+
+    /// Publishes the recording (if any); returns how many samples it holds.
+    pub fn finish(self) -> Result<Option<usize>> {
+        let Some(recorder) = self.recorder else { return Ok(None) };
+        let written = recorder.samples_written();
+        recorder.finish().context("--record")?;
+        Ok(Some(written))
+    }
+}
+
+/// `direction` (VIEW space) as a pixel of the eye located at `eye_in_head` with `size`; `None`
+/// when it lies behind the eye or outside the image.
+pub fn project(direction: Vec3, eye_in_head: &xr::View, size: (u32, u32)) -> Option<Vec2> {
+    let o = eye_in_head.pose.orientation;
+    let in_eye = Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize().inverse() * direction;
+    let f = eye_in_head.fov;
+    let view = EyeView {
+        recommended_width: size.0,
+        recommended_height: size.1,
+        fov: Fov { angle_left: f.angle_left, angle_right: f.angle_right, angle_down: f.angle_down, angle_up: f.angle_up },
+        offset: Vec3::ZERO,
+    };
+    let p = view.direction_to_pixel(in_eye)?;
+    let inside = (-0.5..=size.0 as f32 - 0.5).contains(&p.x) && (-0.5..=size.1 as f32 - 0.5).contains(&p.y);
+    inside.then_some(p)
+}
