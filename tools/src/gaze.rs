@@ -27,6 +27,12 @@ pub struct FrameGaze {
     pub time_ns: XrTime,
 }
 
+/// `index` refresh periods after the start: when `fovea render` shows frame `index` (and the time
+/// `fovea xr --record` gives that frame's gaze, so a replay samples exactly it).
+pub fn frame_time(frame_period_ns: f64, index: u32) -> XrTime {
+    (index as f64 * frame_period_ns) as XrTime
+}
+
 /// Render pixels per headset pixel (the left eye's; both eyes share one render size).
 fn render_scale(hmd: &HmdDescription, render_width: u32, render_height: u32) -> Vec2 {
     let eye = hmd.eye(Eye::Left);
@@ -62,10 +68,9 @@ impl GazeDriver {
         }
     }
 
-    /// The display time of frame `index` in the timebase of simulated and recorded sources:
-    /// `index` refresh periods after the start (`fovea xr --record` writes traces in it).
+    /// The display time of frame `index` in the timebase of simulated and recorded sources.
     pub fn frame_time(&self, index: u32) -> XrTime {
-        (index as f64 * self.frame_period_ns) as XrTime
+        frame_time(self.frame_period_ns, index)
     }
 
     /// The source's sample for display time `t` and the invalid-gaze policy's decision on it.

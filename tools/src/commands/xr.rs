@@ -140,30 +140,25 @@ impl<'a> XrRun<'a> {
         let r = &args.render;
         // SAFETY: the handles are the context's, which outlives the session (dropped after it).
         let mut owner = unsafe { SessionOwner::vulkan(rt, binding(&ctx)) }?;
-        let use_tracker = match args.gaze {
-            Some("openxr") => {
-                if let Some(why) = rt.missing_eye_tracker() {
-                    bail!("--gaze openxr: {why}");
-                }
-                true
-            }
-            Some(_) => false,
-            None => rt.missing_eye_tracker().is_none(),
-        };
+        // Without --gaze the runtime's eye gaze drives the fovea; a runtime without an eye tracker
+        // gives no gaze, so the invalid-gaze policy keeps the fovea at the view centre.
+        let use_runtime_gaze = matches!(args.gaze, None | Some("openxr"));
         let mut notice = None;
-        let (hmd, figures, source) = if use_tracker {
+        if let Some(why) = rt.missing_eye_tracker().filter(|_| use_runtime_gaze) {
+            if args.gaze.is_some() {
+                bail!("--gaze openxr: {why}");
+            }
+            let line = format!("fovea xr: no eye tracker ({why}); foveating at the view centre");
+            eprintln!("{line}");
+            notice = Some(line);
+        }
+        let (hmd, figures, source) = if use_runtime_gaze {
             let actions = GazeActions::new(rt)?;
             owner.attach_action_sets(&actions.action_set().into_iter().collect::<Vec<_>>())?;
             let gaze = OpenXrGaze::new(rt, &owner, actions, base)?;
             let (hmd, figures) = (fovea_hal::GazeSource::describe(&gaze).clone(), gaze.runtime_figures());
             (hmd, figures, Some(gaze))
         } else {
-            if args.gaze.is_none() {
-                let why = rt.missing_eye_tracker().unwrap_or_default();
-                let line = format!("fovea xr: no eye tracker ({why}); foveating at the view centre");
-                eprintln!("{line}");
-                notice = Some(line);
-            }
             let (hmd, figures) = owner.describe(base, false)?;
             (hmd, figures, None)
         };

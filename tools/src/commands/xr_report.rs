@@ -83,6 +83,9 @@ struct GazeAge {
 pub struct XrReport {
     pub runtime: Runtime,
     system: System,
+    /// CLOCK_MONOTONIC − XrTime in ns (XR_KHR_convert_timespec_time), to relate the per-frame log's
+    /// times to other logs; null when the runtime cannot convert.
+    monotonic_minus_xr_time_ns: Option<i64>,
     headset: String,
     headset_toml: String,
     figure_sources: FigureSources,
@@ -138,6 +141,7 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
     let eye = i.hmd.eye(fovea_hal::Eye::Left);
     Ok(XrReport {
         runtime: Runtime { name: props.runtime_name.clone(), version: props.runtime_version.to_string() },
+        monotonic_minus_xr_time_ns: i.rt.now().ok().and_then(|t| Some(i.rt.time_to_monotonic(t).ok()? - t)),
         system: System {
             name: sys.system_name.clone(),
             vendor_id: sys.vendor_id,

@@ -39,6 +39,8 @@ pub struct XrFrameGaze {
 
 pub struct XrGaze {
     driver: GazeDriver,
+    /// The `--headset` TOML's refresh period: the recording's frame timebase.
+    record_period_ns: f64,
     timebase: Timebase,
     first_display_time: Option<XrTime>,
     recorder: Option<TraceWriter>,
@@ -53,7 +55,7 @@ impl XrGaze {
             Some(path) => Some(TraceWriter::create(base, path, false).with_context(|| format!("--record {}", path.display()))?),
             None => None,
         };
-        Ok(XrGaze { driver, timebase, first_display_time: None, recorder })
+        Ok(XrGaze { driver, record_period_ns: 1e9 / base.refresh_hz as f64, timebase, first_display_time: None, recorder })
     }
 
     /// The gaze for the rendered frame `render_index` displayed at `display_time`; `eyes_in_head`:
@@ -96,10 +98,11 @@ impl XrGaze {
 
     fn record(&mut self, render_index: u32, gaze: &XrFrameGaze) -> Result<()> {
         let Some(recorder) = self.recorder.as_mut() else { return Ok(()) };
-        let t = self.driver.frame_time(render_index);
+        let t = crate::gaze::frame_time(self.record_period_ns, render_index);
+        // Held gaze is written as the direction it held, so the replay shows the same pixels; no
+        // gaze stays no gaze (the replay's invalid-gaze policy decides again, on its frame times).
         let sample = match gaze.origin {
             GazeOrigin::Centre => GazeSample::no_gaze(t, render_index as u64),
-            // Held gaze is written as the direction it held, so the replay shows the same pixels.
             _ => GazeSample::looking(t, render_index as u64, gaze.direction),
         };
         recorder.write(&sample);
