@@ -159,7 +159,9 @@ fn sixty_frames_on_the_runtime_with_gaze_at_display_time() {
     let half = |x0: u32| (0..h).flat_map(|y| (0..w).map(move |x| (x0 + x, y))).map(|(x, y)| image.get_pixel(x, y).0).collect::<Vec<_>>();
     let (left, right) = (half(0), half(w));
     let lit = |p: &[[u8; 4]]| p.iter().filter(|c| c[0] as u32 + c[1] as u32 + c[2] as u32 > 30).count();
-    assert!(lit(&left) > (w * h / 4) as usize && lit(&right) > (w * h / 4) as usize, "both eyes show the lit scene");
+    // Monado's ±42° × ±45° eyes see the Cornell box small, in the middle, black around it.
+    let (lit_left, lit_right) = (lit(&left), lit(&right));
+    assert!(lit_left > (w * h / 20) as usize && lit_right > (w * h / 20) as usize, "both eyes show the lit scene: {lit_left}, {lit_right} of {} pixels", w * h);
     assert_ne!(left, right, "the eyes see from different positions");
 
     replay_matches(&out, &rows, &trace);
