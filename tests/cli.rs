@@ -291,3 +291,66 @@ fn reference_force_refuses_non_regular_targets() {
     }
     assert_eq!(std::fs::read_to_string(dir.join("victim.exr")).unwrap(), "old");
 }
+
+/// `fovea bench`'s real-time loop section alone (no scenes, no ray or VP sizes) at 64×72 with 3
+/// timed frames per repeat: report.json's `loop` holds the three runs with counts that follow from
+/// how each run submits. Figures measured in time are only checked to be there, never against a threshold.
+#[test]
+fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
+    use fovea_tools::commands::bench::{run as bench, BenchArgs};
+    let out = temp_dir("bench-loop");
+    let args = |loop_frames| BenchArgs {
+        scenes: &[],
+        sizes: &[],
+        vp_sizes: &[],
+        frames: 1,
+        loop_size: Some((64, 72)),
+        loop_frames,
+        out: &out,
+        device: None,
+        validation: true,
+    };
+    let err = bench(&args(1)).unwrap_err().to_string();
+    assert!(err.contains("--loop-frames"), "{err}");
+    bench(&args(3)).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    for part in ["bvh", "rays", "visual_polar"] {
+        assert_eq!(report[part].as_array().map(Vec::len), Some(0), "{part} was not skipped");
+    }
+    let l = &report["loop"];
+    assert_eq!((l["width"].as_u64(), l["height"].as_u64(), l["frames"].as_u64()), (Some(64), Some(72), Some(3)));
+    assert_eq!(l["repeats"], 2);
+    // (run, frames in flight, renderers = scene uploads, drains in 2 × 3 timed frames): one slot
+    // waits for the newest frame every time; two slots never do.
+    for (name, in_flight, renderers, drains) in [("stereo_in_flight_1", 1, 1, 6), ("stereo_in_flight_2", 2, 1, 0), ("two_mono_in_flight_2", 2, 2, 0)] {
+        let run = &l[name];
+        assert_eq!(run["timed_frames"], 6, "{name}");
+        let f = |key: &str| run[key].as_f64().unwrap_or_else(|| panic!("{name}.{key} missing"));
+        assert_eq!(run["frames_in_flight"], in_flight, "{name}");
+        assert_eq!(run["renderers"], renderers, "{name}");
+        assert_eq!(run["views_per_renderer"], 2 / renderers, "{name}");
+        assert_eq!(f("submits_per_frame"), renderers as f64, "{name}: one submit per renderer and frame");
+        assert_eq!(f("fence_waits_per_frame"), renderers as f64, "{name}: one slot freed per renderer and frame");
+        assert_eq!(run["drain_waits"], drains, "{name}");
+        for key in ["frames_per_second", "wall_ms_per_frame", "gpu_ms_per_frame", "host_ms_per_frame", "process_cpu_ms_per_frame"] {
+            assert!(f(key).is_finite() && f(key) > 0.0, "{name}.{key} = {}", f(key));
+        }
+        assert!(f("others_cpu_ms_per_frame") >= 0.0 && f("steal_ms_per_frame") >= 0.0, "{name}");
+        assert!((f("frames_per_second") * f("wall_ms_per_frame") / 1e3 - 1.0).abs() < 1e-9, "{name}");
+        let passes = run["passes_ms"].as_object().unwrap();
+        assert!(["trace", "svgf_temporal", "remap", "tonemap"].iter().all(|p| passes.contains_key(*p)), "{name}: passes {:?}", passes.keys());
+        let sum: f64 = passes.values().map(|v| v.as_f64().unwrap()).sum();
+        assert!((sum - f("gpu_ms_per_frame")).abs() < 1e-9 * sum.max(1.0), "{name}");
+    }
+    let bytes = |name: &str, key: &str| l[name][key].as_i64().unwrap();
+    // One scene shared by both eyes: stereo = scene + 2 views, two mono = 2 × (scene + view), so
+    // two mono renders hold at least one more scene upload.
+    let (stereo, mono) = (bytes("stereo_in_flight_2", "gpu_bytes"), bytes("two_mono_in_flight_2", "gpu_bytes"));
+    let scene = bytes("stereo_in_flight_2", "scene_bytes");
+    assert!(scene > 0 && bytes("two_mono_in_flight_2", "scene_bytes") == 2 * scene);
+    assert!(stereo < mono && mono - stereo >= scene && stereo > mono / 2, "stereo {stereo} B, two mono {mono} B, scene {scene} B");
+    let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-9;
+    assert!(close(l["stereo_vs_two_mono_bytes"].as_f64().unwrap(), stereo as f64 / mono as f64));
+    let fps = |name: &str| l[name]["frames_per_second"].as_f64().unwrap();
+    assert!(close(l["in_flight_2_vs_1_fps"].as_f64().unwrap(), fps("stereo_in_flight_2") / fps("stereo_in_flight_1")));
+}

@@ -3,6 +3,7 @@
 
 pub mod camera_path;
 pub mod commands;
+pub mod cpu_time;
 pub mod density;
 pub mod gaze;
 pub mod interrupt;

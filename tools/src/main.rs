@@ -1,6 +1,6 @@
 //! `fovea`: the command line of the foveated path tracer. See README.md for the contract.
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand};
 use fovea_tools::commands;
 use fovea_renderer::passes::denoise::DenoiserSettings;
@@ -215,9 +215,10 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
-    /// Benchmark: BVH build, rays per second, per-pass GPU milliseconds (one run, one device).
+    /// Benchmark: BVH build, rays per second, per-pass GPU milliseconds, the real-time loop (one
+    /// run, one device).
     Bench {
-        /// Scenes to measure.
+        /// Scenes of the BVH, ray and frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
         scenes: Vec<String>,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
@@ -229,6 +230,14 @@ enum Command {
         /// Whole frames rendered per size for the per-pass timings.
         #[arg(long, default_value_t = 2)]
         frames: u32,
+        /// Per-eye size WxH of the real-time loop figures: Cornell box, both eyes, VP + SVGF, 1 vs 2
+        /// frames in flight, stereo vs two mono renders ("" skips them).
+        #[arg(long, default_value = "320x360")]
+        loop_size: String,
+        /// Timed frames of each real-time loop run (after 2 warm-up frames; at least 2). Each run
+        /// is made twice (order A B C C B A).
+        #[arg(long, default_value_t = 5)]
+        loop_frames: u32,
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
         #[command(flatten)]
@@ -433,16 +442,21 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, sizes, vp_sizes, frames, out, device } => {
+        Command::Bench { scenes, sizes, vp_sizes, frames, loop_size, loop_frames, out, device } => {
             let parse = |v: &[String]| v.iter().filter(|s| !s.is_empty()).map(|s| parse_size(s)).collect::<Result<Vec<_>>>();
-            let (sizes, vp_sizes) = (parse(&sizes)?, parse(&vp_sizes)?);
+            let (sizes, vp_sizes) = (parse(&sizes).context("--sizes")?, parse(&vp_sizes).context("--vp-sizes")?);
+            let loop_size = (!loop_size.is_empty()).then(|| parse_size(&loop_size)).transpose().context("--loop-size")?;
+            let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
                 sizes: &sizes,
                 vp_sizes: &vp_sizes,
                 frames,
+                loop_size,
+                loop_frames,
                 out: &out,
                 device: device.device.as_deref(),
+                validation: device.validation,
             })
         }
         Command::Headsets => commands::headsets::run(),

@@ -1,7 +1,8 @@
 //! `fovea bench`: BVH build rate and memory on the large scene; primary, shadow and indirect rays
 //! per second on the current device; per-pass GPU milliseconds of whole frames. All figures
 //! come from one run on one device (GPU timestamps for the GPU parts). The Visual-Polar vs
-//! Cartesian comparison lives in `bench_vp.rs`.
+//! Cartesian comparison lives in `bench_vp.rs`, the real-time loop (frames in flight, stereo vs
+//! two mono renders, host CPU time) in `bench_loop.rs`.
 
 use anyhow::{bail, Result};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -25,8 +26,13 @@ pub struct BenchArgs<'a> {
     /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
     pub vp_sizes: &'a [(u32, u32)],
     pub frames: u32,
+    /// Per-eye size of the real-time loop section (`None`: skip it); its scene is the Cornell box.
+    pub loop_size: Option<(u32, u32)>,
+    /// Timed frames of each loop run (after `bench_loop::WARMUP_FRAMES` warm-up frames).
+    pub loop_frames: u32,
     pub out: &'a Path,
     pub device: Option<&'a str>,
+    pub validation: bool,
 }
 
 #[derive(Serialize)]
@@ -57,12 +63,19 @@ struct BenchReport {
     bvh: Vec<BvhReport>,
     rays: Vec<RayReport>,
     visual_polar: Vec<super::bench_vp::VpFrameReport>,
+    /// The real-time loop section (`null` when skipped).
+    #[serde(rename = "loop")]
+    real_time_loop: Option<super::bench_loop::LoopReport>,
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.loop_size.is_some() {
+        super::bench_loop::check_frames(args.loop_frames)?;
+    }
     let _out_dir = crate::output::prepare_output_dir(args.out)?;
-    let ctx = super::open_device(args.device, false)?;
-    let mut report = BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new() };
+    let ctx = super::open_device(args.device, args.validation)?;
+    let mut report =
+        BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new(), real_time_loop: None };
     for name in args.scenes {
         let scene = crate::scenes::load(name)?;
         let positions = scene.triangle_positions();
@@ -126,6 +139,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?);
             report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, size, args.frames)?);
         }
+    }
+    if let Some(size) = args.loop_size {
+        report.real_time_loop = Some(super::bench_loop::measure(&ctx, size, args.loop_frames)?);
     }
     super::check_validation(&ctx)?;
     let path = args.out.join("report.json");

@@ -1,4 +1,5 @@
 pub mod bench;
+mod bench_loop;
 mod bench_vp;
 pub mod eval;
 pub mod debug_views;

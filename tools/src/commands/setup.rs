@@ -148,7 +148,7 @@ impl Setup {
 
 /// The head pose for one eye: a mono run keeps the head pose (the scene camera, as before
 /// stereo); a stereo run offsets each eye by its position in the headset (metres = glTF units).
-fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: Eyes) -> CameraPose {
+pub(crate) fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: Eyes) -> CameraPose {
     match eyes {
         Eyes::Both => CameraPose { world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset), fov_tan: head.fov_tan },
         _ => *head,
