@@ -51,6 +51,17 @@ pub enum GazeOrigin {
     Centre,
 }
 
+impl GazeOrigin {
+    /// The name in reports and logs: live, held, centre.
+    pub fn name(self) -> &'static str {
+        match self {
+            GazeOrigin::Live => "live",
+            GazeOrigin::Held => "held",
+            GazeOrigin::Centre => "centre",
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ResolvedGaze {
     /// Unit direction in view space.

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 use fovea_tools::commands;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_tools::render_profile::{ProfileOverrides, RenderProfile};
+use fovea_tools::replay::Tolerances;
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -190,6 +191,40 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Regression replay: render gaze traces and compare every frame with a stored baseline
+    /// (change: FLIP/RMSE per ring; quality against the converged reference; the gaze used;
+    /// cost, reported). Exit 0 within tolerance, 1 on a regression, 2 on bad input.
+    Replay {
+        /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
+        traces: Vec<String>,
+        /// Baseline folder (one subfolder per trace).
+        #[arg(long)]
+        baseline: PathBuf,
+        /// Write the baselines from this run instead of comparing (overwrites them).
+        #[arg(long)]
+        update_baseline: bool,
+        /// Samples per pixel of the converged reference made with a new baseline.
+        #[arg(long, default_value_t = 256)]
+        reference_spp: u32,
+        /// Rings of distance from the gaze for every per-ring figure.
+        #[arg(long, default_value_t = 4)]
+        rings: usize,
+        /// Largest mean FLIP per ring against the baseline's frame.
+        #[arg(long, default_value_t = Tolerances::default().change_flip)]
+        change_flip: f64,
+        /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
+        #[arg(long, default_value_t = Tolerances::default().change_rmse)]
+        change_rmse: f64,
+        /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
+        #[arg(long, default_value_t = Tolerances::default().quality_rel)]
+        quality_rel: f64,
+        #[arg(long, default_value_t = Tolerances::default().quality_abs)]
+        quality_abs: f64,
+        #[command(flatten)]
+        opts: Box<RenderOpts>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
     /// Render a converged linear-radiance reference EXR.
     Reference {
         #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
@@ -333,6 +368,9 @@ enum Command {
     },
 }
 
+/// `fovea replay`'s length for a new baseline without `--frames`.
+const DEFAULT_REPLAY_FRAMES: u32 = commands::replay::DEFAULT_FRAMES;
+
 /// `fovea render`'s length without `--frames`.
 const DEFAULT_RENDER_FRAMES: u32 = 24;
 
@@ -377,10 +415,14 @@ fn main() -> std::process::ExitCode {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("Error: {e:?}");
-            match e.downcast_ref::<fovea_tools::interrupt::Interrupted>() {
-                Some(interrupted) => std::process::ExitCode::from(interrupted.exit_code()),
-                None => std::process::ExitCode::FAILURE,
+            if let Some(interrupted) = e.downcast_ref::<fovea_tools::interrupt::Interrupted>() {
+                return std::process::ExitCode::from(interrupted.exit_code());
             }
+            // fovea replay: 1 = a regression, 2 = bad input (everything else: 1).
+            if e.downcast_ref::<commands::replay::BadInput>().is_some() {
+                return std::process::ExitCode::from(2);
+            }
+            std::process::ExitCode::FAILURE
         }
     }
 }
@@ -425,6 +467,25 @@ fn run() -> Result<()> {
                 gaze: opts.gaze.as_deref(),
                 record: record.as_deref(),
                 screenshot: screenshot.as_deref(),
+            })
+        }
+        Command::Replay { traces, baseline, update_baseline, reference_spp, rings, change_flip, change_rmse, quality_rel, quality_abs, opts, device } => {
+            let profile = opts.profile()?;
+            let mut render = render_args(&opts, &device, &profile, DEFAULT_REPLAY_FRAMES, "center", "out/replay")?;
+            // Small by default: replays run in the test suite.
+            render.width = Some(opts.width.unwrap_or(64));
+            render.height = Some(opts.height.unwrap_or(72));
+            let tolerances = Tolerances { change_flip, change_rmse, quality_rel, quality_abs, ..Tolerances::default() };
+            commands::replay::run(&commands::replay::ReplayArgs {
+                traces: &traces,
+                baseline: &baseline,
+                frames: opts.frames,
+                out: render.out,
+                render,
+                update: update_baseline,
+                reference_spp,
+                rings,
+                tolerances,
             })
         }
         Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {

@@ -201,7 +201,7 @@ pub fn check_new_file(path: &Path, force: bool) -> Result<()> {
 
 /// Names fovea writes into an output folder.
 fn is_fovea_file(name: &str) -> bool {
-    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md" | "frames.jsonl" | "xr_view.png")
+    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md" | "frames.jsonl" | "replay.json" | "replay.md")
         || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))

@@ -9,6 +9,7 @@ pub mod info;
 pub mod quality;
 pub mod reference;
 pub mod render;
+pub mod replay;
 pub mod setup;
 pub mod view;
 pub mod xr;

@@ -64,6 +64,8 @@ struct Report {
     /// Gaze point per frame in the left eye's render pixels (the Cartesian method traces uniformly and only
     /// records it; foveated methods centre their sampling on it).
     gaze: Vec<[f32; 2]>,
+    /// Per frame: live, held or centre (`fovea replay` checks the playback frame by frame).
+    gaze_origin: Vec<&'static str>,
     /// Frames whose gaze was live / held after a lost sample / the view centre.
     gaze_live: u32,
     gaze_held: u32,
@@ -151,6 +153,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.set_style(ProgressStyle::with_template("{bar:40} frame {pos}/{len}  {elapsed} (eta {eta})")?);
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
+    let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut submitted = 0u32;
     for frame in 0..frames {
@@ -159,6 +162,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         let (input, frame_gaze) = setup.frame_input(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
+        gaze_origin.push(frame_gaze.origin.name());
         origins[match frame_gaze.origin {
             GazeOrigin::Live => 0,
             GazeOrigin::Held => 1,
@@ -205,6 +209,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),
         gaze: gaze_points,
+        gaze_origin,
         gaze_live: origins[0],
         gaze_held: origins[1],
         gaze_centre: origins[2],

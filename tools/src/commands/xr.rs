@@ -416,11 +416,7 @@ fn gaze_row(g: &XrFrameGaze) -> GazeRow {
     GazeRow {
         sample_time_ns: g.sample_time_ns,
         direction: g.direction.to_array(),
-        origin: match g.origin {
-            GazeOrigin::Live => "live",
-            GazeOrigin::Held => "held",
-            GazeOrigin::Centre => "centre",
-        },
+        origin: g.origin.name(),
         age_ns: g.age_ns,
         pixels: [g.pixels[0].to_array(), g.pixels[1].to_array()],
         reason: g.reason,

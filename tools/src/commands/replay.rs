@@ -1,0 +1,271 @@
+//! `fovea replay TRACE… --baseline DIR`: renders each gaze trace deterministically (fixed seed,
+//! frame k at k / refresh of the headset profile, still camera) and compares every frame with the
+//! stored baseline: change (FLIP, RMSE), quality (FLIP against the converged reference; may not grow),
+//! the gaze used (the playback), cost (reported, never a failure). Exit 0 within tolerance, 1 on
+//! a regression, 2 on bad input. `--update-baseline` writes the baseline instead.
+
+use super::render::RenderArgs;
+use crate::flip::{flip_image, flip_map};
+use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_png, write_text};
+use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
+use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
+use anyhow::{bail, Context, Result};
+use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::sampling::Cartesian;
+use glam::{UVec2, Vec2};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+pub struct ReplayArgs<'a> {
+    pub traces: &'a [String],
+    pub baseline: &'a Path,
+    /// The render settings; `gaze`, `out` and `exr` are set per trace.
+    pub render: RenderArgs<'a>,
+    /// `--frames` as given (`None`: the baseline's count, or 8 for a new baseline).
+    pub frames: Option<u32>,
+    pub out: &'a Path,
+    pub update: bool,
+    pub reference_spp: u32,
+    pub rings: usize,
+    pub tolerances: Tolerances,
+}
+
+/// Frames of a new baseline without `--frames`.
+pub const DEFAULT_FRAMES: u32 = 8;
+
+/// Some frame left the tolerances (exit status 1).
+#[derive(Debug)]
+pub struct Regression {
+    pub failed_frames: usize,
+    pub report: std::path::PathBuf,
+}
+
+impl std::fmt::Display for Regression {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} frame(s) outside the tolerances; see {}", self.failed_frames, self.report.display())
+    }
+}
+
+impl std::error::Error for Regression {}
+
+/// Anything but a regression: bad flags, traces or baselines (exit status 2).
+#[derive(Debug)]
+pub struct BadInput(pub String);
+
+impl std::fmt::Display for BadInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BadInput {}
+
+#[derive(Serialize)]
+struct TraceResult {
+    trace: String,
+    baseline: String,
+    baseline_commit: String,
+    baseline_device: String,
+    /// Settings that differ from the baseline's: (name, baseline, now).
+    param_changes: Vec<(String, String, String)>,
+    frames: Vec<FrameCheck>,
+    failed_frames: Vec<u32>,
+    /// Pass → GPU ms now / in the baseline (report only).
+    cost_ratio: BTreeMap<String, f64>,
+}
+
+#[derive(Serialize)]
+struct ReplayReport<'a> {
+    tolerances: &'a Tolerances,
+    traces: Vec<TraceResult>,
+    passed: bool,
+}
+
+pub fn run(args: &ReplayArgs) -> Result<()> {
+    run_checked(args).map_err(|e| if e.is::<Regression>() { e } else { BadInput(format!("{e:#}")).into() })
+}
+
+fn run_checked(args: &ReplayArgs) -> Result<()> {
+    if args.traces.is_empty() {
+        bail!("fovea replay needs at least one trace (a trace file or a gaze source such as sim:1)");
+    }
+    if !(1..=64).contains(&args.rings) || !(1..=1 << 16).contains(&args.reference_spp) {
+        bail!("--rings must be in 1..=64 and --reference-spp in 1..=65536");
+    }
+    if args.render.camera_path || args.render.debug_views {
+        bail!("fovea replay renders a still camera without debug views (--camera-path/--debug-views do not apply)");
+    }
+    let _out_dir = prepare_output_dir(args.out)?;
+    let mut results = Vec::new();
+    for trace in args.traces {
+        let result = replay_trace(args, trace).with_context(|| format!("trace {trace}"))?;
+        results.push(result);
+    }
+    if args.update {
+        println!("fovea replay: wrote {} baseline(s) under {}", results.len(), args.baseline.display());
+        return Ok(());
+    }
+    let failed: usize = results.iter().map(|r| r.failed_frames.len()).sum();
+    let report = ReplayReport { tolerances: &args.tolerances, passed: failed == 0, traces: results };
+    write_json(&args.out.join("replay.json"), &report)?;
+    let table = markdown(&report);
+    write_text(&args.out.join("replay.md"), &table)?;
+    print!("{table}");
+    if failed > 0 {
+        return Err(Regression { failed_frames: failed, report: args.out.join("replay.md") }.into());
+    }
+    Ok(())
+}
+
+fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
+    let name = trace_name(trace);
+    // The trace first: a file that is not one is named as such, not as a missing baseline.
+    let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
+    crate::gaze::GazeDriver::open(trace, &hmd, args.render.width.unwrap_or(64), args.render.height.unwrap_or(72))?;
+    let base_dir = args.baseline.join(&name);
+    let baseline = if args.update { None } else { Some(Baseline::load(&base_dir)?) };
+    let frames = match (&baseline, args.frames) {
+        (Some(b), Some(n)) if n != b.params.frames => bail!("--frames {n}: the baseline {} has {} frames", base_dir.display(), b.params.frames),
+        (Some(b), _) => b.params.frames,
+        (None, n) => n.unwrap_or(DEFAULT_FRAMES),
+    };
+    let run_dir = args.out.join(format!("run_{name}"));
+    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, ..args.render };
+    super::render::run(&render)?;
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run_dir.join("report.json"))?)?;
+    let (width, height) = (report["width"].as_u64().unwrap_or(0) as u32, report["height"].as_u64().unwrap_or(0) as u32);
+    let params = params_of(args, &render, width, height);
+    let reference = match &baseline {
+        Some(_) => read_exr(&Baseline::reference_exr(&base_dir))?.2,
+        None => reference_for(args, &render, width, height)?,
+    };
+    let reference_ldr = tonemap_preview(&reference, render.exposure);
+    let ppd = pixels_per_degree(args, width)?;
+    let passes: BTreeMap<String, f64> = serde_json::from_value(report["passes"].clone()).unwrap_or_default();
+    let mut records = Vec::new();
+    let mut checks = Vec::new();
+    for k in 0..frames {
+        let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?.to_rgba8().into_raw();
+        let reference_flip = flip_map(&reference_ldr, &ldr, width, height, ppd);
+        let g = &report["gaze"][k as usize];
+        let gaze = Vec2::new(g[0].as_f64().unwrap_or(0.0) as f32, g[1].as_f64().unwrap_or(0.0) as f32);
+        let origin = report["gaze_origin"][k as usize].as_str().unwrap_or("").to_string();
+        match &baseline {
+            None => {
+                let images = FrameImages { width, height, ldr: &ldr, ldr_baseline: &ldr, reference_flip: &reference_flip, gaze, origin: &origin };
+                records.push(FrameRecord { frame: k, gaze: gaze.to_array(), origin: origin.clone(), quality_flip: quality_flip(&images, args.rings) });
+                write_png(&Baseline::frame_png(&base_dir_created(&base_dir)?, k), width, height, &ldr)?;
+            }
+            Some(b) => {
+                let base_png = Baseline::frame_png(&base_dir, k);
+                let base_ldr = image::open(&base_png).with_context(|| format!("reading {}", base_png.display()))?.to_rgba8();
+                if base_ldr.dimensions() != (width, height) {
+                    bail!("{}: {}×{}, the replay renders {width}×{height}", base_png.display(), base_ldr.width(), base_ldr.height());
+                }
+                let base_ldr = base_ldr.into_raw();
+                let images = FrameImages { width, height, ldr: &ldr, ldr_baseline: &base_ldr, reference_flip: &reference_flip, gaze, origin: &origin };
+                let flip = flip_map(&base_ldr, &ldr, width, height, ppd);
+                let check = check_frame(&images, &b.frames[k as usize], &flip, &args.tolerances);
+                if check.failed() {
+                    write_png(&run_dir.join(format!("frame_{k:04}_baseline.png")), width, height, &base_ldr)?;
+                    write_png(&run_dir.join(format!("frame_{k:04}_flip.png")), width, height, &flip_image(&flip, width, height))?;
+                }
+                checks.push(check);
+            }
+        }
+    }
+    if baseline.is_none() {
+        write_exr(&Baseline::reference_exr(&base_dir), width, height, &reference)?;
+        let device = report["device"].as_str().unwrap_or("").to_string();
+        let new = Baseline { format: FORMAT.into(), trace: trace.into(), commit: current_commit(), device, params: params.clone(), frames: records, passes: passes.clone() };
+        write_json(&base_dir.join("baseline.json"), &new)?;
+    }
+    let b = baseline.as_ref();
+    Ok(TraceResult {
+        trace: trace.into(),
+        baseline: base_dir.display().to_string(),
+        baseline_commit: b.map(|b| b.commit.clone()).unwrap_or_default(),
+        baseline_device: b.map(|b| b.device.clone()).unwrap_or_default(),
+        param_changes: b.map(|b| param_changes(&b.params, &params)).unwrap_or_default(),
+        failed_frames: checks.iter().filter(|c| c.failed()).map(|c| c.frame).collect(),
+        frames: checks,
+        cost_ratio: b.map(|b| passes.iter().filter_map(|(k, v)| Some((k.clone(), v / b.passes.get(k).filter(|&&x| x > 0.0)?))).collect()).unwrap_or_default(),
+    })
+}
+
+fn base_dir_created(dir: &Path) -> Result<std::path::PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    Ok(dir.to_path_buf())
+}
+
+fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Params {
+    Params {
+        scene: r.scene.to_string(),
+        method: r.method.to_string(),
+        denoiser: r.denoiser.to_string(),
+        taa: r.taa.to_string(),
+        headset: r.headset.to_string(),
+        width,
+        height,
+        frames: r.frames,
+        seed: r.seed,
+        max_depth: r.max_depth,
+        blur_sigma_at_30: r.profile.blur.sigma_at_30,
+        reference_spp: args.reference_spp,
+        rings: args.rings,
+    }
+}
+
+fn param_changes(base: &Params, now: &Params) -> Vec<(String, String, String)> {
+    let (a, b) = (serde_json::to_value(base).unwrap_or_default(), serde_json::to_value(now).unwrap_or_default());
+    let (Some(a), Some(b)) = (a.as_object(), b.as_object()) else { return Vec::new() };
+    a.iter().filter(|(k, v)| b.get(*k) != Some(v)).map(|(k, v)| (k.clone(), v.to_string(), b.get(k).map(|x| x.to_string()).unwrap_or_default())).collect()
+}
+
+/// The converged image of the still camera (Cartesian, `--reference-spp` samples per pixel).
+fn reference_for(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Result<Vec<[f32; 4]>> {
+    let scene = crate::scenes::load(r.scene)?;
+    let Some(camera) = scene.default_camera() else { bail!("{}: the scene has no perspective camera", scene.source.display()) };
+    let ctx = super::open_device(r.device, r.validation)?;
+    let settings = RenderSettings { seed: r.seed.wrapping_add(0x5eed), ..Default::default() };
+    let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(UVec2::new(width, height))), settings)?;
+    let pose = CameraPose::from_scene_camera(camera, width, height);
+    let reference = renderer.render_reference(&pose, args.reference_spp, r.max_depth, |_| {})?;
+    super::check_validation(&ctx)?;
+    Ok(reference)
+}
+
+/// FLIP's viewing condition: the render stretched over the headset eye's horizontal FOV.
+fn pixels_per_degree(args: &ReplayArgs, width: u32) -> Result<f32> {
+    let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
+    let fov = hmd.eye(fovea_hal::Eye::Left).fov;
+    Ok(width as f32 / (fov.angle_right - fov.angle_left).to_degrees().max(1.0))
+}
+
+fn markdown(r: &ReplayReport) -> String {
+    let mut s = format!("# fovea replay: {}\n\n", if r.passed { "within tolerance" } else { "REGRESSION" });
+    for t in &r.traces {
+        s += &format!("## {} (baseline {} from commit {} on {})\n\n", t.trace, t.baseline, t.baseline_commit, t.baseline_device);
+        for (k, was, now) in &t.param_changes {
+            s += &format!("- setting `{k}`: {was} in the baseline, {now} now\n");
+        }
+        if t.failed_frames.is_empty() {
+            s += &format!("{} frame(s), all within tolerance.\n\n", t.frames.len());
+        } else {
+            s += "| frame | changed rings (FLIP, RMSE) | worse rings (error now > limit) | gaze |\n|---|---|---|---|\n";
+            for c in t.frames.iter().filter(|c| c.failed()) {
+                let changed: Vec<String> = c.change.iter().filter(|x| x.changed).map(|x| format!("{}: {:.4}, {:.4}", x.ring, x.flip.unwrap_or(0.0), x.rmse.unwrap_or(0.0))).collect();
+                let worse: Vec<String> = c.quality.iter().filter(|x| x.regressed).map(|x| format!("{}: {:.4} > {:.4}", x.ring, x.actual.unwrap_or(0.0), x.limit.unwrap_or(0.0))).collect();
+                let gaze = if c.gaze_differs { format!("{:?} {} (baseline {:?} {})", c.gaze, c.origin, c.gaze_baseline, c.origin_baseline) } else { "same".into() };
+                s += &format!("| {} | {} | {} | {} |\n", c.frame, changed.join("; "), worse.join("; "), gaze);
+            }
+            s += &format!("\nImages of failing frames: `run_{}/frame_NNNN.png` (now), `_baseline.png`, `_flip.png` (FLIP map).\n\n", trace_name(&t.trace));
+        }
+        if !t.cost_ratio.is_empty() {
+            let costs: Vec<String> = t.cost_ratio.iter().map(|(k, v)| format!("{k} {v:.2}×")).collect();
+            s += &format!("Cost now / baseline (GPU ms per pass, report only): {}\n\n", costs.join(", "));
+        }
+    }
+    s
+}

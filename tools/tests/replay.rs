@@ -1,0 +1,152 @@
+//! `fovea replay` as users run it: the committed baselines (tests/replay/baseline, made on
+//! lavapipe) pass; a planted regression fails with a report naming frames and rings; a better
+//! setting passes the quality check but is a change; a blink replays the held gaze exactly; bad
+//! baselines and traces are exit status 2 naming the file. Validation on.
+
+use fovea_hal::{GazeSample, HmdDescription, TraceWriter};
+use glam::Vec3;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fovea-replay-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `fovea replay` on the committed traces from the repository root (baseline trace names are
+/// relative to it), output into `out`.
+fn replay(traces: &[&str], baseline: &Path, out: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fovea"))
+        .current_dir(repo())
+        .arg("replay")
+        .args(traces)
+        .arg("--baseline")
+        .arg(baseline)
+        .arg("--out")
+        .arg(out)
+        .args(["--validation"])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn committed() -> PathBuf {
+    repo().join("tests/replay/baseline")
+}
+
+const TRACES: [&str; 2] = ["config/gaze/example_trace.csv", "sim:1"];
+
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn the_committed_baselines_replay_within_tolerance() {
+    let out = temp_dir("committed");
+    let done = replay(&TRACES, &committed(), &out, &[]);
+    assert_eq!(done.status.code(), Some(0), "{}\n{}", String::from_utf8_lossy(&done.stdout), stderr(&done));
+    let report = json(&out.join("replay.json"));
+    assert_eq!(report["passed"], true);
+    for t in report["traces"].as_array().unwrap() {
+        assert_eq!(t["frames"].as_array().unwrap().len(), 8);
+        assert!(t["failed_frames"].as_array().unwrap().is_empty());
+        assert!(!t["cost_ratio"].as_object().unwrap().is_empty(), "cost is reported");
+    }
+}
+
+/// No indirect bounce: every frame is a change, and worse against the reference in its rings.
+#[test]
+fn a_planted_regression_fails_naming_frames_and_rings() {
+    let out = temp_dir("planted");
+    let done = replay(&TRACES[..1], &committed(), &out, &["--max-depth", "2"]);
+    assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
+    assert!(stderr(&done).contains("outside the tolerances"), "{}", stderr(&done));
+    let report = json(&out.join("replay.json"));
+    let trace = &report["traces"][0];
+    assert_eq!(trace["failed_frames"].as_array().unwrap().len(), 8);
+    let worse: usize = trace["frames"].as_array().unwrap().iter().map(|f| f["quality"].as_array().unwrap().iter().filter(|r| r["regressed"] == true).count()).sum();
+    assert!(worse >= 8, "quality regressions in {worse} frame-rings");
+    assert!(trace["param_changes"].to_string().contains("max_depth"));
+    let md = std::fs::read_to_string(out.join("replay.md")).unwrap();
+    assert!(md.contains("REGRESSION") && md.contains("| 0 |") && md.contains(" > "), "{md}");
+    assert!(out.join("run_example_trace/frame_0000_baseline.png").is_file() && out.join("run_example_trace/frame_0000_flip.png").is_file());
+}
+
+/// TAA is an intended improvement: the frames change, their error against the reference does not grow.
+#[test]
+fn a_better_setting_is_a_change_but_no_quality_regression() {
+    let out = temp_dir("better");
+    let done = replay(&TRACES[..1], &committed(), &out, &["--taa", "vp"]);
+    assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
+    let report = json(&out.join("replay.json"));
+    let frames = report["traces"][0]["frames"].as_array().unwrap();
+    assert!(frames.iter().any(|f| f["change"].as_array().unwrap().iter().any(|r| r["changed"] == true)));
+    assert!(frames.iter().all(|f| f["quality"].as_array().unwrap().iter().all(|r| r["regressed"] == false)), "{}", report["traces"][0]["frames"]);
+}
+
+/// A trace whose eye closes for 50 ms: the frames in the blink use the held direction, exactly,
+/// and replay against their own baseline identically.
+#[test]
+fn a_blink_replays_the_held_gaze_exactly() {
+    let dir = temp_dir("blink");
+    let trace = dir.join("blink.csv");
+    let mut writer = TraceWriter::create(&HmdDescription::fove0(), &trace, false).unwrap();
+    let (a, b) = (Vec3::new(0.2, 0.1, -1.0).normalize(), Vec3::new(-0.3, 0.0, -1.0).normalize());
+    for i in 0..16u64 {
+        let t = (i as f64 * 1e9 / 120.0) as i64;
+        let sample = match t {
+            t if t < 40_000_000 => GazeSample::looking(t, i, a),
+            t if t < 90_000_000 => GazeSample::no_gaze(t, i),
+            _ => GazeSample::looking(t, i, b),
+        };
+        writer.write(&sample);
+    }
+    writer.finish().unwrap();
+    let (baseline, out) = (dir.join("baseline"), dir.join("out"));
+    let trace_arg = trace.display().to_string();
+    let made = replay(&[&trace_arg], &baseline, &out, &["--update-baseline", "--method", "cartesian", "--reference-spp", "16"]);
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let frames = json(&baseline.join("blink/baseline.json"))["frames"].as_array().unwrap().clone();
+    let origins: Vec<&str> = frames.iter().map(|f| f["origin"].as_str().unwrap()).collect();
+    assert_eq!(origins, ["live", "live", "live", "held", "held", "held", "held", "live"], "frames at k / 70 Hz");
+    for f in &frames[3..7] {
+        assert_eq!(f["gaze"], frames[2]["gaze"], "the held gaze is the last live one, bit for bit");
+    }
+    assert_ne!(frames[7]["gaze"], frames[2]["gaze"]);
+    let again = replay(&[&trace_arg], &baseline, &dir.join("out2"), &["--method", "cartesian", "--reference-spp", "16"]);
+    assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
+}
+
+#[test]
+fn bad_baselines_and_traces_are_exit_2_naming_the_file() {
+    let dir = temp_dir("bad");
+    // No baseline yet: say how to make one.
+    let missing = replay(&TRACES[..1], &dir.join("none"), &dir.join("o1"), &[]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(stderr(&missing).contains("--update-baseline"), "{}", stderr(&missing));
+    // A corrupt baseline.json.
+    let broken = dir.join("broken/example_trace");
+    std::fs::create_dir_all(&broken).unwrap();
+    std::fs::write(broken.join("baseline.json"), "{ \"format\": 3 ").unwrap();
+    let corrupt = replay(&TRACES[..1], &dir.join("broken"), &dir.join("o2"), &[]);
+    assert_eq!(corrupt.status.code(), Some(2));
+    assert!(stderr(&corrupt).contains("baseline.json"), "{}", stderr(&corrupt));
+    // A trace that is not one.
+    let junk = dir.join("junk.csv");
+    std::fs::write(&junk, "this is not a gaze trace\n").unwrap();
+    let junk_arg = junk.display().to_string();
+    let bad_trace = replay(&[&junk_arg], &committed(), &dir.join("o3"), &[]);
+    assert_eq!(bad_trace.status.code(), Some(2));
+    assert!(stderr(&bad_trace).contains("junk.csv"), "{}", stderr(&bad_trace));
+}
