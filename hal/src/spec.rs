@@ -1,4 +1,4 @@
-//! `--gaze center | X,Y | sim[:seed] | <trace path>` for the CLI.
+//! `--gaze center | X,Y | sim[:seed] | gazebase:<file> | <trace path>` for the CLI.
 
 use crate::error::HalError;
 use crate::hmd::HmdDescription;
@@ -18,6 +18,8 @@ pub enum GazeSpec {
     Fixed { x: f32, y: f32 },
     Simulated { seed: u64 },
     Trace(PathBuf),
+    /// A GazeBase-style dataset CSV (`n` ms, `x`/`y` degrees, optional `val`), imported on open.
+    GazeBase(PathBuf),
 }
 
 impl FromStr for GazeSpec {
@@ -38,6 +40,12 @@ impl FromStr for GazeSpec {
         if let Some(seed) = t.strip_prefix("sim:") {
             let seed = seed.parse().map_err(|_| err("the seed after `sim:` must be a non-negative integer"))?;
             return Ok(GazeSpec::Simulated { seed });
+        }
+        if let Some(path) = t.strip_prefix("gazebase:") {
+            if path.is_empty() {
+                return Err(err("a file must follow `gazebase:`"));
+            }
+            return Ok(GazeSpec::GazeBase(PathBuf::from(path)));
         }
         // Something that starts like a number, or two things that parse as numbers (`NaN,5`,
         // `inf,0`), with a comma, is meant as pixel coordinates, never as a trace file name.
@@ -78,6 +86,11 @@ impl GazeSpec {
             }
             GazeSpec::Simulated { seed } => Box::new(SimulatedFove::new(hmd, SimConfig::seeded(*seed))?),
             GazeSpec::Trace(path) => Box::new(Playback::open(path, hmd)?),
+            GazeSpec::GazeBase(path) => {
+                let trace = crate::trace::import::import_gazebase(path, &crate::trace::import::DegreesImport::default())?;
+                // Dataset times start anywhere: frame 0 shows the first sample.
+                Box::new(Playback::new(trace, hmd).aligned_to_first_frame())
+            }
         })
     }
 }

@@ -79,3 +79,18 @@ fn gaze_spec_opens_sources() {
     let e = GazeSpec::Trace("/nonexistent/t.csv".into()).open(hmd).err().unwrap().to_string();
     assert!(e.contains("/nonexistent/t.csv"), "{e}");
 }
+
+#[test]
+fn gazebase_files_are_a_gaze_spec() {
+    assert_eq!("gazebase:d/s.csv".parse::<GazeSpec>().unwrap(), GazeSpec::GazeBase(PathBuf::from("d/s.csv")));
+    assert!("gazebase:".parse::<GazeSpec>().is_err());
+    let dir = std::env::temp_dir().join(format!("fovea-gazebase-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("s.csv");
+    std::fs::write(&file, "n,x,y,val\n100,10,0,0\n101,10,0,0\n102,NaN,NaN,1\n").unwrap();
+    let mut source = GazeSpec::GazeBase(file).open(HmdDescription::fove0()).unwrap();
+    source.begin_frame(0).unwrap();
+    // Frame 0 shows the dataset's first sample (10° right), whatever its own time.
+    let s = source.sample_at(0);
+    assert!(s.valid && (s.gaze.direction.x / -s.gaze.direction.z - 10f32.to_radians().tan()).abs() < 1e-5, "{s:?}");
+}

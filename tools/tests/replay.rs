@@ -41,7 +41,8 @@ fn committed() -> PathBuf {
     repo().join("tests/replay/baseline")
 }
 
-const TRACES: [&str; 2] = ["config/gaze/example_trace.csv", "sim:1"];
+/// The example trace, the simulator, and a GazeBase-style dataset file (a saccade and a blink).
+const TRACES: [&str; 3] = ["config/gaze/example_trace.csv", "sim:1", "gazebase:tests/replay/traces/gazebase_style.csv"];
 
 fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
