@@ -173,6 +173,10 @@ enum Command {
         /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
         #[arg(long, default_value = "fifo")]
         present_mode: String,
+        /// The debug view shown first: off, grid (the sampling grid as traced), density (samples
+        /// per pixel) or rings (eccentricity rings at 5, 10, 20, 30, 40°); key v cycles them.
+        #[arg(long, default_value = "off")]
+        debug_view: String,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -442,7 +446,7 @@ fn run() -> Result<()> {
             let profile = opts.profile()?;
             commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1", "out/render")?)
         }
-        Command::View { opts, screenshot, present_mode, device } => {
+        Command::View { opts, screenshot, present_mode, debug_view, device } => {
             let profile = opts.profile()?;
             // Without --frames the run has no length: the camera path's period is a long one.
             let render = render_args(&opts, &device, &profile, u32::MAX, "center", "out/render")?;
@@ -451,6 +455,7 @@ fn run() -> Result<()> {
                 screenshot: screenshot.as_deref(),
                 present_mode: &present_mode,
                 mouse_gaze: opts.gaze.is_none(),
+                debug_view: fovea_tools::viewer::debug::DebugView::parse(&debug_view)?,
                 render,
             })
         }

@@ -94,3 +94,33 @@ fn view_screenshot_matches_the_offline_render() {
 fn view_screenshot_of_both_eyes_matches_the_offline_stereo_render() {
     check_screenshot_matches_render("stereo", &["--eyes", "both", "--taa", "screen"]);
 }
+
+/// The debug views in the window: the density view of frame N − 1 equals `fovea render
+/// --debug-views`' density picture of that frame byte for byte; the grid and rings views show
+/// something else than the frame (stereo for the rings: both eyes get them).
+#[test]
+fn debug_views_in_the_window() {
+    let x = Xvfb::start();
+    let dir = std::env::temp_dir().join(format!("fovea-view-debug-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let common = ["--width", "80", "--height", "90", "--frames", "4", "--gaze", "sim:2"];
+    let shot = |view: &str, extra: &[&str]| {
+        let path = dir.join(format!("{view}.png"));
+        let args: Vec<&str> = ["view"].iter().chain(&common).chain(extra).copied().chain(["--debug-view", view, "--screenshot", path.to_str().unwrap()]).collect();
+        fovea(&args, Some(&x.display));
+        rgba(&path)
+    };
+    let render_out = dir.join("render");
+    let render_args: Vec<&str> = ["render"].iter().chain(&common).copied().chain(["--debug-views", "--out", render_out.to_str().unwrap()]).collect();
+    fovea(&render_args, None);
+    assert_eq!(shot("density", &[]), rgba(&render_out.join("debug_density_0003.png")), "the window's density view is render's");
+    let frame = rgba(&render_out.join("frame_0003.png"));
+    let grid = shot("grid", &[]);
+    assert_eq!(grid.dimensions(), (80, 90));
+    assert_ne!(grid, frame, "the grid view is not the screen image");
+    let rings = shot("rings", &["--eyes", "both"]);
+    assert_eq!(rings.dimensions(), (160, 90));
+    let white = |x0: u32| (0..90).flat_map(|y| (x0..x0 + 80).map(move |x| (x, y))).filter(|&(x, y)| rings.get_pixel(x, y).0 == [255, 255, 255, 255]).count();
+    assert!(white(0) > 50 && white(80) > 50, "rings drawn in both eyes: {} and {} white pixels", white(0), white(80));
+}

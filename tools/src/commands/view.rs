@@ -6,6 +6,7 @@
 
 use super::render::RenderArgs;
 use super::setup::{space_for, Setup, METHODS};
+use crate::viewer::debug::{compose, DebugView};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
@@ -34,6 +35,8 @@ pub struct ViewArgs<'a> {
     pub present_mode: &'a str,
     /// Gaze from the mouse (no `--gaze` given).
     pub mouse_gaze: bool,
+    /// The debug view shown first (key v cycles).
+    pub debug_view: DebugView,
 }
 
 const DENOISERS: &[&str] = &["none", "svgf", "asvgf", "bmfr"];
@@ -77,6 +80,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         method: args.render.method.to_string(),
         denoiser: args.render.denoiser.to_string(),
         taa: args.render.taa.to_string(),
+        debug: args.debug_view,
         title_at: Instant::now(),
         frames_since_title: 0,
     };
@@ -96,6 +100,8 @@ struct WindowState {
     /// One per frame slot: signalled when the slot's image is acquired.
     acquired: Vec<vk::Semaphore>,
     screenshot: Option<Buffer>,
+    /// The debug views' picture on its way into the swapchain image (made when first needed).
+    debug_staging: Option<Buffer>,
 }
 
 struct Viewer<'a> {
@@ -113,6 +119,7 @@ struct Viewer<'a> {
     method: String,
     denoiser: String,
     taa: String,
+    debug: DebugView,
     title_at: Instant,
     frames_since_title: u32,
 }
@@ -193,7 +200,7 @@ impl Viewer<'_> {
         let acquired = (0..self.renderer.frames_in_flight())
             .map(|_| unsafe { self.ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) })
             .collect::<std::result::Result<Vec<_>, _>>()?;
-        self.window = Some(WindowState { window, surface_loader, surface, swapchain: None, acquired, screenshot: None });
+        self.window = Some(WindowState { window, surface_loader, surface, swapchain: None, acquired, screenshot: None, debug_staging: None });
         self.rebuild_swapchain()
     }
 
@@ -237,6 +244,7 @@ impl Viewer<'_> {
             let bytes = swapchain.extent.width as u64 * swapchain.extent.height as u64 * 4;
             w.screenshot = Some(Buffer::new(&self.ctx, "screenshot", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
         }
+        w.debug_staging = None; // sized by the extent
         w.swapchain = Some(swapchain);
         Ok(())
     }
@@ -264,6 +272,10 @@ impl Viewer<'_> {
                 self.frozen = !self.frozen;
                 return Ok(());
             }
+            Key::Character("v") => {
+                self.debug = self.debug.next();
+                return Ok(());
+            }
             _ => return Ok(()),
         }
         if let Err(e) = self.rebuild_views() {
@@ -278,6 +290,9 @@ impl Viewer<'_> {
             self.save_screenshot()?;
             event_loop.exit();
             return Ok(());
+        }
+        if self.debug != DebugView::Off {
+            return self.redraw_debug();
         }
         // The slot's previous frame must be done before its acquire semaphore is reused.
         self.renderer.retire_next()?;
@@ -326,6 +341,40 @@ impl Viewer<'_> {
         Ok(())
     }
 
+    /// A debug view: the frame into the engine's own images, waited for, its debug picture made
+    /// on the CPU and copied into the swapchain image (and saved as the screenshot of a last frame).
+    fn redraw_debug(&mut self) -> Result<()> {
+        let input = self.frame_input()?.with_grid(self.debug == DebugView::Grid);
+        let frame = self.renderer.submit(&input, None)?;
+        self.renderer.finish()?;
+        let eye = self.setup.screen();
+        let pixels = compose(self.debug, &self.renderer, frame, eye, &self.setup.hmd, self.setup.eyes.list())?;
+        let last = self.args.frames.is_some_and(|n| self.frame + 1 == n);
+        let Some(w) = self.window.as_mut() else { return Ok(()) };
+        let Some(swapchain) = &w.swapchain else { return Ok(()) };
+        let (width, height) = (eye.x * self.setup.eyes.list().len() as u32, eye.y);
+        if (swapchain.extent.width, swapchain.extent.height) != (width, height) {
+            return Ok(()); // mid-resize: the views follow on the next frame
+        }
+        if !swapchain.can_upload(&w.surface_loader, w.surface) {
+            bail!("this surface does not allow copying into its images (TRANSFER_DST): no debug views");
+        }
+        if w.debug_staging.is_none() {
+            w.debug_staging = Some(Buffer::new(&self.ctx, "debug view", pixels.len() as u64, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?);
+        }
+        let presented = swapchain.present_pixels(w.debug_staging.as_ref().expect("made above"), &pixels)?;
+        if let (true, Some(path)) = (last, self.args.screenshot) {
+            crate::output::write_png(path, width, height, &pixels).with_context(|| format!("--screenshot {}", path.display()))?;
+        }
+        self.frame += 1;
+        self.frames_since_title += 1;
+        if !presented {
+            self.rebuild_swapchain()?;
+        }
+        self.update_title();
+        Ok(())
+    }
+
     /// Frame k's input: exactly `fovea render`'s for `--frames` runs and gaze sources; the
     /// mouse (or the frozen gaze) otherwise.
     fn frame_input(&mut self) -> Result<FrameInput> {
@@ -351,8 +400,15 @@ impl Viewer<'_> {
         let total: f64 = self.renderer.timings().iter().map(|t| t.ms).sum();
         let trace: f64 = self.renderer.timings().iter().filter(|t| t.name == "trace").map(|t| t.ms).sum();
         let title = format!(
-            "fovea — {} · {} · taa {} · {:.1} fps · GPU {:.1} ms (trace {:.1}) · {}[m d t f: method denoiser taa freeze]",
-            self.method, self.denoiser, self.taa, fps, total, trace, if self.frozen { "gaze frozen · " } else { "" }
+            "fovea — {} · {} · taa {} · {:.1} fps · GPU {:.1} ms (trace {:.1}) · {}{}[m d t f v: method denoiser taa freeze debug view]",
+            self.method,
+            self.denoiser,
+            self.taa,
+            fps,
+            total,
+            trace,
+            if self.frozen { "gaze frozen · " } else { "" },
+            if self.debug != DebugView::Off { format!("debug view {} · ", self.debug.name()) } else { String::new() }
         );
         if let Some(w) = &self.window {
             w.window.set_title(&title);
@@ -362,6 +418,9 @@ impl Viewer<'_> {
     }
 
     fn save_screenshot(&mut self) -> Result<()> {
+        if self.debug != DebugView::Off {
+            return Ok(()); // redraw_debug saved the picture it presented
+        }
         let (Some(path), Some(w)) = (self.args.screenshot, &self.window) else { return Ok(()) };
         self.renderer.finish()?;
         let (Some(buffer), Some(swapchain)) = (&w.screenshot, &w.swapchain) else { return Ok(()) };

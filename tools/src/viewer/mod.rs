@@ -1,2 +1,3 @@
 //! `fovea view`'s window plumbing.
+pub mod debug;
 pub mod swapchain;

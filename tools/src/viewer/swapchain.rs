@@ -5,7 +5,7 @@
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use fovea_renderer::graph::ExternalImage;
-use fovea_renderer::vk::{next_resource_id, Context};
+use fovea_renderer::vk::{next_resource_id, Buffer, Context};
 use std::sync::Arc;
 
 /// Present modes by `--present-mode` name.
@@ -55,8 +55,9 @@ impl Swapchain {
         if caps.max_image_count > 0 {
             count = count.min(caps.max_image_count);
         }
-        // Screenshots copy the presented image: TRANSFER_SRC where the surface allows it.
-        let usage = vk::ImageUsageFlags::STORAGE | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
+        // Screenshots copy the presented image (TRANSFER_SRC) and debug views copy a CPU-made
+        // picture into it (TRANSFER_DST), where the surface allows them.
+        let usage = vk::ImageUsageFlags::STORAGE | (caps.supported_usage_flags & (vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST));
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface)
             .min_image_count(count)
@@ -132,4 +133,75 @@ fn pick_format(ctx: &Context, surface_loader: &ash::khr::surface::Instance, surf
         }
     }
     bail!("the window surface offers no UNORM format with STORAGE support (offered: {:?})", formats.iter().map(|f| f.format).collect::<Vec<_>>())
+}
+
+impl Swapchain {
+    /// Acquires an image, copies `rgba` (the whole extent, RGBA8 sRGB) into it and presents it:
+    /// the debug views' way to the window. Waits for the acquire and for the copy (a debug frame
+    /// is not the steady state). `Ok(false)`: the swapchain is out of date.
+    pub fn present_pixels(&self, staging: &Buffer, rgba: &[u8]) -> Result<bool> {
+        let device = &self.ctx.device;
+        let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None)? };
+        let acquired = unsafe { self.loader.acquire_next_image(self.raw, u64::MAX, vk::Semaphore::null(), fence) };
+        let index = match acquired {
+            Ok((index, _)) => index,
+            Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => {
+                unsafe { device.destroy_fence(fence, None) };
+                return Ok(false);
+            }
+            Err(e) => {
+                unsafe { device.destroy_fence(fence, None) };
+                return Err(e.into());
+            }
+        };
+        let waited = unsafe { device.wait_for_fences(&[fence], true, u64::MAX) };
+        unsafe { device.destroy_fence(fence, None) };
+        waited?;
+        let mut bytes = rgba.to_vec();
+        if self.format == vk::Format::B8G8R8A8_UNORM {
+            bytes.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
+        staging.write(&bytes)?;
+        let image = self.images[index as usize].raw;
+        let extent = vk::Extent3D { width: self.extent.width, height: self.extent.height, depth: 1 };
+        self.ctx.one_shot(|device, cmd| unsafe {
+            let to_dst = layout_barrier(image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::AccessFlags::empty(), vk::AccessFlags::TRANSFER_WRITE);
+            device.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, vk::PipelineStageFlags::TRANSFER, vk::DependencyFlags::empty(), &[], &[], &[to_dst]);
+            let region = vk::BufferImageCopy::default()
+                .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                .image_extent(extent);
+            device.cmd_copy_buffer_to_image(cmd, staging.raw, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region]);
+            let to_present = layout_barrier(image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR, vk::AccessFlags::TRANSFER_WRITE, vk::AccessFlags::empty());
+            device.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TRANSFER, vk::PipelineStageFlags::BOTTOM_OF_PIPE, vk::DependencyFlags::empty(), &[], &[], &[to_present]);
+        })?;
+        let (swapchains, indices) = ([self.raw], [index]);
+        let present = vk::PresentInfoKHR::default().swapchains(&swapchains).image_indices(&indices);
+        let result = {
+            let _queue = self.ctx.queue_guard();
+            unsafe { self.loader.queue_present(self.ctx.queue, &present) }
+        };
+        match result {
+            Ok(false) => Ok(true),
+            Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(false),
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// Whether debug views can copy into the images (TRANSFER_DST).
+    pub fn can_upload(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> bool {
+        unsafe { surface_loader.get_physical_device_surface_capabilities(self.ctx.physical, surface) }
+            .is_ok_and(|c| c.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_DST))
+    }
+}
+
+fn layout_barrier(image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout, src: vk::AccessFlags, dst: vk::AccessFlags) -> vk::ImageMemoryBarrier<'static> {
+    vk::ImageMemoryBarrier::default()
+        .image(image)
+        .old_layout(from)
+        .new_layout(to)
+        .src_access_mask(src)
+        .dst_access_mask(dst)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .subresource_range(fovea_renderer::vk::color_range())
 }
