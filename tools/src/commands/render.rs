@@ -68,6 +68,9 @@ struct Report {
     gaze_live: u32,
     gaze_held: u32,
     gaze_centre: u32,
+    /// Of `gaze_centre`: frames whose gaze lay behind or outside a rendered eye's view (the
+    /// source gave one, the frame foveated at the image centre).
+    gaze_outside_view: u32,
     device: String,
     width: u32,
     height: u32,
@@ -152,6 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
+    let mut outside_view = 0u32;
     let mut submitted = 0u32;
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
@@ -164,6 +168,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Held => 1,
             GazeOrigin::Centre => 2,
         }] += 1;
+        outside_view += u32::from(frame_gaze.reason.is_some());
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
@@ -208,6 +213,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         gaze_live: origins[0],
         gaze_held: origins[1],
         gaze_centre: origins[2],
+        gaze_outside_view: outside_view,
         device: ctx.info.name.clone(),
         width,
         height,
