@@ -354,3 +354,90 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     let fps = |name: &str| l[name]["frames_per_second"].as_f64().unwrap();
     assert!(close(l["in_flight_2_vs_1_fps"].as_f64().unwrap(), fps("stereo_in_flight_2") / fps("stereo_in_flight_1")));
 }
+
+/// Values that used to render a black, flat or meaningless frame without a word are refused
+/// before the device opens, each error naming its flag and the rule.
+#[test]
+fn meaningless_values_are_refused_with_the_flag_named() {
+    let out = temp_dir("values");
+    let refused = |args: &RenderArgs, needles: &[&str]| {
+        let err = format!("{:#}", render(args).unwrap_err());
+        assert!(needles.iter().all(|n| err.contains(n)), "{needles:?}: {err}");
+    };
+    for exposure in [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e-30, 1e30] {
+        let mut args = render_args("cornell-box", &out);
+        args.exposure = exposure;
+        refused(&args, &["--exposure", "[1e-4, 1e4]"]);
+    }
+    for max_depth in [0, 65, u32::MAX] {
+        let mut args = render_args("cornell-box", &out);
+        args.max_depth = max_depth;
+        refused(&args, &[&format!("--max-depth {max_depth}"), "1..=64"]);
+    }
+    // Visual-Polar: a 2×2 grid at least (3×3 screens at the default --vp-scale 2/3) and 2 pixels
+    // per screen axis; Cartesian renders any size.
+    for (w, h, needle) in [(1, 1, "no periphery"), (2, 2, "1×1 Visual-Polar grid"), (2, 40, "1×27 Visual-Polar grid"), (40, 1, "no periphery")] {
+        let mut args = render_args("cornell-box", &out);
+        (args.method, args.width, args.height) = ("vp", Some(w), Some(h));
+        refused(&args, &[needle, "--width/--height", "--scale", "--method cartesian"]);
+    }
+    let mut args = render_args("cornell-box", &out);
+    args.method = "vp";
+    args.profile.visual_polar.axis_scale = 0.04; // --vp-scale 0.04: 40×36 → a 2×1 grid
+    refused(&args, &["2×1 Visual-Polar grid", "--vp-scale 0.04", "at least 38×38"]);
+    // A fixed radius within 10 screen diagonals (40×36: 538 px); a profile's value alike.
+    let mut args = render_args("cornell-box", &out);
+    args.method = "vp";
+    args.profile.visual_polar.radius_mode = fovea_renderer::sampling::RadiusMode::Fixed(600.0);
+    refused(&args, &["--vp-radius", "visual_polar.radius", "600 px", "538 px"]);
+    assert!(!out.exists(), "nothing is written for a refused run");
+
+    let out = temp_dir("values-ok");
+    let mut args = render_args("cornell-box", &out);
+    (args.method, args.width, args.height, args.frames, args.exr) = ("vp", Some(3), Some(3), 1, false);
+    args.profile.visual_polar.radius_mode = fovea_renderer::sampling::RadiusMode::Fixed(42.0);
+    (args.max_depth, args.exposure) = (64, 1e4);
+    render(&args).unwrap();
+    let mut args = render_args("cornell-box", &out);
+    (args.width, args.height, args.frames, args.exr, args.max_depth, args.exposure) = (Some(1), Some(1), 1, false, 1, 1e-4);
+    render(&args).unwrap();
+
+    for max_depth in [0, 65] {
+        let exr = out.join("ref.exr");
+        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true };
+        let err = format!("{:#}", reference(&args).unwrap_err());
+        assert!(err.contains("--max-depth"), "{err}");
+    }
+}
+
+/// A gaze behind the eye or outside its view foveates at the image centre and is counted as
+/// such in report.json (`gaze_centre`, `gaze_outside_view`), not as live.
+#[test]
+fn gaze_outside_the_view_is_reported_as_centre() {
+    use fovea_hal::{GazeSample, HmdDescription, TraceWriter};
+    use glam::Vec3;
+    let out = temp_dir("gaze-outside");
+    std::fs::create_dir_all(&out).unwrap();
+    let hmd = HmdDescription::resolve("fove0").unwrap();
+    let trace = out.with_extension("csv");
+    let _ = std::fs::remove_file(&trace);
+    let mut writer = TraceWriter::create(&hmd, &trace, false).unwrap();
+    // Live ahead, behind the eye, 71.6° left (the FOVE 0 sees ±45°), live ahead again.
+    let directions = [Vec3::NEG_Z, Vec3::Z, Vec3::new(-3.0, 0.0, -1.0).normalize(), Vec3::new(0.1, 0.0, -1.0).normalize()];
+    for (k, d) in directions.iter().enumerate() {
+        writer.write(&GazeSample::looking(fovea_tools::gaze::frame_time(1e9 / hmd.refresh_hz as f64, k as u32), k as u64, *d));
+    }
+    writer.finish().unwrap();
+    for (method, eyes) in [("cartesian", fovea_tools::commands::setup::Eyes::Left), ("vp", fovea_tools::commands::setup::Eyes::Both)] {
+        let mut args = render_args("cornell-box", &out);
+        (args.method, args.eyes, args.frames, args.exr, args.camera_path) = (method, eyes, 4, false, false);
+        args.gaze = trace.to_str().unwrap();
+        render(&args).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        let counts = ["gaze_live", "gaze_held", "gaze_centre", "gaze_outside_view"].map(|k| report[k].as_u64());
+        assert_eq!(counts, [Some(2), Some(0), Some(2), Some(2)], "{method}: {report}");
+        for frame in [1, 2] {
+            assert_eq!(report["gaze"][frame], serde_json::json!([20.0, 18.0]), "{method}: frame {frame} at the image centre");
+        }
+    }
+}

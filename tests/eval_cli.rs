@@ -135,8 +135,17 @@ fn bad_inputs_are_named_in_the_error() {
         let err = format!("{:#}", eval(&args(&good, &good, gaze, &out)).unwrap_err());
         assert!(err.contains(gaze), "{gaze}: {err}");
     }
+    // --rings: 1..=1000, and at most the half-diagonal (48.2 px for 64×72) so that no ring is
+    // narrower than a pixel. 10⁸ rings used to abort on allocation, 10⁶ wrote a 256 MB eval.json.
+    for (rings, needle) in [(0, "1..=1000"), (1001, "1..=1000"), (1_000_000, "1..=1000"), (100_000_000, "1..=1000"), (49, "at most 48 rings")] {
+        let err = format!("{:#}", eval(&EvalArgs { rings, ..args(&good, &good, "32,36", &out) }).unwrap_err());
+        assert!(err.contains(&format!("--rings {rings}")) && err.contains(needle), "{rings}: {err}");
+    }
     // Nothing was written for failed runs.
     assert!(!out.exists());
+    eval(&EvalArgs { rings: 48, ..args(&good, &good, "0,0", &out) }).unwrap();
+    assert!(read_json(&out)["rings"].as_array().unwrap().iter().all(|r| r["pixels"].as_u64().unwrap() > 0), "every ring holds pixels");
+    std::fs::remove_dir_all(&out).unwrap();
 
     // A folder holding the user's files is refused and left alone.
     std::fs::create_dir_all(&out).unwrap();
@@ -199,6 +208,42 @@ fn quality_command_measures_every_combination() {
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let err = format!("{:#}", run(&args(&denoisers)).unwrap_err());
     assert!(err.contains("notes.txt"), "{err}");
+}
+
+/// `fovea quality --rings` is bounded like `fovea eval`'s (by the render size), before anything
+/// is rendered or written.
+#[test]
+fn quality_rings_are_bounded_before_rendering() {
+    use fovea_tools::commands::quality::{run, QualityArgs};
+    let out = temp_dir("quality-rings").join("out");
+    let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (methods, denoisers, taa, cameras) = (names(&["vp"]), names(&["none"]), names(&["off"]), names(&["still"]));
+    // 40×36: half-diagonal 26.9 px.
+    for (rings, needle) in [(1001, "1..=1000"), (27, "at most 26 rings")] {
+        let args = QualityArgs {
+            scene: "cornell-box",
+            width: 40,
+            height: 36,
+            headset: "fove0",
+            gaze: "sim:2",
+            frames: 3,
+            eval_frames: 2,
+            methods: &methods,
+            denoisers: &denoisers,
+            taa: &taa,
+            cameras: &cameras,
+            reference_spp: 4,
+            rings,
+            seed: 1,
+            profile: Default::default(),
+            out: &out,
+            device: None,
+            validation: true,
+        };
+        let err = format!("{:#}", run(&args).unwrap_err());
+        assert!(err.contains(&format!("--rings {rings}")) && err.contains(needle), "{err}");
+    }
+    assert!(!out.exists());
 }
 
 /// `--headset`: rings of true eccentricity through the FOV, out to the farthest corner's; an

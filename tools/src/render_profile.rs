@@ -160,13 +160,21 @@ pub fn layout_name(layout: VpLayout) -> &'static str {
     }
 }
 
+/// The range of a fixed Visual-Polar radius in pixels. Below one pixel every screen pixel but the
+/// gaze's own lies beyond r_max (the outermost column, clamped); above 10⁶ no screen fovea renders
+/// has a use for it. The command also bounds it by the screen it renders
+/// (`commands::setup::check_space`: at most 10 diagonals).
+pub const VP_RADIUS_RANGE: (f32, f32) = (1.0, 1e6);
+
 pub fn parse_radius(s: &str) -> Result<RadiusMode> {
     if s == "corner" {
         return Ok(RadiusMode::FarthestCorner);
     }
+    let (lo, hi) = VP_RADIUS_RANGE;
     match s.parse::<f32>() {
-        Ok(r) if r.is_finite() && r > 0.0 => Ok(RadiusMode::Fixed(r)),
-        _ => bail!("'{s}' is not a radius mode (corner | a radius in pixels > 0)"),
+        Ok(r) if r.is_finite() && (lo..=hi).contains(&r) => Ok(RadiusMode::Fixed(r)),
+        Ok(r) if r.is_finite() && r > 0.0 => bail!("radius {s} px: must be corner or in [{lo}, {hi:e}] pixels (below one pixel the whole screen lies beyond it)"),
+        _ => bail!("'{s}' is not a radius mode (corner | a radius in pixels in [{lo}, {hi:e}])"),
     }
 }
 
@@ -190,7 +198,8 @@ impl RenderProfile {
                 let text = match radius {
                     toml::Value::String(s) => s,
                     toml::Value::Integer(i) => i.to_string(),
-                    toml::Value::Float(f) => f.to_string(),
+                    // Debug keeps 1e30 short in the message (Display writes every digit).
+                    toml::Value::Float(f) => format!("{f:?}"),
                     other => bail!("{}.radius: expected \"corner\" or pixels, got {other}", at("visual_polar")),
                 };
                 p.radius_mode = parse_radius(&text).with_context(|| format!("{}.radius", at("visual_polar")))?;
@@ -372,6 +381,9 @@ gradient_sigma_normal = 64
             ("range.toml", "[visual_polar]\nclip_fraction = 0.7\n", "clip_fraction"),
             ("mode.toml", "[visual_polar]\ninverse_cdf = \"cubic\"\n", "inverse_cdf"),
             ("radius.toml", "[visual_polar]\nradius = -3\n", "radius"),
+            ("radius_huge.toml", "[visual_polar]\nradius = 1e30\n", "radius"),
+            ("radius_tiny.toml", "[visual_polar]\nradius = 1e-30\n", "radius"),
+            ("radius_text.toml", "[visual_polar]\nradius = \"inf\"\n", "radius"),
             ("layout.toml", "[visual_polar]\nlayout = \"clipped\"\n", "layout"),
             ("layout_type.toml", "[visual_polar]\nlayout = 1\n", "layout"),
             ("ecc.toml", "[visual_polar]\neccentricity = \"true\"\n", "eccentricity"),
@@ -418,6 +430,15 @@ gradient_sigma_normal = 64
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
         let bad = ProfileOverrides { eccentricity: Some("headset".into()), layout: Some("screen-clipped".into()), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
+        for radius in ["1e30", "1e-30", "0.5", "NaN", "inf", "-1", "0"] {
+            let bad = ProfileOverrides { radius: Some(radius.into()), ..Default::default() };
+            let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
+            assert!(err.contains("--vp-radius") && err.contains(radius), "{err}");
+        }
+        for radius in ["1", "1000000"] {
+            let o = ProfileOverrides { radius: Some(radius.into()), ..Default::default() };
+            assert!(RenderProfile::default().override_with(&o).is_ok(), "{radius}");
+        }
         let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));
     }

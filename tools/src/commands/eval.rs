@@ -41,10 +41,29 @@ struct Report<'a> {
     true_eccentricity: Option<TrueEccentricity>,
 }
 
-pub fn run(args: &EvalArgs) -> Result<()> {
-    if args.rings == 0 {
-        bail!("--rings must be at least 1");
+/// The most rings `--rings` takes (eval.json holds one entry per ring, and each ring gets a
+/// per-pixel mask).
+pub const MAX_RINGS: usize = 1000;
+
+/// `--rings` of `fovea eval` and `fovea quality`: 1 to `MAX_RINGS`, and (once the image size is
+/// known) at most the image's half-diagonal in pixels, so that every ring is at least one pixel
+/// wide (the rings reach the farthest corner, which is at least that far from any gaze).
+pub fn check_rings(rings: usize, size: Option<(u32, u32)>) -> Result<()> {
+    if !(1..=MAX_RINGS).contains(&rings) {
+        bail!("--rings {rings} must be in 1..={MAX_RINGS}");
     }
+    if let Some((w, h)) = size {
+        let half_diagonal = 0.5 * (w as f64).hypot(h as f64);
+        let most = (half_diagonal.floor() as usize).max(1);
+        if rings > most {
+            bail!("--rings {rings}: a {w}×{h} image has room for at most {most} rings of at least one pixel (its half-diagonal is {half_diagonal:.1} px)");
+        }
+    }
+    Ok(())
+}
+
+pub fn run(args: &EvalArgs) -> Result<()> {
+    check_rings(args.rings, None)?;
     let (w, h, reference) = read_checked(args.reference)?;
     let (tw, th, test) = read_checked(args.test)?;
     if (tw, th) != (w, h) {
@@ -54,6 +73,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             args.reference.display()
         );
     }
+    check_rings(args.rings, Some((w, h)))?;
     let gaze = parse_gaze(args.gaze, w, h)?;
     let hmd = match args.headset {
         Some(name) => Some(fovea_hal::HmdDescription::resolve(name).with_context(|| format!("--headset {name}"))?),

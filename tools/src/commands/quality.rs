@@ -107,6 +107,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
     }
+    super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let mut runs = Vec::new();

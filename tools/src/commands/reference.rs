@@ -27,6 +27,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     if args.width == 0 || args.height == 0 || args.spp == 0 || args.max_depth == 0 {
         bail!("--width, --height, --spp and --max-depth must be at least 1");
     }
+    if args.max_depth > super::setup::MAX_DEPTH_LIMIT {
+        bail!("--max-depth {} must be in 1..={} (path vertices)", args.max_depth, super::setup::MAX_DEPTH_LIMIT);
+    }
     check_new_file(args.out, args.force)?;
     let preview = args.out.with_extension("png");
     if args.preview {

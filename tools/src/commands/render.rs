@@ -70,6 +70,9 @@ struct Report {
     gaze_live: u32,
     gaze_held: u32,
     gaze_centre: u32,
+    /// Of `gaze_centre`: frames whose gaze lay behind or outside a rendered eye's view (the
+    /// source gave one, the frame foveated at the image centre).
+    gaze_outside_view: u32,
     device: String,
     width: u32,
     height: u32,
@@ -155,6 +158,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut gaze_points = Vec::with_capacity(frames as usize);
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
+    let mut outside_view = 0u32;
     let mut submitted = 0u32;
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
@@ -168,6 +172,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Held => 1,
             GazeOrigin::Centre => 2,
         }] += 1;
+        outside_view += u32::from(frame_gaze.reason.is_some());
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
@@ -213,6 +218,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         gaze_live: origins[0],
         gaze_held: origins[1],
         gaze_centre: origins[2],
+        gaze_outside_view: outside_view,
         device: ctx.info.name.clone(),
         width,
         height,

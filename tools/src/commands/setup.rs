@@ -90,6 +90,9 @@ impl Setup {
         if !METHODS.contains(&args.method) {
             bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
         }
+        check_settings(args.max_depth, args.exposure)?;
+        // Before the device is opened; `space_for` checks again for the viewer's method switch.
+        check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.method, args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
         let scene = crate::scenes::load(args.scene)?;
@@ -135,7 +138,7 @@ impl Setup {
     /// Frame `frame`'s input: each eye's camera (the head pose on the camera path, offset by the
     /// eye's position) and gaze (the combined gaze direction projected into that eye).
     pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
-        let gaze = self.gaze.frame(frame)?;
+        let gaze = self.gaze.frame(frame, self.eyes.list())?;
         let head = camera_path::pose(&self.start_pose, self.scene_centre, frame, self.frames, self.camera_path);
         let mut views = [ViewInput { camera: head, gaze: None }; 2];
         let eyes = self.eyes.list();
@@ -153,6 +156,80 @@ pub(crate) fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: 
         Eyes::Both => CameraPose { world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset), fov_tan: head.fov_tan },
         _ => *head,
     }
+}
+
+/// The longest path `--max-depth` takes (vertices). There is no Russian roulette and a path in a
+/// closed room never escapes, so each vertex costs another trace of the whole frame: a huge value
+/// never finishes a frame (and trips a GPU watchdog). 64 is 20× the real-time default of 3.
+pub const MAX_DEPTH_LIMIT: u32 = 64;
+/// `--exposure` range: 10⁻⁴ to 10⁴ (±13 stops). Outside it (and at 0, negative or non-finite)
+/// the tonemapped frame is all black or blown out.
+pub const EXPOSURE_RANGE: (f32, f32) = (1e-4, 1e4);
+/// The smallest Visual-Polar screen and grid per axis: one grid column would put every sample on
+/// one ring around the gaze (all of the screen at one eccentricity), one row every sample on one
+/// ray from it, either a flat, meaningless frame; a screen one pixel across has no periphery on
+/// that axis to foveate. With the default --vp-scale (2/3) the grid rule needs a 3×3 screen.
+pub const MIN_VP_GRID: u32 = 2;
+/// `--vp-radius PIXELS` at most this many screen diagonals: beyond it the whole screen lies inside
+/// the first 8° of the 80° axis (mostly the fovea) and most samples land off the screen.
+pub const MAX_VP_RADIUS_DIAGONALS: f32 = 10.0;
+
+/// `--max-depth` and `--exposure` (`fovea render`, `view` and `xr`).
+pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
+    if !(1..=MAX_DEPTH_LIMIT).contains(&max_depth) {
+        bail!("--max-depth {max_depth} must be in 1..={MAX_DEPTH_LIMIT} (path vertices: 1 = emission seen directly)");
+    }
+    let (lo, hi) = EXPOSURE_RANGE;
+    if !(exposure.is_finite() && (lo..=hi).contains(&exposure)) {
+        bail!("--exposure {exposure:?} must be a finite multiplier in [{lo:e}, {hi:e}] (outside it the frame is all black or blown out)");
+    }
+    Ok(())
+}
+
+/// What the Visual-Polar mapping needs of the screen `method` renders: a screen and a grid of at
+/// least `MIN_VP_GRID` texels per axis and a fixed radius within `MAX_VP_RADIUS_DIAGONALS`
+/// diagonals. Cartesian takes any size from 1×1.
+pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Result<()> {
+    if method != "vp" {
+        return Ok(());
+    }
+    if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
+        bail!(
+            "--method vp: a {}×{} screen has no periphery to foveate; Visual-Polar needs at least {MIN_VP_GRID}×{MIN_VP_GRID} pixels \
+             (raise --width/--height or --scale, or use --method cartesian)",
+            screen.x,
+            screen.y
+        );
+    }
+    let p = &profile.visual_polar;
+    // As `VisualPolar::new` rounds it.
+    let grid = (screen.as_vec2() * p.axis_scale).round().as_uvec2();
+    if grid.x < MIN_VP_GRID || grid.y < MIN_VP_GRID {
+        let min = (MIN_VP_GRID as f32 - 0.5) / p.axis_scale;
+        bail!(
+            "--method vp: a {}×{} screen at --vp-scale {} gives a {}×{} Visual-Polar grid; it needs at least {MIN_VP_GRID}×{MIN_VP_GRID} \
+             (a screen of at least {}×{} at this --vp-scale): raise --width/--height (or --scale), raise --vp-scale, or use --method cartesian",
+            screen.x,
+            screen.y,
+            p.axis_scale,
+            grid.x,
+            grid.y,
+            min.ceil(),
+            min.ceil()
+        );
+    }
+    if let fovea_renderer::sampling::RadiusMode::Fixed(r) = p.radius_mode {
+        let limit = MAX_VP_RADIUS_DIAGONALS * screen.as_vec2().length();
+        if r > limit {
+            bail!(
+                "--vp-radius (or the profile's visual_polar.radius) {r} px: at most {MAX_VP_RADIUS_DIAGONALS} × the {}×{} screen's diagonal ({limit:.0} px); \
+                 a larger radius puts the whole screen in the fovea and most samples off the screen",
+                screen.x,
+                screen.y
+            );
+        }
+    }
+    Ok(())
 }
 
 /// `--denoiser` and `--taa` with their parameters from the profile, checked against the method
@@ -179,6 +256,7 @@ pub fn filters(method: &str, denoiser: &str, taa: &str, profile: &RenderProfile)
 
 /// The sampling space of `method` for one eye of `hmd` (its FOV drives the headset ρ axis).
 pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, eye: Eye, screen: UVec2) -> Result<Box<dyn SamplingSpace>> {
+    check_space(method, profile, screen)?;
     // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
     let screen_centre = screen.as_vec2() * 0.5;
     let fov = crate::render_profile::fov_tangents(&hmd.eye(eye).fov);

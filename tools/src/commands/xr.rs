@@ -62,6 +62,8 @@ struct Tally {
     frames: u64,
     rendered: u32,
     origins: [u32; 3],
+    /// Frames foveated at the centre because the gaze lay behind or outside an eye's view.
+    outside_view: u32,
     live_ages_ns: Vec<i64>,
     pass_sums: BTreeMap<String, f64>,
     stats: FrameStats,
@@ -90,6 +92,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
     if !METHODS.contains(&r.method) {
         bail!("--method {}: expected one of {}", r.method, METHODS.join(", "));
     }
+    super::setup::check_settings(r.max_depth, r.exposure)?;
     let (denoiser, taa) = filters(r.method, r.denoiser, r.taa, &r.profile)?;
     let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
     let scene = crate::scenes::load(r.scene)?;
@@ -311,6 +314,7 @@ impl<'a> XrRun<'a> {
 
     fn count_gaze(&mut self, gaze: &XrFrameGaze) {
         self.tally.origins[origin_index(gaze.origin)] += 1;
+        self.tally.outside_view += u32::from(gaze.reason.is_some());
         if gaze.origin == GazeOrigin::Live {
             self.tally.live_ages_ns.push(gaze.age_ns);
         }
@@ -365,6 +369,7 @@ impl<'a> XrRun<'a> {
                 rendered: tally.rendered,
                 timed: tally.timed,
                 origins: tally.origins,
+                outside_view: tally.outside_view,
                 live_ages_ns: &tally.live_ages_ns,
                 pass_sums: &tally.pass_sums,
                 stats: tally.stats,

@@ -18,6 +18,8 @@ pub struct Tally<'a> {
     pub timed: u32,
     /// live, held, centre.
     pub origins: [u32; 3],
+    /// Of the centre frames, those whose gaze lay behind or outside an eye's view.
+    pub outside_view: u32,
     pub live_ages_ns: &'a [i64],
     pub pass_sums: &'a BTreeMap<String, f64>,
     pub stats: FrameStats,
@@ -110,6 +112,8 @@ pub struct XrReport {
     gaze_live: u32,
     gaze_held: u32,
     gaze_centre: u32,
+    /// Of `gaze_centre`: frames whose gaze lay behind or outside an eye's view.
+    gaze_outside_view: u32,
     gaze_age: GazeAge,
     gaze_recorded: Option<usize>,
     /// Per eye and rendered frame.
@@ -181,6 +185,7 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
         gaze_live: t.origins[0],
         gaze_held: t.origins[1],
         gaze_centre: t.origins[2],
+        gaze_outside_view: t.outside_view,
         gaze_age: gaze_age(t.live_ages_ns),
         gaze_recorded: i.recorded,
         samples_traced: t.stats.samples_traced / eye_frames,

@@ -4,7 +4,7 @@
 //! eye with that frame's located views; optionally recorded (`--record`) so `fovea render --gaze
 //! TRACE.csv` replays the session.
 
-use crate::gaze::GazeDriver;
+use crate::gaze::{project_gaze, GazeDriver};
 use anyhow::{Context, Result};
 use fovea_hal::openxr::xr;
 use fovea_hal::{EyeView, Fov, GazeOrigin, GazeSample, HmdDescription, SampleTimeKind, TraceWriter, XrTime};
@@ -82,11 +82,11 @@ impl XrGaze {
         };
         for (pixel, view) in gaze.pixels.iter_mut().zip(eyes_in_head) {
             match project(resolved.direction, view, size) {
-                Some(p) => *pixel = p,
-                None if resolved.source != GazeOrigin::Centre => {
-                    gaze.reason = Some("the gaze lies behind or outside an eye's view");
+                Ok(p) => *pixel = p,
+                Err(why) if resolved.source != GazeOrigin::Centre => {
+                    gaze.reason = gaze.reason.or(Some(why));
                 }
-                None => {}
+                Err(_) => {}
             }
         }
         if gaze.reason.is_some() {
@@ -119,9 +119,9 @@ impl XrGaze {
     }
 }
 
-/// `direction` (VIEW space) as a pixel of the eye located at `eye_in_head` with `size`; `None`
-/// when it lies behind the eye or outside the image.
-pub fn project(direction: Vec3, eye_in_head: &xr::View, size: (u32, u32)) -> Option<Vec2> {
+/// `direction` (VIEW space) as a pixel of the eye located at `eye_in_head` with `size`, or why it
+/// has none (`project_gaze`: the same rule as `fovea render`'s).
+pub fn project(direction: Vec3, eye_in_head: &xr::View, size: (u32, u32)) -> Result<Vec2, &'static str> {
     let o = eye_in_head.pose.orientation;
     let in_eye = Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize().inverse() * direction;
     let f = eye_in_head.fov;
@@ -131,7 +131,5 @@ pub fn project(direction: Vec3, eye_in_head: &xr::View, size: (u32, u32)) -> Opt
         fov: Fov { angle_left: f.angle_left, angle_right: f.angle_right, angle_down: f.angle_down, angle_up: f.angle_up },
         offset: Vec3::ZERO,
     };
-    let p = view.direction_to_pixel(in_eye)?;
-    let inside = (-0.5..=size.0 as f32 - 0.5).contains(&p.x) && (-0.5..=size.1 as f32 - 0.5).contains(&p.y);
-    inside.then_some(p)
+    project_gaze(&view, in_eye, Vec2::ONE, Vec2::new(size.0 as f32, size.1 as f32))
 }
