@@ -28,7 +28,7 @@ fn image(w: u32, h: u32) -> Vec<[f32; 4]> {
 }
 
 fn args<'a>(reference: &'a Path, test: &'a Path, gaze: &'a str, out: &'a Path) -> EvalArgs<'a> {
-    EvalArgs { reference, test, gaze, rings: 10, out, headset: None }
+    EvalArgs { reference, test, gaze, rings: 10, out, headset: None, ppd: None }
 }
 
 fn read_json(dir: &Path) -> serde_json::Value {
@@ -291,4 +291,51 @@ fn true_eccentricity_rings_through_a_headset() {
     assert!(read_json(&out).get("true_eccentricity").is_none());
     let err = format!("{:#}", eval(&EvalArgs { headset: Some("nope"), ..args(&reference, &test, "32,36", &out) }).unwrap_err());
     assert!(err.contains("--headset nope"), "{err}");
+}
+
+/// FLIP (NVIDIA's implementation) in eval.json: whole frame and per ring, on EXRs through the
+/// tone curve and on PNGs as they are; `--ppd` recorded as `flip_ppd` (default from the headset).
+#[test]
+fn flip_whole_frame_and_per_ring_for_exr_and_png() {
+    let dir = temp_dir("flip");
+    let (reference, test) = (dir.join("ref.exr"), dir.join("test.exr"));
+    let noisy: Vec<[f32; 4]> = image(W, H).iter().enumerate().map(|(i, p)| {
+        let n = if (i * 7919) % 13 < 6 { 0.25 } else { -0.2 };
+        [p[0] + n, p[1] + n, p[2] + n, 1.0]
+    }).collect();
+    write_exr(&reference, W, H, &image(W, H)).unwrap();
+    write_exr(&test, W, H, &noisy).unwrap();
+    let out = dir.join("exr");
+    eval(&args(&reference, &test, "32,36", &out)).unwrap();
+    let j = read_json(&out);
+    assert_eq!(j["inputs"], "exr");
+    // The FOVE 0's 90° across 64 pixels.
+    let ppd = j["flip_ppd"].as_f64().unwrap();
+    assert!((ppd - 64.0 / 90.0).abs() < 1e-3, "{ppd}");
+    let flip = j["frame"]["flip"].as_f64().unwrap();
+    assert!(flip > 0.05 && flip < 1.0, "{flip}");
+    assert!(j["rings"].as_array().unwrap().iter().all(|r| r["flip"].as_f64().is_some_and(|f| f > 0.0)));
+
+    // The same pictures as PNGs (tonemapped like the EXRs were): the same FLIP; identical → 0.
+    let png = |name: &str, texels: &[[f32; 4]]| {
+        let path = dir.join(name);
+        fovea_tools::output::write_png(&path, W, H, &fovea_tools::output::tonemap_preview(texels, 1.0)).unwrap();
+        path
+    };
+    let (reference_png, test_png) = (png("ref.png", &image(W, H)), png("test.png", &noisy));
+    let out_png = dir.join("png");
+    eval(&EvalArgs { ppd: Some(ppd as f32), ..args(&reference_png, &test_png, "32,36", &out_png) }).unwrap();
+    let p = read_json(&out_png);
+    assert_eq!(p["inputs"], "png");
+    assert!((p["frame"]["flip"].as_f64().unwrap() - flip).abs() < 1e-6, "PNG {} vs EXR {flip}", p["frame"]["flip"]);
+    let same = dir.join("same");
+    eval(&EvalArgs { ppd: Some(30.0), ..args(&reference_png, &reference_png, "center", &same) }).unwrap();
+    let s = read_json(&same);
+    assert_eq!((s["frame"]["flip"].as_f64(), s["flip_ppd"].as_f64()), (Some(0.0), Some(30.0)));
+
+    // Mixed kinds and a bad --ppd are refused.
+    let mixed = format!("{:#}", eval(&args(&reference, &test_png, "32,36", &dir.join("mixed"))).unwrap_err());
+    assert!(mixed.contains("both"), "{mixed}");
+    let bad = format!("{:#}", eval(&EvalArgs { ppd: Some(f32::NAN), ..args(&reference_png, &test_png, "32,36", &dir.join("bad")) }).unwrap_err());
+    assert!(bad.contains("--ppd"), "{bad}");
 }

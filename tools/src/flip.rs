@@ -10,6 +10,13 @@ pub fn flip_map(reference: &[u8], test: &[u8], width: u32, height: u32, pixels_p
     nv_flip::flip(reference, test, pixels_per_degree).to_vec().into_iter().map(f64::from).collect()
 }
 
+/// FLIP's viewing condition for a render shown on a headset eye: its width over the eye's
+/// horizontal FOV, in pixels per degree.
+pub fn headset_ppd(hmd: &fovea_hal::HmdDescription, width: u32) -> f32 {
+    let fov = hmd.eye(fovea_hal::Eye::Left).fov;
+    width as f32 / (fov.angle_right - fov.angle_left).to_degrees().max(1.0)
+}
+
 /// A FLIP map as an image (NVIDIA's magma colour map), RGBA8.
 pub fn flip_image(map: &[f64], width: u32, height: u32) -> Vec<u8> {
     let values: Vec<f32> = map.iter().map(|&v| v as f32).collect();

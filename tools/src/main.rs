@@ -350,10 +350,10 @@ enum Command {
     },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
     Eval {
-        /// Reference linear EXR (e.g. from `fovea reference`).
+        /// Reference: a linear EXR (e.g. from `fovea reference`) or a PNG (taken as displayed).
         #[arg(long)]
         reference: PathBuf,
-        /// Frame to evaluate: a linear EXR of the same size (e.g. `fovea render --exr`).
+        /// Frame to evaluate, of the reference's size and kind (e.g. `fovea render --exr`, or its PNG).
         #[arg(long)]
         test: PathBuf,
         /// Gaze point X,Y in image pixels (y down), or center; rings are centred on it.
@@ -369,6 +369,10 @@ enum Command {
         /// (eval.json `true_eccentricity`).
         #[arg(long)]
         headset: Option<String>,
+        /// FLIP's pixels per degree (default: the image width over the --headset eye's
+        /// horizontal FOV, the FOVE 0's without --headset); eval.json `flip_ppd`.
+        #[arg(long)]
+        ppd: Option<f32>,
     },
 }
 
@@ -575,13 +579,14 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Eval { reference, test, gaze, rings, out, headset } => commands::eval::run(&commands::eval::EvalArgs {
+        Command::Eval { reference, test, gaze, rings, out, headset, ppd } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,
             gaze: &gaze,
             rings,
             out: &out,
             headset: headset.as_deref(),
+            ppd,
         }),
     }
 }

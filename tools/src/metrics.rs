@@ -188,12 +188,31 @@ pub struct Metrics {
     /// dB, peak 1.0, capped at `PSNR_CAP_DB` (identical pixels).
     pub psnr: Option<f64>,
     pub ssim: Option<f64>,
+    /// Mean FLIP (LDR, the image as displayed) where it was measured ([`add_flip`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flip: Option<f64>,
 }
 
 impl Metrics {
     /// From the mean squared error and mean SSIM over `pixels` pixels.
     pub fn from_means(mse: Option<f64>, ssim: Option<f64>, pixels: usize) -> Self {
-        Self { pixels, rmse: mse.map(f64::sqrt), psnr: mse.map(psnr_from_mse), ssim }
+        Self { pixels, rmse: mse.map(f64::sqrt), psnr: mse.map(psnr_from_mse), ssim, flip: None }
+    }
+}
+
+/// Fills `flip` of the whole frame and of every ring of `eval` from a per-pixel FLIP map.
+pub fn add_flip(eval: &mut Evaluation, flip_map: &[f64]) {
+    let rings = Rings::new(eval.width, eval.height, Vec2::from_array(eval.gaze), eval.rings.len());
+    for (ring, flip) in eval.rings.iter_mut().zip(rings.mean(flip_map)) {
+        ring.metrics.flip = flip;
+    }
+    eval.frame.flip = mean(flip_map);
+}
+
+/// Fills `flip` of every ring of a coordinate ring set.
+pub fn add_flip_rings(found: &mut [CoordinateRing], rings: &Rings, flip_map: &[f64]) {
+    for (ring, flip) in found.iter_mut().zip(rings.mean(flip_map)) {
+        ring.metrics.flip = flip;
     }
 }
 

@@ -167,11 +167,7 @@ pub fn write_exr(path: &Path, width: u32, height: u32, texels: &[[f32; 4]]) -> R
 /// Reads a linear EXR's RGB channels (references for `fovea eval` and tests).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     use exr::prelude::*;
-    // A FIFO would block the reader and a device never ends; references are regular files.
-    let meta = std::fs::metadata(path).with_context(|| format!("reading {}", path.display()))?;
-    if !meta.is_file() {
-        bail!("reading {}: it is {}, not a regular file", path.display(), kind_of(&meta));
-    }
+    check_regular_input(path)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |resolution, _| {
@@ -333,6 +329,16 @@ impl OutputDir {
         }
         Ok(removed)
     }
+}
+
+/// Refuses an input image that is not a regular file: a FIFO would block the reader and a device
+/// never ends; references and frames are regular files.
+pub fn check_regular_input(path: &Path) -> Result<()> {
+    let meta = std::fs::metadata(path).with_context(|| format!("reading {}", path.display()))?;
+    if !meta.is_file() {
+        bail!("reading {}: it is {}, not a regular file", path.display(), kind_of(&meta));
+    }
+    Ok(())
 }
 
 /// Linear radiance → sRGB RGBA8 with the same fitted ACES curve as the tonemap pass (previews).

@@ -1,8 +1,11 @@
 //! `fovea eval`: quality of a rendered frame against a reference, whole-frame and per ring of
-//! eccentricity around the gaze → `DIR/eval.json` + `DIR/eval.png`.
+//! eccentricity around the gaze → `DIR/eval.json` + `DIR/eval.png`. RMSE/PSNR/SSIM on the values
+//! given (linear EXR, or PNG as it is), FLIP on the images as displayed (EXR through the
+//! project's tone curve, PNG as it is) at the headset's pixels per degree.
 
-use crate::metrics::{evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings};
-use crate::output::{prepare_output_dir, read_exr, write_json};
+use crate::flip::flip_map;
+use crate::metrics::{add_flip, add_flip_rings, evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings};
+use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_json};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
 use glam::Vec2;
@@ -18,6 +21,18 @@ pub struct EvalArgs<'a> {
     pub out: &'a Path,
     /// Also ring by true eccentricity (degrees) through this headset's left-eye FOV.
     pub headset: Option<&'a str>,
+    /// FLIP's pixels per degree (default: the image across the `--headset` eye's horizontal FOV,
+    /// the FOVE 0's without one).
+    pub ppd: Option<f32>,
+}
+
+/// An input image: values for RMSE/PSNR/SSIM and the picture as displayed (for FLIP).
+struct Input {
+    width: u32,
+    height: u32,
+    values: Vec<[f32; 4]>,
+    displayed: Vec<u8>,
+    png: bool,
 }
 
 /// Rings of true eccentricity: equal widths in degrees from the gaze direction out to the
@@ -35,6 +50,9 @@ struct TrueEccentricity {
 struct Report<'a> {
     reference: String,
     test: String,
+    /// exr (linear; FLIP on the tonemapped image) or png (as it is).
+    inputs: &'static str,
+    flip_ppd: f32,
     #[serde(flatten)]
     eval: &'a Evaluation,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -64,8 +82,13 @@ pub fn check_rings(rings: usize, size: Option<(u32, u32)>) -> Result<()> {
 
 pub fn run(args: &EvalArgs) -> Result<()> {
     check_rings(args.rings, None)?;
-    let (w, h, reference) = read_checked(args.reference)?;
-    let (tw, th, test) = read_checked(args.test)?;
+    let reference_input = read_input(args.reference)?;
+    let test_input = read_input(args.test)?;
+    if reference_input.png != test_input.png {
+        bail!("--reference and --test must both be linear EXR or both PNG (as displayed); got {} and {}", args.reference.display(), args.test.display());
+    }
+    let (w, h, reference) = (reference_input.width, reference_input.height, &reference_input.values);
+    let (tw, th, test) = (test_input.width, test_input.height, &test_input.values);
     if (tw, th) != (w, h) {
         bail!(
             "{} is {tw}×{th} but the reference {} is {w}×{h}; both must have the same size",
@@ -79,8 +102,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         Some(name) => Some(fovea_hal::HmdDescription::resolve(name).with_context(|| format!("--headset {name}"))?),
         None => None,
     };
+    let ppd = flip_ppd(args.ppd, hmd.as_ref(), w)?;
     let _out_dir = prepare_output_dir(args.out)?;
-    let eval = evaluate(&reference, &test, w, h, gaze, args.rings);
+    let flip = flip_map(&reference_input.displayed, &test_input.displayed, w, h, ppd);
+    let mut eval = evaluate(reference, test, w, h, gaze, args.rings);
+    add_flip(&mut eval, &flip);
     let true_eccentricity = hmd.map(|hmd| {
         let fov = crate::render_profile::fov_tangents(&hmd.eye(fovea_hal::Eye::Left).fov);
         let axis = fovea_renderer::sampling::HeadsetAxis::new(fov, glam::UVec2::new(w, h), gaze);
@@ -89,13 +115,17 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             .map(|p| axis.eccentricity(p - gaze) as f64)
             .collect();
         let rings = Rings::from_coordinates(w, gaze, &degrees, axis.e_max as f64, args.rings);
-        TrueEccentricity { headset: hmd.id.clone(), e_max_deg: axis.e_max as f64, rings: evaluate_rings(&reference, &test, w, h, &rings) }
+        let mut found = evaluate_rings(reference, test, w, h, &rings);
+        add_flip_rings(&mut found, &rings, &flip);
+        TrueEccentricity { headset: hmd.id.clone(), e_max_deg: axis.e_max as f64, rings: found }
     });
 
     let json_path = args.out.join("eval.json");
     let report = Report {
         reference: args.reference.display().to_string(),
         test: args.test.display().to_string(),
+        inputs: if reference_input.png { "png" } else { "exr" },
+        flip_ppd: ppd,
         eval: &eval,
         true_eccentricity,
     };
@@ -107,7 +137,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let outer = eval.rings.last().and_then(|r| r.metrics.rmse);
     let fmt = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
     println!(
-        "eval {}×{} gaze ({:.1}, {:.1}): RMSE {} PSNR {} dB SSIM {}; RMSE innermost ring {} outermost {} → {}",
+        "eval {}×{} gaze ({:.1}, {:.1}): RMSE {} PSNR {} dB SSIM {} FLIP {} ({ppd:.1} px/°); RMSE innermost ring {} outermost {} → {}",
         w,
         h,
         gaze.x,
@@ -115,11 +145,40 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         fmt(f.rmse),
         f.psnr.map_or("n/a".to_string(), |v| format!("{v:.2}")),
         fmt(f.ssim),
+        fmt(f.flip),
         fmt(inner),
         fmt(outer),
         json_path.display()
     );
     Ok(())
+}
+
+/// A PNG as it is (values in 0…1, no tone curve) or a linear EXR (tonemapped for FLIP).
+fn read_input(path: &Path) -> Result<Input> {
+    let png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if png {
+        crate::output::check_regular_input(path)?;
+        let image = image::open(path).with_context(|| format!("reading {}", path.display()))?.to_rgba8();
+        let (width, height) = image.dimensions();
+        let displayed = image.into_raw();
+        let values = displayed.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]].map(|c| c as f32 / 255.0)).collect();
+        return Ok(Input { width, height, values, displayed, png });
+    }
+    let (width, height, values) = read_checked(path)?;
+    let displayed = tonemap_preview(&values, 1.0);
+    Ok(Input { width, height, values, displayed, png })
+}
+
+/// `--ppd`, or the image stretched over the headset eye's horizontal FOV.
+fn flip_ppd(given: Option<f32>, hmd: Option<&fovea_hal::HmdDescription>, width: u32) -> Result<f32> {
+    if let Some(ppd) = given {
+        if !(ppd.is_finite() && ppd > 0.0 && ppd <= 1000.0) {
+            bail!("--ppd {ppd} must be in (0, 1000] pixels per degree");
+        }
+        return Ok(ppd);
+    }
+    let fove0 = fovea_hal::HmdDescription::fove0();
+    Ok(crate::flip::headset_ppd(hmd.unwrap_or(&fove0), width))
 }
 
 /// Reads an EXR, refusing NaN and infinite pixels (they would silently poison every mean).

@@ -7,8 +7,9 @@
 
 use super::render::{self, RenderArgs};
 use crate::camera_path;
-use crate::metrics::{evaluate, Evaluation};
-use crate::output::{prepare_output_dir, read_exr, write_exr, write_json, write_text};
+use crate::flip::flip_map;
+use crate::metrics::{add_flip, evaluate, Evaluation};
+use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::denoise::taa::TaaMode;
@@ -59,6 +60,8 @@ struct RunQuality {
     rings: Vec<RingMean>,
     frame_rmse: f64,
     frame_ssim: f64,
+    /// Mean FLIP of the displayed frame against the tonemapped reference.
+    frame_flip: f64,
 }
 
 #[derive(Serialize)]
@@ -68,6 +71,7 @@ struct RingMean {
     ecc_outer: f64,
     rmse: Option<f64>,
     ssim: Option<f64>,
+    flip: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -81,6 +85,8 @@ struct Report<'a> {
     eval_frames: u32,
     reference_spp: u32,
     blur_sigma_at_30: f32,
+    /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
+    flip_ppd: f32,
     runs: &'a [RunQuality],
 }
 
@@ -160,6 +166,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
+        flip_ppd: flip_ppd(args)?,
         runs: &runs,
     };
     write_json(&args.out.join("quality.json"), &report)?;
@@ -207,7 +214,12 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         let gaze = Vec2::new(gaze[0].as_f64().unwrap_or(0.0) as f32, gaze[1].as_f64().unwrap_or(0.0) as f32);
         let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
         let (_, _, test) = read_exr(&path)?;
-        evals.push(evaluate(reference, &test, args.width, args.height, gaze, args.rings));
+        let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
+        // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
+        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?.to_rgba8().into_raw();
+        let flip = flip_map(&tonemap_preview(reference, 1.0), &displayed, args.width, args.height, flip_ppd(args)?);
+        add_flip(&mut eval, &flip);
+        evals.push(eval);
         gazes.push(gaze.to_array());
     }
     let n = evals.len() as f64;
@@ -219,6 +231,7 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
             // RMSE averaged as MSE, so frames add like pixels do.
             rmse: mean(evals.iter().map(|e| e.rings[i].metrics.rmse.map(|r| r * r)).collect()).map(f64::sqrt),
             ssim: mean(evals.iter().map(|e| e.rings[i].metrics.ssim).collect()),
+            flip: mean(evals.iter().map(|e| e.rings[i].metrics.flip).collect()),
         })
         .collect();
     Ok(RunQuality {
@@ -232,7 +245,14 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         rings,
         frame_rmse: (evals.iter().map(|e| e.frame.rmse.unwrap_or(0.0).powi(2)).sum::<f64>() / n).sqrt(),
         frame_ssim: evals.iter().map(|e| e.frame.ssim.unwrap_or(0.0)).sum::<f64>() / n,
+        frame_flip: evals.iter().map(|e| e.frame.flip.unwrap_or(0.0)).sum::<f64>() / n,
     })
+}
+
+/// The render across the headset eye's horizontal FOV, in pixels per degree.
+fn flip_ppd(args: &QualityArgs) -> Result<f32> {
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+    Ok(crate::flip::headset_ppd(&hmd, args.width))
 }
 
 /// Per camera: one row per combination, RMSE / SSIM per ring and whole frame; then, per filter,
@@ -249,7 +269,7 @@ fn markdown(r: &Report) -> String {
     for camera in CAMERAS {
         let runs: Vec<&RunQuality> = r.runs.iter().filter(|q| q.camera == *camera).collect();
         let Some(first) = runs.first() else { continue };
-        let _ = write!(s, "**{camera} camera** — RMSE / SSIM\n\n| method + denoiser, TAA |");
+        let _ = write!(s, "**{camera} camera** — RMSE / SSIM / FLIP\n\n| method + denoiser, TAA |");
         for ring in &first.rings {
             let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
         }
@@ -258,14 +278,14 @@ fn markdown(r: &Report) -> String {
         for q in &runs {
             let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
             for ring in &q.rings {
-                match (ring.rmse, ring.ssim) {
-                    (Some(e), Some(m)) => {
-                        let _ = write!(s, " {e:.4} / {m:.3} |");
+                match (ring.rmse, ring.ssim, ring.flip) {
+                    (Some(e), Some(m), Some(f)) => {
+                        let _ = write!(s, " {e:.4} / {m:.3} / {f:.3} |");
                     }
                     _ => s.push_str(" – |"),
                 }
             }
-            let _ = writeln!(s, " {:.4} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_gpu_ms);
+            let _ = writeln!(s, " {:.4} / {:.3} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_flip, q.frame_gpu_ms);
         }
         s.push('\n');
         for vp in runs.iter().filter(|q| q.method == "vp") {

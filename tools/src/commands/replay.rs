@@ -239,8 +239,7 @@ fn reference_for(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> 
 /// FLIP's viewing condition: the render stretched over the headset eye's horizontal FOV.
 fn pixels_per_degree(args: &ReplayArgs, width: u32) -> Result<f32> {
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
-    let fov = hmd.eye(fovea_hal::Eye::Left).fov;
-    Ok(width as f32 / (fov.angle_right - fov.angle_left).to_degrees().max(1.0))
+    Ok(crate::flip::headset_ppd(&hmd, width))
 }
 
 fn markdown(r: &ReplayReport) -> String {
