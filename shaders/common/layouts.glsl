@@ -92,7 +92,7 @@ struct LightGpu {
 
 // Push constants of the trace pass.
 struct TracePush {
-    uvec4 config;               // x sample index within the frame (reference accumulation), yzw unused
+    uvec4 config;               // x sample index within the frame (reference accumulation), y 0 (the cameras' column base, see trace.comp), zw unused
 };
 
 // Push constants of the accumulate pass.

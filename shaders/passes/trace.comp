@@ -64,11 +64,16 @@ float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(texel, ivec2(sampling.data.grid.xy)))) return;
-    FrameData fd = frame.data;
-    uint rng = rng_seed(uvec2(texel), fd.frame.x, fd.frame.y, push.p.config.x);
+    // The cameras through a column index lavapipe cannot fold (push constant config.y, always 0):
+    // it specialises kernels on foldable uniform values, which recompiled this one on every head
+    // rotation (fovea xr, ~1 s per frame).
+    uint c0 = push.p.config.y;
+    mat4 world_from_view = mat4(frame.data.world_from_view[c0], frame.data.world_from_view[c0 + 1u], frame.data.world_from_view[c0 + 2u], frame.data.world_from_view[c0 + 3u]);
+    mat4 prev_view_from_world = mat4(frame.data.prev_view_from_world[c0], frame.data.prev_view_from_world[c0 + 1u], frame.data.prev_view_from_world[c0 + 2u], frame.data.prev_view_from_world[c0 + 3u]);
+    uint rng = rng_seed(uvec2(texel), frame.data.frame.x, frame.data.frame.y, push.p.config.x);
     vec2 screen;
     vec2 jitter = rng_next2(rng);
-    if ((fd.frame.w & FRAME_FLAG_HALTON_JITTER) != 0u) jitter = fd.jitter.xy;
+    if ((frame.data.frame.w & FRAME_FLAG_HALTON_JITTER) != 0u) jitter = frame.data.jitter.xy;
     if (!sample_screen_position(texel, jitter, screen)) {
         imageStore(out_color, texel, vec4(0.0));
         imageStore(out_radiance, texel, vec4(0.0));
@@ -82,11 +87,11 @@ void main() {
 #endif
         return;
     }
-    if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, fd.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
-    vec3 org = fd.world_from_view[3].xyz;
-    vec3 view_dir = view_direction(screen, fd.fov_tan, fd.screen.xy);
-    vec3 dir = normalize(mat3(fd.world_from_view) * view_dir);
-    uint max_depth = fd.frame.z;
+    if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, frame.data.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
+    vec3 org = world_from_view[3].xyz;
+    vec3 view_dir = view_direction(screen, frame.data.fov_tan, frame.data.screen.xy);
+    vec3 dir = normalize(mat3(world_from_view) * view_dir);
+    uint max_depth = frame.data.frame.z;
 #if defined(TRACE_GRADIENTS)
     // A gradient sample: this texel looks at the surface the forward projection put here instead
     // of along its jitter (the surface lies inside the texel) and, if it is still visible, shades
@@ -123,21 +128,21 @@ void main() {
 #endif
     if (!found) {
         // Nothing hit: no environment light; the previous position is the same direction.
-        vec3 prev_view = mat3(fd.prev_view_from_world) * dir;
-        project_view(prev_view, fd.prev_fov_tan, fd.screen.xy, prev_screen);
+        vec3 prev_view = mat3(prev_view_from_world) * dir;
+        project_view(prev_view, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
     } else {
         Surface s = fetch_surface(hit, dir);
         vec3 p_rel = s.position - org;
-        float depth = dot(p_rel, mat3(fd.world_from_view) * vec3(0.0, 0.0, -1.0));
+        float depth = dot(p_rel, mat3(world_from_view) * vec3(0.0, 0.0, -1.0));
         float cos_view = max(abs(dot(s.geometric_normal, dir)), 0.05);
-        float pixel_tan = (fd.fov_tan.y - fd.fov_tan.x) * fd.screen.z;
+        float pixel_tan = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z;
         float depth_gradient = depth * pixel_tan * texel_footprint(texel, jitter, screen)
                              * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
         albedo = max(s.base_color, vec3(0.01));
         normal_depth = vec4(s.normal, depth);
         position = vec4(p_rel, depth_gradient);
         ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
-        project_view((fd.prev_view_from_world * vec4(s.position, 1.0)).xyz, fd.prev_fov_tan, fd.screen.xy, prev_screen);
+        project_view((prev_view_from_world * vec4(s.position, 1.0)).xyz, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
         color = shade_path(s, dir, max_depth, rng);
     }
     atomicAdd(ray_counters.data[0], 1u);

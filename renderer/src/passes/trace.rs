@@ -126,6 +126,7 @@ impl TracePass {
             extra[0], extra[1], extra[2],
         ];
         let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
+        // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
         rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [out.size.x, out.size.y, 1])
     }

@@ -54,12 +54,13 @@ void main() {
     }
     if (brightest < 0.0) return;
 
-    FrameData fd = frame.data;
-    vec3 world = imageLoad(position, picked).xyz + camera_origin(fd.prev_view_from_world);
-    vec3 view = transpose(mat3(fd.world_from_view)) * (world - fd.world_from_view[3].xyz);
+    // Read the frame data in place, not through a local copy: lavapipe specialises a kernel on
+    // the values of uniforms copied into locals (a recompile whenever the camera turns).
+    vec3 world = imageLoad(position, picked).xyz + camera_origin(frame.data.prev_view_from_world);
+    vec3 view = transpose(mat3(frame.data.world_from_view)) * (world - frame.data.world_from_view[3].xyz);
     vec2 screen;
     vec2 p;
-    if (!project_view(view, fd.fov_tan, fd.screen.xy, screen) || !grid_from_screen(g, screen, p)) return;
+    if (!project_view(view, frame.data.fov_tan, frame.data.screen.xy, screen) || !grid_from_screen(g, screen, p)) return;
     ivec2 target = grid_nearest(g, p);
     if (!grid_holds_sample(g, target)) return;
 

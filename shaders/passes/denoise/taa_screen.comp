@@ -54,7 +54,8 @@ void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(color);
     if (any(greaterThanEqual(t, size))) return;
-    FrameData fd = frame.data;
+    // Read the frame data in place, not through a local copy: lavapipe specialises a kernel on
+    // the values of uniforms copied into locals (a recompile whenever the camera turns).
     VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
     vec2 s = vec2(t) + 0.5;
     vec3 c = svgf_sanitize(imageLoad(color, t).rgb);
@@ -79,18 +80,18 @@ void main() {
     vec3 mean = sum / 9.0;
 
     // Where this pixel's surface (or, for a miss, its direction) was on the previous screen.
-    vec3 view_dir = view_direction(s, fd.fov_tan, fd.screen.xy);
+    vec3 view_dir = view_direction(s, frame.data.fov_tan, frame.data.screen.xy);
     vec3 prev_view;
     if (depth > 0.0) {
-        vec3 world = (fd.world_from_view * vec4(view_dir * depth, 1.0)).xyz;
-        prev_view = (fd.prev_view_from_world * vec4(world, 1.0)).xyz;
+        vec3 world = (frame.data.world_from_view * vec4(view_dir * depth, 1.0)).xyz;
+        prev_view = (frame.data.prev_view_from_world * vec4(world, 1.0)).xyz;
     } else {
-        prev_view = mat3(fd.prev_view_from_world) * (mat3(fd.world_from_view) * view_dir);
+        prev_view = mat3(frame.data.prev_view_from_world) * (mat3(frame.data.world_from_view) * view_dir);
     }
     float expected_depth = depth > 0.0 ? -prev_view.z : 0.0;
     vec2 prev_screen;
-    bool on_screen = project_view(prev_view, fd.prev_fov_tan, fd.screen.xy, prev_screen)
-                  && all(greaterThanEqual(prev_screen, vec2(0.0))) && all(lessThan(prev_screen, fd.screen.xy));
+    bool on_screen = project_view(prev_view, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen)
+                  && all(greaterThanEqual(prev_screen, vec2(0.0))) && all(lessThan(prev_screen, frame.data.screen.xy));
 
     vec3 result = c;
     if (push.p.params.y == 0.0 && on_screen) {
