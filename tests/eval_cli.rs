@@ -195,13 +195,17 @@ fn quality_command_measures_every_combination() {
         assert_eq!(r["frames"], serde_json::json!([1, 2]));
         let rmse = r["frame_rmse"].as_f64().unwrap();
         assert!(rmse.is_finite() && rmse > 0.0, "{r}");
+        // FLIP and flicker (1 spp without a denoiser: every frame differs from the last).
+        let (flip, flicker) = (r["frame_flip"].as_f64().unwrap(), r["frame_flicker"].as_f64().unwrap());
+        assert!(flip > 0.0 && flip < 1.0 && flicker > 0.0 && flicker < 1.0, "{r}");
+        assert!(r["rings"].as_array().unwrap().iter().all(|ring| ring["flip"].is_number() && ring["flicker"].is_number()), "{r}");
     }
     // A still camera needs one reference; a moving one a reference per evaluated frame.
     for name in ["reference_still_0000.exr", "reference_moving_0001.exr", "reference_moving_0002.exr"] {
         assert!(out.join(name).is_file(), "{name} missing");
     }
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
-    assert!(table.contains("**moving camera**") && table.contains("| vp + none, screen |"), "{table}");
+    assert!(table.contains("**moving camera**") && table.contains("| vp + none, screen |") && table.contains("Temporal flicker"), "{table}");
     let bad = strings(&["nlm"]);
     let err = format!("{:#}", run(&args(&bad)).unwrap_err());
     assert!(err.contains("--denoisers nlm"), "{err}");

@@ -200,6 +200,19 @@ impl Metrics {
     }
 }
 
+/// Temporal flicker of a frame pair: per pixel, |Δtest − Δreference| of the displayed sRGB values
+/// (mean of R, G, B in 0…1) from the previous frame to this one — the frame-to-frame change the
+/// converged images do not have (0 for a still camera's reference: all change is flicker).
+pub fn flicker_map(test_prev: &[u8], test: &[u8], reference_prev: &[u8], reference: &[u8]) -> Vec<f64> {
+    let grey = |p: &[u8]| (p[0] as f64 + p[1] as f64 + p[2] as f64) / (3.0 * 255.0);
+    test_prev
+        .chunks_exact(4)
+        .zip(test.chunks_exact(4))
+        .zip(reference_prev.chunks_exact(4).zip(reference.chunks_exact(4)))
+        .map(|((tp, t), (rp, r))| ((grey(t) - grey(tp)) - (grey(r) - grey(rp))).abs())
+        .collect()
+}
+
 /// Fills `flip` of the whole frame and of every ring of `eval` from a per-pixel FLIP map.
 pub fn add_flip(eval: &mut Evaluation, flip_map: &[f64]) {
     let rings = Rings::new(eval.width, eval.height, Vec2::from_array(eval.gaze), eval.rings.len());

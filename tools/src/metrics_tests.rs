@@ -142,3 +142,13 @@ fn empty_rings_report_null() {
     assert!(e.rings[0].metrics.rmse.is_none() && e.rings[0].metrics.ssim.is_none());
     assert_eq!(serde_json::to_value(&e).unwrap()["rings"][0]["rmse"], serde_json::Value::Null);
 }
+
+#[test]
+fn flicker_is_change_the_reference_does_not_have() {
+    let px = |v: u8| [v, v, v, 255];
+    let (a, b) = (px(100).repeat(4), px(140).repeat(4));
+    // Still reference: the whole change is flicker; the same change in the reference: none.
+    let still = flicker_map(&a, &b, &a, &a);
+    assert!(still.iter().all(|&f| (f - 40.0 / 255.0).abs() < 1e-12), "{still:?}");
+    assert!(flicker_map(&a, &b, &a, &b).iter().all(|&f| f == 0.0));
+}

@@ -8,7 +8,7 @@
 use super::render::{self, RenderArgs};
 use crate::camera_path;
 use crate::flip::flip_map;
-use crate::metrics::{add_flip, evaluate, Evaluation};
+use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
 use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
@@ -62,6 +62,9 @@ struct RunQuality {
     frame_ssim: f64,
     /// Mean FLIP of the displayed frame against the tonemapped reference.
     frame_flip: f64,
+    /// Mean temporal flicker over consecutive evaluated frames (`metrics::flicker_map`); null
+    /// with a single evaluated frame.
+    frame_flicker: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -72,6 +75,7 @@ struct RingMean {
     rmse: Option<f64>,
     ssim: Option<f64>,
     flip: Option<f64>,
+    flicker: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -209,6 +213,9 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         .with_context(|| format!("reading {}", report_path.display()))?;
     let mut evals: Vec<Evaluation> = Vec::new();
     let mut gazes = Vec::new();
+    // Per consecutive pair: flicker per ring and whole frame.
+    let mut flickers: Vec<(Vec<Option<f64>>, Option<f64>)> = Vec::new();
+    let mut previous: Option<(u32, Vec<u8>, Vec<u8>)> = None;
     for (&f, reference) in evaluated.iter().zip(references) {
         let gaze = &report["gaze"][f as usize];
         let gaze = Vec2::new(gaze[0].as_f64().unwrap_or(0.0) as f32, gaze[1].as_f64().unwrap_or(0.0) as f32);
@@ -217,8 +224,14 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
         let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?.to_rgba8().into_raw();
-        let flip = flip_map(&tonemap_preview(reference, 1.0), &displayed, args.width, args.height, flip_ppd(args)?);
+        let reference_displayed = tonemap_preview(reference, 1.0);
+        let flip = flip_map(&reference_displayed, &displayed, args.width, args.height, flip_ppd(args)?);
         add_flip(&mut eval, &flip);
+        if let Some((_, test_prev, reference_prev)) = previous.as_ref().filter(|p| p.0 + 1 == f) {
+            let map = flicker_map(test_prev, &displayed, reference_prev, &reference_displayed);
+            flickers.push((Rings::new(args.width, args.height, gaze, args.rings).mean(&map), metrics_mean(&map)));
+        }
+        previous = Some((f, displayed, reference_displayed));
         evals.push(eval);
         gazes.push(gaze.to_array());
     }
@@ -232,6 +245,7 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
             rmse: mean(evals.iter().map(|e| e.rings[i].metrics.rmse.map(|r| r * r)).collect()).map(f64::sqrt),
             ssim: mean(evals.iter().map(|e| e.rings[i].metrics.ssim).collect()),
             flip: mean(evals.iter().map(|e| e.rings[i].metrics.flip).collect()),
+            flicker: (!flickers.is_empty()).then(|| mean(flickers.iter().map(|f| f.0[i]).collect())).flatten(),
         })
         .collect();
     Ok(RunQuality {
@@ -246,6 +260,7 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         frame_rmse: (evals.iter().map(|e| e.frame.rmse.unwrap_or(0.0).powi(2)).sum::<f64>() / n).sqrt(),
         frame_ssim: evals.iter().map(|e| e.frame.ssim.unwrap_or(0.0)).sum::<f64>() / n,
         frame_flip: evals.iter().map(|e| e.frame.flip.unwrap_or(0.0)).sum::<f64>() / n,
+        frame_flicker: (!flickers.is_empty()).then(|| mean(flickers.iter().map(|f| f.1).collect())).flatten(),
     })
 }
 
@@ -288,6 +303,21 @@ fn markdown(r: &Report) -> String {
             let _ = writeln!(s, " {:.4} / {:.3} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_flip, q.frame_gpu_ms);
         }
         s.push('\n');
+        if first.frame_flicker.is_some() {
+            let _ = write!(s, "Temporal flicker (frame-to-frame change beyond the reference's, displayed sRGB)\n\n| method + denoiser, TAA |");
+            for ring in &first.rings {
+                let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
+            }
+            let _ = writeln!(s, " frame |\n|---|{}---|", "---|".repeat(first.rings.len()));
+            for q in &runs {
+                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                for ring in &q.rings {
+                    let _ = write!(s, " {} |", ring.flicker.map_or("–".to_string(), |f| format!("{f:.4}")));
+                }
+                let _ = writeln!(s, " {} |", q.frame_flicker.map_or("–".to_string(), |f| format!("{f:.4}")));
+            }
+            s.push('\n');
+        }
         for vp in runs.iter().filter(|q| q.method == "vp") {
             let cartesian = runs.iter().find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
             if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
