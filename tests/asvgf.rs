@@ -336,6 +336,33 @@ fn asvgf_refuses_the_screen_clipped_layout() {
     assert_clean(&ctx);
 }
 
+/// The renderer itself (not only the CLI) refuses every denoiser and TAA mode on a space whose
+/// capabilities exclude them (the screen-clipped layout), and accepts the bare layout.
+#[test]
+fn the_renderer_refuses_filters_a_space_cannot_run() {
+    use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
+    use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let clipped = || {
+        let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..VisualPolarParams::default() };
+        Box::new(VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap())
+    };
+    assert!(!clipped().capabilities().temporal_filters && clipped().capabilities().needs_remap);
+    let cases = [
+        ("svgf", settings(DenoiserSettings::Svgf(SvgfSettings::default()))),
+        ("bmfr", settings(DenoiserSettings::Bmfr(BmfrSettings::default()))),
+        ("vp", RenderSettings { taa: TaaMode::SamplingGrid(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
+        ("screen", RenderSettings { taa: TaaMode::Screen(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
+    ];
+    for (name, s) in cases {
+        let err = Renderer::new(&ctx, &scene, clipped(), s).err().unwrap_or_else(|| panic!("{name} accepted")).to_string();
+        assert!(err.contains(name) && err.contains("screen-clipped"), "{err}");
+    }
+    assert!(Renderer::new(&ctx, &scene, clipped(), settings(DenoiserSettings::None)).is_ok());
+    assert_clean(&ctx);
+}
+
 /// `fovea render --denoiser asvgf` (moving camera, simulated gaze): the report names the
 /// denoiser and times its passes in both spaces; the screen-clipped layout is a clear error.
 #[test]

@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::denoise::taa::{Taa, TaaMode};
-use crate::passes::denoise::Denoiser;
+use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::sampling::SamplingSpace;
@@ -95,27 +95,30 @@ impl View {
     pub(crate) fn new(ctx: &Arc<Context>, space: Box<dyn SamplingSpace>, settings: &RenderSettings, slots: usize) -> Result<View> {
         let grid = space.grid_size();
         let screen = space.screen_size();
-        // Screen-space TAA runs between the remap and the blur; for Cartesian the sampling grid
-        // is the screen, and it is the sampling-grid filter.
-        let (grid_taa, screen_taa) = match (settings.taa, space.visual_polar()) {
-            (TaaMode::Screen(s), Some(_)) => (None, Some(s)),
+        let caps = space.capabilities();
+        if !caps.temporal_filters && (settings.denoiser != DenoiserSettings::None || settings.taa != TaaMode::Off) {
+            return Err(Error::Invalid(format!(
+                "denoiser '{}' / TAA '{}': the {} space in this layout (screen-clipped) supports no denoiser or TAA (use layout = \"paper\")",
+                settings.denoiser.name(),
+                settings.taa.name(),
+                space.name()
+            )));
+        }
+        // Screen-space TAA runs between the remap and the blur; where the sampling grid is the
+        // screen, it is the sampling-grid filter.
+        let (grid_taa, screen_taa) = match (settings.taa, caps.needs_remap) {
+            (TaaMode::Screen(s), true) => (None, Some(s)),
             (mode, _) => (mode.settings().copied(), None),
         };
-        let to_screen = match space.visual_polar() {
-            Some(_) => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
-            None => None,
+        let to_screen = match caps.needs_remap {
+            true => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
+            false => None,
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
-        let trace_gradients = match (gradients, space.trace_variant()) {
-            (false, _) => None,
-            (true, "visual_polar_clipped") => {
-                return Err(Error::Invalid(format!(
-                    "denoiser '{}' does not support the screen-clipped Visual-Polar layout (use layout = \"paper\")",
-                    settings.denoiser.name()
-                )))
-            }
-            (true, variant) => Some(TracePass::new(ctx, &format!("{variant}_gradients"))?),
+        let trace_gradients = match gradients {
+            false => None,
+            true => Some(TracePass::new(ctx, &format!("{}_gradients", space.trace_variant()))?),
         };
         let taa = match grid_taa {
             Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),

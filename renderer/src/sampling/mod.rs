@@ -17,6 +17,15 @@ use crate::error::Result;
 use crate::layouts::SamplingParams;
 use glam::{UVec2, Vec2};
 
+/// What the pipeline may do with a space: asked by the renderer instead of testing concrete types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SpaceCapabilities {
+    /// The grid is not the screen: φ-mips, the remap and the foveated blur bring it back.
+    pub needs_remap: bool,
+    /// The denoisers and TAA can reproject and filter in this grid (their kernels address it).
+    pub temporal_filters: bool,
+}
+
 pub trait SamplingSpace {
     /// Name used in reports and on the command line (`--method`).
     fn name(&self) -> &'static str;
@@ -61,5 +70,9 @@ pub trait SamplingSpace {
     /// it back (φ-mips, remap) and applies the foveated blur.
     fn visual_polar(&self) -> Option<&VisualPolar> {
         None
+    }
+    /// The space's capabilities (default: a screen-sized grid every filter supports).
+    fn capabilities(&self) -> SpaceCapabilities {
+        SpaceCapabilities { needs_remap: false, temporal_filters: true }
     }
 }

@@ -577,6 +577,11 @@ impl SamplingSpace for VisualPolar {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         Some(self)
     }
+    fn capabilities(&self) -> super::SpaceCapabilities {
+        // The filters reproject and address the grid with the paper's mapping only (no
+        // per-column arc table in their kernels yet).
+        super::SpaceCapabilities { needs_remap: true, temporal_filters: self.params.layout == VpLayout::Paper }
+    }
 }
 
 #[cfg(test)]
