@@ -9,7 +9,7 @@ use crate::layouts::{
 };
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
-use crate::scene::{Aabb, PunctualLight, Scene};
+use crate::scene::{Aabb, PunctualLight, Scene, Sky};
 use crate::vk::{Buffer, Context};
 use ash::vk;
 use glam::{UVec4, Vec4};
@@ -32,6 +32,8 @@ pub struct GpuScene {
     pub material_count: u32,
     pub texture_count: u32,
     pub bounds: Aabb,
+    /// Radiance of escaping rays (`Scene::sky`), passed to the shaders in `FrameData`.
+    pub sky: Sky,
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
     /// Per-material emission factor set at run time (`set_emission_scale`; 1 = as loaded).
@@ -89,6 +91,7 @@ impl GpuScene {
             material_count: materials.len() as u32,
             texture_count: textures.len() as u32,
             bounds: scene.bounds(),
+            sky: scene.sky,
             bvh_depth: depth,
             bvh_bytes: bvh.memory_bytes(),
             emission_scale,

@@ -14,6 +14,14 @@ bool visible(vec3 p, vec3 n, LightSample ls) {
     return !bvh_trace(offset_ray(p, n), ls.direction, 0.0, ls.distance * (1.0 - 1e-4), true, h);
 }
 
+// The analytic sky (fovea_scene::Sky) seen by a ray leaving the scene along `dir`: horizon to
+// zenith with √(sin elevation) above the horizon, constant below. Black when the scene has none.
+vec3 sky_radiance(vec3 dir) {
+    if (frame.data.sky_ground.w == 0.0) return vec3(0.0);
+    if (dir.y < 0.0) return frame.data.sky_ground.rgb;
+    return mix(frame.data.sky_horizon.rgb, frame.data.sky_zenith.rgb, sqrt(dir.y));
+}
+
 vec3 direct_light(Surface s, vec3 v, inout uint rng) {
     LightSample ls;
     if (!sample_light(s.position, rng, ls)) return vec3(0.0);
@@ -40,7 +48,12 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, inout uint rng) {
         throughput *= weight;
         vec3 o = offset_ray(s.position, s.geometric_normal);
         continuation_rays++;
-        if (!bvh_trace(o, l, 0.0, 1e30, false, hit)) break;
+        if (!bvh_trace(o, l, 0.0, 1e30, false, hit)) {
+            // Next-event estimation never samples the sky, so the BRDF-sampled ray that escapes
+            // is its only estimator (no MIS weight needed).
+            color += throughput * sky_radiance(l);
+            break;
+        }
         s = fetch_surface(hit, l);
         // A mirror bounce cannot be found by next-event estimation: count what it sees.
         if (delta) color += throughput * s.emission;

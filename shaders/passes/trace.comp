@@ -122,7 +122,8 @@ void main() {
     uint path_rng = rng;
 #endif
     if (!found) {
-        // Nothing hit: no environment light; the previous position is the same direction.
+        // Nothing hit: the sky (black without one); the previous position is the same direction.
+        if (max_depth >= 1u) color = sky_radiance(dir);
         vec3 prev_view = mat3(fd.prev_view_from_world) * dir;
         project_view(prev_view, fd.prev_fov_tan, fd.screen.xy, prev_screen);
     } else {
