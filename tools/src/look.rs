@@ -73,7 +73,7 @@ impl EnvironmentOptions {
 
     pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
         if let Some([azimuth, elevation]) = self.sun {
-            if !azimuth.is_finite() || !(elevation.is_finite() && elevation > 0.0 && elevation <= 90.0) {
+            if !(azimuth.is_finite() && elevation.is_finite() && elevation > 0.0 && elevation <= 90.0) {
                 bail!(
                     "{} {azimuth},{elevation}: expected AZIMUTH,ELEVATION in degrees, azimuth finite, elevation in (0, 90] (a sun at or below the horizon lights nothing from above)",
                     names.sun

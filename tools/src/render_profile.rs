@@ -360,6 +360,9 @@ mod tests {
         assert_eq!(p.bmfr, BmfrSettings::default());
         assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
+        // The shipped values are the built-in defaults of the sun (no sky key: see the file).
+        let sun = Some(crate::look::DEFAULT_SUN);
+        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None });
     }
 
     #[test]
