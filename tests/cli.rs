@@ -127,6 +127,8 @@ fn output_folders_with_user_files_are_refused() {
         preview: false,
         device: None,
         validation: true,
+        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        environment: Default::default(),
     };
     let err = reference(&args).unwrap_err().to_string();
     assert!(err.contains("already exists"), "{err}");
@@ -284,6 +286,8 @@ fn reference_force_refuses_non_regular_targets() {
                 preview: false,
                 device: None,
                 validation: true,
+                camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+                environment: Default::default(),
             };
             format!("{:#}", reference(&args).unwrap_err())
         });
@@ -404,7 +408,7 @@ fn meaningless_values_are_refused_with_the_flag_named() {
 
     for max_depth in [0, 65] {
         let exr = out.join("ref.exr");
-        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true };
+        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true, camera: &fovea_tools::look::NO_CAMERA_FLAGS, environment: Default::default() };
         let err = format!("{:#}", reference(&args).unwrap_err());
         assert!(err.contains("--max-depth"), "{err}");
     }

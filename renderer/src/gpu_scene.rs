@@ -9,7 +9,7 @@ use crate::layouts::{
 };
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
-use crate::scene::{Aabb, PunctualLight, Scene};
+use crate::scene::{Aabb, PunctualLight, Scene, Sky};
 use crate::vk::{Buffer, Context};
 use ash::vk;
 use glam::{UVec4, Vec4};
@@ -31,7 +31,12 @@ pub struct GpuScene {
     pub triangle_count: u32,
     pub material_count: u32,
     pub texture_count: u32,
+    /// How many times a texture was halved so that all texels fit one storage buffer
+    /// (`maxStorageBufferRange`: 128 MiB on lavapipe, less than Sponza's 250 MB of RGBA8).
+    pub textures_halved: u32,
     pub bounds: Aabb,
+    /// Radiance of escaping rays (`Scene::sky`), passed to the shaders in `FrameData`.
+    pub sky: Sky,
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
     /// Per-material emission factor set at run time (`set_emission_scale`; 1 = as loaded).
@@ -72,7 +77,7 @@ impl GpuScene {
         }
         let emission_scale = vec![1.0; scene.materials.len()];
         let materials: Vec<MaterialGpu> = scene.materials.iter().map(|m| material_gpu(m, 1.0)).collect();
-        let (textures, texels) = pack_textures(scene);
+        let (textures, texels, halvings) = pack_textures(scene, ctx.info.max_storage_buffer_range as usize / 4);
         let lights = light_entries(scene, &emission_scale);
 
         Ok(GpuScene {
@@ -88,7 +93,9 @@ impl GpuScene {
             triangle_count: triangles.len() as u32,
             material_count: materials.len() as u32,
             texture_count: textures.len() as u32,
+            textures_halved: halvings,
             bounds: scene.bounds(),
+            sky: scene.sky,
             bvh_depth: depth,
             bvh_bytes: bvh.memory_bytes(),
             emission_scale,
@@ -171,15 +178,44 @@ fn material_gpu(m: &crate::scene::Material, emission_scale: f32) -> MaterialGpu 
 }
 
 /// All textures in one RGBA8 texel array (one u32 per texel), each with its offset and size.
-fn pack_textures(scene: &Scene) -> (Vec<TextureGpu>, Vec<u32>) {
-    let total: usize = scene.textures.iter().map(|t| (t.width * t.height) as usize).sum();
-    let mut texels = Vec::with_capacity(total);
-    let mut infos = Vec::with_capacity(scene.textures.len());
-    for t in &scene.textures {
+/// While they exceed `max_texels` (one storage buffer's range) the largest is halved (2×2 box
+/// filter): a lower-resolution texture beats a descriptor the device cannot bind. Returns the
+/// number of halvings.
+fn pack_textures(scene: &Scene, max_texels: usize) -> (Vec<TextureGpu>, Vec<u32>, u32) {
+    let mut reduced: Vec<std::borrow::Cow<crate::scene::Texture>> = scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
+    let texel_count = |ts: &[std::borrow::Cow<crate::scene::Texture>]| ts.iter().map(|t| (t.width * t.height) as usize).sum::<usize>();
+    let mut halvings = 0;
+    while texel_count(&reduced) > max_texels.max(1) {
+        let Some((largest, _)) = reduced.iter().enumerate().filter(|(_, t)| t.width * t.height > 1).max_by_key(|(_, t)| t.width * t.height) else {
+            break;
+        };
+        reduced[largest] = std::borrow::Cow::Owned(halve(&reduced[largest]));
+        halvings += 1;
+    }
+    let mut texels = Vec::with_capacity(texel_count(&reduced));
+    let mut infos = Vec::with_capacity(reduced.len());
+    for t in &reduced {
         infos.push(TextureGpu { extent: UVec4::new(texels.len() as u32, t.width, t.height, 0) });
         texels.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
     }
-    (infos, texels)
+    (infos, texels, halvings)
+}
+
+/// `t` at half the size per axis (odd sizes round up; the last row/column is repeated), each
+/// texel the mean of its 2×2 block (in the stored encoding: sRGB textures are averaged encoded).
+fn halve(t: &crate::scene::Texture) -> crate::scene::Texture {
+    let (w, h) = (t.width.div_ceil(2).max(1), t.height.div_ceil(2).max(1));
+    let at = |x: u32, y: u32, c: usize| t.rgba8[((y.min(t.height - 1) * t.width + x.min(t.width - 1)) * 4) as usize + c] as u32;
+    let mut rgba8 = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            for c in 0..4 {
+                let sum = at(2 * x, 2 * y, c) + at(2 * x + 1, 2 * y, c) + at(2 * x, 2 * y + 1, c) + at(2 * x + 1, 2 * y + 1, c);
+                rgba8.push(((sum + 2) / 4) as u8);
+            }
+        }
+    }
+    crate::scene::Texture { width: w, height: h, rgba8 }
 }
 
 fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {

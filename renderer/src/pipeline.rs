@@ -338,6 +338,9 @@ impl Renderer {
             ),
             scene_sphere: self.scene.bounding_sphere(),
             jitter: jitter.extend(0.0).extend(0.0),
+            sky_zenith: self.scene.sky.zenith.extend(0.0),
+            sky_horizon: self.scene.sky.horizon.extend(0.0),
+            sky_ground: self.scene.sky.ground.extend(if self.scene.sky.is_black() { 0.0 } else { 1.0 }),
         };
         v.slots[slot].frame_data.write(&[data])
     }

@@ -35,6 +35,9 @@ struct FrameData {
     uvec4 counts;               // x light entries, y triangles, z materials, w textures
     vec4 scene_sphere;          // xyz centre, w radius of the scene's bounding sphere
     vec4 jitter;                // xy sub-texel sample offset in [0, 1)² (FRAME_FLAG_HALTON_JITTER), zw unused
+    vec4 sky_zenith;            // rgb radiance of escaping rays straight up (Scene::sky), w unused
+    vec4 sky_horizon;           // rgb at the horizon, w unused
+    vec4 sky_ground;            // rgb below the horizon, w = 1 when any sky radiance is non-zero
 };
 
 // Where samples lie on the screen; each sampling space gives the slots its own meaning.

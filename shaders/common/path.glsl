@@ -14,6 +14,14 @@ bool visible(vec3 p, vec3 n, LightSample ls) {
     return !bvh_trace(offset_ray(p, n), ls.direction, 0.0, ls.distance * (1.0 - 1e-4), true, h);
 }
 
+// The analytic sky (fovea_scene::Sky) seen by a ray leaving the scene along `dir`: horizon to
+// zenith with √(sin elevation) above the horizon, constant below. Black when the scene has none.
+vec3 sky_radiance(vec3 dir) {
+    if (frame.data.sky_ground.w == 0.0) return vec3(0.0);
+    if (dir.y < 0.0) return frame.data.sky_ground.rgb;
+    return mix(frame.data.sky_horizon.rgb, frame.data.sky_zenith.rgb, sqrt(dir.y));
+}
+
 vec3 direct_light(Surface s, vec3 v, inout uint rng) {
     LightSample ls;
     if (!sample_light(s.position, rng, ls)) return vec3(0.0);
@@ -32,7 +40,10 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, inout uint rng) {
     Hit hit;
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
         color += throughput * direct_light(s, v, rng);
-        if (depth_i + 1u >= max_depth) break;
+        // The sky is not sampled by next-event estimation, so at the last vertex a BRDF ray still
+        // looks for it (the sky's "direct light"); a surface it hits adds nothing there.
+        bool last = depth_i + 1u >= max_depth;
+        if (last && frame.data.sky_ground.w == 0.0) break;
         vec3 l, weight;
         bool delta;
         vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
@@ -40,7 +51,14 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, inout uint rng) {
         throughput *= weight;
         vec3 o = offset_ray(s.position, s.geometric_normal);
         continuation_rays++;
-        if (!bvh_trace(o, l, 0.0, 1e30, false, hit)) break;
+        // At the last vertex only escaping matters: the cheaper any-hit test answers that.
+        if (!bvh_trace(o, l, 0.0, 1e30, last, hit)) {
+            // Next-event estimation never samples the sky, so the BRDF-sampled ray that escapes
+            // is its only estimator (no MIS weight needed).
+            color += throughput * sky_radiance(l);
+            break;
+        }
+        if (last) break;
         s = fetch_surface(hit, l);
         // A mirror bounce cannot be found by next-event estimation: count what it sees.
         if (delta) color += throughput * s.emission;

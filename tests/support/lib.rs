@@ -132,6 +132,7 @@ pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_
         validation: true,
         eyes: fovea_tools::commands::setup::Eyes::Left,
         frames_in_flight: 2,
+        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
     }
 }
 

@@ -8,6 +8,7 @@ pub mod density;
 pub mod flip;
 pub mod gaze;
 pub mod interrupt;
+pub mod look;
 pub mod metrics;
 pub mod output;
 pub mod plot;

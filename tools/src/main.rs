@@ -25,8 +25,59 @@ struct DeviceArgs {
     validation: bool,
 }
 
+/// The camera and the default environment (every command that renders the scene camera).
+#[derive(clap::Args)]
+struct SceneFlags {
+    /// A camera of the scene file by index or name (default: its first; with none, a camera
+    /// that frames the scene's bounds).
+    #[arg(long)]
+    camera: Option<String>,
+    /// A free camera at X,Y,Z (with --camera-look) instead of the file's.
+    #[arg(long, allow_hyphen_values = true)]
+    camera_pos: Option<String>,
+    /// The point X,Y,Z the free camera looks at (+Y up).
+    #[arg(long, allow_hyphen_values = true)]
+    camera_look: Option<String>,
+    /// Vertical field of view in degrees, in (1, 170): of the free or framing camera (default 60),
+    /// or replacing the chosen glTF camera's.
+    #[arg(long)]
+    fov: Option<f32>,
+    /// The default sun's AZIMUTH,ELEVATION in degrees (azimuth from +Z toward +X; default 30,60);
+    /// only for scenes without lights of their own.
+    #[arg(long, allow_hyphen_values = true)]
+    sun: Option<String>,
+    /// The default sun's illuminance (default 3; 0 = no sun).
+    #[arg(long)]
+    sun_intensity: Option<f32>,
+    /// The sky's radiance scale (default 0.5 for scenes without lights; 0 = no sky; a scene
+    /// with lights gets a sky only when this is given and > 0).
+    #[arg(long)]
+    sky_intensity: Option<f32>,
+}
+
+impl SceneFlags {
+    fn camera(&self) -> fovea_tools::look::CameraOptions {
+        fovea_tools::look::CameraOptions {
+            camera: self.camera.clone(),
+            position: self.camera_pos.clone(),
+            look: self.camera_look.clone(),
+            fov: self.fov,
+        }
+    }
+
+    fn environment(&self) -> Result<fovea_tools::look::EnvironmentOptions> {
+        Ok(fovea_tools::look::EnvironmentOptions {
+            sun: self.sun.as_deref().map(fovea_tools::look::parse_sun).transpose()?,
+            sun_intensity: self.sun_intensity,
+            sky_intensity: self.sky_intensity,
+        })
+    }
+}
+
 #[derive(clap::Args)]
 struct RenderOpts {
+    #[command(flatten)]
+    look: SceneFlags,
     /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
@@ -141,6 +192,7 @@ impl RenderOpts {
             layout: self.vp_layout.clone(),
             eccentricity: self.vp_eccentricity.clone(),
             blur_sigma: self.blur_sigma,
+            environment: self.look.environment()?,
         })
     }
 }
@@ -245,6 +297,8 @@ enum Command {
         seed: u32,
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        look: SceneFlags,
         /// Replace FILE if it exists.
         #[arg(long)]
         force: bool,
@@ -346,6 +400,8 @@ enum Command {
         #[arg(long, default_value = "out/quality")]
         out: PathBuf,
         #[command(flatten)]
+        look: SceneFlags,
+        #[command(flatten)]
         device: DeviceArgs,
     },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
@@ -385,6 +441,7 @@ const DEFAULT_RENDER_FRAMES: u32 = 24;
 /// The flags `fovea render` and `fovea view` share, checked.
 fn render_args<'a>(
     opts: &'a RenderOpts,
+    camera: &'a fovea_tools::look::CameraOptions,
     device: &'a DeviceArgs,
     profile: &RenderProfile,
     default_frames: u32,
@@ -414,6 +471,7 @@ fn render_args<'a>(
         validation: device.validation,
         eyes: commands::setup::Eyes::parse(&opts.eyes)?,
         frames_in_flight: opts.frames_in_flight,
+        camera,
     })
 }
 
@@ -448,12 +506,14 @@ fn run() -> Result<()> {
     match command {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;
-            commands::render::run(&render_args(&opts, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1", "out/render")?)
+            let camera = opts.look.camera();
+            commands::render::run(&render_args(&opts, &camera, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1", "out/render")?)
         }
         Command::View { opts, screenshot, present_mode, debug_view, device } => {
             let profile = opts.profile()?;
+            let camera = opts.look.camera();
             // Without --frames the run has no length: the camera path's period is a long one.
-            let render = render_args(&opts, &device, &profile, u32::MAX, "center", "out/render")?;
+            let render = render_args(&opts, &camera, &device, &profile, u32::MAX, "center", "out/render")?;
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
@@ -465,8 +525,9 @@ fn run() -> Result<()> {
         }
         Command::Xr { opts, record, screenshot, device } => {
             let profile = opts.profile()?;
+            let camera = opts.look.camera();
             // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
-            let render = render_args(&opts, &device, &profile, u32::MAX, "center", "out/xr")?;
+            let render = render_args(&opts, &camera, &device, &profile, u32::MAX, "center", "out/xr")?;
             if opts.eyes != "left" && opts.eyes != "both" {
                 anyhow::bail!("fovea xr renders both eyes; --eyes {} does not apply", opts.eyes);
             }
@@ -480,7 +541,8 @@ fn run() -> Result<()> {
         }
         Command::Replay { traces, baseline, update_baseline, reference_spp, rings, change_flip, change_rmse, quality_rel, quality_abs, opts, device } => {
             let profile = opts.profile()?;
-            let mut render = render_args(&opts, &device, &profile, DEFAULT_REPLAY_FRAMES, "center", "out/replay")?;
+            let camera = opts.look.camera();
+            let mut render = render_args(&opts, &camera, &device, &profile, DEFAULT_REPLAY_FRAMES, "center", "out/replay")?;
             // Small by default: replays run in the test suite.
             render.width = Some(opts.width.unwrap_or(64));
             render.height = Some(opts.height.unwrap_or(72));
@@ -497,8 +559,10 @@ fn run() -> Result<()> {
                 tolerances,
             })
         }
-        Command::Reference { scene, width, height, spp, max_depth, seed, out, force, preview, device } => {
+        Command::Reference { scene, width, height, spp, max_depth, seed, out, look, force, preview, device } => {
             commands::reference::run(&commands::reference::ReferenceArgs {
+                camera: &look.camera(),
+                environment: look.environment()?,
                 scene: &scene,
                 width,
                 height,
@@ -550,13 +614,14 @@ fn run() -> Result<()> {
             profile,
             blur_sigma,
             out,
+            look,
             device,
         } => {
             let base = match &profile {
                 Some(path) => RenderProfile::load(path)?,
                 None => RenderProfile::default(),
             };
-            let profile = base.override_with(&ProfileOverrides { blur_sigma, ..Default::default() })?;
+            let profile = base.override_with(&ProfileOverrides { blur_sigma, environment: look.environment()?, ..Default::default() })?;
             let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();
             commands::quality::run(&commands::quality::QualityArgs {
                 scene: &scene,
@@ -574,6 +639,7 @@ fn run() -> Result<()> {
                 rings,
                 seed,
                 profile,
+                camera: &look.camera(),
                 out: &out,
                 device: device.device.as_deref(),
                 validation: device.validation,

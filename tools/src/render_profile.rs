@@ -13,6 +13,7 @@ use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::to_screen::BlurSettings;
+use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -28,6 +29,8 @@ pub struct RenderProfile {
     /// Its `svgf` is always the `[svgf]` section's.
     pub asvgf: AsvgfSettings,
     pub taa: TaaSettings,
+    /// `[environment]`: the default sun and sky (`crate::look`), flags applied on top.
+    pub environment: EnvironmentOptions,
 }
 
 #[derive(Deserialize, Default)]
@@ -39,6 +42,16 @@ struct ProfileFile {
     bmfr: Option<BmfrSection>,
     asvgf: Option<AsvgfSection>,
     taa: Option<TaaSection>,
+    environment: Option<EnvironmentSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentSection {
+    /// [azimuth, elevation] in degrees.
+    sun: Option<[f32; 2]>,
+    sun_intensity: Option<f32>,
+    sky_intensity: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -108,6 +121,8 @@ pub struct ProfileOverrides {
     pub layout: Option<String>,
     pub eccentricity: Option<String>,
     pub blur_sigma: Option<f32>,
+    /// `--sun`, `--sun-intensity`, `--sky-intensity`.
+    pub environment: EnvironmentOptions,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -251,6 +266,10 @@ impl RenderProfile {
             s.jitter_points = f.jitter_points.unwrap_or(s.jitter_points);
             s.validate().with_context(|| at("taa"))?;
         }
+        if let Some(f) = file.environment {
+            profile.environment = EnvironmentOptions { sun: f.sun, sun_intensity: f.sun_intensity, sky_intensity: f.sky_intensity };
+            profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
+        }
         Ok(profile)
     }
 
@@ -277,6 +296,8 @@ impl RenderProfile {
         self.check_eccentricity().context("--vp-eccentricity")?;
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
         check_blur(&self.blur).context("--blur-sigma")?;
+        o.environment.validate(&EnvironmentNames::flags())?;
+        self.environment = self.environment.overridden(&o.environment);
         Ok(self)
     }
 }
@@ -339,6 +360,9 @@ mod tests {
         assert_eq!(p.bmfr, BmfrSettings::default());
         assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
+        // The shipped values are the built-in defaults of the sun (no sky key: see the file).
+        let sun = Some(crate::look::DEFAULT_SUN);
+        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None });
     }
 
     #[test]
@@ -441,5 +465,20 @@ gradient_sigma_normal = 64
         }
         let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));
+    }
+
+    #[test]
+    fn environment_section_and_flags() {
+        let p = load_str("env.toml", "[environment]\nsun = [45.0, 30.0]\nsky_intensity = 0.0\n").unwrap();
+        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0) });
+        let err = format!("{:#}", load_str("env_bad.toml", "[environment]\nsun_intensity = -1.0\n").unwrap_err());
+        assert!(err.contains("[environment].sun_intensity"), "{err}");
+        assert!(load_str("env_key.toml", "[environment]\nmoon = 1.0\n").is_err());
+        let o = ProfileOverrides { environment: EnvironmentOptions { sky_intensity: Some(2.0), ..Default::default() }, ..Default::default() };
+        let merged = p.override_with(&o).unwrap();
+        assert_eq!(merged.environment.sky_intensity, Some(2.0));
+        assert_eq!(merged.environment.sun, Some([45.0, 30.0]));
+        let bad = ProfileOverrides { environment: EnvironmentOptions { sun: Some([0.0, 95.0]), ..Default::default() }, ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--sun"));
     }
 }

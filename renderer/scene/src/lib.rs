@@ -45,6 +45,8 @@ pub struct Scene {
     pub punctual_lights: Vec<PunctualLight>,
     /// Perspective cameras in scene-traversal order; `cameras[0]` is the default camera.
     pub cameras: Vec<Camera>,
+    /// Radiance of rays that leave the scene (glTF has none: black unless the caller sets one).
+    pub sky: Sky,
     /// Indexed by [`Triangle::mesh`]: the glTF mesh name, or `mesh<i>` when unnamed.
     pub mesh_names: Vec<String>,
     pub source: PathBuf,
@@ -145,6 +147,27 @@ pub struct Camera {
     pub aspect: Option<f32>,
     pub znear: f32,
     pub name: String,
+}
+
+/// A simple analytic sky seen by rays that escape the scene (+Y up, glTF's convention):
+/// above the horizon the radiance goes from `horizon` to `zenith` with √(sin elevation), below
+/// it it is `ground`. All three equal give a uniform environment (the furnace tests); all zero
+/// (the default) is no environment at all.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sky {
+    pub zenith: Vec3,
+    pub horizon: Vec3,
+    pub ground: Vec3,
+}
+
+impl Sky {
+    /// The same radiance in every direction.
+    pub fn uniform(radiance: Vec3) -> Sky {
+        Sky { zenith: radiance, horizon: radiance, ground: radiance }
+    }
+    pub fn is_black(&self) -> bool {
+        self.zenith == Vec3::ZERO && self.horizon == Vec3::ZERO && self.ground == Vec3::ZERO
+    }
 }
 
 /// Axis-aligned bounding box. The empty box has min = +1e30 and max = −1e30 so that a slab
@@ -257,6 +280,58 @@ impl Scene {
     /// The first perspective camera, if any.
     pub fn default_camera(&self) -> Option<&Camera> {
         self.cameras.first()
+    }
+
+    /// Whether anything in the scene emits light: a punctual light or an emissive material that
+    /// a triangle uses (an emissive texture only modulates the factor, so a zero factor is dark).
+    pub fn has_lights(&self) -> bool {
+        if !self.punctual_lights.is_empty() {
+            return true;
+        }
+        let emissive: Vec<bool> = self.materials.iter().map(|m| m.emissive.max_element() > 0.0).collect();
+        self.triangles.iter().any(|t| emissive.get(t.material as usize).copied().unwrap_or(false))
+    }
+
+    /// A camera that frames the whole scene (see [`Camera::framing`]); `None` for an empty scene.
+    pub fn framing_camera(&self, yfov: f32, aspect: f32) -> Option<Camera> {
+        let bounds = self.bounds();
+        (!bounds.is_empty()).then(|| Camera::framing(&bounds, yfov, aspect))
+    }
+}
+
+/// The direction the framing camera looks from, seen from the bounds' centre: in front (+Z, the
+/// side glTF models face), 30° to the right and 20° above, so that a room's floor and two walls
+/// show rather than one flat wall.
+const FRAMING_AZIMUTH_DEG: f32 = 30.0;
+const FRAMING_ELEVATION_DEG: f32 = 20.0;
+/// Extra distance so the bounding sphere does not touch the image's edge.
+const FRAMING_MARGIN: f32 = 1.05;
+
+impl Camera {
+    /// A camera at `position` looking at `target` with +Y up (+Z when the view is vertical),
+    /// vertical FOV `yfov` (radians). `position` ≠ `target`.
+    pub fn look_at(position: Vec3, target: Vec3, yfov: f32, name: &str) -> Camera {
+        let forward = (target - position).normalize();
+        let up = if forward.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y };
+        let view_from_world = Mat4::look_at_rh(position, target, up);
+        let distance = (target - position).length();
+        Camera { world_from_view: view_from_world.inverse(), yfov, aspect: None, znear: (distance * 1e-3).max(1e-5), name: name.to_owned() }
+    }
+
+    /// A camera that sees all of `bounds`: it looks at the centre from the front-right diagonal
+    /// ([`FRAMING_AZIMUTH_DEG`], [`FRAMING_ELEVATION_DEG`]) at the distance where the bounding
+    /// sphere fits the narrower of the vertical FOV `yfov` and the horizontal one that `aspect`
+    /// (width / height) gives, with a 5 % margin. Every point of the bounds then projects inside
+    /// the image.
+    pub fn framing(bounds: &Aabb, yfov: f32, aspect: f32) -> Camera {
+        let centre = bounds.center();
+        let radius = bounds.bounding_sphere_radius().max(1e-3);
+        let tan_y = (yfov * 0.5).tan();
+        let half = tan_y.min(tan_y * aspect).atan();
+        let distance = FRAMING_MARGIN * radius / half.sin();
+        let (az, el) = (FRAMING_AZIMUTH_DEG.to_radians(), FRAMING_ELEVATION_DEG.to_radians());
+        let from = Vec3::new(az.sin() * el.cos(), el.sin(), az.cos() * el.cos());
+        Camera::look_at(centre + from * distance, centre, yfov, "default (frames the scene)")
     }
 }
 

@@ -39,6 +39,7 @@ pub struct QualityArgs<'a> {
     pub rings: usize,
     pub seed: u32,
     pub profile: RenderProfile,
+    pub camera: &'a crate::look::CameraOptions,
     pub out: &'a Path,
     pub device: Option<&'a str>,
     pub validation: bool,
@@ -151,6 +152,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         validation: args.validation,
                         eyes: super::setup::Eyes::Left,
                         frames_in_flight: 2,
+                        camera: args.camera,
                     };
                     render::run(&render_args).with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
                     let mut q = measure(args, &dir, &evaluated, &references)?;
@@ -183,11 +185,8 @@ pub fn run(args: &QualityArgs) -> Result<()> {
 /// Converged references of the evaluated frames' camera poses (one for a still camera), written
 /// to `DIR/reference_<camera>_NNNN.exr`.
 fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
-    let scene = crate::scenes::load(args.scene)?;
-    let Some(camera) = scene.default_camera() else {
-        bail!("{}: the scene has no perspective camera", scene.source.display());
-    };
-    let start = CameraPose::from_scene_camera(camera, args.width, args.height);
+    let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, args.width as f32 / args.height as f32)?;
+    let start = CameraPose::from_scene_camera(&camera, args.width, args.height);
     let centre = scene.bounds().center();
     let ctx = super::open_device(args.device, args.validation)?;
     let size = UVec2::new(args.width, args.height);

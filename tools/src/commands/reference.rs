@@ -21,6 +21,8 @@ pub struct ReferenceArgs<'a> {
     pub preview: bool,
     pub device: Option<&'a str>,
     pub validation: bool,
+    pub camera: &'a crate::look::CameraOptions,
+    pub environment: crate::look::EnvironmentOptions,
 }
 
 pub fn run(args: &ReferenceArgs) -> Result<()> {
@@ -35,11 +37,8 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     if args.preview {
         check_new_file(&preview, args.force)?;
     }
-    let scene = crate::scenes::load(args.scene)?;
-    let Some(camera) = scene.default_camera() else {
-        bail!("{}: the scene has no perspective camera", scene.source.display());
-    };
-    let pose = CameraPose::from_scene_camera(camera, args.width, args.height);
+    let (scene, camera) = crate::look::load(args.scene, args.camera, &args.environment, args.width as f32 / args.height as f32)?;
+    let pose = CameraPose::from_scene_camera(&camera, args.width, args.height);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, ..Default::default() };
     let space = Box::new(Cartesian::new(UVec2::new(args.width, args.height)));

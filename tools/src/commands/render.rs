@@ -43,6 +43,8 @@ pub struct RenderArgs<'a> {
     pub eyes: Eyes,
     /// Frames kept on the GPU at once (a frame's images are written while later ones render).
     pub frames_in_flight: usize,
+    /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
+    pub camera: &'a crate::look::CameraOptions,
 }
 
 pub use super::setup::METHODS;

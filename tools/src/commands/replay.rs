@@ -225,12 +225,11 @@ fn param_changes(base: &Params, now: &Params) -> Vec<(String, String, String)> {
 
 /// The converged image of the still camera (Cartesian, `--reference-spp` samples per pixel).
 fn reference_for(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Result<Vec<[f32; 4]>> {
-    let scene = crate::scenes::load(r.scene)?;
-    let Some(camera) = scene.default_camera() else { bail!("{}: the scene has no perspective camera", scene.source.display()) };
+    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, width as f32 / height as f32)?;
     let ctx = super::open_device(r.device, r.validation)?;
     let settings = RenderSettings { seed: r.seed.wrapping_add(0x5eed), ..Default::default() };
     let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(UVec2::new(width, height))), settings)?;
-    let pose = CameraPose::from_scene_camera(camera, width, height);
+    let pose = CameraPose::from_scene_camera(&camera, width, height);
     let reference = renderer.render_reference(&pose, args.reference_spp, r.max_depth, |_| {})?;
     super::check_validation(&ctx)?;
     Ok(reference)

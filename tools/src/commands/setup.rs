@@ -95,11 +95,8 @@ impl Setup {
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.method, args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
-        let scene = crate::scenes::load(args.scene)?;
-        let Some(camera) = scene.default_camera() else {
-            bail!("{}: the scene has no perspective camera", scene.source.display());
-        };
-        let start_pose = CameraPose::from_scene_camera(camera, width, height);
+        let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, width as f32 / height as f32)?;
+        let start_pose = CameraPose::from_scene_camera(&camera, width, height);
         let settings = RenderSettings {
             max_depth: args.max_depth,
             seed: args.seed,

@@ -95,10 +95,11 @@ pub fn run(args: &XrArgs) -> Result<()> {
     super::setup::check_settings(r.max_depth, r.exposure)?;
     let (denoiser, taa) = filters(r.method, r.denoiser, r.taa, &r.profile)?;
     let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
-    let scene = crate::scenes::load(r.scene)?;
-    let Some(camera) = scene.default_camera() else {
-        bail!("{}: the scene has no perspective camera", scene.source.display());
-    };
+    let eye = base.eye(fovea_hal::Eye::Left);
+    // The runtime's size is known only later; the headset's recommended eye frames the scene.
+    let aspect = eye.recommended_width as f32 / eye.recommended_height.max(1) as f32;
+    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, aspect)?;
+    let camera = &camera;
     let out_dir = prepare_output_dir(r.out)?;
     let rt = Arc::new(OpenXrRuntime::create("fovea").context("fovea xr needs an OpenXR runtime (see README: On a headset)")?);
     let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;

@@ -1,0 +1,287 @@
+//! What a rendered scene looks like beyond its file: the camera (`--camera`, the free camera of
+//! `--camera-pos/--camera-look/--fov`, or one that frames the scene when the file has none) and
+//! the default environment (a sun and an analytic sky) for scenes that bring no light of their own.
+//! Every command that renders the scene camera (render, view, xr, replay, quality, reference)
+//! loads its scene through [`load`], so they all see the same thing.
+//!
+//! The environment rule:
+//! - a scene with no punctual light and no emissive material gets the default sun (a directional
+//!   light in the light table, so next-event estimation samples it) and the default sky;
+//! - a scene with its own lights gets no sun, and the sky only when `--sky-intensity` (or the
+//!   profile's `environment.sky_intensity`) is given explicitly and > 0;
+//! - `--sun-intensity 0` / `--sky-intensity 0` turn either part off.
+
+use anyhow::{bail, Context, Result};
+use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
+use glam::Vec3;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The default sun: azimuth (degrees from +Z, the side glTF models face, toward +X) and elevation
+/// above the horizon. High enough to reach into a courtyard, low enough to cast visible shadows.
+pub const DEFAULT_SUN: [f32; 2] = [30.0, 60.0];
+/// Illuminance (lux-like units) on a surface facing the sun: a white Lambertian surface lit
+/// head-on has radiance E/π ≈ 0.95, bright but not clipped by the ACES curve at exposure 1.
+pub const DEFAULT_SUN_INTENSITY: f32 = 3.0;
+/// Scale of the default sky's radiance (see [`default_sky`]): with the default sun, sky light on
+/// an open floor is about a sixth of the sun's.
+pub const DEFAULT_SKY_INTENSITY: f32 = 0.5;
+/// Largest sun illuminance / sky radiance scale: far beyond anything useful, small enough that
+/// radiance sums stay finite in f32.
+pub const MAX_INTENSITY: f32 = 1e6;
+/// The vertical FOV of the framing camera without `--fov` (degrees).
+pub const DEFAULT_FOV_DEG: f32 = 60.0;
+/// `--fov` is accepted strictly inside this range (degrees): at 0 nothing is seen, at 180 the
+/// pinhole projection is infinite.
+pub const FOV_RANGE_DEG: (f32, f32) = (1.0, 170.0);
+
+/// The default environment's settings, each `None` when neither the flag nor the profile gave it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnvironmentOptions {
+    /// Azimuth, elevation in degrees.
+    pub sun: Option<[f32; 2]>,
+    pub sun_intensity: Option<f32>,
+    pub sky_intensity: Option<f32>,
+}
+
+/// The names used in error messages: the flags, or a profile's keys.
+pub struct EnvironmentNames {
+    pub sun: String,
+    pub sun_intensity: String,
+    pub sky_intensity: String,
+}
+
+impl EnvironmentNames {
+    pub fn flags() -> EnvironmentNames {
+        EnvironmentNames { sun: "--sun".into(), sun_intensity: "--sun-intensity".into(), sky_intensity: "--sky-intensity".into() }
+    }
+    /// `FILE: [environment].key`.
+    pub fn profile(file: &str) -> EnvironmentNames {
+        let key = |k: &str| format!("{file}: [environment].{k}");
+        EnvironmentNames { sun: key("sun"), sun_intensity: key("sun_intensity"), sky_intensity: key("sky_intensity") }
+    }
+}
+
+impl EnvironmentOptions {
+    /// `self` with every value `over` gives replaced.
+    pub fn overridden(self, over: &EnvironmentOptions) -> EnvironmentOptions {
+        EnvironmentOptions {
+            sun: over.sun.or(self.sun),
+            sun_intensity: over.sun_intensity.or(self.sun_intensity),
+            sky_intensity: over.sky_intensity.or(self.sky_intensity),
+        }
+    }
+
+    pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
+        if let Some([azimuth, elevation]) = self.sun {
+            if !(azimuth.is_finite() && elevation.is_finite() && elevation > 0.0 && elevation <= 90.0) {
+                bail!(
+                    "{} {azimuth},{elevation}: expected AZIMUTH,ELEVATION in degrees, azimuth finite, elevation in (0, 90] (a sun at or below the horizon lights nothing from above)",
+                    names.sun
+                );
+            }
+        }
+        check_intensity(self.sun_intensity, &names.sun_intensity)?;
+        check_intensity(self.sky_intensity, &names.sky_intensity)
+    }
+}
+
+fn check_intensity(value: Option<f32>, name: &str) -> Result<()> {
+    match value {
+        Some(v) if !(v.is_finite() && (0.0..=MAX_INTENSITY).contains(&v)) => {
+            bail!("{name} {v:?}: must be finite and in [0, {MAX_INTENSITY:e}] (0 turns it off)")
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `AZIMUTH,ELEVATION` (degrees) as `--sun` takes it.
+pub fn parse_sun(text: &str) -> Result<[f32; 2]> {
+    let values = parse_floats(text).with_context(|| format!("--sun {text}: expected AZIMUTH,ELEVATION in degrees"))?;
+    match values[..] {
+        [a, e] => Ok([a, e]),
+        _ => bail!("--sun {text}: expected two numbers, AZIMUTH,ELEVATION in degrees"),
+    }
+}
+
+fn parse_floats(text: &str) -> Result<Vec<f32>> {
+    text.split(',').map(|v| v.trim().parse::<f32>().with_context(|| format!("'{}' is not a number", v.trim()))).collect()
+}
+
+/// The unit vector toward the sun at `azimuth` (from +Z toward +X) and `elevation` (degrees).
+pub fn sun_direction(azimuth_deg: f32, elevation_deg: f32) -> Vec3 {
+    let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+    Vec3::new(az.sin() * el.cos(), el.sin(), az.cos() * el.cos())
+}
+
+/// The default sky, radiance × `intensity`: a pale horizon (1, 0.97, 0.92), a blue zenith
+/// (0.35, 0.55, 1.0) and a dim grey ground (0.3) below the horizon, so that light from below
+/// (an open floor's bounce) stays weaker than from above.
+pub fn default_sky(intensity: f32) -> Sky {
+    Sky {
+        zenith: Vec3::new(0.35, 0.55, 1.0) * intensity,
+        horizon: Vec3::new(1.0, 0.97, 0.92) * intensity,
+        ground: Vec3::splat(0.3) * intensity,
+    }
+}
+
+/// Adds the default sun and sky where the rule of this module says so; returns the one-line
+/// notice to print when it did.
+pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<String> {
+    if scene.has_lights() {
+        // The scene's own lighting stays as authored; only an explicit sky is added.
+        if let Some(s) = env.sky_intensity.filter(|&s| s > 0.0) {
+            scene.sky = default_sky(s);
+        }
+        return None;
+    }
+    let [azimuth, elevation] = env.sun.unwrap_or(DEFAULT_SUN);
+    let sun = env.sun_intensity.unwrap_or(DEFAULT_SUN_INTENSITY);
+    let sky = env.sky_intensity.unwrap_or(DEFAULT_SKY_INTENSITY);
+    if sun > 0.0 {
+        // `direction` is where the light travels: away from the sun.
+        scene.punctual_lights.push(PunctualLight::Directional { direction: -sun_direction(azimuth, elevation), illuminance: Vec3::splat(sun) });
+    }
+    scene.sky = default_sky(sky);
+    Some(format!(
+        "no lights in the scene: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; sky intensity {sky}; \
+         change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity or a profile's [environment]; 0 turns either off)"
+    ))
+}
+
+/// How the camera is chosen (`--camera`, `--camera-pos`, `--camera-look`, `--fov`), as given.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraOptions {
+    /// A glTF camera by index or name.
+    pub camera: Option<String>,
+    /// The free camera's position and the point it looks at, `X,Y,Z` each.
+    pub position: Option<String>,
+    pub look: Option<String>,
+    /// Vertical FOV in degrees: the free or framing camera's, or overriding a glTF camera's.
+    pub fov: Option<f32>,
+}
+
+/// No camera flag: the file's first camera, else the framing one (code that builds arguments).
+pub static NO_CAMERA_FLAGS: CameraOptions = CameraOptions { camera: None, position: None, look: None, fov: None };
+
+/// A checked camera choice.
+#[derive(Clone, Debug, PartialEq)]
+enum Choice {
+    /// `--camera`, or the file's first camera (None), else the framing camera.
+    Scene(Option<String>),
+    Free { position: Vec3, look: Vec3 },
+}
+
+impl CameraOptions {
+    fn choice(&self) -> Result<Choice> {
+        if let Some(fov) = self.fov {
+            let (lo, hi) = FOV_RANGE_DEG;
+            if !(fov.is_finite() && fov > lo && fov < hi) {
+                bail!("--fov {fov:?}: the vertical field of view must be in ({lo}, {hi}) degrees");
+            }
+        }
+        match (&self.camera, &self.position, &self.look) {
+            (camera, None, None) => Ok(Choice::Scene(camera.clone())),
+            (Some(_), _, _) => bail!("--camera picks a camera of the scene; --camera-pos/--camera-look place a free one: give one or the other"),
+            (None, Some(p), Some(l)) => {
+                let position = parse_point(p, "--camera-pos")?;
+                let look = parse_point(l, "--camera-look")?;
+                if (look - position).length() <= 1e-6 * position.length().max(1.0) {
+                    bail!("--camera-pos {p} and --camera-look {l}: the camera must look at a point other than its own position");
+                }
+                Ok(Choice::Free { position, look })
+            }
+            (None, Some(_), None) => bail!("--camera-pos needs --camera-look X,Y,Z (the point the camera looks at)"),
+            (None, None, Some(_)) => bail!("--camera-look needs --camera-pos X,Y,Z (where the camera stands)"),
+        }
+    }
+
+    /// Checks the flags alone (before a scene is loaded).
+    pub fn check(&self) -> Result<()> {
+        self.choice().map(|_| ())
+    }
+
+    /// The camera these options choose in `scene`; `aspect` (width / height) sizes the framing
+    /// camera so the scene fits both ways. The bool is true when the framing camera stands in for
+    /// a file without one.
+    pub fn camera_for(&self, scene: &Scene, aspect: f32) -> Result<(Camera, bool)> {
+        let fov = self.fov.map(f32::to_radians);
+        match self.choice()? {
+            Choice::Free { position, look } => {
+                Ok((Camera::look_at(position, look, fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), "free (--camera-pos)"), false))
+            }
+            Choice::Scene(Some(wanted)) => {
+                let mut camera = find_camera(scene, &wanted)?.clone();
+                camera.yfov = fov.unwrap_or(camera.yfov);
+                Ok((camera, false))
+            }
+            Choice::Scene(None) => match scene.default_camera() {
+                Some(camera) => Ok((Camera { yfov: fov.unwrap_or(camera.yfov), ..camera.clone() }, false)),
+                None => {
+                    let framing = scene.framing_camera(fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), aspect);
+                    let framing = framing.with_context(|| format!("{}: the scene is empty: no camera can frame it", scene.source.display()))?;
+                    Ok((framing, true))
+                }
+            },
+        }
+    }
+}
+
+fn parse_point(text: &str, flag: &str) -> Result<Vec3> {
+    let values = parse_floats(text).with_context(|| format!("{flag} {text}: expected X,Y,Z"))?;
+    match values[..] {
+        [x, y, z] if [x, y, z].iter().all(|v| v.is_finite()) => Ok(Vec3::new(x, y, z)),
+        [_, _, _] => bail!("{flag} {text}: every coordinate must be finite"),
+        _ => bail!("{flag} {text}: expected three numbers X,Y,Z"),
+    }
+}
+
+/// A glTF camera by index (digits) or by name; the error lists what the file has.
+fn find_camera<'a>(scene: &'a Scene, wanted: &str) -> Result<&'a Camera> {
+    let by_index = wanted.parse::<usize>().ok().and_then(|i| scene.cameras.get(i));
+    if let Some(camera) = by_index.or_else(|| scene.cameras.iter().find(|c| c.name == wanted)) {
+        return Ok(camera);
+    }
+    if scene.cameras.is_empty() {
+        bail!(
+            "--camera {wanted}: {} has no perspective camera (without --camera a default camera frames the scene; --camera-pos/--camera-look place one)",
+            scene.source.display()
+        );
+    }
+    let list: Vec<String> = scene.cameras.iter().enumerate().map(|(i, c)| format!("{i} \"{}\"", c.name)).collect();
+    bail!("--camera {wanted}: no such camera in {}; it has {}", scene.source.display(), list.join(", "))
+}
+
+/// Says `text` on stderr once per process (`fovea quality` sets up many runs of one scene).
+fn notice_once(flag: &AtomicBool, text: &str) {
+    if !flag.swap(true, Ordering::Relaxed) {
+        eprintln!("{text}");
+    }
+}
+
+static ENVIRONMENT_NOTICE: AtomicBool = AtomicBool::new(false);
+static CAMERA_NOTICE: AtomicBool = AtomicBool::new(false);
+
+/// Loads `--scene` with its default environment (when the rule says so) and the chosen camera.
+pub fn load(scene_name: &str, camera: &CameraOptions, env: &EnvironmentOptions, aspect: f32) -> Result<(Scene, Camera)> {
+    camera.check()?;
+    env.validate(&EnvironmentNames::flags())?;
+    let mut scene = crate::scenes::load(scene_name)?;
+    if let Some(notice) = apply_environment(&mut scene, env) {
+        notice_once(&ENVIRONMENT_NOTICE, &notice);
+    }
+    let (chosen, framing) = camera.camera_for(&scene, aspect)?;
+    if framing {
+        notice_once(
+            &CAMERA_NOTICE,
+            &format!(
+                "{}: no camera in the file: using one that frames the scene's bounds (--camera-pos/--camera-look/--fov place another)",
+                scene.source.display()
+            ),
+        );
+    }
+    Ok((scene, chosen))
+}
+
+#[cfg(test)]
+#[path = "look_tests.rs"]
+mod tests;
