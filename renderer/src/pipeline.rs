@@ -611,8 +611,12 @@ fn record_view(
         has_previous: denoise_frame.previous.is_some(),
         jitter,
     });
-    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar()) {
-        (Some(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar(), &view.upscale) {
+        (Some(to_screen), Some(vp), _) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+        (_, _, Some((upscale, screen))) => {
+            upscale.record(rec, grid_hdr, screen)?;
+            screen
+        }
         _ => grid_hdr,
     };
     let (exposure, curve) = (settings.exposure, settings.tone_curve);

@@ -8,6 +8,7 @@ use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::sampling::SamplingSpace;
 use crate::to_screen::ToScreen;
@@ -77,6 +78,8 @@ pub struct View {
     pub(crate) trace_gradients: Option<TracePass>,
     /// Visual-Polar spaces only: the way back to the screen.
     pub(crate) to_screen: Option<ToScreen>,
+    /// Grids coarser than the screen (uniform budget): the upscale and its screen-sized output.
+    pub(crate) upscale: Option<(UpscalePass, Image)>,
     pub(crate) ldr: Image,
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
@@ -98,10 +101,11 @@ impl View {
         let caps = space.capabilities();
         if !caps.temporal_filters && (settings.denoiser != DenoiserSettings::None || settings.taa != TaaMode::Off) {
             return Err(Error::Invalid(format!(
-                "denoiser '{}' / TAA '{}': the {} space in this layout (screen-clipped) supports no denoiser or TAA (use layout = \"paper\")",
+                "denoiser '{}' / TAA '{}': the {} space supports no denoiser or TAA {}",
                 settings.denoiser.name(),
                 settings.taa.name(),
-                space.name()
+                space.name(),
+                caps.filters_note
             )));
         }
         // Screen-space TAA runs between the remap and the blur; where the sampling grid is the
@@ -112,6 +116,10 @@ impl View {
         };
         let to_screen = match caps.needs_remap {
             true => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
+            false => None,
+        };
+        let upscale = match caps.needs_upscale {
+            true => Some((UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?)),
             false => None,
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
@@ -133,6 +141,7 @@ impl View {
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             accum: None,
             to_screen,
+            upscale,
             denoiser,
             taa,
             prev_camera: None,

@@ -9,6 +9,7 @@ pub mod raycast;
 pub mod remap;
 pub mod tonemap;
 pub mod trace;
+pub mod upscale;
 
 /// One Visual-Polar kernel compiled for each layout (`//! variant paper` / `clipped`): lavapipe
 /// pays for both sides of a branch, so the paper's layout gets a kernel without the

@@ -4,11 +4,13 @@
 
 mod acuity;
 mod cartesian;
+mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 
 pub use cartesian::Cartesian;
+pub use uniform_budget::UniformBudget;
 pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadiusMode, VpLayout};
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
@@ -22,8 +24,12 @@ use glam::{UVec2, Vec2};
 pub struct SpaceCapabilities {
     /// The grid is not the screen: φ-mips, the remap and the foveated blur bring it back.
     pub needs_remap: bool,
+    /// A regular grid coarser than the screen: bilinear upscaling brings it back.
+    pub needs_upscale: bool,
     /// The denoisers and TAA can reproject and filter in this grid (their kernels address it).
     pub temporal_filters: bool,
+    /// Why they cannot, for the error (when `temporal_filters` is false).
+    pub filters_note: &'static str,
 }
 
 pub trait SamplingSpace {
@@ -73,6 +79,6 @@ pub trait SamplingSpace {
     }
     /// The space's capabilities (default: a screen-sized grid every filter supports).
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { needs_remap: false, temporal_filters: true }
+        SpaceCapabilities { needs_remap: false, needs_upscale: false, temporal_filters: true, filters_note: "" }
     }
 }

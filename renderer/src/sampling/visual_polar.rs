@@ -580,7 +580,12 @@ impl SamplingSpace for VisualPolar {
     fn capabilities(&self) -> super::SpaceCapabilities {
         // The filters reproject and address the grid with the paper's mapping only (no
         // per-column arc table in their kernels yet).
-        super::SpaceCapabilities { needs_remap: true, temporal_filters: self.params.layout == VpLayout::Paper }
+        super::SpaceCapabilities {
+            needs_remap: true,
+            needs_upscale: false,
+            temporal_filters: self.params.layout == VpLayout::Paper,
+            filters_note: "in its screen-clipped layout (use layout = \"paper\")",
+        }
     }
 }
 

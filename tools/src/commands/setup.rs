@@ -12,12 +12,12 @@ use fovea_hal::{Eye, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VpLayout};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, UniformBudget, VisualPolar, VpLayout};
 use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -187,7 +187,8 @@ pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
 /// least `MIN_VP_GRID` texels per axis and a fixed radius within `MAX_VP_RADIUS_DIAGONALS`
 /// diagonals. Cartesian takes any size from 1×1.
 pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Result<()> {
-    if method != "vp" {
+    // The uniform budget is Visual-Polar's sample count: VP must be possible at this size.
+    if method != "vp" && method != "uniform-budget" {
         return Ok(());
     }
     if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
@@ -261,6 +262,11 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
     Ok(match method {
         "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
         "cartesian" => Box::new(Cartesian::new(screen)),
+        // Visual-Polar's sample count for this eye and profile, spent on a regular grid.
+        "uniform-budget" => {
+            let vp = VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space (the uniform budget's count)")?;
+            Box::new(UniformBudget::with_samples(screen, vp.sample_count())?)
+        }
         other => bail!("--method {other}: expected one of {}", METHODS.join(", ")),
     })
 }

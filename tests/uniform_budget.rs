@@ -1,0 +1,69 @@
+//! The `uniform-budget` comparator: Visual-Polar's sample count on a regular grid, bilinearly
+//! upscaled. It traces the budget it claims, converges to the same image as one sample per pixel,
+//! refuses the filters its grid cannot run, and `fovea render --method uniform-budget` reports it.
+
+use fovea_renderer::passes::denoise::svgf::SvgfSettings;
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::sampling::{Cartesian, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams};
+use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene};
+use glam::UVec2;
+
+const SCREEN: UVec2 = UVec2::new(64, 72);
+
+/// Mean linear colour over `frames` frames (independent noise each frame).
+fn mean_over_frames(renderer: &mut Renderer, camera: CameraPose, frames: u32) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    let mut hdr = Vec::new();
+    for f in 0..frames {
+        renderer.render_frame(&FrameInput::mono(camera, f, None).with_hdr(true)).unwrap();
+        renderer.read_hdr(&mut hdr).unwrap();
+        assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize, "the upscaled image is screen-sized");
+        let m = mean_rgb(&hdr);
+        (0..3).for_each(|c| sum[c] += m[c] / frames as f64);
+    }
+    sum
+}
+
+#[test]
+fn uniform_budget_traces_vp_s_count_and_converges_like_one_sample_per_pixel() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
+    let vp = VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    let budget = UniformBudget::with_samples(SCREEN, vp.sample_count()).unwrap();
+    assert!((budget.sample_count() as f64 / vp.sample_count() as f64 - 1.0).abs() < 0.03, "{} vs {}", budget.sample_count(), vp.sample_count());
+    assert!(budget.grid.x < SCREEN.x && budget.grid.y < SCREEN.y);
+
+    let mut uniform = Renderer::new(&ctx, &scene, Box::new(budget), RenderSettings::default()).unwrap();
+    let stats = uniform.render_frame(&FrameInput::mono(camera, 0, None)).unwrap();
+    assert_eq!(stats.samples_traced, budget.sample_count(), "every texel traced once");
+    let a = mean_over_frames(&mut uniform, camera, 16);
+    let mut cartesian = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(SCREEN)), RenderSettings::default()).unwrap();
+    let b = mean_over_frames(&mut cartesian, camera, 16);
+    for c in 0..3 {
+        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: uniform budget {} vs one per pixel {}", a[c], b[c]);
+    }
+    assert_clean(&ctx);
+}
+
+#[test]
+fn uniform_budget_refuses_the_denoisers_and_the_cli_reports_it() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let budget = UniformBudget::with_samples(SCREEN, 2000).unwrap();
+    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
+    let err = Renderer::new(&ctx, &scene, Box::new(budget), svgf).err().expect("refused").to_string();
+    assert!(err.contains("svgf") && err.contains("uniform-budget"), "{err}");
+    assert_clean(&ctx);
+
+    let out = fovea_tests::artifacts_dir().join(format!("uniform-budget-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let args = fovea_tools::commands::render::RenderArgs { method: "uniform-budget", width: Some(64), height: Some(72), ..fovea_tests::small_render_args("cornell-box", &out) };
+    fovea_tools::commands::render::run(&args).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["method"], "uniform-budget");
+    assert!(report["passes"]["upscale"].as_f64().is_some(), "{}", report["passes"]);
+    let (grid, screen) = (report["vp_width"].as_u64().unwrap() * report["vp_height"].as_u64().unwrap(), 64 * 72);
+    assert!(grid < screen && report["samples_traced"].as_u64().unwrap() == grid, "{report}");
+}
