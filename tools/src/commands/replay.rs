@@ -214,6 +214,8 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
         blur_sigma_at_30: r.profile.blur.sigma_at_30,
         reference_spp: args.reference_spp,
         rings: args.rings,
+        camera: format!("{:?}", r.camera),
+        environment: format!("{:?}", r.profile.environment),
     }
 }
 

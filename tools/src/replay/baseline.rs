@@ -26,6 +26,11 @@ pub struct Params {
     pub blur_sigma_at_30: f32,
     pub reference_spp: u32,
     pub rings: usize,
+    /// The camera and environment flags as given (older baselines: empty).
+    #[serde(default)]
+    pub camera: String,
+    #[serde(default)]
+    pub environment: String,
 }
 
 #[derive(Serialize, Deserialize, Clone, Debug)]
