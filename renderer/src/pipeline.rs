@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::frames::FrameRing;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
-use crate::layouts::{FrameData, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
+use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
@@ -424,7 +424,7 @@ impl Renderer {
             self.views[v].space.set_gaze(gaze)?;
         }
         let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
-        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 };
+        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 } | if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 };
         self.write_frame_data(v, slot, &view_input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;
@@ -518,7 +518,8 @@ impl Renderer {
             let batch = (spp - done).min(REFERENCE_SAMPLES_PER_SUBMIT);
             let slot = self.ring.next_slot();
             self.views[0].ensure_readbacks(&self.ctx, slot, true, false)?;
-            self.write_frame_data(0, slot, camera, 0, max_depth, FRAME_FLAG_REFERENCE, Vec2::ZERO)?;
+            let alpha = if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 };
+            self.write_frame_data(0, slot, camera, 0, max_depth, FRAME_FLAG_REFERENCE | alpha, Vec2::ZERO)?;
             self.views[0].slots[slot].sampling.write(&[self.views[0].space.params()])?;
             let (_, rec) = self.ring.begin_next()?;
             let view = &self.views[0];

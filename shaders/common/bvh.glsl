@@ -133,8 +133,10 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
             vec4 t2 = texelFetch(bvh_triangles, tb + 2);
             uint id = floatBitsToUint(t0.w);
             vec3 tuv;
+            // Alpha-masked scenes only (a frame flag, so others pay nothing): a cut-out is no hit.
             if (intersect_triangle(sh, t0.xyz, t1.xyz, t2.xyz, tmin, tmax, tuv)
-                && (tuv.x < hit.t || (tuv.x == hit.t && id < hit.triangle))) {
+                && (tuv.x < hit.t || (tuv.x == hit.t && id < hit.triangle))
+                && !((frame.data.frame.w & FRAME_FLAG_ALPHA_MASK) != 0u && alpha_rejects(id, tuv.y, tuv.z))) {
                 hit.t = tuv.x;
                 hit.u = tuv.y;
                 hit.v = tuv.z;

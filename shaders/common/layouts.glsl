@@ -12,6 +12,8 @@ const uint WORKGROUP_1D = 64u;
 
 const uint NO_TEXTURE = 0xffffffffu;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
+// alphaMode MASK: MaterialGpu.textures2.w holds the cutoff's float bits.
+const uint MATERIAL_ALPHA_MASK = 2u;
 
 const uint LIGHT_KIND_TRIANGLE = 0u;
 const uint LIGHT_KIND_POINT = 1u;
@@ -23,6 +25,9 @@ const uint FRAME_FLAG_REFERENCE = 1u;
 // The tracer jitters every sample by FrameData.jitter (TAA's Halton sequence) instead of its RNG;
 // the RNG stream itself is drawn unchanged, so everything after the jitter stays the same.
 const uint FRAME_FLAG_HALTON_JITTER = 2u;
+// The scene has alpha-masked materials: traversal tests each candidate hit's alpha (without the
+// flag it costs nothing).
+const uint FRAME_FLAG_ALPHA_MASK = 4u;
 
 // Everything the passes need to know about the current (and previous) frame.
 struct FrameData {
@@ -68,7 +73,7 @@ struct MaterialGpu {
     vec4 specular;              // rgb = KHR_materials_specular colour factor, w = specular factor
     vec4 surface;               // x metallic, y roughness, z ior, w normal-map scale
     uvec4 textures;             // base colour, metallic-roughness, normal, emissive (NO_TEXTURE = none)
-    uvec4 textures2;            // specular (alpha channel), specular colour, MATERIAL_* flags, unused
+    uvec4 textures2;            // specular (alpha channel), specular colour, MATERIAL_* flags, alpha cutoff (float bits, MATERIAL_ALPHA_MASK)
 };
 
 struct TextureGpu {

@@ -17,6 +17,9 @@ layout(std430, set = 0, binding = 7) readonly buffer LightBuffer { LightGpu data
 // reads into one load per lane (std140 = std430 here: FrameData is all vec4/mat4).
 layout(std140, set = 0, binding = 8) uniform FrameBuffer { FrameData data; } frame;
 
+// Defined below; bvh.glsl's traversal calls it for scenes with alpha-masked materials.
+bool alpha_rejects(uint triangle, float u, float v);
+
 #include "bvh.glsl"
 
 vec3 srgb_to_linear(vec3 c) {
@@ -44,6 +47,23 @@ vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
         acc += w * c;
     }
     return acc;
+}
+
+// glTF alphaMode MASK: a hit where base-colour alpha (factor × texture, at the hit's uv) is below
+// the material's cutoff is no hit, for camera, bounce and shadow rays alike.
+bool alpha_rejects(uint triangle, float u, float v) {
+    TriangleGpu tri = triangles.data[triangle];
+    MaterialGpu m = materials.data[tri.vertices.w & 0xffffu];
+    if ((m.textures2.z & MATERIAL_ALPHA_MASK) == 0u) return false;
+    float alpha = m.base_color.a;
+    if (m.textures.x != NO_TEXTURE) {
+        VertexGpu a = vertices.data[tri.vertices.x];
+        VertexGpu b = vertices.data[tri.vertices.y];
+        VertexGpu c = vertices.data[tri.vertices.z];
+        vec2 uv = (1.0 - u - v) * vec2(a.position_u.w, a.normal_v.w) + u * vec2(b.position_u.w, b.normal_v.w) + v * vec2(c.position_u.w, c.normal_v.w);
+        alpha *= sample_texture(m.textures.x, uv, false).a;
+    }
+    return alpha < uintBitsToFloat(m.textures2.w);
 }
 
 struct Surface {

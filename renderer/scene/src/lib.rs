@@ -94,6 +94,9 @@ pub struct Material {
     pub specular_color_texture: Option<u32>,
     pub ior: f32,
     pub double_sided: bool,
+    /// glTF `alphaMode: MASK`: hits where base-colour alpha (factor × texture) is below this
+    /// cutoff are no hits. `None`: opaque (BLEND is rendered opaque too, said as a warning).
+    pub alpha_cutoff: Option<f32>,
 }
 
 impl Default for Material {
@@ -116,6 +119,7 @@ impl Default for Material {
             specular_color_texture: None,
             ior: 1.5,
             double_sided: false,
+            alpha_cutoff: None,
         }
     }
 }

@@ -48,5 +48,9 @@ pub(crate) fn convert_material(m: &gltf::Material, map: ImageMap) -> Material {
         specular_color_texture: specular.as_ref().and_then(|s| image_of(s.specular_color_texture())),
         ior: m.ior().unwrap_or(1.5),
         double_sided: m.double_sided(),
+        alpha_cutoff: match m.alpha_mode() {
+            gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5)),
+            _ => None,
+        },
     }
 }

@@ -1,0 +1,62 @@
+//! glTF `alphaMode: MASK`: a cut-out is no hit for camera, bounce and shadow rays. The Cornell
+//! box's block made fully transparent converges to the box without the block (its shadow gone
+//! too); made fully opaque through the mask, it renders bit for bit as the opaque block.
+
+use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::Scene;
+use fovea_tests::{assert_clean, gpu, owned_scene, rmse};
+use glam::UVec2;
+
+const SIZE: UVec2 = UVec2::new(48, 54);
+
+/// The Cornell box with the block's triangles on a copy of their material, alpha `alpha`, masked
+/// at 0.5 (or without the block at all when `alpha` is `None`).
+fn cornell_with_block(alpha: Option<f32>) -> Scene {
+    let mut scene = owned_scene("cornell-box");
+    let block = scene.mesh_names.iter().position(|n| n == "block").expect("the block mesh") as u32;
+    match alpha {
+        Some(a) => {
+            let mut material = scene.materials[scene.triangles.iter().find(|t| t.mesh == block).unwrap().material as usize].clone();
+            material.base_color.w = a;
+            material.alpha_cutoff = Some(0.5);
+            scene.materials.push(material);
+            let index = scene.materials.len() as u32 - 1;
+            scene.triangles.iter_mut().filter(|t| t.mesh == block).for_each(|t| t.material = index);
+        }
+        None => scene.triangles.retain(|t| t.mesh != block),
+    }
+    scene
+}
+
+fn reference(scene: &Scene, spp: u32) -> Vec<[f32; 4]> {
+    let ctx = gpu();
+    let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SIZE.x, SIZE.y);
+    let mut renderer = Renderer::new(&ctx, scene, Box::new(Cartesian::new(SIZE)), RenderSettings::default()).unwrap();
+    let image = renderer.render_reference(&camera, spp, 3, |_| {}).unwrap();
+    drop(renderer);
+    assert_clean(&ctx);
+    image
+}
+
+#[test]
+fn a_transparent_cut_out_is_no_hit_and_an_opaque_one_is_the_opaque_surface() {
+    let (transparent, removed, opaque) = (reference(&cornell_with_block(Some(0.0)), 64), reference(&cornell_with_block(None), 64), reference(&owned_scene("cornell-box"), 64));
+    let (gone, there) = (rmse(&transparent, &removed), rmse(&transparent, &opaque));
+    // Both sides converge to the same picture (noise only), far from the one with the block.
+    assert!(gone < there / 4.0, "masked-out block vs no block {gone}, vs the opaque block {there}");
+    let masked_opaque = reference(&cornell_with_block(Some(1.0)), 4);
+    assert_eq!(masked_opaque, reference(&owned_scene("cornell-box"), 4), "alpha 1 through the mask is the opaque block, bit for bit");
+}
+
+/// The loader reads alphaMode MASK and its cutoff (Sponza's foliage and chains, when present).
+#[test]
+fn sponza_s_masked_materials_are_read() {
+    let Some(path) = fovea_tests::shared_data("scenes/sponza/Sponza.gltf") else {
+        eprintln!("skipped: ../shared/data/scenes/sponza is not here");
+        return;
+    };
+    let scene = Scene::load(&path).unwrap();
+    let masked: Vec<f32> = scene.materials.iter().filter_map(|m| m.alpha_cutoff).collect();
+    assert!(!masked.is_empty() && masked.iter().all(|c| (0.0..=1.0).contains(c)), "{masked:?}");
+}
