@@ -1,6 +1,7 @@
 //! glTF `alphaMode: MASK`: a cut-out is no hit for camera, bounce and shadow rays. The Cornell
 //! box's block made fully transparent converges to the box without the block (its shadow gone
-//! too); made fully opaque through the mask, it renders bit for bit as the opaque block.
+//! too); made fully opaque through the mask, it renders bit for bit as the opaque block. `BLEND`
+//! (stochastic transparency) does the same at alpha 0 and 1 and lies between them at 0.5.
 
 use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
@@ -13,13 +14,26 @@ const SIZE: UVec2 = UVec2::new(48, 54);
 /// The Cornell box with the block's triangles on a copy of their material, alpha `alpha`, masked
 /// at 0.5 (or without the block at all when `alpha` is `None`).
 fn cornell_with_block(alpha: Option<f32>) -> Scene {
+    cornell_with(alpha, false)
+}
+
+/// As `cornell_with_block`, the block's alpha blended (stochastic) instead of masked.
+fn cornell_with_blended_block(alpha: f32) -> Scene {
+    cornell_with(Some(alpha), true)
+}
+
+fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
     let mut scene = owned_scene("cornell-box");
     let block = scene.mesh_names.iter().position(|n| n == "block").expect("the block mesh") as u32;
     match alpha {
         Some(a) => {
             let mut material = scene.materials[scene.triangles.iter().find(|t| t.mesh == block).unwrap().material as usize].clone();
             material.base_color.w = a;
-            material.alpha_cutoff = Some(0.5);
+            if blend {
+                material.alpha_blend = true;
+            } else {
+                material.alpha_cutoff = Some(0.5);
+            }
             scene.materials.push(material);
             let index = scene.materials.len() as u32 - 1;
             scene.triangles.iter_mut().filter(|t| t.mesh == block).for_each(|t| t.material = index);
@@ -47,6 +61,17 @@ fn a_transparent_cut_out_is_no_hit_and_an_opaque_one_is_the_opaque_surface() {
     assert!(gone < there / 4.0, "masked-out block vs no block {gone}, vs the opaque block {there}");
     let masked_opaque = reference(&cornell_with_block(Some(1.0)), 4);
     assert_eq!(masked_opaque, reference(&owned_scene("cornell-box"), 4), "alpha 1 through the mask is the opaque block, bit for bit");
+}
+
+#[test]
+fn blended_alpha_is_stochastic_transparency() {
+    let (removed, opaque) = (reference(&cornell_with_block(None), 64), reference(&owned_scene("cornell-box"), 64));
+    let gone = reference(&cornell_with_blended_block(0.0), 64);
+    assert!(rmse(&gone, &removed) < rmse(&gone, &opaque) / 4.0, "alpha 0 blends to no block");
+    assert_eq!(reference(&cornell_with_blended_block(1.0), 4), reference(&owned_scene("cornell-box"), 4), "alpha 1 is opaque, bit for bit");
+    let half = reference(&cornell_with_blended_block(0.5), 64);
+    let apart = rmse(&removed, &opaque);
+    assert!(rmse(&half, &removed) < apart && rmse(&half, &opaque) < apart, "alpha 0.5 lies between no block and the opaque one");
 }
 
 /// The loader reads alphaMode MASK and its cutoff (Sponza's foliage and chains, when present).

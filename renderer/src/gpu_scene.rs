@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::graph::{read_buffer, read_texels, Bind};
 use crate::layouts::{
     LightGpu, MaterialGpu, TextureGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_POINT,
-    LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
+    LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
@@ -39,7 +39,7 @@ pub struct GpuScene {
     pub sky: Sky,
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
-    /// Some material is alpha-masked: traversal tests alpha (`FRAME_FLAG_ALPHA_MASK`).
+    /// Some material is alpha-masked or blended: traversal tests alpha (`FRAME_FLAG_ALPHA_MASK`).
     pub alpha_masked: bool,
     /// Per-material emission factor set at run time (`set_emission_scale`; 1 = as loaded).
     emission_scale: Vec<f32>,
@@ -98,7 +98,7 @@ impl GpuScene {
             textures_halved: halvings,
             bounds: scene.bounds(),
             sky: scene.sky,
-            alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some()),
+            alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
             bvh_depth: depth,
             bvh_bytes: bvh.memory_bytes(),
             emission_scale,
@@ -174,7 +174,9 @@ fn material_gpu(m: &crate::scene::Material, emission_scale: f32) -> MaterialGpu 
         textures2: UVec4::new(
             texture_index(m.specular_texture),
             texture_index(m.specular_color_texture),
-            if m.double_sided { MATERIAL_DOUBLE_SIDED } else { 0 } | if m.alpha_cutoff.is_some() { MATERIAL_ALPHA_MASK } else { 0 },
+            if m.double_sided { MATERIAL_DOUBLE_SIDED } else { 0 }
+                | if m.alpha_cutoff.is_some() { MATERIAL_ALPHA_MASK } else { 0 }
+                | if m.alpha_blend { MATERIAL_ALPHA_BLEND } else { 0 },
             m.alpha_cutoff.unwrap_or(0.0).to_bits(),
         ),
     }

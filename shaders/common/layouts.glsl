@@ -14,6 +14,8 @@ const uint NO_TEXTURE = 0xffffffffu;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 // alphaMode MASK: MaterialGpu.textures2.w holds the cutoff's float bits.
 const uint MATERIAL_ALPHA_MASK = 2u;
+// alphaMode BLEND as stochastic transparency: a hit counts with probability alpha.
+const uint MATERIAL_ALPHA_BLEND = 4u;
 
 const uint LIGHT_KIND_TRIANGLE = 0u;
 const uint LIGHT_KIND_POINT = 1u;
@@ -25,8 +27,8 @@ const uint FRAME_FLAG_REFERENCE = 1u;
 // The tracer jitters every sample by FrameData.jitter (TAA's Halton sequence) instead of its RNG;
 // the RNG stream itself is drawn unchanged, so everything after the jitter stays the same.
 const uint FRAME_FLAG_HALTON_JITTER = 2u;
-// The scene has alpha-masked materials: traversal tests each candidate hit's alpha (without the
-// flag it costs nothing).
+// The scene has alpha-masked or blended materials: traversal tests each candidate hit's alpha
+// (without the flag it costs nothing).
 const uint FRAME_FLAG_ALPHA_MASK = 4u;
 
 // Everything the passes need to know about the current (and previous) frame.

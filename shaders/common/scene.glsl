@@ -4,6 +4,7 @@
 #define FOVEA_SCENE_GLSL
 
 #include "layouts.glsl"
+#include "random.glsl"
 
 layout(set = 0, binding = 0) uniform samplerBuffer bvh_nodes;
 layout(set = 0, binding = 1) uniform samplerBuffer bvh_triangles;
@@ -50,11 +51,14 @@ vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
 }
 
 // glTF alphaMode MASK: a hit where base-colour alpha (factor × texture, at the hit's uv) is below
-// the material's cutoff is no hit, for camera, bounce and shadow rays alike.
+// the material's cutoff is no hit, for camera, bounce and shadow rays alike. BLEND: the hit counts
+// with probability alpha (stochastic transparency), decided by a hash of the hit (triangle,
+// barycentrics, frame and seed), so every ray and frame draws anew and the mean converges to the
+// blend.
 bool alpha_rejects(uint triangle, float u, float v) {
     TriangleGpu tri = triangles.data[triangle];
     MaterialGpu m = materials.data[tri.vertices.w & 0xffffu];
-    if ((m.textures2.z & MATERIAL_ALPHA_MASK) == 0u) return false;
+    if ((m.textures2.z & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u) return false;
     float alpha = m.base_color.a;
     if (m.textures.x != NO_TEXTURE) {
         VertexGpu a = vertices.data[tri.vertices.x];
@@ -62,6 +66,10 @@ bool alpha_rejects(uint triangle, float u, float v) {
         VertexGpu c = vertices.data[tri.vertices.z];
         vec2 uv = (1.0 - u - v) * vec2(a.position_u.w, a.normal_v.w) + u * vec2(b.position_u.w, b.normal_v.w) + v * vec2(c.position_u.w, c.normal_v.w);
         alpha *= sample_texture(m.textures.x, uv, false).a;
+    }
+    if ((m.textures2.z & MATERIAL_ALPHA_BLEND) != 0u) {
+        uint h = pcg_hash(triangle ^ pcg_hash(floatBitsToUint(u) ^ pcg_hash(floatBitsToUint(v) ^ pcg_hash(frame.data.frame.x ^ pcg_hash(frame.data.frame.y)))));
+        return float(h >> 8u) * (1.0 / 16777216.0) >= alpha;
     }
     return alpha < uintBitsToFloat(m.textures2.w);
 }

@@ -95,8 +95,10 @@ pub struct Material {
     pub ior: f32,
     pub double_sided: bool,
     /// glTF `alphaMode: MASK`: hits where base-colour alpha (factor × texture) is below this
-    /// cutoff are no hits. `None`: opaque (BLEND is rendered opaque too, said as a warning).
+    /// cutoff are no hits. `None`: not masked.
     pub alpha_cutoff: Option<f32>,
+    /// glTF `alphaMode: BLEND`, as stochastic transparency: a hit counts with probability alpha.
+    pub alpha_blend: bool,
 }
 
 impl Default for Material {
@@ -120,6 +122,7 @@ impl Default for Material {
             ior: 1.5,
             double_sided: false,
             alpha_cutoff: None,
+            alpha_blend: false,
         }
     }
 }

@@ -52,5 +52,6 @@ pub(crate) fn convert_material(m: &gltf::Material, map: ImageMap) -> Material {
             gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5)),
             _ => None,
         },
+        alpha_blend: m.alpha_mode() == gltf::material::AlphaMode::Blend,
     }
 }
