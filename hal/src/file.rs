@@ -23,7 +23,7 @@ pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, HalError
     let file = open_nonblocking(path).map_err(|e| HalError::io(path, e))?;
     let meta = file.metadata().map_err(|e| HalError::io(path, e))?;
     if !meta.is_file() {
-        return Err(refuse(path, format!("it is {}, not a regular file", kind(&meta.file_type()))));
+        return Err(refuse(path, format!("it is {}, not a regular file", file_kind(&meta.file_type()))));
     }
     if meta.len() > limit {
         return Err(refuse(path, format!("{} bytes is more than the {limit}-byte limit for {what}", meta.len())));
@@ -48,7 +48,9 @@ fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
     std::fs::File::open(path)
 }
 
-fn kind(t: &std::fs::FileType) -> &'static str {
+/// What kind of thing a file type is, for messages ("a FIFO (named pipe)", "a symbolic link",
+/// ...). Public so the tools word their output checks the same way.
+pub fn file_kind(t: &std::fs::FileType) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -62,8 +64,12 @@ fn kind(t: &std::fs::FileType) -> &'static str {
             return "a socket";
         }
     }
-    if t.is_dir() {
+    if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_dir() {
         "a folder"
+    } else if t.is_file() {
+        "a regular file"
     } else {
         "not a file"
     }

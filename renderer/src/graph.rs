@@ -537,7 +537,9 @@ impl FrameRecorder {
     }
 }
 
-fn image_transition(
+/// A colour image's layout transition with its access masks (mip 0, layer 0: all the engine's
+/// images and swapchain images have). Public for the callers' own one-shot copies.
+pub fn image_transition(
     image: vk::Image,
     from: vk::ImageLayout,
     to: vk::ImageLayout,

@@ -22,29 +22,7 @@ const TEMP_SUFFIX: &str = ".tmp";
 
 /// What kind of thing a path is, for messages ("a symbolic link", "a FIFO", ...).
 fn kind_of(meta: &std::fs::Metadata) -> &'static str {
-    let t = meta.file_type();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_symlink() {
-        "a symbolic link"
-    } else if t.is_dir() {
-        "a folder"
-    } else if t.is_file() {
-        "a regular file"
-    } else {
-        "not a regular file"
-    }
+    fovea_hal::file::file_kind(&meta.file_type())
 }
 
 /// Refuses a target that exists and is not a regular file (a link could redirect the write, a

@@ -121,6 +121,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
+    let ppd = flip_ppd(args)?;
     let mut runs = Vec::new();
     for camera in args.cameras {
         let moving = camera == "moving";
@@ -155,7 +156,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         camera: args.camera,
                     };
                     render::run(&render_args).with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
-                    let mut q = measure(args, &dir, &evaluated, &references)?;
+                    let mut q = measure(args, &dir, &evaluated, &references, ppd)?;
                     (q.camera, q.method, q.denoiser, q.taa) = (camera.clone(), method.clone(), denoiser.clone(), taa.clone());
                     runs.push(q);
                 }
@@ -172,7 +173,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
-        flip_ppd: flip_ppd(args)?,
+        flip_ppd: ppd,
         runs: &runs,
     };
     write_json(&args.out.join("quality.json"), &report)?;
@@ -206,7 +207,7 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
 }
 
 /// The run's evaluated frames against their references, ring metrics averaged over frames.
-fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<[f32; 4]>]) -> Result<RunQuality> {
+fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<[f32; 4]>], ppd: f32) -> Result<RunQuality> {
     let report_path = dir.join("report.json");
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report_path)?)
         .with_context(|| format!("reading {}", report_path.display()))?;
@@ -224,7 +225,7 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
         let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?.to_rgba8().into_raw();
         let reference_displayed = tonemap_preview(reference, 1.0);
-        let flip = flip_map(&reference_displayed, &displayed, args.width, args.height, flip_ppd(args)?);
+        let flip = flip_map(&reference_displayed, &displayed, args.width, args.height, ppd);
         add_flip(&mut eval, &flip);
         if let Some((_, test_prev, reference_prev)) = previous.as_ref().filter(|p| p.0 + 1 == f) {
             let map = flicker_map(test_prev, &displayed, reference_prev, &reference_displayed);

@@ -8,7 +8,7 @@ use crate::camera_path;
 use crate::gaze::{FrameGaze, GazeDriver};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_hal::{Eye, HmdDescription};
+use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
@@ -78,34 +78,20 @@ impl Setup {
     /// path's period).
     pub fn new(args: &RenderArgs, frames: u32) -> Result<Setup> {
         let hmd = HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
-        if !(args.scale > 0.0 && args.scale <= 4.0) {
-            bail!("--scale {} must be in (0, 4]", args.scale);
-        }
-        let eye = hmd.eye(Eye::Left);
-        let width = args.width.unwrap_or(((eye.recommended_width as f32 * args.scale).round() as u32).max(1));
-        let height = args.height.unwrap_or(((eye.recommended_height as f32 * args.scale).round() as u32).max(1));
+        check_common(args)?;
+        let (scaled_width, scaled_height) = scaled_eye_size(hmd.eye(Eye::Left), args.scale);
+        let width = args.width.unwrap_or(scaled_width);
+        let height = args.height.unwrap_or(scaled_height);
         if width == 0 || height == 0 || frames == 0 {
             bail!("--width, --height and --frames must be at least 1");
         }
-        if !METHODS.contains(&args.method) {
-            bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
-        }
-        check_settings(args.max_depth, args.exposure)?;
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.method, args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
         let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, width as f32 / height as f32)?;
         let start_pose = CameraPose::from_scene_camera(&camera, width, height);
-        let settings = RenderSettings {
-            max_depth: args.max_depth,
-            seed: args.seed,
-            exposure: args.exposure,
-            blur: args.profile.blur,
-            denoiser,
-            taa,
-            ..Default::default()
-        };
+        let settings = render_settings(args, denoiser, taa);
         Ok(Setup {
             scene_centre: scene.bounds().center(),
             eyes: args.eyes,
@@ -228,6 +214,29 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
         }
     }
     Ok(())
+}
+
+/// The checks every command that renders frames makes of `--scale`, `--method`, `--max-depth`
+/// and `--exposure` (render, view and xr).
+pub fn check_common(args: &RenderArgs) -> Result<()> {
+    if !(args.scale > 0.0 && args.scale <= 4.0) {
+        bail!("--scale {} must be in (0, 4]", args.scale);
+    }
+    if !METHODS.contains(&args.method) {
+        bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
+    }
+    check_settings(args.max_depth, args.exposure)
+}
+
+/// A headset eye's recommended size × `--scale`, at least one pixel per axis.
+pub fn scaled_eye_size(eye: &EyeView, scale: f32) -> (u32, u32) {
+    let axis = |n: u32| ((n as f32 * scale).round() as u32).max(1);
+    (axis(eye.recommended_width), axis(eye.recommended_height))
+}
+
+/// The engine settings the render flags give, with the filters already chosen (`filters`).
+pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMode) -> RenderSettings {
+    RenderSettings { max_depth: args.max_depth, seed: args.seed, exposure: args.exposure, blur: args.profile.blur, denoiser, taa, ..Default::default() }
 }
 
 /// `--denoiser` and `--taa` with their parameters from the profile, checked against the method

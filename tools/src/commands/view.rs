@@ -238,7 +238,7 @@ impl Viewer<'_> {
             self.rebuild_views()?;
         }
         if self.args.screenshot.is_some() {
-            if !swapchain.can_copy(&w.surface_loader, w.surface) {
+            if !swapchain.allows(vk::ImageUsageFlags::TRANSFER_SRC) {
                 bail!("this surface does not allow copying its images (TRANSFER_SRC): no --screenshot");
             }
             let bytes = swapchain.extent.width as u64 * swapchain.extent.height as u64 * 4;
@@ -356,7 +356,7 @@ impl Viewer<'_> {
         if (swapchain.extent.width, swapchain.extent.height) != (width, height) {
             return Ok(()); // mid-resize: the views follow on the next frame
         }
-        if !swapchain.can_upload(&w.surface_loader, w.surface) {
+        if !swapchain.allows(vk::ImageUsageFlags::TRANSFER_DST) {
             bail!("this surface does not allow copying into its images (TRANSFER_DST): no debug views");
         }
         if w.debug_staging.is_none() {

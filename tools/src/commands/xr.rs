@@ -5,7 +5,7 @@
 //! `DIR/frames.jsonl` (one row per frame) and `DIR/report.json`.
 
 use super::render::RenderArgs;
-use super::setup::{filters, space_for, METHODS};
+use super::setup::{check_common, filters, render_settings, scaled_eye_size, space_for};
 use crate::gaze::GazeDriver;
 use crate::output::{prepare_output_dir, write_json};
 use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
@@ -50,7 +50,6 @@ struct XrRun<'a> {
     gaze: XrGaze,
     /// World from the runtime's LOCAL space: the scene camera is where the head starts.
     world_from_local: Mat4,
-    eye_size: (u32, u32),
     log: FrameLog,
     screenshot: Option<Buffer>,
     tally: Tally,
@@ -86,13 +85,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
     if args.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
-    if !(r.scale > 0.0 && r.scale <= 4.0) {
-        bail!("--scale {} must be in (0, 4]", r.scale);
-    }
-    if !METHODS.contains(&r.method) {
-        bail!("--method {}: expected one of {}", r.method, METHODS.join(", "));
-    }
-    super::setup::check_settings(r.max_depth, r.exposure)?;
+    check_common(r)?;
     let (denoiser, taa) = filters(r.method, r.denoiser, r.taa, &r.profile)?;
     let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
     let eye = base.eye(fovea_hal::Eye::Left);
@@ -103,15 +96,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
     let out_dir = prepare_output_dir(r.out)?;
     let rt = Arc::new(OpenXrRuntime::create("fovea").context("fovea xr needs an OpenXR runtime (see README: On a headset)")?);
     let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;
-    let settings = RenderSettings {
-        max_depth: r.max_depth,
-        seed: r.seed,
-        exposure: r.exposure,
-        blur: r.profile.blur,
-        denoiser,
-        taa,
-        ..Default::default()
-    };
+    let settings = render_settings(r, denoiser, taa);
     let started = Instant::now();
     let (mut run, session) = XrRun::start(args, &rt, ctx, &base, &scene, camera.world_from_view, settings)?;
     let end = run.frame_loop()?;
@@ -166,8 +151,7 @@ impl<'a> XrRun<'a> {
             let (hmd, figures) = owner.describe(base, false)?;
             (hmd, figures, None)
         };
-        let eye = hmd.eye(Eye::Left);
-        let eye_size = (((eye.recommended_width as f32 * r.scale).round() as u32).max(1), ((eye.recommended_height as f32 * r.scale).round() as u32).max(1));
+        let eye_size = scaled_eye_size(hmd.eye(Eye::Left), r.scale);
         let (driver, timebase, gaze_source) = match source {
             Some(gaze) => (GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1), Timebase::Runtime, "openxr".to_string()),
             None => {
@@ -191,7 +175,7 @@ impl<'a> XrRun<'a> {
             None => None,
         };
         let log = FrameLog::create(&r.out.join("frames.jsonl"))?;
-        let run = XrRun { args, ctx, owner, local, view_space, swapchain, renderer, gaze, world_from_local, eye_size, log, screenshot, tally: Tally::default() };
+        let run = XrRun { args, ctx, owner, local, view_space, swapchain, renderer, gaze, world_from_local, log, screenshot, tally: Tally::default() };
         Ok((run, SessionFacts { hmd, figures, gaze_source, notice }))
     }
 
@@ -245,7 +229,8 @@ impl<'a> XrRun<'a> {
         }
         // One xrSyncActions per frame for every attached set, before the gaze source reads.
         self.owner.sync_actions()?;
-        let gaze = self.gaze.frame(t, self.tally.rendered, &eyes_in_head, self.eye_size)?;
+        let eye_size = (self.swapchain.eye_width, self.swapchain.height);
+        let gaze = self.gaze.frame(t, self.tally.rendered, &eyes_in_head, eye_size)?;
         self.count_gaze(&gaze);
         let mut inputs = [ViewInput { camera: self.camera(&views[0]), gaze: None }; MAX_VIEWS];
         for (i, view) in views.iter().enumerate() {
@@ -364,6 +349,7 @@ impl<'a> XrRun<'a> {
             notice: facts.notice.as_deref(),
             device: &ctx.info.name,
             swapchain_format: swapchain.format,
+            eye_size: (swapchain.eye_width, swapchain.height),
             end,
             tally: &super::xr_report::Tally {
                 frames: tally.frames,

@@ -36,6 +36,8 @@ pub struct Inputs<'a> {
     pub notice: Option<&'a str>,
     pub device: &'a str,
     pub swapchain_format: vk::Format,
+    /// Per eye, as rendered.
+    pub eye_size: (u32, u32),
     pub end: SessionEnd,
     pub tally: &'a Tally<'a>,
     pub logged: u64,
@@ -142,7 +144,6 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
     let source = |from_runtime: bool| if from_runtime { "runtime" } else { "headset TOML" };
     let eye_frames = (t.timed as u64 * 2).max(1);
     let passes: BTreeMap<String, f64> = t.pass_sums.iter().map(|(k, v)| (k.clone(), v / t.timed.max(1) as f64)).collect();
-    let eye = i.hmd.eye(fovea_hal::Eye::Left);
     Ok(XrReport {
         runtime: Runtime { name: props.runtime_name.clone(), version: props.runtime_version.to_string() },
         monotonic_minus_xr_time_ns: i.rt.now().ok().and_then(|t| Some(i.rt.time_to_monotonic(t).ok()? - t)),
@@ -174,8 +175,8 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
         eyes: "both",
         device: i.device.to_string(),
         swapchain_format: format!("{:?}", i.swapchain_format),
-        width: ((eye.recommended_width as f32 * r.scale).round() as u32).max(1),
-        height: ((eye.recommended_height as f32 * r.scale).round() as u32).max(1),
+        width: i.eye_size.0,
+        height: i.eye_size.1,
         frames: t.frames,
         frames_rendered: t.rendered,
         frames_logged: i.logged,

@@ -73,7 +73,7 @@ pub fn compose(mode: DebugView, renderer: &Renderer, frame: u64, eye: UVec2, hmd
             DebugView::Rings => {
                 renderer.read_view_ldr(frame, v, &mut pixels)?;
                 draw_rings(&mut pixels, eye, space.gaze(), hmd, headset_eye);
-                pixels.clone()
+                std::mem::take(&mut pixels)
             }
         };
         for y in 0..h {

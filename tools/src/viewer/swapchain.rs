@@ -4,7 +4,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
-use fovea_renderer::graph::ExternalImage;
+use fovea_renderer::graph::{image_transition, ExternalImage};
 use fovea_renderer::vk::{next_resource_id, Buffer, Context};
 use std::sync::Arc;
 
@@ -26,6 +26,8 @@ pub struct Swapchain {
     pub extent: vk::Extent2D,
     pub format: vk::Format,
     pub present_mode: vk::PresentModeKHR,
+    /// What the images were made for (STORAGE, plus the transfers the surface allows).
+    pub usage: vk::ImageUsageFlags,
 }
 
 impl Swapchain {
@@ -96,12 +98,13 @@ impl Swapchain {
             });
             rendered.push(unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None)? });
         }
-        Ok(Swapchain { ctx: ctx.clone(), loader, raw, images, rendered, extent, format, present_mode })
+        Ok(Swapchain { ctx: ctx.clone(), loader, raw, images, rendered, extent, format, present_mode, usage })
     }
 
-    pub fn can_copy(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> bool {
-        unsafe { surface_loader.get_physical_device_surface_capabilities(self.ctx.physical, surface) }
-            .is_ok_and(|c| c.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_SRC))
+    /// Whether the images allow `usage` (screenshots copy from them: TRANSFER_SRC; debug views
+    /// copy into them: TRANSFER_DST).
+    pub fn allows(&self, usage: vk::ImageUsageFlags) -> bool {
+        self.usage.contains(usage)
     }
 }
 
@@ -165,13 +168,13 @@ impl Swapchain {
         let image = self.images[index as usize].raw;
         let extent = vk::Extent3D { width: self.extent.width, height: self.extent.height, depth: 1 };
         self.ctx.one_shot(|device, cmd| unsafe {
-            let to_dst = layout_barrier(image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::AccessFlags::empty(), vk::AccessFlags::TRANSFER_WRITE);
+            let to_dst = image_transition(image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::AccessFlags::empty(), vk::AccessFlags::TRANSFER_WRITE);
             device.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, vk::PipelineStageFlags::TRANSFER, vk::DependencyFlags::empty(), &[], &[], &[to_dst]);
             let region = vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
                 .image_extent(extent);
             device.cmd_copy_buffer_to_image(cmd, staging.raw, image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, &[region]);
-            let to_present = layout_barrier(image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR, vk::AccessFlags::TRANSFER_WRITE, vk::AccessFlags::empty());
+            let to_present = image_transition(image, vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR, vk::AccessFlags::TRANSFER_WRITE, vk::AccessFlags::empty());
             device.cmd_pipeline_barrier(cmd, vk::PipelineStageFlags::TRANSFER, vk::PipelineStageFlags::BOTTOM_OF_PIPE, vk::DependencyFlags::empty(), &[], &[], &[to_present]);
         })?;
         let (swapchains, indices) = ([self.raw], [index]);
@@ -186,22 +189,4 @@ impl Swapchain {
             Err(e) => Err(e.into()),
         }
     }
-
-    /// Whether debug views can copy into the images (TRANSFER_DST).
-    pub fn can_upload(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> bool {
-        unsafe { surface_loader.get_physical_device_surface_capabilities(self.ctx.physical, surface) }
-            .is_ok_and(|c| c.supported_usage_flags.contains(vk::ImageUsageFlags::TRANSFER_DST))
-    }
-}
-
-fn layout_barrier(image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout, src: vk::AccessFlags, dst: vk::AccessFlags) -> vk::ImageMemoryBarrier<'static> {
-    vk::ImageMemoryBarrier::default()
-        .image(image)
-        .old_layout(from)
-        .new_layout(to)
-        .src_access_mask(src)
-        .dst_access_mask(dst)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .subresource_range(fovea_renderer::vk::color_range())
 }
