@@ -4,12 +4,13 @@
 use crate::error::{Error, Result};
 use crate::graph::{read_buffer, read_texels, Bind};
 use crate::layouts::{
-    LightGpu, MaterialGpu, TextureGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_POINT,
+    LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_POINT,
     LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
-use crate::scene::{Aabb, PunctualLight, Scene, Sky};
+use crate::scene::{Aabb, PunctualLight, Scene, Sky, TextureSlot};
+use crate::texture_pack;
 use crate::vk::{Buffer, Context};
 use ash::vk;
 use glam::{UVec4, Vec4};
@@ -43,6 +44,8 @@ pub struct GpuScene {
     pub alpha_masked: bool,
     /// Per-material emission factor set at run time (`set_emission_scale`; 1 = as loaded).
     emission_scale: Vec<f32>,
+    /// Per material and texture slot, the `textures` entry it reads (`texture_pack`).
+    material_textures: Vec<[Option<u32>; TextureSlot::COUNT]>,
 }
 
 impl GpuScene {
@@ -78,8 +81,9 @@ impl GpuScene {
             triangles.push(TriangleGpu { vertices: UVec4::new(t.indices[0], t.indices[1], t.indices[2], t.material | (t.mesh << 16)) });
         }
         let emission_scale = vec![1.0; scene.materials.len()];
-        let materials: Vec<MaterialGpu> = scene.materials.iter().map(|m| material_gpu(m, 1.0)).collect();
-        let (textures, texels, halvings) = pack_textures(scene, ctx.info.max_storage_buffer_range as usize / 4);
+        let packed = texture_pack::pack(scene, ctx.info.max_storage_buffer_range as usize / 4);
+        let materials: Vec<MaterialGpu> = scene.materials.iter().zip(&packed.material_slots).map(|(m, t)| material_gpu(m, t, 1.0)).collect();
+        let (textures, texels) = (packed.infos, packed.texels);
         let lights = light_entries(scene, &emission_scale);
 
         Ok(GpuScene {
@@ -95,7 +99,8 @@ impl GpuScene {
             triangle_count: triangles.len() as u32,
             material_count: materials.len() as u32,
             texture_count: textures.len() as u32,
-            textures_halved: halvings,
+            textures_halved: packed.halvings,
+            material_textures: packed.material_slots,
             bounds: scene.bounds(),
             sky: scene.sky,
             alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
@@ -122,7 +127,7 @@ impl GpuScene {
         }
         self.emission_scale[material] = scale;
         let materials: Vec<MaterialGpu> =
-            scene.materials.iter().zip(&self.emission_scale).map(|(m, s)| material_gpu(m, *s)).collect();
+            scene.materials.iter().zip(&self.material_textures).zip(&self.emission_scale).map(|((m, t), s)| material_gpu(m, t, *s)).collect();
         self.materials.write(&materials)?;
         let lights = light_entries(scene, &self.emission_scale);
         if std::mem::size_of_val(lights.as_slice()) as u64 > self.lights.size {
@@ -155,72 +160,28 @@ impl GpuScene {
     }
 }
 
-fn texture_index(t: Option<u32>) -> u32 {
-    t.unwrap_or(NO_TEXTURE)
-}
-
-fn material_gpu(m: &crate::scene::Material, emission_scale: f32) -> MaterialGpu {
+fn material_gpu(m: &crate::scene::Material, textures: &[Option<u32>; TextureSlot::COUNT], emission_scale: f32) -> MaterialGpu {
+    let texture_index = |slot: TextureSlot| textures[slot as usize].unwrap_or(NO_TEXTURE);
     MaterialGpu {
         base_color: m.base_color,
         emissive: (m.emissive * emission_scale).extend(0.0),
         specular: m.specular_color.extend(m.specular_factor),
         surface: Vec4::new(m.metallic, m.roughness, m.ior, m.normal_scale),
         textures: UVec4::new(
-            texture_index(m.base_color_texture),
-            texture_index(m.metallic_roughness_texture),
-            texture_index(m.normal_texture),
-            texture_index(m.emissive_texture),
+            texture_index(TextureSlot::BaseColor),
+            texture_index(TextureSlot::MetallicRoughness),
+            texture_index(TextureSlot::Normal),
+            texture_index(TextureSlot::Emissive),
         ),
         textures2: UVec4::new(
-            texture_index(m.specular_texture),
-            texture_index(m.specular_color_texture),
+            texture_index(TextureSlot::Specular),
+            texture_index(TextureSlot::SpecularColor),
             if m.double_sided { MATERIAL_DOUBLE_SIDED } else { 0 }
                 | if m.alpha_cutoff.is_some() { MATERIAL_ALPHA_MASK } else { 0 }
                 | if m.alpha_blend { MATERIAL_ALPHA_BLEND } else { 0 },
             m.alpha_cutoff.unwrap_or(0.0).to_bits(),
         ),
     }
-}
-
-/// All textures in one RGBA8 texel array (one u32 per texel), each with its offset and size.
-/// While they exceed `max_texels` (one storage buffer's range) the largest is halved (2×2 box
-/// filter): a lower-resolution texture beats a descriptor the device cannot bind. Returns the
-/// number of halvings.
-fn pack_textures(scene: &Scene, max_texels: usize) -> (Vec<TextureGpu>, Vec<u32>, u32) {
-    let mut reduced: Vec<std::borrow::Cow<crate::scene::Texture>> = scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
-    let texel_count = |ts: &[std::borrow::Cow<crate::scene::Texture>]| ts.iter().map(|t| (t.width * t.height) as usize).sum::<usize>();
-    let mut halvings = 0;
-    while texel_count(&reduced) > max_texels.max(1) {
-        let Some((largest, _)) = reduced.iter().enumerate().filter(|(_, t)| t.width * t.height > 1).max_by_key(|(_, t)| t.width * t.height) else {
-            break;
-        };
-        reduced[largest] = std::borrow::Cow::Owned(halve(&reduced[largest]));
-        halvings += 1;
-    }
-    let mut texels = Vec::with_capacity(texel_count(&reduced));
-    let mut infos = Vec::with_capacity(reduced.len());
-    for t in &reduced {
-        infos.push(TextureGpu { extent: UVec4::new(texels.len() as u32, t.width, t.height, 0) });
-        texels.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
-    }
-    (infos, texels, halvings)
-}
-
-/// `t` at half the size per axis (odd sizes round up; the last row/column is repeated), each
-/// texel the mean of its 2×2 block (in the stored encoding: sRGB textures are averaged encoded).
-fn halve(t: &crate::scene::Texture) -> crate::scene::Texture {
-    let (w, h) = (t.width.div_ceil(2).max(1), t.height.div_ceil(2).max(1));
-    let at = |x: u32, y: u32, c: usize| t.rgba8[((y.min(t.height - 1) * t.width + x.min(t.width - 1)) * 4) as usize + c] as u32;
-    let mut rgba8 = Vec::with_capacity((w * h * 4) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            for c in 0..4 {
-                let sum = at(2 * x, 2 * y, c) + at(2 * x + 1, 2 * y, c) + at(2 * x, 2 * y + 1, c) + at(2 * x + 1, 2 * y + 1, c);
-                rgba8.push(((sum + 2) / 4) as u8);
-            }
-        }
-    }
-    crate::scene::Texture { width: w, height: h, rgba8 }
 }
 
 fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {

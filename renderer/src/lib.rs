@@ -15,6 +15,7 @@ pub mod passes;
 pub mod pipeline;
 pub mod sampling;
 pub mod shaders;
+pub mod texture_pack;
 pub mod to_screen;
 pub mod view;
 pub mod vk;

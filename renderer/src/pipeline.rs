@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::frames::FrameRing;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
-use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE};
+use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
@@ -58,6 +58,9 @@ pub struct RenderSettings {
     pub taa: TaaMode,
     /// How the views' (eyes') random sequences relate.
     pub stereo_noise: StereoNoise,
+    /// Texture filtering of frames (references always read level 0: point samples converge to
+    /// the box-filtered pixel).
+    pub texture_lod: TextureLod,
 }
 
 impl Default for RenderSettings {
@@ -71,6 +74,37 @@ impl Default for RenderSettings {
             denoiser: DenoiserSettings::None,
             taa: TaaMode::Off,
             stereo_noise: StereoNoise::default(),
+            texture_lod: TextureLod::default(),
+        }
+    }
+}
+
+/// How texture lookups choose a mip level (`RenderSettings::texture_lod`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TextureLod {
+    /// Ray cones (Akenine-Möller et al. 2019): each sample's footprint on the screen sets the
+    /// primary spread, so sparse periphery samples read coarser mips instead of aliasing.
+    #[default]
+    RayCones,
+    /// Every lookup reads level 0 (bilinear point sampling).
+    Off,
+}
+
+impl TextureLod {
+    pub const NAMES: &'static str = "cones, off";
+
+    pub fn parse(name: &str) -> Result<TextureLod> {
+        match name {
+            "cones" => Ok(TextureLod::RayCones),
+            "off" => Ok(TextureLod::Off),
+            other => Err(Error::Invalid(format!("texture LOD '{other}' is not one of {}", Self::NAMES))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureLod::RayCones => "cones",
+            TextureLod::Off => "off",
         }
     }
 }
@@ -424,7 +458,9 @@ impl Renderer {
             self.views[v].space.set_gaze(gaze)?;
         }
         let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
-        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 } | if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 };
+        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 }
+            | if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 }
+            | if self.settings.texture_lod == TextureLod::RayCones { FRAME_FLAG_TEXTURE_LOD } else { 0 };
         self.write_frame_data(v, slot, &view_input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;

@@ -30,6 +30,10 @@ const uint FRAME_FLAG_HALTON_JITTER = 2u;
 // The scene has alpha-masked or blended materials: traversal tests each candidate hit's alpha
 // (without the flag it costs nothing).
 const uint FRAME_FLAG_ALPHA_MASK = 4u;
+// Texture lookups take a level of detail from each ray's cone (primary spread = the sample's
+// footprint on the screen); without the flag every lookup reads mip level 0 (point sampling,
+// what references use: jittered samples then converge to the box-filtered pixel).
+const uint FRAME_FLAG_TEXTURE_LOD = 8u;
 
 // Everything the passes need to know about the current (and previous) frame.
 struct FrameData {
@@ -78,8 +82,13 @@ struct MaterialGpu {
     uvec4 textures2;            // specular (alpha channel), specular colour, MATERIAL_* flags, alpha cutoff (float bits, MATERIAL_ALPHA_MASK)
 };
 
+// One texture as a material slot sees it: an image's mip chain in the texel array and the slot's
+// KHR_texture_transform (identity when none). Level l+1 is max(1, ceil(size_l / 2)) per axis and
+// follows level l in the array.
 struct TextureGpu {
-    uvec4 extent;               // x first texel in the texel array, y width, z height, w unused
+    uvec4 extent;               // x first texel of level 0, y width, z height, w mip levels (≥ 1)
+    vec4 transform_u;           // u' = dot(xy, uv) + z, w unused
+    vec4 transform_v;           // v' = dot(xy, uv) + z, w unused
 };
 
 struct VertexGpu {

@@ -56,7 +56,7 @@ bool sample_light(vec3 p, inout uint rng, out LightSample ls) {
         vec3 cr = cross(b - a, c - a);
         float area = 0.5 * length(cr);
         float cos_light = abs(dot(cr / (2.0 * area), ls.direction));
-        Surface e = fetch_surface(h, ls.direction);
+        Surface e = fetch_surface(h, ls.direction, 0.0);
         ls.radiance_over_pdf = e.emission * cos_light * area / (d2 * select_pdf);
         return cos_light > 0.0 && area > 0.0;
     }

@@ -32,7 +32,10 @@ vec3 direct_light(Surface s, vec3 v, inout uint rng) {
 
 // Radiance arriving along `dir` from the primary hit `s` (its emission included), paths of up to
 // `max_depth` vertices; every random number comes from `rng`, so a surface and a state give one path.
-vec3 shade_path(Surface s, vec3 dir, uint max_depth, inout uint rng) {
+// `cone`: the ray cone's width at `s` and its spread angle (texture level of detail; zero: level
+// 0). Bounces keep the primary spread: no widening by curvature or roughness, so a bounce's
+// textures are never blurrier than the pixel's cone would make them.
+vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) {
     vec3 color = vec3(0.0);
     if (max_depth >= 1u) color += s.emission;
     vec3 throughput = vec3(1.0);
@@ -59,7 +62,8 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, inout uint rng) {
             break;
         }
         if (last) break;
-        s = fetch_surface(hit, l);
+        cone.x += cone.y * hit.t;
+        s = fetch_surface(hit, l, cone.x);
         // A mirror bounce cannot be found by next-event estimation: count what it sees.
         if (delta) color += throughput * s.emission;
         v = -l;

@@ -31,10 +31,9 @@ vec4 texel_rgba8(uint index) {
     return unpackUnorm4x8(texels.data[index]);
 }
 
-// Bilinear, wrap-repeat; `srgb` decodes before filtering (base colour, emissive, specular colour).
-vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
-    TextureGpu info = textures.data[tex];
-    uvec2 size = info.extent.yz;
+// Bilinear, wrap-repeat, in one mip level (`first` texel, `size`); `srgb` decodes before filtering
+// (base colour, emissive, specular colour).
+vec4 sample_bilinear(uint first, uvec2 size, vec2 uv, bool srgb) {
     vec2 p = uv * vec2(size) - 0.5;
     vec2 f = fract(p);
     ivec2 i0 = ivec2(floor(p));
@@ -42,12 +41,40 @@ vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
     for (int k = 0; k < 4; ++k) {
         ivec2 o = ivec2(k & 1, k >> 1);
         uvec2 q = uvec2((i0 + o) % ivec2(size) + ivec2(size)) % size;
-        vec4 c = texel_rgba8(info.extent.x + q.y * size.x + q.x);
+        vec4 c = texel_rgba8(first + q.y * size.x + q.x);
         if (srgb) c.rgb = srgb_to_linear(c.rgb);
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
         acc += w * c;
     }
     return acc;
+}
+
+// Texture `tex` at `uv` (before its KHR_texture_transform), trilinear between mip levels.
+// `lod_uv` is the footprint's level of detail in uv units, log2(footprint width / uv period);
+// the texture adds its own size. −∞ (any value below −1e30) reads level 0.
+vec4 sample_texture_lod(uint tex, vec2 uv, bool srgb, float lod_uv) {
+    TextureGpu info = textures.data[tex];
+    vec2 st = vec2(dot(info.transform_u.xy, uv) + info.transform_u.z, dot(info.transform_v.xy, uv) + info.transform_v.z);
+    uvec2 size = info.extent.yz;
+    uint first = info.extent.x;
+    // The transform scales uv areas by |det|; the footprint in texels by √(w·h·|det|).
+    float det = abs(info.transform_u.x * info.transform_v.y - info.transform_u.y * info.transform_v.x);
+    float lambda = lod_uv + 0.5 * log2(float(size.x) * float(size.y) * max(det, 1e-30));
+    lambda = lod_uv < -1e30 || isnan(lambda) ? 0.0 : clamp(lambda, 0.0, float(info.extent.w - 1u));
+    uint level = uint(lambda);
+    for (uint l = 0u; l < level; ++l) {
+        first += size.x * size.y;
+        size = max((size + 1u) >> 1u, uvec2(1u));
+    }
+    vec4 c = sample_bilinear(first, size, st, srgb);
+    float blend = lambda - float(level);
+    if (blend > 0.0) c = mix(c, sample_bilinear(first + size.x * size.y, max((size + 1u) >> 1u, uvec2(1u)), st, srgb), blend);
+    return c;
+}
+
+// Level 0 (point-sampled footprint): alpha tests and emission seen by light sampling.
+vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
+    return sample_texture_lod(tex, uv, srgb, -1e38);
 }
 
 // glTF alphaMode MASK: a hit where base-colour alpha (factor × texture, at the hit's uv) is below
@@ -89,7 +116,11 @@ struct Surface {
     uint mesh;
 };
 
-Surface fetch_surface(Hit hit, vec3 ray_dir) {
+// The surface at `hit`, textures filtered for a ray cone `cone_width` wide there (world units
+// across the ray; ≤ 0: level 0). Level of detail after Akenine-Möller et al. 2019 (Ray Tracing
+// Gems ch. 20): λ = ½ log2(uv area / world area) + log2(width) − log2|n·d|, plus the texture's
+// ½ log2(w·h) in sample_texture_lod.
+Surface fetch_surface(Hit hit, vec3 ray_dir, float cone_width) {
     TriangleGpu tri = triangles.data[hit.triangle];
     VertexGpu a = vertices.data[tri.vertices.x];
     VertexGpu b = vertices.data[tri.vertices.y];
@@ -105,6 +136,14 @@ Surface fetch_surface(Hit hit, vec3 ray_dir) {
     vec3 n = normalize(w.x * a.normal_v.xyz + w.y * b.normal_v.xyz + w.z * c.normal_v.xyz);
 
     MaterialGpu m = materials.data[s.material];
+    float lod_uv = -1e38;
+    if (cone_width > 0.0) {
+        vec2 uv_a = vec2(a.position_u.w, a.normal_v.w), uv_b = vec2(b.position_u.w, b.normal_v.w), uv_c = vec2(c.position_u.w, c.normal_v.w);
+        vec2 e1 = uv_b - uv_a, e2 = uv_c - uv_a;
+        float uv_area = abs(e1.x * e2.y - e1.y * e2.x);
+        float world_area = length(cross(b.position_u.xyz - a.position_u.xyz, c.position_u.xyz - a.position_u.xyz));
+        lod_uv = 0.5 * log2(uv_area / world_area) + log2(cone_width) - log2(max(abs(dot(ng, ray_dir)), 1e-4));
+    }
     // All texture lookups go through ONE sample_texture in a loop over the lane's bound slots:
     // lavapipe executes both sides of every branch under a lane mask, so six guarded calls cost six
     // full lookups per hit even for untextured materials; the loop costs max(bound slots, 1).
@@ -123,7 +162,7 @@ Surface fetch_surface(Hit hit, vec3 ray_dir) {
         uint tex = slot == 0 ? tex_lo.x : slot == 1 ? tex_lo.y : slot == 2 ? tex_lo.z
             : slot == 3 ? tex_emissive : slot == 4 ? tex_hi.x : tex_hi.y;
         bool srgb = slot == 0 || slot == 3 || slot == 5;
-        vec4 c = sample_texture(tex, s.uv, srgb);
+        vec4 c = sample_texture_lod(tex, s.uv, srgb, lod_uv);
         if (slot == 0) t_base = c;
         if (slot == 1) t_mr = c;
         if (slot == 2) t_normal = c;

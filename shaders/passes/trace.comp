@@ -132,19 +132,28 @@ void main() {
         vec3 prev_view = mat3(prev_view_from_world) * dir;
         project_view(prev_view, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
     } else {
-        Surface s = fetch_surface(hit, dir);
+        float pixel_tan = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z;
+        float footprint = texel_footprint(texel, jitter, screen);
+        // The ray cone (texture LOD): spread = the angle this sample stands for on the screen
+        // (its footprint in pixels, wider in the Visual-Polar periphery; a pixel's angle shrinks
+        // off-axis by cos θ = 1/|view_dir|); from a pinhole, width = spread × distance.
+        vec2 cone = vec2(0.0);
+        if ((frame.data.frame.w & FRAME_FLAG_TEXTURE_LOD) != 0u) {
+            float spread = pixel_tan * footprint / length(view_dir);
+            cone = vec2(spread * hit.t, spread);
+        }
+        Surface s = fetch_surface(hit, dir, cone.x);
         vec3 p_rel = s.position - org;
         float depth = dot(p_rel, mat3(world_from_view) * vec3(0.0, 0.0, -1.0));
         float cos_view = max(abs(dot(s.geometric_normal, dir)), 0.05);
-        float pixel_tan = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z;
-        float depth_gradient = depth * pixel_tan * texel_footprint(texel, jitter, screen)
+        float depth_gradient = depth * pixel_tan * footprint
                              * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
         albedo = max(s.base_color, vec3(0.01));
         normal_depth = vec4(s.normal, depth);
         position = vec4(p_rel, depth_gradient);
         ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
         project_view((prev_view_from_world * vec4(s.position, 1.0)).xyz, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
-        color = shade_path(s, dir, max_depth, rng);
+        color = shade_path(s, dir, max_depth, cone, rng);
     }
     atomicAdd(ray_counters.data[0], 1u);
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);

@@ -99,6 +99,79 @@ pub struct Material {
     pub alpha_cutoff: Option<f32>,
     /// glTF `alphaMode: BLEND`, as stochastic transparency: a hit counts with probability alpha.
     pub alpha_blend: bool,
+    /// KHR_texture_transform of each texture slot, in [`TextureSlot`] order (identity when none).
+    pub uv_transforms: [UvTransform; TextureSlot::COUNT],
+}
+
+/// A material's texture slots, in the order the GPU material and [`Material::uv_transforms`] use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureSlot {
+    BaseColor,
+    MetallicRoughness,
+    Normal,
+    Emissive,
+    Specular,
+    SpecularColor,
+}
+
+impl TextureSlot {
+    pub const COUNT: usize = 6;
+    pub const ALL: [TextureSlot; TextureSlot::COUNT] =
+        [Self::BaseColor, Self::MetallicRoughness, Self::Normal, Self::Emissive, Self::Specular, Self::SpecularColor];
+
+    /// Whether the slot's texels are sRGB-encoded colour (glTF: base colour, emissive, specular
+    /// colour); the others hold linear data.
+    pub fn is_srgb(self) -> bool {
+        matches!(self, Self::BaseColor | Self::Emissive | Self::SpecularColor)
+    }
+}
+
+impl Material {
+    /// The texture (index into [`Scene::textures`]) bound to `slot`, if any.
+    pub fn texture(&self, slot: TextureSlot) -> Option<u32> {
+        match slot {
+            TextureSlot::BaseColor => self.base_color_texture,
+            TextureSlot::MetallicRoughness => self.metallic_roughness_texture,
+            TextureSlot::Normal => self.normal_texture,
+            TextureSlot::Emissive => self.emissive_texture,
+            TextureSlot::Specular => self.specular_texture,
+            TextureSlot::SpecularColor => self.specular_color_texture,
+        }
+    }
+}
+
+/// KHR_texture_transform: uv' = T · R · S · uv, in glTF's order (scale, then rotation by
+/// `rotation` radians, then the offset).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub offset: Vec2,
+    pub rotation: f32,
+    pub scale: Vec2,
+}
+
+impl UvTransform {
+    pub const IDENTITY: UvTransform = UvTransform { offset: Vec2::ZERO, rotation: 0.0, scale: Vec2::ONE };
+
+    /// The affine map as two rows: u' = rows[0].xy · uv + rows[0].z, v' likewise with rows[1]
+    /// (the extension's matrix T · R · S).
+    pub fn rows(&self) -> [Vec3; 2] {
+        let (sin, cos) = self.rotation.sin_cos();
+        [
+            Vec3::new(cos * self.scale.x, sin * self.scale.y, self.offset.x),
+            Vec3::new(-sin * self.scale.x, cos * self.scale.y, self.offset.y),
+        ]
+    }
+
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let [u, v] = self.rows();
+        Vec2::new(u.truncate().dot(uv) + u.z, v.truncate().dot(uv) + v.z)
+    }
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
 }
 
 impl Default for Material {
@@ -123,6 +196,7 @@ impl Default for Material {
             double_sided: false,
             alpha_cutoff: None,
             alpha_blend: false,
+            uv_transforms: [UvTransform::IDENTITY; TextureSlot::COUNT],
         }
     }
 }

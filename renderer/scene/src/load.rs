@@ -26,6 +26,7 @@ pub(crate) const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_specular",
     "KHR_materials_ior",
+    "KHR_texture_transform",
 ];
 
 /// Extensions the loader reads when present (beyond the required-capable ones above). Others in

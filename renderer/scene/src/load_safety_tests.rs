@@ -5,7 +5,8 @@
 use crate::limits::LoadLimits;
 use crate::load::load_unguarded;
 use crate::test_util::{base64, temp_dir};
-use crate::{Scene, SceneError};
+use crate::{Scene, SceneError, TextureSlot, UvTransform};
+use glam::Vec2;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -319,14 +320,14 @@ fn dds_alternatives_are_skipped_and_png_sources_load() {
         ]),
         json!([{"source": 1, "extensions": {"MSFT_texture_dds": {"source": 0}}}]),
     );
-    doc["extensionsUsed"] = json!(["MSFT_texture_dds", "KHR_texture_transform"]);
+    doc["extensionsUsed"] = json!(["MSFT_texture_dds", "EXT_texture_webp", "KHR_texture_transform"]);
     let scene = load(&write_doc(&dir, &doc)).unwrap();
     assert_eq!(scene.textures.len(), 1, "only the PNG a material samples is decoded");
     assert_eq!((scene.textures[0].width, scene.textures[0].height), (4, 2));
     assert_eq!(&scene.textures[0].rgba8[..4], &[200, 100, 50, 255]);
     assert_eq!(scene.materials[0].base_color_texture, Some(0));
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    assert_mentions(&scene.warnings[0], &["MSFT_texture_dds, KHR_texture_transform", "does not understand"]);
+    assert_mentions(&scene.warnings[0], &["MSFT_texture_dds, EXT_texture_webp", "does not understand"]);
     // Required, it is refused as before.
     doc["extensionsRequired"] = json!(["MSFT_texture_dds"]);
     assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["required extension MSFT_texture_dds"]);
@@ -538,4 +539,35 @@ fn shared_real_scenes_load_within_the_default_budgets() {
         assert!(!scene.textures.is_empty(), "{file}");
         assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
     }
+}
+
+/// KHR_texture_transform on a textureInfo (the gltf crate's typed reader) and on normalTexture
+/// (raw JSON), with the extension's defaults for absent members; a non-finite member is refused
+/// naming the material and slot.
+#[test]
+fn texture_transforms_are_read_per_slot_and_checked() {
+    let dir = temp_dir("texture-transform");
+    std::fs::write(dir.join("floor.png"), png_bytes(4, 2)).unwrap();
+    let mut doc = textured_doc(json!([{"uri": "floor.png"}]), json!([{"source": 0}]));
+    doc["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] =
+        json!({"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 1.5707964, "scale": [2, 3]}});
+    doc["materials"][0]["normalTexture"] = json!({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [4, 4]}}});
+    let scene = load(&write_doc(&dir, &doc)).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let m = &scene.materials[0];
+    let base = m.uv_transforms[TextureSlot::BaseColor as usize];
+    assert_eq!((base.offset, base.rotation, base.scale), (Vec2::new(0.5, 0.25), 1.5707964, Vec2::new(2.0, 3.0)));
+    // Rotated a quarter turn: u' = 3v + 0.5, v' = −2u + 0.25.
+    let moved = base.apply(Vec2::new(1.0, 1.0));
+    assert!((moved - Vec2::new(3.5, -1.75)).length() < 1e-5, "{moved}");
+    let normal = m.uv_transforms[TextureSlot::Normal as usize];
+    assert_eq!((normal.offset, normal.rotation, normal.scale), (Vec2::ZERO, 0.0, Vec2::splat(4.0)));
+    assert_eq!(m.uv_transforms[TextureSlot::Emissive as usize], UvTransform::IDENTITY);
+
+    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] = json!("a lot");
+    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["materials[0].normalTexture.extensions.KHR_texture_transform.rotation", "number"]);
+    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] = json!(0);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] = json!([1e30, 1]);
+    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["materials[0].pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform", "finite"]);
 }

@@ -239,6 +239,7 @@ fn check_material(m: &gltf::Material) -> Result<(), String> {
             return Err(format!("{name}.{field} holds {v}: must be finite and ≥ 0"));
         }
     }
+    crate::load_material::uv_transforms(m).map_err(|e| format!("{name}.{e}"))?;
     Ok(())
 }
 
