@@ -53,6 +53,10 @@ struct SceneFlags {
     /// with lights gets a sky only when this is given and > 0).
     #[arg(long)]
     sky_intensity: Option<f32>,
+    /// Texture filtering: cones (a mip level from each ray's cone, whose spread is the sample's
+    /// footprint on the screen; the default) or off (every lookup reads level 0).
+    #[arg(long)]
+    texture_lod: Option<String>,
 }
 
 impl SceneFlags {
@@ -193,6 +197,7 @@ impl RenderOpts {
             eccentricity: self.vp_eccentricity.clone(),
             blur_sigma: self.blur_sigma,
             environment: self.look.environment()?,
+            texture_lod: self.look.texture_lod.clone(),
         })
     }
 }
@@ -621,7 +626,12 @@ fn run() -> Result<()> {
                 Some(path) => RenderProfile::load(path)?,
                 None => RenderProfile::default(),
             };
-            let profile = base.override_with(&ProfileOverrides { blur_sigma, environment: look.environment()?, ..Default::default() })?;
+            let profile = base.override_with(&ProfileOverrides {
+                blur_sigma,
+                environment: look.environment()?,
+                texture_lod: look.texture_lod.clone(),
+                ..Default::default()
+            })?;
             let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();
             commands::quality::run(&commands::quality::QualityArgs {
                 scene: &scene,

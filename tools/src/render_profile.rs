@@ -12,6 +12,7 @@ use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
+use fovea_renderer::pipeline::TextureLod;
 use fovea_renderer::to_screen::BlurSettings;
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
@@ -31,6 +32,8 @@ pub struct RenderProfile {
     pub taa: TaaSettings,
     /// `[environment]`: the default sun and sky (`crate::look`), flags applied on top.
     pub environment: EnvironmentOptions,
+    /// `[textures] lod`: mip-level selection (`cones` or `off`).
+    pub texture_lod: TextureLod,
 }
 
 #[derive(Deserialize, Default)]
@@ -43,6 +46,13 @@ struct ProfileFile {
     asvgf: Option<AsvgfSection>,
     taa: Option<TaaSection>,
     environment: Option<EnvironmentSection>,
+    textures: Option<TexturesSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TexturesSection {
+    lod: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -123,6 +133,8 @@ pub struct ProfileOverrides {
     pub blur_sigma: Option<f32>,
     /// `--sun`, `--sun-intensity`, `--sky-intensity`.
     pub environment: EnvironmentOptions,
+    /// `--texture-lod`.
+    pub texture_lod: Option<String>,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -270,6 +282,9 @@ impl RenderProfile {
             profile.environment = EnvironmentOptions { sun: f.sun, sun_intensity: f.sun_intensity, sky_intensity: f.sky_intensity };
             profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
         }
+        if let Some(lod) = file.textures.and_then(|t| t.lod) {
+            profile.texture_lod = TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
+        }
         Ok(profile)
     }
 
@@ -298,6 +313,9 @@ impl RenderProfile {
         check_blur(&self.blur).context("--blur-sigma")?;
         o.environment.validate(&EnvironmentNames::flags())?;
         self.environment = self.environment.overridden(&o.environment);
+        if let Some(lod) = &o.texture_lod {
+            self.texture_lod = TextureLod::parse(lod).context("--texture-lod")?;
+        }
         Ok(self)
     }
 }
@@ -360,6 +378,7 @@ mod tests {
         assert_eq!(p.bmfr, BmfrSettings::default());
         assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
+        assert_eq!(p.texture_lod, TextureLod::RayCones);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
         assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None });
@@ -427,6 +446,8 @@ gradient_sigma_normal = 64
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),
+            ("lod.toml", "[textures]\nlod = \"trilinear\"\n", "[textures].lod"),
+            ("lod_key.toml", "[textures]\nbias = 1\n", "bias"),
         ];
         for (name, text, key) in cases {
             let err = format!("{:#}", load_str(name, text).unwrap_err());
@@ -448,6 +469,13 @@ gradient_sigma_normal = 64
         let bad = ProfileOverrides { layout: Some("full".into()), ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-layout"));
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(500.0));
+        let p = load_str("lod_off.toml", "[textures]\nlod = \"off\"\n").unwrap();
+        assert_eq!(p.texture_lod, TextureLod::Off);
+        let o = ProfileOverrides { texture_lod: Some("cones".into()), ..Default::default() };
+        assert_eq!(p.override_with(&o).unwrap().texture_lod, TextureLod::RayCones);
+        let bad = ProfileOverrides { texture_lod: Some("on".into()), ..Default::default() };
+        let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
+        assert!(err.contains("--texture-lod") && err.contains("cones, off"), "{err}");
         let o = ProfileOverrides { eccentricity: Some("headset".into()), ..Default::default() };
         assert_eq!(RenderProfile::default().override_with(&o).unwrap().eccentricity, EccentricityMode::Headset);
         let bad = ProfileOverrides { eccentricity: Some("degrees".into()), ..Default::default() };

@@ -57,6 +57,8 @@ struct Report {
     /// TAA: `off`, `vp` (in the sampling grid) or `screen` (after the remap; for Cartesian the
     /// sampling-grid filter, the grid being the screen).
     taa: String,
+    /// Texture filtering: `cones` (ray-cone mip levels) or `off` (level 0).
+    texture_lod: &'static str,
     scene: String,
     headset: String,
     /// "left", "right" or "both".
@@ -210,6 +212,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         method: args.method.to_string(),
         denoiser: setup.denoiser.name().to_string(),
         taa: setup.taa.name().to_string(),
+        texture_lod: args.profile.texture_lod.name(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         eyes: eyes.name().to_string(),

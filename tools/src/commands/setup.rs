@@ -236,7 +236,16 @@ pub fn scaled_eye_size(eye: &EyeView, scale: f32) -> (u32, u32) {
 
 /// The engine settings the render flags give, with the filters already chosen (`filters`).
 pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMode) -> RenderSettings {
-    RenderSettings { max_depth: args.max_depth, seed: args.seed, exposure: args.exposure, blur: args.profile.blur, denoiser, taa, ..Default::default() }
+    RenderSettings {
+        max_depth: args.max_depth,
+        seed: args.seed,
+        exposure: args.exposure,
+        blur: args.profile.blur,
+        denoiser,
+        taa,
+        texture_lod: args.profile.texture_lod,
+        ..Default::default()
+    }
 }
 
 /// `--denoiser` and `--taa` with their parameters from the profile, checked against the method
