@@ -45,7 +45,7 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     let mut args = render_args("cornell-box", &out);
     args.method = "vp";
     args.gaze = "2,3";
-    args.camera_path = false;
+    args.camera_path = Default::default();
     args.debug_views = true;
     render(&args).unwrap();
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
@@ -86,7 +86,7 @@ fn headset_eccentricity_runs_every_vp_pass() {
         args.method = "vp";
         args.gaze = "12,20";
         args.frames = 3;
-        args.camera_path = false;
+        args.camera_path = Default::default();
         args.denoiser = "svgf";
         args.taa = "vp";
         args.profile.eccentricity = mode;
@@ -434,7 +434,7 @@ fn gaze_outside_the_view_is_reported_as_centre() {
     writer.finish().unwrap();
     for (method, eyes) in [("cartesian", fovea_tools::commands::setup::Eyes::Left), ("vp", fovea_tools::commands::setup::Eyes::Both)] {
         let mut args = render_args("cornell-box", &out);
-        (args.method, args.eyes, args.frames, args.exr, args.camera_path) = (method, eyes, 4, false, false);
+        (args.method, args.eyes, args.frames, args.exr, args.camera_path) = (method, eyes, 4, false, Default::default());
         args.gaze = trace.to_str().unwrap();
         render(&args).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
@@ -444,4 +444,44 @@ fn gaze_outside_the_view_is_reported_as_centre() {
             assert_eq!(report["gaze"][frame], serde_json::json!([20.0, 18.0]), "{method}: frame {frame} at the image centre");
         }
     }
+}
+
+/// `--camera-path FILE`: keyframes drive the camera. A path that stands still at a point renders
+/// exactly what the free camera at that point renders; one that moves changes the next frame;
+/// report.json says which motion ran; a bad file is named.
+#[test]
+fn camera_path_files_drive_the_camera() {
+    use fovea_tools::camera_path::CameraMotion;
+    let dir = temp_dir("camera-keys");
+    std::fs::create_dir_all(&dir).unwrap();
+    let still = dir.join("still.toml");
+    let keys = "[[key]]\ntime = 0\nposition = [0.2, 1.0, 3.4]\nlook = [0.0, 1.0, 0.0]\nfov = 50\n";
+    std::fs::write(&still, format!("{keys}[[key]]\ntime = 10\nposition = [0.2, 1.0, 3.4]\nlook = [0.0, 1.0, 0.0]\nfov = 50\n")).unwrap();
+    let moving = dir.join("moving.toml");
+    // The headset's 70 Hz: frame 1 is shown 1/70 s in, a third of the way to the second key.
+    std::fs::write(&moving, format!("{keys}[[key]]\ntime = 0.04\nposition = [-0.6, 1.3, 3.0]\nlook = [0.0, 1.0, 0.0]\nfov = 50\n")).unwrap();
+    let frames = |out: &Path| (0..2).map(|i| std::fs::read(out.join(format!("frame_{i:04}.png"))).unwrap()).collect::<Vec<_>>();
+
+    let free = fovea_tools::look::CameraOptions { position: Some("0.2,1.0,3.4".into()), look: Some("0,1,0".into()), fov: Some(50.0), camera: None };
+    let out_free = dir.join("free");
+    let args = RenderArgs { camera: &free, camera_path: CameraMotion::Still, ..render_args("cornell-box", &out_free) };
+    render(&args).unwrap();
+    let out_still = dir.join("still");
+    let args = RenderArgs { camera_path: CameraMotion::from_flag(Some(still.to_str().unwrap())).unwrap(), ..render_args("cornell-box", &out_still) };
+    render(&args).unwrap();
+    assert_eq!(frames(&out_free), frames(&out_still), "a path standing at the free camera's point renders the free camera's frames");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_still.join("report.json")).unwrap()).unwrap();
+    assert_eq!((report["camera_path"].as_bool(), report["camera_motion"].as_str()), (Some(true), Some("keys")));
+
+    let out_moving = dir.join("moving");
+    let args = RenderArgs { camera_path: CameraMotion::from_flag(Some(moving.to_str().unwrap())).unwrap(), ..render_args("cornell-box", &out_moving) };
+    render(&args).unwrap();
+    let (moved, held) = (frames(&out_moving), frames(&out_still));
+    assert_eq!(moved[0], held[0], "both paths start at the same key");
+    assert_ne!(moved[1], held[1], "the moving path's second frame sees the scene from elsewhere");
+
+    assert_eq!(CameraMotion::from_flag(Some("orbit")).unwrap(), CameraMotion::Orbit);
+    assert_eq!(CameraMotion::from_flag(None).unwrap(), CameraMotion::Still);
+    let err = format!("{:#}", CameraMotion::from_flag(Some(dir.join("absent.toml").to_str().unwrap())).unwrap_err());
+    assert!(err.contains("--camera-path") && err.contains("absent.toml"), "{err}");
 }

@@ -152,7 +152,7 @@ fn flight_helmet_renders_through_fovea_render_with_the_default_camera() {
     let out = fovea_tests::artifacts_dir().join("environment_flight_helmet");
     let _ = std::fs::remove_dir_all(&out);
     let scene = path.to_str().unwrap();
-    let args = fovea_tools::commands::render::RenderArgs { frames: 1, camera_path: false, ..fovea_tests::small_render_args(scene, &out) };
+    let args = fovea_tools::commands::render::RenderArgs { frames: 1, camera_path: Default::default(), ..fovea_tests::small_render_args(scene, &out) };
     fovea_tools::commands::render::run(&args).unwrap();
     let png = image::open(out.join("frame_0000.png")).unwrap().to_rgb8();
     let mean = png.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>() / 3.0).sum::<f64>() / png.pixels().len() as f64;

@@ -37,7 +37,7 @@ fn a_thousand_frames_hold_gpu_and_host_memory_flat_without_validation_messages()
     let out = fovea_tests::artifacts_dir().join("soak-unused");
     let mut args = fovea_tests::small_render_args("cornell-box", &out);
     (args.method, args.denoiser, args.width, args.height, args.gaze) = ("vp", "svgf", Some(64), Some(72), "sim:1");
-    (args.frames, args.exr, args.camera_path) = (FRAMES, false, true);
+    (args.frames, args.exr, args.camera_path) = (FRAMES, false, fovea_tools::camera_path::CameraMotion::Orbit);
     let mut setup = Setup::new(&args, FRAMES).unwrap();
     let spaces = setup.spaces(args.method, &args.profile).unwrap();
     let scene = GpuScene::upload(&ctx, &setup.scene).unwrap();

@@ -120,7 +120,7 @@ pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_
         frames: 2,
         out,
         exr: true,
-        camera_path: true,
+        camera_path: fovea_tools::camera_path::CameraMotion::Orbit,
         seed: 1,
         max_depth: 3,
         exposure: 1.0,

@@ -122,9 +122,10 @@ struct RenderOpts {
     /// Also write linear EXR frames.
     #[arg(long)]
     exr: bool,
-    /// Move the camera along the scene's default path (a slow orbit) instead of holding it still.
-    #[arg(long)]
-    camera_path: bool,
+    /// Move the camera: without a value along the scene's default path (a slow orbit), with a
+    /// TOML file along its keyframes (time, position, look, optional fov; see the README).
+    #[arg(long, num_args = 0..=1, default_missing_value = "orbit", value_name = "FILE")]
+    camera_path: Option<String>,
     #[arg(long, default_value_t = 1)]
     seed: u32,
     /// Path vertices: 1 = emission seen directly, 2 = + direct light, 3 = + one indirect bounce.
@@ -464,7 +465,7 @@ fn render_args<'a>(
         frames: opts.frames.unwrap_or(default_frames),
         out: opts.out.as_deref().unwrap_or(std::path::Path::new(default_out)),
         exr: opts.exr,
-        camera_path: opts.camera_path,
+        camera_path: fovea_tools::camera_path::CameraMotion::from_flag(opts.camera_path.as_deref())?,
         seed: opts.seed,
         max_depth: opts.max_depth,
         exposure: opts.exposure,

@@ -141,7 +141,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         frames: args.frames,
                         out: &dir,
                         exr: true,
-                        camera_path: moving,
+                        camera_path: if moving { camera_path::CameraMotion::Orbit } else { camera_path::CameraMotion::Still },
                         seed: args.seed,
                         max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
                         exposure: 1.0,
@@ -196,7 +196,7 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
     let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
     let mut out = Vec::new();
     for &f in &poses {
-        let pose = camera_path::pose(&start, centre, f, args.frames, moving);
+        let pose = if moving { camera_path::orbit(&start, centre, f, args.frames) } else { start };
         let reference = renderer.render_reference(&pose, args.reference_spp, fovea_renderer::pipeline::REALTIME_MAX_DEPTH, |_| {})?;
         let name = format!("reference_{}_{f:04}.exr", if moving { "moving" } else { "still" });
         write_exr(&args.out.join(name), args.width, args.height, &reference)?;

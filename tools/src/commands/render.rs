@@ -25,7 +25,8 @@ pub struct RenderArgs<'a> {
     pub frames: u32,
     pub out: &'a Path,
     pub exr: bool,
-    pub camera_path: bool,
+    /// Still, the default orbit, or keyframes (`--camera-path [FILE]`).
+    pub camera_path: crate::camera_path::CameraMotion,
     pub seed: u32,
     pub max_depth: u32,
     pub exposure: f32,
@@ -94,7 +95,10 @@ struct Report {
     rays: RayReport,
     max_depth: u32,
     seed: u32,
+    /// Whether the camera moved (`camera_motion` says how).
     camera_path: bool,
+    /// `still`, `orbit` or `keys` (a `--camera-path` file).
+    camera_motion: &'static str,
     /// Visual-Polar parameters (vp only).
     visual_polar: Option<VpReport>,
     /// Foveated blur σ at 30° for a 1280×1440 eye (vp only; 0 = off).
@@ -237,7 +241,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         rays,
         max_depth: args.max_depth,
         seed: args.seed,
-        camera_path: args.camera_path,
+        camera_path: args.camera_path.moves(),
+        camera_motion: args.camera_path.name(),
         visual_polar: (args.method == "vp").then(|| vp_report(&args.profile)),
         blur_sigma_at_30: (args.method == "vp").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),

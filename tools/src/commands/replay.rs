@@ -93,7 +93,7 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
     if !(1..=64).contains(&args.rings) || !(1..=1 << 16).contains(&args.reference_spp) {
         bail!("--rings must be in 1..=64 and --reference-spp in 1..=65536");
     }
-    if args.render.camera_path || args.render.debug_views {
+    if args.render.camera_path.moves() || args.render.debug_views {
         bail!("fovea replay renders a still camera without debug views (--camera-path/--debug-views do not apply)");
     }
     let _out_dir = prepare_output_dir(args.out)?;
@@ -131,7 +131,7 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         (None, n) => n.unwrap_or(DEFAULT_FRAMES),
     };
     let run_dir = args.out.join(format!("run_{name}"));
-    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, ..args.render };
+    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, camera_path: Default::default(), ..args.render };
     super::render::run(&render)?;
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run_dir.join("report.json"))?)?;
     let (width, height) = (report["width"].as_u64().unwrap_or(0) as u32, report["height"].as_u64().unwrap_or(0) as u32);

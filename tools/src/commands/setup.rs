@@ -70,7 +70,7 @@ pub struct Setup {
     pub start_pose: CameraPose,
     scene_centre: Vec3,
     frames: u32,
-    camera_path: bool,
+    camera_path: camera_path::CameraMotion,
 }
 
 impl Setup {
@@ -105,7 +105,7 @@ impl Setup {
             gaze,
             start_pose,
             frames,
-            camera_path: args.camera_path,
+            camera_path: args.camera_path.clone(),
         })
     }
 
@@ -122,7 +122,7 @@ impl Setup {
     /// eye's position) and gaze (the combined gaze direction projected into that eye).
     pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
         let gaze = self.gaze.frame(frame, self.eyes.list())?;
-        let head = camera_path::pose(&self.start_pose, self.scene_centre, frame, self.frames, self.camera_path);
+        let head = camera_path::pose(&self.start_pose, self.scene_centre, frame, self.frames, &self.camera_path, self.hmd.refresh_hz);
         let mut views = [ViewInput { camera: head, gaze: None }; 2];
         let eyes = self.eyes.list();
         for (view, &eye) in views.iter_mut().zip(eyes) {

@@ -76,7 +76,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
     if r.width.is_some() || r.height.is_some() {
         bail!("fovea xr: the size is the runtime's recommended one × --scale; --width/--height do not apply");
     }
-    if r.camera_path || r.exr || r.debug_views {
+    if r.camera_path.moves() || r.exr || r.debug_views {
         bail!("fovea xr: --camera-path, --exr and --debug-views do not apply (the headset moves the camera; frames go to the runtime)");
     }
     if args.screenshot.is_some() && args.frames.is_none() {
