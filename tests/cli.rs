@@ -62,7 +62,7 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     for pass in ["trace", "mip_phi", "remap", "blur_h", "blur_v", "tonemap"] {
         assert!(report["passes"][pass].as_f64().unwrap() > 0.0, "pass {pass} missing");
     }
-    for f in ["debug_grid_0000.png", "debug_density_0001.png", "debug_density_plot.png", "frame_0001.exr"] {
+    for f in ["debug_grid_0000.png", "debug_density_0001.png", "debug_overlay_0001.png", "debug_density_plot.png", "frame_0001.exr"] {
         assert!(out.join(f).exists(), "{f} missing");
     }
     let grid = image::open(out.join("debug_grid_0000.png")).unwrap();

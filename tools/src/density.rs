@@ -113,6 +113,23 @@ pub fn heatmap_rgba(density: &[f32], width: u32, height: u32, gaze: Vec2) -> Vec
     rgba
 }
 
+/// `frame` (RGBA8) with `heat` (RGBA8, same size) laid over it at `weight` (0: the frame, 1: the
+/// heat map); the gaze marks, drawn white in `heat`, stay fully white.
+pub fn overlay(frame: &[u8], heat: &[u8], weight: f32) -> Vec<u8> {
+    assert_eq!(frame.len(), heat.len(), "overlay of images of different sizes");
+    frame
+        .chunks_exact(4)
+        .zip(heat.chunks_exact(4))
+        .flat_map(|(f, h)| {
+            if h[..3] == [255, 255, 255] {
+                return [255, 255, 255, 255];
+            }
+            let mix = |k: usize| (f[k] as f32 * (1.0 - weight) + h[k] as f32 * weight).round() as u8;
+            [mix(0), mix(1), mix(2), 255]
+        })
+        .collect()
+}
+
 /// Mean of `density` over a (2·radius + 1)² box around each pixel (clipped at the borders).
 /// Peripheral counts are 0 or 1 per pixel; smoothing them first makes the heatmap readable.
 pub fn box_filter(density: &[f32], width: u32, height: u32, radius: u32) -> Vec<f32> {
@@ -239,6 +256,14 @@ mod tests {
 
     fn centred_vp() -> VisualPolar {
         VisualPolar::new(UVec2::new(320, 360), Vec2::new(160.0, 180.0), VisualPolarParams::default()).unwrap()
+    }
+
+    #[test]
+    fn overlay_mixes_by_weight_and_keeps_the_gaze_marks_white() {
+        let frame = [100, 0, 200, 255, 10, 20, 30, 255];
+        let heat = [0, 100, 0, 255, 255, 255, 255, 255];
+        assert_eq!(overlay(&frame, &heat, 0.25), vec![75, 25, 150, 255, 255, 255, 255, 255]);
+        assert_eq!(overlay(&frame, &heat, 0.0)[..4], frame[..4]);
     }
 
     #[test]
