@@ -2,7 +2,10 @@
 //! `shaders.rs`, a table of (name, bytes) the engine looks pipelines up in.
 //!
 //! A shader may declare variants with lines `//! variant NAME: DEFINE[=VALUE] …`; each variant is
-//! compiled as `path.NAME` with those macros defined (e.g. one trace kernel per sampling space).
+//! compiled as `path.NAME` with those macros defined. `//! variants per space[ SUFFIX: DEFINES]`
+//! stands for one such line per sampling space of `shaders/sampling/spaces.txt` (`NAME: DEFINES`),
+//! named `SPACE SUFFIX` with the space's and the line's defines, so a new space is one line there,
+//! not one in every kernel.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -15,11 +18,17 @@ pub fn compile_all(root: &Path, out_dir: &Path, generated: &[(String, String)]) 
     let spv_dir = out_dir.join("spv");
     std::fs::create_dir_all(&spv_dir).map_err(|e| e.to_string())?;
 
+    let spaces_file = root.join("sampling/spaces.txt");
+    let spaces_text = std::fs::read_to_string(&spaces_file).map_err(|e| format!("{}: {e}", spaces_file.display()))?;
+    let spaces = parse_variant_list(spaces_text.lines().filter(|l| !l.trim_start().starts_with('#')));
+    if spaces.is_empty() {
+        return Err(format!("{}: no sampling space listed", spaces_file.display()));
+    }
     let mut jobs: Vec<(String, PathBuf, String, Defines)> = Vec::new();
     for path in find_shaders(root) {
         let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let stem = path.strip_prefix(root).unwrap().with_extension("").to_string_lossy().replace('\\', "/");
-        let variants = parse_variants(&source);
+        let variants = parse_variants(&source, &spaces);
         if variants.is_empty() {
             jobs.push((stem, path, source, Vec::new()));
         } else {
@@ -107,20 +116,36 @@ fn options<'a>(root: &Path, defines: &[(String, Option<String>)]) -> Result<shad
     Ok(options)
 }
 
-fn parse_variants(source: &str) -> Vec<(String, Defines)> {
-    source
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("//! variant "))
+/// The variants a shader declares, `variants per space` lines expanded over `spaces`.
+fn parse_variants(source: &str, spaces: &[(String, Defines)]) -> Vec<(String, Defines)> {
+    let mut variants = parse_variant_list(source.lines().filter_map(|l| l.trim().strip_prefix("//! variant ")));
+    for line in source.lines().filter_map(|l| l.trim().strip_prefix("//! variants per space")) {
+        let (suffix, extra) = match line.split_once(':') {
+            Some((suffix, defs)) => (suffix.trim(), parse_defines(defs)),
+            None => (line.trim(), Vec::new()),
+        };
+        for (space, defines) in spaces {
+            variants.push((format!("{space}{suffix}"), defines.iter().chain(&extra).cloned().collect()));
+        }
+    }
+    variants
+}
+
+fn parse_defines(defs: &str) -> Defines {
+    defs.split_whitespace()
+        .map(|d| match d.split_once('=') {
+            Some((k, v)) => (k.to_string(), Some(v.to_string())),
+            None => (d.to_string(), None),
+        })
+        .collect()
+}
+
+/// `NAME: DEFINE[=VALUE] …` lines.
+fn parse_variant_list<'a>(lines: impl Iterator<Item = &'a str>) -> Vec<(String, Defines)> {
+    lines
         .filter_map(|rest| {
             let (name, defs) = rest.split_once(':')?;
-            let defines = defs
-                .split_whitespace()
-                .map(|d| match d.split_once('=') {
-                    Some((k, v)) => (k.to_string(), Some(v.to_string())),
-                    None => (d.to_string(), None),
-                })
-                .collect();
-            Some((name.trim().to_string(), defines))
+            Some((name.trim().to_string(), parse_defines(defs)))
         })
         .collect()
 }

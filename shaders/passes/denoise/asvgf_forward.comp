@@ -9,8 +9,7 @@
 // the G-buffer still holds last frame. Each invocation also clears its stratum of the gradient
 // image, where the tracer writes the strata that got a gradient sample (the strata grids of both
 // frames are one). Strata in the Visual-Polar grid: shaders/denoise/strata.glsl.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../common/camera.glsl"
 #include "../../denoise/strata.glsl"

@@ -7,8 +7,7 @@
 // re-shaded gradient sample; z carries the fraction of the kernel's weight that had one, which is
 // the next iteration's confidence. The first iteration reads what the tracer wrote (δ, max f, 1
 // where a stratum has a gradient sample, zeros elsewhere).
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/strata.glsl"
 #include "../../denoise/svgf.glsl"

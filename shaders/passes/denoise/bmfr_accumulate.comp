@@ -3,8 +3,7 @@
 // radiance and the features (normal, camera-relative position) blended with their reprojected
 // history, α = max(1/n, α_floor) for history length n (this frame included). Writes this frame's
 // half of the history; texels without a sample get zeros.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;

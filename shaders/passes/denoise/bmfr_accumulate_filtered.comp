@@ -3,8 +3,7 @@
 // with its reprojected history — the same taps as the accumulation before the fit — with
 // α = max(1/n, α_floor), n the history length that accumulation counted; then re-modulated by
 // albedo, the denoiser's output. Texels without a sample have albedo 0 and stay 0.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;

@@ -10,8 +10,7 @@
 // constant get uniform noise of ±params.x (stochastic regularisation: no exactly collinear
 // columns). A column left with a near-zero norm is skipped (weight 0): rank-deficient blocks.
 // Writes BMFR_WEIGHT_TEXELS texels per block: 10 × rgb weights, then the position offset and scale.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../common/random.glsl"
 #include "../../denoise/bmfr.glsl"

@@ -2,8 +2,7 @@
 // BMFR weighted sum: each texel evaluates its own block's fit on its features (without the fit's
 // regularisation noise), clamped ≥ 0. Texels without a hit keep their accumulated noisy radiance
 // (they took no part in any fit); texels without a sample get zeros.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/bmfr.glsl"
 

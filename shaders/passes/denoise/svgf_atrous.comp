@@ -3,8 +3,7 @@
 // `config.x` texels apart, stopped at edges by depth (relative to the gradient), normal and
 // luminance (relative to σ_l·√(3×3-Gaussian variance)); the variance is filtered with the squared
 // weights. Texels without a sample are never read and get zeros.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"

@@ -8,10 +8,8 @@
 // The *_adaptive variants are A-SVGF's (Schied et al. 2018, §4.3): the reconstructed temporal
 // gradient of the texel's stratum gives λ = |δ̂| / max(f_i, f_{i−1}), which raises both alphas to
 // (1 − λ)·α + λ and shortens the history length by the same factor (a changed light restarts it).
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
-//! variant cartesian_adaptive: SAMPLING_CARTESIAN SVGF_ADAPTIVE_ALPHA
-//! variant visual_polar_adaptive: SAMPLING_VISUAL_POLAR SVGF_ADAPTIVE_ALPHA
+//! variants per space
+//! variants per space _adaptive: SVGF_ADAPTIVE_ALPHA
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"

@@ -2,8 +2,7 @@
 // SVGF variance estimate (Schied et al. 2017, §4.2): the temporal variance where the history is
 // long enough; below that, colour and moments are averaged over a 7×7 edge-stopped neighbourhood
 // and the variance from those moments is boosted by 4/history (few frames underestimate it).
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"

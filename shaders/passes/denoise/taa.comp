@@ -6,8 +6,7 @@
 // Without a usable history (first frame, disocclusion, off the previous grid) the sample starts
 // afresh: the bilinear taps are the reprojected history, the previous 3×3 surfaces decide
 // whether it may be used. Writes the new history, which is also the pass's output, and this frame's surface.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR
+//! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"
