@@ -114,7 +114,7 @@ fn default_sun_and_sky_only_for_scenes_without_lights() {
 #[test]
 fn environment_values_are_checked_with_the_name() {
     let flags = EnvironmentNames::flags();
-    assert!(EnvironmentOptions { sun: Some([10.0, 90.0]), sun_intensity: Some(0.0), sky_intensity: Some(1e6) }.validate(&flags).is_ok());
+    assert!(EnvironmentOptions { sun: Some([10.0, 90.0]), sun_intensity: Some(0.0), sky_intensity: Some(1e6), ..Default::default() }.validate(&flags).is_ok());
     for (env, needle) in [
         (EnvironmentOptions { sun: Some([0.0, 0.0]), ..Default::default() }, "--sun"),
         (EnvironmentOptions { sun: Some([f32::NAN, 10.0]), ..Default::default() }, "--sun"),

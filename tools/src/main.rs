@@ -53,6 +53,17 @@ struct SceneFlags {
     /// with lights gets a sky only when this is given and > 0).
     #[arg(long)]
     sky_intensity: Option<f32>,
+    /// An equirectangular HDR environment map (.exr or .hdr, at most 8192×4096) seen by escaping
+    /// rays and sampled by next-event estimation; replaces the sky, and the default sun stays off
+    /// unless --sun is given.
+    #[arg(long)]
+    env: Option<std::path::PathBuf>,
+    /// The environment map's rotation about +Y in degrees (counter-clockwise seen from above; default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    env_rotation: Option<f32>,
+    /// The environment map's radiance scale (default 1).
+    #[arg(long)]
+    env_intensity: Option<f32>,
 }
 
 impl SceneFlags {
@@ -70,6 +81,9 @@ impl SceneFlags {
             sun: self.sun.as_deref().map(fovea_tools::look::parse_sun).transpose()?,
             sun_intensity: self.sun_intensity,
             sky_intensity: self.sky_intensity,
+            env: self.env.clone(),
+            env_rotation: self.env_rotation,
+            env_intensity: self.env_intensity,
         })
     }
 }
@@ -463,7 +477,7 @@ fn render_args<'a>(
         seed: opts.seed,
         max_depth: opts.max_depth,
         exposure: opts.exposure,
-        profile: *profile,
+        profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
         taa: &opts.taa,

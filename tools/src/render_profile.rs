@@ -17,7 +17,7 @@ use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
 use std::path::Path;
 
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
@@ -52,6 +52,10 @@ struct EnvironmentSection {
     sun: Option<[f32; 2]>,
     sun_intensity: Option<f32>,
     sky_intensity: Option<f32>,
+    /// An HDR environment map, relative to the profile's folder.
+    env: Option<std::path::PathBuf>,
+    env_rotation: Option<f32>,
+    env_intensity: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -267,7 +271,15 @@ impl RenderProfile {
             s.validate().with_context(|| at("taa"))?;
         }
         if let Some(f) = file.environment {
-            profile.environment = EnvironmentOptions { sun: f.sun, sun_intensity: f.sun_intensity, sky_intensity: f.sky_intensity };
+            let env = f.env.map(|e| path.parent().map_or(e.clone(), |dir| dir.join(&e)));
+            profile.environment = EnvironmentOptions {
+                sun: f.sun,
+                sun_intensity: f.sun_intensity,
+                sky_intensity: f.sky_intensity,
+                env,
+                env_rotation: f.env_rotation,
+                env_intensity: f.env_intensity,
+            };
             profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
         }
         Ok(profile)
@@ -362,7 +374,7 @@ mod tests {
         assert_eq!(p.taa, TaaSettings::default());
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
-        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None });
+        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None, ..Default::default() });
     }
 
     #[test]
@@ -470,7 +482,7 @@ gradient_sigma_normal = 64
     #[test]
     fn environment_section_and_flags() {
         let p = load_str("env.toml", "[environment]\nsun = [45.0, 30.0]\nsky_intensity = 0.0\n").unwrap();
-        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0) });
+        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0), ..Default::default() });
         let err = format!("{:#}", load_str("env_bad.toml", "[environment]\nsun_intensity = -1.0\n").unwrap_err());
         assert!(err.contains("[environment].sun_intensity"), "{err}");
         assert!(load_str("env_key.toml", "[environment]\nmoon = 1.0\n").is_err());
