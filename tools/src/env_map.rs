@@ -9,15 +9,34 @@ use fovea_renderer::scene::environment::{check_size, EnvironmentMap};
 use glam::Vec3;
 use std::path::Path;
 
+#[derive(Clone, Copy)]
+enum Format {
+    Exr,
+    Hdr,
+}
+
+/// What can be said of `path` without decoding it: a regular file with a supported extension.
+/// Profiles check their `env` this way when they are read, so the error names the key.
+pub fn check_path(path: &Path) -> Result<()> {
+    format_of(path).map(|_| ())
+}
+
+fn format_of(path: &Path) -> Result<Format> {
+    let name = path.display();
+    crate::output::check_regular_input(path).with_context(|| format!("environment map {name}"))?;
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("exr") => Ok(Format::Exr),
+        Some("hdr") => Ok(Format::Hdr),
+        _ => bail!("environment map {name}: unsupported format (expected an equirectangular OpenEXR .exr or Radiance .hdr file)"),
+    }
+}
+
 /// The map in `path`, turned `rotation_deg` about +Y and scaled by `intensity`.
 pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<EnvironmentMap> {
     let name = path.display();
-    crate::output::check_regular_input(path).with_context(|| format!("environment map {name}"))?;
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let (width, height, texels) = match ext.as_deref() {
-        Some("exr") => read_exr(path),
-        Some("hdr") => read_hdr(path),
-        _ => bail!("environment map {name}: unsupported format (expected an equirectangular OpenEXR .exr or Radiance .hdr file)"),
+    let (width, height, texels) = match format_of(path)? {
+        Format::Exr => read_exr(path),
+        Format::Hdr => read_hdr(path),
     }
     .with_context(|| format!("environment map {name}"))?;
     let mut map = EnvironmentMap::new(width, height, texels).map_err(|e| anyhow::anyhow!("environment map {name}: {e}"))?;

@@ -281,6 +281,9 @@ impl RenderProfile {
                 env_intensity: f.env_intensity,
             };
             profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
+            if let Some(env) = &profile.environment.env {
+                crate::env_map::check_path(env).with_context(|| format!("{}: [environment].env", path.display()))?;
+            }
         }
         Ok(profile)
     }
@@ -492,5 +495,34 @@ gradient_sigma_normal = 64
         assert_eq!(merged.environment.sun, Some([45.0, 30.0]));
         let bad = ProfileOverrides { environment: EnvironmentOptions { sun: Some([0.0, 95.0]), ..Default::default() }, ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--sun"));
+    }
+
+    #[test]
+    fn environment_map_keys_and_flags() {
+        // The map's path is relative to the profile's folder.
+        let dir = std::env::temp_dir().join(format!("fovea-profile-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("sky.hdr"), b"").unwrap();
+        let p = load_str("envmap.toml", "[environment]\nenv = \"sky.hdr\"\nenv_rotation = -90.0\nenv_intensity = 2.5\n").unwrap();
+        assert_eq!(p.environment.env, Some(dir.join("sky.hdr")));
+        assert_eq!((p.environment.env_rotation, p.environment.env_intensity), (Some(-90.0), Some(2.5)));
+        // Flags override the profile, key by key.
+        let o = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(1.0), ..Default::default() }, ..Default::default() };
+        let merged = p.clone().override_with(&o).unwrap();
+        assert_eq!((merged.environment.env_intensity, merged.environment.env_rotation), (Some(1.0), Some(-90.0)));
+        let o = ProfileOverrides { environment: EnvironmentOptions { env: Some("other.exr".into()), ..Default::default() }, ..Default::default() };
+        assert_eq!(p.override_with(&o).unwrap().environment.env, Some("other.exr".into()));
+        // Errors name the file and the key.
+        for (text, key) in [
+            ("env = \"nowhere.exr\"", "[environment].env"),
+            ("env = \"envmap.toml\"", "[environment].env"),
+            ("env_intensity = -1.0", "[environment].env_intensity"),
+            ("env_rotation = inf", "[environment].env_rotation"),
+        ] {
+            let err = format!("{:#}", load_str("envmap_bad.toml", &format!("[environment]\n{text}\n")).unwrap_err());
+            assert!(err.contains("envmap_bad.toml") && err.contains(key), "{text}: {err}");
+        }
+        let bad = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(f32::NAN), ..Default::default() }, ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--env-intensity"));
     }
 }
