@@ -103,6 +103,16 @@ impl EnvironmentOptions {
         }
     }
 
+    /// The settings as replay baselines record them: the sun and sky fields as before environment
+    /// maps existed (so older baselines do not read as changed), the map's fields only when given.
+    pub fn describe(&self) -> String {
+        let base = format!("EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}", self.sun, self.sun_intensity, self.sky_intensity);
+        if self.env.is_none() && self.env_rotation.is_none() && self.env_intensity.is_none() {
+            return base + " }";
+        }
+        format!("{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?} }}", self.env, self.env_rotation, self.env_intensity)
+    }
+
     pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
         if let Some([azimuth, elevation]) = self.sun {
             if !(azimuth.is_finite() && elevation.is_finite() && elevation > 0.0 && elevation <= 90.0) {

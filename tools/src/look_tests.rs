@@ -159,3 +159,10 @@ fn an_environment_map_replaces_the_sky_and_the_sun_needs_asking_for() {
     let err = format!("{:#}", apply_environment_map(&mut scene_with(Vec3::ZERO, Vec3::ONE, Material::default()), &missing).unwrap_err());
     assert!(err.contains("none.exr"), "{err}");
 }
+
+#[test]
+fn replay_description_of_the_default_environment_is_unchanged() {
+    // What the committed baselines (tests/replay/baseline/*/baseline.json) recorded.
+    assert_eq!(EnvironmentOptions::default().describe(), "EnvironmentOptions { sun: None, sun_intensity: None, sky_intensity: None }");
+    assert!(EnvironmentOptions { env_intensity: Some(2.0), ..Default::default() }.describe().contains("env_intensity: Some(2.0)"));
+}

@@ -215,7 +215,7 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
         reference_spp: args.reference_spp,
         rings: args.rings,
         camera: format!("{:?}", r.camera),
-        environment: format!("{:?}", r.profile.environment),
+        environment: r.profile.environment.describe(),
     }
 }
 
