@@ -26,11 +26,7 @@ impl GpuEnvironment {
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuEnvironment> {
         let max_texels = (ctx.info.max_storage_buffer_range as usize / std::mem::size_of::<EnvTexelGpu>()).min(MAX_GPU_TEXELS);
         let Some(map) = scene.environment_map() else { return Self::black(ctx) };
-        let (mut map, mut halvings) = (map.into_owned(), 0);
-        while map.texels.len() > max_texels && map.texels.len() > 1 {
-            map = map.halved();
-            halvings += 1;
-        }
+        let (map, halvings) = fit(map.into_owned(), max_texels);
         let Some(dist) = EnvironmentDistribution::new(&map) else { return Self::black(ctx) };
         let buffer = Buffer::with_data(ctx, "environment", &gpu_texels(&map, &dist), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         Ok(GpuEnvironment { buffer, map: Some((map.width, map.height, map.rotation, map.intensity)), halvings })
@@ -51,6 +47,16 @@ impl GpuEnvironment {
     }
 }
 
+/// `map` halved per axis until it has at most `max_texels` texels; returns the halvings.
+pub fn fit(mut map: EnvironmentMap, max_texels: usize) -> (EnvironmentMap, u32) {
+    let mut halvings = 0;
+    while map.texels.len() > max_texels.max(1) && map.texels.len() > 1 {
+        map = map.halved();
+        halvings += 1;
+    }
+    (map, halvings)
+}
+
 /// The buffer's contents: radiance and probability per texel with its alias slot.
 pub fn gpu_texels(map: &EnvironmentMap, dist: &EnvironmentDistribution) -> Vec<EnvTexelGpu> {
     map.texels
@@ -58,4 +64,25 @@ pub fn gpu_texels(map: &EnvironmentMap, dist: &EnvironmentDistribution) -> Vec<E
         .zip(&dist.alias)
         .map(|(t, slot)| EnvTexelGpu { radiance: t.extend(slot.pdf), alias: UVec4::new(slot.alias, slot.threshold.to_bits(), 0, 0) })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn maps_beyond_the_budget_are_halved_until_they_fit() {
+        let map = EnvironmentMap::new(64, 32, (0..64 * 32).map(|i| Vec3::splat(i as f32)).collect()).unwrap();
+        let (same, none) = fit(map.clone(), 64 * 32);
+        assert_eq!((same.width, same.height, none), (64, 32, 0));
+        let (small, n) = fit(map.clone(), 100);
+        assert_eq!((small.width, small.height, n), (8, 4, 3));
+        assert!((small.luminance_integral() - map.luminance_integral()).abs() < 1e-3 * map.luminance_integral());
+        let dist = EnvironmentDistribution::new(&small).unwrap();
+        let texels = gpu_texels(&small, &dist);
+        assert_eq!(texels.len(), 32);
+        assert_eq!(texels[5].radiance.w, dist.alias[5].pdf);
+        assert_eq!(f32::from_bits(texels[5].alias.y), dist.alias[5].threshold);
+    }
 }
