@@ -1,15 +1,16 @@
 //! Uploads a CPU scene (`fovea_scene::Scene`) into the GPU buffers the tracing passes bind:
 //! BVH nodes and leaf triangles as texel buffers, shading data as std430 storage buffers.
 
+use crate::environment::GpuEnvironment;
 use crate::error::{Error, Result};
 use crate::graph::{read_buffer, read_texels, Bind};
 use crate::layouts::{
-    LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_POINT,
+    LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT,
     LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
-use crate::scene::{Aabb, PunctualLight, Scene, Sky, TextureSlot};
+use crate::scene::{Aabb, PunctualLight, Scene, TextureSlot};
 use crate::texture_pack;
 use crate::vk::{Buffer, Context};
 use ash::vk;
@@ -36,8 +37,10 @@ pub struct GpuScene {
     /// (`maxStorageBufferRange`: 128 MiB on lavapipe, less than Sponza's 250 MB of RGBA8).
     pub textures_halved: u32,
     pub bounds: Aabb,
-    /// Radiance of escaping rays (`Scene::sky`), passed to the shaders in `FrameData`.
-    pub sky: Sky,
+    /// What escaping rays see (`Scene::environment_map`: a loaded map or the baked sky).
+    pub environment: GpuEnvironment,
+    /// `FrameData.environment` and `.environment_map` for this upload and light table.
+    pub environment_slots: (Vec4, UVec4),
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
     /// Some material is alpha-masked or blended: traversal tests alpha (`FRAME_FLAG_ALPHA_MASK`).
@@ -85,6 +88,7 @@ impl GpuScene {
         let materials: Vec<MaterialGpu> = scene.materials.iter().zip(&packed.material_slots).map(|(m, t)| material_gpu(m, t, 1.0)).collect();
         let (textures, texels) = (packed.infos, packed.texels);
         let lights = light_entries(scene, &emission_scale);
+        let environment = GpuEnvironment::upload(ctx, scene)?;
 
         Ok(GpuScene {
             bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &bvh.node_texels())?,
@@ -102,7 +106,8 @@ impl GpuScene {
             textures_halved: packed.halvings,
             material_textures: packed.material_slots,
             bounds: scene.bounds(),
-            sky: scene.sky,
+            environment_slots: environment.frame_slots(&lights),
+            environment,
             alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
             bvh_depth: depth,
             bvh_bytes: bvh.memory_bytes(),
@@ -136,11 +141,12 @@ impl GpuScene {
             self.lights.write(&lights)?;
         }
         self.light_count = lights.len() as u32;
+        self.environment_slots = self.environment.frame_slots(&lights);
         Ok(())
     }
 
-    /// The scene bindings of `shaders/common/scene.glsl` (all read-only).
-    pub fn binds(&self) -> [Bind<'_>; 8] {
+    /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only).
+    pub fn binds(&self) -> [Bind<'_>; 9] {
         [
             read_texels("bvh_nodes", &self.bvh_nodes),
             read_texels("bvh_triangles", &self.bvh_triangles),
@@ -150,6 +156,7 @@ impl GpuScene {
             read_buffer("textures", &self.textures),
             read_buffer("texels", &self.texels),
             read_buffer("lights", &self.lights),
+            read_buffer("environment", &self.environment.buffer),
         ]
     }
 
@@ -196,7 +203,9 @@ fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {
                 sampling: Vec4::new(slot.threshold, slot.pdf, 0.0, 0.0),
                 ..Default::default()
             };
-            if entry.kind != LightKind::EmissiveTriangle {
+            if entry.kind == LightKind::Environment {
+                gpu.kind_index.x = LIGHT_KIND_ENVIRONMENT;
+            } else if entry.kind != LightKind::EmissiveTriangle {
                 match &scene.punctual_lights[entry.index as usize] {
                     PunctualLight::Point { position, intensity, range } => {
                         gpu.kind_index.x = LIGHT_KIND_POINT;

@@ -1,11 +1,13 @@
 //! The fovea engine: records Vulkan compute command buffers that trace, filter and remap
 //! foveated samples. Read the modules in pipeline order:
-//! `scene` (what is traced, CPU side, crate `fovea_scene`) → `gpu_scene` (its upload) →
+//! `scene` (what is traced, CPU side, crate `fovea_scene`) → `gpu_scene` (its upload; the
+//! environment map's in `environment`) →
 //! `sampling` (where samples go) → `passes` (trace; mip_phi, remap, blur; tonemap; accumulate) →
 //! `to_screen` (VP grid → screen) → `view` (one eye's state) → `pipeline` (the engine: views,
 //! one submit per frame) → `frames` (frames in flight).
 //! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
 
+pub mod environment;
 pub mod error;
 pub mod frames;
 pub mod gpu_scene;

@@ -61,6 +61,20 @@ pub struct RenderSettings {
     /// Texture filtering of frames (references always read level 0: point samples converge to
     /// the box-filtered pixel).
     pub texture_lod: TextureLod,
+    /// How the environment map is found: next-event estimation with MIS (the default), or by
+    /// BRDF-sampled rays alone (the comparison the importance-sampling tests measure against).
+    pub environment_sampling: EnvironmentSampling,
+}
+
+/// `RenderSettings::environment_sampling`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EnvironmentSampling {
+    /// Light selection picks the environment like any light, and BRDF rays that escape to it
+    /// are weighed against that sample (power heuristic).
+    #[default]
+    ImportanceMis,
+    /// Only escaping BRDF rays count it (a selected environment sample contributes nothing).
+    BrdfOnly,
 }
 
 impl Default for RenderSettings {
@@ -74,6 +88,7 @@ impl Default for RenderSettings {
             denoiser: DenoiserSettings::None,
             taa: TaaMode::Off,
             stereo_noise: StereoNoise::default(),
+            environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
         }
     }
@@ -372,9 +387,12 @@ impl Renderer {
             ),
             scene_sphere: self.scene.bounding_sphere(),
             jitter: jitter.extend(0.0).extend(0.0),
-            sky_zenith: self.scene.sky.zenith.extend(0.0),
-            sky_horizon: self.scene.sky.horizon.extend(0.0),
-            sky_ground: self.scene.sky.ground.extend(if self.scene.sky.is_black() { 0.0 } else { 1.0 }),
+            // Selection probability 0 tells the shaders not to sample it (BRDF-only).
+            environment: match self.settings.environment_sampling {
+                EnvironmentSampling::ImportanceMis => self.scene.environment_slots.0,
+                EnvironmentSampling::BrdfOnly => self.scene.environment_slots.0 * Vec4::new(1.0, 1.0, 1.0, 0.0),
+            },
+            environment_map: self.scene.environment_slots.1,
         };
         v.slots[slot].frame_data.write(&[data])
     }

@@ -21,6 +21,8 @@ const uint LIGHT_KIND_TRIANGLE = 0u;
 const uint LIGHT_KIND_POINT = 1u;
 const uint LIGHT_KIND_SPOT = 2u;
 const uint LIGHT_KIND_DIRECTIONAL = 3u;
+// The environment map (FrameData.environment*): sampled by shaders/common/environment.glsl.
+const uint LIGHT_KIND_ENVIRONMENT = 4u;
 
 // FrameData.frame.w flags.
 const uint FRAME_FLAG_REFERENCE = 1u;
@@ -46,9 +48,21 @@ struct FrameData {
     uvec4 counts;               // x light entries, y triangles, z materials, w textures
     vec4 scene_sphere;          // xyz centre, w radius of the scene's bounding sphere
     vec4 jitter;                // xy sub-texel sample offset in [0, 1)² (FRAME_FLAG_HALTON_JITTER), zw unused
-    vec4 sky_zenith;            // rgb radiance of escaping rays straight up (Scene::sky), w unused
-    vec4 sky_horizon;           // rgb at the horizon, w unused
-    vec4 sky_ground;            // rgb below the horizon, w = 1 when any sky radiance is non-zero
+    vec4 environment;           // what escaping rays see (Scene::environment_map): x cos, y sin of the map's rotation about +Y, z radiance scale, w probability that light selection picks it (0: not sampled)
+    uvec4 environment_map;      // x width, y height (texels), z 1 when there is an environment (0: escaping rays see black), w unused
+};
+
+// One texel of the environment map with its alias-table slot (environment::EnvironmentDistribution).
+struct EnvTexelGpu {
+    vec4 radiance;              // rgb linear radiance (before FrameData.environment.z), w probability of choosing this texel
+    uvec4 alias;                // x alias texel, y threshold (float bits): keep this texel when u < threshold, zw unused
+};
+
+// Push constants of the environment probe (device test of Rust vs GLSL mapping and sampling).
+struct EnvProbePush {
+    vec4 environment;           // as FrameData.environment
+    uvec4 environment_map;      // as FrameData.environment_map
+    uvec4 config;               // x point count, yzw unused
 };
 
 // Where samples lie on the screen; each sampling space gives the slots its own meaning.

@@ -1,12 +1,18 @@
 // Next-event estimation: pick one light from the alias table (probability ∝ power), then a point
-// on it. Emissive triangles are sampled uniformly by area; punctual lights follow KHR_lights_punctual.
+// on it. Emissive triangles are sampled uniformly by area; punctual lights follow KHR_lights_punctual;
+// the environment map by its luminance (environment.glsl), one entry of the same table.
 #ifndef FOVEA_LIGHTS_GLSL
 #define FOVEA_LIGHTS_GLSL
 
+#include "environment.glsl"
+
 struct LightSample {
     vec3 direction;     // from the shading point toward the light
-    float distance;     // to the light point (1e30 for directional)
+    float distance;     // to the light point (1e30 for directional and the environment)
     vec3 radiance_over_pdf; // incident radiance × geometry term / (selection pdf × point pdf)
+    // Selection × solid-angle pdf for lights a BRDF-sampled ray can also find (the environment),
+    // for the MIS weight in path.glsl; 0 for lights only next-event estimation counts.
+    float mis_pdf;
 };
 
 uint pick_light(inout uint rng, out float select_pdf) {
@@ -31,6 +37,7 @@ bool sample_light(vec3 p, inout uint rng, out LightSample ls) {
     ls.radiance_over_pdf = vec3(0.0);
     ls.distance = 0.0;
     ls.direction = vec3(0.0, 1.0, 0.0);
+    ls.mis_pdf = 0.0;
     if (frame.data.counts.x == 0u) return false;
     float select_pdf;
     LightGpu l = lights.data[pick_light(rng, select_pdf)];
@@ -59,6 +66,18 @@ bool sample_light(vec3 p, inout uint rng, out LightSample ls) {
         Surface e = fetch_surface(h, ls.direction, 0.0);
         ls.radiance_over_pdf = e.emission * cos_light * area / (d2 * select_pdf);
         return cos_light > 0.0 && area > 0.0;
+    }
+    if (kind == LIGHT_KIND_ENVIRONMENT) {
+        // environment.w = 0: BRDF-only (RenderSettings::environment_sampling), the pick is wasted.
+        if (frame.data.environment.w == 0.0) return false;
+        vec3 radiance;
+        float pdf;
+        vec4 u = vec4(rng_next2(rng), rng_next2(rng));
+        if (!env_sample(frame.data.environment, frame.data.environment_map, u, ls.direction, radiance, pdf)) return false;
+        ls.distance = 1e30;
+        ls.mis_pdf = select_pdf * pdf;
+        ls.radiance_over_pdf = radiance / ls.mis_pdf;
+        return true;
     }
     if (kind == LIGHT_KIND_DIRECTIONAL) {
         ls.direction = -l.direction.xyz;

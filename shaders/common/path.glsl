@@ -14,12 +14,16 @@ bool visible(vec3 p, vec3 n, LightSample ls) {
     return !bvh_trace(offset_ray(p, n), ls.direction, 0.0, ls.distance * (1.0 - 1e-4), true, h);
 }
 
-// The analytic sky (fovea_scene::Sky) seen by a ray leaving the scene along `dir`: horizon to
-// zenith with √(sin elevation) above the horizon, constant below. Black when the scene has none.
+// What a ray leaving the scene along `dir` sees: the environment map (a loaded one or the
+// analytic sky baked into one, fovea_scene::Scene::environment_map); black when there is none.
 vec3 sky_radiance(vec3 dir) {
-    if (frame.data.sky_ground.w == 0.0) return vec3(0.0);
-    if (dir.y < 0.0) return frame.data.sky_ground.rgb;
-    return mix(frame.data.sky_horizon.rgb, frame.data.sky_zenith.rgb, sqrt(dir.y));
+    return env_radiance(frame.data.environment, frame.data.environment_map, dir);
+}
+
+// The power heuristic (Veach, β = 2): the weight of the strategy with density `a` against `b`.
+float mis_power(float a, float b) {
+    float a2 = a * a;
+    return a2 / max(a2 + b * b, 1e-30);
 }
 
 vec3 direct_light(Surface s, vec3 v, inout uint rng) {
@@ -27,7 +31,9 @@ vec3 direct_light(Surface s, vec3 v, inout uint rng) {
     if (!sample_light(s.position, rng, ls)) return vec3(0.0);
     vec3 f = brdf_eval_cos(s, v, ls.direction);
     if (all(equal(f, vec3(0.0))) || !visible(s.position, s.geometric_normal, ls)) return vec3(0.0);
-    return f * ls.radiance_over_pdf;
+    // The environment is also found by the BRDF-sampled ray: each strategy keeps its MIS share.
+    float w = ls.mis_pdf > 0.0 ? mis_power(ls.mis_pdf, brdf_pdf(s, v, ls.direction)) : 1.0;
+    return f * ls.radiance_over_pdf * w;
 }
 
 // Radiance arriving along `dir` from the primary hit `s` (its emission included), paths of up to
@@ -43,10 +49,10 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
     Hit hit;
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
         color += throughput * direct_light(s, v, rng);
-        // The sky is not sampled by next-event estimation, so at the last vertex a BRDF ray still
-        // looks for it (the sky's "direct light"); a surface it hits adds nothing there.
+        // The environment's second strategy: at the last vertex a BRDF ray still looks for it
+        // (its MIS share of the direct light); a surface it hits adds nothing there.
         bool last = depth_i + 1u >= max_depth;
-        if (last && frame.data.sky_ground.w == 0.0) break;
+        if (last && frame.data.environment_map.z == 0u) break;
         vec3 l, weight;
         bool delta;
         vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
@@ -56,9 +62,11 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         continuation_rays++;
         // At the last vertex only escaping matters: the cheaper any-hit test answers that.
         if (!bvh_trace(o, l, 0.0, 1e30, last, hit)) {
-            // Next-event estimation never samples the sky, so the BRDF-sampled ray that escapes
-            // is its only estimator (no MIS weight needed).
-            color += throughput * sky_radiance(l);
+            // Next-event estimation samples the environment too (when light selection can pick
+            // it): weigh this estimate against it. A mirror bounce is this ray's alone.
+            float light_pdf = delta ? 0.0 : frame.data.environment.w * env_pdf(frame.data.environment, frame.data.environment_map, l);
+            float w = light_pdf > 0.0 ? mis_power(brdf_pdf(s, v, l), light_pdf) : 1.0;
+            color += throughput * sky_radiance(l) * w;
             break;
         }
         if (last) break;

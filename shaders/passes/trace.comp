@@ -127,7 +127,7 @@ void main() {
     uint path_rng = rng;
 #endif
     if (!found) {
-        // Nothing hit: the sky (black without one); the previous position is the same direction.
+        // Nothing hit: the environment (black without one); the previous position is the same direction.
         if (max_depth >= 1u) color = sky_radiance(dir);
         vec3 prev_view = mat3(prev_view_from_world) * dir;
         project_view(prev_view, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);

@@ -6,6 +6,7 @@ pub mod camera_path;
 pub mod commands;
 pub mod cpu_time;
 pub mod density;
+pub mod env_map;
 pub mod flip;
 pub mod gaze;
 pub mod interrupt;

@@ -9,11 +9,16 @@
 //!   light in the light table, so next-event estimation samples it) and the default sky;
 //! - a scene with its own lights gets no sun, and the sky only when `--sky-intensity` (or the
 //!   profile's `environment.sky_intensity`) is given explicitly and > 0;
-//! - `--sun-intensity 0` / `--sky-intensity 0` turn either part off.
+//! - `--sun-intensity 0` / `--sky-intensity 0` turn either part off;
+//! - `--env FILE` (an HDR environment map, `crate::env_map`) replaces the sky in every scene; the
+//!   sun then stays off unless `--sun` (or the profile's `sun`) is given, because a captured map
+//!   usually holds its own sun — adding one would light the scene twice. Scenes with lights of
+//!   their own never get the sun.
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
 use glam::Vec3;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The default sun: azimuth (degrees from +Z, the side glTF models face, toward +X) and elevation
@@ -34,13 +39,23 @@ pub const DEFAULT_FOV_DEG: f32 = 60.0;
 /// pinhole projection is infinite.
 pub const FOV_RANGE_DEG: (f32, f32) = (1.0, 170.0);
 
+/// Largest `--env-rotation` magnitude (degrees): any angle is meaningful, this only keeps the
+/// radians conversion exact enough.
+pub const MAX_ENV_ROTATION_DEG: f32 = 1e6;
+
 /// The default environment's settings, each `None` when neither the flag nor the profile gave it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct EnvironmentOptions {
     /// Azimuth, elevation in degrees.
     pub sun: Option<[f32; 2]>,
     pub sun_intensity: Option<f32>,
     pub sky_intensity: Option<f32>,
+    /// An equirectangular HDR environment map (`--env`; a profile's path is relative to its file).
+    pub env: Option<PathBuf>,
+    /// Degrees about +Y, counter-clockwise seen from above (default 0).
+    pub env_rotation: Option<f32>,
+    /// Radiance scale of the map (default 1).
+    pub env_intensity: Option<f32>,
 }
 
 /// The names used in error messages: the flags, or a profile's keys.
@@ -48,27 +63,54 @@ pub struct EnvironmentNames {
     pub sun: String,
     pub sun_intensity: String,
     pub sky_intensity: String,
+    pub env_rotation: String,
+    pub env_intensity: String,
 }
 
 impl EnvironmentNames {
     pub fn flags() -> EnvironmentNames {
-        EnvironmentNames { sun: "--sun".into(), sun_intensity: "--sun-intensity".into(), sky_intensity: "--sky-intensity".into() }
+        EnvironmentNames {
+            sun: "--sun".into(),
+            sun_intensity: "--sun-intensity".into(),
+            sky_intensity: "--sky-intensity".into(),
+            env_rotation: "--env-rotation".into(),
+            env_intensity: "--env-intensity".into(),
+        }
     }
     /// `FILE: [environment].key`.
     pub fn profile(file: &str) -> EnvironmentNames {
         let key = |k: &str| format!("{file}: [environment].{k}");
-        EnvironmentNames { sun: key("sun"), sun_intensity: key("sun_intensity"), sky_intensity: key("sky_intensity") }
+        EnvironmentNames {
+            sun: key("sun"),
+            sun_intensity: key("sun_intensity"),
+            sky_intensity: key("sky_intensity"),
+            env_rotation: key("env_rotation"),
+            env_intensity: key("env_intensity"),
+        }
     }
 }
 
 impl EnvironmentOptions {
     /// `self` with every value `over` gives replaced.
-    pub fn overridden(self, over: &EnvironmentOptions) -> EnvironmentOptions {
+    pub fn overridden(&self, over: &EnvironmentOptions) -> EnvironmentOptions {
         EnvironmentOptions {
             sun: over.sun.or(self.sun),
             sun_intensity: over.sun_intensity.or(self.sun_intensity),
             sky_intensity: over.sky_intensity.or(self.sky_intensity),
+            env: over.env.clone().or_else(|| self.env.clone()),
+            env_rotation: over.env_rotation.or(self.env_rotation),
+            env_intensity: over.env_intensity.or(self.env_intensity),
         }
+    }
+
+    /// The settings as replay baselines record them: the sun and sky fields as before environment
+    /// maps existed (so older baselines do not read as changed), the map's fields only when given.
+    pub fn describe(&self) -> String {
+        let base = format!("EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}", self.sun, self.sun_intensity, self.sky_intensity);
+        if self.env.is_none() && self.env_rotation.is_none() && self.env_intensity.is_none() {
+            return base + " }";
+        }
+        format!("{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?} }}", self.env, self.env_rotation, self.env_intensity)
     }
 
     pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
@@ -80,8 +122,12 @@ impl EnvironmentOptions {
                 );
             }
         }
+        if let Some(r) = self.env_rotation.filter(|r| !(r.is_finite() && r.abs() <= MAX_ENV_ROTATION_DEG)) {
+            bail!("{} {r:?}: must be a finite angle in degrees within ±{MAX_ENV_ROTATION_DEG:e}", names.env_rotation);
+        }
         check_intensity(self.sun_intensity, &names.sun_intensity)?;
-        check_intensity(self.sky_intensity, &names.sky_intensity)
+        check_intensity(self.sky_intensity, &names.sky_intensity)?;
+        check_intensity(self.env_intensity, &names.env_intensity)
     }
 }
 
@@ -146,6 +192,27 @@ pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<
         "no lights in the scene: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; sky intensity {sky}; \
          change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity or a profile's [environment]; 0 turns either off)"
     ))
+}
+
+/// With `--env`: the map replaces the sky; the sun only with an explicit `sun` in a scene without
+/// lights (see the module's rule). Returns the notice for scenes without lights of their own.
+pub fn apply_environment_map(scene: &mut Scene, env: &EnvironmentOptions) -> Result<Option<String>> {
+    let Some(path) = &env.env else { return Ok(apply_environment(scene, env)) };
+    let map = crate::env_map::load(path, env.env_rotation.unwrap_or(0.0), env.env_intensity.unwrap_or(1.0))?;
+    scene.environment = Some(map);
+    scene.sky = Sky::default();
+    if scene.has_lights() {
+        return Ok(None);
+    }
+    let sun = match env.sun {
+        Some([azimuth, elevation]) if env.sun_intensity.unwrap_or(DEFAULT_SUN_INTENSITY) > 0.0 => {
+            let e = env.sun_intensity.unwrap_or(DEFAULT_SUN_INTENSITY);
+            scene.punctual_lights.push(PunctualLight::Directional { direction: -sun_direction(azimuth, elevation), illuminance: Vec3::splat(e) });
+            format!("sun at azimuth {azimuth}°, elevation {elevation}°, intensity {e}")
+        }
+        _ => "no sun: --sun AZIMUTH,ELEVATION adds one".into(),
+    };
+    Ok(Some(format!("no lights in the scene: lit by the environment map {} ({sun})", path.display())))
 }
 
 /// How the camera is chosen (`--camera`, `--camera-pos`, `--camera-look`, `--fov`), as given.
@@ -266,7 +333,7 @@ pub fn load(scene_name: &str, camera: &CameraOptions, env: &EnvironmentOptions, 
     camera.check()?;
     env.validate(&EnvironmentNames::flags())?;
     let mut scene = crate::scenes::load(scene_name)?;
-    if let Some(notice) = apply_environment(&mut scene, env) {
+    if let Some(notice) = apply_environment_map(&mut scene, env)? {
         notice_once(&ENVIRONMENT_NOTICE, &notice);
     }
     let (chosen, framing) = camera.camera_for(&scene, aspect)?;

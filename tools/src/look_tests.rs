@@ -114,7 +114,7 @@ fn default_sun_and_sky_only_for_scenes_without_lights() {
 #[test]
 fn environment_values_are_checked_with_the_name() {
     let flags = EnvironmentNames::flags();
-    assert!(EnvironmentOptions { sun: Some([10.0, 90.0]), sun_intensity: Some(0.0), sky_intensity: Some(1e6) }.validate(&flags).is_ok());
+    assert!(EnvironmentOptions { sun: Some([10.0, 90.0]), sun_intensity: Some(0.0), sky_intensity: Some(1e6), ..Default::default() }.validate(&flags).is_ok());
     for (env, needle) in [
         (EnvironmentOptions { sun: Some([0.0, 0.0]), ..Default::default() }, "--sun"),
         (EnvironmentOptions { sun: Some([f32::NAN, 10.0]), ..Default::default() }, "--sun"),
@@ -127,4 +127,42 @@ fn environment_values_are_checked_with_the_name() {
     assert!(format!("{:#}", key.unwrap_err()).contains("p.toml: [environment].sky_intensity"));
     assert_eq!(parse_sun("-20, 35").unwrap(), [-20.0, 35.0]);
     assert!(parse_sun("20").is_err() && parse_sun("a,b").is_err());
+}
+
+#[test]
+fn an_environment_map_replaces_the_sky_and_the_sun_needs_asking_for() {
+    let dir = std::env::temp_dir().join(format!("fovea-look-env-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("grey.hdr");
+    let pixels = vec![image::Rgb([0.5f32, 0.5, 0.5]); 8 * 4];
+    image::codecs::hdr::HdrEncoder::new(std::fs::File::create(&file).unwrap()).encode(&pixels, 8, 4).unwrap();
+    let env = EnvironmentOptions { env: Some(file.clone()), env_rotation: Some(45.0), env_intensity: Some(2.0), ..Default::default() };
+
+    let mut dark = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    let notice = apply_environment_map(&mut dark, &env).unwrap().unwrap();
+    assert!(notice.contains("grey.hdr") && notice.contains("no sun"), "{notice}");
+    assert!(dark.punctual_lights.is_empty() && dark.sky.is_black());
+    let map = dark.environment.as_ref().unwrap();
+    assert_eq!((map.width, map.height, map.intensity, map.rotation), (8, 4, 2.0, 45f32.to_radians()));
+
+    let mut sunny = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    let with_sun = EnvironmentOptions { sun: Some([10.0, 50.0]), ..env.clone() };
+    assert!(apply_environment_map(&mut sunny, &with_sun).unwrap().unwrap().contains("sun at azimuth 10°"));
+    assert_eq!(sunny.punctual_lights.len(), 1);
+
+    // A scene with its own lights gets the map, never the sun, and no notice.
+    let mut lit = scene_with(Vec3::ZERO, Vec3::ONE, Material { emissive: Vec3::ONE, ..Default::default() });
+    assert!(apply_environment_map(&mut lit, &with_sun).unwrap().is_none());
+    assert!(lit.punctual_lights.is_empty() && lit.environment.is_some());
+
+    let missing = EnvironmentOptions { env: Some(dir.join("none.exr")), ..Default::default() };
+    let err = format!("{:#}", apply_environment_map(&mut scene_with(Vec3::ZERO, Vec3::ONE, Material::default()), &missing).unwrap_err());
+    assert!(err.contains("none.exr"), "{err}");
+}
+
+#[test]
+fn replay_description_of_the_default_environment_is_unchanged() {
+    // What the committed baselines (tests/replay/baseline/*/baseline.json) recorded.
+    assert_eq!(EnvironmentOptions::default().describe(), "EnvironmentOptions { sun: None, sun_intensity: None, sky_intensity: None }");
+    assert!(EnvironmentOptions { env_intensity: Some(2.0), ..Default::default() }.describe().contains("env_intensity: Some(2.0)"));
 }

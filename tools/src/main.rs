@@ -57,6 +57,17 @@ struct SceneFlags {
     /// footprint on the screen; the default) or off (every lookup reads level 0).
     #[arg(long)]
     texture_lod: Option<String>,
+    /// An equirectangular HDR environment map (.exr or .hdr, at most 8192×4096) seen by escaping
+    /// rays and sampled by next-event estimation; replaces the sky, and the default sun stays off
+    /// unless --sun is given.
+    #[arg(long)]
+    env: Option<std::path::PathBuf>,
+    /// The environment map's rotation about +Y in degrees (counter-clockwise seen from above; default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    env_rotation: Option<f32>,
+    /// The environment map's radiance scale (default 1).
+    #[arg(long)]
+    env_intensity: Option<f32>,
 }
 
 impl SceneFlags {
@@ -74,6 +85,9 @@ impl SceneFlags {
             sun: self.sun.as_deref().map(fovea_tools::look::parse_sun).transpose()?,
             sun_intensity: self.sun_intensity,
             sky_intensity: self.sky_intensity,
+            env: self.env.clone(),
+            env_rotation: self.env_rotation,
+            env_intensity: self.env_intensity,
         })
     }
 }
@@ -469,7 +483,7 @@ fn render_args<'a>(
         seed: opts.seed,
         max_depth: opts.max_depth,
         exposure: opts.exposure,
-        profile: *profile,
+        profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
         taa: &opts.taa,

@@ -18,7 +18,7 @@ use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
 use std::path::Path;
 
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
@@ -62,6 +62,10 @@ struct EnvironmentSection {
     sun: Option<[f32; 2]>,
     sun_intensity: Option<f32>,
     sky_intensity: Option<f32>,
+    /// An HDR environment map, relative to the profile's folder.
+    env: Option<std::path::PathBuf>,
+    env_rotation: Option<f32>,
+    env_intensity: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -279,8 +283,19 @@ impl RenderProfile {
             s.validate().with_context(|| at("taa"))?;
         }
         if let Some(f) = file.environment {
-            profile.environment = EnvironmentOptions { sun: f.sun, sun_intensity: f.sun_intensity, sky_intensity: f.sky_intensity };
+            let env = f.env.map(|e| path.parent().map_or(e.clone(), |dir| dir.join(&e)));
+            profile.environment = EnvironmentOptions {
+                sun: f.sun,
+                sun_intensity: f.sun_intensity,
+                sky_intensity: f.sky_intensity,
+                env,
+                env_rotation: f.env_rotation,
+                env_intensity: f.env_intensity,
+            };
             profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
+            if let Some(env) = &profile.environment.env {
+                crate::env_map::check_path(env).with_context(|| format!("{}: [environment].env", path.display()))?;
+            }
         }
         if let Some(lod) = file.textures.and_then(|t| t.lod) {
             profile.texture_lod = TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
@@ -381,7 +396,7 @@ mod tests {
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
-        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None });
+        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None, ..Default::default() });
     }
 
     #[test]
@@ -498,7 +513,7 @@ gradient_sigma_normal = 64
     #[test]
     fn environment_section_and_flags() {
         let p = load_str("env.toml", "[environment]\nsun = [45.0, 30.0]\nsky_intensity = 0.0\n").unwrap();
-        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0) });
+        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0), ..Default::default() });
         let err = format!("{:#}", load_str("env_bad.toml", "[environment]\nsun_intensity = -1.0\n").unwrap_err());
         assert!(err.contains("[environment].sun_intensity"), "{err}");
         assert!(load_str("env_key.toml", "[environment]\nmoon = 1.0\n").is_err());
@@ -508,5 +523,34 @@ gradient_sigma_normal = 64
         assert_eq!(merged.environment.sun, Some([45.0, 30.0]));
         let bad = ProfileOverrides { environment: EnvironmentOptions { sun: Some([0.0, 95.0]), ..Default::default() }, ..Default::default() };
         assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--sun"));
+    }
+
+    #[test]
+    fn environment_map_keys_and_flags() {
+        // The map's path is relative to the profile's folder.
+        let dir = std::env::temp_dir().join(format!("fovea-profile-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("sky.hdr"), b"").unwrap();
+        let p = load_str("envmap.toml", "[environment]\nenv = \"sky.hdr\"\nenv_rotation = -90.0\nenv_intensity = 2.5\n").unwrap();
+        assert_eq!(p.environment.env, Some(dir.join("sky.hdr")));
+        assert_eq!((p.environment.env_rotation, p.environment.env_intensity), (Some(-90.0), Some(2.5)));
+        // Flags override the profile, key by key.
+        let o = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(1.0), ..Default::default() }, ..Default::default() };
+        let merged = p.clone().override_with(&o).unwrap();
+        assert_eq!((merged.environment.env_intensity, merged.environment.env_rotation), (Some(1.0), Some(-90.0)));
+        let o = ProfileOverrides { environment: EnvironmentOptions { env: Some("other.exr".into()), ..Default::default() }, ..Default::default() };
+        assert_eq!(p.override_with(&o).unwrap().environment.env, Some("other.exr".into()));
+        // Errors name the file and the key.
+        for (text, key) in [
+            ("env = \"nowhere.exr\"", "[environment].env"),
+            ("env = \"envmap.toml\"", "[environment].env"),
+            ("env_intensity = -1.0", "[environment].env_intensity"),
+            ("env_rotation = inf", "[environment].env_rotation"),
+        ] {
+            let err = format!("{:#}", load_str("envmap_bad.toml", &format!("[environment]\n{text}\n")).unwrap_err());
+            assert!(err.contains("envmap_bad.toml") && err.contains(key), "{text}: {err}");
+        }
+        let bad = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(f32::NAN), ..Default::default() }, ..Default::default() };
+        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--env-intensity"));
     }
 }

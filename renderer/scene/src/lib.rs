@@ -6,6 +6,7 @@
 //! path tracer traverses one BVH over all triangles and has no instancing level.
 
 pub mod bvh;
+pub mod environment;
 mod geometry;
 mod images;
 pub mod intersect;
@@ -23,6 +24,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 
 pub use bvh::{Bvh, BvhNode};
+pub use environment::{EnvironmentDistribution, EnvironmentMap};
 pub use intersect::{Hit, Ray};
 pub use lights::{build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable};
 pub use limits::LoadLimits;
@@ -47,6 +49,8 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Radiance of rays that leave the scene (glTF has none: black unless the caller sets one).
     pub sky: Sky,
+    /// An HDR environment map seen by escaping rays; replaces `sky` when set (see [`Scene::environment_map`]).
+    pub environment: Option<EnvironmentMap>,
     /// Indexed by [`Triangle::mesh`]: the glTF mesh name, or `mesh<i>` when unnamed.
     pub mesh_names: Vec<String>,
     pub source: PathBuf,
@@ -361,6 +365,16 @@ impl Scene {
     /// The first perspective camera, if any.
     pub fn default_camera(&self) -> Option<&Camera> {
         self.cameras.first()
+    }
+
+    /// What escaping rays see, as one equirectangular map: the loaded environment map, else the
+    /// analytic sky baked into one (so both take the same importance-sampled path), else none.
+    pub fn environment_map(&self) -> Option<std::borrow::Cow<'_, EnvironmentMap>> {
+        match &self.environment {
+            Some(m) => Some(std::borrow::Cow::Borrowed(m)),
+            None if !self.sky.is_black() => Some(std::borrow::Cow::Owned(EnvironmentMap::from_sky(&self.sky))),
+            None => None,
+        }
     }
 
     /// Whether anything in the scene emits light: a punctual light or an emissive material that

@@ -7,7 +7,9 @@
 //! - point: 4π · luminance(I);
 //! - spot: 2π(1 − cos outer_cone) · luminance(I), the flux inside the outer cone (an upper bound
 //!   of the emitted flux, tighter than 4π·lum(I));
-//! - directional: luminance(E) · π r², r = radius of the scene's bounding sphere.
+//! - directional: luminance(E) · π r², r = radius of the scene's bounding sphere;
+//! - environment (a loaded map or the baked sky, `Scene::environment_map`): ∫ luminance(L) dω · π r²
+//!   (every direction is a parallel beam of illuminance L dω through the scene's cross-section).
 //!
 //! Emitters with zero power are left out (they could never be chosen).
 //!
@@ -25,6 +27,8 @@ pub enum LightKind {
     Point,
     Spot,
     Directional,
+    /// The environment map (index 0); sampled by `environment::EnvironmentDistribution`.
+    Environment,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +118,10 @@ pub fn build_light_table_scaled(scene: &Scene, emission_scale: &[f32]) -> LightT
             }
         };
         entries.push(LightEntry { kind, index: i as u32, power });
+    }
+    if let Some(map) = scene.environment_map() {
+        let power = map.luminance_integral() * PI * scene_radius * scene_radius;
+        entries.push(LightEntry { kind: LightKind::Environment, index: 0, power });
     }
     entries.retain(|e| e.power > 0.0 && e.power.is_finite());
     let powers: Vec<f64> = entries.iter().map(|e| e.power as f64).collect();

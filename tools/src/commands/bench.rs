@@ -217,6 +217,8 @@ fn secondary_rays(scene: &Scene, tris: &[[Vec3; 3]], primary: &[RayGpu], hits: &
                     let (u, v) = (hash01(i, 2).sqrt(), hash01(i, 3));
                     Some(la * (1.0 - u) + lb * (u * (1.0 - v)) + lc * (u * v))
                 }
+                // The bench's shadow rays go to points; an environment has none.
+                LightKind::Environment => None,
                 _ => match &scene.punctual_lights[entry.index as usize] {
                     PunctualLight::Point { position, .. } | PunctualLight::Spot { position, .. } => Some(*position),
                     PunctualLight::Directional { direction, .. } => Some(p - *direction * 1e4),

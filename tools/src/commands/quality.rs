@@ -145,7 +145,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         seed: args.seed,
                         max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
                         exposure: 1.0,
-                        profile: args.profile,
+                        profile: args.profile.clone(),
                         debug_views: false,
                         denoiser,
                         taa,

@@ -13,6 +13,7 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+#[derive(Clone)]
 pub struct RenderArgs<'a> {
     pub scene: &'a str,
     pub method: &'a str,

@@ -131,7 +131,7 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         (None, n) => n.unwrap_or(DEFAULT_FRAMES),
     };
     let run_dir = args.out.join(format!("run_{name}"));
-    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, camera_path: Default::default(), ..args.render };
+    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, camera_path: Default::default(), ..args.render.clone() };
     super::render::run(&render)?;
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run_dir.join("report.json"))?)?;
     let (width, height) = (report["width"].as_u64().unwrap_or(0) as u32, report["height"].as_u64().unwrap_or(0) as u32);
@@ -215,7 +215,7 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
         reference_spp: args.reference_spp,
         rings: args.rings,
         camera: format!("{:?}", r.camera),
-        environment: format!("{:?}", r.profile.environment),
+        environment: r.profile.environment.describe(),
     }
 }
 
