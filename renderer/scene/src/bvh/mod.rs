@@ -13,6 +13,7 @@
 //! Build: single-threaded, 16 bins on each axis, leaves of ≤ 4 triangles, ≤ 8 when no split is
 //! cheaper by SAH (more than 8 forces an object-median split).
 
+mod sbvh;
 mod traverse;
 #[cfg(test)]
 mod tests;
@@ -129,9 +130,54 @@ struct Builder {
     order: Vec<u32>,
 }
 
+/// Which builder makes the tree (`fovea bench --bvh` compares them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BvhBuilder {
+    /// Object splits only (binned SAH): every triangle in exactly one leaf.
+    Binned,
+    /// Object and spatial splits (SBVH), at most `budget` × triangles extra leaf references.
+    Spatial { budget: f32 },
+}
+
+impl BvhBuilder {
+    /// What [`Bvh::build`] uses.
+    pub const DEFAULT: BvhBuilder = BvhBuilder::Binned;
+
+    /// `binned`, `sbvh` (budget 0.5) or `sbvh:BUDGET`.
+    pub fn parse(s: &str) -> Result<BvhBuilder, String> {
+        match s {
+            "binned" => Ok(BvhBuilder::Binned),
+            "sbvh" => Ok(BvhBuilder::Spatial { budget: 0.5 }),
+            _ => match s.strip_prefix("sbvh:").map(str::parse::<f32>) {
+                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => Ok(BvhBuilder::Spatial { budget }),
+                _ => Err(format!("unknown BVH builder '{s}': binned, sbvh or sbvh:BUDGET (0 to 4 extra references per triangle)")),
+            },
+        }
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            BvhBuilder::Binned => "binned".into(),
+            BvhBuilder::Spatial { budget } => format!("sbvh:{budget}"),
+        }
+    }
+}
+
 impl Bvh {
-    /// Builds the tree over `tris` (world-space corners, by triangle index).
+    /// Builds the tree over `tris` (world-space corners, by triangle index) with
+    /// [`BvhBuilder::DEFAULT`].
     pub fn build(tris: &[[Vec3; 3]]) -> Bvh {
+        Bvh::build_with(tris, BvhBuilder::DEFAULT)
+    }
+
+    pub fn build_with(tris: &[[Vec3; 3]], builder: BvhBuilder) -> Bvh {
+        match builder {
+            BvhBuilder::Binned => Bvh::build_binned(tris),
+            BvhBuilder::Spatial { budget } => sbvh::build(tris, budget),
+        }
+    }
+
+    fn build_binned(tris: &[[Vec3; 3]]) -> Bvh {
         let prim_bounds: Vec<Box3> =
             tris.iter().map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into()))).collect();
         let centroids = prim_bounds.iter().map(|b| (b.min + b.max) * 0.5).collect();
@@ -187,6 +233,91 @@ impl Bvh {
     /// Bytes the GPU holds for this BVH: 64 per node plus 48 per triangle (the texel buffers).
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * 64 + self.tri_order.len() * 48
+    }
+}
+
+/// What a tree looks like, for `fovea bench` and for tuning the builder (see [`Bvh::stats`]).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BvhStats {
+    pub nodes: usize,
+    pub leaves: usize,
+    /// Leaf references (`tri_order.len()`): the triangle count plus any duplicates.
+    pub references: usize,
+    pub depth: u32,
+    /// Mean depth of the leaves weighted by their triangles (a ray's path length to a leaf).
+    pub mean_leaf_depth: f64,
+    pub mean_leaf_size: f64,
+    /// Leaves by triangle count: `leaf_sizes[k]` leaves hold `k` triangles (index 0 unused).
+    pub leaf_sizes: Vec<usize>,
+    /// SAH cost of the tree relative to the root box (node visit 1, triangle test 1): the expected
+    /// number of node and triangle tests of a ray that crosses the root box, uniformly.
+    pub sah_cost: f64,
+    /// The node part of `sah_cost` (box tests: both children of a visited node count once).
+    pub sah_node_cost: f64,
+    /// Mean over interior nodes of area(left ∩ right) / area(parent): 0 for disjoint children.
+    pub mean_child_overlap: f64,
+    /// Triangles whose box is more than 10× as long as the triangle is wide (long thin ones) ...
+    pub thin_triangles: usize,
+    /// ... and triangles whose box has more than 1/100 of the scene box's surface area.
+    pub large_triangles: usize,
+}
+
+impl Bvh {
+    /// Counts and costs of the tree over `tris` (the array it was built from).
+    pub fn stats(&self, tris: &[[Vec3; 3]]) -> BvhStats {
+        let mut s = BvhStats { nodes: self.nodes.len(), references: self.tri_order.len(), ..Default::default() };
+        let area = |b: &Aabb| b.surface_area() as f64;
+        let root = (0..2).filter(|&c| !self.nodes[0].is_empty_child(c)).fold(Aabb::EMPTY, |b, c| b.union(&self.nodes[0].child_bounds(c)));
+        let root_area = area(&root).max(f64::MIN_POSITIVE);
+        let (mut overlap_sum, mut interior, mut leaf_depth_sum) = (0.0, 0usize, 0.0);
+        // (node, depth, area of the node's own box)
+        let mut stack = vec![(0u32, 1u32, root_area)];
+        while let Some((node, depth, node_area)) = stack.pop() {
+            s.depth = s.depth.max(depth);
+            s.sah_node_cost += node_area / root_area;
+            let n = &self.nodes[node as usize];
+            interior += 1;
+            if !n.is_empty_child(0) && !n.is_empty_child(1) {
+                let (a, b) = (n.child_bounds(0), n.child_bounds(1));
+                let inter = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
+                overlap_sum += area(&inter) / node_area.max(f64::MIN_POSITIVE);
+            }
+            for c in (0..2).filter(|&c| !n.is_empty_child(c)) {
+                let b = n.child_bounds(c);
+                let count = n.child_count[c] as usize;
+                if count == 0 {
+                    stack.push((n.child_ref[c], depth + 1, area(&b)));
+                } else {
+                    s.leaves += 1;
+                    if s.leaf_sizes.len() <= count {
+                        s.leaf_sizes.resize(count + 1, 0);
+                    }
+                    s.leaf_sizes[count] += 1;
+                    s.sah_cost += area(&b) / root_area * count as f64;
+                    leaf_depth_sum += (depth + 1) as f64 * count as f64;
+                }
+            }
+        }
+        s.sah_cost += s.sah_node_cost;
+        s.mean_child_overlap = overlap_sum / interior.max(1) as f64;
+        s.mean_leaf_size = s.references as f64 / s.leaves.max(1) as f64;
+        s.mean_leaf_depth = leaf_depth_sum / s.references.max(1) as f64;
+        let scene_area = area(&Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>()));
+        for t in tris {
+            let b = Aabb::of_points(t);
+            let d = b.max - b.min;
+            let (longest, [e0, e1, e2]) = (d.max_element(), [t[1] - t[0], t[2] - t[1], t[0] - t[2]]);
+            // Width: twice the area over the longest edge (the triangle's height on it).
+            let edge = e0.length().max(e1.length()).max(e2.length());
+            let width = e0.cross(-e2).length() / edge.max(f32::MIN_POSITIVE);
+            if longest > 10.0 * width {
+                s.thin_triangles += 1;
+            }
+            if area(&b) > scene_area / 100.0 {
+                s.large_triangles += 1;
+            }
+        }
+        s
     }
 }
 

@@ -2,12 +2,15 @@ use super::*;
 use crate::intersect::{brute_force, Hit, Ray};
 use crate::test_util::*;
 
-/// Every triangle in exactly one leaf; every child box contains its subtree; leaves ≤ 8.
-fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]]) {
-    let mut seen = vec![0u32; tris.len()];
-    let mut sorted = bvh.tri_order.clone();
-    sorted.sort_unstable();
-    assert_eq!(sorted, (0..tris.len() as u32).collect::<Vec<_>>(), "tri_order is a permutation");
+const SPATIAL: BvhBuilder = BvhBuilder::Spatial { budget: 0.5 };
+
+/// Every node reachable exactly once; every child box contains its subtree; leaves ≤ 8. Binned:
+/// every triangle in exactly one leaf, inside the leaf box. Spatial: every triangle in at least
+/// one leaf, the references within the budget, and every point of every triangle (a grid of
+/// barycentric points, in f64) inside one of that triangle's leaf boxes (the clipped parts cover
+/// the triangle).
+fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
+    let mut leaf_boxes: Vec<Vec<Aabb>> = vec![Vec::new(); tris.len()];
     let mut stack = vec![0u32];
     let mut visited_nodes = 0;
     while let Some(node) = stack.pop() {
@@ -23,8 +26,7 @@ fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]]) {
                 assert!(n.child_count[slot] as usize <= LEAF_MAX, "leaf of {} triangles", n.child_count[slot]);
                 let start = n.child_ref[slot] as usize;
                 for &t in &bvh.tri_order[start..start + n.child_count[slot] as usize] {
-                    seen[t as usize] += 1;
-                    tris[t as usize].iter().for_each(|&p| assert!(bounds.contains_point(p), "leaf box contains its triangles"));
+                    leaf_boxes[t as usize].push(bounds);
                 }
             } else {
                 let child = &bvh.nodes[n.child_ref[slot] as usize];
@@ -37,7 +39,38 @@ fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]]) {
         }
     }
     assert_eq!(visited_nodes, bvh.nodes.len(), "every node is reachable exactly once");
-    assert!(seen.iter().all(|&c| c == 1), "every triangle in exactly one leaf");
+    assert_eq!(leaf_boxes.iter().map(Vec::len).sum::<usize>(), bvh.tri_order.len(), "every reference is in a leaf");
+    match builder {
+        BvhBuilder::Binned => {
+            assert!(leaf_boxes.iter().all(|b| b.len() == 1), "every triangle in exactly one leaf");
+            for (t, boxes) in tris.iter().zip(&leaf_boxes) {
+                t.iter().for_each(|&p| assert!(boxes[0].contains_point(p), "leaf box contains its triangles"));
+            }
+        }
+        BvhBuilder::Spatial { budget } => {
+            assert!(leaf_boxes.iter().all(|b| !b.is_empty()), "every triangle in some leaf");
+            let limit = tris.len() + (tris.len() as f64 * budget as f64) as usize;
+            assert!(bvh.tri_order.len() <= limit, "{} references over the budget's {limit}", bvh.tri_order.len());
+            const STEPS: usize = 8;
+            for (i, (t, boxes)) in tris.iter().zip(&leaf_boxes).enumerate() {
+                let v = t.map(|p| [p.x as f64, p.y as f64, p.z as f64]);
+                for a in 0..=STEPS {
+                    for b in 0..=STEPS - a {
+                        let (wa, wb) = (a as f64 / STEPS as f64, b as f64 / STEPS as f64);
+                        let wc = 1.0 - wa - wb;
+                        let p: [f64; 3] = std::array::from_fn(|k| v[0][k] * wa + v[1][k] * wb + v[2][k] * wc);
+                        let inside = |bx: &Aabb| {
+                            (0..3).all(|k| {
+                                let tol = 1e-9 * (p[k].abs() + 1.0);
+                                p[k] >= bx.min[k] as f64 - tol && p[k] <= bx.max[k] as f64 + tol
+                            })
+                        };
+                        assert!(boxes.iter().any(inside), "triangle {i}: point {p:?} in none of its {} leaf boxes", boxes.len());
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The BVH must report the brute-force hit. When a ray passes exactly through an edge or vertex,
@@ -56,8 +89,15 @@ fn assert_same_hit(name: &str, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, got: O
 
 /// Random rays that mostly point at the mesh, plus a few random ones.
 fn compare_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u64) {
-    let bvh = Bvh::build(tris);
-    check_invariants(&bvh, tris);
+    for builder in [BvhBuilder::Binned, SPATIAL] {
+        compare_builder_with_brute_force(name, tris, rays, seed, builder);
+    }
+}
+
+fn compare_builder_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u64, builder: BvhBuilder) {
+    let bvh = Bvh::build_with(tris, builder);
+    check_invariants(&bvh, tris, builder);
+    let name = &format!("{name} ({})", builder.name());
     let bounds = Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>());
     let (center, radius) = (bounds.center(), bounds.bounding_sphere_radius().max(1e-3));
     let mut rng = TestRng::new(seed);
@@ -127,8 +167,14 @@ fn bvh_handles_coincident_and_tiny_inputs() {
 fn rays_through_shared_edges_and_vertices_never_leak() {
     let n = 8;
     let tris = quad_grid(n);
-    let bvh = Bvh::build(&tris);
-    check_invariants(&bvh, &tris);
+    for builder in [BvhBuilder::Binned, SPATIAL] {
+        edges_and_vertices_never_leak(&tris, builder, n);
+    }
+}
+
+fn edges_and_vertices_never_leak(tris: &[[Vec3; 3]], builder: BvhBuilder, n: u32) {
+    let bvh = Bvh::build_with(tris, builder);
+    check_invariants(&bvh, tris, builder);
     let mut rng = TestRng::new(8);
     let mut tested = 0;
     for gy in 1..n * 2 {
@@ -147,9 +193,9 @@ fn rays_through_shared_edges_and_vertices_never_leak() {
                 };
                 let origin = target - dir * rng.range(0.5, 4.0);
                 let ray = Ray { origin, dir };
-                let expected = brute_force(&tris, &ray, f32::INFINITY, false);
+                let expected = brute_force(tris, &ray, f32::INFINITY, false);
                 assert!(expected.is_some(), "leak at {target:?} dir {dir:?}");
-                assert_same_hit("grid", &tris, &ray, f32::INFINITY, bvh.intersect(&tris, &ray, f32::INFINITY, false), expected);
+                assert_same_hit("grid", tris, &ray, f32::INFINITY, bvh.intersect(tris, &ray, f32::INFINITY, false), expected);
                 tested += 1;
             }
         }
@@ -205,5 +251,66 @@ fn bvh_build_rate() {
         bvh.depth(),
         bvh.memory_bytes() as f64 / (1 << 20) as f64
     );
-    check_invariants(&bvh, &tris);
+    check_invariants(&bvh, &tris, BvhBuilder::DEFAULT);
 }
+
+#[test]
+fn stats_count_the_tree() {
+    let one = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+    let s = Bvh::build(&one).stats(&one);
+    assert_eq!((s.nodes, s.leaves, s.references, s.depth, s.leaf_sizes.clone()), (1, 1, 1, 1, vec![0, 1]));
+    // The root node's visit (1) plus one triangle test in a leaf as large as the root.
+    assert!((s.sah_cost - 2.0).abs() < 1e-9 && (s.sah_node_cost - 1.0).abs() < 1e-9, "{s:?}");
+    assert_eq!((s.thin_triangles, s.large_triangles, s.mean_child_overlap), (0, 1, 0.0));
+    let thin = [[Vec3::ZERO, Vec3::new(100.0, 0.0, 0.0), Vec3::Y], [Vec3::ZERO, Vec3::X, Vec3::Y]];
+    assert_eq!(Bvh::build(&thin).stats(&thin).thin_triangles, 1);
+
+    let tris = sphere(Vec3::ZERO, 1.0, 24, 48);
+    let bvh = Bvh::build(&tris);
+    let s = bvh.stats(&tris);
+    assert_eq!((s.nodes, s.references, s.depth), (bvh.nodes.len(), tris.len(), bvh.depth()));
+    assert_eq!(s.leaf_sizes.iter().sum::<usize>(), s.leaves);
+    assert_eq!(s.leaf_sizes.iter().enumerate().map(|(k, n)| k * n).sum::<usize>(), s.references);
+    assert!(s.leaves > tris.len() / LEAF_MAX && s.mean_leaf_depth > 2.0 && s.mean_leaf_depth <= s.depth as f64 + 1.0);
+    assert!(s.sah_node_cost > 1.0 && s.sah_cost > s.sah_node_cost && s.mean_child_overlap > 0.0 && s.mean_child_overlap < 1.0);
+}
+
+/// Long thin triangles lying diagonally in one plane (a floor of slivers) are where spatial
+/// splits pay: the SBVH must duplicate some references (within the budget) and find a tree of
+/// lower SAH cost than object splits.
+#[test]
+fn spatial_splits_lower_the_sah_cost_of_slivers() {
+    let mut rng = TestRng::new(10);
+    let tris: Vec<[Vec3; 3]> = (0..3000)
+        .map(|_| {
+            let c = Vec3::new(rng.range(-5.0, 5.0), rng.range(-5.0, 5.0), 0.0);
+            let d = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0).normalize_or(Vec3::X) * 2.0;
+            [c - d, c + d, c + Vec3::new(-d.y, d.x, 0.0) * 0.01]
+        })
+        .collect();
+    let binned = Bvh::build_with(&tris, BvhBuilder::Binned).stats(&tris);
+    let spatial_bvh = Bvh::build_with(&tris, SPATIAL);
+    check_invariants(&spatial_bvh, &tris, SPATIAL);
+    let spatial = spatial_bvh.stats(&tris);
+    assert!(spatial.references > tris.len(), "no reference was split");
+    assert!(spatial.sah_cost < binned.sah_cost * 0.9, "SAH cost {} (SBVH) vs {} (binned)", spatial.sah_cost, binned.sah_cost);
+    // No budget, no duplicates: the spatial builder then makes a plain object-split tree.
+    let none = BvhBuilder::Spatial { budget: 0.0 };
+    let bvh = Bvh::build_with(&tris, none);
+    check_invariants(&bvh, &tris, none);
+    let mut order = bvh.tri_order.clone();
+    order.sort_unstable();
+    assert_eq!(order, (0..tris.len() as u32).collect::<Vec<_>>());
+}
+
+#[test]
+fn builder_names_parse() {
+    for b in [BvhBuilder::Binned, BvhBuilder::Spatial { budget: 0.25 }] {
+        assert_eq!(BvhBuilder::parse(&b.name()), Ok(b));
+    }
+    assert_eq!(BvhBuilder::parse("sbvh"), Ok(BvhBuilder::Spatial { budget: 0.5 }));
+    for bad in ["", "sah", "sbvh:", "sbvh:-1", "sbvh:9", "sbvh:nan"] {
+        assert!(BvhBuilder::parse(bad).is_err(), "{bad}");
+    }
+}
+
