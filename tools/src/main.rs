@@ -317,7 +317,7 @@ enum Command {
         scenes: Vec<String>,
         /// BVH builders to compare: binned, sbvh, sbvh:BUDGET (extra references per triangle).
         /// The first also serves the frame and VP figures; several are measured A B … B A.
-        #[arg(long, value_delimiter = ',', default_value = "binned")]
+        #[arg(long, value_delimiter = ',', default_value = "sbvh")]
         bvh: Vec<String>,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]

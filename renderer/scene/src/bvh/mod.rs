@@ -1,20 +1,32 @@
-//! A binary BVH built with binned SAH, laid out for GPU traversal.
+//! A binary BVH built with binned SAH (optionally with spatial splits), collapsed to 4-wide nodes
+//! for GPU traversal ([`wide`]).
 //!
-//! We build our own rather than use a crate (e.g. `obvhs`): the GPU node format below is fixed by
-//! the GLSL traversal (measured fastest on lavapipe, see build-notes.md), the builder is ~200
-//! lines, and owning it means the layout, leaf sizes and tie rules are tested here, not adapted.
+//! We build our own rather than use a crate (e.g. `obvhs`): the GPU node format is fixed by the
+//! GLSL traversal (measured fastest on lavapipe, see build-notes.md), the builders are a few
+//! hundred lines, and owning them means the layout, leaf sizes and tie rules are tested here.
 //!
-//! Node format: each [`BvhNode`] holds the boxes of BOTH children, so the traversal tests two
-//! boxes per node fetch (64 bytes). `child_count == 0` marks an interior child (`child_ref` = node
-//! index); `child_count > 0` a leaf with triangles `tri_order[child_ref .. child_ref + count]`.
-//! Node 0 is the root. A scene that fits one leaf gets a root whose child 1 is empty (an inverted
-//! box that every slab test misses, count 0, ref 0).
+//! Binary node format: each [`BvhNode`] holds the boxes of BOTH children (64 bytes).
+//! `child_count == 0` marks an interior child (`child_ref` = node index); `child_count > 0` a leaf
+//! with triangles `tri_order[child_ref .. child_ref + count]`. Node 0 is the root. A scene that
+//! fits one leaf gets a root whose child 1 is empty (an inverted box that every slab test misses,
+//! count 0, ref 0). The GPU gets [`wide::Bvh4`], collapsed from this tree with the same leaves;
+//! [`Bvh::intersect`] and [`wide::Bvh4::intersect`] are the CPU references.
 //!
-//! Build: single-threaded, 16 bins on each axis, leaves of ≤ 4 triangles, ≤ 8 when no split is
-//! cheaper by SAH (more than 8 forces an object-median split).
+//! Builders ([`BvhBuilder`]): single-threaded, 16 bins on each axis, leaves of ≤ 4 triangles, ≤ 8
+//! when no split is cheaper by SAH (more than 8 forces an object-median split).
+//! - `binned`: object splits only; every triangle in exactly one leaf (≈ 1–2.6 M triangles/s).
+//! - `sbvh` ([`sbvh`], Stich et al. 2009): object or spatial splits, at most `budget` × triangles
+//!   extra leaf references; a triangle may sit in several leaves, each leaf box bounding only its
+//!   clipped part. About 10× slower to build (Sponza: 3.0 s vs 0.23 s) for a tree of 18 % lower
+//!   SAH cost on Sponza and 16 % on the Breakfast Room, and 1.6–2.4× the primary-ray rate there
+//!   (`fovea bench --bvh binned,sbvh`, README Performance). The default since the seventh session.
+//!
+//! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
+//! long thin and large triangles); `fovea bench` prints it for each scene and builder.
 
 mod sbvh;
 mod traverse;
+pub mod wide;
 #[cfg(test)]
 mod tests;
 
@@ -66,10 +78,7 @@ pub struct Bvh {
 }
 
 const BINS: usize = 16;
-const LEAF_TARGET: usize = 4;
 const LEAF_MAX: usize = 8;
-/// Cost of one node visit relative to one triangle test, in the SAH.
-const TRAVERSAL_COST: f32 = 1.0;
 
 /// Builder-internal box on SIMD vectors (the build is bound by these unions).
 #[derive(Clone, Copy)]
@@ -125,41 +134,71 @@ struct Bin {
 }
 
 struct Builder {
+    options: BvhBuilder,
     prim_bounds: Vec<Box3>,
     centroids: Vec<Vec3A>,
     order: Vec<u32>,
 }
 
-/// Which builder makes the tree (`fovea bench --bvh` compares them).
+/// Which builder makes the tree, and its knobs (`fovea bench --bvh` compares them).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BvhBuilder {
-    /// Object splits only (binned SAH): every triangle in exactly one leaf.
-    Binned,
-    /// Object and spatial splits (SBVH), at most `budget` × triangles extra leaf references.
-    Spatial { budget: f32 },
+pub struct BvhBuilder {
+    /// `None`: object splits only (binned SAH), every triangle in exactly one leaf. `Some(b)`:
+    /// object and spatial splits (SBVH), at most `b` × triangles extra leaf references.
+    pub spatial_budget: Option<f32>,
+    /// Ranges of at most this many triangles always become leaves (larger ones up to 8 when no
+    /// split is cheaper by SAH).
+    pub leaf_target: usize,
+    /// Cost of one node visit relative to one triangle test, in the SAH.
+    pub node_cost: f32,
 }
 
 impl BvhBuilder {
-    /// What [`Bvh::build`] uses.
-    pub const DEFAULT: BvhBuilder = BvhBuilder::Binned;
+    pub const BINNED: BvhBuilder = BvhBuilder { spatial_budget: None, leaf_target: 4, node_cost: 1.0 };
+    pub const SBVH: BvhBuilder = BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED };
+    /// What [`Bvh::build`] (and so every scene upload) uses.
+    pub const DEFAULT: BvhBuilder = BvhBuilder::SBVH;
 
-    /// `binned`, `sbvh` (budget 0.5) or `sbvh:BUDGET`.
+    /// `binned` or `sbvh[:BUDGET]` (budget 0.5 when not given), optionally followed by
+    /// `/leafN` (leaf target, 1 to 8) and `/costC` (node cost, 0.1 to 10).
     pub fn parse(s: &str) -> Result<BvhBuilder, String> {
-        match s {
-            "binned" => Ok(BvhBuilder::Binned),
-            "sbvh" => Ok(BvhBuilder::Spatial { budget: 0.5 }),
-            _ => match s.strip_prefix("sbvh:").map(str::parse::<f32>) {
-                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => Ok(BvhBuilder::Spatial { budget }),
-                _ => Err(format!("unknown BVH builder '{s}': binned, sbvh or sbvh:BUDGET (0 to 4 extra references per triangle)")),
+        let err = || format!("unknown BVH builder '{s}': binned or sbvh[:BUDGET] (0 to 4), then optionally /leafN (1 to 8), /costC (0.1 to 10)");
+        let mut parts = s.split('/');
+        let mut b = match parts.next().unwrap_or("") {
+            "binned" => BvhBuilder::BINNED,
+            "sbvh" => BvhBuilder::SBVH,
+            kind => match kind.strip_prefix("sbvh:").map(str::parse::<f32>) {
+                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => BvhBuilder { spatial_budget: Some(budget), ..BvhBuilder::BINNED },
+                _ => return Err(err()),
             },
+        };
+        for part in parts {
+            if let Some(Ok(n)) = part.strip_prefix("leaf").map(str::parse::<usize>) {
+                b.leaf_target = n;
+            } else if let Some(Ok(c)) = part.strip_prefix("cost").map(str::parse::<f32>) {
+                b.node_cost = c;
+            } else {
+                return Err(err());
+            }
         }
+        if !(1..=LEAF_MAX).contains(&b.leaf_target) || !(0.1..=10.0).contains(&b.node_cost) {
+            return Err(err());
+        }
+        Ok(b)
     }
 
     pub fn name(&self) -> String {
-        match self {
-            BvhBuilder::Binned => "binned".into(),
-            BvhBuilder::Spatial { budget } => format!("sbvh:{budget}"),
+        let mut name = match self.spatial_budget {
+            None => "binned".to_string(),
+            Some(budget) => format!("sbvh:{budget}"),
+        };
+        if self.leaf_target != BvhBuilder::BINNED.leaf_target {
+            name += &format!("/leaf{}", self.leaf_target);
         }
+        if self.node_cost != BvhBuilder::BINNED.node_cost {
+            name += &format!("/cost{}", self.node_cost);
+        }
+        name
     }
 }
 
@@ -171,17 +210,17 @@ impl Bvh {
     }
 
     pub fn build_with(tris: &[[Vec3; 3]], builder: BvhBuilder) -> Bvh {
-        match builder {
-            BvhBuilder::Binned => Bvh::build_binned(tris),
-            BvhBuilder::Spatial { budget } => sbvh::build(tris, budget),
+        match builder.spatial_budget {
+            None => Bvh::build_binned(tris, builder),
+            Some(budget) => sbvh::build(tris, budget, builder),
         }
     }
 
-    fn build_binned(tris: &[[Vec3; 3]]) -> Bvh {
+    fn build_binned(tris: &[[Vec3; 3]], options: BvhBuilder) -> Bvh {
         let prim_bounds: Vec<Box3> =
             tris.iter().map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into()))).collect();
         let centroids = prim_bounds.iter().map(|b| (b.min + b.max) * 0.5).collect();
-        let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect() };
+        let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect(), options };
         let n = tris.len();
         let mut nodes = vec![BvhNode::EMPTY];
         let root = b.range_bounds(0, n);
@@ -332,7 +371,7 @@ impl Builder {
     /// Decides leaf or split for `order[start..end]`, partitioning the range for a split.
     fn plan(&mut self, start: usize, end: usize, range: RangeBounds) -> Plan {
         let count = end - start;
-        if count <= LEAF_TARGET {
+        if count <= self.options.leaf_target {
             return Plan::Leaf;
         }
         let lo = range.centroids.min;
@@ -369,7 +408,7 @@ impl Builder {
                 if n == 0 || n as usize == count {
                     continue;
                 }
-                let cost = TRAVERSAL_COST + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
+                let cost = self.options.node_cost + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, split));
                 }

@@ -2,7 +2,7 @@ use super::*;
 use crate::intersect::{brute_force, Hit, Ray};
 use crate::test_util::*;
 
-const SPATIAL: BvhBuilder = BvhBuilder::Spatial { budget: 0.5 };
+const SPATIAL: BvhBuilder = BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED };
 
 /// Every node reachable exactly once; every child box contains its subtree; leaves ≤ 8. Binned:
 /// every triangle in exactly one leaf, inside the leaf box. Spatial: every triangle in at least
@@ -40,14 +40,14 @@ fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     }
     assert_eq!(visited_nodes, bvh.nodes.len(), "every node is reachable exactly once");
     assert_eq!(leaf_boxes.iter().map(Vec::len).sum::<usize>(), bvh.tri_order.len(), "every reference is in a leaf");
-    match builder {
-        BvhBuilder::Binned => {
+    match builder.spatial_budget {
+        None => {
             assert!(leaf_boxes.iter().all(|b| b.len() == 1), "every triangle in exactly one leaf");
             for (t, boxes) in tris.iter().zip(&leaf_boxes) {
                 t.iter().for_each(|&p| assert!(boxes[0].contains_point(p), "leaf box contains its triangles"));
             }
         }
-        BvhBuilder::Spatial { budget } => {
+        Some(budget) => {
             assert!(leaf_boxes.iter().all(|b| !b.is_empty()), "every triangle in some leaf");
             let limit = tris.len() + (tris.len() as f64 * budget as f64) as usize;
             assert!(bvh.tri_order.len() <= limit, "{} references over the budget's {limit}", bvh.tri_order.len());
@@ -73,6 +73,46 @@ fn check_invariants(bvh: &Bvh, tris: &[[Vec3; 3]], builder: BvhBuilder) {
     }
 }
 
+/// The 4-wide tree holds exactly the binary tree's leaves; every node is reachable once, every
+/// child box contains its children's boxes, every node but a lone root has ≥ 2 children, and
+/// there are fewer wide nodes than binary ones.
+fn check_wide(bvh: &Bvh, wide: &wide::Bvh4) {
+    let leaves = |list: &mut Vec<(u32, u32, [u32; 6])>, min: Vec3, max: Vec3, r: u32, c: u32| {
+        list.push((r, c, [min.x, min.y, min.z, max.x, max.y, max.z].map(f32::to_bits)));
+    };
+    let mut binary = Vec::new();
+    for n in &bvh.nodes {
+        for s in (0..2).filter(|&s| n.child_count[s] > 0) {
+            leaves(&mut binary, n.child_min[s], n.child_max[s], n.child_ref[s], n.child_count[s]);
+        }
+    }
+    let (mut four, mut visited, mut stack) = (Vec::new(), 0, vec![0u32]);
+    while let Some(node) = stack.pop() {
+        visited += 1;
+        let n = &wide.nodes[node as usize];
+        let used = (0..wide::WIDTH).filter(|&s| !n.is_empty_child(s)).count();
+        assert!(used >= 2 || (node == 0 && bvh.nodes.len() == 1), "node {node} has {used} children");
+        for s in (0..wide::WIDTH).filter(|&s| !n.is_empty_child(s)) {
+            if n.child_count[s] > 0 {
+                leaves(&mut four, n.child_min[s], n.child_max[s], n.child_ref[s], n.child_count[s]);
+            } else {
+                let (outer, child) = (n.child_bounds(s), &wide.nodes[n.child_ref[s] as usize]);
+                for g in (0..wide::WIDTH).filter(|&g| !child.is_empty_child(g)) {
+                    let inner = child.child_bounds(g);
+                    assert!(outer.contains_point(inner.min) && outer.contains_point(inner.max), "wide child box contains its children");
+                }
+                stack.push(n.child_ref[s]);
+            }
+        }
+    }
+    assert_eq!(visited, wide.nodes.len(), "every wide node reachable exactly once");
+    binary.sort_unstable();
+    four.sort_unstable();
+    assert_eq!(binary, four, "the wide tree has the binary tree's leaves");
+    assert_eq!(wide.tri_order, bvh.tri_order);
+    assert!(wide.nodes.len() < bvh.nodes.len() || bvh.nodes.len() == 1, "{} wide nodes for {} binary", wide.nodes.len(), bvh.nodes.len());
+}
+
 /// The BVH must report the brute-force hit. When a ray passes exactly through an edge or vertex,
 /// both neighbours may report a hit at the same t and box culling can hide the lower-indexed one
 /// from the BVH; then the BVH's triangle must be a genuine tie (hit by the ray at the same t).
@@ -89,7 +129,7 @@ fn assert_same_hit(name: &str, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, got: O
 
 /// Random rays that mostly point at the mesh, plus a few random ones.
 fn compare_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u64) {
-    for builder in [BvhBuilder::Binned, SPATIAL] {
+    for builder in [BvhBuilder::BINNED, SPATIAL] {
         compare_builder_with_brute_force(name, tris, rays, seed, builder);
     }
 }
@@ -97,6 +137,8 @@ fn compare_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u
 fn compare_builder_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize, seed: u64, builder: BvhBuilder) {
     let bvh = Bvh::build_with(tris, builder);
     check_invariants(&bvh, tris, builder);
+    let wide = wide::Bvh4::from_binary(&bvh);
+    check_wide(&bvh, &wide);
     let name = &format!("{name} ({})", builder.name());
     let bounds = Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>());
     let (center, radius) = (bounds.center(), bounds.bounding_sphere_radius().max(1e-3));
@@ -111,10 +153,12 @@ fn compare_builder_with_brute_force(name: &str, tris: &[[Vec3; 3]], rays: usize,
         let expected = brute_force(tris, &ray, t_max, false);
         let got = bvh.intersect(tris, &ray, t_max, false);
         assert_same_hit(name, tris, &ray, t_max, got, expected);
-        let any = bvh.intersect(tris, &ray, t_max, true);
-        assert_eq!(any.is_some(), expected.is_some(), "{name}: any-hit ray {i}");
-        if let Some(h) = any {
-            assert!(h.t > 0.0 && h.t < t_max);
+        assert_same_hit(&format!("{name} 4-wide"), tris, &ray, t_max, wide.intersect(tris, &ray, t_max, false), expected);
+        for any in [bvh.intersect(tris, &ray, t_max, true), wide.intersect(tris, &ray, t_max, true)] {
+            assert_eq!(any.is_some(), expected.is_some(), "{name}: any-hit ray {i}");
+            if let Some(h) = any {
+                assert!(h.t > 0.0 && h.t < t_max);
+            }
         }
         hits += expected.is_some() as usize;
     }
@@ -167,7 +211,7 @@ fn bvh_handles_coincident_and_tiny_inputs() {
 fn rays_through_shared_edges_and_vertices_never_leak() {
     let n = 8;
     let tris = quad_grid(n);
-    for builder in [BvhBuilder::Binned, SPATIAL] {
+    for builder in [BvhBuilder::BINNED, SPATIAL] {
         edges_and_vertices_never_leak(&tris, builder, n);
     }
 }
@@ -175,6 +219,8 @@ fn rays_through_shared_edges_and_vertices_never_leak() {
 fn edges_and_vertices_never_leak(tris: &[[Vec3; 3]], builder: BvhBuilder, n: u32) {
     let bvh = Bvh::build_with(tris, builder);
     check_invariants(&bvh, tris, builder);
+    let wide = wide::Bvh4::from_binary(&bvh);
+    check_wide(&bvh, &wide);
     let mut rng = TestRng::new(8);
     let mut tested = 0;
     for gy in 1..n * 2 {
@@ -196,6 +242,7 @@ fn edges_and_vertices_never_leak(tris: &[[Vec3; 3]], builder: BvhBuilder, n: u32
                 let expected = brute_force(tris, &ray, f32::INFINITY, false);
                 assert!(expected.is_some(), "leak at {target:?} dir {dir:?}");
                 assert_same_hit("grid", tris, &ray, f32::INFINITY, bvh.intersect(tris, &ray, f32::INFINITY, false), expected);
+                assert_same_hit("grid 4-wide", tris, &ray, f32::INFINITY, wide.intersect(tris, &ray, f32::INFINITY, false), expected);
                 tested += 1;
             }
         }
@@ -226,6 +273,20 @@ fn texels_follow_the_gpu_layout() {
         }
     }
     assert_eq!(bvh.memory_bytes(), bvh.nodes.len() * 64 + tris.len() * 48);
+    let wide = wide::Bvh4::from_binary(&bvh);
+    let texels = wide.node_texels();
+    assert_eq!(texels.len(), wide.nodes.len() * 8);
+    for (i, n) in wide.nodes.iter().enumerate() {
+        let t = &texels[i * 8..i * 8 + 8];
+        for c in 0..wide::WIDTH {
+            assert_eq!([t[0][c], t[1][c], t[2][c]], n.child_min[c].to_array());
+            assert_eq!([t[3][c], t[4][c], t[5][c]], n.child_max[c].to_array());
+            assert_eq!([t[6][c].to_bits(), t[7][c].to_bits()], [n.child_ref[c], n.child_count[c]]);
+        }
+    }
+    assert_eq!(wide.memory_bytes(), wide.nodes.len() * 128 + tris.len() * 48);
+    assert!(wide.max_stack() >= wide.depth() - 1 && wide.max_stack() <= 3 * (wide.depth() - 1), "{} {}", wide.max_stack(), wide.depth());
+    assert!(wide.depth() < bvh.depth());
 }
 
 /// Build rate on ≥ 250k triangles. Timing is printed, not asserted (shared machine); run with
@@ -288,14 +349,14 @@ fn spatial_splits_lower_the_sah_cost_of_slivers() {
             [c - d, c + d, c + Vec3::new(-d.y, d.x, 0.0) * 0.01]
         })
         .collect();
-    let binned = Bvh::build_with(&tris, BvhBuilder::Binned).stats(&tris);
+    let binned = Bvh::build_with(&tris, BvhBuilder::BINNED).stats(&tris);
     let spatial_bvh = Bvh::build_with(&tris, SPATIAL);
     check_invariants(&spatial_bvh, &tris, SPATIAL);
     let spatial = spatial_bvh.stats(&tris);
     assert!(spatial.references > tris.len(), "no reference was split");
     assert!(spatial.sah_cost < binned.sah_cost * 0.9, "SAH cost {} (SBVH) vs {} (binned)", spatial.sah_cost, binned.sah_cost);
     // No budget, no duplicates: the spatial builder then makes a plain object-split tree.
-    let none = BvhBuilder::Spatial { budget: 0.0 };
+    let none = BvhBuilder { spatial_budget: Some(0.0), ..BvhBuilder::BINNED };
     let bvh = Bvh::build_with(&tris, none);
     check_invariants(&bvh, &tris, none);
     let mut order = bvh.tri_order.clone();
@@ -305,12 +366,13 @@ fn spatial_splits_lower_the_sah_cost_of_slivers() {
 
 #[test]
 fn builder_names_parse() {
-    for b in [BvhBuilder::Binned, BvhBuilder::Spatial { budget: 0.25 }] {
+    let leaf2 = BvhBuilder { spatial_budget: Some(0.25), leaf_target: 2, node_cost: 1.5 };
+    for b in [BvhBuilder::BINNED, BvhBuilder { spatial_budget: Some(0.25), ..BvhBuilder::BINNED }, leaf2] {
         assert_eq!(BvhBuilder::parse(&b.name()), Ok(b));
     }
-    assert_eq!(BvhBuilder::parse("sbvh"), Ok(BvhBuilder::Spatial { budget: 0.5 }));
-    for bad in ["", "sah", "sbvh:", "sbvh:-1", "sbvh:9", "sbvh:nan"] {
+    assert_eq!(leaf2.name(), "sbvh:0.25/leaf2/cost1.5");
+    assert_eq!(BvhBuilder::parse("sbvh"), Ok(SPATIAL));
+    for bad in ["", "sah", "sbvh:", "sbvh:-1", "sbvh:9", "sbvh:nan", "binned/leaf0", "binned/leaf9", "binned/cost0", "binned/x"] {
         assert!(BvhBuilder::parse(bad).is_err(), "{bad}");
     }
 }
-
