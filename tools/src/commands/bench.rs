@@ -1,4 +1,4 @@
-//! `fovea bench`: BVH build rate and memory on the large scene; primary, shadow and indirect rays
+//! `fovea bench`: BVH build rate, memory and tree statistics per builder (`--bvh`); primary, shadow and indirect rays
 //! per second on the current device; per-pass GPU milliseconds of whole frames. All figures
 //! come from one run on one device (GPU timestamps for the GPU parts). The Visual-Polar vs
 //! Cartesian comparison lives in `bench_vp.rs`, the real-time loop (frames in flight, stereo vs
@@ -10,6 +10,7 @@ use fovea_renderer::layouts::{HitGpu, RayGpu};
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::bvh::wide::Bvh4;
 use fovea_renderer::scene::bvh::{Bvh, BvhBuilder, BvhStats};
 use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
 use fovea_renderer::scene::{PunctualLight, Scene};
@@ -45,8 +46,12 @@ struct BvhReport {
     triangles: usize,
     build_seconds: f64,
     triangles_per_second: f64,
+    /// GPU bytes of the 4-wide tree the shaders traverse (128 B per node, 48 per leaf reference).
     memory_bytes: usize,
+    /// Depth of the binary tree (`stats`) and of the 4-wide one collapsed from it.
     depth: u32,
+    wide_depth: u32,
+    wide_nodes: usize,
     stats: BvhStats,
 }
 
@@ -96,25 +101,30 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let bvh = Bvh::build_with(&positions, builder);
             let seconds = started.elapsed().as_secs_f64();
             let stats = bvh.stats(&positions);
+            let wide = Bvh4::from_binary(&bvh);
             let bvh_report = BvhReport {
                 scene: name.clone(),
                 builder: builder.name(),
                 triangles: positions.len(),
                 build_seconds: seconds,
                 triangles_per_second: positions.len() as f64 / seconds,
-                memory_bytes: bvh.memory_bytes(),
+                memory_bytes: wide.memory_bytes(),
                 depth: bvh.depth(),
+                wide_depth: wide.depth(),
+                wide_nodes: wide.nodes.len(),
                 stats,
             };
             let s = &bvh_report.stats;
             println!(
-                "{name} [{}]: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB, depth {}, {} nodes, {} references, \
+                "{name} [{}]: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB on the GPU (4-wide: {} nodes, depth {}), binary depth {}, {} nodes, {} references, \
                  mean leaf {:.2} at depth {:.1}, SAH {:.1} (nodes {:.1}), child overlap {:.3}, {} thin / {} large triangles",
                 bvh_report.builder,
                 bvh_report.triangles,
                 seconds,
                 bvh_report.triangles_per_second * 1e-6,
                 bvh_report.memory_bytes as f64 / (1 << 20) as f64,
+                bvh_report.wide_nodes,
+                bvh_report.wide_depth,
                 bvh_report.depth,
                 s.nodes,
                 s.references,

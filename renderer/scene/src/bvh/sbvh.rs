@@ -133,7 +133,7 @@ fn area(b: Box3) -> f32 {
 /// The box of the part of triangle `t` with `lo ≤ p[axis] ≤ hi`: its corners inside the slab and
 /// its edges' crossings of the two planes, computed in f64 and rounded outwards to f32 (empty when
 /// the triangle misses the slab).
-fn clip_triangle(t: &[Vec3; 3], axis: usize, lo: f32, hi: f32) -> Box3 {
+pub(super) fn clip_triangle(t: &[Vec3; 3], axis: usize, lo: f32, hi: f32) -> Box3 {
     let v = t.map(|p| [p.x as f64, p.y as f64, p.z as f64]);
     let (lo64, hi64) = (lo as f64, hi as f64);
     let mut min = [f64::INFINITY; 3];
@@ -163,17 +163,28 @@ fn clip_triangle(t: &[Vec3; 3], axis: usize, lo: f32, hi: f32) -> Box3 {
     }
     let down = |x: f64| {
         let f = x as f32;
-        if f as f64 > x { f.next_down() } else { f }
+        if f as f64 > x { step(f, -1.0) } else { f }
     };
     let up = |x: f64| {
         let f = x as f32;
-        if (f as f64) < x { f.next_up() } else { f }
+        if (f as f64) < x { step(f, 1.0) } else { f }
     };
     let mut b = Box3 { min: Vec3A::new(down(min[0]), down(min[1]), down(min[2])), max: Vec3A::new(up(max[0]), up(max[1]), up(max[2])) };
     // On the split axis the planes themselves bound the part (they are f32 already).
     b.min[axis] = b.min[axis].max(lo);
     b.max[axis] = b.max[axis].min(hi);
     b
+}
+
+/// The next f32 after finite `f` toward the sign of `dir` (`f32::next_up`/`next_down`, which
+/// need Rust 1.86; the workspace's MSRV is 1.85).
+pub(super) fn step(f: f32, dir: f32) -> f32 {
+    if f == 0.0 {
+        return f32::from_bits(1).copysign(dir);
+    }
+    let bits = f.to_bits();
+    // Away from zero is one more in the bit pattern, toward zero one less, for either sign.
+    f32::from_bits(if (f > 0.0) == (dir > 0.0) { bits + 1 } else { bits - 1 })
 }
 
 impl Builder<'_> {

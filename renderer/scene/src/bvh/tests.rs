@@ -253,7 +253,7 @@ fn edges_and_vertices_never_leak(tris: &[[Vec3; 3]], builder: BvhBuilder, n: u32
 #[test]
 fn texels_follow_the_gpu_layout() {
     let tris = sphere(Vec3::ZERO, 1.0, 8, 16);
-    let bvh = Bvh::build(&tris);
+    let bvh = Bvh::build_with(&tris, BvhBuilder::BINNED);
     let nodes = bvh.node_texels();
     assert_eq!(nodes.len(), bvh.nodes.len() * 4);
     for (i, n) in bvh.nodes.iter().enumerate() {
@@ -278,9 +278,9 @@ fn texels_follow_the_gpu_layout() {
     assert_eq!(texels.len(), wide.nodes.len() * 8);
     for (i, n) in wide.nodes.iter().enumerate() {
         let t = &texels[i * 8..i * 8 + 8];
-        for c in 0..wide::WIDTH {
-            assert_eq!([t[0][c], t[1][c], t[2][c]], n.child_min[c].to_array());
-            assert_eq!([t[3][c], t[4][c], t[5][c]], n.child_max[c].to_array());
+        for (c, (lo, hi)) in n.child_min.iter().zip(&n.child_max).enumerate() {
+            assert_eq!([t[0][c], t[1][c], t[2][c]], lo.to_array());
+            assert_eq!([t[3][c], t[4][c], t[5][c]], hi.to_array());
             assert_eq!([t[6][c].to_bits(), t[7][c].to_bits()], [n.child_ref[c], n.child_count[c]]);
         }
     }
@@ -327,7 +327,7 @@ fn stats_count_the_tree() {
     assert_eq!(Bvh::build(&thin).stats(&thin).thin_triangles, 1);
 
     let tris = sphere(Vec3::ZERO, 1.0, 24, 48);
-    let bvh = Bvh::build(&tris);
+    let bvh = Bvh::build_with(&tris, BvhBuilder::BINNED);
     let s = bvh.stats(&tris);
     assert_eq!((s.nodes, s.references, s.depth), (bvh.nodes.len(), tris.len(), bvh.depth()));
     assert_eq!(s.leaf_sizes.iter().sum::<usize>(), s.leaves);
@@ -362,6 +362,24 @@ fn spatial_splits_lower_the_sah_cost_of_slivers() {
     let mut order = bvh.tri_order.clone();
     order.sort_unstable();
     assert_eq!(order, (0..tris.len() as u32).collect::<Vec<_>>());
+}
+
+#[test]
+fn clipping_rounds_outwards() {
+    for f in [1.0f32, -1.0, 0.0, 3.5e-3, -7.25e8] {
+        assert!(sbvh::step(f, 1.0) > f && sbvh::step(f, -1.0) < f, "{f}");
+        assert_eq!(sbvh::step(sbvh::step(f, 1.0), -1.0), f, "{f}");
+    }
+    // A triangle cut by the plane x = 0.3 at irrational-ish points: the f32 box must contain the
+    // f64 crossing points.
+    let t = [Vec3::new(0.0, 0.1, 0.7), Vec3::new(1.0, 0.35, -0.2), Vec3::new(0.6, 0.9, 0.33)];
+    let left = sbvh::clip_triangle(&t, 0, f32::NEG_INFINITY, 0.3);
+    let (a, b) = ([0.0f64, 0.1, 0.7], [1.0f64, 0.35, -0.2]);
+    let s = (0.3f32 as f64 - a[0]) / (b[0] - a[0]);
+    let p = [a[1] + (b[1] - a[1]) * s, a[2] + (b[2] - a[2]) * s];
+    assert!(left.max.x == 0.3 && left.min.x == 0.0);
+    assert!((left.min.y as f64) <= p[0] && (left.max.y as f64) >= p[0] && (left.min.z as f64) <= p[1] && (left.max.z as f64) >= p[1]);
+    assert!(sbvh::clip_triangle(&t, 0, 2.0, 3.0).min.x > sbvh::clip_triangle(&t, 0, 2.0, 3.0).max.x, "a missed slab is empty");
 }
 
 #[test]
