@@ -17,9 +17,10 @@
 //! - `binned`: object splits only; every triangle in exactly one leaf (≈ 1–2.6 M triangles/s).
 //! - `sbvh` ([`sbvh`], Stich et al. 2009): object or spatial splits, at most `budget` × triangles
 //!   extra leaf references; a triangle may sit in several leaves, each leaf box bounding only its
-//!   clipped part. About 10× slower to build (Sponza: 3.0 s vs 0.23 s) for a tree of 18 % lower
-//!   SAH cost on Sponza and 16 % on the Breakfast Room, and 1.6–2.4× the primary-ray rate there
-//!   (`fovea bench --bvh binned,sbvh`, README Performance). The default since the seventh session.
+//!   clipped part. About 10× slower to build (Sponza: 1.35 s vs 0.14 s) for a tree of 18 % lower
+//!   SAH cost on Sponza and 19 % on the Breakfast Room, +21 / +18 % references, and 1.5× their
+//!   primary-ray rate (`fovea bench --bvh sbvh,binned`, README Performance). The default since
+//!   the seventh session.
 //!
 //! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
 //! long thin and large triangles); `fovea bench` prints it for each scene and builder.
