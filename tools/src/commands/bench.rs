@@ -70,6 +70,9 @@ struct RayReport {
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
     frame_rays: u64,
+    /// Primary rays whose hit (hit or miss, or distance beyond 1e-5 relative) differs from the
+    /// first builder's: every tree must find the same surfaces, so anything but 0 is a bug.
+    primary_hits_differ: usize,
 }
 
 #[derive(Serialize)]
@@ -156,7 +159,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let (shadow, indirect) = secondary_rays(&scene, &positions, &primary, &hits);
             for &(v, pass) in &order {
                 let (builder, bvh, gpu) = &variants[v];
-                let (_, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;
+                let (primary_hits, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;
+                let primary_hits_differ = hits
+                    .iter()
+                    .zip(&primary_hits)
+                    .filter(|(a, b)| {
+                        let (ta, tb) = (a.t_u_v.x, b.t_u_v.x);
+                        (ta < 0.0) != (tb < 0.0) || (ta - tb).abs() > 1e-5 * ta.abs().max(1.0)
+                    })
+                    .count();
                 let shadow_ms = if shadow.is_empty() { None } else { Some(timed_trace(&mut caster, gpu, &shadow, true)?.1) };
                 let (_, indirect_ms) = timed_trace(&mut caster, gpu, &indirect, false)?;
                 let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
@@ -184,15 +195,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     indirect_mrays_per_s: rate(indirect.len(), indirect_ms),
                     frame_passes_ms: sums,
                     frame_rays,
+                    primary_hits_differ,
                 };
                 println!(
-                    "{name} {w}×{h} [{} pass {pass}]: primary {:.2} Mrays/s, shadow {}, indirect {:.2} Mrays/s; frame passes (ms) {:?} (load {})",
+                    "{name} {w}×{h} [{} pass {pass}]: primary {:.2} Mrays/s, shadow {}, indirect {:.2} Mrays/s; frame passes (ms) {:?} (load {}); {} primary hits differ from the first builder's",
                     r.builder,
                     r.primary_mrays_per_s,
                     r.shadow_mrays_per_s.map_or("- (no light)".into(), |m| format!("{m:.2} Mrays/s")),
                     r.indirect_mrays_per_s,
                     r.frame_passes_ms,
-                    load_average()
+                    load_average(),
+                    r.primary_hits_differ
                 );
                 report.rays.push(r);
             }

@@ -17,8 +17,8 @@
 //! - `binned`: object splits only; every triangle in exactly one leaf (≈ 1–2.6 M triangles/s).
 //! - `sbvh` ([`sbvh`], Stich et al. 2009): object or spatial splits, at most `budget` × triangles
 //!   extra leaf references; a triangle may sit in several leaves, each leaf box bounding only its
-//!   clipped part. About 10× slower to build (Sponza: 1.35 s vs 0.14 s) for a tree of 18 % lower
-//!   SAH cost on Sponza and 19 % on the Breakfast Room, +21 / +18 % references, and 1.5× their
+//!   clipped part. About 6–8× slower to build (Sponza: 1.18 s vs 0.19 s) for a tree of 18 % lower
+//!   SAH cost on Sponza and 19 % on the Breakfast Room, +21 / +18 % references, and 1.5–1.6× their
 //!   primary-ray rate (`fovea bench --bvh sbvh,binned`, README Performance). The default since
 //!   the seventh session.
 //!
