@@ -253,8 +253,8 @@ impl Bvh {
         Bvh { nodes, tri_order: b.order }
     }
 
-    /// Longest root-to-leaf path counted in nodes (the root alone is depth 1). The GPU traversal
-    /// stack never holds more than `depth()` entries.
+    /// Longest root-to-leaf path counted in nodes (the root alone is depth 1). The binary
+    /// traversal's stack never holds more than `depth()` entries (the GPU's: [`wide::Bvh4::max_stack`]).
     pub fn depth(&self) -> u32 {
         let mut deepest = 0;
         let mut stack = vec![(0u32, 1u32)];
@@ -270,7 +270,8 @@ impl Bvh {
         deepest
     }
 
-    /// Bytes the GPU holds for this BVH: 64 per node plus 48 per triangle (the texel buffers).
+    /// Bytes of this binary tree at 64 per node plus 48 per leaf reference; the GPU holds the
+    /// 4-wide tree instead ([`wide::Bvh4::memory_bytes`]).
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * 64 + self.tri_order.len() * 48
     }
