@@ -4,6 +4,7 @@
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::raycast::RayCaster;
+use fovea_scene::bvh::{Bvh, BvhBuilder};
 use fovea_scene::intersect::{brute_force, Ray};
 use fovea_scene::{Material, Scene, Triangle, Vertex};
 use fovea_tests::{assert_clean, gpu};
@@ -106,10 +107,20 @@ fn bunny() -> Option<Vec<[Vec3; 3]>> {
     }).collect())
 }
 
+/// Both builders' trees: the binned one (one leaf per triangle) and the SBVH (triangles split
+/// across leaves, leaf boxes holding only their clipped parts).
 fn check_mesh(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool) {
+    for builder in [BvhBuilder::BINNED, BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED }] {
+        check_mesh_with(&format!("{name} ({})", builder.name()), tris, rays, any_hit, builder);
+    }
+}
+
+fn check_mesh_with(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool, builder: BvhBuilder) {
     let ctx = gpu();
     let scene = scene_from_triangles(tris);
-    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+    let positions = scene.triangle_positions();
+    let bvh = Bvh::build_with(&positions, builder);
+    let gpu_scene = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh).unwrap();
     let mut caster = RayCaster::new(&ctx).unwrap();
     let gpu_rays: Vec<RayGpu> =
         rays.iter().map(|r| RayGpu { origin_tmin: r.origin.extend(0.0), direction_tmax: r.dir.extend(1e30) }).collect();

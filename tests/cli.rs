@@ -305,6 +305,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     let out = temp_dir("bench-loop");
     let args = |loop_frames| BenchArgs {
         scenes: &[],
+        builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
         sizes: &[],
         vp_sizes: &[],
         frames: 1,

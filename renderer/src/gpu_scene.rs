@@ -8,6 +8,7 @@ use crate::layouts::{
     LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT,
     LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
+use crate::scene::bvh::wide::Bvh4;
 use crate::scene::bvh::Bvh;
 use crate::scene::lights::{build_light_table_scaled, LightKind};
 use crate::scene::{Aabb, PunctualLight, Scene, TextureSlot};
@@ -17,8 +18,9 @@ use ash::vk;
 use glam::{UVec4, Vec4};
 use std::sync::Arc;
 
-/// Must match BVH_STACK_SIZE in shaders/common/bvh.glsl: deeper trees could lose hits.
-pub const MAX_BVH_DEPTH: u32 = 64;
+/// Must match BVH_STACK_SIZE in shaders/common/bvh.glsl: trees whose traversal could push more
+/// entries (`Bvh4::max_stack`) could lose hits.
+pub const MAX_BVH_STACK: u32 = 64;
 
 pub struct GpuScene {
     pub bvh_nodes: Buffer,
@@ -41,6 +43,7 @@ pub struct GpuScene {
     pub environment: GpuEnvironment,
     /// `FrameData.environment` and `.environment_map` for this upload and light table.
     pub environment_slots: (Vec4, UVec4),
+    /// Depth and GPU bytes of the 4-wide tree the shaders traverse (nodes + leaf triangles).
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
     /// Some material is alpha-masked or blended: traversal tests alpha (`FRAME_FLAG_ALPHA_MASK`).
@@ -59,10 +62,13 @@ impl GpuScene {
     }
 
     pub fn upload_with_bvh(ctx: &Arc<Context>, scene: &Scene, positions: &[[glam::Vec3; 3]], bvh: &Bvh) -> Result<GpuScene> {
-        let depth = bvh.depth();
-        if depth > MAX_BVH_DEPTH {
+        // The GPU traverses the 4-wide tree collapsed from the binary one (same leaves).
+        let wide = Bvh4::from_binary(bvh);
+        let depth = wide.depth();
+        let stack = wide.max_stack();
+        if stack > MAX_BVH_STACK {
             return Err(Error::Invalid(format!(
-                "{}: BVH depth {depth} exceeds the traversal stack ({MAX_BVH_DEPTH})",
+                "{}: BVH traversal could need {stack} stack entries, more than the shaders' {MAX_BVH_STACK}",
                 scene.source.display()
             )));
         }
@@ -91,7 +97,7 @@ impl GpuScene {
         let environment = GpuEnvironment::upload(ctx, scene)?;
 
         Ok(GpuScene {
-            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &bvh.node_texels())?,
+            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &wide.node_texels())?,
             bvh_triangles: Buffer::texels(ctx, "bvh_triangles", &bvh.triangle_texels(positions))?,
             vertices: Buffer::with_data(ctx, "vertices", &vertices, storage)?,
             triangles: Buffer::with_data(ctx, "triangles", &triangles, storage)?,
@@ -110,7 +116,7 @@ impl GpuScene {
             environment,
             alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
             bvh_depth: depth,
-            bvh_bytes: bvh.memory_bytes(),
+            bvh_bytes: wide.memory_bytes(),
             emission_scale,
         })
     }

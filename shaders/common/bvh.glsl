@@ -1,10 +1,11 @@
-// BVH2 traversal over texel buffers (5–6× faster than std430 reads on lavapipe). Node = 4 RGBA32F
-// texels holding both children's boxes; triangles = 3 texels in leaf order (see fovea_scene::bvh).
+// 4-wide BVH traversal over texel buffers (5–6× faster than std430 reads on lavapipe). Node = 8
+// RGBA32F texels, one component per child (fovea_scene::bvh::wide); triangles = 3 texels in leaf
+// order (see fovea_scene::bvh).
 // Needs `bvh_nodes` and `bvh_triangles` (samplerBuffer) declared by the includer.
 #ifndef FOVEA_BVH_GLSL
 #define FOVEA_BVH_GLSL
 
-const int BVH_STACK_SIZE = 64; // the upload refuses deeper trees
+const int BVH_STACK_SIZE = 64; // the upload refuses trees whose traversal could push more (Bvh4::max_stack)
 
 // Overflow of the traversal stack (below its 8 register entries) lives in shared memory, one slice
 // per invocation: lavapipe turns a dynamically indexed array (private or shared) into per-lane
@@ -77,19 +78,19 @@ bool intersect_triangle(RayShear sh, vec3 v0, vec3 v1, vec3 v2, float tmin, floa
 // holds a hit; identical to fovea_scene::bvh::slab_test.
 const float SLAB_SLACK = 1.0 + 2.0 * (3.0 * 5.9604645e-8) / (1.0 - 3.0 * 5.9604645e-8);
 
-// Slab test of one box; returns the entry distance or 1e30 when missed.
-float box_entry(vec3 bmin, vec3 bmax, vec3 org, vec3 inv_dir, float tmin, float limit) {
-    vec3 t0 = (bmin - org) * inv_dir;
-    vec3 t1 = (bmax - org) * inv_dir;
-    vec3 lo = min(t0, t1), hi = max(t0, t1);
-    float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
-    float leave = min(min(hi.x, hi.y), hi.z) * SLAB_SLACK;
-    // An empty child is an inverted box: the slab test alone would accept it.
-    return (enter <= leave && enter <= limit && bmin.x <= bmax.x) ? enter : 1e30;
+// Sorts (key, ref) pairs a and b so that a has the smaller key (a compare-exchange).
+void cswap(inout float ka, inout uint ra, inout float kb, inout uint rb) {
+    bool sw = kb < ka;
+    float k = ka; uint r = ra;
+    ka = sw ? kb : ka; ra = sw ? rb : ra;
+    kb = sw ? k : kb; rb = sw ? r : rb;
 }
 
 // Closest hit (any_hit = false: smallest (t, triangle index), the CPU reference's tie rule) or
-// the first hit found (shadow rays, any_hit = true).
+// the first hit found (shadow rays, any_hit = true). Same algorithm as
+// fovea_scene::bvh::wide::Bvh4::intersect: 4-wide nodes (8 texels, one component per child),
+// the hit leaves' triangles tested on the spot in one loop, interior children visited nearest
+// first.
 bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit hit) {
     hit.t = tmax;
     hit.triangle = 0xffffffffu;
@@ -109,25 +110,28 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
     uint node = 0u;
     bool done = false;
     while (!done) {
-        int base = int(node) * 4;
-        vec4 n0 = texelFetch(bvh_nodes, base + 0);
-        vec4 n1 = texelFetch(bvh_nodes, base + 1);
-        vec4 n2 = texelFetch(bvh_nodes, base + 2);
-        vec4 n3 = texelFetch(bvh_nodes, base + 3);
-        uint child0 = floatBitsToUint(n0.w), child1 = floatBitsToUint(n1.w);
-        uint count0 = floatBitsToUint(n2.w), count1 = floatBitsToUint(n3.w);
-        float e0 = box_entry(n0.xyz, n1.xyz, org, inv_dir, tmin, limit);
-        float e1 = box_entry(n2.xyz, n3.xyz, org, inv_dir, tmin, limit);
-        bool hit0 = e0 < 1e30, hit1 = e1 < 1e30;
-        // Leaves are tested on the spot, nearer one first (the CPU traversal's order), in one loop
-        // over both leaves' triangles.
-        bool swap = hit0 && hit1 && e1 < e0;
-        uint leaf_a = (hit0 && count0 != 0u) ? count0 : 0u;
-        uint leaf_b = (hit1 && count1 != 0u) ? count1 : 0u;
-        uint first_a = swap ? child1 : child0, first_b = swap ? child0 : child1;
-        uint n_a = swap ? leaf_b : leaf_a, n_leaf = leaf_a + leaf_b;
+        int base = int(node) * 8;
+        vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
+        vec4 hix = texelFetch(bvh_nodes, base + 3), hiy = texelFetch(bvh_nodes, base + 4), hiz = texelFetch(bvh_nodes, base + 5);
+        uvec4 refs = floatBitsToUint(texelFetch(bvh_nodes, base + 6));
+        uvec4 counts = floatBitsToUint(texelFetch(bvh_nodes, base + 7));
+        // Four slab tests at once, each as fovea_scene::bvh::slab_test with tmin for 0.
+        vec4 ax = (lox - org.x) * inv_dir.x, bx = (hix - org.x) * inv_dir.x;
+        vec4 ay = (loy - org.y) * inv_dir.y, by = (hiy - org.y) * inv_dir.y;
+        vec4 az = (loz - org.z) * inv_dir.z, bz = (hiz - org.z) * inv_dir.z;
+        vec4 enter = max(max(min(ax, bx), min(ay, by)), max(min(az, bz), vec4(tmin)));
+        vec4 leave = min(min(max(ax, bx), max(ay, by)), max(az, bz)) * SLAB_SLACK;
+        // An empty child is an inverted box: the slab test alone would accept it.
+        bvec4 hit4 = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(lessThanEqual(enter, vec4(limit))) & uvec4(lessThanEqual(lox, hix)));
+        uvec4 leaf = uvec4(hit4) * counts;
+        // Leaves: all hit leaves' triangles in one loop, in slot order.
+        uint c01 = leaf.x + leaf.y, c012 = c01 + leaf.z, n_leaf = c012 + leaf.w;
         for (uint i = 0u; i < n_leaf; ++i) {
-            int tb = int(i < n_a ? first_a + i : first_b + (i - n_a)) * 3;
+            uint tri = i < leaf.x ? refs.x + i
+                     : i < c01 ? refs.y + (i - leaf.x)
+                     : i < c012 ? refs.z + (i - c01)
+                     : refs.w + (i - c012);
+            int tb = int(tri) * 3;
             vec4 t0 = texelFetch(bvh_triangles, tb + 0);
             vec4 t1 = texelFetch(bvh_triangles, tb + 1);
             vec4 t2 = texelFetch(bvh_triangles, tb + 2);
@@ -146,20 +150,31 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
             }
         }
         if (done) break;
-        bool in0 = hit0 && count0 == 0u, in1 = hit1 && count1 == 0u;
-        if (in0 && in1) {
-            // Push: the deepest register entry spills to shared memory when all 8 are in use.
-            if (sp >= 8 && sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp - 8)] = s7;
-            s7 = s6; s6 = s5; s5 = s4; s4 = s3; s3 = s2; s2 = s1; s1 = s0; s0 = swap ? child0 : child1;
-            sp = min(sp + 1, BVH_STACK_SIZE + 8);
-            node = swap ? child1 : child0;
-        } else if (in0 || in1) {
-            node = in0 ? child0 : child1;
-        } else if (sp == 0) {
-            done = true;
+        // Interior children: sort by entry distance (misses and leaves get 1e30), visit the
+        // nearest, push the others farthest first.
+        bvec4 inner = bvec4(uvec4(hit4) & uvec4(equal(counts, uvec4(0u))));
+        vec4 key = mix(vec4(1e30), enter, inner);
+        float k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
+        uint r0 = refs.x, r1 = refs.y, r2 = refs.z, r3 = refs.w;
+        cswap(k0, r0, k1, r1); cswap(k2, r2, k3, r3); cswap(k0, r0, k2, r2); cswap(k1, r1, k3, r3); cswap(k1, r1, k2, r2);
+        int n_inner = int(inner.x) + int(inner.y) + int(inner.z) + int(inner.w);
+        if (n_inner == 0) {
+            if (sp == 0) {
+                done = true;
+            } else {
+                node = s0; s0 = s1; s1 = s2; s2 = s3; s3 = s4; s4 = s5; s5 = s6; s6 = s7;
+                if (--sp >= 8) s7 = bvh_stack[stack_base + uint(sp - 8)];
+            }
         } else {
-            node = s0; s0 = s1; s1 = s2; s2 = s3; s3 = s4; s4 = s5; s5 = s6; s6 = s7;
-            if (--sp >= 8) s7 = bvh_stack[stack_base + uint(sp - 8)];
+            node = r0;
+            // Push r3, r2, r1 as present (r1 ends on top: the second nearest is popped first).
+            for (int k = n_inner - 1; k >= 1; --k) {
+                uint r = k == 3 ? r3 : (k == 2 ? r2 : r1);
+                // The deepest register entry spills to shared memory when all 8 are in use.
+                if (sp >= 8 && sp < BVH_STACK_SIZE) bvh_stack[stack_base + uint(sp - 8)] = s7;
+                s7 = s6; s6 = s5; s5 = s4; s4 = s3; s3 = s2; s2 = s1; s1 = s0; s0 = r;
+                sp = min(sp + 1, BVH_STACK_SIZE + 8);
+            }
         }
     }
     return hit.triangle != 0xffffffffu;

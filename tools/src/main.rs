@@ -1,9 +1,10 @@
 //! `fovea`: the command line of the foveated path tracer. See README.md for the contract.
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use fovea_tools::commands;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_tools::render_profile::{ProfileOverrides, RenderProfile};
 use fovea_tools::replay::Tolerances;
 use std::path::PathBuf;
@@ -334,6 +335,10 @@ enum Command {
         /// Scenes of the BVH, ray and frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
         scenes: Vec<String>,
+        /// BVH builders to compare: binned, sbvh, sbvh:BUDGET (extra references per triangle).
+        /// The first also serves the frame and VP figures; several are measured A B … B A.
+        #[arg(long, value_delimiter = ',', default_value = "sbvh")]
+        bvh: Vec<String>,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]
         sizes: Vec<String>,
@@ -596,13 +601,18 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, sizes, vp_sizes, frames, loop_size, loop_frames, out, device } => {
+        Command::Bench { scenes, bvh, sizes, vp_sizes, frames, loop_size, loop_frames, out, device } => {
+            let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
+            if builders.is_empty() {
+                bail!("--bvh: name at least one builder");
+            }
             let parse = |v: &[String]| v.iter().filter(|s| !s.is_empty()).map(|s| parse_size(s)).collect::<Result<Vec<_>>>();
             let (sizes, vp_sizes) = (parse(&sizes).context("--sizes")?, parse(&vp_sizes).context("--vp-sizes")?);
             let loop_size = (!loop_size.is_empty()).then(|| parse_size(&loop_size)).transpose().context("--loop-size")?;
             let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
+                builders: &builders,
                 sizes: &sizes,
                 vp_sizes: &vp_sizes,
                 frames,

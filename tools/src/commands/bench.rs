@@ -1,4 +1,4 @@
-//! `fovea bench`: BVH build rate and memory on the large scene; primary, shadow and indirect rays
+//! `fovea bench`: BVH build rate, memory and tree statistics per builder (`--bvh`); primary, shadow and indirect rays
 //! per second on the current device; per-pass GPU milliseconds of whole frames. All figures
 //! come from one run on one device (GPU timestamps for the GPU parts). The Visual-Polar vs
 //! Cartesian comparison lives in `bench_vp.rs`, the real-time loop (frames in flight, stereo vs
@@ -10,7 +10,8 @@ use fovea_renderer::layouts::{HitGpu, RayGpu};
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
-use fovea_renderer::scene::bvh::Bvh;
+use fovea_renderer::scene::bvh::wide::Bvh4;
+use fovea_renderer::scene::bvh::{Bvh, BvhBuilder, BvhStats};
 use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
 use fovea_renderer::scene::{PunctualLight, Scene};
 use glam::{UVec2, Vec3, Vec4};
@@ -21,6 +22,9 @@ use std::time::Instant;
 
 pub struct BenchArgs<'a> {
     pub scenes: &'a [String],
+    /// BVH builders to compare (the first also serves the frame and VP figures); with more than
+    /// one, the ray figures are measured in the order A B … B A within one run.
+    pub builders: &'a [BvhBuilder],
     /// Sizes of the ray-throughput and Cartesian frame measurements (empty: skip them).
     pub sizes: &'a [(u32, u32)],
     /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
@@ -38,23 +42,37 @@ pub struct BenchArgs<'a> {
 #[derive(Serialize)]
 struct BvhReport {
     scene: String,
+    builder: String,
     triangles: usize,
     build_seconds: f64,
     triangles_per_second: f64,
+    /// GPU bytes of the 4-wide tree the shaders traverse (128 B per node, 48 per leaf reference).
     memory_bytes: usize,
+    /// Depth of the binary tree (`stats`) and of the 4-wide one collapsed from it.
     depth: u32,
+    wide_depth: u32,
+    wide_nodes: usize,
+    stats: BvhStats,
 }
 
 #[derive(Serialize)]
 struct RayReport {
     scene: String,
+    builder: String,
+    /// 1 on the way there, 2 on the way back (A B … B A); a single builder measures once.
+    pass: u32,
     width: u32,
     height: u32,
     primary_mrays_per_s: f64,
-    shadow_mrays_per_s: f64,
+    /// `null` when the scene has no light to aim shadow rays at (Sponza, the Breakfast Room: the
+    /// default sun is the renderer's, not the scene's).
+    shadow_mrays_per_s: Option<f64>,
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
     frame_rays: u64,
+    /// Primary rays whose hit (hit or miss, or distance beyond 1e-5 relative) differs from the
+    /// first builder's: every tree must find the same surfaces, so anything but 0 is a bug.
+    primary_hits_differ: usize,
 }
 
 #[derive(Serialize)]
@@ -79,64 +97,122 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for name in args.scenes {
         let scene = crate::scenes::load(name)?;
         let positions = scene.triangle_positions();
-        let started = Instant::now();
-        let bvh = Bvh::build(&positions);
-        let seconds = started.elapsed().as_secs_f64();
-        let bvh_report = BvhReport {
-            scene: name.clone(),
-            triangles: positions.len(),
-            build_seconds: seconds,
-            triangles_per_second: positions.len() as f64 / seconds,
-            memory_bytes: bvh.memory_bytes(),
-            depth: bvh.depth(),
-        };
-        println!(
-            "{name}: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB, depth {}",
-            bvh_report.triangles,
-            seconds,
-            bvh_report.triangles_per_second * 1e-6,
-            bvh_report.memory_bytes as f64 / (1 << 20) as f64,
-            bvh_report.depth
-        );
-        report.bvh.push(bvh_report);
         let Some(camera) = scene.default_camera() else { bail!("{name}: no camera") };
-        let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
+        let mut variants = Vec::new();
+        for &builder in args.builders {
+            let started = Instant::now();
+            let bvh = Bvh::build_with(&positions, builder);
+            let seconds = started.elapsed().as_secs_f64();
+            let stats = bvh.stats(&positions);
+            let wide = Bvh4::from_binary(&bvh);
+            let bvh_report = BvhReport {
+                scene: name.clone(),
+                builder: builder.name(),
+                triangles: positions.len(),
+                build_seconds: seconds,
+                triangles_per_second: positions.len() as f64 / seconds,
+                memory_bytes: wide.memory_bytes(),
+                depth: bvh.depth(),
+                wide_depth: wide.depth(),
+                wide_nodes: wide.nodes.len(),
+                stats,
+            };
+            let s = &bvh_report.stats;
+            println!(
+                "{name} [{}]: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB on the GPU (4-wide: {} nodes, depth {}), binary depth {}, {} nodes, {} references, \
+                 mean leaf {:.2} at depth {:.1}, SAH {:.1} (nodes {:.1}), child overlap {:.3}, {} thin / {} large triangles",
+                bvh_report.builder,
+                bvh_report.triangles,
+                seconds,
+                bvh_report.triangles_per_second * 1e-6,
+                bvh_report.memory_bytes as f64 / (1 << 20) as f64,
+                bvh_report.wide_nodes,
+                bvh_report.wide_depth,
+                bvh_report.depth,
+                s.nodes,
+                s.references,
+                s.mean_leaf_size,
+                s.mean_leaf_depth,
+                s.sah_cost,
+                s.sah_node_cost,
+                s.mean_child_overlap,
+                s.thin_triangles,
+                s.large_triangles,
+            );
+            report.bvh.push(bvh_report);
+            let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
+            variants.push((builder, bvh, gpu));
+        }
         let mut caster = RayCaster::new(&ctx)?;
+        // A B … B A: a drift of the machine's load over the run hits every builder alike.
+        let order: Vec<(usize, u32)> = if variants.len() > 1 {
+            (0..variants.len()).map(|i| (i, 1)).chain((0..variants.len()).rev().map(|i| (i, 2))).collect()
+        } else {
+            vec![(0, 1)]
+        };
         for &(w, h) in args.sizes {
             let pose = CameraPose::from_scene_camera(camera, w, h);
             let primary = primary_rays(&pose, w, h);
-            let (hits, primary_ms) = timed_trace(&mut caster, &gpu, &primary, false)?;
+            // The secondary rays start from the first builder's hits so that every builder traces
+            // the same rays (hits may differ in the last bit between trees).
+            let (hits, _) = caster.trace(&variants[0].2, &primary, false)?;
             let (shadow, indirect) = secondary_rays(&scene, &positions, &primary, &hits);
-            let (_, shadow_ms) = timed_trace(&mut caster, &gpu, &shadow, true)?;
-            let (_, indirect_ms) = timed_trace(&mut caster, &gpu, &indirect, false)?;
-            let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
-
-            let space = Box::new(Cartesian::new(UVec2::new(w, h)));
-            let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
-            let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
-            // One untimed frame first: the first dispatch of a pipeline pays one-off costs
-            // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
-            let sums = super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
-            let input = FrameInput::mono(pose, 0, None);
-            let frame_rays = renderer.render_frame(&input)?.rays_traced();
-            let r = RayReport {
-                scene: name.clone(),
-                width: w,
-                height: h,
-                primary_mrays_per_s: rate(primary.len(), primary_ms),
-                shadow_mrays_per_s: rate(shadow.len(), shadow_ms),
-                indirect_mrays_per_s: rate(indirect.len(), indirect_ms),
-                frame_passes_ms: sums,
-                frame_rays,
-            };
-            println!(
-                "{name} {w}×{h}: primary {:.2} Mrays/s, shadow {:.2} Mrays/s, indirect {:.2} Mrays/s; frame passes (ms) {:?}",
-                r.primary_mrays_per_s, r.shadow_mrays_per_s, r.indirect_mrays_per_s, r.frame_passes_ms
-            );
-            report.rays.push(r);
+            for &(v, pass) in &order {
+                let (builder, bvh, gpu) = &variants[v];
+                let (primary_hits, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;
+                let primary_hits_differ = hits
+                    .iter()
+                    .zip(&primary_hits)
+                    .filter(|(a, b)| {
+                        let (ta, tb) = (a.t_u_v.x, b.t_u_v.x);
+                        (ta < 0.0) != (tb < 0.0) || (ta - tb).abs() > 1e-5 * ta.abs().max(1.0)
+                    })
+                    .count();
+                let shadow_ms = if shadow.is_empty() { None } else { Some(timed_trace(&mut caster, gpu, &shadow, true)?.1) };
+                let (_, indirect_ms) = timed_trace(&mut caster, gpu, &indirect, false)?;
+                let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
+                // Whole frames once per builder (on the way there).
+                let (sums, frame_rays) = if pass == 1 {
+                    let space = Box::new(Cartesian::new(UVec2::new(w, h)));
+                    let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?;
+                    let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
+                    // One untimed frame first: the first dispatch of a pipeline pays one-off costs
+                    // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
+                    let sums = super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
+                    let input = FrameInput::mono(pose, 0, None);
+                    (sums, renderer.render_frame(&input)?.rays_traced())
+                } else {
+                    (BTreeMap::new(), 0)
+                };
+                let r = RayReport {
+                    scene: name.clone(),
+                    builder: builder.name(),
+                    pass,
+                    width: w,
+                    height: h,
+                    primary_mrays_per_s: rate(primary.len(), primary_ms),
+                    shadow_mrays_per_s: shadow_ms.map(|ms| rate(shadow.len(), ms)),
+                    indirect_mrays_per_s: rate(indirect.len(), indirect_ms),
+                    frame_passes_ms: sums,
+                    frame_rays,
+                    primary_hits_differ,
+                };
+                println!(
+                    "{name} {w}×{h} [{} pass {pass}]: primary {:.2} Mrays/s, shadow {}, indirect {:.2} Mrays/s; frame passes (ms) {:?} (load {}); {} primary hits differ from the first builder's",
+                    r.builder,
+                    r.primary_mrays_per_s,
+                    r.shadow_mrays_per_s.map_or("- (no light)".into(), |m| format!("{m:.2} Mrays/s")),
+                    r.indirect_mrays_per_s,
+                    r.frame_passes_ms,
+                    load_average(),
+                    r.primary_hits_differ
+                );
+                report.rays.push(r);
+            }
         }
+        let (_, bvh, _) = &variants[0];
         for &size in args.vp_sizes {
-            let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?);
+            let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
             report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, size, args.frames)?);
         }
     }
@@ -148,6 +224,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     crate::output::write_json(&path, &report)?;
     println!("wrote {}", path.display());
     Ok(())
+}
+
+/// The 1-minute load average (`/proc/loadavg`), printed beside each ray figure: on a shared
+/// machine a figure taken at a load above the core count is disturbed.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg").ok().and_then(|s| s.split_whitespace().next().map(str::to_owned)).unwrap_or_else(|| "?".into())
 }
 
 /// Runs of each ray set after the untimed warm-up; the median GPU time is reported.

@@ -1,19 +1,33 @@
-//! A binary BVH built with binned SAH, laid out for GPU traversal.
+//! A binary BVH built with binned SAH (optionally with spatial splits), collapsed to 4-wide nodes
+//! for GPU traversal ([`wide`]).
 //!
-//! We build our own rather than use a crate (e.g. `obvhs`): the GPU node format below is fixed by
-//! the GLSL traversal (measured fastest on lavapipe, see build-notes.md), the builder is ~200
-//! lines, and owning it means the layout, leaf sizes and tie rules are tested here, not adapted.
+//! We build our own rather than use a crate (e.g. `obvhs`): the GPU node format is fixed by the
+//! GLSL traversal (measured fastest on lavapipe, see build-notes.md), the builders are a few
+//! hundred lines, and owning them means the layout, leaf sizes and tie rules are tested here.
 //!
-//! Node format: each [`BvhNode`] holds the boxes of BOTH children, so the traversal tests two
-//! boxes per node fetch (64 bytes). `child_count == 0` marks an interior child (`child_ref` = node
-//! index); `child_count > 0` a leaf with triangles `tri_order[child_ref .. child_ref + count]`.
-//! Node 0 is the root. A scene that fits one leaf gets a root whose child 1 is empty (an inverted
-//! box that every slab test misses, count 0, ref 0).
+//! Binary node format: each [`BvhNode`] holds the boxes of BOTH children (64 bytes).
+//! `child_count == 0` marks an interior child (`child_ref` = node index); `child_count > 0` a leaf
+//! with triangles `tri_order[child_ref .. child_ref + count]`. Node 0 is the root. A scene that
+//! fits one leaf gets a root whose child 1 is empty (an inverted box that every slab test misses,
+//! count 0, ref 0). The GPU gets [`wide::Bvh4`], collapsed from this tree with the same leaves;
+//! [`Bvh::intersect`] and [`wide::Bvh4::intersect`] are the CPU references.
 //!
-//! Build: single-threaded, 16 bins on each axis, leaves of ≤ 4 triangles, ≤ 8 when no split is
-//! cheaper by SAH (more than 8 forces an object-median split).
+//! Builders ([`BvhBuilder`]): single-threaded, 16 bins on each axis, leaves of ≤ 4 triangles, ≤ 8
+//! when no split is cheaper by SAH (more than 8 forces an object-median split).
+//! - `binned`: object splits only; every triangle in exactly one leaf (≈ 1–2.6 M triangles/s).
+//! - `sbvh` ([`sbvh`], Stich et al. 2009): object or spatial splits, at most `budget` × triangles
+//!   extra leaf references; a triangle may sit in several leaves, each leaf box bounding only its
+//!   clipped part. About 6–8× slower to build (Sponza: 1.18 s vs 0.19 s) for a tree of 18 % lower
+//!   SAH cost on Sponza and 19 % on the Breakfast Room, +21 / +18 % references, and 1.5–1.6× their
+//!   primary-ray rate (`fovea bench --bvh sbvh,binned`, README Performance). The default since
+//!   the seventh session.
+//!
+//! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
+//! long thin and large triangles); `fovea bench` prints it for each scene and builder.
 
+mod sbvh;
 mod traverse;
+pub mod wide;
 #[cfg(test)]
 mod tests;
 
@@ -65,10 +79,7 @@ pub struct Bvh {
 }
 
 const BINS: usize = 16;
-const LEAF_TARGET: usize = 4;
 const LEAF_MAX: usize = 8;
-/// Cost of one node visit relative to one triangle test, in the SAH.
-const TRAVERSAL_COST: f32 = 1.0;
 
 /// Builder-internal box on SIMD vectors (the build is bound by these unions).
 #[derive(Clone, Copy)]
@@ -124,18 +135,93 @@ struct Bin {
 }
 
 struct Builder {
+    options: BvhBuilder,
     prim_bounds: Vec<Box3>,
     centroids: Vec<Vec3A>,
     order: Vec<u32>,
 }
 
+/// Which builder makes the tree, and its knobs (`fovea bench --bvh` compares them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhBuilder {
+    /// `None`: object splits only (binned SAH), every triangle in exactly one leaf. `Some(b)`:
+    /// object and spatial splits (SBVH), at most `b` × triangles extra leaf references.
+    pub spatial_budget: Option<f32>,
+    /// Ranges of at most this many triangles always become leaves (larger ones up to 8 when no
+    /// split is cheaper by SAH).
+    pub leaf_target: usize,
+    /// Cost of one node visit relative to one triangle test, in the SAH.
+    pub node_cost: f32,
+}
+
+impl BvhBuilder {
+    pub const BINNED: BvhBuilder = BvhBuilder { spatial_budget: None, leaf_target: 4, node_cost: 1.0 };
+    pub const SBVH: BvhBuilder = BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED };
+    /// What [`Bvh::build`] (and so every scene upload) uses.
+    pub const DEFAULT: BvhBuilder = BvhBuilder::SBVH;
+
+    /// `binned` or `sbvh[:BUDGET]` (budget 0.5 when not given), optionally followed by
+    /// `/leafN` (leaf target, 1 to 8) and `/costC` (node cost, 0.1 to 10).
+    pub fn parse(s: &str) -> Result<BvhBuilder, String> {
+        let err = || format!("unknown BVH builder '{s}': binned or sbvh[:BUDGET] (0 to 4), then optionally /leafN (1 to 8), /costC (0.1 to 10)");
+        let mut parts = s.split('/');
+        let mut b = match parts.next().unwrap_or("") {
+            "binned" => BvhBuilder::BINNED,
+            "sbvh" => BvhBuilder::SBVH,
+            kind => match kind.strip_prefix("sbvh:").map(str::parse::<f32>) {
+                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => BvhBuilder { spatial_budget: Some(budget), ..BvhBuilder::BINNED },
+                _ => return Err(err()),
+            },
+        };
+        for part in parts {
+            if let Some(Ok(n)) = part.strip_prefix("leaf").map(str::parse::<usize>) {
+                b.leaf_target = n;
+            } else if let Some(Ok(c)) = part.strip_prefix("cost").map(str::parse::<f32>) {
+                b.node_cost = c;
+            } else {
+                return Err(err());
+            }
+        }
+        if !(1..=LEAF_MAX).contains(&b.leaf_target) || !(0.1..=10.0).contains(&b.node_cost) {
+            return Err(err());
+        }
+        Ok(b)
+    }
+
+    pub fn name(&self) -> String {
+        let mut name = match self.spatial_budget {
+            None => "binned".to_string(),
+            Some(budget) => format!("sbvh:{budget}"),
+        };
+        if self.leaf_target != BvhBuilder::BINNED.leaf_target {
+            name += &format!("/leaf{}", self.leaf_target);
+        }
+        if self.node_cost != BvhBuilder::BINNED.node_cost {
+            name += &format!("/cost{}", self.node_cost);
+        }
+        name
+    }
+}
+
 impl Bvh {
-    /// Builds the tree over `tris` (world-space corners, by triangle index).
+    /// Builds the tree over `tris` (world-space corners, by triangle index) with
+    /// [`BvhBuilder::DEFAULT`].
     pub fn build(tris: &[[Vec3; 3]]) -> Bvh {
+        Bvh::build_with(tris, BvhBuilder::DEFAULT)
+    }
+
+    pub fn build_with(tris: &[[Vec3; 3]], builder: BvhBuilder) -> Bvh {
+        match builder.spatial_budget {
+            None => Bvh::build_binned(tris, builder),
+            Some(budget) => sbvh::build(tris, budget, builder),
+        }
+    }
+
+    fn build_binned(tris: &[[Vec3; 3]], options: BvhBuilder) -> Bvh {
         let prim_bounds: Vec<Box3> =
             tris.iter().map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into()))).collect();
         let centroids = prim_bounds.iter().map(|b| (b.min + b.max) * 0.5).collect();
-        let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect() };
+        let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect(), options };
         let n = tris.len();
         let mut nodes = vec![BvhNode::EMPTY];
         let root = b.range_bounds(0, n);
@@ -167,8 +253,8 @@ impl Bvh {
         Bvh { nodes, tri_order: b.order }
     }
 
-    /// Longest root-to-leaf path counted in nodes (the root alone is depth 1). The GPU traversal
-    /// stack never holds more than `depth()` entries.
+    /// Longest root-to-leaf path counted in nodes (the root alone is depth 1). The binary
+    /// traversal's stack never holds more than `depth()` entries (the GPU's: [`wide::Bvh4::max_stack`]).
     pub fn depth(&self) -> u32 {
         let mut deepest = 0;
         let mut stack = vec![(0u32, 1u32)];
@@ -184,9 +270,95 @@ impl Bvh {
         deepest
     }
 
-    /// Bytes the GPU holds for this BVH: 64 per node plus 48 per triangle (the texel buffers).
+    /// Bytes of this binary tree at 64 per node plus 48 per leaf reference; the GPU holds the
+    /// 4-wide tree instead ([`wide::Bvh4::memory_bytes`]).
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * 64 + self.tri_order.len() * 48
+    }
+}
+
+/// What a tree looks like, for `fovea bench` and for tuning the builder (see [`Bvh::stats`]).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BvhStats {
+    pub nodes: usize,
+    pub leaves: usize,
+    /// Leaf references (`tri_order.len()`): the triangle count plus any duplicates.
+    pub references: usize,
+    pub depth: u32,
+    /// Mean depth of the leaves weighted by their triangles (a ray's path length to a leaf).
+    pub mean_leaf_depth: f64,
+    pub mean_leaf_size: f64,
+    /// Leaves by triangle count: `leaf_sizes[k]` leaves hold `k` triangles (index 0 unused).
+    pub leaf_sizes: Vec<usize>,
+    /// SAH cost of the tree relative to the root box (node visit 1, triangle test 1): the expected
+    /// number of node and triangle tests of a ray that crosses the root box, uniformly.
+    pub sah_cost: f64,
+    /// The node part of `sah_cost` (box tests: both children of a visited node count once).
+    pub sah_node_cost: f64,
+    /// Mean over interior nodes of area(left ∩ right) / area(parent): 0 for disjoint children.
+    pub mean_child_overlap: f64,
+    /// Triangles whose box is more than 10× as long as the triangle is wide (long thin ones) ...
+    pub thin_triangles: usize,
+    /// ... and triangles whose box has more than 1/100 of the scene box's surface area.
+    pub large_triangles: usize,
+}
+
+impl Bvh {
+    /// Counts and costs of the tree over `tris` (the array it was built from).
+    pub fn stats(&self, tris: &[[Vec3; 3]]) -> BvhStats {
+        let mut s = BvhStats { nodes: self.nodes.len(), references: self.tri_order.len(), ..Default::default() };
+        let area = |b: &Aabb| b.surface_area() as f64;
+        let root = (0..2).filter(|&c| !self.nodes[0].is_empty_child(c)).fold(Aabb::EMPTY, |b, c| b.union(&self.nodes[0].child_bounds(c)));
+        let root_area = area(&root).max(f64::MIN_POSITIVE);
+        let (mut overlap_sum, mut interior, mut leaf_depth_sum) = (0.0, 0usize, 0.0);
+        // (node, depth, area of the node's own box)
+        let mut stack = vec![(0u32, 1u32, root_area)];
+        while let Some((node, depth, node_area)) = stack.pop() {
+            s.depth = s.depth.max(depth);
+            s.sah_node_cost += node_area / root_area;
+            let n = &self.nodes[node as usize];
+            interior += 1;
+            if !n.is_empty_child(0) && !n.is_empty_child(1) {
+                let (a, b) = (n.child_bounds(0), n.child_bounds(1));
+                let inter = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
+                overlap_sum += area(&inter) / node_area.max(f64::MIN_POSITIVE);
+            }
+            for c in (0..2).filter(|&c| !n.is_empty_child(c)) {
+                let b = n.child_bounds(c);
+                let count = n.child_count[c] as usize;
+                if count == 0 {
+                    stack.push((n.child_ref[c], depth + 1, area(&b)));
+                } else {
+                    s.leaves += 1;
+                    if s.leaf_sizes.len() <= count {
+                        s.leaf_sizes.resize(count + 1, 0);
+                    }
+                    s.leaf_sizes[count] += 1;
+                    s.sah_cost += area(&b) / root_area * count as f64;
+                    leaf_depth_sum += (depth + 1) as f64 * count as f64;
+                }
+            }
+        }
+        s.sah_cost += s.sah_node_cost;
+        s.mean_child_overlap = overlap_sum / interior.max(1) as f64;
+        s.mean_leaf_size = s.references as f64 / s.leaves.max(1) as f64;
+        s.mean_leaf_depth = leaf_depth_sum / s.references.max(1) as f64;
+        let scene_area = area(&Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>()));
+        for t in tris {
+            let b = Aabb::of_points(t);
+            let d = b.max - b.min;
+            let (longest, [e0, e1, e2]) = (d.max_element(), [t[1] - t[0], t[2] - t[1], t[0] - t[2]]);
+            // Width: twice the area over the longest edge (the triangle's height on it).
+            let edge = e0.length().max(e1.length()).max(e2.length());
+            let width = e0.cross(-e2).length() / edge.max(f32::MIN_POSITIVE);
+            if longest > 10.0 * width {
+                s.thin_triangles += 1;
+            }
+            if area(&b) > scene_area / 100.0 {
+                s.large_triangles += 1;
+            }
+        }
+        s
     }
 }
 
@@ -201,7 +373,7 @@ impl Builder {
     /// Decides leaf or split for `order[start..end]`, partitioning the range for a split.
     fn plan(&mut self, start: usize, end: usize, range: RangeBounds) -> Plan {
         let count = end - start;
-        if count <= LEAF_TARGET {
+        if count <= self.options.leaf_target {
             return Plan::Leaf;
         }
         let lo = range.centroids.min;
@@ -238,7 +410,7 @@ impl Builder {
                 if n == 0 || n as usize == count {
                     continue;
                 }
-                let cost = TRAVERSAL_COST + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
+                let cost = self.options.node_cost + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, split));
                 }

@@ -1,4 +1,5 @@
-//! GPU texel packing and the CPU traversal (the reference for the GLSL one, same algorithm).
+//! Triangle texel packing and the binary tree's CPU traversal (the 4-wide tree the GPU traverses
+//! has its own, `wide::Bvh4::intersect`, with the GLSL's algorithm).
 
 use super::{Bvh, BvhNode};
 use crate::intersect::{Hit, Ray, WatertightRay};
@@ -28,24 +29,6 @@ pub fn slab_test(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, t_limit: f32
 }
 
 impl Bvh {
-    /// 4 RGBA32F texels per node:
-    /// (left.min, bits(left.ref)), (left.max, bits(right.ref)), (right.min, bits(left.count)), (right.max, bits(right.count)).
-    pub fn node_texels(&self) -> Vec<[f32; 4]> {
-        let bits = f32::from_bits;
-        self.nodes
-            .iter()
-            .flat_map(|n| {
-                let (lmin, lmax, rmin, rmax) = (n.child_min[0], n.child_max[0], n.child_min[1], n.child_max[1]);
-                [
-                    [lmin.x, lmin.y, lmin.z, bits(n.child_ref[0])],
-                    [lmax.x, lmax.y, lmax.z, bits(n.child_ref[1])],
-                    [rmin.x, rmin.y, rmin.z, bits(n.child_count[0])],
-                    [rmax.x, rmax.y, rmax.z, bits(n.child_count[1])],
-                ]
-            })
-            .collect()
-    }
-
     /// 3 texels per triangle in `tri_order` order: (v0, bits(original index)), (v1, 0), (v2, 0).
     pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
         self.tri_order
