@@ -311,6 +311,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         frames: 1,
         loop_size: Some((64, 72)),
         loop_frames,
+        camera_path: None,
         out: &out,
         device: None,
         validation: true,
@@ -485,4 +486,35 @@ fn camera_path_files_drive_the_camera() {
     assert_eq!(CameraMotion::from_flag(None).unwrap(), CameraMotion::Still);
     let err = format!("{:#}", CameraMotion::from_flag(Some(dir.join("absent.toml").to_str().unwrap())).unwrap_err());
     assert!(err.contains("--camera-path") && err.contains("absent.toml"), "{err}");
+}
+
+/// `fovea bench --camera-path FILE`: the VP vs Cartesian frames follow the keyframes, and the
+/// report says so; the frames' passes are measured as on a still camera.
+#[test]
+fn bench_vp_frames_follow_a_camera_path() {
+    use fovea_tools::camera_keys::{CameraKeys, Key};
+    use fovea_tools::commands::bench::{run as bench, BenchArgs};
+    use glam::Vec3;
+    let out = temp_dir("bench-camera-path");
+    let key = |time, x| Key { time, position: Vec3::new(x, 1.0, 3.4), look: Vec3::new(0.0, 1.0, 0.0), fov: None };
+    let keys = CameraKeys::new(vec![key(0.0, -0.3), key(0.05, 0.3)]).unwrap();
+    let scenes = ["cornell-box".to_string()];
+    let args = BenchArgs {
+        scenes: &scenes,
+        builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
+        sizes: &[],
+        vp_sizes: &[(64, 72)],
+        frames: 2,
+        loop_size: None,
+        loop_frames: 2,
+        camera_path: Some(&keys),
+        out: &out,
+        device: None,
+        validation: true,
+    };
+    bench(&args).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let vp = &report["visual_polar"][0];
+    assert_eq!(vp["camera_motion"], "keys");
+    assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
 }

@@ -356,6 +356,10 @@ enum Command {
         /// is made twice (order A B C C B A).
         #[arg(long, default_value_t = 5)]
         loop_frames: u32,
+        /// A keyframe file (as `fovea render --camera-path FILE`) the VP vs Cartesian frames
+        /// follow, frame i at i / 70 Hz (default: the scene camera, still).
+        #[arg(long)]
+        camera_path: Option<PathBuf>,
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
         #[command(flatten)]
@@ -601,7 +605,8 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, bvh, sizes, vp_sizes, frames, loop_size, loop_frames, out, device } => {
+        Command::Bench { scenes, bvh, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, device } => {
+            let camera_path = camera_path.map(|f| fovea_tools::camera_keys::CameraKeys::load(&f)).transpose().context("--camera-path")?;
             let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
             if builders.is_empty() {
                 bail!("--bvh: name at least one builder");
@@ -618,6 +623,7 @@ fn run() -> Result<()> {
                 frames,
                 loop_size,
                 loop_frames,
+                camera_path: camera_path.as_ref(),
                 out: &out,
                 device: device.device.as_deref(),
                 validation: device.validation,

@@ -34,6 +34,8 @@ pub struct BenchArgs<'a> {
     pub loop_size: Option<(u32, u32)>,
     /// Timed frames of each loop run (after `bench_loop::WARMUP_FRAMES` warm-up frames).
     pub loop_frames: u32,
+    /// Keyframes the VP vs Cartesian frames follow (`--camera-path FILE`; none: the still camera).
+    pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
     pub out: &'a Path,
     pub device: Option<&'a str>,
     pub validation: bool,
@@ -213,7 +215,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let (_, bvh, _) = &variants[0];
         for &size in args.vp_sizes {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
-            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, size, args.frames)?);
+            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, args.camera_path, size, args.frames)?);
         }
     }
     if let Some(size) = args.loop_size {

@@ -3,6 +3,7 @@
 //! screen (φ-mips + remap + blur); and primary-ray coherence: the VP samples traced in VP order
 //! vs the same rays shuffled.
 
+use crate::camera_keys::CameraKeys;
 use anyhow::Result;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
@@ -26,6 +27,8 @@ pub struct VpFrameReport {
     pub vp_height: u32,
     pub vp_samples: u64,
     pub gaze: [f32; 2],
+    /// `still`, or `keys`: the frames followed `--camera-path FILE` (frame i at i / 70 Hz).
+    pub camera_motion: &'static str,
     /// Median GPU ms per pass over the timed frames.
     pub cartesian_passes_ms: BTreeMap<String, f64>,
     pub vp_passes_ms: BTreeMap<String, f64>,
@@ -76,17 +79,22 @@ pub struct DenoiserCost {
     pub vp_history_bytes: u64,
 }
 
+/// Display rate of `--camera-path` keyframes in the bench (no headset there): the FOVE 0's 70 Hz,
+/// the default headset of `fovea render`, so a path times the same in both.
+pub const CAMERA_PATH_HZ: f64 = 70.0;
+
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
 pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<BTreeMap<String, f64>> {
-    let mut medians = interleaved_pass_medians(&mut [(renderer, gaze)], camera, frames)?;
+    let mut medians = interleaved_pass_medians(&mut [(renderer, gaze)], &|_| camera, frames)?;
     Ok(medians.remove(0))
 }
 
 /// `pass_medians` of several renderers (each with its gaze) whose frames alternate: a drift of
 /// the machine's speed during the run (up to ±25 % within an hour on these CPU machines) then
-/// hits every side alike, and the ratios between them stay fair.
-pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: CameraPose, frames: u32) -> Result<Vec<BTreeMap<String, f64>>> {
-    let input = |frame_index, gaze| FrameInput::mono(camera, frame_index, gaze);
+/// hits every side alike, and the ratios between them stay fair. `camera` gives frame i's camera
+/// (every renderer sees the same one).
+pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: &dyn Fn(u32) -> CameraPose, frames: u32) -> Result<Vec<BTreeMap<String, f64>>> {
+    let input = |frame_index, gaze| FrameInput::mono(camera(frame_index), frame_index, gaze);
     for (renderer, gaze) in renderers.iter_mut() {
         renderer.render_frame(&input(0, *gaze))?;
     }
@@ -130,12 +138,14 @@ pub fn measure(
     make_scene: &dyn Fn() -> Result<GpuScene>,
     caster: &mut RayCaster,
     camera: &fovea_renderer::scene::Camera,
+    camera_path: Option<&CameraKeys>,
     (w, h): (u32, u32),
     frames: u32,
 ) -> Result<VpFrameReport> {
     let screen = UVec2::new(w, h);
     let gaze = screen.as_vec2() * 0.5;
     let pose = CameraPose::from_scene_camera(camera, w, h);
+    let camera_at = |frame: u32| camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose));
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
     // A Cartesian and a VP renderer with these settings, their frames interleaved: each one's
     // pass medians and denoiser history bytes (the renderers are dropped before the next pair).
@@ -144,7 +154,7 @@ pub fn measure(
         let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
         let history = |r: &Renderer| r.denoiser().map_or(0, |d| d.history_bytes());
         let (cart_history, vp_history) = (history(&cart), history(&vpr));
-        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], pose, frames)?.into_iter();
+        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], &camera_at, frames)?.into_iter();
         let mut next = |bytes| medians.next().map(|m| (m, bytes)).expect("one median map per renderer");
         Ok([next(cart_history), next(vp_history)])
     };
@@ -179,6 +189,7 @@ pub fn measure(
     let grid = vp.grid_size();
     let report = VpFrameReport {
         scene: scene_name.to_string(),
+        camera_motion: if camera_path.is_some() { "keys" } else { "still" },
         width: w,
         height: h,
         vp_width: grid.x,
