@@ -1,6 +1,6 @@
 // Addressing of a sampling grid (texel = sample) for the denoisers. The space-specific half —
-// struct Grid, grid_make, grid_rows, grid_tap, grid_column_tap, grid_from_screen, grid_nearest,
-// grid_bilinear — is one include per sampling space (shaders/sampling/<space>_grid.glsl), chosen
+// GRID_ROWS_WRAP, struct Grid, grid_make, grid_rows, grid_tap, grid_column_tap, grid_from_screen,
+// grid_nearest, grid_bilinear — is one include per sampling space (shaders/sampling/<space>_grid.glsl), chosen
 // by the kernel variant like the tracer's mapping; what every space shares is here.
 // The parameters come as the four SamplingParams slots (push constants).
 #ifndef FOVEA_DENOISE_GRID_GLSL

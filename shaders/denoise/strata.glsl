@@ -39,18 +39,16 @@ ivec2 stratum_centre_texel(Grid g, ivec2 s) {
 }
 
 // The stratum `o` strata away from s (o.y in strata of s's column); false when it leaves the
-// strata grid (Cartesian: any side; Visual-Polar: ρ only, φ wraps).
+// strata grid (on x always; on y only in a space whose rows do not wrap, GRID_ROWS_WRAP).
 bool strata_tap(Grid g, ivec2 s, ivec2 o, out ivec2 tap) {
     tap = s + o;
     if (tap.x < 0 || tap.x >= strata_size(g).x) return false;
-#if defined(SAMPLING_VISUAL_POLAR)
-    int n0 = strata_rows(g, s.x);
-    int n1 = o.x == 0 ? n0 : strata_rows(g, tap.x);
+    int n1 = strata_rows(g, tap.x);
+    if (!GRID_ROWS_WRAP) return tap.y >= 0 && tap.y < n1;
+    // Keep the angle across stratum columns of different height.
+    int n0 = o.x == 0 ? n1 : strata_rows(g, s.x);
     tap.y = grid_wrap(int(floor((float(s.y) + 0.5 + float(o.y)) * float(n1) / float(n0))), n1);
     return true;
-#else
-    return tap.y >= 0 && tap.y < strata_size(g).y;
-#endif
 }
 
 #endif

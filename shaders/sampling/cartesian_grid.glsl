@@ -3,6 +3,9 @@
 #ifndef FOVEA_CARTESIAN_GRID_GLSL
 #define FOVEA_CARTESIAN_GRID_GLSL
 
+// Rows end at the grid like columns.
+const bool GRID_ROWS_WRAP = false;
+
 struct Grid {
     ivec2 size;
 };

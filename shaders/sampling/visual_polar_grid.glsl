@@ -8,6 +8,9 @@
 
 #include "visual_polar_math.glsl"
 
+// Rows (φ) wrap around; columns (ρ) end at the grid.
+const bool GRID_ROWS_WRAP = true;
+
 struct Grid {
     ivec2 size;
     VpParams vp;
