@@ -34,22 +34,24 @@ mod tests;
 use crate::Aabb;
 use glam::{Vec3, Vec3A};
 
-/// One BVH2 node with both children's boxes (see the module doc for the meaning of the fields).
+/// One BVH node with the boxes of all its `W` children, so a traversal tests them per node fetch
+/// (see the module doc for the meaning of the fields): [`BvhNode`] (binary, what the builders
+/// make) and [`wide::Bvh4Node`] (what the GPU traverses).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BvhNode {
-    pub child_min: [Vec3; 2],
-    pub child_max: [Vec3; 2],
-    pub child_ref: [u32; 2],
-    pub child_count: [u32; 2],
+pub struct NodeOf<const W: usize> {
+    pub child_min: [Vec3; W],
+    pub child_max: [Vec3; W],
+    /// Interior child: its node index; leaf: first entry in `tri_order`.
+    pub child_ref: [u32; W],
+    /// 0: interior child (or empty when `child_ref` is 0 too); > 0: leaf of that many triangles.
+    pub child_count: [u32; W],
 }
 
-impl BvhNode {
-    const EMPTY: BvhNode = BvhNode {
-        child_min: [Aabb::EMPTY.min; 2],
-        child_max: [Aabb::EMPTY.max; 2],
-        child_ref: [0; 2],
-        child_count: [0; 2],
-    };
+/// One BVH2 node with both children's boxes.
+pub type BvhNode = NodeOf<2>;
+
+impl<const W: usize> NodeOf<W> {
+    const EMPTY: NodeOf<W> = NodeOf { child_min: [Aabb::EMPTY.min; W], child_max: [Aabb::EMPTY.max; W], child_ref: [0; W], child_count: [0; W] };
 
     fn set_child(&mut self, slot: usize, bounds: &Aabb, child_ref: u32, count: u32) {
         self.child_min[slot] = bounds.min;

@@ -29,9 +29,9 @@ struct Ref {
 #[derive(Clone, Copy)]
 struct Bin {
     bounds: Box3,
-    /// Object bins: references; spatial bins: references that start here.
+    /// References that start here (object bins: the references binned here).
     enter: u32,
-    /// Spatial bins: references that end here.
+    /// References that end here (object bins: the same as `enter`).
     exit: u32,
 }
 
@@ -243,33 +243,40 @@ impl Builder<'_> {
                 let bin = &mut bins[axis][k[axis] as usize];
                 bin.bounds = bin.bounds.union(r.bounds);
                 bin.enter += 1;
+                bin.exit += 1;
             }
         }
         let mut best: Option<Candidate> = None;
         for axis in (0..3).filter(|&a| extent[a] > 0.0) {
-            let bins = &bins[axis];
-            let mut right = [(Box3::EMPTY, 0u32); BINS];
-            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
-            for i in (1..BINS).rev() {
-                acc = acc.union(bins[i].bounds);
-                n += bins[i].enter;
-                right[i] = (acc, n);
-            }
-            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
-            for split in 1..BINS {
-                acc = acc.union(bins[split - 1].bounds);
-                n += bins[split - 1].enter;
-                let (rb, rn) = right[split];
-                if n == 0 || rn == 0 {
-                    continue;
-                }
-                let cost = self.options.node_cost + (area(acc) * n as f32 + area(rb) * rn as f32) / parent_area;
-                if best.as_ref().is_none_or(|b| cost < b.cost) {
-                    best = Some(Candidate { cost, axis, split, left: acc, right: rb, counts: (n, rn) });
-                }
-            }
+            self.sweep(&bins[axis], axis, parent_area, |_, _| true, &mut best);
         }
         best
+    }
+
+    /// The SAH sweep over one axis' bins: every boundary with references on both sides (left:
+    /// those entering a bin left of it, right: those leaving one right of it) that `allowed`
+    /// accepts by (left, right) counts, kept in `best` when cheaper.
+    fn sweep(&self, bins: &[Bin; BINS], axis: usize, parent_area: f32, allowed: impl Fn(u32, u32) -> bool, best: &mut Option<Candidate>) {
+        let mut right = [(Box3::EMPTY, 0u32); BINS];
+        let (mut acc, mut n) = (Box3::EMPTY, 0u32);
+        for i in (1..BINS).rev() {
+            acc = acc.union(bins[i].bounds);
+            n += bins[i].exit;
+            right[i] = (acc, n);
+        }
+        let (mut acc, mut n) = (Box3::EMPTY, 0u32);
+        for split in 1..BINS {
+            acc = acc.union(bins[split - 1].bounds);
+            n += bins[split - 1].enter;
+            let (rb, rn) = right[split];
+            if n == 0 || rn == 0 || !allowed(n, rn) {
+                continue;
+            }
+            let cost = self.options.node_cost + (area(acc) * n as f32 + area(rb) * rn as f32) / parent_area;
+            if best.as_ref().is_none_or(|b| cost < b.cost) {
+                *best = Some(Candidate { cost, axis, split, left: acc, right: rb, counts: (n, rn) });
+            }
+        }
     }
 
     /// The split plane of spatial bin boundary `split` on `axis` of `bounds`.
@@ -304,30 +311,8 @@ impl Builder<'_> {
                     }
                 }
             }
-            let mut right = [(Box3::EMPTY, 0u32); BINS];
-            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
-            for i in (1..BINS).rev() {
-                acc = acc.union(bins[i].bounds);
-                n += bins[i].exit;
-                right[i] = (acc, n);
-            }
-            let (mut acc, mut n) = (Box3::EMPTY, 0u32);
-            for split in 1..BINS {
-                acc = acc.union(bins[split - 1].bounds);
-                n += bins[split - 1].enter;
-                let (rb, rn) = right[split];
-                if n == 0 || rn == 0 {
-                    continue;
-                }
-                let duplicates = (n + rn) as usize - refs.len();
-                if duplicates > self.spare_refs {
-                    continue;
-                }
-                let cost = self.options.node_cost + (area(acc) * n as f32 + area(rb) * rn as f32) / parent_area;
-                if best.as_ref().is_none_or(|b| cost < b.cost) {
-                    best = Some(Candidate { cost, axis, split, left: acc, right: rb, counts: (n, rn) });
-                }
-            }
+            // A reference straddling the plane sits on both sides: within the spare budget only.
+            self.sweep(&bins, axis, parent_area, |n, rn| (n + rn) as usize - refs.len() <= self.spare_refs, &mut best);
         }
         best
     }

@@ -28,6 +28,25 @@ pub fn slab_test(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, t_limit: f32
     (t_near <= t_far && t_near <= t_limit * SLAB_SLACK).then_some(t_near)
 }
 
+/// Tests a leaf's triangles (original indices) for `0 < t < t_max`: with `any_hit` the first
+/// hit is returned at once; otherwise the closest so far (ties by [`crate::intersect`]'s rule) is
+/// kept in `best` and `None` returned.
+pub(super) fn test_leaf(tris: &[[Vec3; 3]], leaf: &[u32], wray: &WatertightRay, t_max: f32, any_hit: bool, best: &mut Option<Hit>) -> Option<Hit> {
+    for &tri in leaf {
+        let [a, b, c] = tris[tri as usize];
+        if let Some((t, u, v)) = wray.intersect(a, b, c, t_max) {
+            let hit = Hit { t, triangle: tri, u, v };
+            if any_hit {
+                return Some(hit);
+            }
+            if best.is_none_or(|b| hit.is_closer_than(&b)) {
+                *best = Some(hit);
+            }
+        }
+    }
+    None
+}
+
 impl Bvh {
     /// 3 texels per triangle in `tri_order` order: (v0, bits(original index)), (v1, 0), (v2, 0).
     pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
@@ -66,17 +85,8 @@ impl Bvh {
                     continue;
                 }
                 let start = n.child_ref[c] as usize;
-                for &tri in &self.tri_order[start..start + n.child_count[c] as usize] {
-                    let [a, b, cc] = tris[tri as usize];
-                    if let Some((t, u, v)) = wray.intersect(a, b, cc, t_max) {
-                        let hit = Hit { t, triangle: tri, u, v };
-                        if any_hit {
-                            return Some(hit);
-                        }
-                        if best.is_none_or(|b| hit.is_closer_than(&b)) {
-                            best = Some(hit);
-                        }
-                    }
+                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, &mut best) {
+                    return Some(hit);
                 }
             }
             match next {

@@ -10,36 +10,16 @@
 //! traversal tests the four boxes as vec4 operations): min.x, min.y, min.z, max.x, max.y, max.z,
 //! bits(child_ref), bits(child_count).
 
-use super::traverse::{safe_inverse_dir, slab_test};
-use super::{Bvh, BvhNode};
+use super::traverse::{safe_inverse_dir, slab_test, test_leaf};
+use super::{Bvh, BvhNode, NodeOf};
 use crate::intersect::{Hit, Ray, WatertightRay};
 use crate::Aabb;
 use glam::Vec3;
 
 pub const WIDTH: usize = 4;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bvh4Node {
-    pub child_min: [Vec3; WIDTH],
-    pub child_max: [Vec3; WIDTH],
-    /// Interior child: its node index; leaf: first entry in `tri_order`.
-    pub child_ref: [u32; WIDTH],
-    /// 0: interior child (or empty when `child_ref` is 0 too); > 0: leaf of that many triangles.
-    pub child_count: [u32; WIDTH],
-}
-
-impl Bvh4Node {
-    const EMPTY: Bvh4Node =
-        Bvh4Node { child_min: [Aabb::EMPTY.min; WIDTH], child_max: [Aabb::EMPTY.max; WIDTH], child_ref: [0; WIDTH], child_count: [0; WIDTH] };
-
-    pub fn is_empty_child(&self, slot: usize) -> bool {
-        self.child_count[slot] == 0 && self.child_ref[slot] == 0
-    }
-
-    pub fn child_bounds(&self, slot: usize) -> Aabb {
-        Aabb { min: self.child_min[slot], max: self.child_max[slot] }
-    }
-}
+/// One 4-wide node: the four children's boxes, refs and counts (as [`BvhNode`]'s two).
+pub type Bvh4Node = NodeOf<WIDTH>;
 
 #[derive(Clone, Debug, Default)]
 pub struct Bvh4 {
@@ -74,11 +54,7 @@ impl Bvh4 {
                 children.extend(children_of(node));
             }
             for (slot, &(bounds, child_ref, count)) in children.iter().enumerate() {
-                let n = &mut nodes[wide];
-                n.child_min[slot] = bounds.min;
-                n.child_max[slot] = bounds.max;
-                n.child_count[slot] = count;
-                n.child_ref[slot] = child_ref;
+                nodes[wide].set_child(slot, &bounds, child_ref, count);
                 if count == 0 {
                     let child = nodes.len();
                     nodes.push(Bvh4Node::EMPTY);
@@ -163,17 +139,8 @@ impl Bvh4 {
             });
             for c in (0..WIDTH).filter(|&c| near[c].is_some() && n.child_count[c] > 0) {
                 let start = n.child_ref[c] as usize;
-                for &tri in &self.tri_order[start..start + n.child_count[c] as usize] {
-                    let [a, b, cc] = tris[tri as usize];
-                    if let Some((t, u, v)) = wray.intersect(a, b, cc, t_max) {
-                        let hit = Hit { t, triangle: tri, u, v };
-                        if any_hit {
-                            return Some(hit);
-                        }
-                        if best.is_none_or(|b| hit.is_closer_than(&b)) {
-                            best = Some(hit);
-                        }
-                    }
+                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, &mut best) {
+                    return Some(hit);
                 }
             }
             // Interior children nearest first: the farther ones are pushed, farthest deepest.
