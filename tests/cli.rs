@@ -129,6 +129,7 @@ fn output_folders_with_user_files_are_refused() {
         validation: true,
         camera: &fovea_tools::look::NO_CAMERA_FLAGS,
         environment: Default::default(),
+        path_regularisation: 1.0,
     };
     let err = reference(&args).unwrap_err().to_string();
     assert!(err.contains("already exists"), "{err}");
@@ -288,6 +289,7 @@ fn reference_force_refuses_non_regular_targets() {
                 validation: true,
                 camera: &fovea_tools::look::NO_CAMERA_FLAGS,
                 environment: Default::default(),
+                path_regularisation: 1.0,
             };
             format!("{:#}", reference(&args).unwrap_err())
         });
@@ -410,7 +412,7 @@ fn meaningless_values_are_refused_with_the_flag_named() {
 
     for max_depth in [0, 65] {
         let exr = out.join("ref.exr");
-        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true, camera: &fovea_tools::look::NO_CAMERA_FLAGS, environment: Default::default() };
+        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true, camera: &fovea_tools::look::NO_CAMERA_FLAGS, environment: Default::default(), path_regularisation: 1.0 };
         let err = format!("{:#}", reference(&args).unwrap_err());
         assert!(err.contains("--max-depth"), "{err}");
     }

@@ -64,6 +64,11 @@ pub struct RenderSettings {
     /// How the environment map is found: next-event estimation with MIS (the default), or by
     /// BRDF-sampled rays alone (the comparison the importance-sampling tests measure against).
     pub environment_sampling: EnvironmentSampling,
+    /// Path regularisation strength (shaders/common/path.glsl, `regularise`): after a scattering
+    /// bounce of low pdf, later vertices are roughened so that light a near-specular lobe would
+    /// focus (sunlight through a diffuse-then-glossy path: fireflies) is spread out. Biased, like
+    /// every such filter; 0 turns it off (the unbiased estimator), 1 is the default.
+    pub path_regularisation: f32,
 }
 
 /// `RenderSettings::environment_sampling`.
@@ -90,9 +95,13 @@ impl Default for RenderSettings {
             stereo_noise: StereoNoise::default(),
             environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
+            path_regularisation: DEFAULT_PATH_REGULARISATION,
         }
     }
 }
+
+/// `RenderSettings::path_regularisation` unless the user sets it.
+pub const DEFAULT_PATH_REGULARISATION: f32 = 1.0;
 
 /// How texture lookups choose a mip level (`RenderSettings::texture_lod`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -393,6 +402,7 @@ impl Renderer {
                 EnvironmentSampling::BrdfOnly => self.scene.environment_slots.0 * Vec4::new(1.0, 1.0, 1.0, 0.0),
             },
             environment_map: self.scene.environment_slots.1,
+            path: Vec4::new(self.settings.path_regularisation, 0.0, 0.0, 0.0),
         };
         v.slots[slot].frame_data.write(&[data])
     }

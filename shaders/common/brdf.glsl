@@ -106,10 +106,12 @@ float brdf_pdf(Surface s, vec3 v, vec3 l) {
 }
 
 // Samples a direction; returns false when the path ends. `weight` = f·cos / pdf; `delta` marks
-// a mirror reflection (next-event estimation could not have found that light).
-bool brdf_sample(Surface s, vec3 v, vec3 u, out vec3 l, out vec3 weight, out bool delta) {
+// a mirror reflection (next-event estimation could not have found that light; `pdf` is then
+// 1e30, "infinite"), otherwise `pdf` is the sampled direction's solid-angle density.
+bool brdf_sample(Surface s, vec3 v, vec3 u, out vec3 l, out vec3 weight, out bool delta, out float pdf) {
     delta = false;
     weight = vec3(0.0);
+    pdf = 1e30;
     float n_v = dot(s.normal, v);
     if (n_v <= 0.0) return false;
     float ps = specular_probability(s, n_v);
@@ -122,6 +124,7 @@ bool brdf_sample(Surface s, vec3 v, vec3 u, out vec3 l, out vec3 weight, out boo
             vec3 f = mix(fd, fresnel_schlick(s.base_color, n_v), s.metallic);
             weight = f / ps;
             delta = true;
+            pdf = 1e30;
             return true;
         }
         float alpha = max(s.roughness * s.roughness, 1e-4);
@@ -131,10 +134,22 @@ bool brdf_sample(Surface s, vec3 v, vec3 u, out vec3 l, out vec3 weight, out boo
         float r = sqrt(u.x), phi = 2.0 * PI * u.y;
         l = frame * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
     }
-    float pdf = brdf_pdf(s, v, l);
+    pdf = brdf_pdf(s, v, l);
     if (pdf <= 0.0) return false;
     weight = brdf_eval_cos(s, v, l) / pdf;
     return any(greaterThan(weight, vec3(0.0)));
+}
+
+// Path regularisation (Kaplanyan & Dachsbacher 2013, in the practical form of Cycles' "filter
+// glossy"): a vertex reached through bounces whose smallest density was `min_pdf` gets a GGX
+// alpha of at least ½·sqrt(1 − k·min_pdf) while k·min_pdf < 1. After a diffuse bounce (pdf ≤ 1/π)
+// a near-specular lobe is widened, so sunlight that only next-event estimation can find through it
+// (diffuse → glossy → sun: caustic fireflies) spreads over many samples instead of a few; a
+// sharp earlier bounce (high pdf) leaves mirror-in-mirror reflections as they are. k = 0: unbiased.
+void regularise(inout Surface s, float min_pdf, float k) {
+    float b = k * min_pdf;
+    if (k <= 0.0 || b >= 1.0) return;
+    s.roughness = max(s.roughness, sqrt(0.5 * sqrt(1.0 - b)));
 }
 
 #endif

@@ -47,6 +47,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
     vec3 throughput = vec3(1.0);
     vec3 v = -dir;
     Hit hit;
+    float min_pdf = 1e30;   // smallest bounce density so far (regularise)
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
         color += throughput * direct_light(s, v, rng);
         // The environment's second strategy: at the last vertex a BRDF ray still looks for it
@@ -55,8 +56,10 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         if (last && frame.data.environment_map.z == 0u) break;
         vec3 l, weight;
         bool delta;
+        float pdf;
         vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
-        if (!brdf_sample(s, v, u3, l, weight, delta)) break;
+        if (!brdf_sample(s, v, u3, l, weight, delta, pdf)) break;
+        min_pdf = min(min_pdf, pdf);
         throughput *= weight;
         vec3 o = offset_ray(s.position, s.geometric_normal);
         continuation_rays++;
@@ -72,6 +75,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         if (last) break;
         cone.x += cone.y * hit.t;
         s = fetch_surface(hit, l, cone.x);
+        regularise(s, min_pdf, frame.data.path.x);
         // A mirror bounce cannot be found by next-event estimation: count what it sees.
         if (delta) color += throughput * s.emission;
         v = -l;

@@ -58,6 +58,11 @@ struct SceneFlags {
     /// footprint on the screen; the default) or off (every lookup reads level 0).
     #[arg(long)]
     texture_lod: Option<String>,
+    /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
+    /// vertices' glossy lobes are widened so sunlight focused through them stops making
+    /// fireflies; biased, 0 = off (the unbiased estimator).
+    #[arg(long)]
+    path_regularisation: Option<f32>,
     /// An equirectangular HDR environment map (.exr or .hdr, at most 8192×4096) seen by escaping
     /// rays and sampled by next-event estimation; replaces the sky, and the default sun stays off
     /// unless --sun is given.
@@ -214,6 +219,7 @@ impl RenderOpts {
             blur_sigma: self.blur_sigma,
             environment: self.look.environment()?,
             texture_lod: self.look.texture_lod.clone(),
+            path_regularisation: self.look.path_regularisation,
         })
     }
 }
@@ -592,6 +598,7 @@ fn run() -> Result<()> {
             commands::reference::run(&commands::reference::ReferenceArgs {
                 camera: &look.camera(),
                 environment: look.environment()?,
+                path_regularisation: fovea_tools::render_profile::check_path_regularisation(look.path_regularisation, "--path-regularisation")?,
                 scene: &scene,
                 width,
                 height,
@@ -661,6 +668,7 @@ fn run() -> Result<()> {
                 blur_sigma,
                 environment: look.environment()?,
                 texture_lod: look.texture_lod.clone(),
+                path_regularisation: look.path_regularisation,
                 ..Default::default()
             })?;
             let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();

@@ -12,7 +12,7 @@ use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
-use fovea_renderer::pipeline::TextureLod;
+use fovea_renderer::pipeline::{TextureLod, DEFAULT_PATH_REGULARISATION};
 use fovea_renderer::to_screen::BlurSettings;
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
@@ -34,6 +34,8 @@ pub struct RenderProfile {
     pub environment: EnvironmentOptions,
     /// `[textures] lod`: mip-level selection (`cones` or `off`).
     pub texture_lod: TextureLod,
+    /// `[path] regularisation` (`RenderSettings::path_regularisation`); `None`: the engine's default.
+    pub path_regularisation: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -47,6 +49,13 @@ struct ProfileFile {
     taa: Option<TaaSection>,
     environment: Option<EnvironmentSection>,
     textures: Option<TexturesSection>,
+    path: Option<PathSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct PathSection {
+    regularisation: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -139,6 +148,8 @@ pub struct ProfileOverrides {
     pub environment: EnvironmentOptions,
     /// `--texture-lod`.
     pub texture_lod: Option<String>,
+    /// `--path-regularisation`.
+    pub path_regularisation: Option<f32>,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -300,6 +311,9 @@ impl RenderProfile {
         if let Some(lod) = file.textures.and_then(|t| t.lod) {
             profile.texture_lod = TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
+        if let Some(strength) = file.path.and_then(|p| p.regularisation) {
+            profile.path_regularisation = Some(check_path_regularisation(Some(strength), &format!("{}.regularisation", at("path")))?);
+        }
         Ok(profile)
     }
 
@@ -331,8 +345,29 @@ impl RenderProfile {
         if let Some(lod) = &o.texture_lod {
             self.texture_lod = TextureLod::parse(lod).context("--texture-lod")?;
         }
+        if let Some(strength) = o.path_regularisation {
+            self.path_regularisation = Some(check_path_regularisation(Some(strength), "--path-regularisation")?);
+        }
         Ok(self)
     }
+
+    /// The strength the engine runs with.
+    pub fn path_regularisation(&self) -> f32 {
+        self.path_regularisation.unwrap_or(DEFAULT_PATH_REGULARISATION)
+    }
+}
+
+/// The largest path regularisation strength: k·pdf ≥ 1 switches it off for a bounce, so beyond
+/// this only bounces of density below 0.01 are still roughened (nothing meaningful changes).
+pub const MAX_PATH_REGULARISATION: f32 = 100.0;
+
+/// `value` (or the default when `None`) when it is a meaningful strength; `name` is the flag or key.
+pub fn check_path_regularisation(value: Option<f32>, name: &str) -> Result<f32> {
+    let v = value.unwrap_or(DEFAULT_PATH_REGULARISATION);
+    if !(0.0..=MAX_PATH_REGULARISATION).contains(&v) {
+        bail!("{name} {v} must be in [0, {MAX_PATH_REGULARISATION}] (0 = off, 1 = the default)");
+    }
+    Ok(v)
 }
 
 /// An HMD eye's FOV as the plain tangents the renderer takes.

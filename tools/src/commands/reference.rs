@@ -23,6 +23,8 @@ pub struct ReferenceArgs<'a> {
     pub validation: bool,
     pub camera: &'a crate::look::CameraOptions,
     pub environment: crate::look::EnvironmentOptions,
+    /// `RenderSettings::path_regularisation` (already checked).
+    pub path_regularisation: f32,
 }
 
 pub fn run(args: &ReferenceArgs) -> Result<()> {
@@ -40,7 +42,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let (scene, camera) = crate::look::load(args.scene, args.camera, &args.environment, args.width as f32 / args.height as f32)?;
     let pose = CameraPose::from_scene_camera(&camera, args.width, args.height);
     let ctx = super::open_device(args.device, args.validation)?;
-    let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, ..Default::default() };
+    let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, path_regularisation: args.path_regularisation, ..Default::default() };
     let space = Box::new(Cartesian::new(UVec2::new(args.width, args.height)));
     let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
     let bar = ProgressBar::new(args.spp as u64);
@@ -54,12 +56,13 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     }
     super::check_validation(&ctx)?;
     println!(
-        "wrote {} ({}×{}, {} spp, max depth {}) in {:.1} s on {}",
+        "wrote {} ({}×{}, {} spp, max depth {}, path regularisation {}) in {:.1} s on {}",
         args.out.display(),
         args.width,
         args.height,
         args.spp,
         args.max_depth,
+        args.path_regularisation,
         started.elapsed().as_secs_f64(),
         ctx.info.name
     );

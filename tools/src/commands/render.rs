@@ -61,6 +61,8 @@ struct Report {
     taa: String,
     /// Texture filtering: `cones` (ray-cone mip levels) or `off` (level 0).
     texture_lod: &'static str,
+    /// Path regularisation strength (0 = off, the unbiased estimator).
+    path_regularisation: f32,
     scene: String,
     headset: String,
     /// "left", "right" or "both".
@@ -218,6 +220,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         denoiser: setup.denoiser.name().to_string(),
         taa: setup.taa.name().to_string(),
         texture_lod: args.profile.texture_lod.name(),
+        path_regularisation: args.profile.path_regularisation(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         eyes: eyes.name().to_string(),

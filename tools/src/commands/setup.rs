@@ -244,6 +244,7 @@ pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMo
         denoiser,
         taa,
         texture_lod: args.profile.texture_lod,
+        path_regularisation: args.profile.path_regularisation(),
         ..Default::default()
     }
 }
