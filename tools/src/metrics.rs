@@ -174,6 +174,26 @@ impl Rings {
     }
 }
 
+/// Fireflies of an 8-bit RGBA image (as `tonemap_preview` writes it): pixels whose luma (Rec. 709
+/// weights on the encoded values) is more than `levels` above that of every neighbour in its 3×3
+/// window (border pixels compare with the neighbours they have).
+pub fn isolated_bright_pixels(rgba: &[u8], width: usize, height: usize, levels: f64) -> usize {
+    let luma = |i: usize| 0.2126 * rgba[4 * i] as f64 + 0.7152 * rgba[4 * i + 1] as f64 + 0.0722 * rgba[4 * i + 2] as f64;
+    let mut count = 0;
+    for y in 0..height {
+        for x in 0..width {
+            let centre = luma(y * width + x);
+            let brightest_neighbour = (y.saturating_sub(1)..(y + 2).min(height))
+                .flat_map(|ny| (x.saturating_sub(1)..(x + 2).min(width)).map(move |nx| (nx, ny)))
+                .filter(|&(nx, ny)| (nx, ny) != (x, y))
+                .map(|(nx, ny)| luma(ny * width + nx))
+                .fold(f64::NEG_INFINITY, f64::max);
+            count += (centre - brightest_neighbour > levels) as usize;
+        }
+    }
+    count
+}
+
 /// Mean of a map, skipping NaN entries.
 pub fn mean(map: &[f64]) -> Option<f64> {
     let (s, n) = map.iter().filter(|v| !v.is_nan()).fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));

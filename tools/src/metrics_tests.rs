@@ -152,3 +152,18 @@ fn flicker_is_change_the_reference_does_not_have() {
     assert!(still.iter().all(|&f| (f - 40.0 / 255.0).abs() < 1e-12), "{still:?}");
     assert!(flicker_map(&a, &b, &a, &b).iter().all(|&f| f == 0.0));
 }
+
+#[test]
+fn isolated_bright_pixels_counts_only_pixels_brighter_than_every_neighbour() {
+    let (w, h) = (6usize, 5usize);
+    let mut img: Vec<u8> = std::iter::repeat_n([40u8, 40, 40, 255], w * h).flatten().collect();
+    let mut set = |x: usize, y: usize, v: u8| img[4 * (y * w + x)..4 * (y * w + x) + 3].copy_from_slice(&[v, v, v]);
+    set(2, 2, 200); // a firefly
+    set(0, 0, 150); // one in the corner (three neighbours)
+    set(4, 1, 220); // two bright neighbours: neither is isolated
+    set(5, 1, 210);
+    set(4, 3, 90); // only 50 levels above its neighbours
+    assert_eq!(isolated_bright_pixels(&img, w, h, 60.0), 2);
+    assert_eq!(isolated_bright_pixels(&img, w, h, 40.0), 3);
+    assert_eq!(isolated_bright_pixels(&img, w, h, 200.0), 0);
+}

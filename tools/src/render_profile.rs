@@ -429,6 +429,7 @@ mod tests {
         assert_eq!(p.asvgf, AsvgfSettings::default());
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
+        assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
         assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None, ..Default::default() });
@@ -498,6 +499,10 @@ gradient_sigma_normal = 64
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),
             ("lod.toml", "[textures]\nlod = \"trilinear\"\n", "[textures].lod"),
             ("lod_key.toml", "[textures]\nbias = 1\n", "bias"),
+            ("reg.toml", "[path]\nregularisation = -1\n", "[path].regularisation"),
+            ("reg_nan.toml", "[path]\nregularisation = nan\n", "[path].regularisation"),
+            ("reg_big.toml", "[path]\nregularisation = 101\n", "[path].regularisation"),
+            ("reg_key.toml", "[path]\nfilter = 1\n", "filter"),
         ];
         for (name, text, key) in cases {
             let err = format!("{:#}", load_str(name, text).unwrap_err());
@@ -526,6 +531,15 @@ gradient_sigma_normal = 64
         let bad = ProfileOverrides { texture_lod: Some("on".into()), ..Default::default() };
         let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
         assert!(err.contains("--texture-lod") && err.contains("cones, off"), "{err}");
+        let p = load_str("reg_off.toml", "[path]\nregularisation = 0\n").unwrap();
+        assert_eq!(p.path_regularisation(), 0.0);
+        let o = ProfileOverrides { path_regularisation: Some(2.5), ..Default::default() };
+        assert_eq!(p.override_with(&o).unwrap().path_regularisation(), 2.5);
+        for bad in [f32::NAN, -0.5, f32::INFINITY, 1e9] {
+            let o = ProfileOverrides { path_regularisation: Some(bad), ..Default::default() };
+            let err = format!("{:#}", RenderProfile::default().override_with(&o).unwrap_err());
+            assert!(err.contains("--path-regularisation") && err.contains("[0, 100]"), "{err}");
+        }
         let o = ProfileOverrides { eccentricity: Some("headset".into()), ..Default::default() };
         assert_eq!(RenderProfile::default().override_with(&o).unwrap().eccentricity, EccentricityMode::Headset);
         let bad = ProfileOverrides { eccentricity: Some("degrees".into()), ..Default::default() };

@@ -51,8 +51,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let image = renderer.render_reference(&pose, args.spp, args.max_depth, |done| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     write_exr(args.out, args.width, args.height, &image)?;
+    let displayed = tonemap_preview(&image, 1.0);
     if args.preview {
-        write_png(&preview, args.width, args.height, &tonemap_preview(&image, 1.0))?;
+        write_png(&preview, args.width, args.height, &displayed)?;
     }
     super::check_validation(&ctx)?;
     println!(
@@ -66,5 +67,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         ctx.info.name
     );
+    // What a converged image should not have: isolated pixels far brighter than their neighbours.
+    let (w, h) = (args.width as usize, args.height as usize);
+    let [ff30, ff60, ff100] = [30.0, 60.0, 100.0].map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
+    println!("fireflies (pixels of the tonemapped image brighter than all 8 neighbours by > 30 / 60 / 100 of 255 levels): {ff30} / {ff60} / {ff100} of {}", w * h);
     Ok(())
 }
