@@ -490,8 +490,8 @@ fn camera_path_files_drive_the_camera() {
     assert!(err.contains("--camera-path") && err.contains("absent.toml"), "{err}");
 }
 
-/// `fovea bench --camera-path FILE`: the VP vs Cartesian frames follow the keyframes, and the
-/// report says so; the frames' passes are measured as on a still camera.
+/// `fovea bench --camera-path FILE`: the VP vs Cartesian frames follow the keyframes and the ray
+/// rates take their primary rays from frames along it, and the report says so.
 #[test]
 fn bench_vp_frames_follow_a_camera_path() {
     use fovea_tools::camera_keys::{CameraKeys, Key};
@@ -504,7 +504,7 @@ fn bench_vp_frames_follow_a_camera_path() {
     let args = BenchArgs {
         scenes: &scenes,
         builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
-        sizes: &[],
+        sizes: &[(32, 36)],
         vp_sizes: &[(64, 72)],
         frames: 2,
         loop_size: None,
@@ -519,4 +519,7 @@ fn bench_vp_frames_follow_a_camera_path() {
     let vp = &report["visual_polar"][0];
     assert_eq!(vp["camera_motion"], "keys");
     assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
+    let rays = &report["rays"][0];
+    assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
+    assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");
 }

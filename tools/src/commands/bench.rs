@@ -34,7 +34,8 @@ pub struct BenchArgs<'a> {
     pub loop_size: Option<(u32, u32)>,
     /// Timed frames of each loop run (after `bench_loop::WARMUP_FRAMES` warm-up frames).
     pub loop_frames: u32,
-    /// Keyframes the VP vs Cartesian frames follow (`--camera-path FILE`; none: the still camera).
+    /// Keyframes the VP vs Cartesian frames follow and the ray rates are measured along
+    /// (`--camera-path FILE`; none: the still camera).
     pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
     pub out: &'a Path,
     pub device: Option<&'a str>,
@@ -72,6 +73,9 @@ struct RayReport {
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
     frame_rays: u64,
+    /// Camera poses the primary rays come from: 1 (the scene's camera), or with `--camera-path`
+    /// [`PATH_RAY_POSES`] frames spread over the keyframes (each a whole w×h frame of rays).
+    ray_poses: usize,
     /// Primary rays whose hit (hit or miss, or distance beyond 1e-5 relative) differs from the
     /// first builder's: every tree must find the same surfaces, so anything but 0 is a bug.
     primary_hits_differ: usize,
@@ -154,7 +158,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         };
         for &(w, h) in args.sizes {
             let pose = CameraPose::from_scene_camera(camera, w, h);
-            let primary = primary_rays(&pose, w, h);
+            let poses = ray_poses(args.camera_path, &pose);
+            let primary: Vec<RayGpu> = poses.iter().flat_map(|p| primary_rays(p, w, h)).collect();
             // The secondary rays start from the first builder's hits so that every builder traces
             // the same rays (hits may differ in the last bit between trees).
             let (hits, _) = caster.trace(&variants[0].2, &primary, false)?;
@@ -197,6 +202,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     indirect_mrays_per_s: rate(indirect.len(), indirect_ms),
                     frame_passes_ms: sums,
                     frame_rays,
+                    ray_poses: poses.len(),
                     primary_hits_differ,
                 };
                 println!(
@@ -247,6 +253,17 @@ pub(crate) fn timed_trace(caster: &mut RayCaster, gpu: &GpuScene, rays: &[RayGpu
     }
     ms.sort_by(f64::total_cmp);
     Ok((hits, ms[TIMED_RUNS / 2]))
+}
+
+/// Frames of primary rays the ray-rate figures take along a camera path: its start, its end and
+/// evenly between (the rates then describe the path's views, not one of them).
+pub const PATH_RAY_POSES: usize = 4;
+
+/// The poses of the ray-rate figures: the still camera, or [`PATH_RAY_POSES`] along the keyframes.
+fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) -> Vec<CameraPose> {
+    let Some(keys) = path else { return vec![*still] };
+    let (first, last) = (keys.keys()[0].time, keys.keys()[keys.keys().len() - 1].time);
+    (0..PATH_RAY_POSES).map(|i| keys.pose(first + (last - first) * i as f64 / (PATH_RAY_POSES - 1) as f64, still)).collect()
 }
 
 fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
