@@ -143,6 +143,35 @@ fn luminance(pixels: &[[f32; 4]]) -> f64 {
     0.2126 * r + 0.7152 * g + 0.0722 * b
 }
 
+/// The Preetham sky is scaled to the gradient sky's irradiance on an upward plane, so a white
+/// floor under either (sun off) has radiance albedo · E / π: the rendered luminance checks the
+/// bake, its scale and the importance sampling of a map with a circumsolar peak at once.
+#[test]
+fn preetham_and_gradient_skies_light_an_upward_plane_alike() {
+    use fovea_tools::sky_model::{upward_irradiance, SkyModel};
+    let ctx = gpu();
+    let albedo = 0.8f32;
+    let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    let mut means = Vec::new();
+    for sky in [SkyModel::Gradient, SkyModel::Preetham] {
+        let mut scene = Scene { materials: vec![lambert(albedo, 0.0)], mesh_names: vec!["floor".into()], ..Default::default() };
+        let s = 50.0;
+        add_quad(&mut scene, [Vec3::new(-s, 0.0, -s), Vec3::new(-s, 0.0, s), Vec3::new(s, 0.0, s), Vec3::new(s, 0.0, -s)], 0);
+        let env = EnvironmentOptions { sun: Some([40.0, 25.0]), sun_intensity: Some(0.0), sky_intensity: Some(1.0), sky: Some(sky), ..Default::default() };
+        look::apply_environment(&mut scene, &env);
+        let map = scene.environment_map().unwrap().into_owned();
+        let expected = albedo * upward_irradiance(&map) / std::f32::consts::PI;
+        let camera = Camera::look_at(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 0.0, -0.01), 0.5, "down");
+        let image = reference(&ctx, &scene, &camera, UVec2::splat(8), 256, 2);
+        let mean = image.iter().map(luminance).sum::<f32>() / image.len() as f32;
+        println!("{} sky: floor luminance {mean:.5}, expected {expected:.5}", sky.name());
+        assert!((mean - expected).abs() < 0.02 * expected, "{}: {mean} vs {expected}", sky.name());
+        means.push(expected);
+    }
+    assert!((means[0] - means[1]).abs() < 1e-3 * means[0], "{means:?}");
+    assert_clean(&ctx);
+}
+
 /// A real scene loaded as every command loads it (default sun, sky, camera), 64×72, 4 spp.
 fn real_scene_luminance(name: &str, file: &str) -> Option<f64> {
     let Some(path) = shared_data(&format!("scenes/{name}/{file}")) else {

@@ -18,5 +18,6 @@ pub mod render_profile;
 pub mod replay;
 pub mod scenegen;
 pub mod scenes;
+pub mod sky_model;
 pub mod viewer;
 pub mod xr;

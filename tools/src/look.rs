@@ -16,6 +16,7 @@
 //!   their own never get the sun.
 
 use anyhow::{bail, Context, Result};
+use crate::sky_model::{preetham_map, SkyModel};
 use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
 use glam::Vec3;
 use std::path::PathBuf;
@@ -56,6 +57,8 @@ pub struct EnvironmentOptions {
     pub env_rotation: Option<f32>,
     /// Radiance scale of the map (default 1).
     pub env_intensity: Option<f32>,
+    /// The sky's model (`--sky`; default the gradient).
+    pub sky: Option<SkyModel>,
 }
 
 /// The names used in error messages: the flags, or a profile's keys.
@@ -100,6 +103,7 @@ impl EnvironmentOptions {
             env: over.env.clone().or_else(|| self.env.clone()),
             env_rotation: over.env_rotation.or(self.env_rotation),
             env_intensity: over.env_intensity.or(self.env_intensity),
+            sky: over.sky.or(self.sky),
         }
     }
 
@@ -107,10 +111,11 @@ impl EnvironmentOptions {
     /// maps existed (so older baselines do not read as changed), the map's fields only when given.
     pub fn describe(&self) -> String {
         let base = format!("EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}", self.sun, self.sun_intensity, self.sky_intensity);
+        let sky = self.sky.map_or(String::new(), |m| format!(", sky: {}", m.name()));
         if self.env.is_none() && self.env_rotation.is_none() && self.env_intensity.is_none() {
-            return base + " }";
+            return format!("{base}{sky} }}");
         }
-        format!("{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?} }}", self.env, self.env_rotation, self.env_intensity)
+        format!("{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?}{sky} }}", self.env, self.env_rotation, self.env_intensity)
     }
 
     pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
@@ -176,7 +181,7 @@ pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<
     if scene.has_lights() {
         // The scene's own lighting stays as authored; only an explicit sky is added.
         if let Some(s) = env.sky_intensity.filter(|&s| s > 0.0) {
-            scene.sky = default_sky(s);
+            set_sky(scene, env, s);
         }
         return None;
     }
@@ -187,11 +192,26 @@ pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<
         // `direction` is where the light travels: away from the sun.
         scene.punctual_lights.push(PunctualLight::Directional { direction: -sun_direction(azimuth, elevation), illuminance: Vec3::splat(sun) });
     }
-    scene.sky = default_sky(sky);
+    set_sky(scene, env, sky);
+    let model = env.sky.unwrap_or_default().name();
     Some(format!(
-        "no lights in the scene: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; sky intensity {sky}; \
-         change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity or a profile's [environment]; 0 turns either off)"
+        "no lights in the scene: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; {model} sky, intensity {sky}; \
+         change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity, --sky gradient|preetham or a profile's [environment]; 0 turns either off)"
     ))
+}
+
+/// The sky of intensity `intensity` in the chosen model: the gradient as the scene's `Sky`, the
+/// Preetham sky (around the sun's position, with or without the sun light itself) as a baked map.
+fn set_sky(scene: &mut Scene, env: &EnvironmentOptions, intensity: f32) {
+    match env.sky.unwrap_or_default() {
+        SkyModel::Gradient => scene.sky = default_sky(intensity),
+        SkyModel::Preetham if intensity > 0.0 => {
+            let [azimuth, elevation] = env.sun.unwrap_or(DEFAULT_SUN);
+            scene.sky = Sky::default();
+            scene.environment = Some(preetham_map(sun_direction(azimuth, elevation), intensity));
+        }
+        SkyModel::Preetham => scene.sky = Sky::default(),
+    }
 }
 
 /// With `--env`: the map replaces the sky; the sun only with an explicit `sun` in a scene without

@@ -112,6 +112,27 @@ fn default_sun_and_sky_only_for_scenes_without_lights() {
 }
 
 #[test]
+fn preetham_sky_travels_as_a_map_around_the_sun() {
+    use crate::sky_model::{preetham_map, SkyModel};
+    let preetham = EnvironmentOptions { sun: Some([120.0, 35.0]), sky: Some(SkyModel::Preetham), ..Default::default() };
+    let mut dark = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    let notice = apply_environment(&mut dark, &preetham).unwrap();
+    assert!(notice.contains("preetham sky"), "{notice}");
+    assert!(dark.sky.is_black() && dark.punctual_lights.len() == 1);
+    assert_eq!(dark.environment, Some(preetham_map(sun_direction(120.0, 35.0), DEFAULT_SKY_INTENSITY)));
+    // A scene with lights: only on request, and then around the default sun's position.
+    let mut lit = scene_with(Vec3::ZERO, Vec3::ONE, Material { emissive: Vec3::ONE, ..Default::default() });
+    apply_environment(&mut lit, &EnvironmentOptions { sky: Some(SkyModel::Preetham), ..Default::default() });
+    assert!(lit.environment.is_none());
+    apply_environment(&mut lit, &EnvironmentOptions { sky: Some(SkyModel::Preetham), sky_intensity: Some(2.0), ..Default::default() });
+    assert_eq!(lit.environment, Some(preetham_map(sun_direction(DEFAULT_SUN[0], DEFAULT_SUN[1]), 2.0)));
+    assert!(lit.punctual_lights.is_empty());
+    let mut off = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    apply_environment(&mut off, &EnvironmentOptions { sky_intensity: Some(0.0), ..preetham });
+    assert!(off.environment.is_none() && off.sky.is_black());
+}
+
+#[test]
 fn environment_values_are_checked_with_the_name() {
     let flags = EnvironmentNames::flags();
     assert!(EnvironmentOptions { sun: Some([10.0, 90.0]), sun_intensity: Some(0.0), sky_intensity: Some(1e6), ..Default::default() }.validate(&flags).is_ok());

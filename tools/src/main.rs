@@ -68,6 +68,10 @@ struct SceneFlags {
     /// unless --sun is given.
     #[arg(long)]
     env: Option<std::path::PathBuf>,
+    /// The default sky's model: gradient (the default: a horizon-to-zenith gradient) or preetham
+    /// (Preetham et al. 1999's daylight, turbidity 3, around the --sun position).
+    #[arg(long)]
+    sky: Option<String>,
     /// The environment map's rotation about +Y in degrees (counter-clockwise seen from above; default 0).
     #[arg(long, allow_hyphen_values = true)]
     env_rotation: Option<f32>,
@@ -94,6 +98,7 @@ impl SceneFlags {
             env: self.env.clone(),
             env_rotation: self.env_rotation,
             env_intensity: self.env_intensity,
+            sky: self.sky.as_deref().map(fovea_tools::sky_model::SkyModel::parse).transpose().context("--sky")?,
         })
     }
 }

@@ -75,6 +75,8 @@ struct EnvironmentSection {
     env: Option<std::path::PathBuf>,
     env_rotation: Option<f32>,
     env_intensity: Option<f32>,
+    /// "gradient" or "preetham".
+    sky: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -302,6 +304,7 @@ impl RenderProfile {
                 env,
                 env_rotation: f.env_rotation,
                 env_intensity: f.env_intensity,
+                sky: f.sky.as_deref().map(crate::sky_model::SkyModel::parse).transpose().with_context(|| format!("{}.sky", at("environment")))?,
             };
             profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
             if let Some(env) = &profile.environment.env {
@@ -595,6 +598,7 @@ gradient_sigma_normal = 64
             ("env = \"envmap.toml\"", "[environment].env"),
             ("env_intensity = -1.0", "[environment].env_intensity"),
             ("env_rotation = inf", "[environment].env_rotation"),
+            ("sky = \"hosek\"", "[environment].sky"),
         ] {
             let err = format!("{:#}", load_str("envmap_bad.toml", &format!("[environment]\n{text}\n")).unwrap_err());
             assert!(err.contains("envmap_bad.toml") && err.contains(key), "{text}: {err}");
