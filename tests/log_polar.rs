@@ -30,22 +30,32 @@ fn log_polar_traces_exactly_its_buffer() {
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), screen.x, screen.y);
     for (gaze, extent) in [(Vec2::new(32.0, 36.0), LogPolarExtent::FarthestCorner), (Vec2::new(5.0, 60.0), LogPolarExtent::Diagonal)] {
         let space = log_polar(screen, gaze, extent);
+        // Texel centres off the screen (full circles out to the extent); the GPU's jittered
+        // samples differ only where a texel straddles the screen's border.
+        let inside = |p: Vec2| p.x >= 0.0 && p.y >= 0.0 && p.x < screen.x as f32 && p.y < screen.y as f32;
+        let off_centres = (0..36 * 40)
+            .filter(|i| !inside(space.grid_to_screen(Vec2::new((i % 36) as f32 + 0.5, (i / 36) as f32 + 0.5)).unwrap()))
+            .count() as f64;
         // 64 / 1.8 = 35.6, 72 / 1.8 = 40: every texel of the 36 × 40 buffer holds a sample.
         assert_eq!((space.grid_size(), SamplingSpace::sample_count(&space)), (UVec2::new(36, 40), 36 * 40));
         let mut r = Renderer::new(&ctx, &scene, Box::new(space), RenderSettings::default()).unwrap();
         let stats = r.render_frame(&FrameInput::mono(camera, 0, Some(gaze))).unwrap();
         assert_eq!(stats.samples_traced, 36 * 40, "{extent:?}: every texel traced once");
-        // Full circles out to the extent: the corners' circle leaves some samples off the screen.
-        assert!(stats.samples_offscreen > 0 && stats.samples_offscreen < stats.samples_traced / 2, "{extent:?}: {stats:?}");
+        let off = stats.samples_offscreen as f64;
+        println!("{extent:?}: {off} samples off the screen, {off_centres} texel centres");
+        assert!(off > 0.0 && (off - off_centres).abs() <= 0.05 * 1440.0, "{extent:?}: {stats:?}, {off_centres} centres off the screen");
         assert_eq!(stats.primary_rays, stats.samples_traced, "one primary ray per sample");
     }
     assert_clean(&ctx);
 }
 
 /// 96×108 Cornell box, still camera, gaze at the centre, blur off: 16 frames of each filter
-/// against the raw one-sample frame, both against a 128-spp Cartesian reference, on the surface
-/// interiors after the remap. The log-polar buffer is coarse away from the gaze (α = 4 pushes
-/// samples outward, but 1/σ² of the pixels is still ~0.3 per pixel), so the bound is 2×.
+/// against the raw one-sample frame, both against the space's own converged image (the mean of
+/// 128 raw frames after the remap), on the surface interiors. Against a full-resolution
+/// Cartesian reference the buffer's resolution (≈ 0.3 samples per pixel) bounds what any filter
+/// can do (measured: SVGF 1.8×, BMFR 3.0×); the noise the filters are for is measured against
+/// the space's own limit. Bound: 2× (measured SVGF 2.4×, A-SVGF 2.3×, BMFR 2.5×, TAA 4.0×; the
+/// à-trous and BMFR fits also smooth the coarse periphery, a bias the converged image lacks).
 #[test]
 fn each_filter_runs_on_log_polar_and_reduces_noise() {
     let ctx = gpu();
@@ -54,16 +64,23 @@ fn each_filter_runs_on_log_polar_and_reduces_noise() {
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
     let blur_off = RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, ..Default::default() };
     let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), blur_off).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 128, 3, |_| {}).unwrap();
+    let full_reference = reference_renderer.render_reference(&camera, 128, 3, |_| {}).unwrap();
     drop(reference_renderer);
     let gaze = size.as_vec2() * 0.5;
     let frame = |f: u32| FrameInput::mono(camera, f, Some(gaze)).with_hdr(true);
 
     let mut raw_renderer = Renderer::new(&ctx, &scene, Box::new(log_polar(size, gaze, LogPolarExtent::FarthestCorner)), blur_off).unwrap();
-    let mut raw = Vec::new();
-    raw_renderer.render_frame(&frame(0)).unwrap();
-    raw_renderer.read_hdr(&mut raw).unwrap();
+    let (mut raw, mut reference) = (Vec::new(), vec![[0.0f32; 4]; (size.x * size.y) as usize]);
+    const CONVERGED_FRAMES: u32 = 128;
+    for f in (0..CONVERGED_FRAMES).rev() {
+        raw_renderer.render_frame(&frame(f)).unwrap();
+        raw_renderer.read_hdr(&mut raw).unwrap();
+        for (m, p) in reference.iter_mut().zip(&raw) {
+            (0..4).for_each(|c| m[c] += p[c] / CONVERGED_FRAMES as f32);
+        }
+    }
     drop(raw_renderer);
+    save_preview("log_polar_converged.png", size.x, size.y, &reference);
     save_preview("log_polar_raw.png", size.x, size.y, &raw);
 
     let taa = TaaMode::SamplingGrid(TaaSettings::default());
@@ -86,7 +103,8 @@ fn each_filter_runs_on_log_polar_and_reduces_noise() {
         save_preview(&format!("log_polar_{name}.png"), size.x, size.y, &out);
         let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         let (a, b) = (rmse_where(&raw, &reference, |i| interior[i]), rmse_where(&out, &reference, |i| interior[i]));
-        println!("log-polar {name}: surface interiors RMSE {a:.4} → {b:.4} ({:.2}×)", a / b);
+        let (fa, fb) = (rmse_where(&raw, &full_reference, |i| interior[i]), rmse_where(&out, &full_reference, |i| interior[i]));
+        println!("log-polar {name}: surface interiors RMSE {a:.4} → {b:.4} ({:.2}×) against the converged log-polar image, {fa:.4} → {fb:.4} ({:.2}×) against full resolution", a / b, fa / fb);
         if a / b < 2.0 {
             failures.push(format!("{name}: RMSE fell only {:.2}× ({a:.4} → {b:.4})", a / b));
         }
