@@ -15,6 +15,9 @@
 //!   some thousand pixels out): toward the image plane's horizon the distance a·sin e/(h·cos e −
 //!   b·sin e) magnifies one ulp of e or of the driver's sin/cos (an op-for-op sin/cos was tried
 //!   and changed nothing measurable), and nothing off the screen is ever displayed.
+//! - log-polar law (log_polar.rs / log_polar.glsl, plain-arithmetic exp and ln on both sides):
+//!   the paper's bounds, on-screen samples < 1e-3 px, off-screen ones (the diagonal extent) 1e-5
+//!   of their distance from the gaze.
 //! - screen → grid: x and y each < 1e-3 texel (a texel is ≥ ~0.3 px in the fovea, far more
 //!   outside). y is compared as the angle φ wrapped to [−π, π) and then expressed in rows, so the
 //!   seam (y ≈ 0 vs y ≈ n) and column-boundary cases compare correctly. In arc length at the far
@@ -26,7 +29,7 @@
 
 use fovea_renderer::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use fovea_renderer::layouts::VpProbePush;
-use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::{Buffer, ComputePipeline};
 use fovea_tests::{assert_clean, gpu};
 use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
@@ -269,6 +272,42 @@ fn rust_and_glsl_headset_mappings_agree() {
                 println!("{line}");
                 let screen_ok =
                     r.screen_px_on_screen < SCREEN_BOUND_PX && r.screen_relative_off_screen < RELATIVE_BOUND_HEADSET_OFF_SCREEN;
+                if !(screen_ok && r.grid_x < GRID_BOUND && r.grid_y < GRID_BOUND) {
+                    failures.push(line);
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert_clean(&ctx);
+}
+
+/// The log-polar radial law (Meng et al. 2018) through the same probe: α 4 (Meng) and 1 (plain
+/// log-polar), L from the farthest corner and from the diagonal, gaze at the centre, near an edge
+/// and in a corner, two screen sizes.
+#[test]
+fn rust_and_glsl_log_polar_mappings_agree() {
+    let ctx = gpu();
+    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
+    let mut failures = Vec::new();
+    let mut seed = 200u64;
+    for screen in [UVec2::new(1280, 1440), UVec2::new(320, 360)] {
+        let s = screen.as_vec2();
+        let gazes = [("centre", s * 0.5), ("edge", Vec2::new(0.02, 0.45) * s), ("corner", Vec2::new(0.97, 0.985) * s)];
+        for (gaze_name, gaze) in gazes {
+            for (alpha, extent) in [(4.0, LogPolarExtent::FarthestCorner), (4.0, LogPolarExtent::Diagonal), (1.0, LogPolarExtent::FarthestCorner)] {
+                let lp = LogPolarParams { alpha, extent, ..Default::default() };
+                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(lp), ..Default::default() }).unwrap();
+                seed += 1;
+                let r = run_case(&ctx, &pipeline, &mut recorder, &vp, seed);
+                let line = format!(
+                    "log-polar {}x{} gaze {gaze_name} α {alpha} {extent:?}: grid→screen {:.2e} px on screen ({:.2e} of the distance off it), \
+                     screen→grid x {:.2e} / y {:.2e} texels",
+                    screen.x, screen.y, r.screen_px_on_screen, r.screen_relative_off_screen, r.grid_x, r.grid_y
+                );
+                println!("{line}");
+                let screen_ok = r.screen_px_on_screen < SCREEN_BOUND_PX && r.screen_relative_off_screen < 1e-5;
                 if !(screen_ok && r.grid_x < GRID_BOUND && r.grid_y < GRID_BOUND) {
                     failures.push(line);
                 }

@@ -36,15 +36,17 @@ impl Default for BlurSettings {
 }
 
 impl BlurSettings {
-    /// The blur for one gaze: σ = 0 inside the fovea, linear beyond, `sigma_at_30` (scaled to
-    /// this screen) at 30°.
+    /// The blur for one gaze: σ = 0 inside `blur_start`, then growing at the paper's rate
+    /// (`sigma_at_30`, scaled to this screen, at 30° for a blur starting at the fovea's edge).
     pub fn shape(&self, vp: &VisualPolar) -> BlurShape {
         let screen = vp.screen().as_vec2();
         let sigma_30 = self.sigma_at_30 * (screen.x * screen.y / FOVE_EYE_PIXELS).sqrt();
         let r_f = vp.r_fovea();
         let r_30 = vp.radius_of_eccentricity(SIGMA_REFERENCE_DEG);
         let slope = if r_30 > r_f { sigma_30 / (r_30 - r_f) } else { 0.0 };
-        BlurShape { gaze: vp.gaze(), fovea_radius: r_f, sigma_slope: slope }
+        // The slope is the paper's (fovea edge → 30°); the blur starts where the space leaves the
+        // image sharp (the fovea; log-polar: the buffer's inner half).
+        BlurShape { gaze: vp.gaze(), fovea_radius: vp.blur_start(), sigma_slope: slope }
     }
 }
 

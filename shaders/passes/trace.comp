@@ -11,6 +11,8 @@
 //! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
 //! variant cartesian_gradients: SAMPLING_CARTESIAN TRACE_GRADIENTS
 //! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
+//! variant log_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
+//! variant log_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"

@@ -12,6 +12,10 @@
 // degrees (r_max = e_norm = 1, r_f = fovea°, derived here), the CDF runs over [0, e_max] with the
 // exact inverse; screen offsets convert through the eye's FOV tangents (vp_headset_*).
 //
+// Log-polar radial law (flag 8, Rust log_polar.rs): r(u) and u(r) are Meng's kernel log-polar
+// law (log_polar.glsl) with α, L in shape1.zw; no clip (u_f = 0). The paper-axis kernels
+// (VP_NORMALIZED_AXIS_ONLY) compile it out, like the headset axis.
+//
 // Self-contained on purpose (no layouts.glsl): the parameters come as the four vectors of the
 // `SamplingParams` slots, packed by `VisualPolar::sampling_params()`, and `vp_unpack` names them.
 #ifndef FOVEA_SAMPLING_VISUAL_POLAR_MATH_GLSL
@@ -32,8 +36,10 @@ const float VP_FAR_PIXELS_PER_SCREEN = 4.0;
 // would otherwise cost every default frame. Everywhere else P.headset decides at run time.
 #if defined(VP_NORMALIZED_AXIS_ONLY)
 const bool VP_MAY_USE_HEADSET_AXIS = false;
+const bool VP_MAY_USE_LOG_POLAR = false;
 #else
 const bool VP_MAY_USE_HEADSET_AXIS = true;
+const bool VP_MAY_USE_LOG_POLAR = true;
 #endif
 
 struct VpParams {
@@ -54,6 +60,9 @@ struct VpParams {
     vec2 gaze_tan;   // headset: the gaze in tangent space
     vec2 tan_scale;  // headset: tangent units per pixel
     float far;       // headset: where samples beyond their ray's horizon are parked (pixels)
+    bool log_polar;  // the radial law is Meng's kernel log-polar (log_polar.glsl)
+    float lp_alpha;  // log-polar: kernel exponent α
+    float lp_l;      // log-polar: L = ln of the extent (pixels)
 };
 
 // Reddy's acuity V(e), cycles per degree.
@@ -78,6 +87,8 @@ float vp_ln(float x) {
     float l = float(k) * 0.6931472 + (2.0 * s + 2.0 * s * q);
     return l;
 }
+
+#include "log_polar.glsl"
 
 // Eq. 2 literally (d >= 5.79); below the knee the fovea part ∝ d², continuous.
 float vp_cdf_eq2(float d) {
@@ -124,7 +135,8 @@ float vp_cdf_derivative(float d, float k) {
 }
 
 // Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
-// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis), and
+// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis, 8 log-polar
+// law: shape1.zw = (α, L)), and
 // - paper axis: gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
 //   shape1 = (cdf_max, flags, fovea° (unused here), 0);
 // - headset axis: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
@@ -150,6 +162,9 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.gaze_tan = vec2(gaze.z, shape0.w);
     p.tan_scale = shape1.zw;
     p.far = VP_FAR_PIXELS_PER_SCREEN * (p.screen.x + p.screen.y);
+    p.log_polar = VP_MAY_USE_LOG_POLAR && (flags & 8u) != 0u;
+    p.lp_alpha = shape1.z;
+    p.lp_l = shape1.w;
     return p;
 }
 
@@ -220,6 +235,7 @@ bool vp_is_valid_texel(VpParams P, ivec2 t) {
 }
 
 float vp_r_of_u(VpParams P, float u) {
+    if (P.log_polar) return lp_r_of_u(u, P.lp_l, P.lp_alpha);
     if (u < P.u_f) return u / P.u_f * P.r_f;
     float e_top = P.headset ? VP_E_TOP_HEADSET_DEG : VP_E_MAX_DEG;
     float e = P.exact
@@ -294,6 +310,7 @@ vec2 vp_offset_of(VpParams P, float u, float phi) {
 }
 
 float vp_u_of_r(VpParams P, float r) {
+    if (P.log_polar) return lp_u_of_r(r, P.lp_l, P.lp_alpha);
     if (r < P.r_f) return r / P.r_f * P.u_f;
     float e = r / P.r_max * P.e_norm;
     if (P.exact) return 1.0 - vp_cdf_tail(e, P.k, P.e_max, P.cdf_max) / P.cdf_max / (1.0 - P.p_f) * (1.0 - P.u_f);

@@ -187,6 +187,10 @@ struct RenderOpts {
     /// (true degrees through the --headset eye's FOV).
     #[arg(long)]
     vp_eccentricity: Option<String>,
+    /// --method log-polar: L from the farthest corner (Meng et al. 2018, default) or the screen
+    /// diagonal (Andersson & Hansson 2020); σ and α from the profile's [log_polar].
+    #[arg(long)]
+    log_polar_extent: Option<String>,
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
@@ -221,6 +225,7 @@ impl RenderOpts {
             radius: self.vp_radius.clone(),
             layout: self.vp_layout.clone(),
             eccentricity: self.vp_eccentricity.clone(),
+            log_polar_extent: self.log_polar_extent.clone(),
             blur_sigma: self.blur_sigma,
             environment: self.look.environment()?,
             texture_lod: self.look.texture_lod.clone(),

@@ -7,7 +7,7 @@
 //! (`RenderProfile::visual_polar_for`).
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
@@ -21,6 +21,8 @@ use std::path::Path;
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
+    /// `[log_polar]`: `--method log-polar` (Meng et al. 2018; σ, α, the extent L comes from).
+    pub log_polar: LogPolarParams,
     /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
     /// until `visual_polar_for` adds the headset's FOV.
     pub eccentricity: EccentricityMode,
@@ -42,6 +44,7 @@ pub struct RenderProfile {
 #[serde(deny_unknown_fields)]
 struct ProfileFile {
     visual_polar: Option<VpSection>,
+    log_polar: Option<LogPolarSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
     bmfr: Option<BmfrSection>,
@@ -130,6 +133,14 @@ struct VpSection {
 
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
+struct LogPolarSection {
+    sigma: Option<f32>,
+    alpha: Option<f32>,
+    extent: Option<String>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 struct BlurSection {
     sigma_at_30: Option<f32>,
 }
@@ -145,6 +156,8 @@ pub struct ProfileOverrides {
     pub radius: Option<String>,
     pub layout: Option<String>,
     pub eccentricity: Option<String>,
+    /// `--log-polar-extent`.
+    pub log_polar_extent: Option<String>,
     pub blur_sigma: Option<f32>,
     /// `--sun`, `--sun-intensity`, `--sky-intensity`.
     pub environment: EnvironmentOptions,
@@ -177,6 +190,23 @@ pub fn eccentricity_name(mode: EccentricityMode) -> &'static str {
     match mode {
         EccentricityMode::Normalized => "normalized",
         EccentricityMode::Headset => "headset",
+    }
+}
+
+/// `--log-polar-extent` / `[log_polar] extent`: where L comes from.
+pub fn parse_log_polar_extent(s: &str) -> Result<LogPolarExtent> {
+    match s {
+        "corner" => Ok(LogPolarExtent::FarthestCorner),
+        "diagonal" => Ok(LogPolarExtent::Diagonal),
+        other => bail!("'{other}' is not a log-polar extent (corner: Meng's farthest corner | diagonal: Andersson & Hansson's screen diagonal)"),
+    }
+}
+
+/// The name `parse_log_polar_extent` reads.
+pub fn log_polar_extent_name(e: LogPolarExtent) -> &'static str {
+    match e {
+        LogPolarExtent::FarthestCorner => "corner",
+        LogPolarExtent::Diagonal => "diagonal",
     }
 }
 
@@ -257,6 +287,15 @@ impl RenderProfile {
             }
             p.validate().with_context(|| at("visual_polar"))?;
             profile.check_eccentricity().with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
+        }
+        if let Some(lp) = file.log_polar {
+            let p = &mut profile.log_polar;
+            p.sigma = lp.sigma.unwrap_or(p.sigma);
+            p.alpha = lp.alpha.unwrap_or(p.alpha);
+            if let Some(extent) = lp.extent {
+                p.extent = parse_log_polar_extent(&extent).with_context(|| format!("{}.extent", at("log_polar")))?;
+            }
+            p.validate().with_context(|| at("log_polar"))?;
         }
         if let Some(blur) = file.blur {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
@@ -341,6 +380,9 @@ impl RenderProfile {
             self.eccentricity = parse_eccentricity(mode).context("--vp-eccentricity")?;
         }
         self.check_eccentricity().context("--vp-eccentricity")?;
+        if let Some(extent) = &o.log_polar_extent {
+            self.log_polar.extent = parse_log_polar_extent(extent).context("--log-polar-extent")?;
+        }
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
         check_blur(&self.blur).context("--blur-sigma")?;
         o.environment.validate(&EnvironmentNames::flags())?;
@@ -387,6 +429,12 @@ impl RenderProfile {
         }
         p.validate().context("Visual-Polar parameters")?;
         Ok(p)
+    }
+
+    /// The polar-space parameters of `--method log-polar`: Visual-Polar's defaults (fovea° for the
+    /// blur's slope) with the profile's log-polar law.
+    pub fn log_polar_space(&self) -> VisualPolarParams {
+        VisualPolarParams { radial: RadialLaw::LogPolar(self.log_polar), ..Default::default() }
     }
 
     /// The combinations the headset axis refuses, checked with a stand-in FOV (the real one is

@@ -4,14 +4,16 @@
 
 mod acuity;
 mod cartesian;
+mod log_polar;
 mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 
 pub use cartesian::Cartesian;
+pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use uniform_budget::UniformBudget;
-pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadiusMode, VpLayout};
+pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
 

@@ -25,7 +25,12 @@
 //! e_norm = 1, r_f = fovea°), the CDF runs over [0, e_max] (e_max = the largest true eccentricity
 //! of a screen corner for this gaze) and always uses the exact inverse (the quartic is a fit for
 //! [0, 80]); φ stays the angle in pixels, so the rows, the clip and the φ mips are unchanged.
+//!
+//! The radial law r(u) is a parameter (`RadialLaw`): the paper's acuity law above, or Meng's
+//! kernel log-polar law (`log_polar.rs`: no clip, grid = screen / σ, r_max = the law's extent).
+//! Everything else — rows, φ wrap, arcs, mips, remap, the denoisers' grid addressing — is shared.
 
+use super::log_polar::{LogPolarLaw, LogPolarParams};
 use super::visual_polar_headset::{FovTangents, HeadsetAxis};
 use super::acuity::*;
 use super::SamplingSpace;
@@ -40,6 +45,7 @@ pub const E_TOP_HEADSET_DEG: f32 = 180.0;
 const FLAG_EXACT: u32 = 1;
 const FLAG_CLIPPED: u32 = 2;
 const FLAG_HEADSET: u32 = 4;
+const FLAG_LOG_POLAR: u32 = 8;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InverseCdf {
@@ -71,6 +77,16 @@ pub enum VpLayout {
     ScreenClipped,
 }
 
+/// How a column's normalised position u maps to a distance from the gaze.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RadialLaw {
+    /// The paper's: linear fovea, then the acuity CDF (Koskela 2019).
+    Acuity,
+    /// Meng et al. 2018's kernel log-polar law (`log_polar.rs`); `axis_scale`, `clip_fraction`,
+    /// `radius_mode` and the inverse CDF do not apply (σ, the extent and α replace them).
+    LogPolar(LogPolarParams),
+}
+
 /// What the ρ axis measures.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Eccentricity {
@@ -94,6 +110,7 @@ pub struct VisualPolarParams {
     pub radius_mode: RadiusMode,
     pub layout: VpLayout,
     pub eccentricity: Eccentricity,
+    pub radial: RadialLaw,
 }
 
 impl Default for VisualPolarParams {
@@ -107,6 +124,7 @@ impl Default for VisualPolarParams {
             radius_mode: RadiusMode::FarthestCorner,
             layout: VpLayout::Paper,
             eccentricity: Eccentricity::Normalized,
+            radial: RadialLaw::Acuity,
         }
     }
 }
@@ -136,6 +154,15 @@ impl VisualPolarParams {
         if let RadiusMode::Fixed(r) = self.radius_mode {
             if !(r.is_finite() && r > 0.0) {
                 return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
+            }
+        }
+        if let RadialLaw::LogPolar(lp) = self.radial {
+            lp.validate()?;
+            // Meng's buffer spans full circles on the screen's own distances, its extent set by L.
+            if self.layout != VpLayout::Paper || self.eccentricity != Eccentricity::Normalized || self.radius_mode != RadiusMode::FarthestCorner {
+                return Err(invalid(
+                    "the log-polar law takes the paper layout, the normalized axis and the corner radius (its extent is set by L)".to_string(),
+                ));
             }
         }
         if let Eccentricity::Headset(fov) = self.eccentricity {
@@ -190,6 +217,8 @@ pub struct VisualPolar {
     headset: Option<HeadsetAxis>,
     /// Largest gaze-to-corner distance in pixels (= r_max on the paper's axis).
     r_corner_px: f32,
+    /// The log-polar law (`RadialLaw::LogPolar`), for this gaze.
+    log_polar: Option<LogPolarLaw>,
 }
 
 impl VisualPolar {
@@ -203,7 +232,11 @@ impl VisualPolar {
         if !gaze.is_finite() {
             return Err(invalid(format!("gaze must be finite, got ({}, {})", gaze.x, gaze.y)));
         }
-        let grid = (screen.as_vec2() * params.axis_scale)
+        let axis_scale = match params.radial {
+            RadialLaw::Acuity => params.axis_scale,
+            RadialLaw::LogPolar(lp) => 1.0 / lp.sigma,
+        };
+        let grid = (screen.as_vec2() * axis_scale)
             .round()
             .as_uvec2()
             .max(UVec2::ONE);
@@ -218,11 +251,16 @@ impl VisualPolar {
             let far = gaze.max(screen.as_vec2() - gaze).abs();
             far.length()
         };
+        let log_polar = match params.radial {
+            RadialLaw::Acuity => None,
+            RadialLaw::LogPolar(lp) => Some(LogPolarLaw::new(lp.extent_px(screen, gaze), lp.alpha)?),
+        };
         let (cdf_max, r_max, r_f, e_norm) = match headset {
             None => {
-                let r_max = match params.radius_mode {
-                    RadiusMode::FarthestCorner => r_corner_px,
-                    RadiusMode::Fixed(r) => r,
+                let r_max = match (params.radius_mode, params.radial) {
+                    (_, RadialLaw::LogPolar(lp)) => lp.extent_px(screen, gaze),
+                    (RadiusMode::FarthestCorner, _) => r_corner_px,
+                    (RadiusMode::Fixed(r), _) => r,
                 };
                 let (e_f, e_norm) = if exact {
                     (params.fovea_deg, E_MAX_DEG)
@@ -238,7 +276,8 @@ impl VisualPolar {
             gaze,
             params,
             grid,
-            u_f: 2.0 * params.clip_fraction,
+            // Log-polar columns keep every row (u_f = 0: no clip).
+            u_f: if log_polar.is_some() { 0.0 } else { 2.0 * params.clip_fraction },
             p_f: cdf(params.fovea_deg, k) / cdf_max,
             r_max,
             r_f,
@@ -247,6 +286,7 @@ impl VisualPolar {
             exact,
             headset,
             r_corner_px,
+            log_polar,
         };
         if let Some(axis) = headset {
             if !axis.e_max.is_finite() || axis.e_max <= params.fovea_deg {
@@ -299,6 +339,20 @@ impl VisualPolar {
             Some(axis) => axis.mean_distance(self.params.fovea_deg),
         }
     }
+    /// Where the foveated blur starts (pixels): the fovea's edge; with the log-polar law the
+    /// outer half of the buffer (u ≥ ½, comparators.md §D: Meng blurs the outer half).
+    pub fn blur_start(&self) -> f32 {
+        match self.log_polar {
+            Some(law) => law.r_of_u(0.5),
+            None => self.r_fovea(),
+        }
+    }
+
+    /// The log-polar law, with `RadialLaw::LogPolar`.
+    pub fn log_polar(&self) -> Option<&LogPolarLaw> {
+        self.log_polar.as_ref()
+    }
+
     /// The tangent-space geometry, with `Eccentricity::Headset`.
     pub fn headset(&self) -> Option<&HeadsetAxis> {
         self.headset.as_ref()
@@ -360,6 +414,9 @@ impl VisualPolar {
     /// Normalised ρ coordinate → the axis value: screen distance (pixels) on the paper's axis,
     /// true eccentricity (degrees) on the headset's.
     pub fn r_of_u(&self, u: f32) -> f32 {
+        if let Some(law) = &self.log_polar {
+            return law.r_of_u(u);
+        }
         if u < self.u_f {
             return u / self.u_f * self.r_f;
         }
@@ -395,6 +452,9 @@ impl VisualPolar {
 
     /// Axis value (see `r_of_u`) → normalised ρ coordinate (inverse of `r_of_u`).
     pub fn u_of_r(&self, r: f32) -> f32 {
+        if let Some(law) = &self.log_polar {
+            return law.u_of_r(r);
+        }
         if r < self.r_f {
             return r / self.r_f * self.u_f;
         }
@@ -471,7 +531,8 @@ impl VisualPolar {
     pub fn sampling_params(&self) -> SamplingParams {
         let flags = self.exact as u32 * FLAG_EXACT
             + (self.params.layout == VpLayout::ScreenClipped) as u32 * FLAG_CLIPPED
-            + self.headset.is_some() as u32 * FLAG_HEADSET;
+            + self.headset.is_some() as u32 * FLAG_HEADSET
+            + self.log_polar.is_some() as u32 * FLAG_LOG_POLAR;
         let grid = UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y);
         let k = self.params.density_exponent;
         match &self.headset {
@@ -479,7 +540,11 @@ impl VisualPolar {
                 grid,
                 gaze: Vec4::new(self.gaze.x, self.gaze.y, self.r_max, k),
                 shape0: Vec4::new(self.u_f, self.p_f, self.r_f, self.e_norm),
-                shape1: Vec4::new(self.cdf_max, flags as f32, self.params.fovea_deg, 0.0),
+                // Log-polar: shape1.zw = (α, L) instead of (fovea°, 0).
+                shape1: match &self.log_polar {
+                    None => Vec4::new(self.cdf_max, flags as f32, self.params.fovea_deg, 0.0),
+                    Some(law) => Vec4::new(self.cdf_max, flags as f32, law.alpha, law.l),
+                },
             },
             Some(axis) => SamplingParams {
                 grid,
@@ -502,7 +567,7 @@ pub fn params_select_clipped_layout(p: &SamplingParams) -> bool {
 /// so the default pays for neither the screen-clipped mapping, the headset axis nor the exact
 /// CDF that the remap's screen → VP mapping evaluates).
 pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
-    (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET | FLAG_EXACT) != 0
+    (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET | FLAG_EXACT | FLAG_LOG_POLAR) != 0
 }
 
 /// The tracer's view of the space: one sample per kept texel; the GPU twin is
@@ -511,15 +576,20 @@ pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
 /// the paper. The screen-clipped layout keeps them on it.
 impl SamplingSpace for VisualPolar {
     fn name(&self) -> &'static str {
-        "vp"
+        match self.log_polar {
+            Some(_) => "log-polar",
+            None => "vp",
+        }
     }
     fn shader_variant(&self) -> &'static str {
         "visual_polar"
     }
-    /// `visual_polar`: specialised for the paper's layout and normalised axis; otherwise the
-    /// general kernel (`visual_polar_clipped`: either layout, either axis).
+    /// `visual_polar`: specialised for the paper's layout and normalised axis; `log_polar`: the
+    /// paper's layout with the radial law read at run time; otherwise the general kernel
+    /// (`visual_polar_clipped`: either layout, either axis).
     fn trace_variant(&self) -> &'static str {
         match (self.params.layout, self.headset.is_some()) {
+            _ if self.log_polar.is_some() => "log_polar",
             (VpLayout::Paper, false) => "visual_polar",
             _ => "visual_polar_clipped",
         }

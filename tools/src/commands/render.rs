@@ -104,7 +104,9 @@ struct Report {
     camera_motion: &'static str,
     /// Visual-Polar parameters (vp only).
     visual_polar: Option<VpReport>,
-    /// Foveated blur σ at 30° for a 1280×1440 eye (vp only; 0 = off).
+    /// Log-polar parameters (log-polar only).
+    log_polar: Option<LogPolarReport>,
+    /// Foveated blur σ at 30° for a 1280×1440 eye (vp and log-polar; 0 = off).
     blur_sigma_at_30: Option<f32>,
     /// Pass name → mean GPU milliseconds per frame (both eyes' passes summed in a stereo run).
     passes: BTreeMap<String, f64>,
@@ -128,6 +130,14 @@ struct VpReport {
     layout: String,
     /// The ρ axis: "normalized" (the paper's) or "headset" (true degrees through the eye's FOV).
     eccentricity: String,
+}
+
+#[derive(Serialize)]
+struct LogPolarReport {
+    sigma: f32,
+    alpha: f32,
+    /// "corner" (Meng) or "diagonal" (Andersson & Hansson).
+    extent: &'static str,
 }
 
 #[derive(Serialize, Default)]
@@ -248,7 +258,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
         visual_polar: (args.method == "vp").then(|| vp_report(&args.profile)),
-        blur_sigma_at_30: (args.method == "vp").then_some(args.profile.blur.sigma_at_30),
+        log_polar: (args.method == "log-polar").then(|| {
+            let p = &args.profile.log_polar;
+            LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
+        }),
+        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),

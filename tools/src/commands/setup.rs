@@ -17,7 +17,7 @@ use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -174,6 +174,9 @@ pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
 /// diagonals. Cartesian takes any size from 1×1.
 pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Result<()> {
     // The uniform budget is Visual-Polar's sample count: VP must be possible at this size.
+    if method == "log-polar" {
+        return check_log_polar(profile, screen);
+    }
     if method != "vp" && method != "uniform-budget" {
         return Ok(());
     }
@@ -212,6 +215,24 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
                 screen.y
             );
         }
+    }
+    Ok(())
+}
+
+/// `--method log-polar` needs a buffer (screen / σ) of at least `MIN_VP_GRID` texels per axis.
+fn check_log_polar(profile: &RenderProfile, screen: UVec2) -> Result<()> {
+    let sigma = profile.log_polar.sigma;
+    // As `VisualPolar::new` rounds it.
+    let grid = (screen.as_vec2() / sigma).round().as_uvec2();
+    if grid.x < MIN_VP_GRID || grid.y < MIN_VP_GRID {
+        bail!(
+            "--method log-polar: a {}×{} screen at [log_polar] sigma {sigma} gives a {}×{} buffer; it needs at least {MIN_VP_GRID}×{MIN_VP_GRID} \
+             (raise --width/--height or --scale, lower sigma, or use --method cartesian)",
+            screen.x,
+            screen.y,
+            grid.x,
+            grid.y
+        );
     }
     Ok(())
 }
@@ -281,6 +302,8 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
     Ok(match method {
         "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
         "cartesian" => Box::new(Cartesian::new(screen)),
+        // Meng's kernel log-polar buffer: the polar space with the log-polar radial law.
+        "log-polar" => Box::new(VisualPolar::new(screen, screen_centre, profile.log_polar_space()).context("log-polar space")?),
         // Visual-Polar's sample count for this eye and profile, spent on a regular grid.
         "uniform-budget" => {
             let vp = VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space (the uniform budget's count)")?;
