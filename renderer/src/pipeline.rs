@@ -393,6 +393,7 @@ impl Renderer {
                 EnvironmentSampling::BrdfOnly => self.scene.environment_slots.0 * Vec4::new(1.0, 1.0, 1.0, 0.0),
             },
             environment_map: self.scene.environment_slots.1,
+            instancing: self.scene.instancing_slots,
         };
         v.slots[slot].frame_data.write(&[data])
     }
