@@ -136,7 +136,9 @@ fn base64(bytes: &[u8]) -> String {
 fn load(name: &str, doc: &Value) -> Scene {
     let path = artifacts_dir().join(format!("instancing_{name}.gltf"));
     std::fs::write(&path, serde_json::to_vec(doc).unwrap()).unwrap();
-    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    // Instance whatever repeats (by default scenes this small are flattened: faster on lavapipe).
+    let limits = fovea_scene::LoadLimits { instance_above: 1, ..Default::default() };
+    Scene::load_with_limits(&path, &limits).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The instanced scene and its hand-made duplicate.

@@ -65,7 +65,9 @@ fn placements() -> Vec<Value> {
 fn load(test: &str, doc: &Value) -> Scene {
     let path = temp_dir(test).join("scene.gltf");
     std::fs::write(&path, serde_json::to_vec(doc).unwrap()).unwrap();
-    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    // Instance whatever repeats (by default scenes this small are flattened).
+    let limits = crate::LoadLimits { instance_above: 1, ..Default::default() };
+    Scene::load_with_limits(&path, &limits).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -96,6 +98,14 @@ fn a_mesh_placed_by_several_nodes_is_kept_once_and_flattens_to_the_hand_made_cop
         }
     }
     assert_eq!(instanced.bounds(), by_hand.bounds());
+}
+
+#[test]
+fn small_scenes_are_flattened_by_default() {
+    let path = temp_dir("instancing_default").join("scene.gltf");
+    std::fs::write(&path, serde_json::to_vec(&cubes_doc(&placements(), false)).unwrap()).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    assert!(scene.instancing.instances.is_empty() && scene.triangles.len() == 62, "62 placed triangles are below the threshold");
 }
 
 #[test]

@@ -83,7 +83,7 @@ pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, 
     let inputs = ImageInputs { file: &file, folder, buffers: &buffers, budget: &mut budget, max_texels: limits.max_texels };
     let textures = decode_images(document.as_json(), &used_images, inputs)?;
 
-    let placements = placements_per_mesh(&document, &placed);
+    let placements = placements_per_mesh(&document, &placed, limits);
     let instanced = vec![None; placements.len()];
     let mut loader = Loader { file: file.clone(), buffers: &buffers, scene: Scene::default(), default_material: None, placements, instanced };
     loader.scene.source = file.clone();
@@ -194,10 +194,19 @@ fn primitive_size(json: &gltf::json::Root, prim: &gltf::json::mesh::Primitive) -
     (triangles, if has_normals { positions } else { triangles.saturating_mul(3) })
 }
 
-/// How many nodes place each glTF mesh.
-fn placements_per_mesh(document: &gltf::Document, placed: &[Placed]) -> Vec<u32> {
+/// How many nodes place each glTF mesh, as instancing sees it: all 1 (everything flattened)
+/// when the scene places no more than `limits.instance_above` triangles.
+fn placements_per_mesh(document: &gltf::Document, placed: &[Placed], limits: &LoadLimits) -> Vec<u32> {
     let mut n = vec![0u32; document.meshes().len()];
     placed.iter().filter_map(|p| p.node.mesh()).for_each(|m| n[m.index()] += 1);
+    let json = document.as_json();
+    let placed_triangles = json.meshes.iter().zip(&n).fold(0u64, |sum, (m, &k)| {
+        let tris = m.primitives.iter().fold(0u64, |t, p| t.saturating_add(primitive_size(json, p).0));
+        sum.saturating_add(tris.saturating_mul(u64::from(k)))
+    });
+    if placed_triangles <= limits.instance_above {
+        n.iter_mut().for_each(|k| *k = (*k).min(1));
+    }
     n
 }
 
@@ -212,7 +221,7 @@ fn check_geometry_budget(document: &gltf::Document, placed: &[Placed], limits: &
         .iter()
         .map(|m| m.primitives.iter().map(|p| primitive_size(json, p)).fold((0u64, 0u64), |a, b| (a.0.saturating_add(b.0), a.1.saturating_add(b.1))))
         .collect();
-    let placements = placements_per_mesh(document, placed);
+    let placements = placements_per_mesh(document, placed, limits);
     // Per mesh: copies uploaded, and instances.
     let mut copies = vec![0u64; sizes.len()];
     let mut instances = vec![0u64; sizes.len()];
