@@ -1,6 +1,7 @@
 //! Meshes placed by two or more nodes, kept once in object space and placed by affine transforms
 //! (true instancing). Meshes placed once stay flattened in [`Scene::vertices`]/[`Scene::triangles`]
-//! so scenes without repeats keep the single world-space BVH.
+//! so scenes without repeats keep the single world-space BVH; scenes that place no more than
+//! [`crate::LoadLimits::instance_above`] triangles are flattened whole (faster on lavapipe).
 //!
 //! **Placed triangle ids.** Every triangle the renderer can hit has one id: the flattened
 //! triangles are `0 .. triangles.len()`, then instance k's are `first_id + local index`, instances

@@ -10,8 +10,9 @@
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadLimits {
     /// Triangles uploaded: a mesh placed by one node counts once (its world-space copy), a mesh
-    /// placed by N ≥ 2 nodes once too (it is instanced, not copied). Uploaded vertices are bounded
-    /// by 3 × this (a triangle never needs more than three).
+    /// placed by N ≥ 2 nodes once too when the scene is instanced (see `instance_above`), N times
+    /// when it is flattened. Uploaded vertices are bounded by 3 × this (a triangle never needs
+    /// more than three).
     pub max_triangles: u64,
     /// Mesh instances: placements of meshes that several nodes place.
     pub max_instances: u64,
