@@ -27,7 +27,10 @@ fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
     let block = scene.mesh_names.iter().position(|n| n == "block").expect("the block mesh") as u32;
     match alpha {
         Some(a) => {
-            let mut material = scene.materials[scene.triangles.iter().find(|t| t.mesh == block).unwrap().material as usize].clone();
+            // The two blocks are one instanced mesh: its triangles are in `instancing.meshes`.
+            let instanced = scene.instancing.meshes.iter().flat_map(|m| &m.triangles);
+            let tri = *scene.triangles.iter().chain(instanced).find(|t| t.mesh == block).unwrap();
+            let mut material = scene.materials[tri.material as usize].clone();
             material.base_color.w = a;
             if blend {
                 material.alpha_blend = true;
@@ -36,9 +39,13 @@ fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
             }
             scene.materials.push(material);
             let index = scene.materials.len() as u32 - 1;
-            scene.triangles.iter_mut().filter(|t| t.mesh == block).for_each(|t| t.material = index);
+            let instanced = scene.instancing.meshes.iter_mut().flat_map(|m| &mut m.triangles);
+            scene.triangles.iter_mut().chain(instanced).filter(|t| t.mesh == block).for_each(|t| t.material = index);
         }
-        None => scene.triangles.retain(|t| t.mesh != block),
+        None => {
+            scene = scene.flattened();
+            scene.triangles.retain(|t| t.mesh != block);
+        }
     }
     scene
 }

@@ -308,6 +308,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     let args = |loop_frames| BenchArgs {
         scenes: &[],
         builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
+        flatten: false,
         sizes: &[],
         vp_sizes: &[],
         frames: 1,
@@ -504,6 +505,7 @@ fn bench_vp_frames_follow_a_camera_path() {
     let args = BenchArgs {
         scenes: &scenes,
         builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
+        flatten: false,
         sizes: &[(32, 36)],
         vp_sizes: &[(64, 72)],
         frames: 2,

@@ -1,15 +1,19 @@
 //! Uploads a CPU scene (`fovea_scene::Scene`) into the GPU buffers the tracing passes bind:
 //! BVH nodes and leaf triangles as texel buffers, shading data as std430 storage buffers.
+//! Instanced meshes (`fovea_scene::instancing`) are uploaded once: their vertices, triangles and
+//! object-space trees follow the flattened ones in the same buffers, with one `InstanceGpu` per
+//! placement and a top-level tree over the instances (`fovea_scene::bvh::instanced`).
 
 use crate::environment::GpuEnvironment;
 use crate::error::{Error, Result};
 use crate::graph::{read_buffer, read_texels, Bind};
 use crate::layouts::{
-    LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT,
+    InstanceGpu, LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT,
     LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
-use crate::scene::bvh::wide::Bvh4;
-use crate::scene::bvh::Bvh;
+use crate::scene::bvh::instanced::{InstancingStats, SceneBvh};
+use crate::scene::bvh::wide::{Bvh4, Bvh4Node};
+use crate::scene::bvh::{Bvh, BvhBuilder};
 use crate::scene::lights::{build_light_table_scaled, LightKind};
 use crate::scene::{Aabb, PunctualLight, Scene, TextureSlot};
 use crate::texture_pack;
@@ -21,6 +25,8 @@ use std::sync::Arc;
 /// Must match BVH_STACK_SIZE in shaders/common/bvh.glsl: trees whose traversal could push more
 /// entries (`Bvh4::max_stack`) could lose hits.
 pub const MAX_BVH_STACK: u32 = 64;
+/// Must match TOP_STACK_SIZE in shaders/common/bvh.glsl (the instance level's stack).
+pub const MAX_TOP_STACK: u32 = 16;
 
 pub struct GpuScene {
     pub bvh_nodes: Buffer,
@@ -31,6 +37,11 @@ pub struct GpuScene {
     pub textures: Buffer,
     pub texels: Buffer,
     pub lights: Buffer,
+    pub instances: Buffer,
+    /// `FrameData.instancing` for this upload.
+    pub instancing_slots: UVec4,
+    /// Instance count and the bytes instancing keeps off the GPU (`fovea bench`).
+    pub instancing_stats: InstancingStats,
     pub light_count: u32,
     pub triangle_count: u32,
     pub material_count: u32,
@@ -43,7 +54,8 @@ pub struct GpuScene {
     pub environment: GpuEnvironment,
     /// `FrameData.environment` and `.environment_map` for this upload and light table.
     pub environment_slots: (Vec4, UVec4),
-    /// Depth and GPU bytes of the 4-wide tree the shaders traverse (nodes + leaf triangles).
+    /// Depth and GPU bytes of the 4-wide trees the shaders traverse (nodes + leaf triangles; with
+    /// instances also every BLAS, the top level and the instance data). Depth is the world tree's.
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
     /// Some material is alpha-masked or blended: traversal tests alpha (`FRAME_FLAG_ALPHA_MASK`).
@@ -56,39 +68,22 @@ pub struct GpuScene {
 
 impl GpuScene {
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
-        let positions = scene.triangle_positions();
+        let positions = scene.flat_positions();
         let bvh = Bvh::build(&positions);
         GpuScene::upload_with_bvh(ctx, scene, &positions, &bvh)
     }
 
+    /// `positions` and `bvh`: the flattened triangles ([`Scene::flat_positions`]) and the world
+    /// tree over them; instanced meshes get [`BvhBuilder::DEFAULT`] trees.
     pub fn upload_with_bvh(ctx: &Arc<Context>, scene: &Scene, positions: &[[glam::Vec3; 3]], bvh: &Bvh) -> Result<GpuScene> {
-        // The GPU traverses the 4-wide tree collapsed from the binary one (same leaves).
-        let wide = Bvh4::from_binary(bvh);
-        let depth = wide.depth();
-        let stack = wide.max_stack();
-        if stack > MAX_BVH_STACK {
-            return Err(Error::Invalid(format!(
-                "{}: BVH traversal could need {stack} stack entries, more than the shaders' {MAX_BVH_STACK}",
-                scene.source.display()
-            )));
-        }
+        // The GPU traverses the 4-wide trees collapsed from the binary ones (same leaves).
+        let levels = SceneBvh::with_world(scene, positions.to_vec(), Bvh4::from_binary(bvh), BvhBuilder::DEFAULT);
+        let depth = levels.world.depth();
+        check_stacks(scene, &levels)?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let vertices: Vec<VertexGpu> = scene
-            .vertices
-            .iter()
-            .map(|v| VertexGpu {
-                position_u: v.position.extend(v.uv.x),
-                normal_v: v.normal.extend(v.uv.y),
-                tangent: v.tangent,
-            })
-            .collect();
-        let mut triangles = Vec::with_capacity(scene.triangles.len());
-        for t in &scene.triangles {
-            if t.material > 0xffff || t.mesh > 0xffff {
-                return Err(Error::Invalid(format!("{}: more than 65536 materials or meshes", scene.source.display())));
-            }
-            triangles.push(TriangleGpu { vertices: UVec4::new(t.indices[0], t.indices[1], t.indices[2], t.material | (t.mesh << 16)) });
-        }
+        let (vertices, triangles) = geometry(scene)?;
+        let trees = pack_trees(&levels, scene);
+        let stats = InstancingStats::of(scene, &levels);
         let emission_scale = vec![1.0; scene.materials.len()];
         let packed = texture_pack::pack(scene, ctx.info.max_storage_buffer_range as usize / 4);
         let materials: Vec<MaterialGpu> = scene.materials.iter().zip(&packed.material_slots).map(|(m, t)| material_gpu(m, t, 1.0)).collect();
@@ -96,9 +91,13 @@ impl GpuScene {
         let lights = light_entries(scene, &emission_scale);
         let environment = GpuEnvironment::upload(ctx, scene)?;
 
+        let tree_bytes = (trees.nodes.len() + trees.triangles.len()) * 16 + std::mem::size_of_val(trees.instances.as_slice());
         Ok(GpuScene {
-            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &wide.node_texels())?,
-            bvh_triangles: Buffer::texels(ctx, "bvh_triangles", &bvh.triangle_texels(positions))?,
+            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &trees.nodes)?,
+            bvh_triangles: Buffer::texels(ctx, "bvh_triangles", &trees.triangles)?,
+            instances: Buffer::with_data(ctx, "instances", &trees.instances, storage)?,
+            instancing_slots: trees.slots,
+            instancing_stats: stats,
             vertices: Buffer::with_data(ctx, "vertices", &vertices, storage)?,
             triangles: Buffer::with_data(ctx, "triangles", &triangles, storage)?,
             materials: Buffer::with_data(ctx, "materials", &materials, storage)?,
@@ -116,7 +115,7 @@ impl GpuScene {
             environment,
             alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
             bvh_depth: depth,
-            bvh_bytes: wide.memory_bytes(),
+            bvh_bytes: tree_bytes,
             emission_scale,
         })
     }
@@ -152,7 +151,7 @@ impl GpuScene {
     }
 
     /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only).
-    pub fn binds(&self) -> [Bind<'_>; 9] {
+    pub fn binds(&self) -> [Bind<'_>; 10] {
         [
             read_texels("bvh_nodes", &self.bvh_nodes),
             read_texels("bvh_triangles", &self.bvh_triangles),
@@ -163,6 +162,7 @@ impl GpuScene {
             read_buffer("texels", &self.texels),
             read_buffer("lights", &self.lights),
             read_buffer("environment", &self.environment.buffer),
+            read_buffer("instances", &self.instances),
         ]
     }
 
@@ -171,6 +171,113 @@ impl GpuScene {
         let centre = (self.bounds.min + self.bounds.max) * 0.5;
         centre.extend((self.bounds.max - self.bounds.min).length() * 0.5)
     }
+}
+
+/// Vertices and triangles: the flattened ones, then each instanced mesh's (object space).
+fn geometry(scene: &Scene) -> Result<(Vec<VertexGpu>, Vec<TriangleGpu>)> {
+    let vertex = |v: &crate::scene::Vertex| VertexGpu { position_u: v.position.extend(v.uv.x), normal_v: v.normal.extend(v.uv.y), tangent: v.tangent };
+    let mut vertices: Vec<VertexGpu> = scene.vertices.iter().map(vertex).collect();
+    let mut triangles = Vec::with_capacity(scene.unique_triangle_count());
+    let meshes = scene.instancing.meshes.iter().map(|m| (&m.vertices, &m.triangles));
+    for (k, (verts, tris)) in std::iter::once((&scene.vertices, &scene.triangles)).chain(meshes).enumerate() {
+        let base = if k == 0 { 0 } else { vertices.len() as u32 };
+        if k > 0 {
+            vertices.extend(verts.iter().map(vertex));
+        }
+        for t in tris {
+            if t.material > 0xffff || t.mesh > 0xffff {
+                return Err(Error::Invalid(format!("{}: more than 65536 materials or meshes", scene.source.display())));
+            }
+            let [a, b, c] = t.indices.map(|i| i + base);
+            triangles.push(TriangleGpu { vertices: UVec4::new(a, b, c, t.material | (t.mesh << 16)) });
+        }
+    }
+    Ok((vertices, triangles))
+}
+
+fn check_stacks(scene: &Scene, levels: &SceneBvh) -> Result<()> {
+    let deepest = levels.meshes.iter().map(Bvh4::max_stack).chain([levels.world.max_stack()]).max().unwrap_or(0);
+    let top = levels.top_max_stack();
+    if deepest > MAX_BVH_STACK || top > MAX_TOP_STACK {
+        return Err(Error::Invalid(format!(
+            "{}: BVH traversal could need {deepest} stack entries (the shaders have {MAX_BVH_STACK}) and {top} at the instance level (the shaders have {MAX_TOP_STACK})",
+            scene.source.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Every tree in one node and one leaf texel buffer (module doc of `fovea_scene::bvh::instanced`).
+struct PackedTrees {
+    nodes: Vec<[f32; 4]>,
+    triangles: Vec<[f32; 4]>,
+    instances: Vec<InstanceGpu>,
+    slots: UVec4,
+}
+
+/// Moves a tree's nodes to `node_base` and its leaves to leaf entry `leaf_base` (empty children
+/// stay count 0, ref 0).
+fn rebased(tree: &Bvh4, node_base: u32, leaf_base: u32) -> Bvh4 {
+    let nodes = tree
+        .nodes
+        .iter()
+        .map(|n| {
+            let mut n: Bvh4Node = *n;
+            for c in 0..n.child_ref.len() {
+                if n.child_count[c] > 0 {
+                    n.child_ref[c] += leaf_base;
+                } else if !n.is_empty_child(c) {
+                    n.child_ref[c] += node_base;
+                }
+            }
+            n
+        })
+        .collect();
+    Bvh4 { nodes, tri_order: tree.tri_order.clone() }
+}
+
+fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
+    let mut nodes = levels.world.node_texels();
+    let mut triangles = levels.world.triangle_texels(&levels.world_tris);
+    let (mut roots, mut first_triangle) = (Vec::new(), scene.triangles.len() as u32);
+    let mut mesh_first = Vec::new();
+    for (tree, tris) in levels.meshes.iter().zip(&levels.mesh_tris) {
+        let node_base = (nodes.len() / 8) as u32;
+        roots.push(node_base);
+        nodes.extend(rebased(tree, node_base, (triangles.len() / 3) as u32).node_texels());
+        triangles.extend(tree.triangle_texels(tris));
+        mesh_first.push(first_triangle);
+        first_triangle += tris.len() as u32;
+    }
+    let top_root = (nodes.len() / 8) as u32;
+    let top_leaves = triangles.len() as u32;
+    if !levels.instances.is_empty() {
+        nodes.extend(rebased(&levels.top, top_root, 0).node_texels());
+        triangles.extend(levels.top.tri_order.iter().map(|&k| [f32::from_bits(k), 0.0, 0.0, 0.0]));
+    }
+    let mut instances: Vec<InstanceGpu> = levels
+        .instances
+        .iter()
+        .zip(&scene.instancing.instances)
+        .map(|(ray, inst)| {
+            let w = inst.world_from_object;
+            let [o0, o1, o2] = ray.object_from_world;
+            InstanceGpu {
+                object_from_world0: o0,
+                object_from_world1: o1,
+                object_from_world2: o2,
+                world_from_object0: w.row(0),
+                world_from_object1: w.row(1),
+                world_from_object2: w.row(2),
+                mesh: UVec4::new(inst.first_id, roots[inst.mesh as usize], mesh_first[inst.mesh as usize], inst.mirrors() as u32),
+            }
+        })
+        .collect();
+    let slots = UVec4::new(instances.len() as u32, scene.triangles.len() as u32, top_root, top_leaves);
+    if instances.is_empty() {
+        instances.push(InstanceGpu::default()); // a buffer cannot be empty; instancing.x = 0 skips it
+    }
+    PackedTrees { nodes, triangles, instances, slots }
 }
 
 fn material_gpu(m: &crate::scene::Material, textures: &[Option<u32>; TextureSlot::COUNT], emission_scale: f32) -> MaterialGpu {

@@ -403,6 +403,7 @@ impl Renderer {
             },
             environment_map: self.scene.environment_slots.1,
             path: Vec4::new(self.settings.path_regularisation, 0.0, 0.0, 0.0),
+            instancing: self.scene.instancing_slots,
         };
         v.slots[slot].frame_data.write(&[data])
     }

@@ -1,7 +1,10 @@
 // 4-wide BVH traversal over texel buffers (5–6× faster than std430 reads on lavapipe). Node = 8
 // RGBA32F texels, one component per child (fovea_scene::bvh::wide); triangles = 3 texels in leaf
 // order (see fovea_scene::bvh).
-// Needs `bvh_nodes` and `bvh_triangles` (samplerBuffer) declared by the includer.
+// Needs `bvh_nodes` and `bvh_triangles` (samplerBuffer), `instances` and `frame` declared by the
+// includer. The world tree's root is node 0; with instances (fovea_scene::bvh::instanced) a top
+// level over them follows, leading to each instanced mesh's object-space tree (all in the same
+// texel buffers).
 #ifndef FOVEA_BVH_GLSL
 #define FOVEA_BVH_GLSL
 
@@ -12,6 +15,10 @@ const int BVH_STACK_SIZE = 64; // the upload refuses trees whose traversal could
 // scalar loops, so the hot top of the stack is kept in registers instead.
 // Every kernel that traces uses 64 invocations per workgroup (WORKGROUP_2D² = WORKGROUP_1D).
 shared uint bvh_stack[64 * BVH_STACK_SIZE];
+// The top level's stack (it calls the tree walk, which uses bvh_stack, at its leaves); the upload
+// refuses top levels that could push more.
+const int TOP_STACK_SIZE = 16;
+shared uint top_stack[64 * TOP_STACK_SIZE];
 
 struct Hit {
     float t;
@@ -86,29 +93,30 @@ void cswap(inout float ka, inout uint ra, inout float kb, inout uint rb) {
     kb = sw ? k : kb; rb = sw ? r : rb;
 }
 
-// Closest hit (any_hit = false: smallest (t, triangle index), the CPU reference's tie rule) or
-// the first hit found (shadow rays, any_hit = true). Same algorithm as
-// fovea_scene::bvh::wide::Bvh4::intersect: 4-wide nodes (8 texels, one component per child),
-// the hit leaves' triangles tested on the spot in one loop, interior children visited nearest
-// first.
-bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit hit) {
-    hit.t = tmax;
-    hit.triangle = 0xffffffffu;
-    hit.u = 0.0;
-    hit.v = 0.0;
-    RayShear sh = ray_shear(org, dir);
-    // Like fovea_scene::bvh::safe_inverse_dir: a zero component becomes ±1e-30 (no 0·inf = NaN).
+// Like fovea_scene::bvh::safe_inverse_dir: a zero component becomes ±1e-30 (no 0·inf = NaN).
+vec3 safe_inverse_dir(vec3 dir) {
     bvec3 zero = equal(dir, vec3(0.0));
     vec3 signed_tiny = uintBitsToFloat((floatBitsToUint(dir) & 0x80000000u) | floatBitsToUint(1e-30));
-    vec3 inv_dir = 1.0 / mix(dir, signed_tiny, zero);
-    float limit = tmax * SLAB_SLACK;
+    return 1.0 / mix(dir, signed_tiny, zero);
+}
+
+// Walks one tree from `root`, continuing `hit` (closest: smallest (t, placed id), the CPU
+// reference's tie rule; any_hit: stops at the first hit and returns true). A leaf entry's
+// texel w = k is placed id id_base + k and TriangleGpu tri_base + k (the world tree: 0, 0).
+// Same algorithm as fovea_scene::bvh::wide::Bvh4::intersect_into: 4-wide nodes (8 texels, one
+// component per child), the hit leaves' triangles tested on the spot in one loop, interior
+// children visited nearest first.
+bool bvh_walk(uint root, vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, uint tri_base, uint id_base, inout Hit hit) {
+    RayShear sh = ray_shear(org, dir);
+    vec3 inv_dir = safe_inverse_dir(dir);
+    float limit = hit.t * SLAB_SLACK;
     // Traversal stack: the top 8 entries in registers (s0 = top), shifted on push/pop; deeper
     // entries in this invocation's slice of shared memory.
     uint s0 = 0u, s1 = 0u, s2 = 0u, s3 = 0u, s4 = 0u, s5 = 0u, s6 = 0u, s7 = 0u;
     uint stack_base = gl_LocalInvocationIndex * uint(BVH_STACK_SIZE);
     int sp = 0;
-    uint node = 0u;
-    bool done = false;
+    uint node = root;
+    bool done = false, found = false;
     while (!done) {
         int base = int(node) * 8;
         vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
@@ -135,18 +143,19 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
             vec4 t0 = texelFetch(bvh_triangles, tb + 0);
             vec4 t1 = texelFetch(bvh_triangles, tb + 1);
             vec4 t2 = texelFetch(bvh_triangles, tb + 2);
-            uint id = floatBitsToUint(t0.w);
+            uint k = floatBitsToUint(t0.w);
+            uint id = id_base + k;
             vec3 tuv;
             // Alpha-masked scenes only (a frame flag, so others pay nothing): a cut-out is no hit.
             if (intersect_triangle(sh, t0.xyz, t1.xyz, t2.xyz, tmin, tmax, tuv)
                 && (tuv.x < hit.t || (tuv.x == hit.t && id < hit.triangle))
-                && !((frame.data.frame.w & FRAME_FLAG_ALPHA_MASK) != 0u && alpha_rejects(id, tuv.y, tuv.z))) {
+                && !((frame.data.frame.w & FRAME_FLAG_ALPHA_MASK) != 0u && alpha_rejects(tri_base + k, id, tuv.y, tuv.z))) {
                 hit.t = tuv.x;
                 hit.u = tuv.y;
                 hit.v = tuv.z;
                 hit.triangle = id;
                 limit = hit.t * SLAB_SLACK;
-                if (any_hit) { done = true; break; }
+                if (any_hit) { done = true; found = true; break; }
             }
         }
         if (done) break;
@@ -176,6 +185,79 @@ bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit
                 sp = min(sp + 1, BVH_STACK_SIZE + 8);
             }
         }
+    }
+    return found;
+}
+
+// The ray in an instance's object space (rows of its inverse), with fovea_scene's arithmetic
+// (InstanceRay::to_object). The direction stays unnormalised, so t is the same parameter.
+void to_object(InstanceGpu inst, vec3 org, vec3 dir, out vec3 o, out vec3 d) {
+    vec4 r0 = inst.object_from_world0, r1 = inst.object_from_world1, r2 = inst.object_from_world2;
+    o = vec3(r0.x * org.x + r0.y * org.y + r0.z * org.z + r0.w,
+             r1.x * org.x + r1.y * org.y + r1.z * org.z + r1.w,
+             r2.x * org.x + r2.y * org.y + r2.z * org.z + r2.w);
+    d = vec3(r0.x * dir.x + r0.y * dir.y + r0.z * dir.z,
+             r1.x * dir.x + r1.y * dir.y + r1.z * dir.z,
+             r2.x * dir.x + r2.y * dir.y + r2.z * dir.z);
+}
+
+// The top level (frame.data.instancing): its leaves hold instance indices (one texel each from
+// texel instancing.w); each instance hit walks its mesh's tree with the ray in object space. As
+// fovea_scene::bvh::instanced::SceneBvh::intersect (the closest hit does not depend on the order).
+bool instances_walk(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, inout Hit hit) {
+    vec3 inv_dir = safe_inverse_dir(dir);
+    uint stack_base = gl_LocalInvocationIndex * uint(TOP_STACK_SIZE);
+    int sp = 0;
+    uint node = frame.data.instancing.z;
+    while (true) {
+        int base = int(node) * 8;
+        vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
+        vec4 hix = texelFetch(bvh_nodes, base + 3), hiy = texelFetch(bvh_nodes, base + 4), hiz = texelFetch(bvh_nodes, base + 5);
+        uvec4 refs = floatBitsToUint(texelFetch(bvh_nodes, base + 6));
+        uvec4 counts = floatBitsToUint(texelFetch(bvh_nodes, base + 7));
+        vec4 ax = (lox - org.x) * inv_dir.x, bx = (hix - org.x) * inv_dir.x;
+        vec4 ay = (loy - org.y) * inv_dir.y, by = (hiy - org.y) * inv_dir.y;
+        vec4 az = (loz - org.z) * inv_dir.z, bz = (hiz - org.z) * inv_dir.z;
+        vec4 enter = max(max(min(ax, bx), min(ay, by)), max(min(az, bz), vec4(tmin)));
+        vec4 leave = min(min(max(ax, bx), max(ay, by)), max(az, bz)) * SLAB_SLACK;
+        bvec4 hit4 = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(lessThanEqual(enter, vec4(hit.t * SLAB_SLACK))) & uvec4(lessThanEqual(lox, hix)));
+        bool have_next = false;
+        uint next = 0u;
+        for (int c = 0; c < 4; ++c) {
+            if (!hit4[c]) continue;
+            if (counts[c] == 0u) {
+                // The first interior child is visited next, the others wait on the stack.
+                if (have_next && sp < TOP_STACK_SIZE) top_stack[stack_base + uint(sp++)] = refs[c];
+                if (!have_next) { next = refs[c]; have_next = true; }
+                continue;
+            }
+            for (uint i = 0u; i < counts[c]; ++i) {
+                uint k = floatBitsToUint(texelFetch(bvh_triangles, int(frame.data.instancing.w + refs[c] + i)).x);
+                InstanceGpu inst = instances.data[k];
+                vec3 o, d;
+                to_object(inst, org, dir, o, d);
+                if (bvh_walk(inst.mesh.y, o, d, tmin, tmax, any_hit, inst.mesh.z, inst.mesh.x, hit)) return true;
+            }
+        }
+        if (have_next) {
+            node = next;
+        } else if (sp > 0) {
+            node = top_stack[stack_base + uint(--sp)];
+        } else {
+            return false;
+        }
+    }
+}
+
+// Closest hit (any_hit = false: smallest (t, placed id)) or the first hit found (shadow rays,
+// any_hit = true) over the world tree and, when the scene has any, the instances.
+bool bvh_trace(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, out Hit hit) {
+    hit.t = tmax;
+    hit.triangle = 0xffffffffu;
+    hit.u = 0.0;
+    hit.v = 0.0;
+    if (!bvh_walk(0u, org, dir, tmin, tmax, any_hit, 0u, 0u, hit) && frame.data.instancing.x != 0u) {
+        instances_walk(org, dir, tmin, tmax, any_hit, hit);
     }
     return hit.triangle != 0xffffffffu;
 }

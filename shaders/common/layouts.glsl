@@ -51,6 +51,7 @@ struct FrameData {
     vec4 environment;           // what escaping rays see (Scene::environment_map): x cos, y sin of the map's rotation about +Y, z radiance scale, w probability that light selection picks it (0: not sampled)
     uvec4 environment_map;      // x width, y height (texels), z 1 when there is an environment (0: escaping rays see black), w unused
     vec4 path;                  // x path regularisation strength (RenderSettings::path_regularisation; 0: off), yzw unused
+    uvec4 instancing;           // x instances (0: none, the instance level is skipped), y flattened triangles (placed ids below are theirs), z top-level root node, w first bvh_triangles texel of its leaf entries
 };
 
 // One texel of the environment map with its alias-table slot (environment::EnvironmentDistribution).
@@ -116,8 +117,20 @@ struct TriangleGpu {
     uvec4 vertices;             // xyz vertex indices, w = material | mesh << 16
 };
 
+// One placement of an instanced mesh (fovea_scene::instancing): the 3×4 transforms both ways as
+// rows, and where its mesh lives. Placed id first_id + k is the mesh's triangle k.
+struct InstanceGpu {
+    vec4 object_from_world0;    // rows of the inverse (rays into object space; its columns are the normal matrix's rows)
+    vec4 object_from_world1;
+    vec4 object_from_world2;
+    vec4 world_from_object0;    // rows of the node's world matrix
+    vec4 world_from_object1;
+    vec4 world_from_object2;
+    uvec4 mesh;                 // x first placed id, y BLAS root node in bvh_nodes, z TriangleGpu index of the mesh's triangle 0, w 1 when the transform mirrors
+};
+
 struct LightGpu {
-    uvec4 kind_index;           // x LIGHT_KIND_*, y triangle or punctual light index, z alias slot, w unused
+    uvec4 kind_index;           // x LIGHT_KIND_*, y placed triangle id or punctual light index, z alias slot, w unused
     vec4 position;              // point/spot position, w = range (0: unlimited)
     vec4 direction;             // direction the light travels (spot, directional), w = cos(outer cone)
     vec4 intensity;             // rgb intensity (cd) or illuminance (lux), w = cos(inner cone)

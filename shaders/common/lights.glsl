@@ -44,10 +44,9 @@ bool sample_light(vec3 p, inout uint rng, out LightSample ls) {
     if (select_pdf <= 0.0) return false;
     uint kind = l.kind_index.x;
     if (kind == LIGHT_KIND_TRIANGLE) {
-        TriangleGpu tri = triangles.data[l.kind_index.y];
-        vec3 a = vertices.data[tri.vertices.x].position_u.xyz;
-        vec3 b = vertices.data[tri.vertices.y].position_u.xyz;
-        vec3 c = vertices.data[tri.vertices.z].position_u.xyz;
+        // An instanced emitter is listed once per instance, by placed id, and sampled in world space.
+        PlacedTriangle placed = placed_triangle(l.kind_index.y);
+        vec3 a = placed.a.position_u.xyz, b = placed.b.position_u.xyz, c = placed.c.position_u.xyz;
         vec2 u = rng_next2(rng);
         float su = sqrt(u.x);
         Hit h;

@@ -17,11 +17,63 @@ layout(std430, set = 0, binding = 7) readonly buffer LightBuffer { LightGpu data
 // Uniform, not storage: every lane reads the same frame data, and lavapipe turns storage-buffer
 // reads into one load per lane (std140 = std430 here: FrameData is all vec4/mat4).
 layout(std140, set = 0, binding = 8) uniform FrameBuffer { FrameData data; } frame;
+// Instances in fovea_scene's order (ascending first placed id); a dummy entry when there are none.
+layout(std430, set = 0, binding = 25) readonly buffer InstanceBuffer { InstanceGpu data[]; } instances;
 
 // Defined below; bvh.glsl's traversal calls it for scenes with alpha-masked materials.
-bool alpha_rejects(uint triangle, float u, float v);
+bool alpha_rejects(uint triangle, uint id, float u, float v);
 
 #include "bvh.glsl"
+
+// A vertex of an instanced mesh in world space, as fovea_scene::Instance::vertex_to_world:
+// positions by the matrix, normals by its inverse transpose (the inverse's columns), tangents by
+// its 3×3 part with the handedness flipped by a mirror.
+VertexGpu instance_vertex(InstanceGpu inst, VertexGpu v) {
+    vec4 p = vec4(v.position_u.xyz, 1.0);
+    vec3 n = v.normal_v.xyz, t = v.tangent.xyz;
+    mat3 linear = mat3(inst.world_from_object0.xyz, inst.world_from_object1.xyz, inst.world_from_object2.xyz); // rows as columns: transposed
+    vec3 wn = n.x * inst.object_from_world0.xyz + n.y * inst.object_from_world1.xyz + n.z * inst.object_from_world2.xyz;
+    vec3 wt = t * linear;
+    VertexGpu w;
+    w.position_u = vec4(dot(inst.world_from_object0, p), dot(inst.world_from_object1, p), dot(inst.world_from_object2, p), v.position_u.w);
+    w.normal_v = vec4(normalize(wn), v.normal_v.w);
+    w.tangent = vec4(normalize(wt), inst.mesh.w != 0u ? -v.tangent.w : v.tangent.w);
+    return w;
+}
+
+// A placed triangle (fovea_scene::instancing: flattened ids first, then each instance's) in world
+// space: its TriangleGpu (material, mesh) and corners. `mirrored`: the corners wind clockwise
+// seen from the front (the flattened copy would have swapped two of them).
+struct PlacedTriangle {
+    TriangleGpu tri;
+    VertexGpu a, b, c;
+    bool mirrored;
+};
+
+PlacedTriangle placed_triangle(uint id) {
+    PlacedTriangle p;
+    p.mirrored = false;
+    if (id < frame.data.instancing.y) {
+        p.tri = triangles.data[id];
+        p.a = vertices.data[p.tri.vertices.x];
+        p.b = vertices.data[p.tri.vertices.y];
+        p.c = vertices.data[p.tri.vertices.z];
+        return p;
+    }
+    // The instance with the largest first id ≤ id (instances are in ascending first id).
+    uint lo = 0u, hi = frame.data.instancing.x;
+    while (hi - lo > 1u) {
+        uint mid = (lo + hi) >> 1u;
+        if (instances.data[mid].mesh.x <= id) lo = mid; else hi = mid;
+    }
+    InstanceGpu inst = instances.data[lo];
+    p.tri = triangles.data[inst.mesh.z + (id - inst.mesh.x)];
+    p.a = instance_vertex(inst, vertices.data[p.tri.vertices.x]);
+    p.b = instance_vertex(inst, vertices.data[p.tri.vertices.y]);
+    p.c = instance_vertex(inst, vertices.data[p.tri.vertices.z]);
+    p.mirrored = inst.mesh.w != 0u;
+    return p;
+}
 
 vec3 srgb_to_linear(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
@@ -81,8 +133,8 @@ vec4 sample_texture(uint tex, vec2 uv, bool srgb) {
 // the material's cutoff is no hit, for camera, bounce and shadow rays alike. BLEND: the hit counts
 // with probability alpha (stochastic transparency), decided by a hash of the hit (triangle,
 // barycentrics, frame and seed), so every ray and frame draws anew and the mean converges to the
-// blend.
-bool alpha_rejects(uint triangle, float u, float v) {
+// blend. `triangle` is the TriangleGpu (uv need no transform), `id` the placed id (the hash).
+bool alpha_rejects(uint triangle, uint id, float u, float v) {
     TriangleGpu tri = triangles.data[triangle];
     MaterialGpu m = materials.data[tri.vertices.w & 0xffffu];
     if ((m.textures2.z & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u) return false;
@@ -95,7 +147,7 @@ bool alpha_rejects(uint triangle, float u, float v) {
         alpha *= sample_texture(m.textures.x, uv, false).a;
     }
     if ((m.textures2.z & MATERIAL_ALPHA_BLEND) != 0u) {
-        uint h = pcg_hash(triangle ^ pcg_hash(floatBitsToUint(u) ^ pcg_hash(floatBitsToUint(v) ^ pcg_hash(frame.data.frame.x ^ pcg_hash(frame.data.frame.y)))));
+        uint h = pcg_hash(id ^ pcg_hash(floatBitsToUint(u) ^ pcg_hash(floatBitsToUint(v) ^ pcg_hash(frame.data.frame.x ^ pcg_hash(frame.data.frame.y)))));
         return float(h >> 8u) * (1.0 / 16777216.0) >= alpha;
     }
     return alpha < uintBitsToFloat(m.textures2.w);
@@ -121,10 +173,9 @@ struct Surface {
 // Gems ch. 20): λ = ½ log2(uv area / world area) + log2(width) − log2|n·d|, plus the texture's
 // ½ log2(w·h) in sample_texture_lod.
 Surface fetch_surface(Hit hit, vec3 ray_dir, float cone_width) {
-    TriangleGpu tri = triangles.data[hit.triangle];
-    VertexGpu a = vertices.data[tri.vertices.x];
-    VertexGpu b = vertices.data[tri.vertices.y];
-    VertexGpu c = vertices.data[tri.vertices.z];
+    PlacedTriangle placed = placed_triangle(hit.triangle);
+    TriangleGpu tri = placed.tri;
+    VertexGpu a = placed.a, b = placed.b, c = placed.c;
     vec3 w = vec3(1.0 - hit.u - hit.v, hit.u, hit.v);
     Surface s;
     s.material = tri.vertices.w & 0xffffu;
@@ -132,6 +183,7 @@ Surface fetch_surface(Hit hit, vec3 ray_dir, float cone_width) {
     s.position = w.x * a.position_u.xyz + w.y * b.position_u.xyz + w.z * c.position_u.xyz;
     s.uv = w.x * vec2(a.position_u.w, a.normal_v.w) + w.y * vec2(b.position_u.w, b.normal_v.w) + w.z * vec2(c.position_u.w, c.normal_v.w);
     vec3 ng = normalize(cross(b.position_u.xyz - a.position_u.xyz, c.position_u.xyz - a.position_u.xyz));
+    if (placed.mirrored) ng = -ng;
     bool front = dot(ng, ray_dir) < 0.0;
     vec3 n = normalize(w.x * a.normal_v.xyz + w.y * b.normal_v.xyz + w.z * c.normal_v.xyz);
 

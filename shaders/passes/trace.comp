@@ -103,10 +103,10 @@ void main() {
     bool gradient = gs.surface.x != 0u && gs.shading.x == (uint(texel.x) | (uint(texel.y) << 16u));
     vec2 gradient_bary = uintBitsToFloat(gs.surface.zw);
     if (gradient) {
-        TriangleGpu tri = triangles.data[gs.surface.y - 1u];
-        vec3 p = (1.0 - gradient_bary.x - gradient_bary.y) * vertices.data[tri.vertices.x].position_u.xyz
-               + gradient_bary.x * vertices.data[tri.vertices.y].position_u.xyz
-               + gradient_bary.y * vertices.data[tri.vertices.z].position_u.xyz;
+        PlacedTriangle placed = placed_triangle(gs.surface.y - 1u); // placed id: world space also for instances
+        vec3 p = (1.0 - gradient_bary.x - gradient_bary.y) * placed.a.position_u.xyz
+               + gradient_bary.x * placed.b.position_u.xyz
+               + gradient_bary.y * placed.c.position_u.xyz;
         dir = normalize(p - org);
     }
 #endif

@@ -355,6 +355,10 @@ enum Command {
         /// The first also serves the frame and VP figures; several are measured A B … B A.
         #[arg(long, value_delimiter = ',', default_value = "sbvh")]
         bvh: Vec<String>,
+        /// Copy every instance into world space (meshes placed by several nodes flattened, as
+        /// before instancing): the comparison of the two in one build.
+        #[arg(long)]
+        flatten: bool,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]
         sizes: Vec<String>,
@@ -622,7 +626,7 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, bvh, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, device } => {
+        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, device } => {
             let camera_path = camera_path.map(|f| fovea_tools::camera_keys::CameraKeys::load(&f)).transpose().context("--camera-path")?;
             let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
             if builders.is_empty() {
@@ -635,6 +639,7 @@ fn run() -> Result<()> {
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
                 builders: &builders,
+                flatten,
                 sizes: &sizes,
                 vp_sizes: &vp_sizes,
                 frames,

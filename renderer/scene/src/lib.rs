@@ -2,13 +2,16 @@
 //! traversal, a watertight CPU ray–triangle intersector (the reference the GPU is tested against)
 //! and the light-selection table. No Vulkan here: the renderer uploads what this crate produces.
 //!
-//! Everything a [`Scene`] holds is already in world space (node transforms applied), because the
-//! path tracer traverses one BVH over all triangles and has no instancing level.
+//! Meshes placed once are flattened into world space (node transforms applied); meshes placed by
+//! several nodes are kept once in object space with one transform per placement
+//! ([`instancing`]). The tracer traverses one world-space BVH over the flattened triangles and a
+//! top-level BVH over the instances, each leading to its mesh's object-space BVH.
 
 pub mod bvh;
 pub mod environment;
 mod geometry;
 mod images;
+pub mod instancing;
 pub mod intersect;
 pub mod lights;
 pub mod limits;
@@ -25,16 +28,21 @@ use std::path::{Path, PathBuf};
 
 pub use bvh::{Bvh, BvhNode};
 pub use environment::{EnvironmentDistribution, EnvironmentMap};
+pub use instancing::{Instance, InstancedMesh, Instancing};
 pub use intersect::{Hit, Ray};
 pub use lights::{build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable};
 pub use limits::LoadLimits;
 pub use validate::MAX_EMISSIVE_STRENGTH;
 
-/// A loaded scene, flattened to world space.
+/// A loaded scene: meshes placed once flattened to world space, repeated ones instanced.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
+    /// World-space vertices of the meshes placed by exactly one node.
     pub vertices: Vec<Vertex>,
+    /// Their triangles: placed ids `0 .. triangles.len()` (see [`instancing`]).
     pub triangles: Vec<Triangle>,
+    /// Meshes placed by two or more nodes, once each in object space, and their placements.
+    pub instancing: Instancing,
     /// glTF materials in document order; when some primitive has no material, one default material
     /// (all glTF defaults) is appended at the end. A material that no rendered primitive uses is
     /// kept (so indices stay glTF's) but without textures: its images are never decoded.
@@ -343,23 +351,24 @@ impl Scene {
         load::load(path, limits)
     }
 
-    /// World-space bounds of all triangles (empty box for an empty scene).
+    /// World-space bounds of all placed triangles (empty box for an empty scene).
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
-        for t in &self.triangles {
-            for &i in &t.indices {
-                b.grow(self.vertices[i as usize].position);
-            }
+        for (corners, _) in self.placed_triangles() {
+            corners.iter().for_each(|&p| b.grow(p));
         }
         b
     }
 
-    /// World-space triangle corners, by triangle index (the BVH's input).
+    /// World-space corners of every placed triangle, by placed id (instances expanded: what a
+    /// flat reference traverses; the world BVH's input is [`Scene::flat_positions`]).
     pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
-        self.triangles
-            .iter()
-            .map(|t| t.indices.map(|i| self.vertices[i as usize].position))
-            .collect()
+        self.placed_triangles().map(|(corners, _)| corners).collect()
+    }
+
+    /// World-space corners of the flattened triangles only (the world-space BVH's input).
+    pub fn flat_positions(&self) -> Vec<[Vec3; 3]> {
+        self.triangles.iter().map(|t| t.indices.map(|i| self.vertices[i as usize].position)).collect()
     }
 
     /// The first perspective camera, if any.
@@ -384,7 +393,8 @@ impl Scene {
             return true;
         }
         let emissive: Vec<bool> = self.materials.iter().map(|m| m.emissive.max_element() > 0.0).collect();
-        self.triangles.iter().any(|t| emissive.get(t.material as usize).copied().unwrap_or(false))
+        let mut used = self.instancing.meshes.iter().flat_map(|m| &m.triangles).chain(&self.triangles);
+        used.any(|t| emissive.get(t.material as usize).copied().unwrap_or(false))
     }
 
     /// A camera that frames the whole scene (see [`Camera::framing`]); `None` for an empty scene.

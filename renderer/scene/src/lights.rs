@@ -96,13 +96,13 @@ pub fn build_light_table_scaled(scene: &Scene, emission_scale: &[f32]) -> LightT
             m.emissive * texture_mean.unwrap_or(Vec3::ONE) * emission_scale.get(i).copied().unwrap_or(1.0)
         })
         .collect();
-    for (i, tri) in scene.triangles.iter().enumerate() {
+    // Placed ids: an instanced emissive mesh is listed once per instance, in world space.
+    for (i, ([a, b, c], tri)) in scene.placed_triangles().enumerate() {
         let emission = material_emission.get(tri.material as usize).copied().unwrap_or(Vec3::ZERO);
         let lum = luminance(emission);
         if lum <= 0.0 {
             continue;
         }
-        let [a, b, c] = tri.indices.map(|k| scene.vertices[k as usize].position);
         let area = 0.5 * (b - a).cross(c - a).length();
         entries.push(LightEntry { kind: LightKind::EmissiveTriangle, index: i as u32, power: lum * area * PI });
     }

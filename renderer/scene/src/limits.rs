@@ -9,10 +9,17 @@
 /// Every budget, with the environment variable that overrides it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LoadLimits {
-    /// Triangles after instancing: a mesh used by N nodes counts N times, because the tracer has
-    /// no instancing level and every node gets its own world-space copy. Vertices after instancing
-    /// are bounded by 3 × this (a triangle never needs more than three).
+    /// Triangles uploaded: a mesh placed by one node counts once (its world-space copy), a mesh
+    /// placed by N ≥ 2 nodes once too when the scene is instanced (see `instance_above`), N times
+    /// when it is flattened. Uploaded vertices are bounded by 3 × this (a triangle never needs
+    /// more than three).
     pub max_triangles: u64,
+    /// Mesh instances: placements of meshes that several nodes place.
+    pub max_instances: u64,
+    /// Repeated meshes are instanced only when the scene places more triangles than this;
+    /// below it everything is flattened (on lavapipe the two-level traversal cost Sponza 1.2× its
+    /// primary-ray rate and the large scene 3×, while flattening them costs 14–19 MiB).
+    pub instance_above: u64,
     /// Texels of all decoded textures together (stored as RGBA8, 4 bytes each).
     pub max_texels: u64,
     /// Bytes read: the glTF/GLB file itself, its buffers and its encoded images together
@@ -28,12 +35,14 @@ pub struct Budget {
 }
 
 pub const TRIANGLES: Budget = Budget { name: "triangle", env: "FOVEA_MAX_TRIANGLES", default: 4_000_000 };
+pub const INSTANCES: Budget = Budget { name: "instance", env: "FOVEA_MAX_INSTANCES", default: 1_000_000 };
+pub const INSTANCE_ABOVE: Budget = Budget { name: "instancing threshold", env: "FOVEA_INSTANCE_ABOVE", default: 1_000_000 };
 pub const TEXELS: Budget = Budget { name: "texel", env: "FOVEA_MAX_TEXELS", default: 256 << 20 };
 pub const BYTES: Budget = Budget { name: "byte", env: "FOVEA_MAX_SCENE_BYTES", default: 2 << 30 };
 
 impl Default for LoadLimits {
     fn default() -> Self {
-        LoadLimits { max_triangles: TRIANGLES.default, max_texels: TEXELS.default, max_bytes: BYTES.default }
+        LoadLimits { max_triangles: TRIANGLES.default, max_instances: INSTANCES.default, instance_above: INSTANCE_ABOVE.default, max_texels: TEXELS.default, max_bytes: BYTES.default }
     }
 }
 
@@ -56,7 +65,13 @@ impl Budget {
 impl LoadLimits {
     /// The defaults, each overridden by its environment variable when set.
     pub fn from_env() -> Result<LoadLimits, String> {
-        Ok(LoadLimits { max_triangles: TRIANGLES.read_env()?, max_texels: TEXELS.read_env()?, max_bytes: BYTES.read_env()? })
+        Ok(LoadLimits {
+            max_triangles: TRIANGLES.read_env()?,
+            max_instances: INSTANCES.read_env()?,
+            instance_above: INSTANCE_ABOVE.read_env()?,
+            max_texels: TEXELS.read_env()?,
+            max_bytes: BYTES.read_env()?,
+        })
     }
 }
 

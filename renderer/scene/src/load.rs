@@ -1,5 +1,6 @@
-//! glTF 2.0 → [`Scene`]: walks the node hierarchy and flattens every mesh primitive, camera and
-//! punctual light into world space. Order matters for safety: the document is validated
+//! glTF 2.0 → [`Scene`]: walks the node hierarchy and flattens every camera, punctual light and
+//! mesh placed by one node into world space; a mesh placed by several nodes is read once in object
+//! space and placed by instances ([`crate::instancing`]). Order matters for safety: the document is validated
 //! (`validate`) and the geometry budget checked from accessor counts before any buffer is read;
 //! buffers and images are read through `source` (inside the scene's folder, regular files,
 //! bounded), images decoded in `images` (only those rendered materials sample), materials
@@ -8,11 +9,12 @@
 
 use crate::geometry::{self, PrimitiveData};
 use crate::images::{decode_images, ImageInputs};
-use crate::limits::{over_budget, ByteBudget, LoadLimits, TRIANGLES};
+use crate::limits::{over_budget, ByteBudget, LoadLimits, INSTANCES, TRIANGLES};
 use crate::load_material::{convert_material, images_used};
 use crate::source::{self, ReadError, Uri};
 use crate::validate;
-use crate::{Camera, Material, PunctualLight, Scene, SceneError, Triangle};
+use crate::instancing::{Instance, InstancedMesh};
+use crate::{Camera, Material, PunctualLight, Scene, SceneError, Triangle, Vertex};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind as LightKindGltf;
 use gltf::mesh::Mode;
@@ -39,6 +41,10 @@ struct Loader<'a> {
     scene: Scene,
     /// Index of the appended default material, created the first time a primitive needs it.
     default_material: Option<u32>,
+    /// Per glTF mesh: how many nodes place it (≥ 2: instanced).
+    placements: Vec<u32>,
+    /// Per glTF mesh: its [`InstancedMesh`], once read.
+    instanced: Vec<Option<u32>>,
 }
 
 /// A node placed in the world: every mesh, camera and light the scene renders hangs off one.
@@ -77,7 +83,9 @@ pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, 
     let inputs = ImageInputs { file: &file, folder, buffers: &buffers, budget: &mut budget, max_texels: limits.max_texels };
     let textures = decode_images(document.as_json(), &used_images, inputs)?;
 
-    let mut loader = Loader { file: file.clone(), buffers: &buffers, scene: Scene::default(), default_material: None };
+    let placements = placements_per_mesh(&document, &placed, limits);
+    let instanced = vec![None; placements.len()];
+    let mut loader = Loader { file: file.clone(), buffers: &buffers, scene: Scene::default(), default_material: None, placements, instanced };
     loader.scene.source = file.clone();
     loader.scene.warnings = warnings;
     loader.scene.textures = textures;
@@ -92,6 +100,9 @@ pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, 
     for p in &placed {
         loader.append_node(&p.node, p.world)?;
     }
+    let flat = loader.scene.triangles.len();
+    // check_geometry_budget bounds placed triangles far below 2³², so this cannot fail.
+    loader.scene.instancing.assign_ids(flat).ok_or_else(|| SceneError::Budget { file, detail: "placed triangles do not fit 32-bit ids".into() })?;
     Ok(loader.scene)
 }
 
@@ -183,8 +194,26 @@ fn primitive_size(json: &gltf::json::Root, prim: &gltf::json::mesh::Primitive) -
     (triangles, if has_normals { positions } else { triangles.saturating_mul(3) })
 }
 
-/// Refuses, before any geometry is read or copied, a scene whose triangles (or vertices) after
-/// instancing exceed the budget: each node gets its own world-space copy of its mesh.
+/// How many nodes place each glTF mesh, as instancing sees it: all 1 (everything flattened)
+/// when the scene places no more than `limits.instance_above` triangles.
+fn placements_per_mesh(document: &gltf::Document, placed: &[Placed], limits: &LoadLimits) -> Vec<u32> {
+    let mut n = vec![0u32; document.meshes().len()];
+    placed.iter().filter_map(|p| p.node.mesh()).for_each(|m| n[m.index()] += 1);
+    let json = document.as_json();
+    let placed_triangles = json.meshes.iter().zip(&n).fold(0u64, |sum, (m, &k)| {
+        let tris = m.primitives.iter().fold(0u64, |t, p| t.saturating_add(primitive_size(json, p).0));
+        sum.saturating_add(tris.saturating_mul(u64::from(k)))
+    });
+    if placed_triangles <= limits.instance_above {
+        n.iter_mut().for_each(|k| *k = (*k).min(1));
+    }
+    n
+}
+
+/// Refuses, before any geometry is read, a scene whose uploaded triangles (or vertices), instances
+/// or placed triangles exceed what the renderer takes: a mesh placed once is uploaded once (its
+/// world-space copy), a mesh placed by several nodes once plus one instance per node (an extra
+/// flattened copy per node with a singular transform), and every placed triangle needs a 32-bit id.
 fn check_geometry_budget(document: &gltf::Document, placed: &[Placed], limits: &LoadLimits, file: &Path) -> Result<(), SceneError> {
     let json = document.as_json();
     let sizes: Vec<(u64, u64)> = json
@@ -192,23 +221,45 @@ fn check_geometry_budget(document: &gltf::Document, placed: &[Placed], limits: &
         .iter()
         .map(|m| m.primitives.iter().map(|p| primitive_size(json, p)).fold((0u64, 0u64), |a, b| (a.0.saturating_add(b.0), a.1.saturating_add(b.1))))
         .collect();
+    let placements = placements_per_mesh(document, placed, limits);
+    // Per mesh: copies uploaded, and instances.
+    let mut copies = vec![0u64; sizes.len()];
     let mut instances = vec![0u64; sizes.len()];
-    placed.iter().filter_map(|p| p.node.mesh()).for_each(|m| instances[m.index()] += 1);
-    let total = |pick: fn(&(u64, u64)) -> u64| {
-        sizes.iter().zip(&instances).fold(0u64, |sum, (s, &n)| sum.saturating_add(pick(s).saturating_mul(n)))
+    for m in placed.iter().filter_map(|p| p.node.mesh().map(|m| (m.index(), p.world))) {
+        match (placements[m.0] >= 2, invertible(m.1)) {
+            (true, true) => instances[m.0] += 1,
+            _ => copies[m.0] += 1,
+        }
+    }
+    let uploaded = |m: usize| copies[m] + u64::from(instances[m] > 0);
+    let total = |pick: fn(&(u64, u64)) -> u64, count: &dyn Fn(usize) -> u64| {
+        (0..sizes.len()).fold(0u64, |sum, m| sum.saturating_add(pick(&sizes[m]).saturating_mul(count(m))))
     };
-    let (triangles, vertices) = (total(|s| s.0), total(|s| s.1));
-    let budget_error = |what: String| SceneError::Budget { file: file.to_path_buf(), detail: over_budget(&TRIANGLES, limits.max_triangles, what) };
+    let name = |m: usize| document.meshes().nth(m).and_then(|m| m.name().map(str::to_owned)).unwrap_or_else(|| format!("mesh{m}"));
+    let fail = |budget, limit, what: String| SceneError::Budget { file: file.to_path_buf(), detail: over_budget(budget, limit, what) };
+    let (triangles, vertices) = (total(|s| s.0, &uploaded), total(|s| s.1, &uploaded));
     if triangles > limits.max_triangles {
-        let largest = (0..sizes.len()).max_by_key(|&m| sizes[m].0.saturating_mul(instances[m])).unwrap_or(0);
-        let name = document.meshes().nth(largest).and_then(|m| m.name().map(str::to_owned)).unwrap_or_else(|| format!("mesh{largest}"));
-        return Err(budget_error(format!(
-            "{triangles} triangles after instancing (the largest share: mesh '{name}', {} triangles × {} nodes; every node gets its own copy, there is no GPU instancing)",
-            sizes[largest].0, instances[largest]
+        let largest = (0..sizes.len()).max_by_key(|&m| sizes[m].0.saturating_mul(uploaded(m))).unwrap_or(0);
+        return Err(fail(&TRIANGLES, limits.max_triangles, format!(
+            "meshes: {triangles} triangles to upload (the largest share: mesh '{}', {} triangles × {} copies; a mesh placed by several nodes is uploaded once and instanced)",
+            name(largest), sizes[largest].0, uploaded(largest)
         )));
     }
     if vertices > limits.max_triangles.saturating_mul(3) {
-        return Err(budget_error(format!("{vertices} vertices after instancing (3 per budgeted triangle at most)")));
+        return Err(fail(&TRIANGLES, limits.max_triangles, format!("meshes: {vertices} vertices to upload (3 per budgeted triangle at most)")));
+    }
+    let instance_count: u64 = instances.iter().sum();
+    if instance_count > limits.max_instances {
+        let most = (0..sizes.len()).max_by_key(|&m| instances[m]).unwrap_or(0);
+        return Err(fail(&INSTANCES, limits.max_instances, format!(
+            "nodes: {instance_count} mesh instances (the most: mesh '{}', placed by {} nodes)", name(most), instances[most]
+        )));
+    }
+    let placed_triangles = total(|s| s.0, &|m| copies[m] + instances[m]);
+    if placed_triangles >= u64::from(u32::MAX) {
+        return Err(SceneError::Budget { file: file.to_path_buf(), detail: format!(
+            "nodes: {placed_triangles} placed triangles (each node's copy or instance of its mesh counts): every placed triangle needs a 32-bit id, at most {}", u32::MAX - 1
+        )});
     }
     Ok(())
 }
@@ -271,6 +322,12 @@ fn images_of(document: &gltf::Document, materials: &[usize]) -> Vec<usize> {
     images
 }
 
+/// Whether rays can be taken into the node's object space (a finite inverse).
+fn invertible(world: Mat4) -> bool {
+    let det = glam::Mat3::from_mat4(world).determinant();
+    det != 0.0 && det.is_finite() && world.inverse().is_finite()
+}
+
 fn describe(e: gltf::Error) -> String {
     match e {
         gltf::Error::Validation(list) => {
@@ -283,8 +340,13 @@ fn describe(e: gltf::Error) -> String {
 impl Loader<'_> {
     fn append_node(&mut self, node: &gltf::Node, world: Mat4) -> Result<(), SceneError> {
         if let Some(mesh) = node.mesh() {
-            for primitive in mesh.primitives() {
-                self.append_primitive(&mesh, &primitive, world)?;
+            if self.placements[mesh.index()] >= 2 && invertible(world) {
+                self.append_instance(&mesh, world)?;
+            } else {
+                // Placed once (or by a singular transform, which has no object-space ray).
+                for primitive in mesh.primitives() {
+                    self.append_primitive(&mesh, &primitive, world)?;
+                }
             }
         }
         if let Some(camera) = node.camera() {
@@ -301,7 +363,46 @@ impl Loader<'_> {
         SceneError::BadPrimitive { file: self.file.clone(), mesh, primitive, problem }
     }
 
+    /// One placement of a mesh several nodes place: the mesh is read in object space the first
+    /// time, and every placement adds an instance.
+    fn append_instance(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+        let index = match self.instanced[mesh.index()] {
+            Some(i) => i,
+            None => {
+                let mut object = InstancedMesh::default();
+                for primitive in mesh.primitives() {
+                    let (vertices, triangles) = self.read_primitive(mesh, &primitive, Mat4::IDENTITY)?;
+                    let base = object.vertices.len() as u32;
+                    object.vertices.extend(vertices);
+                    object.triangles.extend(triangles.into_iter().map(|t| Triangle { indices: t.indices.map(|i| i + base), ..t }));
+                }
+                self.scene.instancing.meshes.push(object);
+                let i = (self.scene.instancing.meshes.len() - 1) as u32;
+                self.instanced[mesh.index()] = Some(i);
+                i
+            }
+        };
+        let object = &self.scene.instancing.meshes[index as usize];
+        // Affine, so the corners of the object-space box bound every transformed position.
+        let bounds = crate::Aabb::of_points(&object.vertices.iter().map(|v| v.position).collect::<Vec<_>>());
+        let corners = (0..8).map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), bounds.max, bounds.min));
+        if !bounds.is_empty() && corners.map(|c| world.transform_point3(c)).any(|p| !p.is_finite()) {
+            return Err(self.bad(mesh, 0, "world-space positions overflow f32 (the node transforms scale them too far)".into()));
+        }
+        self.scene.instancing.instances.push(Instance { mesh: index, world_from_object: world, first_id: 0 });
+        Ok(())
+    }
+
     fn append_primitive(&mut self, mesh: &gltf::Mesh, prim: &gltf::Primitive, world: Mat4) -> Result<(), SceneError> {
+        let (vertices, tris) = self.read_primitive(mesh, prim, world)?;
+        let base = self.scene.vertices.len() as u32;
+        self.scene.vertices.extend(vertices);
+        self.scene.triangles.extend(tris.into_iter().map(|t| Triangle { indices: t.indices.map(|i| i + base), ..t }));
+        Ok(())
+    }
+
+    /// One primitive's vertices (transformed by `world`) and triangles (indices local to them).
+    fn read_primitive(&mut self, mesh: &gltf::Mesh, prim: &gltf::Primitive, world: Mat4) -> Result<(Vec<Vertex>, Vec<Triangle>), SceneError> {
         let pi = prim.index();
         let mode = prim.mode();
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
@@ -377,11 +478,8 @@ impl Loader<'_> {
         if vertices.iter().any(|v| !v.position.is_finite()) {
             return Err(self.bad(mesh, pi, "world-space positions overflow f32 (the node transforms scale them too far)".into()));
         }
-        let base = self.scene.vertices.len() as u32;
-        self.scene.vertices.extend(vertices);
         let mesh_id = mesh.index() as u32;
-        self.scene.triangles.extend(tris.into_iter().map(|t| Triangle { indices: t.map(|i| i + base), material, mesh: mesh_id }));
-        Ok(())
+        Ok((vertices, tris.into_iter().map(|t| Triangle { indices: t, material, mesh: mesh_id }).collect()))
     }
 
     fn default_material_index(&mut self) -> u32 {

@@ -261,24 +261,23 @@ fn instancing_bomb(triangles: usize, nodes: usize) -> Value {
 }
 
 #[test]
-fn the_instancing_bomb_is_refused_before_any_geometry_is_read() {
+fn the_instancing_bomb_is_instanced_and_its_budgets_are_checked_before_any_geometry_is_read() {
     let dir = temp_dir("bomb");
+    // 12 M placed triangles but 20 000 uploaded: instancing makes it fit the triangle budget, so
+    // the load gets as far as reading its (missing) buffer.
     let path = write_doc(&dir, &instancing_bomb(20_000, 600));
-    let started = std::time::Instant::now();
-    let msg = error_text(load(&path));
-    assert_mentions(&msg, &[
-        "12000000 triangles after instancing",
-        "mesh 'bomb', 20000 triangles × 600 nodes",
-        "triangle budget of 4000000",
-        "FOVEA_MAX_TRIANGLES",
-    ]);
+    assert_mentions(&error_text(load(&path)), &["buffers[0]", "never-read.bin", "cannot open"]);
+    let limits = LoadLimits { max_triangles: 19_999, ..LoadLimits::default() };
+    let msg = error_text(load_unguarded(&path, &limits));
+    assert_mentions(&msg, &["meshes: 20000 triangles to upload", "mesh 'bomb', 20000 triangles × 1 copies", "triangle budget of 19999", "FOVEA_MAX_TRIANGLES"]);
     assert!(!msg.contains("never-read.bin"), "the budget must be checked before buffers are read: {msg}");
+    let limits = LoadLimits { max_instances: 599, ..LoadLimits::default() };
+    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["nodes: 600 mesh instances", "mesh 'bomb', placed by 600 nodes", "instance budget of 599", "FOVEA_MAX_INSTANCES"]);
+    // Placed triangles beyond 32-bit ids are refused whatever the budgets, without expanding.
+    let started = std::time::Instant::now();
+    let path = write_doc(&dir, &instancing_bomb(1_500_000, 3_000));
+    assert_mentions(&error_text(load(&path)), &["nodes: 4500000000 placed triangles", "32-bit id"]);
     assert!(started.elapsed().as_secs() < 5, "refusing must not expand the copies");
-    // Within an explicit budget the same file gets as far as reading its (missing) buffer.
-    let limits = LoadLimits { max_triangles: 12_000_000, ..LoadLimits::default() };
-    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["buffers[0]", "never-read.bin", "cannot open"]);
-    let limits = LoadLimits { max_triangles: 11_999_999, ..LoadLimits::default() };
-    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["triangle budget of 11999999"]);
 }
 
 fn png_bytes(width: u32, height: u32) -> Vec<u8> {
@@ -535,7 +534,14 @@ fn shared_real_scenes_load_within_the_default_budgets() {
             continue;
         }
         let scene = load(&path).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((scene.triangles.len(), scene.cameras.len()), (triangles, cameras), "{file}");
+        assert_eq!((scene.placed_triangle_count(), scene.cameras.len()), (triangles, cameras), "{file}");
+        println!(
+            "{file}: {} flattened triangles, {} instanced meshes ({} triangles) placed by {} instances",
+            scene.triangles.len(),
+            scene.instancing.meshes.len(),
+            scene.unique_triangle_count() - scene.triangles.len(),
+            scene.instancing.instances.len()
+        );
         assert!(!scene.textures.is_empty(), "{file}");
         assert!(scene.warnings.is_empty(), "{file}: {:?}", scene.warnings);
     }

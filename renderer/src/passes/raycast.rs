@@ -35,7 +35,7 @@ impl RaycastPass {
     ) -> Result<()> {
         let s = scene.binds();
         let binds = [
-            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
+            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[9],
             read_buffer("frame", frame),
             read_texels("rays", rays),
             write_buffer("hits", hits),
@@ -81,6 +81,8 @@ impl RayCaster {
         }
         let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());
         ray_buf.write(rays)?;
+        // The instance level's slots are the scene's; everything else in the frame stays default.
+        self.frame.write(&[crate::layouts::FrameData { instancing: scene.instancing_slots, ..Default::default() }])?;
         self.recorder.begin()?;
         let name = if any_hit { "raycast_any" } else { "raycast_closest" };
         self.pass.record(&mut self.recorder, name, scene, &self.frame, ray_buf, hit_buf, rays.len() as u32, any_hit)?;

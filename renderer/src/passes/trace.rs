@@ -111,7 +111,7 @@ impl TracePass {
         };
         let extra = gradient_binds.unwrap_or([s[0]; 3]);
         let binds = [
-            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8],
+            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], s[9],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
             read_texels("sampling_table", sampling_table),

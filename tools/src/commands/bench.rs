@@ -11,6 +11,7 @@ use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::scene::bvh::wide::Bvh4;
+use fovea_renderer::scene::bvh::instanced::InstancingStats;
 use fovea_renderer::scene::bvh::{Bvh, BvhBuilder, BvhStats};
 use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
 use fovea_renderer::scene::{PunctualLight, Scene};
@@ -25,6 +26,8 @@ pub struct BenchArgs<'a> {
     /// BVH builders to compare (the first also serves the frame and VP figures); with more than
     /// one, the ray figures are measured in the order A B … B A within one run.
     pub builders: &'a [BvhBuilder],
+    /// Expand instances into world-space copies before measuring (`Scene::flattened`).
+    pub flatten: bool,
     /// Sizes of the ray-throughput and Cartesian frame measurements (empty: skip them).
     pub sizes: &'a [(u32, u32)],
     /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
@@ -56,6 +59,9 @@ struct BvhReport {
     wide_depth: u32,
     wide_nodes: usize,
     stats: BvhStats,
+    /// Instances and what instancing keeps off the GPU (the tree above is the world tree over
+    /// the flattened triangles; `memory_bytes` counts it alone).
+    instancing: InstancingStats,
 }
 
 #[derive(Serialize)]
@@ -102,7 +108,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new(), real_time_loop: None };
     for name in args.scenes {
         let scene = crate::scenes::load(name)?;
-        let positions = scene.triangle_positions();
+        let scene = if args.flatten { scene.flattened() } else { scene };
+        // The builders compared make the world tree over the flattened triangles; hits name placed
+        // ids (instances expanded), which the secondary rays look up.
+        let positions = scene.flat_positions();
+        let placed = scene.triangle_positions();
         let Some(camera) = scene.default_camera() else { bail!("{name}: no camera") };
         let mut variants = Vec::new();
         for &builder in args.builders {
@@ -111,6 +121,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let seconds = started.elapsed().as_secs_f64();
             let stats = bvh.stats(&positions);
             let wide = Bvh4::from_binary(&bvh);
+            let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
             let bvh_report = BvhReport {
                 scene: name.clone(),
                 builder: builder.name(),
@@ -122,6 +133,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 wide_depth: wide.depth(),
                 wide_nodes: wide.nodes.len(),
                 stats,
+                instancing: gpu.instancing_stats.clone(),
             };
             let s = &bvh_report.stats;
             println!(
@@ -145,8 +157,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 s.thin_triangles,
                 s.large_triangles,
             );
+            let inst = &bvh_report.instancing;
+            println!(
+                "{name} [{}]: {} instances of {} meshes: {} placed triangles, {} uploaded, {:.1} MiB saved against flattening",
+                bvh_report.builder,
+                inst.instances,
+                inst.instanced_meshes,
+                inst.placed_triangles,
+                inst.uploaded_triangles,
+                inst.bytes_saved as f64 / (1 << 20) as f64
+            );
             report.bvh.push(bvh_report);
-            let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
             variants.push((builder, bvh, gpu));
         }
         let mut caster = RayCaster::new(&ctx)?;
@@ -163,7 +184,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             // The secondary rays start from the first builder's hits so that every builder traces
             // the same rays (hits may differ in the last bit between trees).
             let (hits, _) = caster.trace(&variants[0].2, &primary, false)?;
-            let (shadow, indirect) = secondary_rays(&scene, &positions, &primary, &hits);
+            let (shadow, indirect) = secondary_rays(&scene, &placed, &primary, &hits);
             for &(v, pass) in &order {
                 let (builder, bvh, gpu) = &variants[v];
                 let (primary_hits, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;

@@ -25,6 +25,7 @@
 //! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
 //! long thin and large triangles); `fovea bench` prints it for each scene and builder.
 
+pub mod instanced;
 mod sbvh;
 mod traverse;
 pub mod wide;

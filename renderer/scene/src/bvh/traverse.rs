@@ -31,11 +31,12 @@ pub fn slab_test(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, t_limit: f32
 /// Tests a leaf's triangles (original indices) for `0 < t < t_max`: with `any_hit` the first
 /// hit is returned at once; otherwise the closest so far (ties by [`crate::intersect`]'s rule) is
 /// kept in `best` and `None` returned.
-pub(super) fn test_leaf(tris: &[[Vec3; 3]], leaf: &[u32], wray: &WatertightRay, t_max: f32, any_hit: bool, best: &mut Option<Hit>) -> Option<Hit> {
+/// Hits carry `id_base` + the triangle's index (an instance's placed ids, 0 for the world tree).
+pub(super) fn test_leaf(tris: &[[Vec3; 3]], leaf: &[u32], wray: &WatertightRay, t_max: f32, any_hit: bool, id_base: u32, best: &mut Option<Hit>) -> Option<Hit> {
     for &tri in leaf {
         let [a, b, c] = tris[tri as usize];
         if let Some((t, u, v)) = wray.intersect(a, b, c, t_max) {
-            let hit = Hit { t, triangle: tri, u, v };
+            let hit = Hit { t, triangle: id_base + tri, u, v };
             if any_hit {
                 return Some(hit);
             }
@@ -85,7 +86,7 @@ impl Bvh {
                     continue;
                 }
                 let start = n.child_ref[c] as usize;
-                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, &mut best) {
+                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, 0, &mut best) {
                     return Some(hit);
                 }
             }

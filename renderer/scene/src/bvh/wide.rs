@@ -126,9 +126,15 @@ impl Bvh4 {
     /// The GPU traversal's algorithm on the CPU: closest hit (ties as in [`crate::intersect`])
     /// or, with `any_hit`, the first hit found, for `0 < t < t_max`.
     pub fn intersect(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> Option<Hit> {
+        let mut best = None;
+        self.intersect_into(tris, ray, t_max, any_hit, 0, &mut best).or(best)
+    }
+
+    /// [`Bvh4::intersect`] continuing from `best` (boxes beyond it are skipped, closer hits
+    /// replace it), hit ids offset by `id_base` (an instance's BLAS); returns the any-hit answer.
+    pub fn intersect_into(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool, id_base: u32, best: &mut Option<Hit>) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let inv_dir = safe_inverse_dir(ray.dir);
-        let mut best: Option<Hit> = None;
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         let mut node = 0u32;
         loop {
@@ -139,7 +145,7 @@ impl Bvh4 {
             });
             for c in (0..WIDTH).filter(|&c| near[c].is_some() && n.child_count[c] > 0) {
                 let start = n.child_ref[c] as usize;
-                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, &mut best) {
+                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, id_base, best) {
                     return Some(hit);
                 }
             }
@@ -154,9 +160,14 @@ impl Bvh4 {
                 }
                 None => match stack.pop() {
                     Some(a) => node = a,
-                    None => return best,
+                    None => return None,
                 },
             }
         }
+    }
+
+    /// 3 texels per leaf reference, as [`Bvh::triangle_texels`] (the same leaf order).
+    pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
+        Bvh { nodes: Vec::new(), tri_order: self.tri_order.clone() }.triangle_texels(tris)
     }
 }
