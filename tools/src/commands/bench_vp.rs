@@ -10,7 +10,7 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
+use fovea_renderer::sampling::{Cartesian, LogPolarParams, RadialLaw, VisualPolar, VisualPolarParams};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -42,6 +42,9 @@ pub struct VpFrameReport {
     pub to_screen_share: f64,
     /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
     pub denoisers: Vec<DenoiserCost>,
+    /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
+    /// frames above, no denoiser: today `log-polar` (Meng et al. 2018, its defaults).
+    pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
     pub shuffled_mrays_per_s: f64,
@@ -77,6 +80,20 @@ pub struct DenoiserCost {
     pub ratio: f64,
     pub cartesian_history_bytes: u64,
     pub vp_history_bytes: u64,
+}
+
+/// A comparator method's whole frames against the Cartesian ones of the same run.
+#[derive(Serialize)]
+pub struct MethodCost {
+    pub method: &'static str,
+    pub grid: [u32; 2],
+    pub samples: u64,
+    pub passes_ms: BTreeMap<String, f64>,
+    pub frame_ms: f64,
+    /// Its frame / the Cartesian frame.
+    pub frame_ratio: f64,
+    /// Its trace / the Cartesian trace.
+    pub trace_ratio: f64,
 }
 
 /// Display rate of `--camera-path` keyframes in the bench (no headset there): the FOVE 0's 70 Hz,
@@ -158,7 +175,17 @@ pub fn measure(
         let mut next = |bytes| medians.next().map(|m| (m, bytes)).expect("one median map per renderer");
         Ok([next(cart_history), next(vp_history)])
     };
-    let [(cartesian_passes_ms, _), (vp_passes_ms, _)] = measure_pair(RenderSettings::default())?;
+    // Without a denoiser the comparators join the same interleaved run.
+    let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
+    let (cartesian_passes_ms, vp_passes_ms, log_polar_passes_ms) = {
+        let settings = RenderSettings::default();
+        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
+        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
+        let mut lpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(log_polar), settings)?;
+        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze)), (&mut lpr, Some(gaze))], &camera_at, frames)?.into_iter();
+        let mut next = || medians.next().expect("one median map per renderer");
+        (next(), next(), next())
+    };
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
@@ -178,6 +205,16 @@ pub fn measure(
         });
     }
     let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cartesian_passes_ms), frame_ms(&vp_passes_ms));
+    let log_polar_frame_ms = frame_ms(&log_polar_passes_ms);
+    let comparators = vec![MethodCost {
+        method: "log-polar",
+        grid: log_polar.grid_size().to_array(),
+        samples: log_polar.sample_count(),
+        frame_ratio: log_polar_frame_ms / cartesian_frame_ms,
+        trace_ratio: log_polar_passes_ms["trace"] / cartesian_passes_ms["trace"],
+        passes_ms: log_polar_passes_ms,
+        frame_ms: log_polar_frame_ms,
+    }];
     let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
 
     let rays = vp_primary_rays(&vp, &pose);
@@ -204,6 +241,7 @@ pub fn measure(
         cartesian_frame_ms,
         vp_frame_ms,
         denoisers: costs,
+        comparators,
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
         coherence_gain: shuffled_ms / ordered_ms,
@@ -222,6 +260,12 @@ pub fn measure(
         report.shuffled_mrays_per_s,
         report.coherence_gain,
     );
+    for m in &report.comparators {
+        println!(
+            "  {} {}×{} ({} samples vs VP's {}): frame {:.1} ms = {:.3} of Cartesian (trace {:.3})",
+            m.method, m.grid[0], m.grid[1], m.samples, report.vp_samples, m.frame_ms, m.frame_ratio, m.trace_ratio
+        );
+    }
     let mib = |b: u64| b as f64 / (1 << 20) as f64;
     for d in &report.denoisers {
         let passes: Vec<String> = d
