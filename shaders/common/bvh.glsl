@@ -100,6 +100,24 @@ vec3 safe_inverse_dir(vec3 dir) {
     return 1.0 / mix(dir, signed_tiny, zero);
 }
 
+// Reads 4-wide node `node` (8 texels, one component per child: fovea_scene::bvh::wide) and
+// slab-tests its four children at once, each as fovea_scene::bvh::slab_test with tmin for 0:
+// which children the ray enters before `limit`, their entry distances, references and counts.
+bvec4 node_children_hit(uint node, vec3 org, vec3 inv_dir, float tmin, float limit, out uvec4 refs, out uvec4 counts, out vec4 enter) {
+    int base = int(node) * 8;
+    vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
+    vec4 hix = texelFetch(bvh_nodes, base + 3), hiy = texelFetch(bvh_nodes, base + 4), hiz = texelFetch(bvh_nodes, base + 5);
+    refs = floatBitsToUint(texelFetch(bvh_nodes, base + 6));
+    counts = floatBitsToUint(texelFetch(bvh_nodes, base + 7));
+    vec4 ax = (lox - org.x) * inv_dir.x, bx = (hix - org.x) * inv_dir.x;
+    vec4 ay = (loy - org.y) * inv_dir.y, by = (hiy - org.y) * inv_dir.y;
+    vec4 az = (loz - org.z) * inv_dir.z, bz = (hiz - org.z) * inv_dir.z;
+    enter = max(max(min(ax, bx), min(ay, by)), max(min(az, bz), vec4(tmin)));
+    vec4 leave = min(min(max(ax, bx), max(ay, by)), max(az, bz)) * SLAB_SLACK;
+    // An empty child is an inverted box: the slab test alone would accept it.
+    return bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(lessThanEqual(enter, vec4(limit))) & uvec4(lessThanEqual(lox, hix)));
+}
+
 // Walks one tree from `root`, continuing `hit` (closest: smallest (t, placed id), the CPU
 // reference's tie rule; any_hit: stops at the first hit and returns true). A leaf entry's
 // texel w = k is placed id id_base + k and TriangleGpu tri_base + k (the world tree: 0, 0).
@@ -118,19 +136,9 @@ bool bvh_walk(uint root, vec3 org, vec3 dir, float tmin, float tmax, bool any_hi
     uint node = root;
     bool done = false, found = false;
     while (!done) {
-        int base = int(node) * 8;
-        vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
-        vec4 hix = texelFetch(bvh_nodes, base + 3), hiy = texelFetch(bvh_nodes, base + 4), hiz = texelFetch(bvh_nodes, base + 5);
-        uvec4 refs = floatBitsToUint(texelFetch(bvh_nodes, base + 6));
-        uvec4 counts = floatBitsToUint(texelFetch(bvh_nodes, base + 7));
-        // Four slab tests at once, each as fovea_scene::bvh::slab_test with tmin for 0.
-        vec4 ax = (lox - org.x) * inv_dir.x, bx = (hix - org.x) * inv_dir.x;
-        vec4 ay = (loy - org.y) * inv_dir.y, by = (hiy - org.y) * inv_dir.y;
-        vec4 az = (loz - org.z) * inv_dir.z, bz = (hiz - org.z) * inv_dir.z;
-        vec4 enter = max(max(min(ax, bx), min(ay, by)), max(min(az, bz), vec4(tmin)));
-        vec4 leave = min(min(max(ax, bx), max(ay, by)), max(az, bz)) * SLAB_SLACK;
-        // An empty child is an inverted box: the slab test alone would accept it.
-        bvec4 hit4 = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(lessThanEqual(enter, vec4(limit))) & uvec4(lessThanEqual(lox, hix)));
+        uvec4 refs, counts;
+        vec4 enter;
+        bvec4 hit4 = node_children_hit(node, org, inv_dir, tmin, limit, refs, counts, enter);
         uvec4 leaf = uvec4(hit4) * counts;
         // Leaves: all hit leaves' triangles in one loop, in slot order.
         uint c01 = leaf.x + leaf.y, c012 = c01 + leaf.z, n_leaf = c012 + leaf.w;
@@ -210,17 +218,9 @@ bool instances_walk(vec3 org, vec3 dir, float tmin, float tmax, bool any_hit, in
     int sp = 0;
     uint node = frame.data.instancing.z;
     while (true) {
-        int base = int(node) * 8;
-        vec4 lox = texelFetch(bvh_nodes, base + 0), loy = texelFetch(bvh_nodes, base + 1), loz = texelFetch(bvh_nodes, base + 2);
-        vec4 hix = texelFetch(bvh_nodes, base + 3), hiy = texelFetch(bvh_nodes, base + 4), hiz = texelFetch(bvh_nodes, base + 5);
-        uvec4 refs = floatBitsToUint(texelFetch(bvh_nodes, base + 6));
-        uvec4 counts = floatBitsToUint(texelFetch(bvh_nodes, base + 7));
-        vec4 ax = (lox - org.x) * inv_dir.x, bx = (hix - org.x) * inv_dir.x;
-        vec4 ay = (loy - org.y) * inv_dir.y, by = (hiy - org.y) * inv_dir.y;
-        vec4 az = (loz - org.z) * inv_dir.z, bz = (hiz - org.z) * inv_dir.z;
-        vec4 enter = max(max(min(ax, bx), min(ay, by)), max(min(az, bz), vec4(tmin)));
-        vec4 leave = min(min(max(ax, bx), max(ay, by)), max(az, bz)) * SLAB_SLACK;
-        bvec4 hit4 = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(lessThanEqual(enter, vec4(hit.t * SLAB_SLACK))) & uvec4(lessThanEqual(lox, hix)));
+        uvec4 refs, counts;
+        vec4 enter;
+        bvec4 hit4 = node_children_hit(node, org, inv_dir, tmin, hit.t * SLAB_SLACK, refs, counts, enter);
         bool have_next = false;
         uint next = 0u;
         for (int c = 0; c < 4; ++c) {
