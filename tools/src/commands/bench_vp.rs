@@ -164,32 +164,27 @@ pub fn measure(
     let pose = CameraPose::from_scene_camera(camera, w, h);
     let camera_at = |frame: u32| camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose));
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
-    // A Cartesian and a VP renderer with these settings, their frames interleaved: each one's
-    // pass medians and denoiser history bytes (the renderers are dropped before the next pair).
-    let measure_pair = |settings: RenderSettings| -> Result<[(BTreeMap<String, f64>, u64); 2]> {
-        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
-        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
-        let history = |r: &Renderer| r.denoiser().map_or(0, |d| d.history_bytes());
-        let (cart_history, vp_history) = (history(&cart), history(&vpr));
-        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze))], &camera_at, frames)?.into_iter();
-        let mut next = |bytes| medians.next().map(|m| (m, bytes)).expect("one median map per renderer");
-        Ok([next(cart_history), next(vp_history)])
+    // One renderer per space (Cartesian first, gaze-less) with these settings, their frames
+    // interleaved: each one's pass medians and denoiser history bytes (the renderers are dropped
+    // before the next measurement).
+    let measure = |settings: RenderSettings, foveated: &[VisualPolar]| -> Result<Vec<(BTreeMap<String, f64>, u64)>> {
+        let mut renderers = vec![(Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?, None)];
+        for space in foveated {
+            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(*space), settings)?, Some(gaze)));
+        }
+        let history: Vec<u64> = renderers.iter().map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes())).collect();
+        let mut timed: Vec<(&mut Renderer, Option<Vec2>)> = renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
+        Ok(interleaved_pass_medians(&mut timed, &camera_at, frames)?.into_iter().zip(history).collect())
     };
     // Without a denoiser the comparators join the same interleaved run.
     let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
-    let (cartesian_passes_ms, vp_passes_ms, log_polar_passes_ms) = {
-        let settings = RenderSettings::default();
-        let mut cart = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?;
-        let mut vpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(vp), settings)?;
-        let mut lpr = Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(log_polar), settings)?;
-        let mut medians = interleaved_pass_medians(&mut [(&mut cart, None), (&mut vpr, Some(gaze)), (&mut lpr, Some(gaze))], &camera_at, frames)?.into_iter();
-        let mut next = || medians.next().expect("one median map per renderer");
-        (next(), next(), next())
-    };
+    let [(cartesian_passes_ms, _), (vp_passes_ms, _), (log_polar_passes_ms, _)]: [_; 3] =
+        measure(RenderSettings::default(), &[vp, log_polar])?.try_into().expect("one median map per renderer");
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
-        let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)] = measure_pair(RenderSettings { denoiser, ..Default::default() })?;
+        let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)]: [_; 2] =
+            measure(RenderSettings { denoiser, ..Default::default() }, &[vp])?.try_into().expect("one median map per renderer");
         let (cartesian_passes_ms, vp_passes_ms) = (denoiser_passes(cart_all, &prefixes), denoiser_passes(vp_all, &prefixes));
         let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
