@@ -101,23 +101,22 @@ pub fn upward_irradiance(map: &EnvironmentMap) -> f32 {
 pub fn preetham_map(sun: Vec3, intensity: f32) -> EnvironmentMap {
     let sky = Preetham::new(sun, TURBIDITY);
     let (width, height) = BAKE_SIZE;
-    let mut texels = Vec::with_capacity((width * height) as usize);
-    for y in 0..height {
-        for x in 0..width {
-            let dir = uv_to_direction(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32));
-            texels.push(if dir.y >= 0.0 { sky.radiance(dir) } else { Vec3::ZERO });
-        }
-    }
+    let direction = |x: u32, y: u32| uv_to_direction(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32));
+    let below: Vec<bool> = (0..height).map(|y| direction(0, y).y < 0.0).collect();
+    // The ground rows are filled once the sky's scale is known.
+    let texels = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| if below[y as usize] { Vec3::ZERO } else { sky.radiance(direction(x, y)) })
+        .collect();
     let mut map = EnvironmentMap::new(width, height, texels).expect("a finite, non-negative bake of a valid size");
     let target = upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(intensity)));
     let scale = if intensity > 0.0 { target / upward_irradiance(&map) } else { 0.0 };
-    let upper: Vec<Vec3> = map.texels.iter().filter(|c| **c != Vec3::ZERO).copied().collect();
-    let ground = upper.iter().sum::<Vec3>() / upper.len().max(1) as f32 * scale * GROUND_SHARE;
-    let ground = Vec3::splat((ground.x + ground.y + ground.z) / 3.0);
-    for (i, c) in map.texels.iter_mut().enumerate() {
-        let row = i as u32 / width;
-        let below = uv_to_direction(Vec2::new(0.5, (row as f32 + 0.5) / height as f32)).y < 0.0;
-        *c = if below { ground } else { *c * scale };
+    let rows = map.texels.chunks_exact(width as usize).zip(&below);
+    let (sum, count) = rows.filter(|(_, &b)| !b).fold((Vec3::ZERO, 0usize), |(s, n), (row, _)| (s + row.iter().sum::<Vec3>(), n + row.len()));
+    let mean = sum / count.max(1) as f32 * scale * GROUND_SHARE;
+    let ground = Vec3::splat((mean.x + mean.y + mean.z) / 3.0);
+    for (row, &b) in map.texels.chunks_exact_mut(width as usize).zip(&below) {
+        row.iter_mut().for_each(|c| *c = if b { ground } else { *c * scale });
     }
     map
 }
