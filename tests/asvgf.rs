@@ -348,7 +348,7 @@ fn the_renderer_refuses_filters_a_space_cannot_run() {
         let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..VisualPolarParams::default() };
         Box::new(VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap())
     };
-    assert!(!clipped().capabilities().temporal_filters && clipped().capabilities().needs_remap);
+    assert!(!clipped().capabilities().temporal_filters && clipped().capabilities().way_back == fovea_renderer::sampling::WayBack::Remap);
     let cases = [
         ("svgf", settings(DenoiserSettings::Svgf(SvgfSettings::default()))),
         ("bmfr", settings(DenoiserSettings::Bmfr(BmfrSettings::default()))),

@@ -9,6 +9,7 @@
 
 pub mod environment;
 pub mod error;
+pub mod fill_to_screen;
 pub mod frames;
 pub mod gpu_scene;
 pub mod graph;

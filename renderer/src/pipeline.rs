@@ -677,12 +677,13 @@ fn record_view(
         has_previous: denoise_frame.previous.is_some(),
         jitter,
     });
-    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar(), &view.upscale) {
-        (Some(to_screen), Some(vp), _) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
-        (_, _, Some((upscale, screen))) => {
+    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar(), &view.upscale, &view.fill) {
+        (Some(to_screen), Some(vp), _, _) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+        (_, _, Some((upscale, screen)), _) => {
             upscale.record(rec, grid_hdr, screen)?;
             screen
         }
+        (_, _, _, Some(fill)) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
         _ => grid_hdr,
     };
     let (exposure, curve) = (settings.exposure, settings.tone_curve);

@@ -10,7 +10,8 @@ use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
-use crate::sampling::SamplingSpace;
+use crate::fill_to_screen::FillToScreen;
+use crate::sampling::{SamplingSpace, WayBack};
 use crate::to_screen::ToScreen;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
@@ -80,6 +81,8 @@ pub struct View {
     pub(crate) to_screen: Option<ToScreen>,
     /// Grids coarser than the screen (uniform budget): the upscale and its screen-sized output.
     pub(crate) upscale: Option<(UpscalePass, Image)>,
+    /// Screens traced in part (`WayBack::Fill`): hole filling and the blur.
+    pub(crate) fill: Option<FillToScreen>,
     pub(crate) ldr: Image,
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
@@ -110,17 +113,22 @@ impl View {
         }
         // Screen-space TAA runs between the remap and the blur; where the sampling grid is the
         // screen, it is the sampling-grid filter.
-        let (grid_taa, screen_taa) = match (settings.taa, caps.needs_remap) {
+        let remapped = caps.way_back == WayBack::Remap;
+        let (grid_taa, screen_taa) = match (settings.taa, remapped) {
             (TaaMode::Screen(s), true) => (None, Some(s)),
             (mode, _) => (mode.settings().copied(), None),
         };
-        let to_screen = match caps.needs_remap {
+        let to_screen = match remapped {
             true => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
             false => None,
         };
-        let upscale = match caps.needs_upscale {
-            true => Some((UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?)),
-            false => None,
+        let upscale = match caps.way_back {
+            WayBack::Upscale => Some((UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?)),
+            _ => None,
+        };
+        let fill = match caps.way_back {
+            WayBack::Fill => Some(FillToScreen::new(ctx, screen)?),
+            _ => None,
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
@@ -142,6 +150,7 @@ impl View {
             accum: None,
             to_screen,
             upscale,
+            fill,
             denoiser,
             taa,
             prev_camera: None,
@@ -154,7 +163,7 @@ impl View {
 
     /// Passes one frame of this view records at most (sizes the timestamp pool).
     pub(crate) fn max_passes(&self) -> u32 {
-        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
+        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + self.fill.as_ref().map_or(0, |f| f.passes())
     }
 
     /// GPU bytes of TAA history carried between frames (either mode; 0 when off).

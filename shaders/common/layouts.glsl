@@ -37,6 +37,11 @@ const uint FRAME_FLAG_ALPHA_MASK = 4u;
 // what references use: jittered samples then converge to the box-filtered pixel).
 const uint FRAME_FLAG_TEXTURE_LOD = 8u;
 
+// Salts of unit_hash (random.glsl) for the sparse spaces' choices, apart from the paths' streams:
+// whether linear falloff keeps a pixel, where a random-acuity sample lies.
+const uint SPARSE_SALT_KEEP = 0x6b656570u;
+const uint SPARSE_SALT_POSITION = 0x706f7369u;
+
 // Everything the passes need to know about the current (and previous) frame.
 struct FrameData {
     mat4 world_from_view;       // camera: +X right, +Y up, −Z forward (glTF/OpenXR view axes)
@@ -72,7 +77,9 @@ struct EnvProbePush {
 // (1 exact inverse CDF, 2 screen-clipped layout, 4 headset eccentricity axis); paper axis: gaze.zw
 // = (r_max, k), shape0 = (u_f, p_f, r_f, e_norm), shape1 = (cdf_max, flags, fovea°, 0); headset
 // axis: gaze.zw = (gaze tangent x, k), shape0 = (u_f, p_f, fovea°, gaze tangent y), shape1 =
-// (e_max, flags, tangent per pixel x, y). Cartesian: zero.
+// (e_max, flags, tangent per pixel x, y). Cartesian: zero. Linear falloff
+// (sampling/linear_falloff.glsl): gaze.zw = (inner, outer radius px), shape0 = (floor probability,
+// budget scale, 0, 0).
 struct SamplingParams {
     uvec4 grid;                 // xy sampling-grid size in texels, zw screen size in pixels
     vec4 gaze;                  // xy gaze in screen pixels, zw space-specific (see above)
@@ -145,6 +152,11 @@ struct TracePush {
 // Push constants of the accumulate pass.
 struct AccumulatePush {
     uvec4 config;               // x number of samples already in the accumulator
+};
+
+// Push constants of the push-pull fill (passes/fill.comp).
+struct FillPush {
+    uvec4 config;               // x 0: pull (fine → coarse), 1: push (coarse under fine); yzw unused
 };
 
 // Push constants of the tonemap pass.

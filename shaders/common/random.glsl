@@ -23,4 +23,10 @@ vec2 rng_next2(inout uint state) {
     return vec2(rng_next(state), rng_next(state));
 }
 
+// One uniform number in [0, 1) per (texel, frame, seed, salt), independent of the path's stream
+// (another salt): which texels a sparse space traces. Rust: sampling::unit_hash.
+float unit_hash(uvec2 texel, uint frame_index, uint seed, uint salt) {
+    return float(rng_seed(texel, frame_index, seed, salt) >> 8u) * (1.0 / 16777216.0);
+}
+
 #endif

@@ -14,9 +14,7 @@ layout(std430, set = 0, binding = 4) readonly buffer MaterialBuffer { MaterialGp
 layout(std430, set = 0, binding = 5) readonly buffer TextureBuffer { TextureGpu data[]; } textures;
 layout(std430, set = 0, binding = 6) readonly buffer TexelBuffer { uint data[]; } texels;     // RGBA8
 layout(std430, set = 0, binding = 7) readonly buffer LightBuffer { LightGpu data[]; } lights;
-// Uniform, not storage: every lane reads the same frame data, and lavapipe turns storage-buffer
-// reads into one load per lane (std140 = std430 here: FrameData is all vec4/mat4).
-layout(std140, set = 0, binding = 8) uniform FrameBuffer { FrameData data; } frame;
+#include "frame.glsl"
 // Instances in fovea_scene's order (ascending first placed id); a dummy entry when there are none.
 layout(std430, set = 0, binding = 25) readonly buffer InstanceBuffer { InstanceGpu data[]; } instances;
 

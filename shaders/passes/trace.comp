@@ -13,6 +13,7 @@
 //! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 //! variant log_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
 //! variant log_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
+//! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"

@@ -13,6 +13,8 @@ layout(std140, set = 0, binding = 9) uniform SamplingBuffer { SamplingParams dat
 #include "cartesian.glsl"
 #elif defined(SAMPLING_VISUAL_POLAR)
 #include "visual_polar.glsl"
+#elif defined(SAMPLING_LINEAR_FALLOFF)
+#include "linear_falloff.glsl"
 #else
 #error "no sampling space selected"
 #endif

@@ -4,6 +4,7 @@
 pub mod accumulate;
 pub mod blur;
 pub mod denoise;
+pub mod fill;
 pub mod mip_phi;
 pub mod raycast;
 pub mod remap;

@@ -4,13 +4,16 @@
 
 mod acuity;
 mod cartesian;
+mod linear_falloff;
 mod log_polar;
+pub mod random;
 mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 
 pub use cartesian::Cartesian;
+pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use uniform_budget::UniformBudget;
 pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
@@ -21,13 +24,24 @@ use crate::error::Result;
 use crate::layouts::SamplingParams;
 use glam::{UVec2, Vec2};
 
+/// How a space's samples come back to the screen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WayBack {
+    /// The grid is the screen.
+    Direct,
+    /// A polar grid: φ-mips, the remap and the foveated blur.
+    Remap,
+    /// A regular grid coarser than the screen: bilinear upscaling.
+    Upscale,
+    /// The screen's pixels, some not traced (alpha 0): push-pull hole filling, then the foveated
+    /// blur (`blur_axis`).
+    Fill,
+}
+
 /// What the pipeline may do with a space: asked by the renderer instead of testing concrete types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SpaceCapabilities {
-    /// The grid is not the screen: φ-mips, the remap and the foveated blur bring it back.
-    pub needs_remap: bool,
-    /// A regular grid coarser than the screen: bilinear upscaling brings it back.
-    pub needs_upscale: bool,
+    pub way_back: WayBack,
     /// The denoisers and TAA can reproject and filter in this grid (their kernels address it).
     pub temporal_filters: bool,
     /// Why they cannot, for the error (when `temporal_filters` is false).
@@ -79,8 +93,13 @@ pub trait SamplingSpace {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         None
     }
+    /// The eccentricity axis that shapes the foveated blur after a sparse way back (the polar
+    /// spaces' own blur comes with the remap).
+    fn blur_axis(&self) -> Option<&VisualPolar> {
+        None
+    }
     /// The space's capabilities (default: a screen-sized grid every filter supports).
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { needs_remap: false, needs_upscale: false, temporal_filters: true, filters_note: "" }
+        SpaceCapabilities { way_back: WayBack::Direct, temporal_filters: true, filters_note: "" }
     }
 }

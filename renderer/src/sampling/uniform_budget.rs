@@ -3,7 +3,7 @@
 //! spends the foveated budget uniformly. Same kernels as Cartesian (`cartesian.glsl` scales the
 //! texel to the screen when the grid is smaller).
 
-use super::{SamplingSpace, SpaceCapabilities};
+use super::{SamplingSpace, SpaceCapabilities, WayBack};
 use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
 use glam::{UVec2, UVec4, Vec2, Vec4};
@@ -75,7 +75,7 @@ impl SamplingSpace for UniformBudget {
     fn capabilities(&self) -> SpaceCapabilities {
         // The denoisers' Cartesian addressing takes the grid for the screen (no scaled
         // reprojection yet), so they and TAA are refused rather than run wrong.
-        SpaceCapabilities { needs_remap: false, needs_upscale: true, temporal_filters: false, filters_note: "(its grid is coarser than the screen)" }
+        SpaceCapabilities { way_back: WayBack::Upscale, temporal_filters: false, filters_note: "(its grid is coarser than the screen)" }
     }
 }
 

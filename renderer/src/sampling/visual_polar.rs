@@ -651,8 +651,7 @@ impl SamplingSpace for VisualPolar {
         // The filters reproject and address the grid with the paper's mapping only (no
         // per-column arc table in their kernels yet).
         super::SpaceCapabilities {
-            needs_remap: true,
-            needs_upscale: false,
+            way_back: super::WayBack::Remap,
             temporal_filters: self.params.layout == VpLayout::Paper,
             filters_note: "in its screen-clipped layout (use layout = \"paper\")",
         }

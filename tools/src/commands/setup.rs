@@ -12,12 +12,12 @@ use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, UniformBudget, VisualPolar, VpLayout};
+use fovea_renderer::sampling::{Cartesian, FalloffShape, LinearFalloff, SamplingSpace, UniformBudget, VisualPolar, VpLayout, FALLOFF_BUDGET_OF_VP};
 use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -177,7 +177,8 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
     if method == "log-polar" {
         return check_log_polar(profile, screen);
     }
-    if method != "vp" && method != "uniform-budget" {
+    // So are linear falloff's budget and degrees.
+    if !matches!(method, "vp" | "uniform-budget" | "linear-falloff") {
         return Ok(());
     }
     if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
@@ -309,6 +310,8 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
             let vp = VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space (the uniform budget's count)")?;
             Box::new(UniformBudget::with_samples(screen, vp.sample_count())?)
         }
+        // Weier et al.'s falloff on VP's eccentricity axis with 1.5× its samples (Koskela 2019).
+        "linear-falloff" => Box::new(LinearFalloff::new(screen, vp_params, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).context("linear falloff")?),
         other => bail!("--method {other}: expected one of {}", METHODS.join(", ")),
     })
 }
