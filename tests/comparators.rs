@@ -10,7 +10,7 @@ use fovea_renderer::passes::fill::FillPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, FalloffShape, LinearFalloff, SamplingSpace, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
 use fovea_renderer::vk::Image;
-use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene};
+use fovea_tests::{assert_clean, gpu, owned_scene};
 use glam::{UVec2, Vec2};
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
@@ -19,19 +19,13 @@ fn falloff() -> LinearFalloff {
     LinearFalloff::new(SCREEN, VisualPolarParams::default(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()
 }
 
-/// Mean linear colour of the screen over `frames` frames with the gaze at `gaze`.
+/// Mean linear colour over `frames` frames with the gaze at `gaze`; no frame may hold a hole or
+/// a non-finite pixel.
 fn mean_over_frames(renderer: &mut Renderer, camera: CameraPose, gaze: Vec2, frames: u32) -> [f64; 3] {
-    let mut sum = [0.0; 3];
-    let mut hdr = Vec::new();
-    for f in 0..frames {
-        renderer.render_frame(&FrameInput::mono(camera, f, Some(gaze)).with_hdr(true)).unwrap();
-        renderer.read_hdr(&mut hdr).unwrap();
+    fovea_tests::mean_over_frames(renderer, camera, Some(gaze), frames, |f, hdr| {
         assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize);
         assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] > 0.0), "frame {f}: a hole or a non-finite pixel");
-        let m = mean_rgb(&hdr);
-        (0..3).for_each(|c| sum[c] += m[c] / frames as f64);
-    }
-    sum
+    })
 }
 
 #[test]

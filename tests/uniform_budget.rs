@@ -6,23 +6,16 @@ use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams};
-use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene};
+use fovea_tests::{assert_clean, gpu, owned_scene};
 use glam::UVec2;
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
 
-/// Mean linear colour over `frames` frames (independent noise each frame).
+/// Mean linear colour over `frames` frames; the upscaled image must be screen-sized.
 fn mean_over_frames(renderer: &mut Renderer, camera: CameraPose, frames: u32) -> [f64; 3] {
-    let mut sum = [0.0; 3];
-    let mut hdr = Vec::new();
-    for f in 0..frames {
-        renderer.render_frame(&FrameInput::mono(camera, f, None).with_hdr(true)).unwrap();
-        renderer.read_hdr(&mut hdr).unwrap();
+    fovea_tests::mean_over_frames(renderer, camera, None, frames, |_, hdr| {
         assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize, "the upscaled image is screen-sized");
-        let m = mean_rgb(&hdr);
-        (0..3).for_each(|c| sum[c] += m[c] / frames as f64);
-    }
-    sum
+    })
 }
 
 #[test]

@@ -18,6 +18,7 @@ use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSetting
 use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
+use fovea_renderer::sampling::random::{pcg_hash, rng_seed};
 use fovea_tests::{assert_clean, gpu, read_image};
 use glam::{IVec2, UVec2, Vec2};
 use std::sync::Arc;
@@ -25,19 +26,9 @@ use std::sync::Arc;
 const SCREEN: UVec2 = UVec2::new(160, 180);
 const FRAME_INDEX: u32 = 3;
 
-fn pcg_hash(v: u32) -> u32 {
-    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
-    (word >> 22) ^ word
-}
-
 /// `rng_seed` + the first `rng_next2` of `shaders/common/random.glsl`.
 fn kernel_jitter(texel: UVec2, frame: u32, seed: u32, sample_index: u32) -> Vec2 {
-    let mut state = pcg_hash(
-        texel.x.wrapping_add(pcg_hash(
-            texel.y.wrapping_add(pcg_hash(frame.wrapping_add(pcg_hash(seed.wrapping_add(pcg_hash(sample_index)))))),
-        )),
-    );
+    let mut state = rng_seed(texel.to_array(), frame, seed, sample_index);
     let mut next = || {
         state = pcg_hash(state);
         (state >> 8) as f32 * (1.0 / 16_777_216.0)

@@ -4,26 +4,21 @@
 
 use crate::error::Result;
 use crate::graph::FrameRecorder;
-use crate::passes::blur::BlurPass;
 use crate::passes::fill::FillPass;
 use crate::sampling::SamplingSpace;
-use crate::to_screen::BlurSettings;
+use crate::to_screen::{BlurSettings, FoveatedBlur};
 use crate::vk::{Context, Image};
-use ash::vk;
 use glam::UVec2;
 use std::sync::Arc;
 
 pub struct FillToScreen {
     fill: FillPass,
-    blur: BlurPass,
-    scratch: Image,
-    blurred: Image,
+    blur: FoveatedBlur,
 }
 
 impl FillToScreen {
     pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FillToScreen> {
-        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
-        Ok(FillToScreen { fill: FillPass::new(ctx, screen)?, blur: BlurPass::new(ctx)?, scratch: image("fill.blur_scratch")?, blurred: image("fill.blurred")? })
+        Ok(FillToScreen { fill: FillPass::new(ctx, screen)?, blur: FoveatedBlur::new(ctx, screen)? })
     }
 
     pub fn passes(&self) -> u32 {
@@ -34,11 +29,8 @@ impl FillToScreen {
     pub fn record<'a>(&'a self, rec: &mut FrameRecorder, space: &dyn SamplingSpace, sparse: &'a Image, blur: &BlurSettings) -> Result<&'a Image> {
         let filled = self.fill.record(rec, sparse)?;
         match space.blur_axis() {
-            Some(axis) if blur.sigma_at_30 > 0.0 => {
-                self.blur.record(rec, &blur.shape(axis), filled, &self.scratch, &self.blurred)?;
-                Ok(&self.blurred)
-            }
-            _ => Ok(filled),
+            Some(axis) => self.blur.record(rec, blur, axis, filled),
+            None => Ok(filled),
         }
     }
 }

@@ -14,7 +14,7 @@ use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSetti
 use crate::passes::tonemap::{LdrTarget, TonemapPass, ToneCurve};
 use crate::sampling::SamplingSpace;
 use crate::to_screen::BlurSettings;
-use crate::view::View;
+use crate::view::{BackPasses, View};
 use crate::scene::{Camera, Scene};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
@@ -677,13 +677,13 @@ fn record_view(
         has_previous: denoise_frame.previous.is_some(),
         jitter,
     });
-    let screen_hdr = match (&mut view.to_screen, view.space.visual_polar(), &view.upscale, &view.fill) {
-        (Some(to_screen), Some(vp), _, _) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
-        (_, _, Some((upscale, screen)), _) => {
+    let screen_hdr = match (&mut view.back, view.space.visual_polar()) {
+        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+        (BackPasses::Upscale(upscale, screen), _) => {
             upscale.record(rec, grid_hdr, screen)?;
             screen
         }
-        (_, _, _, Some(fill)) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
+        (BackPasses::Fill(fill), _) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
         _ => grid_hdr,
     };
     let (exposure, curve) = (settings.exposure, settings.tone_curve);

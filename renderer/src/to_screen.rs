@@ -50,16 +50,37 @@ impl BlurSettings {
     }
 }
 
-pub struct ToScreen {
-    mip_phi: MipPhiPass,
-    remap: RemapPass,
-    blur: BlurPass,
-    pub mips: PhiMips,
-    /// Remapped linear radiance (before the blur).
-    pub remapped: Image,
+/// The foveated blur at the end of a way back, with its screen-sized scratch and output.
+pub struct FoveatedBlur {
+    pass: BlurPass,
     scratch: Image,
     /// Final linear radiance on the screen.
     pub blurred: Image,
+}
+
+impl FoveatedBlur {
+    pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FoveatedBlur> {
+        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
+        Ok(FoveatedBlur { pass: BlurPass::new(ctx)?, scratch: image("screen.blur_scratch")?, blurred: image("screen.blurred")? })
+    }
+
+    /// Blurs `src` around `axis`'s gaze into `blurred`; `src` itself when σ is 0.
+    pub fn record<'a>(&'a self, rec: &mut FrameRecorder, settings: &BlurSettings, axis: &VisualPolar, src: &'a Image) -> Result<&'a Image> {
+        if settings.sigma_at_30 <= 0.0 {
+            return Ok(src);
+        }
+        self.pass.record(rec, &settings.shape(axis), src, &self.scratch, &self.blurred)?;
+        Ok(&self.blurred)
+    }
+}
+
+pub struct ToScreen {
+    mip_phi: MipPhiPass,
+    remap: RemapPass,
+    pub mips: PhiMips,
+    /// Remapped linear radiance (before the blur).
+    pub remapped: Image,
+    blur: FoveatedBlur,
     /// TAA between the remap and the blur (`--taa screen`).
     pub taa: Option<ScreenTaa>,
 }
@@ -71,11 +92,9 @@ impl ToScreen {
         Ok(ToScreen {
             mip_phi: MipPhiPass::new(ctx)?,
             remap: RemapPass::new(ctx)?,
-            blur: BlurPass::new(ctx)?,
+            blur: FoveatedBlur::new(ctx, screen)?,
             mips: PhiMips::new(ctx, grid)?,
             remapped: image("screen.remapped")?,
-            scratch: image("screen.blur_scratch")?,
-            blurred: image("screen.blurred")?,
             taa: taa.map(|t| ScreenTaa::new(ctx, screen, t)).transpose()?,
         })
     }
@@ -105,10 +124,6 @@ impl ToScreen {
             (Some(resolver), Some(frame)) => resolver.record(rec, &self.remapped, frame)?,
             _ => &self.remapped,
         };
-        if blur.sigma_at_30 <= 0.0 {
-            return Ok(resolved);
-        }
-        self.blur.record(rec, &blur.shape(vp), resolved, &self.scratch, &self.blurred)?;
-        Ok(&self.blurred)
+        self.blur.record(rec, blur, vp, resolved)
     }
 }

@@ -70,6 +70,17 @@ pub(crate) fn readback(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Buf
     Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
 }
 
+/// The passes of one `WayBack` (sampling::WayBack), owned by the view.
+// One per view, made once and never moved on a hot path: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
+pub(crate) enum BackPasses {
+    Direct,
+    Remap(ToScreen),
+    /// The upscale and its screen-sized output.
+    Upscale(UpscalePass, Image),
+    Fill(FillToScreen),
+}
+
 pub struct View {
     pub space: Box<dyn SamplingSpace>,
     pub gbuffer: GBuffer,
@@ -77,12 +88,8 @@ pub struct View {
     /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
     /// (references keep `trace`).
     pub(crate) trace_gradients: Option<TracePass>,
-    /// Visual-Polar spaces only: the way back to the screen.
-    pub(crate) to_screen: Option<ToScreen>,
-    /// Grids coarser than the screen (uniform budget): the upscale and its screen-sized output.
-    pub(crate) upscale: Option<(UpscalePass, Image)>,
-    /// Screens traced in part (`WayBack::Fill`): hole filling and the blur.
-    pub(crate) fill: Option<FillToScreen>,
+    /// The passes of the space's way back to the screen.
+    pub(crate) back: BackPasses,
     pub(crate) ldr: Image,
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
@@ -118,17 +125,11 @@ impl View {
             (TaaMode::Screen(s), true) => (None, Some(s)),
             (mode, _) => (mode.settings().copied(), None),
         };
-        let to_screen = match remapped {
-            true => Some(ToScreen::new(ctx, grid, screen, screen_taa)?),
-            false => None,
-        };
-        let upscale = match caps.way_back {
-            WayBack::Upscale => Some((UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?)),
-            _ => None,
-        };
-        let fill = match caps.way_back {
-            WayBack::Fill => Some(FillToScreen::new(ctx, screen)?),
-            _ => None,
+        let back = match caps.way_back {
+            WayBack::Direct => BackPasses::Direct,
+            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa)?),
+            WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
+            WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
@@ -148,9 +149,7 @@ impl View {
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             accum: None,
-            to_screen,
-            upscale,
-            fill,
+            back,
             denoiser,
             taa,
             prev_camera: None,
@@ -163,13 +162,19 @@ impl View {
 
     /// Passes one frame of this view records at most (sizes the timestamp pool).
     pub(crate) fn max_passes(&self) -> u32 {
-        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + self.fill.as_ref().map_or(0, |f| f.passes())
+        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
+            BackPasses::Fill(f) => f.passes(),
+            _ => 0,
+        }
     }
 
     /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
     pub fn taa_history_bytes(&self) -> u64 {
         let grid = self.taa.as_ref().map_or(0, |t| t.history_bytes());
-        let screen = self.to_screen.as_ref().and_then(|s| s.taa.as_ref()).map_or(0, |t| t.history_bytes());
+        let screen = match &self.back {
+            BackPasses::Remap(s) => s.taa.as_ref().map_or(0, |t| t.history_bytes()),
+            _ => 0,
+        };
         grid + screen
     }
 

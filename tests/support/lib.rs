@@ -136,11 +136,30 @@ pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_
     }
 }
 
+/// Mean linear colour of the screen over `frames` real-time frames (independent noise each), with
+/// the gaze at `gaze`; each frame's HDR screen goes to `check` first.
+pub fn mean_over_frames(
+    renderer: &mut fovea_renderer::pipeline::Renderer,
+    camera: fovea_renderer::pipeline::CameraPose,
+    gaze: Option<glam::Vec2>,
+    frames: u32,
+    mut check: impl FnMut(u32, &[[f32; 4]]),
+) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    let mut hdr = Vec::new();
+    for f in 0..frames {
+        renderer.render_frame(&fovea_renderer::pipeline::FrameInput::mono(camera, f, gaze).with_hdr(true)).unwrap();
+        renderer.read_hdr(&mut hdr).unwrap();
+        check(f, &hdr);
+        let m = mean_rgb(&hdr);
+        (0..3).for_each(|c| sum[c] += m[c] / frames as f64);
+    }
+    sum
+}
+
 /// A hash of `v` in [0, 1] (PCG output permutation): deterministic picks in tests.
-pub fn unit_hash(mut v: u32) -> f32 {
-    v = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    v = ((v >> ((v >> 28) + 4)) ^ v).wrapping_mul(277_803_737);
-    ((v >> 22) ^ v) as f32 / u32::MAX as f32
+pub fn unit_hash(v: u32) -> f32 {
+    fovea_renderer::sampling::random::pcg_hash(v) as f32 / u32::MAX as f32
 }
 
 /// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a

@@ -44,8 +44,7 @@ impl SamplingSpace for Cartesian {
         }
     }
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
-        let inside = grid.cmpge(Vec2::ZERO).all() && grid.cmplt(self.screen.as_vec2()).all();
-        inside.then_some(grid)
+        super::within(grid, self.screen).then_some(grid)
     }
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
         self.grid_to_screen(screen)

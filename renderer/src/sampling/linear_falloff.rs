@@ -7,7 +7,7 @@
 //! same foveated blur. GLSL: sampling/linear_falloff.glsl.
 
 use super::random::unit_hash;
-use super::{SamplingSpace, SpaceCapabilities, VisualPolar, VisualPolarParams, WayBack};
+use super::{within, SamplingSpace, SpaceCapabilities, VisualPolar, VisualPolarParams, WayBack};
 use crate::error::{Error, Result};
 use crate::layouts::{SamplingParams, SPARSE_SALT_KEEP};
 use glam::{UVec2, UVec4, Vec2, Vec4};
@@ -39,8 +39,6 @@ pub struct LinearFalloff {
     outer_px: f32,
     /// Probability multiplier that meets the budget (≥ 1 raises the floor and widens the core).
     scale: f32,
-    /// Expected traced pixels for the current gaze.
-    expected: f64,
 }
 
 impl LinearFalloff {
@@ -55,11 +53,10 @@ impl LinearFalloff {
         }
         let centre = screen.as_vec2() * 0.5;
         let axis = VisualPolar::new(screen, centre, vp)?;
-        let mut space = LinearFalloff { axis, shape, inner_px: 0.0, outer_px: 0.0, scale: 1.0, expected: 0.0 };
+        let mut space = LinearFalloff { axis, shape, inner_px: 0.0, outer_px: 0.0, scale: 1.0 };
         space.set_radii();
         let target = (budget_of_vp * axis.sample_count() as f64).min(screen.x as f64 * screen.y as f64);
         space.scale = space.scale_for(target);
-        space.expected = space.expected_count();
         Ok(space)
     }
 
@@ -138,9 +135,10 @@ impl SamplingSpace for LinearFalloff {
     fn screen_size(&self) -> UVec2 {
         self.axis.screen()
     }
-    /// The expected count for the current gaze (the traced count varies from frame to frame).
+    /// The expected count for the current gaze (the traced count varies from frame to frame);
+    /// a sum over the screen, so computed when a report asks, not on every gaze change.
     fn sample_count(&self) -> u64 {
-        self.expected.round() as u64
+        self.expected_count().round() as u64
     }
     fn params(&self) -> SamplingParams {
         let (s, g) = (self.axis.screen(), self.axis.gaze());
@@ -152,8 +150,7 @@ impl SamplingSpace for LinearFalloff {
         }
     }
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
-        let inside = grid.cmpge(Vec2::ZERO).all() && grid.cmplt(self.axis.screen().as_vec2()).all();
-        inside.then_some(grid)
+        within(grid, self.axis.screen()).then_some(grid)
     }
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
         self.grid_to_screen(screen)
@@ -164,7 +161,6 @@ impl SamplingSpace for LinearFalloff {
     fn set_gaze(&mut self, gaze: Vec2) -> Result<()> {
         self.axis = VisualPolar::new(self.axis.screen(), gaze, *self.axis.params())?;
         self.set_radii();
-        self.expected = self.expected_count();
         Ok(())
     }
     fn blur_axis(&self) -> Option<&VisualPolar> {

@@ -24,6 +24,11 @@ use crate::error::Result;
 use crate::layouts::SamplingParams;
 use glam::{UVec2, Vec2};
 
+/// Whether `p` lies in the rectangle [0, size) (texel or pixel units).
+fn within(p: Vec2, size: UVec2) -> bool {
+    p.cmpge(Vec2::ZERO).all() && p.cmplt(size.as_vec2()).all()
+}
+
 /// How a space's samples come back to the screen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WayBack {

@@ -3,7 +3,7 @@
 //! spends the foveated budget uniformly. Same kernels as Cartesian (`cartesian.glsl` scales the
 //! texel to the screen when the grid is smaller).
 
-use super::{SamplingSpace, SpaceCapabilities, WayBack};
+use super::{within, SamplingSpace, SpaceCapabilities, WayBack};
 use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
 use glam::{UVec2, UVec4, Vec2, Vec4};
@@ -58,12 +58,10 @@ impl SamplingSpace for UniformBudget {
         }
     }
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
-        let inside = grid.cmpge(Vec2::ZERO).all() && grid.cmplt(self.grid.as_vec2()).all();
-        inside.then_some(grid * self.scale())
+        within(grid, self.grid).then_some(grid * self.scale())
     }
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
-        let inside = screen.cmpge(Vec2::ZERO).all() && screen.cmplt(self.screen.as_vec2()).all();
-        inside.then_some(screen / self.scale())
+        within(screen, self.screen).then_some(screen / self.scale())
     }
     fn gaze(&self) -> Vec2 {
         self.gaze
