@@ -14,6 +14,7 @@ use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSetti
 use crate::passes::tonemap::{LdrTarget, TonemapPass, ToneCurve};
 use crate::sampling::SamplingSpace;
 use crate::to_screen::BlurSettings;
+use crate::passes::splat::SplatInputs;
 use crate::view::{BackPasses, View};
 use crate::scene::{Camera, Scene};
 use crate::vk::{Buffer, Context, Image};
@@ -684,6 +685,11 @@ fn record_view(
             screen
         }
         (BackPasses::Fill(fill), _) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
+        (BackPasses::Splat(splat, fill), _) => {
+            let inputs = SplatInputs { frame_data: &s.frame_data, sampling: &s.sampling, sampling_table: &s.sampling_table };
+            let sparse = splat.record(rec, &inputs, grid_hdr)?;
+            fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?
+        }
         _ => grid_hdr,
     };
     let (exposure, curve) = (settings.exposure, settings.tone_curve);

@@ -8,6 +8,7 @@ use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::passes::splat::SplatPass;
 use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::fill_to_screen::FillToScreen;
@@ -79,6 +80,8 @@ pub(crate) enum BackPasses {
     /// The upscale and its screen-sized output.
     Upscale(UpscalePass, Image),
     Fill(FillToScreen),
+    /// The splat to a sparse screen image, then the fill's way back.
+    Splat(SplatPass, FillToScreen),
 }
 
 pub struct View {
@@ -130,6 +133,7 @@ impl View {
             WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa)?),
             WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
+            WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.shader_variant(), screen)?, FillToScreen::new(ctx, screen)?),
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
@@ -164,6 +168,7 @@ impl View {
     pub(crate) fn max_passes(&self) -> u32 {
         25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
             BackPasses::Fill(f) => f.passes(),
+            BackPasses::Splat(s, f) => s.passes() + f.passes(),
             _ => 0,
         }
     }

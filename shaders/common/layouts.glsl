@@ -41,6 +41,13 @@ const uint FRAME_FLAG_TEXTURE_LOD = 8u;
 // whether linear falloff keeps a pixel, where a random-acuity sample lies.
 const uint SPARSE_SALT_KEEP = 0x6b656570u;
 const uint SPARSE_SALT_POSITION = 0x706f7369u;
+// Draws a random-acuity texel makes before it gives up (each rejects a clipped texel; VP clips
+// 12 % of the grid by default, so all eight miss about once in 2·10⁷ texels).
+const uint RANDOM_ACUITY_TRIES = 8u;
+// The splat's fixed point (passes/splat.comp): radiance × this, summed with integer atomics;
+// one sample adds at most SPLAT_MAX_RADIANCE (16 of them fill 32 bits).
+const float SPLAT_FIXED_POINT = 16384.0;
+const float SPLAT_MAX_RADIANCE = 16384.0;
 
 // Everything the passes need to know about the current (and previous) frame.
 struct FrameData {
@@ -157,6 +164,11 @@ struct AccumulatePush {
 // Push constants of the push-pull fill (passes/fill.comp).
 struct FillPush {
     uvec4 config;               // x 0: pull (fine → coarse), 1: push (coarse under fine); yzw unused
+};
+
+// Push constants of the splat (passes/splat.comp).
+struct SplatPush {
+    uvec4 config;               // x 0: scatter the grid's samples into the sums, 1: resolve the sums into the sparse screen image; yzw unused
 };
 
 // Push constants of the tonemap pass.

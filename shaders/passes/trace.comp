@@ -14,6 +14,8 @@
 //! variant log_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
 //! variant log_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 //! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
+//! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
+//! variant random_acuity_headset: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -52,6 +54,9 @@ layout(set = 0, binding = 23, rgba32f) uniform writeonly image2D out_gradient;  
 // two grid axes; 1 in Cartesian space): the denoisers compare depths per grid texel. Visual-Polar
 // texels cover anything from a fraction of a pixel (fovea) to many pixels (periphery).
 float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
+#if defined(SAMPLING_HAS_FOOTPRINT)
+    return sample_footprint(texel, screen);
+#else
     float size = 0.0;
     for (int axis = 0; axis < 2; ++axis) {
         ivec2 step = axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
@@ -62,6 +67,7 @@ float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
         if (sample_screen_position(neighbour, jitter, next)) size = max(size, length(next - screen));
     }
     return size > 0.0 ? size : 1.0;
+#endif
 }
 
 void main() {

@@ -1,6 +1,8 @@
 // Selects the sampling space a kernel variant is compiled for. Every space provides
 // `bool sample_screen_position(ivec2 texel, vec2 jitter, out vec2 screen)` and
-// `bool sample_exists(ivec2 texel)` (whether the former returns true, without mapping).
+// `bool sample_exists(ivec2 texel)` (whether the former returns true, without mapping). A space
+// whose neighbouring texels are not neighbours on the screen defines SAMPLING_HAS_FOOTPRINT and
+// `float sample_footprint(ivec2 texel, vec2 screen)` (the screen spacing of its samples there).
 #ifndef FOVEA_SAMPLING_SPACE_GLSL
 #define FOVEA_SAMPLING_SPACE_GLSL
 
@@ -15,6 +17,8 @@ layout(std140, set = 0, binding = 9) uniform SamplingBuffer { SamplingParams dat
 #include "visual_polar.glsl"
 #elif defined(SAMPLING_LINEAR_FALLOFF)
 #include "linear_falloff.glsl"
+#elif defined(SAMPLING_RANDOM_ACUITY)
+#include "random_acuity.glsl"
 #else
 #error "no sampling space selected"
 #endif

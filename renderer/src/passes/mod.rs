@@ -8,6 +8,7 @@ pub mod fill;
 pub mod mip_phi;
 pub mod raycast;
 pub mod remap;
+pub mod splat;
 pub mod tonemap;
 pub mod trace;
 pub mod upscale;

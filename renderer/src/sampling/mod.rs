@@ -7,6 +7,7 @@ mod cartesian;
 mod linear_falloff;
 mod log_polar;
 pub mod random;
+mod random_acuity;
 mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
@@ -15,6 +16,7 @@ mod visual_polar_headset;
 pub use cartesian::Cartesian;
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
+pub use random_acuity::RandomAcuity;
 pub use uniform_budget::UniformBudget;
 pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
@@ -41,6 +43,9 @@ pub enum WayBack {
     /// The screen's pixels, some not traced (alpha 0): push-pull hole filling, then the foveated
     /// blur (`blur_axis`).
     Fill,
+    /// Samples anywhere on the screen: each splatted to its pixel (`passes/splat`), then as
+    /// `Fill`.
+    Splat,
 }
 
 /// What the pipeline may do with a space: asked by the renderer instead of testing concrete types.

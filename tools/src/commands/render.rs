@@ -106,7 +106,7 @@ struct Report {
     visual_polar: Option<VpReport>,
     /// Log-polar parameters (log-polar only).
     log_polar: Option<LogPolarReport>,
-    /// Foveated blur σ at 30° for a 1280×1440 eye (vp and log-polar; 0 = off).
+    /// Foveated blur σ at 30° for a 1280×1440 eye (the methods with the foveated blur; 0 = off).
     blur_sigma_at_30: Option<f32>,
     /// Pass name → mean GPU milliseconds per frame (both eyes' passes summed in a stereo run).
     passes: BTreeMap<String, f64>,
@@ -262,7 +262,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let p = &args.profile.log_polar;
             LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
         }),
-        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar").then_some(args.profile.blur.sigma_at_30),
+        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar" | "linear-falloff" | "random-acuity").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
