@@ -521,9 +521,14 @@ fn bench_vp_frames_follow_a_camera_path() {
     let vp = &report["visual_polar"][0];
     assert_eq!(vp["camera_motion"], "keys");
     assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
-    let log_polar = &vp["comparators"][0];
-    assert_eq!(log_polar["method"], "log-polar");
-    assert!(log_polar["samples"].as_u64().unwrap() > 0 && log_polar["frame_ms"].as_f64().unwrap() > 0.0, "{log_polar}");
+    let comparators = vp["comparators"].as_array().unwrap();
+    let methods: Vec<&str> = comparators.iter().map(|c| c["method"].as_str().unwrap()).collect();
+    assert_eq!(methods, ["log-polar", "uniform-budget", "linear-falloff", "random-acuity"]);
+    for c in comparators {
+        assert!(c["samples"].as_u64().unwrap() > 0 && c["frame_ms"].as_f64().unwrap() > 0.0 && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0, "{c}");
+    }
+    // Random acuity traces Visual-Polar's samples.
+    assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
     let rays = &report["rays"][0];
     assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
     assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");

@@ -215,6 +215,52 @@ fn quality_command_measures_every_combination() {
     assert!(err.contains("notes.txt"), "{err}");
 }
 
+/// `fovea quality --methods all`: every method of `fovea render` is measured, and the
+/// combinations a method cannot run (a denoiser on a space without temporal filters) are listed
+/// with the space's reason, in quality.json and in the table, instead of failing or vanishing.
+#[test]
+fn quality_methods_all_lists_what_a_method_refuses() {
+    use fovea_tools::commands::quality::{expand_methods, run, QualityArgs};
+    let out = temp_dir("quality-all");
+    let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let methods = expand_methods(strings(&["all"]));
+    assert_eq!(methods, strings(fovea_tools::commands::render::METHODS));
+    let (denoisers, taa, cameras) = (strings(&["none", "svgf"]), strings(&["off"]), strings(&["still"]));
+    let args = QualityArgs {
+        scene: "cornell-box",
+        width: 40,
+        height: 36,
+        headset: "fove0",
+        gaze: "sim:2",
+        frames: 2,
+        eval_frames: 1,
+        methods: &methods,
+        denoisers: &denoisers,
+        taa: &taa,
+        cameras: &cameras,
+        reference_spp: 4,
+        rings: 3,
+        seed: 1,
+        profile: Default::default(),
+        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        out: &out,
+        device: None,
+        validation: true,
+    };
+    run(&args).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
+    let refused: Vec<&str> = report["refused"].as_array().unwrap().iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(refused, ["uniform-budget", "linear-falloff", "random-acuity"]);
+    assert!(report["refused"].as_array().unwrap().iter().all(|r| r["denoiser"] == "svgf" && r["reason"].as_str().unwrap().contains("supports no denoiser")));
+    let runs = report["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2 * methods.len() - refused.len(), "{runs:?}");
+    for m in &methods {
+        assert!(runs.iter().any(|r| r["method"] == m.as_str() && r["denoiser"] == "none" && r["frame_flip"].as_f64().unwrap() > 0.0), "{m}");
+    }
+    let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
+    assert!(table.contains("| random-acuity + svgf, off | refused: random-acuity supports no denoiser"), "{table}");
+}
+
 /// `fovea quality --rings` is bounded like `fovea eval`'s (by the render size), before anything
 /// is rendered or written.
 #[test]

@@ -423,6 +423,7 @@ enum Command {
         /// The last this many frames are evaluated and averaged.
         #[arg(long, default_value_t = 4)]
         eval_frames: u32,
+        /// Sampling methods (`all`: every `--method` of `fovea render`).
         #[arg(long, value_delimiter = ',', default_value = "vp,cartesian")]
         methods: Vec<String>,
         /// Denoisers to compare (default: every one built in).
@@ -695,7 +696,7 @@ fn run() -> Result<()> {
                 gaze: &gaze,
                 frames,
                 eval_frames,
-                methods: &methods,
+                methods: &commands::quality::expand_methods(methods),
                 denoisers: if denoisers.is_empty() { &all } else { &denoisers },
                 taa: &taa,
                 cameras: &cameras,

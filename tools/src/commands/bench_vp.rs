@@ -10,7 +10,9 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, LogPolarParams, RadialLaw, VisualPolar, VisualPolarParams};
+use fovea_renderer::sampling::{
+    Cartesian, FalloffShape, LinearFalloff, LogPolarParams, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP,
+};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -43,7 +45,8 @@ pub struct VpFrameReport {
     /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
     pub denoisers: Vec<DenoiserCost>,
     /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
-    /// frames above, no denoiser: today `log-polar` (Meng et al. 2018, its defaults).
+    /// frames above, no denoiser, each with its paper's defaults (`comparator_spaces`):
+    /// `log-polar`, `uniform-budget`, `linear-falloff` (samples: the expected count), `random-acuity`.
     pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
@@ -143,6 +146,20 @@ pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)],
         .collect())
 }
 
+/// The comparator methods of issue 14 with their papers' defaults, around `gaze`: log-polar
+/// (Meng et al. 2018), the uniform budget, linear falloff (1.5× VP's samples) and random acuity
+/// (VP's samples at random positions), each one measured beside `vp`.
+fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<Box<dyn SamplingSpace>>> {
+    let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
+    let falloff = LinearFalloff::new(screen, *vp.params(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP)?;
+    Ok(vec![
+        Box::new(log_polar),
+        Box::new(UniformBudget::with_samples(screen, vp.sample_count())?),
+        Box::new(falloff),
+        Box::new(RandomAcuity::new(screen, gaze, *vp.params())?),
+    ])
+}
+
 /// Passes of the displayed frame (read-backs are I/O, not rendering).
 fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {
     passes.iter().filter(|(k, _)| !k.starts_with("readback") && *k != "clear_counters").map(|(_, v)| v).sum()
@@ -167,24 +184,45 @@ pub fn measure(
     // One renderer per space (Cartesian first, gaze-less) with these settings, their frames
     // interleaved: each one's pass medians and denoiser history bytes (the renderers are dropped
     // before the next measurement).
-    let measure = |settings: RenderSettings, foveated: &[VisualPolar]| -> Result<Vec<(BTreeMap<String, f64>, u64)>> {
+    let measure = |settings: RenderSettings, foveated: Vec<Box<dyn SamplingSpace>>| -> Result<Vec<(BTreeMap<String, f64>, u64)>> {
         let mut renderers = vec![(Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?, None)];
         for space in foveated {
-            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(*space), settings)?, Some(gaze)));
+            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, space, settings)?, Some(gaze)));
         }
         let history: Vec<u64> = renderers.iter().map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes())).collect();
         let mut timed: Vec<(&mut Renderer, Option<Vec2>)> = renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
         Ok(interleaved_pass_medians(&mut timed, &camera_at, frames)?.into_iter().zip(history).collect())
     };
     // Without a denoiser the comparators join the same interleaved run.
-    let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
-    let [(cartesian_passes_ms, _), (vp_passes_ms, _), (log_polar_passes_ms, _)]: [_; 3] =
-        measure(RenderSettings::default(), &[vp, log_polar])?.try_into().expect("one median map per renderer");
+    let comparator_spaces = comparator_spaces(screen, gaze, &vp)?;
+    let described: Vec<(&'static str, [u32; 2], u64)> = comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())).collect();
+    let mut spaces: Vec<Box<dyn SamplingSpace>> = vec![Box::new(vp)];
+    spaces.extend(comparator_spaces);
+    let mut plain = measure(RenderSettings::default(), spaces)?.into_iter().map(|(passes, _)| passes);
+    let cartesian_passes_ms = plain.next().expect("the Cartesian medians");
+    let vp_passes_ms = plain.next().expect("the Visual-Polar medians");
+    let cartesian_frame_ms = frame_ms(&cartesian_passes_ms);
+    let comparators: Vec<MethodCost> = described
+        .into_iter()
+        .zip(plain)
+        .map(|((method, grid, samples), passes_ms)| {
+            let frame = frame_ms(&passes_ms);
+            MethodCost {
+                method,
+                grid,
+                samples,
+                frame_ratio: frame / cartesian_frame_ms,
+                trace_ratio: passes_ms["trace"] / cartesian_passes_ms["trace"],
+                passes_ms,
+                frame_ms: frame,
+            }
+        })
+        .collect();
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
         let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)]: [_; 2] =
-            measure(RenderSettings { denoiser, ..Default::default() }, &[vp])?.try_into().expect("one median map per renderer");
+            measure(RenderSettings { denoiser, ..Default::default() }, vec![Box::new(vp)])?.try_into().expect("one median map per renderer");
         let (cartesian_passes_ms, vp_passes_ms) = (denoiser_passes(cart_all, &prefixes), denoiser_passes(vp_all, &prefixes));
         let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
@@ -199,17 +237,7 @@ pub fn measure(
             vp_history_bytes,
         });
     }
-    let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cartesian_passes_ms), frame_ms(&vp_passes_ms));
-    let log_polar_frame_ms = frame_ms(&log_polar_passes_ms);
-    let comparators = vec![MethodCost {
-        method: "log-polar",
-        grid: log_polar.grid_size().to_array(),
-        samples: log_polar.sample_count(),
-        frame_ratio: log_polar_frame_ms / cartesian_frame_ms,
-        trace_ratio: log_polar_passes_ms["trace"] / cartesian_passes_ms["trace"],
-        passes_ms: log_polar_passes_ms,
-        frame_ms: log_polar_frame_ms,
-    }];
+    let vp_frame_ms = frame_ms(&vp_passes_ms);
     let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
 
     let rays = vp_primary_rays(&vp, &pose);

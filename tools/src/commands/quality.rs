@@ -68,6 +68,17 @@ struct RunQuality {
     frame_flicker: Option<f64>,
 }
 
+/// A combination the method cannot run (a denoiser or TAA on a space without temporal filters):
+/// listed in the table with the reason instead of silently left out.
+#[derive(Serialize)]
+struct RefusedRun {
+    camera: String,
+    method: String,
+    denoiser: String,
+    taa: String,
+    reason: String,
+}
+
 #[derive(Serialize)]
 struct RingMean {
     /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
@@ -93,6 +104,7 @@ struct Report<'a> {
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
     runs: &'a [RunQuality],
+    refused: &'a [RefusedRun],
 }
 
 fn check_names(flag: &str, given: &[String], allowed: &[&str]) -> Result<()> {
@@ -105,6 +117,24 @@ fn check_names(flag: &str, given: &[String], allowed: &[&str]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--methods all` → every method of `fovea render`.
+pub fn expand_methods(methods: Vec<String>) -> Vec<String> {
+    match methods.as_slice() {
+        [one] if one == "all" => render::METHODS.iter().map(|m| m.to_string()).collect(),
+        _ => methods,
+    }
+}
+
+/// Why `method` cannot run `denoiser` / `taa`, if it cannot (asked of the space itself).
+fn refusal(args: &QualityArgs, hmd: &fovea_hal::HmdDescription, method: &str, denoiser: &str, taa: &str) -> Result<Option<String>> {
+    if denoiser == "none" && taa == "off" {
+        return Ok(None);
+    }
+    let space = super::setup::space_for(method, &args.profile, hmd, fovea_hal::Eye::Left, UVec2::new(args.width, args.height))?;
+    let caps = space.capabilities();
+    Ok((!caps.temporal_filters).then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
 }
 
 pub fn run(args: &QualityArgs) -> Result<()> {
@@ -122,13 +152,18 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let ppd = flip_ppd(args)?;
-    let mut runs = Vec::new();
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+    let (mut runs, mut refused) = (Vec::new(), Vec::new());
     for camera in args.cameras {
         let moving = camera == "moving";
         let references = references(args, moving, &evaluated)?;
         for method in args.methods {
             for denoiser in args.denoisers {
                 for taa in args.taa {
+                    if let Some(reason) = refusal(args, &hmd, method, denoiser, taa)? {
+                        refused.push(RefusedRun { camera: camera.clone(), method: method.clone(), denoiser: denoiser.clone(), taa: taa.clone(), reason });
+                        continue;
+                    }
                     let dir = args.out.join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
                     let render_args = RenderArgs {
                         scene: args.scene,
@@ -175,6 +210,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
         flip_ppd: ppd,
         runs: &runs,
+        refused: &refused,
     };
     write_json(&args.out.join("quality.json"), &report)?;
     let table = markdown(&report);
@@ -283,7 +319,12 @@ fn markdown(r: &Report) -> String {
     );
     for camera in CAMERAS {
         let runs: Vec<&RunQuality> = r.runs.iter().filter(|q| q.camera == *camera).collect();
-        let Some(first) = runs.first() else { continue };
+        let Some(first) = runs.first() else {
+            for q in r.refused.iter().filter(|q| q.camera == *camera) {
+                let _ = writeln!(s, "- {camera} camera, {} + {}, {}: refused: {}", q.method, q.denoiser, q.taa, q.reason);
+            }
+            continue;
+        };
         let _ = write!(s, "**{camera} camera** — RMSE / SSIM / FLIP\n\n| method + denoiser, TAA |");
         for ring in &first.rings {
             let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
@@ -301,6 +342,9 @@ fn markdown(r: &Report) -> String {
                 }
             }
             let _ = writeln!(s, " {:.4} / {:.3} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_flip, q.frame_gpu_ms);
+        }
+        for q in r.refused.iter().filter(|q| q.camera == *camera) {
+            let _ = writeln!(s, "| {} + {}, {} | refused: {}{} |", q.method, q.denoiser, q.taa, q.reason, " |".repeat(first.rings.len() + 1));
         }
         s.push('\n');
         if first.frame_flicker.is_some() {
