@@ -9,14 +9,11 @@ use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::fill::FillPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
-use fovea_renderer::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
-use fovea_renderer::layouts::FrameData;
+use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
-use fovea_renderer::vk::{Buffer, ComputePipeline, Image};
-use glam::UVec4;
-use fovea_tests::{assert_clean, gpu, owned_scene};
+use fovea_renderer::vk::Image;
+use fovea_tests::{assert_clean, gpu, owned_scene, probe};
 use glam::{UVec2, Vec2};
-use std::sync::Arc;
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
 
@@ -123,41 +120,6 @@ fn random_acuity(screen: UVec2, gaze: Vec2) -> RandomAcuity {
     RandomAcuity::new(screen, gaze, VisualPolarParams::default()).unwrap()
 }
 
-/// The buffers a space's kernels read (`frame`, `sampling`, `sampling_table`) for frame `frame`.
-struct SpaceBuffers {
-    frame: Buffer,
-    sampling: Buffer,
-    table: Buffer,
-}
-
-impl SpaceBuffers {
-    fn new(ctx: &Arc<fovea_renderer::vk::Context>, space: &dyn SamplingSpace, frame: u32, seed: u32) -> SpaceBuffers {
-        let uniform = ash::vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let data = FrameData { frame: UVec4::new(frame, seed, 3, 0), ..Default::default() };
-        SpaceBuffers {
-            frame: Buffer::with_data(ctx, "frame", &[data], uniform).unwrap(),
-            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform).unwrap(),
-            table: Buffer::texels(ctx, "sampling_table", &space.sampling_table()).unwrap(),
-        }
-    }
-}
-
-/// Every texel's `sample_screen_position` as the GPU computes it (passes/space_probe).
-fn probe_positions(ctx: &Arc<fovea_renderer::vk::Context>, space: &dyn SamplingSpace, frame: u32, seed: u32) -> Vec<Option<Vec2>> {
-    let grid = space.grid_size();
-    let pipeline = ComputePipeline::new(ctx, &format!("passes/space_probe.{}", space.shader_variant()), 0).unwrap();
-    let buffers = SpaceBuffers::new(ctx, space, frame, seed);
-    let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
-    let out = Buffer::new(ctx, "probe_out", grid.x as u64 * grid.y as u64 * 16, storage, gpu_allocator::MemoryLocation::GpuToCpu).unwrap();
-    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
-    rec.begin().unwrap();
-    let binds = [read_buffer("frame", &buffers.frame), read_buffer("sampling", &buffers.sampling), read_texels("sampling_table", &buffers.table), write_buffer("mapped", &out)];
-    rec.dispatch("space_probe", &pipeline, &binds, &[], [grid.x, grid.y, 1]).unwrap();
-    rec.submit_and_wait().unwrap();
-    let got: Vec<[f32; 4]> = out.read().unwrap();
-    got.iter().map(|o| (o[2] > 0.0).then(|| Vec2::new(o[0], o[1]))).collect()
-}
-
 /// Rust = GLSL on every texel of two screens, three gazes and two frames: the same texels draw,
 /// and their samples land within 2e-3 px of each other (the mapping's float order; the draws
 /// themselves are the same bits).
@@ -169,7 +131,7 @@ fn random_acuity_draws_agree_between_rust_and_glsl() {
         for gaze in [s * 0.5, Vec2::new(0.1, 0.2) * s, Vec2::new(0.97, 0.9) * s] {
             let space = random_acuity(screen, gaze);
             for frame in [0, 7] {
-                let gpu = probe_positions(&ctx, &space, frame, 11);
+                let gpu: Vec<Option<Vec2>> = probe(&ctx, &space, frame, 11).iter().map(|p| p.position).collect();
                 let g = space.grid_size();
                 let mut worst: f32 = 0.0;
                 for (i, got) in gpu.iter().enumerate() {
@@ -238,7 +200,7 @@ fn the_splat_puts_every_sample_in_its_pixel() {
     let value = [0.25, 0.5, 2.0, 1.0];
     let color = Image::new(&ctx, "grid_color", grid.x, grid.y, ash::vk::Format::R32G32B32A32_SFLOAT).unwrap();
     fovea_tests::write_image(&ctx, &color, &vec![value; (grid.x * grid.y) as usize]);
-    let buffers = SpaceBuffers::new(&ctx, &space, 5, 2);
+    let buffers = fovea_tests::SpaceBuffers::new(&ctx, &space, 5, 2);
     let splat = SplatPass::new(&ctx, space.shader_variant(), screen).unwrap();
     let mut rec = FrameRecorder::new(&ctx, splat.passes() + 1).unwrap();
     rec.begin().unwrap();

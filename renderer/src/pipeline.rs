@@ -465,7 +465,7 @@ impl Renderer {
         for (v, view_input) in inputs.iter().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
-            record_view(rec, &mut self.views[v], slot, &self.scene, &self.tonemap, &self.settings, view_input, input, external)?;
+            record_view(rec, &mut self.views[v], slot, &self.scene, (&self.tonemap, &self.accumulate), &self.settings, view_input, input, external)?;
         }
         let sync = match target {
             Some(t) => {
@@ -642,7 +642,7 @@ fn record_view(
     view: &mut View,
     slot: usize,
     scene: &GpuScene,
-    tonemap: &TonemapPass,
+    (tonemap, accumulate): (&TonemapPass, &AccumulatePass),
     settings: &RenderSettings,
     view_input: &ViewInput,
     input: &FrameInput,
@@ -660,12 +660,25 @@ fn record_view(
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
     trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, 0, gradients)?;
+    // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
+    // texel's mean kept (no denoiser or TAA runs on them).
+    let traced = match &view.sample_mean {
+        Some(mean) => {
+            accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
+            for k in 1..view.space.samples_per_texel() {
+                trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, k, None)?;
+                accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
+            }
+            mean
+        }
+        None => &view.gbuffer.color,
+    };
     let denoised = match &mut view.denoiser {
         Some(d) => {
             let scene = DenoiseScene { camera_origin: view_input.camera.world_from_view.w_axis.truncate(), materials: &scene.materials };
             d.record(rec, &view.gbuffer, &denoise_frame, &scene)?
         }
-        None => &view.gbuffer.color,
+        None => traced,
     };
     let grid_hdr = match (&mut view.taa, jitter) {
         (Some(taa), Some(jitter)) => taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?,
@@ -685,6 +698,10 @@ fn record_view(
             screen
         }
         (BackPasses::Fill(fill), _) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
+        (BackPasses::BlockFill(fill, screen), _) => {
+            fill.record(rec, &s.sampling, grid_hdr, screen)?;
+            screen
+        }
         (BackPasses::Splat(splat, fill), _) => {
             let inputs = SplatInputs { frame_data: &s.frame_data, sampling: &s.sampling, sampling_table: &s.sampling_table };
             let sparse = splat.record(rec, &inputs, grid_hdr)?;

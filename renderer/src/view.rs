@@ -8,6 +8,7 @@ use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::passes::block_fill::BlockFillPass;
 use crate::passes::splat::SplatPass;
 use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
@@ -82,6 +83,8 @@ pub(crate) enum BackPasses {
     Fill(FillToScreen),
     /// The splat to a sparse screen image, then the fill's way back.
     Splat(SplatPass, FillToScreen),
+    /// The block fill and its screen-sized output.
+    BlockFill(BlockFillPass, Image),
 }
 
 pub struct View {
@@ -93,6 +96,8 @@ pub struct View {
     pub(crate) trace_gradients: Option<TracePass>,
     /// The passes of the space's way back to the screen.
     pub(crate) back: BackPasses,
+    /// Each texel's mean over the frame's samples, for spaces that trace several per texel.
+    pub(crate) sample_mean: Option<Image>,
     pub(crate) ldr: Image,
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
@@ -134,6 +139,7 @@ impl View {
             WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
             WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.shader_variant(), screen)?, FillToScreen::new(ctx, screen)?),
+            WayBack::BlockFill => BackPasses::BlockFill(BlockFillPass::new(ctx, space.shader_variant())?, Image::new(ctx, "block_filled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
@@ -153,6 +159,10 @@ impl View {
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             accum: None,
+            sample_mean: match space.samples_per_texel() > 1 {
+                true => Some(Image::new(ctx, "sample_mean", grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT)?),
+                false => None,
+            },
             back,
             denoiser,
             taa,
@@ -166,7 +176,8 @@ impl View {
 
     /// Passes one frame of this view records at most (sizes the timestamp pool).
     pub(crate) fn max_passes(&self) -> u32 {
-        25 + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
+        let extra_samples = 2 * self.space.samples_per_texel();
+        25 + extra_samples + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
             BackPasses::Fill(f) => f.passes(),
             BackPasses::Splat(s, f) => s.passes() + f.passes(),
             _ => 0,

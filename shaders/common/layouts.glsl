@@ -158,7 +158,7 @@ struct TracePush {
 
 // Push constants of the accumulate pass.
 struct AccumulatePush {
-    uvec4 config;               // x number of samples already in the accumulator
+    uvec4 config;               // x number of samples already in the accumulator, y 1: untraced samples (alpha 0) leave the mean as it is
 };
 
 // Push constants of the push-pull fill (passes/fill.comp).

@@ -1,10 +1,12 @@
 #version 460
 // Evaluates a sampling space's `sample_screen_position` for every texel of its grid as the tracer
 // does (the frame index and seed of the `frame` buffer, no jitter), so a device test can compare
-// it with the space's Rust twin texel by texel (tests/comparators.rs). out[i] = (screen x, y,
-// 1 if the texel holds a sample else 0, 0), i = y · width + x.
+// it with the space's Rust twin texel by texel (tests/comparators.rs, tests/pixel_blocks.rs).
+// out[i] = (screen x, y, 1 if the texel holds a sample else 0, samples it traces per frame),
+// i = y · width + x.
 //! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
 //! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
+//! variant pixel_blocks: SAMPLING_PIXEL_BLOCKS
 #include "../common/layouts.glsl"
 #include "../sampling/space.glsl"
 
@@ -17,5 +19,10 @@ void main() {
     if (any(greaterThanEqual(t, size))) return;
     vec2 screen;
     bool exists = sample_screen_position(t, vec2(0.5), screen);
-    mapped.data[t.y * size.x + t.x] = vec4(screen, exists ? 1.0 : 0.0, 0.0);
+#if defined(SAMPLING_SAMPLES_PER_TEXEL)
+    float samples = float(sample_count_in_texel(t));
+#else
+    float samples = exists ? 1.0 : 0.0;
+#endif
+    mapped.data[t.y * size.x + t.x] = vec4(screen, exists ? 1.0 : 0.0, samples);
 }

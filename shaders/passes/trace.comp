@@ -16,6 +16,7 @@
 //! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
 //! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
 //! variant random_acuity_headset: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
+//! variant pixel_blocks: SAMPLING_PIXEL_BLOCKS
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -83,7 +84,11 @@ void main() {
     vec2 screen;
     vec2 jitter = rng_next2(rng);
     if ((frame.data.frame.w & FRAME_FLAG_HALTON_JITTER) != 0u) jitter = frame.data.jitter.xy;
-    if (!sample_screen_position(texel, jitter, screen)) {
+    bool traced = sample_screen_position(texel, jitter, screen);
+#if defined(SAMPLING_SAMPLES_PER_TEXEL)
+    traced = traced && push.p.config.x < sample_count_in_texel(texel);
+#endif
+    if (!traced) {
         imageStore(out_color, texel, vec4(0.0));
         imageStore(out_radiance, texel, vec4(0.0));
         imageStore(out_albedo, texel, vec4(0.0));

@@ -174,3 +174,45 @@ pub fn inject_fireflies(ctx: &Arc<Context>, image: &Image, f: u32) {
     texels[pick(4)] = [-5.0, 1.0, 1.0, 1.0];
     write_image(ctx, image, &texels);
 }
+
+/// The buffers a space's kernels read (`frame`, `sampling`, `sampling_table`) for frame `frame`.
+pub struct SpaceBuffers {
+    pub frame: Buffer,
+    pub sampling: Buffer,
+    pub table: Buffer,
+}
+
+impl SpaceBuffers {
+    pub fn new(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace, frame: u32, seed: u32) -> SpaceBuffers {
+        let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
+        let data = fovea_renderer::layouts::FrameData { frame: glam::UVec4::new(frame, seed, 3, 0), ..Default::default() };
+        SpaceBuffers {
+            frame: Buffer::with_data(ctx, "frame", &[data], uniform).unwrap(),
+            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform).unwrap(),
+            table: Buffer::texels(ctx, "sampling_table", &space.sampling_table()).unwrap(),
+        }
+    }
+}
+
+/// One texel as the GPU's space sees it (passes/space_probe): its sample's screen position at
+/// jitter (½, ½), and the samples it traces per frame.
+pub struct ProbedTexel {
+    pub position: Option<glam::Vec2>,
+    pub samples: u32,
+}
+
+/// Every texel of `space`'s grid through its kernel variant of passes/space_probe (row-major).
+pub fn probe(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace, frame: u32, seed: u32) -> Vec<ProbedTexel> {
+    use fovea_renderer::graph::{read_buffer, read_texels, write_buffer};
+    let grid = space.grid_size();
+    let pipeline = fovea_renderer::vk::ComputePipeline::new(ctx, &format!("passes/space_probe.{}", space.shader_variant()), 0).unwrap();
+    let buffers = SpaceBuffers::new(ctx, space, frame, seed);
+    let out = Buffer::new(ctx, "probe_out", grid.x as u64 * grid.y as u64 * 16, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let mut rec = FrameRecorder::new(ctx, 2).unwrap();
+    rec.begin().unwrap();
+    let binds = [read_buffer("frame", &buffers.frame), read_buffer("sampling", &buffers.sampling), read_texels("sampling_table", &buffers.table), write_buffer("mapped", &out)];
+    rec.dispatch("space_probe", &pipeline, &binds, &[], [grid.x, grid.y, 1]).unwrap();
+    rec.submit_and_wait().unwrap();
+    let got: Vec<[f32; 4]> = out.read().unwrap();
+    got.iter().map(|o| ProbedTexel { position: (o[2] > 0.0).then(|| glam::Vec2::new(o[0], o[1])), samples: o[3] as u32 }).collect()
+}

@@ -2,6 +2,7 @@
 //! records into a `FrameRecorder`.
 
 pub mod accumulate;
+pub mod block_fill;
 pub mod blur;
 pub mod denoise;
 pub mod fill;

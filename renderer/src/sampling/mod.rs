@@ -6,6 +6,7 @@ mod acuity;
 mod cartesian;
 mod linear_falloff;
 mod log_polar;
+mod pixel_blocks;
 pub mod random;
 mod random_acuity;
 mod uniform_budget;
@@ -16,6 +17,7 @@ mod visual_polar_headset;
 pub use cartesian::Cartesian;
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
+pub use pixel_blocks::{BlockShape, PixelBlocks, BLOCK_LEVELS};
 pub use random_acuity::RandomAcuity;
 pub use uniform_budget::UniformBudget;
 pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
@@ -46,6 +48,9 @@ pub enum WayBack {
     /// Samples anywhere on the screen: each splatted to its pixel (`passes/splat`), then as
     /// `Fill`.
     Splat,
+    /// An atlas of pixel blocks: each pixel interpolated between its level's block centres
+    /// (`passes/block_fill`), no blur.
+    BlockFill,
 }
 
 /// What the pipeline may do with a space: asked by the renderer instead of testing concrete types.
@@ -107,6 +112,11 @@ pub trait SamplingSpace {
     /// spaces' own blur comes with the remap).
     fn blur_axis(&self) -> Option<&VisualPolar> {
         None
+    }
+    /// The most samples one texel traces per frame (the trace runs this many times, sample index
+    /// k tracing where k < the texel's count, and the results are averaged per texel).
+    fn samples_per_texel(&self) -> u32 {
+        1
     }
     /// The space's capabilities (default: a screen-sized grid every filter supports).
     fn capabilities(&self) -> SpaceCapabilities {

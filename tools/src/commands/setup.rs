@@ -12,12 +12,12 @@ use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
-use fovea_renderer::sampling::{Cartesian, FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VpLayout, FALLOFF_BUDGET_OF_VP};
+use fovea_renderer::sampling::{BlockShape, Cartesian, FalloffShape, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VpLayout, FALLOFF_BUDGET_OF_VP};
 use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -177,8 +177,8 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
     if method == "log-polar" {
         return check_log_polar(profile, screen);
     }
-    // So are linear falloff's budget and degrees, and random acuity's grid.
-    if !matches!(method, "vp" | "uniform-budget" | "linear-falloff" | "random-acuity") {
+    // So are linear falloff's and pixel blocks' degrees, and random acuity's grid.
+    if !matches!(method, "vp" | "uniform-budget" | "linear-falloff" | "random-acuity" | "pixel-blocks") {
         return Ok(());
     }
     if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
@@ -314,6 +314,8 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
         "linear-falloff" => Box::new(LinearFalloff::new(screen, vp_params, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).context("linear falloff")?),
         // VP's samples at random positions drawn from its density (Koskela et al. 2018).
         "random-acuity" => Box::new(RandomAcuity::new(screen, screen_centre, vp_params).context("random acuity")?),
+        // Mohanto et al.'s pixel / 2×2 / 4×4 regions on VP's eccentricity axis, 4 / 2 / 1 samples.
+        "pixel-blocks" => Box::new(PixelBlocks::new(screen, vp_params, BlockShape::default()).context("pixel blocks")?),
         other => bail!("--method {other}: expected one of {}", METHODS.join(", ")),
     })
 }
