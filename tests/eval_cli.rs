@@ -259,6 +259,45 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     }
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
     assert!(table.contains("| random-acuity + svgf, off | refused: random-acuity supports no denoiser"), "{table}");
+
+    // The method table from this run and a bench report, into a README between its markers.
+    let bench_out = out.join("bench");
+    let scenes = strings(&["cornell-box"]);
+    fovea_tools::commands::bench::run(&fovea_tools::commands::bench::BenchArgs {
+        scenes: &scenes,
+        builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
+        flatten: false,
+        sizes: &[],
+        vp_sizes: &[(64, 72)],
+        frames: 1,
+        loop_size: None,
+        loop_frames: 2,
+        camera_path: None,
+        out: &bench_out,
+        device: None,
+        validation: true,
+    })
+    .unwrap();
+    let docs = temp_dir("method-table");
+    let readme = docs.join("README.md");
+    std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter\n").unwrap();
+    let pictures = docs.join("docs").join("methods");
+    let bench_report = bench_out.join("report.json");
+    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures };
+    fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
+    let text = std::fs::read_to_string(&readme).unwrap();
+    assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter\n") && !text.contains("old"), "{text}");
+    for m in &methods {
+        assert!(text.contains(&format!("| {m} + none | ")), "{m}: {text}");
+        assert!(pictures.join(format!("{m}.png")).is_file() && pictures.join(format!("{m}_flip.png")).is_file(), "{m}");
+        assert!(text.contains(&format!("![{m}](docs/methods/{m}.png)")), "{m}");
+    }
+    assert!(text.contains("| pixel-blocks + svgf | refused:") && text.contains("faster traversal per sample for Visual-Polar than random acuity"), "{text}");
+    let bare = docs.join("BARE.md");
+    std::fs::write(&bare, "no markers").unwrap();
+    let err = format!("{:#}", fovea_tools::commands::method_table::run(&table_args(&bare)).unwrap_err());
+    assert!(err.contains("BARE.md") && err.contains("method-table:begin"), "{err}");
+    assert_eq!(std::fs::read_to_string(&bare).unwrap(), "no markers");
 }
 
 /// `fovea quality --rings` is bounded like `fovea eval`'s (by the render size), before anything

@@ -454,6 +454,21 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Write issue 14's method table into the README (between its method-table markers) from a
+    /// `fovea quality` folder and a `fovea bench` report, with a picture row and the papers' claims.
+    MethodTable {
+        /// A `fovea quality` output folder (e.g. run with `--methods all`).
+        #[arg(long)]
+        quality: PathBuf,
+        /// A `fovea bench` report.json (its first `--vp-sizes` screen gives the costs).
+        #[arg(long)]
+        bench: PathBuf,
+        #[arg(long, default_value = "README.md")]
+        readme: PathBuf,
+        /// Folder for the picture row's images.
+        #[arg(long, default_value = "docs/methods")]
+        pictures: PathBuf,
+    },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
     Eval {
         /// Reference: a linear EXR (e.g. from `fovea reference`) or a PNG (taken as displayed).
@@ -709,6 +724,9 @@ fn run() -> Result<()> {
                 device: device.device.as_deref(),
                 validation: device.validation,
             })
+        }
+        Command::MethodTable { quality, bench, readme, pictures } => {
+            commands::method_table::run(&commands::method_table::MethodTableArgs { quality: &quality, bench: &bench, readme: &readme, pictures: &pictures })
         }
         Command::Eval { reference, test, gaze, rings, out, headset, ppd } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,

@@ -6,6 +6,7 @@ pub mod debug_views;
 pub mod gen_scene;
 pub mod headsets;
 pub mod info;
+pub mod method_table;
 pub mod quality;
 pub mod reference;
 pub mod render;

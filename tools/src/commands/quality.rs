@@ -55,6 +55,9 @@ struct RunQuality {
     denoiser: String,
     taa: String,
     frame_gpu_ms: f64,
+    /// Samples and rays per frame (the run's mean, its report.json).
+    samples_traced: u64,
+    rays_traced: u64,
     /// Frames whose metrics are averaged, and their gaze points (render pixels).
     frames: Vec<u32>,
     gaze: Vec<[f32; 2]>,
@@ -290,6 +293,8 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         denoiser: String::new(),
         taa: String::new(),
         frame_gpu_ms: report["frame_gpu_ms"].as_f64().unwrap_or(0.0),
+        samples_traced: report["samples_traced"].as_u64().unwrap_or(0),
+        rays_traced: report["rays_traced"].as_u64().unwrap_or(0),
         frames: evaluated.to_vec(),
         gaze: gazes,
         rings,

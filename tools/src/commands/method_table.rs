@@ -1,0 +1,263 @@
+//! `fovea method-table`: issue 14's one table of every foveation method, generated from a
+//! `fovea quality` run (quality per ring band, samples, rays) and a `fovea bench` report (cost:
+//! whole frames of every method interleaved in one run on one device), written into the README
+//! between `<!-- method-table:begin -->` and `<!-- method-table:end -->`, with a picture row
+//! (each method's last evaluated still frame and its FLIP map against the reference) and the
+//! papers' claims each figure confirms or refutes.
+
+use crate::flip::{flip_image, flip_map};
+use crate::output::{read_exr, tonemap_preview, write_png, write_text};
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+pub const BEGIN: &str = "<!-- method-table:begin -->";
+pub const END: &str = "<!-- method-table:end -->";
+
+/// Ring bands of the paper's normalised eccentricity (degrees): a ring belongs to the band its
+/// middle falls in.
+const BANDS: [(&str, f64, f64); 3] = [("fovea", 0.0, 10.0), ("mid", 10.0, 30.0), ("periphery", 30.0, f64::INFINITY)];
+
+#[derive(Deserialize)]
+struct Quality {
+    scene: String,
+    width: u32,
+    height: u32,
+    gaze_source: String,
+    frames: u32,
+    eval_frames: u32,
+    reference_spp: u32,
+    runs: Vec<Run>,
+    #[serde(default)]
+    refused: Vec<Refused>,
+}
+
+#[derive(Deserialize)]
+struct Run {
+    camera: String,
+    method: String,
+    denoiser: String,
+    taa: String,
+    samples_traced: u64,
+    rays_traced: u64,
+    frames: Vec<u32>,
+    rings: Vec<Ring>,
+}
+
+#[derive(Deserialize)]
+struct Ring {
+    ecc_inner: f64,
+    ecc_outer: f64,
+    flip: Option<f64>,
+    flicker: Option<f64>,
+}
+
+#[derive(Deserialize)]
+struct Refused {
+    camera: String,
+    method: String,
+    denoiser: String,
+    reason: String,
+}
+
+#[derive(Deserialize)]
+struct Bench {
+    device: String,
+    visual_polar: Vec<BenchSize>,
+}
+
+#[derive(Deserialize)]
+struct BenchSize {
+    scene: String,
+    width: u32,
+    height: u32,
+    vp_samples: u64,
+    cartesian_passes_ms: BTreeMap<String, f64>,
+    vp_passes_ms: BTreeMap<String, f64>,
+    cartesian_frame_ms: f64,
+    vp_frame_ms: f64,
+    comparators: Vec<BenchMethod>,
+}
+
+#[derive(Deserialize)]
+struct BenchMethod {
+    method: String,
+    samples: u64,
+    passes_ms: BTreeMap<String, f64>,
+    frame_ms: f64,
+}
+
+/// One method's cost in the bench run: samples, frame ms, trace ms.
+struct Cost {
+    samples: u64,
+    frame_ms: f64,
+    trace_ms: f64,
+}
+
+pub struct MethodTableArgs<'a> {
+    /// A `fovea quality` output folder (quality.json, run_*/, reference_still_0000.exr).
+    pub quality: &'a Path,
+    /// A `fovea bench` report.json.
+    pub bench: &'a Path,
+    pub readme: &'a Path,
+    /// Where the picture row's images go (relative to the README's folder in the links).
+    pub pictures: &'a Path,
+}
+
+fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{}: not the expected report", path.display()))
+}
+
+pub fn run(args: &MethodTableArgs) -> Result<()> {
+    let quality: Quality = read(&args.quality.join("quality.json"))?;
+    let bench: Bench = read(args.bench)?;
+    let Some(size) = bench.visual_polar.first() else { bail!("{}: no visual_polar section (run fovea bench with --vp-sizes)", args.bench.display()) };
+    let readme = std::fs::read_to_string(args.readme).with_context(|| format!("reading {}", args.readme.display()))?;
+    let (Some(begin), Some(end)) = (readme.find(BEGIN), readme.find(END)) else {
+        bail!("{}: needs the markers {BEGIN} and {END} around the table's place", args.readme.display())
+    };
+    if end < begin {
+        bail!("{}: {END} comes before {BEGIN}", args.readme.display());
+    }
+    let costs = costs(size);
+    let pictures = pictures(args, &quality)?;
+    let mut table = String::new();
+    write_table(&mut table, &quality, &bench, size, &costs);
+    write_pictures(&mut table, &pictures, args)?;
+    write_claims(&mut table, &quality, &costs);
+    let updated = format!("{}{BEGIN}\n{table}{}", &readme[..begin], &readme[end..]);
+    write_text(args.readme, &updated)?;
+    println!("{table}");
+    Ok(())
+}
+
+fn costs(size: &BenchSize) -> BTreeMap<String, Cost> {
+    let trace = |p: &BTreeMap<String, f64>| p.get("trace").copied().unwrap_or(0.0);
+    let screen = size.width as u64 * size.height as u64;
+    let mut out = BTreeMap::from([
+        ("cartesian".to_string(), Cost { samples: screen, frame_ms: size.cartesian_frame_ms, trace_ms: trace(&size.cartesian_passes_ms) }),
+        ("vp".to_string(), Cost { samples: size.vp_samples, frame_ms: size.vp_frame_ms, trace_ms: trace(&size.vp_passes_ms) }),
+    ]);
+    for m in &size.comparators {
+        out.insert(m.method.clone(), Cost { samples: m.samples, frame_ms: m.frame_ms, trace_ms: trace(&m.passes_ms) });
+    }
+    out
+}
+
+/// A run's mean of `metric` over the rings of each band ("–" where none).
+fn bands(run: &Run, metric: impl Fn(&Ring) -> Option<f64>) -> String {
+    let cells: Vec<String> = BANDS
+        .iter()
+        .map(|&(_, lo, hi)| {
+            let values: Vec<f64> = run.rings.iter().filter(|r| (lo..hi).contains(&(0.5 * (r.ecc_inner + r.ecc_outer)))).filter_map(&metric).collect();
+            if values.is_empty() { "–".to_string() } else { format!("{:.3}", values.iter().sum::<f64>() / values.len() as f64) }
+        })
+        .collect();
+    cells.join(" / ")
+}
+
+fn write_table(s: &mut String, q: &Quality, bench: &Bench, size: &BenchSize, costs: &BTreeMap<String, Cost>) {
+    let _ = writeln!(
+        s,
+        "Generated by `fovea method-table` from `fovea quality` ({} at {}×{}, gaze `{}`, {} frames, the last {} evaluated against {}-spp references; \
+         FLIP and flicker per band of the paper's normalised eccentricity — fovea < 10°, mid 10–30°, periphery > 30°) and `fovea bench` \
+         (cost: {} at {}×{}, gaze centred, no denoiser, every method's frames interleaved in one run on {}).\n",
+        q.scene, q.width, q.height, q.gaze_source, q.frames, q.eval_frames, q.reference_spp, size.scene, size.width, size.height, bench.device
+    );
+    let _ = writeln!(
+        s,
+        "| method + denoiser | samples / rays per frame | bench: samples, frame ms (× Cartesian), trace µs per 1k samples | FLIP still: fovea / mid / periphery | flicker still | flicker moving |\n|---|---|---|---|---|---|"
+    );
+    let cartesian_ms = costs.get("cartesian").map_or(f64::NAN, |c| c.frame_ms);
+    for run in q.runs.iter().filter(|r| r.camera == "still" && r.taa == "off") {
+        let moving = q.runs.iter().find(|m| m.camera == "moving" && m.method == run.method && m.denoiser == run.denoiser && m.taa == run.taa);
+        let cost = match (run.denoiser.as_str(), costs.get(&run.method)) {
+            ("none", Some(c)) => format!("{}, {:.1} ({:.2}×), {:.1}", c.samples, c.frame_ms, c.frame_ms / cartesian_ms, 1e6 * c.trace_ms / c.samples.max(1) as f64),
+            _ => "–".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "| {} + {} | {} / {} | {cost} | {} | {} | {} |",
+            run.method,
+            run.denoiser,
+            run.samples_traced,
+            run.rays_traced,
+            bands(run, |r| r.flip),
+            bands(run, |r| r.flicker),
+            moving.map_or("–".to_string(), |m| bands(m, |r| r.flicker))
+        );
+    }
+    for r in q.refused.iter().filter(|r| r.camera == "still") {
+        let _ = writeln!(s, "| {} + {} | refused: {} | | | | |", r.method, r.denoiser, r.reason);
+    }
+    s.push('\n');
+}
+
+/// Each method's last evaluated still frame without a denoiser and its FLIP map, written to
+/// `args.pictures`: (method, frame file, map file).
+fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, String)>> {
+    let reference_path = args.quality.join("reference_still_0000.exr");
+    let (w, h, reference) = read_exr(&reference_path)?;
+    let reference = tonemap_preview(&reference, 1.0);
+    std::fs::create_dir_all(args.pictures).with_context(|| format!("creating {}", args.pictures.display()))?;
+    write_png(&args.pictures.join("reference.png"), w, h, &reference)?;
+    let ppd = crate::flip::headset_ppd(&fovea_hal::HmdDescription::resolve("fove0")?, w);
+    let mut out = Vec::new();
+    for run in q.runs.iter().filter(|r| r.camera == "still" && r.denoiser == "none" && r.taa == "off") {
+        let Some(&last) = run.frames.last() else { continue };
+        let dir = args.quality.join(format!("run_still_{}_none_taa-off", run.method));
+        let frame_path = dir.join(format!("frame_{last:04}.png"));
+        let frame = image::open(&frame_path).with_context(|| format!("reading {}", frame_path.display()))?.to_rgba8();
+        if frame.dimensions() != (w, h) {
+            bail!("{}: {}×{}, the reference is {w}×{h}", frame_path.display(), frame.width(), frame.height());
+        }
+        let map = flip_image(&flip_map(&reference, frame.as_raw(), w, h, ppd), w, h);
+        let (frame_name, map_name) = (format!("{}.png", run.method), format!("{}_flip.png", run.method));
+        write_png(&args.pictures.join(&frame_name), w, h, frame.as_raw())?;
+        write_png(&args.pictures.join(&map_name), w, h, &map)?;
+        out.push((run.method.clone(), frame_name, map_name));
+    }
+    Ok(out)
+}
+
+fn write_pictures(s: &mut String, pictures: &[(String, String, String)], args: &MethodTableArgs) -> Result<()> {
+    let base = args.readme.parent().unwrap_or(Path::new("."));
+    let dir = args.pictures.strip_prefix(base).unwrap_or(args.pictures).display().to_string();
+    let _ = writeln!(s, "Still camera, no denoiser, the last evaluated frame (same gaze for every method); below each, its FLIP map against the reference (`{dir}/reference.png`).\n");
+    let _ = writeln!(s, "| {} |", pictures.iter().map(|p| p.0.as_str()).collect::<Vec<_>>().join(" | "));
+    let _ = writeln!(s, "|{}", "---|".repeat(pictures.len()));
+    let _ = writeln!(s, "| {} |", pictures.iter().map(|p| format!("![{}]({dir}/{})", p.0, p.1)).collect::<Vec<_>>().join(" | "));
+    let _ = writeln!(s, "| {} |\n", pictures.iter().map(|p| format!("![{} FLIP]({dir}/{})", p.0, p.2)).collect::<Vec<_>>().join(" | "));
+    Ok(())
+}
+
+/// The papers' claims against this run's figures.
+fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>) {
+    let per_sample = |m: &str| costs.get(m).map(|c| c.trace_ms / c.samples.max(1) as f64);
+    let flip = |m: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m && r.denoiser == "none" && r.taa == "off").map(|r| bands(r, |g| g.flip));
+    let _ = writeln!(s, "Claims (trace time per sample from the bench; ≥ 1.15× counts as confirmed):\n");
+    for (other, paper, claim) in [
+        ("linear-falloff", "Koskela et al. 2019", "≈ 1.3× faster traversal per sample for Visual-Polar than linear falloff"),
+        ("random-acuity", "Koskela et al. 2019 / 2018", "1.3–1.5× faster traversal per sample for Visual-Polar than random acuity samples"),
+    ] {
+        if let (Some(vp), Some(o)) = (per_sample("vp"), per_sample(other)) {
+            let ratio = o / vp;
+            let verdict = if ratio >= 1.15 { "confirmed" } else { "not confirmed here" };
+            let _ = writeln!(s, "- {paper}: {claim} — measured {ratio:.2}× ({verdict}).");
+        }
+    }
+    if let (Some(vp), Some(lp), Some(cv), Some(cl)) = (flip("vp"), flip("log-polar"), costs.get("vp"), costs.get("log-polar")) {
+        let _ = writeln!(s, "- Visual-Polar vs log-polar (Meng et al. 2018): FLIP {vp} with {} samples vs {lp} with {} (not equal samples: log-polar's buffer is screen / σ²).", cv.samples, cl.samples);
+    }
+    if let (Some(pb), Some(c), Some(pf), Some(cf)) = (costs.get("pixel-blocks"), costs.get("cartesian"), flip("pixel-blocks"), flip("cartesian")) {
+        let _ = writeln!(
+            s,
+            "- Pixel blocks (Mohanto et al. 2023: 23–30× faster than uniform 32 spp, offline): its frames take {:.2}× the time of one sample per pixel here, FLIP {pf} vs {cf}.",
+            pb.frame_ms / c.frame_ms
+        );
+    }
+    s.push('\n');
+}
