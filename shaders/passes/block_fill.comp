@@ -17,7 +17,7 @@ void main() {
     if (any(greaterThanEqual(p, imageSize(screen)))) return;
     int level = pb_level_of(vec2(p) + 0.5);
     if (level == 0) {
-        imageStore(screen, p, vec4(imageLoad(grid, p).rgb, 1.0));
+        imageStore(screen, p, vec4(imageLoad(grid, pb_atlas_texel(0, p)).rgb, 1.0));
         return;
     }
     float b = float(1 << level);
@@ -25,12 +25,11 @@ void main() {
     ivec2 i0 = ivec2(floor(q));
     vec2 f = q - vec2(i0);
     ivec2 size = pb_level_size(level);
-    ivec2 origin = pb_level_origin(level);
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     for (int i = 0; i < 4; ++i) {
         ivec2 o = ivec2(i & 1, i >> 1);
-        vec4 v = imageLoad(grid, origin + clamp(i0 + o, ivec2(0), size - 1));
+        vec4 v = imageLoad(grid, pb_atlas_texel(level, clamp(i0 + o, ivec2(0), size - 1)));
         float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) * v.a;
         sum += w * v.rgb;
         weight += w;

@@ -2,10 +2,13 @@
 // fovea of single pixels (r ≤ r_f), an intermediate ring of 2×2 blocks (to r_m) and a periphery of
 // 4×4 blocks, each unit tracing its level's sample count (τ per pixel / per block) and filled back
 // by bilinear interpolation between the block centres of a pixel's level (passes/block_fill).
-// The grid is an atlas: level 0 (the screen's pixels) at x ∈ [0, W), level 1 at (W, 0), level 2
-// at (W, ⌈H/2⌉). A unit outside its level's region (dilated by B·√2 for levels 1 and 2, so every
-// pixel's four interpolation neighbours are traced) holds no sample. Parameters: grid = (atlas w,
-// h, screen w, h), gaze = (x, y, r_f, r_m) px, shape0 = (τ0, τ1, τ2, 0). Rust: sampling::PixelBlocks.
+// The grid is an atlas of windows: level 2's blocks over the whole screen at the origin, beside it
+// a square window of level-0 pixels and one of level-1 blocks, both centred on the gaze and just
+// large enough for their regions (so few lanes idle). A unit outside its level's region (dilated
+// by B·√2 for levels 1 and 2, so every pixel's four interpolation neighbours are traced) holds no
+// sample. Parameters: grid = (atlas w, h, screen w, h), gaze = (x, y, r_f, r_m) px, shape0 =
+// (τ0, τ1, τ2, 0), shape1 = (level-0 window, level-1 window, 0, 0) in units. Rust:
+// sampling::PixelBlocks.
 #ifndef FOVEA_SAMPLING_PIXEL_BLOCKS_GLSL
 #define FOVEA_SAMPLING_PIXEL_BLOCKS_GLSL
 
@@ -21,16 +24,37 @@ ivec2 pb_level_size(int level) {
     return (pb_screen() + b - 1) / b;
 }
 
-ivec2 pb_level_origin(int level) {
-    ivec2 s = pb_screen();
-    return level == 0 ? ivec2(0) : level == 1 ? ivec2(s.x, 0) : ivec2(s.x, (s.y + 1) / 2);
+// Each level's window of the atlas, in units (shape1 = (level-0 window, level-1 window) edges;
+// level 2's window is the whole screen).
+ivec2 pb_window_size(int level) {
+    return level == 2 ? pb_level_size(2) : ivec2(int(sampling.data.shape1[level]));
 }
 
-// The level and block of an atlas texel; false for the atlas's unused corners.
+// Where a level's window starts in the atlas: level 2 at the origin, 0 and 1 stacked beside it.
+ivec2 pb_atlas_origin(int level) {
+    int x = pb_level_size(2).x;
+    return level == 2 ? ivec2(0) : level == 0 ? ivec2(x, 0) : ivec2(x, pb_window_size(0).y);
+}
+
+// The first block of a level's window: the gaze's block less half the window (levels 0 and 1
+// follow the gaze; their windows hold every unit their dilated regions can trace).
+ivec2 pb_window_first_block(int level) {
+    if (level == 2) return ivec2(0);
+    ivec2 gaze_block = ivec2(floor(sampling.data.gaze.xy / float(1 << level)));
+    return gaze_block - pb_window_size(level) / 2;
+}
+
+// The level and block of an atlas texel; false outside the windows or the screen.
 bool pb_unit(ivec2 texel, out int level, out ivec2 block) {
-    level = texel.x < pb_screen().x ? 0 : texel.y < pb_level_origin(2).y ? 1 : 2;
-    block = texel - pb_level_origin(level);
-    return all(greaterThanEqual(block, ivec2(0))) && all(lessThan(block, pb_level_size(level)));
+    level = texel.x < pb_atlas_origin(0).x ? 2 : texel.y < pb_atlas_origin(1).y ? 0 : 1;
+    ivec2 local = texel - pb_atlas_origin(level);
+    block = local + pb_window_first_block(level);
+    return all(lessThan(local, pb_window_size(level))) && all(greaterThanEqual(block, ivec2(0))) && all(lessThan(block, pb_level_size(level)));
+}
+
+// The atlas texel of a level's block (inside its window).
+ivec2 pb_atlas_texel(int level, ivec2 block) {
+    return pb_atlas_origin(level) + block - pb_window_first_block(level);
 }
 
 // The level whose region holds a screen position (pixels).
