@@ -270,3 +270,37 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Composite foveation (Andersson & Hansson 2020) is a radial law of the polar space: every
+/// filter runs on it without validation messages, and `fovea render --method composite
+/// --composite-mode M` reports it end to end.
+#[test]
+fn composite_runs_the_filters_and_the_cli_reports_it() {
+    use fovea_renderer::passes::denoise::taa::TaaMode;
+    use fovea_renderer::sampling::{CompositeMode, RadialLaw};
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
+    let radial = RadialLaw::Composite(CompositeMode::Composite.params(SCREEN.x as f32 / 2.0));
+    let space = VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, VisualPolarParams { radial, ..Default::default() }).unwrap();
+    assert!(space.u_fovea() > 0.0, "the gaze disc");
+    for denoiser in ["svgf", "asvgf", "bmfr"] {
+        let settings = RenderSettings { denoiser: DenoiserSettings::parse(denoiser).unwrap(), taa: TaaMode::parse("vp").unwrap(), ..Default::default() };
+        let mut r = Renderer::new(&ctx, &scene, Box::new(space), settings).unwrap();
+        fovea_tests::mean_over_frames(&mut r, camera, Some(Vec2::new(25.0, 40.0)), 3, |f, hdr| {
+            assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite())), "{denoiser} frame {f}");
+        });
+    }
+    assert_clean(&ctx);
+
+    let out = fovea_tests::artifacts_dir().join(format!("composite-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let profile = fovea_tools::render_profile::RenderProfile { composite_mode: CompositeMode::Kernel, ..Default::default() };
+    let args = fovea_tools::commands::render::RenderArgs { method: "composite", width: Some(64), height: Some(72), profile, ..fovea_tests::small_render_args("cornell-box", &out) };
+    fovea_tools::commands::render::run(&args).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["method"], "composite");
+    assert_eq!(report["composite_mode"], "kernel");
+    assert!(report["passes"]["remap"].as_f64().is_some(), "{}", report["passes"]);
+    let _ = std::fs::remove_dir_all(&out);
+}

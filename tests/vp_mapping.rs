@@ -282,6 +282,49 @@ fn rust_and_glsl_headset_mappings_agree() {
     assert_clean(&ctx);
 }
 
+/// Composite foveation (Andersson & Hansson 2020): the gaze disc as a linear fovea and the
+/// log-polar law from the disc's edge, their four modes, through the same probe.
+#[test]
+fn rust_and_glsl_composite_mappings_agree() {
+    use fovea_renderer::sampling::CompositeMode;
+    let ctx = gpu();
+    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
+    let mut failures = Vec::new();
+    let mut seed = 300u64;
+    for screen in [UVec2::new(1280, 1440), UVec2::new(320, 360)] {
+        let s = screen.as_vec2();
+        for (gaze_name, gaze) in [("centre", s * 0.5), ("corner", Vec2::new(0.97, 0.985) * s)] {
+            for mode in [CompositeMode::Fov, CompositeMode::Kernel, CompositeMode::Composite, CompositeMode::CompositeKernel] {
+                let radial = RadialLaw::Composite(mode.params(s.x / 2.0));
+                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+                seed += 1;
+                let r = run_case(&ctx, &pipeline, &mut recorder, &vp, seed);
+                let line = format!(
+                    "composite {}x{} gaze {gaze_name} {}: grid→screen {:.2e} px on screen ({:.2e} of the distance off it), screen→grid x {:.2e} / y {:.2e} texels",
+                    screen.x,
+                    screen.y,
+                    mode.name(),
+                    r.screen_px_on_screen,
+                    r.screen_relative_off_screen,
+                    r.grid_x,
+                    r.grid_y
+                );
+                println!("{line}");
+                let screen_ok = r.screen_px_on_screen < SCREEN_BOUND_PX && r.screen_relative_off_screen < 1e-5;
+                // Rows span 2π however many there are: the driver's atan error, in rows, grows with
+                // the grid's height (up to 1688 rows here, 2.1× the 800 the bound was set for).
+                let rows_bound = GRID_BOUND * (vp.grid_size().y as f32 / 800.0).max(1.0);
+                if !(screen_ok && r.grid_x < GRID_BOUND && r.grid_y < rows_bound) {
+                    failures.push(line);
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert_clean(&ctx);
+}
+
 /// The log-polar radial law (Meng et al. 2018) through the same probe: α 4 (Meng) and 1 (plain
 /// log-polar), L from the farthest corner and from the diagonal, gaze at the centre, near an edge
 /// and in a corner, two screen sizes.

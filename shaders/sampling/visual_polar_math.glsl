@@ -13,7 +13,8 @@
 // exact inverse; screen offsets convert through the eye's FOV tangents (vp_headset_*).
 //
 // Log-polar radial law (flag 8, Rust log_polar.rs): r(u) and u(r) are Meng's kernel log-polar
-// law (log_polar.glsl) with α, L in shape1.zw; no clip (u_f = 0). The paper-axis kernels
+// law (log_polar.glsl) with α, L in shape1.zw; no clip (u_f = 0), or composite foveation's gaze
+// disc as a linear fovea (u_f, r_f) and the law from its inner column (shape0.y). The paper-axis kernels
 // (VP_NORMALIZED_AXIS_ONLY) compile it out, like the headset axis.
 //
 // Self-contained on purpose (no layouts.glsl): the parameters come as the four vectors of the
@@ -63,6 +64,7 @@ struct VpParams {
     bool log_polar;  // the radial law is Meng's kernel log-polar (log_polar.glsl)
     float lp_alpha;  // log-polar: kernel exponent α
     float lp_l;      // log-polar: L = ln of the extent (pixels)
+    float lp_inner;  // log-polar: the law's column where the first log-polar column starts (composite: the gaze disc's edge; shape0.y)
 };
 
 // Reddy's acuity V(e), cycles per degree.
@@ -165,6 +167,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.log_polar = VP_MAY_USE_LOG_POLAR && (flags & 8u) != 0u;
     p.lp_alpha = shape1.z;
     p.lp_l = shape1.w;
+    p.lp_inner = shape0.y;
     return p;
 }
 
@@ -235,7 +238,10 @@ bool vp_is_valid_texel(VpParams P, ivec2 t) {
 }
 
 float vp_r_of_u(VpParams P, float u) {
-    if (P.log_polar) return lp_r_of_u(u, P.lp_l, P.lp_alpha);
+    if (P.log_polar) {
+        if (u < P.u_f) return u / P.u_f * P.r_f;
+        return lp_r_of_u(P.lp_inner + (u - P.u_f) / (1.0 - P.u_f) * (1.0 - P.lp_inner), P.lp_l, P.lp_alpha);
+    }
     if (u < P.u_f) return u / P.u_f * P.r_f;
     float e_top = P.headset ? VP_E_TOP_HEADSET_DEG : VP_E_MAX_DEG;
     float e = P.exact
@@ -310,7 +316,10 @@ vec2 vp_offset_of(VpParams P, float u, float phi) {
 }
 
 float vp_u_of_r(VpParams P, float r) {
-    if (P.log_polar) return lp_u_of_r(r, P.lp_l, P.lp_alpha);
+    if (P.log_polar) {
+        if (P.u_f > 0.0 && r < P.r_f) return r / P.r_f * P.u_f;
+        return P.u_f + (lp_u_of_r(r, P.lp_l, P.lp_alpha) - P.lp_inner) / (1.0 - P.lp_inner) * (1.0 - P.u_f);
+    }
     if (r < P.r_f) return r / P.r_f * P.u_f;
     float e = r / P.r_max * P.e_norm;
     if (P.exact) return 1.0 - vp_cdf_tail(e, P.k, P.e_max, P.cdf_max) / P.cdf_max / (1.0 - P.p_f) * (1.0 - P.u_f);

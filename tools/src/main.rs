@@ -191,6 +191,10 @@ struct RenderOpts {
     /// diagonal (Andersson & Hansson 2020); σ and α from the profile's [log_polar].
     #[arg(long)]
     log_polar_extent: Option<String>,
+    /// --method composite: Andersson & Hansson 2020's mode, fov|kernel|composite|composite-kernel
+    /// (default composite).
+    #[arg(long)]
+    composite_mode: Option<String>,
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
@@ -226,6 +230,7 @@ impl RenderOpts {
             layout: self.vp_layout.clone(),
             eccentricity: self.vp_eccentricity.clone(),
             log_polar_extent: self.log_polar_extent.clone(),
+            composite_mode: self.composite_mode.clone(),
             blur_sigma: self.blur_sigma,
             environment: self.look.environment()?,
             texture_lod: self.look.texture_lod.clone(),

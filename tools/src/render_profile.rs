@@ -7,7 +7,7 @@
 //! (`RenderProfile::visual_polar_for`).
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{CompositeMode, Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
@@ -23,6 +23,8 @@ pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     /// `[log_polar]`: `--method log-polar` (Meng et al. 2018; σ, α, the extent L comes from).
     pub log_polar: LogPolarParams,
+    /// `--composite-mode`: `--method composite`'s mode (Andersson & Hansson 2020).
+    pub composite_mode: CompositeMode,
     /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
     /// until `visual_polar_for` adds the headset's FOV.
     pub eccentricity: EccentricityMode,
@@ -158,6 +160,8 @@ pub struct ProfileOverrides {
     pub eccentricity: Option<String>,
     /// `--log-polar-extent`.
     pub log_polar_extent: Option<String>,
+    /// `--composite-mode`.
+    pub composite_mode: Option<String>,
     pub blur_sigma: Option<f32>,
     /// `--sun`, `--sun-intensity`, `--sky-intensity`.
     pub environment: EnvironmentOptions,
@@ -383,6 +387,10 @@ impl RenderProfile {
         if let Some(extent) = &o.log_polar_extent {
             self.log_polar.extent = parse_log_polar_extent(extent).context("--log-polar-extent")?;
         }
+        if let Some(mode) = &o.composite_mode {
+            self.composite_mode = CompositeMode::parse(mode)
+                .with_context(|| format!("--composite-mode {mode}: expected one of {}", CompositeMode::NAMES.join(", ")))?;
+        }
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
         check_blur(&self.blur).context("--blur-sigma")?;
         o.environment.validate(&EnvironmentNames::flags())?;
@@ -435,6 +443,12 @@ impl RenderProfile {
     /// blur's slope) with the profile's log-polar law.
     pub fn log_polar_space(&self) -> VisualPolarParams {
         VisualPolarParams { radial: RadialLaw::LogPolar(self.log_polar), ..Default::default() }
+    }
+
+    /// The polar-space parameters of `--method composite` for an eye `viewing_distance_px` from
+    /// the image (its gaze disc is d · tan a_G).
+    pub fn composite_space(&self, viewing_distance_px: f32) -> VisualPolarParams {
+        VisualPolarParams { radial: RadialLaw::Composite(self.composite_mode.params(viewing_distance_px)), ..Default::default() }
     }
 
     /// The combinations the headset axis refuses, checked with a stand-in FOV (the real one is

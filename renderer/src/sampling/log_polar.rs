@@ -73,6 +73,9 @@ impl LogPolarParams {
 pub struct LogPolarLaw {
     pub l: f32,
     pub alpha: f32,
+    /// The law's column where the polar space's first log-polar column starts (0 for Meng;
+    /// composite foveation's gaze disc edge, `composite.rs`).
+    pub inner: f32,
 }
 
 impl LogPolarLaw {
@@ -81,7 +84,7 @@ impl LogPolarLaw {
         if !(extent_px.is_finite() && extent_px > 1.0) {
             return Err(Error::Invalid(format!("log-polar: the extent must exceed one pixel, got {extent_px} px")));
         }
-        Ok(LogPolarLaw { l: ln_f32(extent_px), alpha })
+        Ok(LogPolarLaw { l: ln_f32(extent_px), alpha, inner: 0.0 })
     }
 
     /// Pixels from the gaze of normalised column u. GLSL `lp_r_of_u`.

@@ -4,6 +4,7 @@
 
 mod acuity;
 mod cartesian;
+mod composite;
 mod linear_falloff;
 mod log_polar;
 mod pixel_blocks;
@@ -15,6 +16,7 @@ mod visual_polar_clipped;
 mod visual_polar_headset;
 
 pub use cartesian::Cartesian;
+pub use composite::{CompositeMode, CompositeParams};
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use pixel_blocks::{BlockShape, PixelBlocks, BLOCK_LEVELS};

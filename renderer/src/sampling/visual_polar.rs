@@ -30,6 +30,7 @@
 //! kernel log-polar law (`log_polar.rs`: no clip, grid = screen / σ, r_max = the law's extent).
 //! Everything else — rows, φ wrap, arcs, mips, remap, the denoisers' grid addressing — is shared.
 
+use super::composite::CompositeParams;
 use super::log_polar::{LogPolarLaw, LogPolarParams};
 use super::visual_polar_headset::{FovTangents, HeadsetAxis};
 use super::acuity::*;
@@ -85,6 +86,9 @@ pub enum RadialLaw {
     /// Meng et al. 2018's kernel log-polar law (`log_polar.rs`); `axis_scale`, `clip_fraction`,
     /// `radius_mode` and the inverse CDF do not apply (σ, the extent and α replace them).
     LogPolar(LogPolarParams),
+    /// Andersson & Hansson 2020's composite foveation (`composite.rs`): the log-polar law from the
+    /// screen diagonal past a gaze disc traced at one sample per pixel as the fovea.
+    Composite(CompositeParams),
 }
 
 /// What the ρ axis measures.
@@ -156,8 +160,13 @@ impl VisualPolarParams {
                 return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
             }
         }
-        if let RadialLaw::LogPolar(lp) = self.radial {
-            lp.validate()?;
+        if let RadialLaw::Composite(c) = self.radial {
+            c.validate()?;
+        }
+        if matches!(self.radial, RadialLaw::LogPolar(_) | RadialLaw::Composite(_)) {
+            if let RadialLaw::LogPolar(lp) = self.radial {
+                lp.validate()?;
+            }
             // Meng's buffer spans full circles on the screen's own distances, its extent set by L.
             if self.layout != VpLayout::Paper || self.eccentricity != Eccentricity::Normalized || self.radius_mode != RadiusMode::FarthestCorner {
                 return Err(invalid(
@@ -232,14 +241,18 @@ impl VisualPolar {
         if !gaze.is_finite() {
             return Err(invalid(format!("gaze must be finite, got ({}, {})", gaze.x, gaze.y)));
         }
+        let composite = match params.radial {
+            RadialLaw::Composite(c) => Some(c.layout(screen)?),
+            _ => None,
+        };
         let axis_scale = match params.radial {
-            RadialLaw::Acuity => params.axis_scale,
+            RadialLaw::Acuity | RadialLaw::Composite(_) => params.axis_scale,
             RadialLaw::LogPolar(lp) => 1.0 / lp.sigma,
         };
-        let grid = (screen.as_vec2() * axis_scale)
-            .round()
-            .as_uvec2()
-            .max(UVec2::ONE);
+        let grid = match &composite {
+            Some(c) => c.grid,
+            None => (screen.as_vec2() * axis_scale).round().as_uvec2().max(UVec2::ONE),
+        };
         let k = params.density_exponent;
         let headset = match params.eccentricity {
             Eccentricity::Normalized => None,
@@ -254,11 +267,13 @@ impl VisualPolar {
         let log_polar = match params.radial {
             RadialLaw::Acuity => None,
             RadialLaw::LogPolar(lp) => Some(LogPolarLaw::new(lp.extent_px(screen, gaze), lp.alpha)?),
+            RadialLaw::Composite(_) => composite.as_ref().map(|c| c.law),
         };
         let (cdf_max, r_max, r_f, e_norm) = match headset {
             None => {
                 let r_max = match (params.radius_mode, params.radial) {
                     (_, RadialLaw::LogPolar(lp)) => lp.extent_px(screen, gaze),
+                    (_, RadialLaw::Composite(_)) => screen.as_vec2().length(),
                     (RadiusMode::FarthestCorner, _) => r_corner_px,
                     (RadiusMode::Fixed(r), _) => r,
                 };
@@ -276,11 +291,15 @@ impl VisualPolar {
             gaze,
             params,
             grid,
-            // Log-polar columns keep every row (u_f = 0: no clip).
-            u_f: if log_polar.is_some() { 0.0 } else { 2.0 * params.clip_fraction },
+            // Log-polar columns keep every row (u_f = 0: no clip); composite's gaze disc is the fovea.
+            u_f: match (&composite, log_polar) {
+                (Some(c), _) => c.u_f,
+                (None, Some(_)) => 0.0,
+                (None, None) => 2.0 * params.clip_fraction,
+            },
             p_f: cdf(params.fovea_deg, k) / cdf_max,
             r_max,
-            r_f,
+            r_f: composite.as_ref().filter(|c| c.u_f > 0.0).map_or(r_f, |c| c.r_f),
             e_norm,
             cdf_max,
             exact,
@@ -342,9 +361,11 @@ impl VisualPolar {
     /// Where the foveated blur starts (pixels): the fovea's edge; with the log-polar law the
     /// outer half of the buffer (u ≥ ½, comparators.md §D: Meng blurs the outer half).
     pub fn blur_start(&self) -> f32 {
-        match self.log_polar {
-            Some(law) => law.r_of_u(0.5),
-            None => self.r_fovea(),
+        match (self.params.radial, self.log_polar) {
+            // Andersson & Hansson blur beyond a sixth of the diagonal.
+            (RadialLaw::Composite(_), _) => self.screen.as_vec2().length() / 6.0,
+            (_, Some(law)) => law.r_of_u(0.5),
+            _ => self.r_fovea(),
         }
     }
 
@@ -415,7 +436,10 @@ impl VisualPolar {
     /// true eccentricity (degrees) on the headset's.
     pub fn r_of_u(&self, u: f32) -> f32 {
         if let Some(law) = &self.log_polar {
-            return law.r_of_u(u);
+            if u < self.u_f {
+                return u / self.u_f * self.r_f;
+            }
+            return law.r_of_u(law.inner + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - law.inner));
         }
         if u < self.u_f {
             return u / self.u_f * self.r_f;
@@ -453,7 +477,10 @@ impl VisualPolar {
     /// Axis value (see `r_of_u`) → normalised ρ coordinate (inverse of `r_of_u`).
     pub fn u_of_r(&self, r: f32) -> f32 {
         if let Some(law) = &self.log_polar {
-            return law.u_of_r(r);
+            if self.u_f > 0.0 && r < self.r_f {
+                return r / self.r_f * self.u_f;
+            }
+            return self.u_f + (law.u_of_r(r) - law.inner) / (1.0 - law.inner) * (1.0 - self.u_f);
         }
         if r < self.r_f {
             return r / self.r_f * self.u_f;
@@ -539,7 +566,8 @@ impl VisualPolar {
             None => SamplingParams {
                 grid,
                 gaze: Vec4::new(self.gaze.x, self.gaze.y, self.r_max, k),
-                shape0: Vec4::new(self.u_f, self.p_f, self.r_f, self.e_norm),
+                // Log-polar: shape0.y = the law's inner column instead of p_f (unused by the law).
+                shape0: Vec4::new(self.u_f, self.log_polar.map_or(self.p_f, |law| law.inner), self.r_f, self.e_norm),
                 // Log-polar: shape1.zw = (α, L) instead of (fovea°, 0).
                 shape1: match &self.log_polar {
                     None => Vec4::new(self.cdf_max, flags as f32, self.params.fovea_deg, 0.0),
@@ -576,9 +604,10 @@ pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
 /// the paper. The screen-clipped layout keeps them on it.
 impl SamplingSpace for VisualPolar {
     fn name(&self) -> &'static str {
-        match self.log_polar {
-            Some(_) => "log-polar",
-            None => "vp",
+        match (self.params.radial, self.log_polar) {
+            (RadialLaw::Composite(_), _) => "composite",
+            (_, Some(_)) => "log-polar",
+            _ => "vp",
         }
     }
     fn shader_variant(&self) -> &'static str {

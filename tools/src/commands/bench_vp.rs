@@ -11,7 +11,7 @@ use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP,
+    BlockShape, Cartesian, CompositeMode, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP,
 };
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
@@ -47,7 +47,7 @@ pub struct VpFrameReport {
     /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
     /// frames above, no denoiser, each with its paper's defaults (`comparator_spaces`):
     /// `log-polar`, `uniform-budget`, `linear-falloff` (samples: the expected count), `random-acuity`,
-    /// `pixel-blocks`.
+    /// `pixel-blocks`, `composite`.
     pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
@@ -149,8 +149,8 @@ pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)],
 
 /// The comparator methods of issue 14 with their papers' defaults, around `gaze`: log-polar
 /// (Meng et al. 2018), the uniform budget, linear falloff (1.5× VP's samples) and random acuity
-/// (VP's samples at random positions) and pixel blocks (Mohanto et al. 2023, 4 / 2 / 1 samples),
-/// each one measured beside `vp`.
+/// (VP's samples at random positions), pixel blocks (Mohanto et al. 2023, 4 / 2 / 1 samples) and
+/// composite (Andersson & Hansson 2020, their composite mode), each one measured beside `vp`.
 fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<Box<dyn SamplingSpace>>> {
     let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
     let falloff = LinearFalloff::new(screen, *vp.params(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP)?;
@@ -160,6 +160,8 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<
         Box::new(falloff),
         Box::new(RandomAcuity::new(screen, gaze, *vp.params())?),
         Box::new(PixelBlocks::new(screen, *vp.params(), BlockShape::default())?),
+        // A 90° eye: the gaze disc's viewing distance is half the width.
+        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::default().params(screen.x as f32 / 2.0)), ..Default::default() })?),
     ])
 }
 

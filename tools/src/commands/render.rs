@@ -106,6 +106,8 @@ struct Report {
     visual_polar: Option<VpReport>,
     /// Log-polar parameters (log-polar only).
     log_polar: Option<LogPolarReport>,
+    /// Andersson & Hansson's mode (composite only).
+    composite_mode: Option<&'static str>,
     /// Foveated blur σ at 30° for a 1280×1440 eye (the methods with the foveated blur; 0 = off).
     blur_sigma_at_30: Option<f32>,
     /// Pass name → mean GPU milliseconds per frame (both eyes' passes summed in a stereo run).
@@ -262,7 +264,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let p = &args.profile.log_polar;
             LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
         }),
-        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar" | "linear-falloff" | "random-acuity").then_some(args.profile.blur.sigma_at_30),
+        composite_mode: (args.method == "composite").then(|| args.profile.composite_mode.name()),
+        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar" | "linear-falloff" | "random-acuity" | "composite").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),

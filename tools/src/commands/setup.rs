@@ -17,7 +17,7 @@ use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -177,6 +177,9 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
     if method == "log-polar" {
         return check_log_polar(profile, screen);
     }
+    if method == "composite" && (screen.x < 16 || screen.y < 16) {
+        bail!("--method composite: a {}×{} screen is too small for a gaze disc and a log-polar buffer (at least 16×16)", screen.x, screen.y);
+    }
     // So are linear falloff's and pixel blocks' degrees, and random acuity's grid.
     if !matches!(method, "vp" | "uniform-budget" | "linear-falloff" | "random-acuity" | "pixel-blocks") {
         return Ok(());
@@ -305,6 +308,11 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
         "cartesian" => Box::new(Cartesian::new(screen)),
         // Meng's kernel log-polar buffer: the polar space with the log-polar radial law.
         "log-polar" => Box::new(VisualPolar::new(screen, screen_centre, profile.log_polar_space()).context("log-polar space")?),
+        // Andersson & Hansson's gaze disc + log-polar; the eye's distance from its FOV.
+        "composite" => {
+            let viewing_distance = screen.x as f32 / (fov.right + fov.left).max(1e-3);
+            Box::new(VisualPolar::new(screen, screen_centre, profile.composite_space(viewing_distance)).context("composite space")?)
+        }
         // Visual-Polar's sample count for this eye and profile, spent on a regular grid.
         "uniform-budget" => {
             let vp = VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space (the uniform budget's count)")?;
