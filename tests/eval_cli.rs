@@ -282,7 +282,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     let readme = docs.join("README.md");
     std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter\n").unwrap();
     let pictures = docs.join("docs").join("methods");
-    let bench_report = bench_out.join("report.json");
+    let bench_report = [bench_out.join("report.json")];
     let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures };
     fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
     let text = std::fs::read_to_string(&readme).unwrap();

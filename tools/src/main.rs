@@ -465,9 +465,10 @@ enum Command {
         /// A `fovea quality` output folder (e.g. run with `--methods all`).
         #[arg(long)]
         quality: PathBuf,
-        /// A `fovea bench` report.json (its first `--vp-sizes` screen gives the costs).
-        #[arg(long)]
-        bench: PathBuf,
+        /// `fovea bench` report.json files, comma-separated: the first one's first `--vp-sizes`
+        /// screen gives the table's costs; every screen of every one a figure in the claims.
+        #[arg(long, value_delimiter = ',', required = true)]
+        bench: Vec<PathBuf>,
         #[arg(long, default_value = "README.md")]
         readme: PathBuf,
         /// Folder for the picture row's images.

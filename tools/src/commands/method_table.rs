@@ -99,8 +99,9 @@ struct Cost {
 pub struct MethodTableArgs<'a> {
     /// A `fovea quality` output folder (quality.json, run_*/, reference_still_0000.exr).
     pub quality: &'a Path,
-    /// A `fovea bench` report.json.
-    pub bench: &'a Path,
+    /// `fovea bench` report.json files: the first gives the table's costs, every one a figure per
+    /// scene in the claims.
+    pub bench: &'a [std::path::PathBuf],
     pub readme: &'a Path,
     /// Where the picture row's images go (relative to the README's folder in the links).
     pub pictures: &'a Path,
@@ -113,8 +114,16 @@ fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
 
 pub fn run(args: &MethodTableArgs) -> Result<()> {
     let quality: Quality = read(&args.quality.join("quality.json"))?;
-    let bench: Bench = read(args.bench)?;
-    let Some(size) = bench.visual_polar.first() else { bail!("{}: no visual_polar section (run fovea bench with --vp-sizes)", args.bench.display()) };
+    let mut benches = Vec::new();
+    for path in args.bench {
+        let bench: Bench = read(path)?;
+        if bench.visual_polar.is_empty() {
+            bail!("{}: no visual_polar section (run fovea bench with --vp-sizes)", path.display());
+        }
+        benches.push(bench);
+    }
+    let Some(bench) = benches.first() else { bail!("--bench: at least one fovea bench report") };
+    let size = &bench.visual_polar[0];
     let readme = std::fs::read_to_string(args.readme).with_context(|| format!("reading {}", args.readme.display()))?;
     let (Some(begin), Some(end)) = (readme.find(BEGIN), readme.find(END)) else {
         bail!("{}: needs the markers {BEGIN} and {END} around the table's place", args.readme.display())
@@ -125,9 +134,11 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
     let costs = costs(size);
     let pictures = pictures(args, &quality)?;
     let mut table = String::new();
-    write_table(&mut table, &quality, &bench, size, &costs);
+    write_table(&mut table, &quality, bench, size, &costs);
     write_pictures(&mut table, &pictures, args)?;
-    write_claims(&mut table, &quality, &costs);
+    let scenes: Vec<(String, BTreeMap<String, Cost>)> =
+        benches.iter().flat_map(|b| &b.visual_polar).map(|v| (format!("{} {}×{}", scene_name(&v.scene), v.width, v.height), self::costs(v))).collect();
+    write_claims(&mut table, &quality, &costs, &scenes);
     let updated = format!("{}{BEGIN}\n{table}{}", &readme[..begin], &readme[end..]);
     write_text(args.readme, &updated)?;
     println!("{table}");
@@ -234,19 +245,29 @@ fn write_pictures(s: &mut String, pictures: &[(String, String, String)], args: &
     Ok(())
 }
 
-/// The papers' claims against this run's figures.
-fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>) {
-    let per_sample = |m: &str| costs.get(m).map(|c| c.trace_ms / c.samples.max(1) as f64);
+/// A scene path's file stem (reports name scenes by path or by name).
+fn scene_name(scene: &str) -> &str {
+    Path::new(scene).file_stem().and_then(|s| s.to_str()).unwrap_or(scene)
+}
+
+/// The papers' claims against this run's figures (`scenes`: every bench screen's costs).
+fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, scenes: &[(String, BTreeMap<String, Cost>)]) {
+    let per_sample = |c: &BTreeMap<String, Cost>, m: &str| c.get(m).map(|c| c.trace_ms / c.samples.max(1) as f64);
     let flip = |m: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m && r.denoiser == "none" && r.taa == "off").map(|r| bands(r, |g| g.flip));
-    let _ = writeln!(s, "Claims (trace time per sample from the bench; ≥ 1.15× counts as confirmed):\n");
+    let _ = writeln!(s, "Claims (trace time per sample from the bench, per scene; ≥ 1.15× counts as confirmed):\n");
     for (other, paper, claim) in [
         ("linear-falloff", "Koskela et al. 2019", "≈ 1.3× faster traversal per sample for Visual-Polar than linear falloff"),
         ("random-acuity", "Koskela et al. 2019 / 2018", "1.3–1.5× faster traversal per sample for Visual-Polar than random acuity samples"),
     ] {
-        if let (Some(vp), Some(o)) = (per_sample("vp"), per_sample(other)) {
-            let ratio = o / vp;
-            let verdict = if ratio >= 1.15 { "confirmed" } else { "not confirmed here" };
-            let _ = writeln!(s, "- {paper}: {claim} — measured {ratio:.2}× ({verdict}).");
+        let figures: Vec<String> = scenes
+            .iter()
+            .filter_map(|(name, c)| {
+                let ratio = per_sample(c, other)? / per_sample(c, "vp")?;
+                Some(format!("{ratio:.2}× on {name} ({})", if ratio >= 1.15 { "confirmed" } else { "not confirmed" }))
+            })
+            .collect();
+        if !figures.is_empty() {
+            let _ = writeln!(s, "- {paper}: {claim} — measured {}.", figures.join(", "));
         }
     }
     if let (Some(vp), Some(lp), Some(cv), Some(cl)) = (flip("vp"), flip("log-polar"), costs.get("vp"), costs.get("log-polar")) {
