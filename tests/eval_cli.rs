@@ -280,13 +280,13 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     .unwrap();
     let docs = temp_dir("method-table");
     let readme = docs.join("README.md");
-    std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter\n").unwrap();
+    std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
     let pictures = docs.join("docs").join("methods");
     let bench_report = [bench_out.join("report.json")];
     let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures };
     fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
     let text = std::fs::read_to_string(&readme).unwrap();
-    assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter\n") && !text.contains("old"), "{text}");
+    assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n") && !text.contains("old"), "{text}");
     for m in &methods {
         assert!(text.contains(&format!("| {m} + none | ")), "{m}: {text}");
         assert!(pictures.join(format!("{m}.png")).is_file() && pictures.join(format!("{m}_flip.png")).is_file(), "{m}");

@@ -125,8 +125,10 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
     let Some(bench) = benches.first() else { bail!("--bench: at least one fovea bench report") };
     let size = &bench.visual_polar[0];
     let readme = std::fs::read_to_string(args.readme).with_context(|| format!("reading {}", args.readme.display()))?;
-    let (Some(begin), Some(end)) = (readme.find(BEGIN), readme.find(END)) else {
-        bail!("{}: needs the markers {BEGIN} and {END} around the table's place", args.readme.display())
+    // The markers on lines of their own (the README may quote them elsewhere).
+    let line_of = |marker: &str| readme.match_indices(marker).map(|(i, _)| i).find(|&i| (i == 0 || readme[..i].ends_with('\n')) && readme[i + marker.len()..].starts_with('\n'));
+    let (Some(begin), Some(end)) = (line_of(BEGIN), line_of(END)) else {
+        bail!("{}: needs the markers {BEGIN} and {END}, each on a line of its own, around the table's place", args.readme.display())
     };
     if end < begin {
         bail!("{}: {END} comes before {BEGIN}", args.readme.display());
@@ -270,8 +272,11 @@ fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, sce
             let _ = writeln!(s, "- {paper}: {claim} — measured {}.", figures.join(", "));
         }
     }
-    if let (Some(vp), Some(lp), Some(cv), Some(cl)) = (flip("vp"), flip("log-polar"), costs.get("vp"), costs.get("log-polar")) {
-        let _ = writeln!(s, "- Visual-Polar vs log-polar (Meng et al. 2018): FLIP {vp} with {} samples vs {lp} with {} (not equal samples: log-polar's buffer is screen / σ²).", cv.samples, cl.samples);
+    let samples = |m: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m).map(|r| r.samples_traced);
+    for (other, paper) in [("log-polar", "Meng et al. 2018"), ("composite", "Andersson & Hansson 2020")] {
+        if let (Some(vp), Some(o), Some(nv), Some(no)) = (flip("vp"), flip(other), samples("vp"), samples(other)) {
+            let _ = writeln!(s, "- Visual-Polar vs {other} ({paper}), no denoiser: FLIP {vp} with {nv} samples vs {o} with {no} (each at its paper's budget, not equal samples).");
+        }
     }
     if let (Some(pb), Some(c), Some(pf), Some(cf)) = (costs.get("pixel-blocks"), costs.get("cartesian"), flip("pixel-blocks"), flip("cartesian")) {
         let _ = writeln!(
