@@ -607,6 +607,8 @@ impl SamplingSpace for VisualPolar {
         match (self.params.radial, self.log_polar) {
             (RadialLaw::Composite(_), _) => "composite",
             (_, Some(_)) => "log-polar",
+            _ if self.headset.is_some() => "vp-headset",
+            _ if self.params.layout == VpLayout::ScreenClipped => "vp-screen-clipped",
             _ => "vp",
         }
     }

@@ -11,7 +11,7 @@ use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, CompositeMode, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP,
+    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FovTangents, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
@@ -47,7 +47,7 @@ pub struct VpFrameReport {
     /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
     /// frames above, no denoiser, each with its paper's defaults (`comparator_spaces`):
     /// `log-polar`, `uniform-budget`, `linear-falloff` (samples: the expected count), `random-acuity`,
-    /// `pixel-blocks`, `composite`.
+    /// `pixel-blocks`, `composite`, and VP's variants (`vp-screen-clipped`, `vp-headset`: the FOVE 0's FOV).
     pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
@@ -162,8 +162,14 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<
         Box::new(PixelBlocks::new(screen, *vp.params(), BlockShape::default())?),
         // A 90° eye: the gaze disc's viewing distance is half the width.
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::default().params(screen.x as f32 / 2.0)), ..Default::default() })?),
+        // Visual-Polar's variants: the screen-clipped layout and the FOVE 0's headset axis.
+        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..*vp.params() })?),
+        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(FOVE0_FOV), ..*vp.params() })?),
     ])
 }
+
+/// The FOVE 0 eye's FOV (config/headsets/fove0.toml), for the headset-axis variant.
+const FOVE0_FOV: FovTangents = FovTangents { left: 1.0, right: 1.0, up: 1.127_2, down: 1.127_2 };
 
 /// Passes of the displayed frame (read-backs are I/O, not rendering).
 fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {

@@ -259,13 +259,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         seed: args.seed,
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
-        visual_polar: (args.method == "vp").then(|| vp_report(&args.profile)),
+        visual_polar: args.method.starts_with("vp").then(|| vp_report(&args.profile, args.method)),
         log_polar: (args.method == "log-polar").then(|| {
             let p = &args.profile.log_polar;
             LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
         }),
         composite_mode: (args.method == "composite").then(|| args.profile.composite_mode.name()),
-        blur_sigma_at_30: matches!(args.method, "vp" | "log-polar" | "linear-falloff" | "random-acuity" | "composite").then_some(args.profile.blur.sigma_at_30),
+        blur_sigma_at_30: matches!(args.method, "vp" | "vp-screen-clipped" | "vp-headset" | "log-polar" | "linear-falloff" | "random-acuity" | "composite").then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -340,24 +340,27 @@ impl FrameWriter<'_> {
     }
 }
 
-fn vp_report(profile: &RenderProfile) -> VpReport {
+/// `method`: `vp` or one of its variants (`vp-screen-clipped`, `vp-headset`), which set the layout
+/// or the axis whatever the profile says.
+fn vp_report(profile: &RenderProfile, method: &str) -> VpReport {
     use fovea_renderer::sampling::{InverseCdf, RadiusMode};
     let p = &profile.visual_polar;
+    let headset = method == "vp-headset" || profile.eccentricity == crate::render_profile::EccentricityMode::Headset;
     VpReport {
         axis_scale: p.axis_scale,
         clip_fraction: p.clip_fraction,
         fovea_deg: p.fovea_deg,
         density_exponent: p.density_exponent,
         // The headset axis always uses the exact inverse (the quartic is a fit for [0, 80]).
-        inverse_cdf: match (p.inverse_cdf, profile.eccentricity) {
-            (_, crate::render_profile::EccentricityMode::Headset) | (InverseCdf::Exact, _) => "exact".into(),
-            (InverseCdf::Polynomial, _) => "polynomial".into(),
+        inverse_cdf: match (p.inverse_cdf, headset) {
+            (_, true) | (InverseCdf::Exact, _) => "exact".into(),
+            (InverseCdf::Polynomial, false) => "polynomial".into(),
         },
         radius: match p.radius_mode {
             RadiusMode::FarthestCorner => "corner".into(),
             RadiusMode::Fixed(r) => format!("{r}"),
         },
-        layout: crate::render_profile::layout_name(p.layout).into(),
-        eccentricity: crate::render_profile::eccentricity_name(profile.eccentricity).into(),
+        layout: if method == "vp-screen-clipped" { "screen-clipped".into() } else { crate::render_profile::layout_name(p.layout).into() },
+        eccentricity: if headset { "headset".into() } else { crate::render_profile::eccentricity_name(profile.eccentricity).into() },
     }
 }

@@ -12,12 +12,15 @@ use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
-use fovea_renderer::sampling::{BlockShape, Cartesian, FalloffShape, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VpLayout, FALLOFF_BUDGET_OF_VP};
+use fovea_renderer::sampling::{
+    BlockShape, Cartesian, Eccentricity, FalloffShape, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, VpLayout,
+    FALLOFF_BUDGET_OF_VP,
+};
 use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
 /// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite"];
+pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-headset"];
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -181,7 +184,7 @@ pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Resu
         bail!("--method composite: a {}×{} screen is too small for a gaze disc and a log-polar buffer (at least 16×16)", screen.x, screen.y);
     }
     // So are linear falloff's and pixel blocks' degrees, and random acuity's grid.
-    if !matches!(method, "vp" | "uniform-budget" | "linear-falloff" | "random-acuity" | "pixel-blocks") {
+    if !matches!(method, "vp" | "vp-screen-clipped" | "vp-headset" | "uniform-budget" | "linear-falloff" | "random-acuity" | "pixel-blocks") {
         return Ok(());
     }
     if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
@@ -305,6 +308,15 @@ pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, ey
     let vp_params = profile.visual_polar_for(fov).with_context(|| format!("--headset {}", hmd.id))?;
     Ok(match method {
         "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
+        // Visual-Polar's variants as methods of their own (the method table's rows).
+        "vp-screen-clipped" => {
+            let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp_params };
+            Box::new(VisualPolar::new(screen, screen_centre, params).context("Visual-Polar space, screen-clipped layout")?)
+        }
+        "vp-headset" => {
+            let params = VisualPolarParams { eccentricity: Eccentricity::Headset(fov), layout: VpLayout::Paper, ..vp_params };
+            Box::new(VisualPolar::new(screen, screen_centre, params).with_context(|| format!("Visual-Polar space, headset axis of {}", hmd.id))?)
+        }
         "cartesian" => Box::new(Cartesian::new(screen)),
         // Meng's kernel log-polar buffer: the polar space with the log-polar radial law.
         "log-polar" => Box::new(VisualPolar::new(screen, screen_centre, profile.log_polar_space()).context("log-polar space")?),
