@@ -11,6 +11,7 @@
 //! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
 //! variant cartesian_gradients: SAMPLING_CARTESIAN TRACE_GRADIENTS
 //! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
+//! variant visual_polar_clipped_gradients: SAMPLING_VISUAL_POLAR TRACE_GRADIENTS
 //! variant log_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
 //! variant log_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
 //! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
