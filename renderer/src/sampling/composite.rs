@@ -10,7 +10,10 @@
 //! g = the log-polar column of r_G. A mode with a_G = 0 is plain log-polar with their σ, α and
 //! aspect. GLSL: the log-polar branch of `vp_r_of_u` / `vp_u_of_r` (visual_polar_math.glsl).
 
-use super::log_polar::LogPolarLaw;
+use super::log_polar::{LogPolarLaw, ALPHA_RANGE, SIGMA_RANGE};
+
+/// The log-polar buffer's width / height: their modes use 0.33–1.2.
+const ASPECT_RANGE: (f32, f32) = (0.05, 20.0);
 use crate::error::{Error, Result};
 use glam::{UVec2, Vec2};
 
@@ -77,9 +80,14 @@ pub struct CompositeLayout {
 
 impl CompositeParams {
     pub fn validate(&self) -> Result<()> {
-        let ok = self.sigma >= 0.25 && self.sigma <= 16.0 && self.alpha >= 1.0 && self.alpha <= 8.0 && self.aspect >= 0.05 && self.aspect <= 20.0;
+        // σ and α within log-polar's own ranges.
+        let within = |v: f32, (lo, hi): (f32, f32)| v >= lo && v <= hi;
+        let ok = within(self.sigma, SIGMA_RANGE) && within(self.alpha, ALPHA_RANGE) && within(self.aspect, ASPECT_RANGE);
         if !(ok && (0.0..1.2).contains(&self.gaze_angle) && self.viewing_distance_px.is_finite() && self.viewing_distance_px > 0.0) {
-            return Err(Error::Invalid(format!("composite: σ in [0.25, 16], α in [1, 8], aspect in [0.05, 20], a_G in [0, 1.2) rad and a positive viewing distance, got {self:?}")));
+            let ((s0, s1), (a0, a1), (p0, p1)) = (SIGMA_RANGE, ALPHA_RANGE, ASPECT_RANGE);
+            return Err(Error::Invalid(format!(
+                "composite: σ in [{s0}, {s1}], α in [{a0}, {a1}], aspect in [{p0}, {p1}], a_G in [0, 1.2) rad and a positive viewing distance, got {self:?}"
+            )));
         }
         Ok(())
     }

@@ -160,13 +160,12 @@ impl VisualPolarParams {
                 return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
             }
         }
-        if let RadialLaw::Composite(c) = self.radial {
-            c.validate()?;
+        match self.radial {
+            RadialLaw::Acuity => {}
+            RadialLaw::LogPolar(lp) => lp.validate()?,
+            RadialLaw::Composite(c) => c.validate()?,
         }
-        if matches!(self.radial, RadialLaw::LogPolar(_) | RadialLaw::Composite(_)) {
-            if let RadialLaw::LogPolar(lp) = self.radial {
-                lp.validate()?;
-            }
+        if self.radial != RadialLaw::Acuity {
             // Meng's buffer spans full circles on the screen's own distances, its extent set by L.
             if self.layout != VpLayout::Paper || self.eccentricity != Eccentricity::Normalized || self.radius_mode != RadiusMode::FarthestCorner {
                 return Err(invalid(

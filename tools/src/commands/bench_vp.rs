@@ -164,12 +164,15 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::default().params(screen.x as f32 / 2.0)), ..Default::default() })?),
         // Visual-Polar's variants: the screen-clipped layout and the FOVE 0's headset axis.
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..*vp.params() })?),
-        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(FOVE0_FOV), ..*vp.params() })?),
+        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0_fov()?), ..*vp.params() })?),
     ])
 }
 
-/// The FOVE 0 eye's FOV (config/headsets/fove0.toml), for the headset-axis variant.
-const FOVE0_FOV: FovTangents = FovTangents { left: 1.0, right: 1.0, up: 1.127_2, down: 1.127_2 };
+/// The FOVE 0 left eye's FOV from its headset profile, for the headset-axis variant.
+pub fn fove0_fov() -> Result<FovTangents> {
+    let hmd = fovea_hal::HmdDescription::resolve("fove0")?;
+    Ok(crate::render_profile::fov_tangents(&hmd.eye(fovea_hal::Eye::Left).fov))
+}
 
 /// Passes of the displayed frame (read-backs are I/O, not rendering).
 fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {

@@ -1,6 +1,6 @@
 pub mod bench;
 mod bench_loop;
-mod bench_vp;
+pub mod bench_vp;
 pub mod eval;
 pub mod debug_views;
 pub mod gen_scene;

@@ -130,11 +130,9 @@ pub fn expand_methods(methods: Vec<String>) -> Vec<String> {
     }
 }
 
-/// Why `method` cannot run `denoiser` / `taa`, if it cannot (asked of the space itself).
-fn refusal(args: &QualityArgs, hmd: &fovea_hal::HmdDescription, method: &str, denoiser: &str, taa: &str) -> Result<Option<String>> {
-    if denoiser == "none" && taa == "off" {
-        return Ok(None);
-    }
+/// Why `method` cannot run a denoiser or TAA, if it cannot (asked of the space itself, once per
+/// method: some spaces take a full-screen sum to build).
+fn filters_refusal(args: &QualityArgs, hmd: &fovea_hal::HmdDescription, method: &str) -> Result<Option<String>> {
     let space = super::setup::space_for(method, &args.profile, hmd, fovea_hal::Eye::Left, UVec2::new(args.width, args.height))?;
     let caps = space.capabilities();
     Ok((!caps.temporal_filters).then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
@@ -161,10 +159,12 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         let moving = camera == "moving";
         let references = references(args, moving, &evaluated)?;
         for method in args.methods {
+            let filtered = args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
+            let refusal = if filtered { filters_refusal(args, &hmd, method)? } else { None };
             for denoiser in args.denoisers {
                 for taa in args.taa {
-                    if let Some(reason) = refusal(args, &hmd, method, denoiser, taa)? {
-                        refused.push(RefusedRun { camera: camera.clone(), method: method.clone(), denoiser: denoiser.clone(), taa: taa.clone(), reason });
+                    if let (Some(reason), false) = (&refusal, denoiser == "none" && taa == "off") {
+                        refused.push(RefusedRun { camera: camera.clone(), method: method.clone(), denoiser: denoiser.clone(), taa: taa.clone(), reason: reason.clone() });
                         continue;
                     }
                     let dir = args.out.join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
