@@ -4,11 +4,10 @@
 //! keeps the traced pixels, it converges to the image one sample per pixel gives, it refuses the
 //! filters it cannot run, and `fovea render --method NAME` reports it end to end.
 
-use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::fill::FillPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
+use fovea_renderer::sampling::{FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
 use fovea_renderer::vk::Image;
@@ -21,13 +20,10 @@ fn falloff() -> LinearFalloff {
     LinearFalloff::new(SCREEN, VisualPolarParams::default(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()
 }
 
-/// Mean linear colour over `frames` frames with the gaze at `gaze`; no frame may hold a hole or
-/// a non-finite pixel.
-fn mean_over_frames(renderer: &mut Renderer, camera: CameraPose, gaze: Vec2, frames: u32) -> [f64; 3] {
-    fovea_tests::mean_over_frames(renderer, camera, Some(gaze), frames, |f, hdr| {
-        assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize);
-        assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] > 0.0), "frame {f}: a hole or a non-finite pixel");
-    })
+/// No frame may hold a hole or a non-finite pixel.
+fn no_holes(f: u32, hdr: &[[f32; 4]]) {
+    assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize);
+    assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] > 0.0), "frame {f}: a hole or a non-finite pixel");
 }
 
 #[test]
@@ -47,12 +43,7 @@ fn linear_falloff_traces_the_pixels_its_rule_keeps_and_converges_like_one_sample
     }
     let expected = host.sample_count() as f64;
     assert!(expected < (SCREEN.x * SCREEN.y) as f64 * 0.9, "{expected}: the periphery is thinned");
-    let a = mean_over_frames(&mut r, camera, gaze, 16);
-    let mut cartesian = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(SCREEN)), settings).unwrap();
-    let b = mean_over_frames(&mut cartesian, camera, gaze, 16);
-    for c in 0..3 {
-        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: linear falloff {} vs one per pixel {}", a[c], b[c]);
-    }
+    fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, no_holes);
     assert_clean(&ctx);
 }
 
@@ -99,21 +90,14 @@ fn push_pull_keeps_the_samples_and_fills_the_holes_smoothly() {
 fn linear_falloff_refuses_the_filters_and_the_cli_reports_it() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
-    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let err = Renderer::new(&ctx, &scene, Box::new(falloff()), svgf).err().expect("refused").to_string();
-    assert!(err.contains("svgf") && err.contains("linear-falloff"), "{err}");
+    fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(falloff()));
     assert_clean(&ctx);
 
-    let out = fovea_tests::artifacts_dir().join(format!("linear-falloff-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let args = fovea_tools::commands::render::RenderArgs { method: "linear-falloff", width: Some(64), height: Some(72), ..fovea_tests::small_render_args("cornell-box", &out) };
-    fovea_tools::commands::render::run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = fovea_tests::render_report("linear-falloff", Default::default());
     assert_eq!(report["method"], "linear-falloff");
     assert!(report["passes"]["fill_push"].as_f64().is_some() && report["passes"]["blur_v"].as_f64().is_some(), "{}", report["passes"]);
     let traced = report["samples_traced"].as_u64().unwrap();
     assert!(traced > 0 && traced < 64 * 72, "{report}");
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 fn random_acuity(screen: UVec2, gaze: Vec2) -> RandomAcuity {
@@ -248,27 +232,15 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
         assert_eq!(stats.samples_traced, host.traced_count(f, settings.seed), "frame {f}");
         assert_eq!(stats.samples_traced, host.sample_count(), "frame {f}: every kept texel drew");
     }
-    let a = mean_over_frames(&mut r, camera, gaze, 16);
-    let mut cartesian = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(SCREEN)), settings).unwrap();
-    let b = mean_over_frames(&mut cartesian, camera, gaze, 16);
-    for c in 0..3 {
-        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: random acuity {} vs one per pixel {}", a[c], b[c]);
-    }
-    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let err = Renderer::new(&ctx, &scene, Box::new(host), svgf).err().expect("refused").to_string();
-    assert!(err.contains("svgf") && err.contains("random-acuity"), "{err}");
+    fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, no_holes);
+    fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(host));
     assert_clean(&ctx);
 
-    let out = fovea_tests::artifacts_dir().join(format!("random-acuity-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let args = fovea_tools::commands::render::RenderArgs { method: "random-acuity", width: Some(64), height: Some(72), ..fovea_tests::small_render_args("cornell-box", &out) };
-    fovea_tools::commands::render::run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = fovea_tests::render_report("random-acuity", Default::default());
     assert_eq!(report["method"], "random-acuity");
     for pass in ["splat_scatter", "splat_resolve", "fill_push", "blur_v"] {
         assert!(report["passes"][pass].as_f64().is_some(), "{pass}: {}", report["passes"]);
     }
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// Composite foveation (Andersson & Hansson 2020) is a radial law of the polar space: every
@@ -293,14 +265,9 @@ fn composite_runs_the_filters_and_the_cli_reports_it() {
     }
     assert_clean(&ctx);
 
-    let out = fovea_tests::artifacts_dir().join(format!("composite-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
     let profile = fovea_tools::render_profile::RenderProfile { composite_mode: CompositeMode::Kernel, ..Default::default() };
-    let args = fovea_tools::commands::render::RenderArgs { method: "composite", width: Some(64), height: Some(72), profile, ..fovea_tests::small_render_args("cornell-box", &out) };
-    fovea_tools::commands::render::run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = fovea_tests::render_report("composite", profile);
     assert_eq!(report["method"], "composite");
     assert_eq!(report["composite_mode"], "kernel");
     assert!(report["passes"]["remap"].as_f64().is_some(), "{}", report["passes"]);
-    let _ = std::fs::remove_dir_all(&out);
 }

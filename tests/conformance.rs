@@ -10,7 +10,7 @@ use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FovTangents, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
+    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
     VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
 use fovea_renderer::to_screen::BlurSettings;
@@ -22,9 +22,6 @@ const SIZE: UVec2 = UVec2::new(96, 108);
 const CONVERGED_FRAMES: u32 = 96;
 const FILTERED_FRAMES: u32 = 12;
 
-/// The FOVE 0 eye's FOV tangents (config/headsets/fove0.toml), for the headset axis.
-const FOVE0_FOV: FovTangents = FovTangents { left: 1.0, right: 1.0, up: 1.127_2, down: 1.127_2 };
-
 /// Makes a fresh space (a renderer owns the one it gets).
 type MakeSpace = Box<dyn Fn() -> Box<dyn SamplingSpace>>;
 
@@ -32,13 +29,14 @@ type MakeSpace = Box<dyn Fn() -> Box<dyn SamplingSpace>>;
 fn spaces() -> Vec<(&'static str, MakeSpace)> {
     let gaze = SIZE.as_vec2() * 0.5;
     let vp = VisualPolarParams::default();
+    let fove0 = fovea_tools::commands::bench_vp::fove0_fov().unwrap();
     let polar = move |radial| VisualPolar::new(SIZE, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
     vec![
         ("cartesian", Box::new(|| Box::new(Cartesian::new(SIZE)))),
         ("vp", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, vp).unwrap()))),
         ("log-polar", Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams::default()))))),
         ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(SIZE.x as f32 / 2.0)))))),
-        ("vp-headset", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(FOVE0_FOV), ..vp }).unwrap()))),
+        ("vp-headset", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp }).unwrap()))),
         ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp }).unwrap()))),
         ("uniform-budget", Box::new(|| Box::new(UniformBudget::with_samples(SIZE, 4000).unwrap()))),
         ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(SIZE, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),

@@ -155,6 +155,32 @@ fn bad_inputs_are_named_in_the_error() {
     assert_eq!(std::fs::read_to_string(out.join("mine.txt")).unwrap(), "mine");
 }
 
+/// `fovea quality` of the Cornell box at 40×36 for `[methods, denoisers, taa, cameras]`: 3 frames,
+/// the last 2 evaluated against 4-spp references, 4 rings, validation on.
+fn quality_args<'a>([methods, denoisers, taa, cameras]: [&'a [String]; 4], out: &'a std::path::Path) -> fovea_tools::commands::quality::QualityArgs<'a> {
+    fovea_tools::commands::quality::QualityArgs {
+        scene: "cornell-box",
+        width: 40,
+        height: 36,
+        headset: "fove0",
+        gaze: "sim:2",
+        frames: 3,
+        eval_frames: 2,
+        methods,
+        denoisers,
+        taa,
+        cameras,
+        reference_spp: 4,
+        rings: 4,
+        seed: 1,
+        profile: Default::default(),
+        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        out,
+        device: None,
+        validation: true,
+    }
+}
+
 /// `fovea quality` on a tiny sequence: every combination of the asked methods, denoisers, TAA
 /// modes and cameras is rendered and measured against references of its own camera poses; the
 /// folder can be reused; bad names and foreign files are refused.
@@ -164,27 +190,7 @@ fn quality_command_measures_every_combination() {
     let out = temp_dir("quality");
     let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     let (methods, denoisers, taa, cameras) = (strings(&["vp", "cartesian"]), strings(&["none"]), strings(&["off", "screen"]), strings(&["still", "moving"]));
-    let args = |denoisers| QualityArgs {
-        scene: "cornell-box",
-        width: 40,
-        height: 36,
-        headset: "fove0",
-        gaze: "sim:2",
-        frames: 3,
-        eval_frames: 2,
-        methods: &methods,
-        denoisers,
-        taa: &taa,
-        cameras: &cameras,
-        reference_spp: 4,
-        rings: 4,
-        seed: 1,
-        profile: Default::default(),
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
-        out: &out,
-        device: None,
-        validation: true,
-    };
+    let args = |d| QualityArgs { denoisers: d, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
     for _ in 0..2 {
         run(&args(&denoisers)).unwrap();
     }
@@ -226,27 +232,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     let methods = expand_methods(strings(&["all"]));
     assert_eq!(methods, strings(fovea_tools::commands::render::METHODS));
     let (denoisers, taa, cameras) = (strings(&["none", "svgf"]), strings(&["off"]), strings(&["still"]));
-    let args = QualityArgs {
-        scene: "cornell-box",
-        width: 40,
-        height: 36,
-        headset: "fove0",
-        gaze: "sim:2",
-        frames: 2,
-        eval_frames: 1,
-        methods: &methods,
-        denoisers: &denoisers,
-        taa: &taa,
-        cameras: &cameras,
-        reference_spp: 4,
-        rings: 3,
-        seed: 1,
-        profile: Default::default(),
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
-        out: &out,
-        device: None,
-        validation: true,
-    };
+    let args = QualityArgs { frames: 2, eval_frames: 1, rings: 3, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
     run(&args).unwrap();
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
     let refused: Vec<&str> = report["refused"].as_array().unwrap().iter().map(|r| r["method"].as_str().unwrap()).collect();
@@ -310,27 +296,7 @@ fn quality_rings_are_bounded_before_rendering() {
     let (methods, denoisers, taa, cameras) = (names(&["vp"]), names(&["none"]), names(&["off"]), names(&["still"]));
     // 40×36: half-diagonal 26.9 px.
     for (rings, needle) in [(1001, "1..=1000"), (27, "at most 26 rings")] {
-        let args = QualityArgs {
-            scene: "cornell-box",
-            width: 40,
-            height: 36,
-            headset: "fove0",
-            gaze: "sim:2",
-            frames: 3,
-            eval_frames: 2,
-            methods: &methods,
-            denoisers: &denoisers,
-            taa: &taa,
-            cameras: &cameras,
-            reference_spp: 4,
-            rings,
-            seed: 1,
-            profile: Default::default(),
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
-            out: &out,
-            device: None,
-            validation: true,
-        };
+        let args = QualityArgs { rings, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
         let err = format!("{:#}", run(&args).unwrap_err());
         assert!(err.contains(&format!("--rings {rings}")) && err.contains(needle), "{err}");
     }

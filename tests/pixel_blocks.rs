@@ -4,10 +4,8 @@
 //! the frames converge to what one sample per pixel gives, and the filters are refused.
 
 use fovea_renderer::passes::block_fill::BlockFillPass;
-use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{BlockShape, Cartesian, PixelBlocks, SamplingSpace, VisualPolarParams};
+use fovea_renderer::sampling::{BlockShape, PixelBlocks, SamplingSpace, VisualPolarParams};
 use fovea_renderer::vk::Image;
 use fovea_tests::{assert_clean, gpu, owned_scene, probe, SpaceBuffers};
 use glam::{IVec2, UVec2, Vec2};
@@ -114,25 +112,13 @@ fn pixel_blocks_converge_like_one_sample_per_pixel_and_refuse_the_filters() {
     let gaze = Vec2::new(30.0, 40.0);
     let check = |f: u32, hdr: &[[f32; 4]]| assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] == 1.0), "frame {f}");
     let mut r = Renderer::new(&ctx, &scene, Box::new(blocks(screen, gaze)), RenderSettings::default()).unwrap();
-    let a = fovea_tests::mean_over_frames(&mut r, camera, Some(gaze), 16, check);
-    let mut cartesian = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(screen)), RenderSettings::default()).unwrap();
-    let b = fovea_tests::mean_over_frames(&mut cartesian, camera, Some(gaze), 16, check);
-    for c in 0..3 {
-        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: pixel blocks {} vs one per pixel {}", a[c], b[c]);
-    }
-    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let err = Renderer::new(&ctx, &scene, Box::new(blocks(screen, gaze)), svgf).err().expect("refused").to_string();
-    assert!(err.contains("svgf") && err.contains("pixel-blocks"), "{err}");
+    fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, check);
+    fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(blocks(screen, gaze)));
     assert_clean(&ctx);
 
-    let out = fovea_tests::artifacts_dir().join(format!("pixel-blocks-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let args = fovea_tools::commands::render::RenderArgs { method: "pixel-blocks", width: Some(64), height: Some(72), ..fovea_tests::small_render_args("cornell-box", &out) };
-    fovea_tools::commands::render::run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = fovea_tests::render_report("pixel-blocks", Default::default());
     assert_eq!(report["method"], "pixel-blocks");
     for pass in ["block_fill", "accumulate", "trace"] {
         assert!(report["passes"][pass].as_f64().is_some(), "{pass}: {}", report["passes"]);
     }
-    let _ = std::fs::remove_dir_all(&out);
 }

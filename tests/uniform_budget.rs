@@ -2,8 +2,6 @@
 //! upscaled. It traces the budget it claims, converges to the same image as one sample per pixel,
 //! refuses the filters its grid cannot run, and `fovea render --method uniform-budget` reports it.
 
-use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams};
 use fovea_tests::{assert_clean, gpu, owned_scene};
@@ -45,16 +43,10 @@ fn uniform_budget_refuses_the_denoisers_and_the_cli_reports_it() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let budget = UniformBudget::with_samples(SCREEN, 2000).unwrap();
-    let svgf = RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let err = Renderer::new(&ctx, &scene, Box::new(budget), svgf).err().expect("refused").to_string();
-    assert!(err.contains("svgf") && err.contains("uniform-budget"), "{err}");
+    fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(budget));
     assert_clean(&ctx);
 
-    let out = fovea_tests::artifacts_dir().join(format!("uniform-budget-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let args = fovea_tools::commands::render::RenderArgs { method: "uniform-budget", width: Some(64), height: Some(72), ..fovea_tests::small_render_args("cornell-box", &out) };
-    fovea_tools::commands::render::run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report = fovea_tests::render_report("uniform-budget", Default::default());
     assert_eq!(report["method"], "uniform-budget");
     assert!(report["passes"]["upscale"].as_f64().is_some(), "{}", report["passes"]);
     let (grid, screen) = (report["vp_width"].as_u64().unwrap() * report["vp_height"].as_u64().unwrap(), 64 * 72);

@@ -216,3 +216,46 @@ pub fn probe(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingS
     let got: Vec<[f32; 4]> = out.read().unwrap();
     got.iter().map(|o| ProbedTexel { position: (o[2] > 0.0).then(|| glam::Vec2::new(o[0], o[1])), samples: o[3] as u32 }).collect()
 }
+
+/// `fovea render --method METHOD` of the Cornell box at 64×72 (`small_render_args` otherwise,
+/// with `profile`): its report.json (the output folder is removed).
+pub fn render_report(method: &str, profile: fovea_tools::render_profile::RenderProfile) -> serde_json::Value {
+    let out = artifacts_dir().join(format!("{method}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let args = fovea_tools::commands::render::RenderArgs { method, width: Some(64), height: Some(72), profile, ..small_render_args("cornell-box", &out) };
+    fovea_tools::commands::render::run(&args).unwrap();
+    let report = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    report
+}
+
+/// `Renderer::new` refuses SVGF on `space`, naming both.
+pub fn assert_refuses_svgf(ctx: &Arc<Context>, scene: &fovea_scene::Scene, space: Box<dyn fovea_renderer::sampling::SamplingSpace>) {
+    use fovea_renderer::passes::denoise::{svgf::SvgfSettings, DenoiserSettings};
+    let name = space.name();
+    let svgf = fovea_renderer::pipeline::RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
+    let err = fovea_renderer::pipeline::Renderer::new(ctx, scene, space, svgf).err().expect("refused").to_string();
+    assert!(err.contains("svgf") && err.contains(name), "{err}");
+}
+
+/// The mean colour of `renderer`'s frames (`frames` of them, gaze `gaze`, each through `check`)
+/// within 8 % per channel of one sample per pixel's on the same screen and camera.
+pub fn assert_mean_like_cartesian(
+    ctx: &Arc<Context>,
+    scene: &fovea_scene::Scene,
+    renderer: &mut fovea_renderer::pipeline::Renderer,
+    camera: fovea_renderer::pipeline::CameraPose,
+    gaze: glam::Vec2,
+    frames: u32,
+    mut check: impl FnMut(u32, &[[f32; 4]]),
+) {
+    use fovea_renderer::pipeline::{RenderSettings, Renderer};
+    let name = renderer.space().name();
+    let screen = renderer.space().screen_size();
+    let a = mean_over_frames(renderer, camera, Some(gaze), frames, &mut check);
+    let mut cartesian = Renderer::new(ctx, scene, Box::new(fovea_renderer::sampling::Cartesian::new(screen)), RenderSettings::default()).unwrap();
+    let b = mean_over_frames(&mut cartesian, camera, Some(gaze), frames, &mut check);
+    for c in 0..3 {
+        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: {name} {} vs one per pixel {}", a[c], b[c]);
+    }
+}
