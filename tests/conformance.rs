@@ -3,20 +3,28 @@
 //! `SpaceCapabilities`) runs SVGF, A-SVGF, BMFR and both TAA
 //! modes without validation messages, with finite non-negative output, reducing the noise against
 //! the space's own converged image, and rejecting its history when the camera jumps
-//! (disocclusion); each space that does not refuses every filter by name. Adding a space means
-//! adding it to `spaces()`, not copying these tests.
+//! (disocclusion), keeping its output finite when the light blows up to Inf and exactly black on an
+//! empty view, and (polar spaces) filtering across the φ seam like any other angle; each space that
+//! does not refuses every filter by name. Adding a space means adding it to `spaces()`, not
+//! copying these tests.
 
 use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::graph::FrameRecorder;
+use fovea_renderer::layouts::MaterialGpu;
+use fovea_renderer::passes::denoise::taa::Taa;
+use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
+use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
     BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
     VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
-use fovea_tests::{assert_clean, gpu, owned_scene};
-use glam::{Mat4, UVec2};
+use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_tests::denoise::{assert_finite_non_negative, rmse_where, seam_texels, upload, upload_gbuffer, SeamErrors};
+use fovea_tests::{assert_clean, gpu, owned_scene, read_image, SpaceBuffers};
+use glam::{Mat4, UVec2, Vec3};
+use std::sync::Arc;
 
 const SIZE: UVec2 = UVec2::new(96, 108);
 const CONVERGED_FRAMES: u32 = 96;
@@ -89,6 +97,34 @@ fn smooth_interior(converged: &[[f32; 4]]) -> Vec<bool> {
         .collect()
 }
 
+/// The Cornell box's only emissive material (its ceiling light).
+fn light_material(scene: &fovea_scene::Scene) -> usize {
+    let lights: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].emissive.max_element() > 0.0).collect();
+    assert_eq!(lights.len(), 1, "the Cornell box has one light material");
+    lights[0]
+}
+
+/// Fireflies through the whole frame: the light scaled by 1e30 for two frames (radiance that
+/// overflows to Inf in the tracer and saturates moments, fits and histories) between normal
+/// frames, so the filter sees the jump both ways — every output pixel finite and non-negative;
+/// then the camera turned out of the box: two frames exactly black (no history ghosts into
+/// an empty view).
+fn blow_up_the_light_and_look_away(r: &mut Renderer, scene: &fovea_scene::Scene, (camera, away): (CameraPose, CameraPose), first: u32, what: &str) {
+    let light = light_material(scene);
+    let mut out = Vec::new();
+    for (k, scale) in [1e30, 1e30, 1.0, 1.0].into_iter().enumerate() {
+        r.set_emission_scale(scene, light, scale).unwrap();
+        r.render_frame(&FrameInput::mono(camera, first + k as u32, Some(SIZE.as_vec2() * 0.5)).with_hdr(true)).unwrap();
+        r.read_hdr(&mut out).unwrap();
+        assert_finite_non_negative(&format!("{what}, light ×{scale:e}, frame {k}"), &out);
+    }
+    for k in 4..6 {
+        r.render_frame(&FrameInput::mono(away, first + k, Some(SIZE.as_vec2() * 0.5)).with_hdr(true)).unwrap();
+        r.read_hdr(&mut out).unwrap();
+        assert!(out.iter().all(|p| p[..3] == [0.0; 3]), "{what}: the empty view is not black (frame {k})");
+    }
+}
+
 /// Noise: 12 filtered frames against the raw one-sample frame, both against the space's own
 /// converged image on its smooth interiors; bound 1.15× (measured, tenth session: Cartesian
 /// 3.5–5.5×; the polar spaces' SVGF, A-SVGF and BMFR 1.19–1.9×, A-SVGF the least (its gradients
@@ -106,6 +142,8 @@ fn every_filter_on_every_space_that_supports_it() {
     let centre = scene.bounds().center();
     let turn = Mat4::from_translation(centre) * Mat4::from_rotation_y(20f32.to_radians()) * Mat4::from_translation(-centre);
     let jumped = CameraPose { world_from_view: turn * start.world_from_view, fov_tan: start.fov_tan };
+    // Turned around, the camera looks out of the box's open side into nothing.
+    let away = CameraPose { world_from_view: start.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..start };
     let gaze = Some(SIZE.as_vec2() * 0.5);
     let mut failures = Vec::new();
     for (space_name, make) in spaces() {
@@ -144,8 +182,96 @@ fn every_filter_on_every_space_that_supports_it() {
             if filtered_jump > 1.5 * raw_jump {
                 failures.push(format!("{space_name} + {filter}: the first frame after the jump {filtered_jump:.4} vs raw {raw_jump:.4}"));
             }
+            blow_up_the_light_and_look_away(&mut r, &scene, (jumped, away), FILTERED_FRAMES + 1, &format!("{space_name} + {filter}"));
             assert_clean(&ctx);
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// One grid filter run on its own over a synthetic G-buffer (the seam test's), as the renderer
+/// records it: a denoiser (A-SVGF's forward projection first) or TAA in the grid.
+enum GridFilter {
+    Denoiser(Box<Denoiser>),
+    Taa(Box<Taa>),
+}
+
+impl GridFilter {
+    fn new(ctx: &Arc<Context>, denoiser: &DenoiserSettings, taa: TaaMode, space: &dyn SamplingSpace) -> GridFilter {
+        let (grid, variant) = (space.grid_size(), space.shader_variant());
+        match (Denoiser::new(ctx, denoiser, grid, variant).unwrap(), taa) {
+            (Some(d), _) => GridFilter::Denoiser(Box::new(d)),
+            (None, TaaMode::SamplingGrid(s)) => GridFilter::Taa(Box::new(Taa::new(ctx, grid, variant, s).unwrap())),
+            (None, other) => panic!("no grid filter for TAA {other:?}"),
+        }
+    }
+
+    fn run(&mut self, ctx: &Arc<Context>, g: &GBuffer, frame: &DenoiseFrame, buffers: &SpaceBuffers, materials: &Buffer) -> Vec<[f32; 4]> {
+        let mut rec = FrameRecorder::new(ctx, 32).unwrap();
+        rec.begin().unwrap();
+        let out: &Image = match self {
+            GridFilter::Denoiser(d) => {
+                d.record_before_trace(&mut rec, g, frame, &buffers.frame).unwrap();
+                d.record(&mut rec, g, frame, &DenoiseScene { camera_origin: Vec3::ZERO, materials }).unwrap()
+            }
+            GridFilter::Taa(t) => t.record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5)).unwrap(),
+        };
+        rec.submit_and_wait().unwrap();
+        read_image(ctx, &out)
+    }
+}
+
+/// The φ seam, every grid filter on every polar space that runs them: radiance 0.5 + 0.3·sin φ
+/// plus noise on one face-on plane (`seam_texels`, 128×144). Rows at the seam (φ ≈ 0, rows 0 and
+/// n − 1) sit on a zero crossing exactly like the rows at φ ≈ π; a filter (or a TAA neighbourhood
+/// clamp, or a BMFR block) that did not wrap would see one side of the slope only there. After 8
+/// frames the seam's error must be like the other angles' (`SeamErrors::like_elsewhere`).
+/// Screen-space TAA runs after the remap, where there is no seam.
+#[test]
+fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
+    const SEAM_SIZE: UVec2 = UVec2::new(128, 144);
+    let ctx = gpu();
+    let materials = Buffer::with_data(&ctx, "materials", &[MaterialGpu::default()], ash::vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+    let mut failures = Vec::new();
+    for (space_name, make) in seam_spaces(SEAM_SIZE) {
+        let space = make();
+        let vp = *space.visual_polar().expect("a polar space");
+        let grid = space.grid_size();
+        // A-SVGF projects its gradient samples from last frame's visibility: none here (zero),
+        // so it filters like SVGF with the adaptive α.
+        let g = GBuffer::with_visibility(&ctx, grid).unwrap();
+        upload(&ctx, g.visibility.as_ref().unwrap(), &vec![[0u32; 4]; (grid.x * grid.y) as usize]);
+        let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
+        let params = space.params();
+        for (filter, denoiser, taa) in filters().into_iter().filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_))) {
+            let mut f = GridFilter::new(&ctx, &denoiser, taa, space.as_ref());
+            let mut out = Vec::new();
+            for frame in 0..8u32 {
+                upload_gbuffer(&ctx, &g, &seam_texels(&vp, frame));
+                out = f.run(&ctx, &g, &DenoiseFrame { current: params, previous: (frame > 0).then_some(params) }, &buffers, &materials);
+            }
+            assert_finite_non_negative(&format!("{space_name} + {filter} at the seam"), &out);
+            let e = SeamErrors::of(&vp, &out);
+            println!("{space_name} + {filter}: seam rows RMSE {:.4}, at φ ≈ π {:.4}, median row bin {:.4}; per bin {:.4?}", e.seam, e.opposite, e.median, e.bins);
+            if !e.like_elsewhere() {
+                failures.push(format!("{space_name} + {filter}: seam {:.4} vs {:.4} at φ ≈ π, median {:.4}", e.seam, e.opposite, e.median));
+            }
+            assert_clean(&ctx);
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The polar spaces that run the filters, at `size`, gaze centred (the seam test's).
+fn seam_spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
+    let gaze = size.as_vec2() * 0.5;
+    let fove0 = fovea_tools::commands::bench_vp::fove0_fov().unwrap();
+    let polar = move |params: VisualPolarParams| -> MakeSpace { Box::new(move || Box::new(VisualPolar::new(size, gaze, params).unwrap())) };
+    let vp = VisualPolarParams::default();
+    vec![
+        ("vp", polar(vp)),
+        ("vp-headset", polar(VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp })),
+        ("log-polar", polar(VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..vp })),
+        ("composite", polar(VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::Composite.params(size.x as f32 / 2.0)), ..vp })),
+    ]
 }

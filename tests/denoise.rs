@@ -2,7 +2,7 @@
 //! Noise reduction against a converged reference on the Cornell box (whole frame, fovea and
 //! eccentricity rings, after the remap for VP); no NaN/Inf/negative output with fireflies, NaNs
 //! and an empty view; no history across a disocclusion (synthetic G-buffers with a moving
-//! occluder); the φ seam filtered like any other angle; the `--denoiser` flag end to end.
+//! occluder); the `--denoiser` flag end to end (the φ seam: tests/conformance.rs, every filter).
 //! TAA in the sampling grid (Karis 2014): noise and edge aliasing reduced against the reference,
 //! fireflies, disocclusion resets, the tracer's Halton jitter, the `--taa` flag.
 
@@ -16,7 +16,7 @@ use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPola
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};
 use fovea_tests::denoise::{
-    assert_finite_non_negative, assert_seam_like_elsewhere, rmse_where, seam_noise, seam_truth, surface_interiors, texel_screens, upload,
+    assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload,
 };
 use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{Mat4, UVec2, Vec2};
@@ -256,39 +256,6 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
         println!("{name}: {uncovered} uncovered, {followed} moved-occluder and {stayed} static texels checked");
         assert!(uncovered > 20 && followed > 5 && stayed > 20, "{name}: too few texels checked");
     }
-    assert_clean(&ctx);
-}
-
-/// Visual-Polar: radiance 0.5 + 0.3·sin φ plus noise on one face-on surface. Rows at the seam
-/// (φ ≈ 0, rows 0 and n − 1) sit on a zero crossing exactly like the rows at φ ≈ π; a filter that
-/// does not wrap sees one side only there and is biased by the slope. The seam's error must be no
-/// larger than at φ ≈ π and than the median row of the same columns.
-#[test]
-fn vp_seam_is_filtered_like_any_other_angle() {
-    let ctx = gpu();
-    let screen = UVec2::new(128, 144);
-    let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
-    let grid = vp.grid_size();
-    let g = GBuffer::new(&ctx, grid).unwrap();
-    let mut svgf = Svgf::new(&ctx, grid, vp.shader_variant(), SvgfSettings::default()).unwrap();
-    let params = vp.sampling_params();
-    let screens = texel_screens(&vp);
-    let mut out = Vec::new();
-    for f in 0..8u32 {
-        let samples: Vec<Option<Sample>> = screens
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
-                let noise = seam_noise(i as u32, f);
-                s.map(|s| Sample { radiance: seam_truth(&vp, x, y) + noise, depth: 5.0, mesh: 1, motion: s })
-            })
-            .collect();
-        upload_gbuffer(&ctx, &g, &samples);
-        out = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }).0;
-    }
-    assert_finite_non_negative("seam", &out);
-    assert_seam_like_elsewhere(&vp, &out);
     assert_clean(&ctx);
 }
 

@@ -396,3 +396,30 @@ fn flip_whole_frame_and_per_ring_for_exr_and_png() {
     let bad = format!("{:#}", eval(&EvalArgs { ppd: Some(f32::NAN), ..args(&reference_png, &test_png, "32,36", &dir.join("bad")) }).unwrap_err());
     assert!(bad.contains("--ppd"), "{bad}");
 }
+
+/// `fovea eval`'s FLIP against NVIDIA's own tool on the same files: the pairs and the values of
+/// `flip-evaluator` 1.7 (`flip -r reference.png -t TEST -ppd PPD`) are in tests/data/flip/ (its
+/// README: how they were made). The whole-frame `flip` must equal the tool's mean within 2e-6
+/// (measured: at most 8e-7 apart; the tool sums its mean in f32, eval in f64).
+#[test]
+fn flip_matches_nvidias_tool_on_a_known_pair() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/flip");
+    let reference = data.join("reference.png");
+    // (test image, ppd, the tool's mean)
+    let cases = [
+        ("test.png", 67.0206, 0.1883212924003601),
+        ("test.png", 10.0, 0.2579818069934845),
+        ("test.png", 14.2222, 0.25202101469039917),
+        ("test_blocks.png", 67.0206, 0.25503864884376526),
+        ("test_blocks.png", 10.0, 0.31406715512275696),
+        ("test_blocks.png", 14.2222, 0.308245450258255),
+    ];
+    let dir = temp_dir("flip-nvidia");
+    for (k, (test, ppd, expected)) in cases.into_iter().enumerate() {
+        let out = dir.join(k.to_string());
+        eval(&EvalArgs { ppd: Some(ppd), ..args(&reference, &data.join(test), "center", &out) }).unwrap();
+        let flip = read_json(&out)["frame"]["flip"].as_f64().unwrap();
+        println!("{test} at {ppd} ppd: fovea eval {flip:.7}, NVIDIA's flip {expected:.7}");
+        assert!((flip - expected).abs() < 2e-6, "{test} at {ppd} ppd: {flip} vs NVIDIA's {expected}");
+    }
+}

@@ -118,39 +118,75 @@ pub fn seam_noise(i: u32, f: u32) -> f32 {
     0.6 * (crate::unit_hash(i * 13 + f * 104_729) - 0.5)
 }
 
-/// A filtered VP grid (`out`, green channel) against `seam_truth`: the squared error of the rows
-/// next to the φ = 0/2π seam must be no larger (×1.25) than at φ ≈ π and than the median of 16 row
-/// bins, over columns with at least 32 rows.
-pub fn assert_seam_like_elsewhere(vp: &VisualPolar, out: &[[f32; 4]]) {
-    const BINS: usize = 16;
-    let grid = vp.grid_size();
-    let (mut sum, mut count) = ([0f64; BINS], [0u32; BINS]);
-    let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
-    for x in 0..grid.x {
-        let n = vp.rows_in_column(x);
-        if n < 32 {
-            continue;
-        }
-        for y in 0..n {
-            let e = (out[(y * grid.x + x) as usize][1] - seam_truth(vp, x, y)) as f64;
-            let bin = (y as usize * BINS) / n as usize;
-            sum[bin] += e * e;
-            count[bin] += 1;
-            if y < 2 || y + 2 >= n {
-                seam += e * e;
-                seam_n += 1;
-            } else if y + 2 >= n / 2 && y < n / 2 + 2 {
-                opposite += e * e;
-                opposite_n += 1;
+/// The seam tests' G-buffer for frame `f`: `seam_truth` plus `seam_noise` on one face-on plane
+/// at depth 5 (positions spread with the screen so BMFR's features span it).
+pub fn seam_texels(vp: &VisualPolar, f: u32) -> Vec<Option<Texel>> {
+    let (grid, centre) = (vp.grid_size(), vp.screen_size().as_vec2() * 0.5);
+    texel_screens(vp)
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (x, y) = (i as u32 % grid.x, i as u32 / grid.x);
+            let radiance = seam_truth(vp, x, y) + seam_noise(i as u32, f);
+            s.map(|s| {
+                let p = (s - centre) / 64.0 * 5.0;
+                Texel { radiance: [radiance; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }
+            })
+        })
+        .collect()
+}
+
+/// RMS error against `seam_truth` of a filtered polar grid (`out`, green channel), over columns
+/// with at least 32 rows: the rows next to the φ = 0/2π seam, the rows at φ ≈ π, and the median
+/// of 16 row bins.
+#[derive(Clone, Copy, Debug)]
+pub struct SeamErrors {
+    pub seam: f64,
+    pub opposite: f64,
+    pub median: f64,
+    /// Per row bin, from φ = 0.
+    pub bins: [f64; 16],
+}
+
+impl SeamErrors {
+    pub fn of(vp: &VisualPolar, out: &[[f32; 4]]) -> SeamErrors {
+        const BINS: usize = 16;
+        let grid = vp.grid_size();
+        let (mut sum, mut count) = ([0f64; BINS], [0u32; BINS]);
+        let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
+        for x in 0..grid.x {
+            let n = vp.rows_in_column(x);
+            if n < 32 {
+                continue;
+            }
+            for y in 0..n {
+                let e = (out[(y * grid.x + x) as usize][1] - seam_truth(vp, x, y)) as f64;
+                let bin = (y as usize * BINS) / n as usize;
+                sum[bin] += e * e;
+                count[bin] += 1;
+                if y < 2 || y + 2 >= n {
+                    seam += e * e;
+                    seam_n += 1;
+                } else if y + 2 >= n / 2 && y < n / 2 + 2 {
+                    opposite += e * e;
+                    opposite_n += 1;
+                }
             }
         }
+        let bins: [f64; BINS] = std::array::from_fn(|b| (sum[b] / count[b] as f64).sqrt());
+        let mut sorted = bins;
+        sorted.sort_by(f64::total_cmp);
+        SeamErrors { seam: (seam / seam_n as f64).sqrt(), opposite: (opposite / opposite_n as f64).sqrt(), median: sorted[BINS / 2], bins }
     }
-    let rms: Vec<f64> = (0..BINS).map(|b| (sum[b] / count[b] as f64).sqrt()).collect();
-    let mut sorted = rms.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[BINS / 2];
-    let (seam, opposite) = ((seam / seam_n as f64).sqrt(), (opposite / opposite_n as f64).sqrt());
-    println!("seam rows RMSE {seam:.4}, rows at φ ≈ π {opposite:.4}, median row bin {median:.4}; per bin {rms:.4?}");
-    assert!(seam <= 1.25 * opposite, "seam error {seam} vs {opposite} at φ ≈ π");
-    assert!(seam <= 1.25 * median, "seam error {seam} vs median {median}");
+
+    /// The seam filtered like any other angle: its error no larger (×1.25) than the median row
+    /// bin and (×3) than the rows at φ ≈ π. A filter that stopped at the seam would average one
+    /// side of the slope there: with 0.3·2π/n per row over taps reaching 8–16 rows that is a bias
+    /// of 0.1–0.2 on an 80-row column, 20–40× the 0.003–0.006 measured. The φ ≈ π bound is loose
+    /// because the filtered error is spatially correlated, so two zero crossings of one run differ:
+    /// log-polar's SVGF measures 0.0022 at φ ≈ π and 0.0043–0.0045 in the bins beside it and the
+    /// seam's (tenth/eleventh session).
+    pub fn like_elsewhere(&self) -> bool {
+        self.seam <= 3.0 * self.opposite && self.seam <= 1.25 * self.median
+    }
 }
