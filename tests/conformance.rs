@@ -217,7 +217,7 @@ impl GridFilter {
             GridFilter::Taa(t) => t.record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5)).unwrap(),
         };
         rec.submit_and_wait().unwrap();
-        read_image(ctx, &out)
+        read_image(ctx, out)
     }
 }
 
