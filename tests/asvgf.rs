@@ -12,7 +12,7 @@ use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_tests::{assert_clean, gpu, mean_rgb, owned_scene, read_image, rmse, save_preview};
+use fovea_tests::{assert_clean, gpu, light_material, mean_rgb, owned_scene, read_image, rmse, save_preview};
 use glam::{Mat4, UVec2};
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
@@ -41,13 +41,6 @@ fn svgf() -> DenoiserSettings {
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
     FrameInput::mono(camera, frame_index, None).with_hdr(true)
-}
-
-/// The Cornell box's only emissive material (its ceiling light).
-fn light_material(scene: &fovea_scene::Scene) -> usize {
-    let lights: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].emissive.max_element() > 0.0).collect();
-    assert_eq!(lights.len(), 1, "the Cornell box has one light material");
-    lights[0]
 }
 
 fn luminance(p: &[f32; 4]) -> f64 {

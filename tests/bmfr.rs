@@ -5,8 +5,7 @@
 //! end to end. The φ seam is the conformance suite's (tests/conformance.rs), for every filter.
 
 use fovea_renderer::graph::FrameRecorder;
-use ash::vk;
-use fovea_renderer::layouts::{MaterialGpu, BMFR_BLOCK};
+use fovea_renderer::layouts::BMFR_BLOCK;
 use fovea_renderer::passes::denoise::bmfr::{Bmfr, BmfrSettings, BLOCK_OFFSETS};
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, DenoiserSettings};
 use fovea_renderer::passes::trace::GBuffer;
@@ -15,7 +14,7 @@ use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPola
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
 use fovea_tests::denoise::{
-    assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
+    assert_finite_non_negative, plain_materials, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
     Texel,
 };
 use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
@@ -47,11 +46,6 @@ fn with_bmfr() -> DenoiserSettings {
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
     FrameInput::mono(camera, frame_index, None).with_hdr(true)
-}
-
-/// One material, not emissive (what the synthetic G-buffers' material index 0 reads).
-fn plain_materials(ctx: &Arc<Context>) -> Buffer {
-    Buffer::with_data(ctx, "materials", &[MaterialGpu::default()], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap()
 }
 
 /// Runs one BMFR frame; returns its output (re-modulated).

@@ -10,7 +10,6 @@
 
 use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::layouts::MaterialGpu;
 use fovea_renderer::passes::denoise::taa::Taa;
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
 use fovea_renderer::passes::trace::GBuffer;
@@ -21,8 +20,8 @@ use fovea_renderer::sampling::{
 };
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::denoise::{assert_finite_non_negative, rmse_where, seam_texels, upload, upload_gbuffer, SeamErrors};
-use fovea_tests::{assert_clean, gpu, owned_scene, read_image, SpaceBuffers};
+use fovea_tests::denoise::{assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer, SeamErrors};
+use fovea_tests::{assert_clean, gpu, light_material, owned_scene, read_image, SpaceBuffers};
 use glam::{Mat4, UVec2, Vec3};
 use std::sync::Arc;
 
@@ -33,23 +32,23 @@ const FILTERED_FRAMES: u32 = 12;
 /// Makes a fresh space (a renderer owns the one it gets).
 type MakeSpace = Box<dyn Fn() -> Box<dyn SamplingSpace>>;
 
-/// Every space of the product, gaze at the centre.
-fn spaces() -> Vec<(&'static str, MakeSpace)> {
-    let gaze = SIZE.as_vec2() * 0.5;
+/// Every space of the product at `size`, gaze at the centre.
+fn spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
+    let gaze = size.as_vec2() * 0.5;
     let vp = VisualPolarParams::default();
     let fove0 = fovea_tools::commands::bench_vp::fove0_fov().unwrap();
-    let polar = move |radial| VisualPolar::new(SIZE, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+    let polar = move |radial| VisualPolar::new(size, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
     vec![
-        ("cartesian", Box::new(|| Box::new(Cartesian::new(SIZE)))),
-        ("vp", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, vp).unwrap()))),
+        ("cartesian", Box::new(move || Box::new(Cartesian::new(size)))),
+        ("vp", Box::new(move || Box::new(VisualPolar::new(size, gaze, vp).unwrap()))),
         ("log-polar", Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams::default()))))),
-        ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(SIZE.x as f32 / 2.0)))))),
-        ("vp-headset", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp }).unwrap()))),
-        ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp }).unwrap()))),
-        ("uniform-budget", Box::new(|| Box::new(UniformBudget::with_samples(SIZE, 4000).unwrap()))),
-        ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(SIZE, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),
-        ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(SIZE, gaze, vp).unwrap()))),
-        ("pixel-blocks", Box::new(move || Box::new(PixelBlocks::new(SIZE, vp, BlockShape::default()).unwrap()))),
+        ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(size.x as f32 / 2.0)))))),
+        ("vp-headset", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp }).unwrap()))),
+        ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp }).unwrap()))),
+        ("uniform-budget", Box::new(move || Box::new(UniformBudget::with_samples(size, 4000).unwrap()))),
+        ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(size, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),
+        ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(size, gaze, vp).unwrap()))),
+        ("pixel-blocks", Box::new(move || Box::new(PixelBlocks::new(size, vp, BlockShape::default()).unwrap()))),
     ]
 }
 
@@ -97,13 +96,6 @@ fn smooth_interior(converged: &[[f32; 4]]) -> Vec<bool> {
         .collect()
 }
 
-/// The Cornell box's only emissive material (its ceiling light).
-fn light_material(scene: &fovea_scene::Scene) -> usize {
-    let lights: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].emissive.max_element() > 0.0).collect();
-    assert_eq!(lights.len(), 1, "the Cornell box has one light material");
-    lights[0]
-}
-
 /// Fireflies through the whole frame: the light scaled by 1e30 for two frames (radiance that
 /// overflows to Inf in the tracer and saturates moments, fits and histories) between normal
 /// frames, so the filter sees the jump both ways — every output pixel finite and non-negative;
@@ -146,7 +138,7 @@ fn every_filter_on_every_space_that_supports_it() {
     let away = CameraPose { world_from_view: start.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..start };
     let gaze = Some(SIZE.as_vec2() * 0.5);
     let mut failures = Vec::new();
-    for (space_name, make) in spaces() {
+    for (space_name, make) in spaces(SIZE) {
         if !make().capabilities().temporal_filters {
             for (filter, denoiser, taa) in filters() {
                 let err = Renderer::new(&ctx, &scene, make(), settings(denoiser, taa)).err().map(|e| e.to_string()).unwrap_or_default();
@@ -231,11 +223,12 @@ impl GridFilter {
 fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
     const SEAM_SIZE: UVec2 = UVec2::new(128, 144);
     let ctx = gpu();
-    let materials = Buffer::with_data(&ctx, "materials", &[MaterialGpu::default()], ash::vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+    let materials = plain_materials(&ctx);
     let mut failures = Vec::new();
-    for (space_name, make) in seam_spaces(SEAM_SIZE) {
+    for (space_name, make) in spaces(SEAM_SIZE) {
         let space = make();
-        let vp = *space.visual_polar().expect("a polar space");
+        // The polar spaces that run the filters have a seam.
+        let Some(&vp) = space.visual_polar().filter(|_| space.capabilities().temporal_filters) else { continue };
         let grid = space.grid_size();
         // A-SVGF projects its gradient samples from last frame's visibility: none here (zero),
         // so it filters like SVGF with the adaptive α.
@@ -260,18 +253,4 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
-
-/// The polar spaces that run the filters, at `size`, gaze centred (the seam test's).
-fn seam_spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
-    let gaze = size.as_vec2() * 0.5;
-    let fove0 = fovea_tools::commands::bench_vp::fove0_fov().unwrap();
-    let polar = move |params: VisualPolarParams| -> MakeSpace { Box::new(move || Box::new(VisualPolar::new(size, gaze, params).unwrap())) };
-    let vp = VisualPolarParams::default();
-    vec![
-        ("vp", polar(vp)),
-        ("vp-headset", polar(VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp })),
-        ("log-polar", polar(VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..vp })),
-        ("composite", polar(VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::Composite.params(size.x as f32 / 2.0)), ..vp })),
-    ]
 }

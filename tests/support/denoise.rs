@@ -49,6 +49,11 @@ pub fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, texels: &[Option<Texel>])
     upload(ctx, &g.motion, &texels.iter().map(|t| t.map_or([-1.0f32; 2], |t| t.motion.to_array())).collect::<Vec<_>>());
 }
 
+/// One material, not emissive (what the synthetic G-buffers' material index 0 reads).
+pub fn plain_materials(ctx: &Arc<Context>) -> Buffer {
+    Buffer::with_data(ctx, "materials", &[fovea_renderer::layouts::MaterialGpu::default()], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap()
+}
+
 /// Screen position of each grid texel's centre (`None`: no sample there).
 pub fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
     let g = space.grid_size();

@@ -162,6 +162,13 @@ pub fn unit_hash(v: u32) -> f32 {
     fovea_renderer::sampling::random::pcg_hash(v) as f32 / u32::MAX as f32
 }
 
+/// The Cornell box's only emissive material (its ceiling light).
+pub fn light_material(scene: &fovea_scene::Scene) -> usize {
+    let lights: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].emissive.max_element() > 0.0).collect();
+    assert_eq!(lights.len(), 1, "the Cornell box has one light material");
+    lights[0]
+}
+
 /// Overwrites four traced texels of `image` (frame `f` picks which) with a huge, an infinite, a
 /// NaN and a negative colour.
 pub fn inject_fireflies(ctx: &Arc<Context>, image: &Image, f: u32) {
