@@ -187,7 +187,7 @@ impl SeamErrors {
     /// The seam filtered like any other angle: its error no larger (×1.25) than the median row
     /// bin and (×3) than the rows at φ ≈ π. A filter that stopped at the seam would average one
     /// side of the slope there: with 0.3·2π/n per row over taps reaching 8–16 rows that is a bias
-    /// of 0.1–0.2 on an 80-row column, 20–40× the 0.003–0.006 measured. The φ ≈ π bound is loose
+    /// of 0.1–0.2 on an 80-row column (estimated, not measured), 20–40× the 0.003–0.006 measured. The φ ≈ π bound is loose
     /// because the filtered error is spatially correlated, so two zero crossings of one run differ:
     /// log-polar's SVGF measures 0.0022 at φ ≈ π and 0.0043–0.0045 in the bins beside it and the
     /// seam's (tenth/eleventh session).
