@@ -317,53 +317,49 @@ fn emission_scale_switches_a_light_consistently() {
     assert_clean(&ctx);
 }
 
-/// The tracer has no gradient variant of the screen-clipped VP layout: a clear error, not a panic.
-#[test]
-fn asvgf_refuses_the_screen_clipped_layout() {
-    let ctx = gpu();
-    let scene = owned_scene("cornell-box");
-    let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..VisualPolarParams::default() };
-    let vp = VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap();
-    let err = Renderer::new(&ctx, &scene, Box::new(vp), settings(asvgf())).err().expect("screen-clipped A-SVGF refused").to_string();
-    assert!(err.contains("asvgf") && err.contains("screen-clipped"), "{err}");
-    assert_clean(&ctx);
-}
-
 /// The renderer itself (not only the CLI) refuses every denoiser and TAA mode on a space whose
-/// capabilities exclude them (the screen-clipped layout), and accepts the bare layout.
+/// capabilities exclude them (linear falloff: its pixels are killed at random), naming the space
+/// and why, and accepts the bare space; the screen-clipped VP layout takes every filter.
 #[test]
 fn the_renderer_refuses_filters_a_space_cannot_run() {
     use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
     use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
+    use fovea_renderer::sampling::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
+    let falloff = || Box::new(LinearFalloff::new(SCREEN, VisualPolarParams::default(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap());
     let clipped = || {
         let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..VisualPolarParams::default() };
         Box::new(VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap())
     };
-    assert!(!clipped().capabilities().temporal_filters && clipped().capabilities().way_back == fovea_renderer::sampling::WayBack::Remap);
+    assert!(!falloff().capabilities().temporal_filters);
+    assert!(clipped().capabilities().temporal_filters && clipped().capabilities().way_back == fovea_renderer::sampling::WayBack::Remap);
     let cases = [
         ("svgf", settings(DenoiserSettings::Svgf(SvgfSettings::default()))),
+        ("asvgf", settings(asvgf())),
         ("bmfr", settings(DenoiserSettings::Bmfr(BmfrSettings::default()))),
         ("vp", RenderSettings { taa: TaaMode::SamplingGrid(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
         ("screen", RenderSettings { taa: TaaMode::Screen(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
     ];
     for (name, s) in cases {
-        let err = Renderer::new(&ctx, &scene, clipped(), s).err().unwrap_or_else(|| panic!("{name} accepted")).to_string();
-        assert!(err.contains(name) && err.contains("screen-clipped"), "{err}");
+        let err = Renderer::new(&ctx, &scene, falloff(), s).err().unwrap_or_else(|| panic!("{name} accepted")).to_string();
+        assert!(err.contains(name) && err.contains("linear-falloff") && err.contains("killed"), "{err}");
+        if let Err(e) = Renderer::new(&ctx, &scene, clipped(), s) {
+            panic!("{name} refused on the screen-clipped layout: {e}");
+        }
     }
-    assert!(Renderer::new(&ctx, &scene, clipped(), settings(DenoiserSettings::None)).is_ok());
+    assert!(Renderer::new(&ctx, &scene, falloff(), settings(DenoiserSettings::None)).is_ok());
     assert_clean(&ctx);
 }
 
 /// `fovea render --denoiser asvgf` (moving camera, simulated gaze): the report names the
-/// denoiser and times its passes in both spaces; the screen-clipped layout is a clear error.
+/// denoiser and times its passes in every Visual-Polar layout and Cartesian space.
 #[test]
 fn render_command_runs_asvgf_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
     let out = fovea_tests::artifacts_dir().join(format!("asvgf-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    for method in ["cartesian", "vp"] {
+    for method in ["cartesian", "vp", "vp-screen-clipped"] {
         run(&RenderArgs { method, denoiser: "asvgf", frames: 3, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
         assert_eq!(report["denoiser"], "asvgf");
@@ -371,8 +367,4 @@ fn render_command_runs_asvgf_and_reports_it() {
             assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
         }
     }
-    let mut args = RenderArgs { method: "vp", denoiser: "asvgf", ..fovea_tests::small_render_args("cornell-box", &out) };
-    args.profile.visual_polar.layout = VpLayout::ScreenClipped;
-    let err = format!("{:#}", run(&args).unwrap_err());
-    assert!(err.contains("asvgf") && err.contains("layout"), "{err}");
 }

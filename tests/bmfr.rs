@@ -17,7 +17,7 @@ use fovea_tests::denoise::{
     assert_finite_non_negative, plain_materials, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
     Texel,
 };
-use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
+use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -155,7 +155,8 @@ fn fit_matches_a_cpu_least_squares_solve() {
         upload_gbuffer(&ctx, &g, &texels);
         let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
         assert_eq!(bmfr.next_block_offset().to_array(), offset);
-        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO, &plain_materials(&ctx));
+        let table = grid_table(&ctx, space.as_ref(), None);
+        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table }, Vec3::ZERO, &plain_materials(&ctx));
         let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
         let mut blocks: Vec<(i32, i32)> = blocks_of.iter().flatten().copied().collect();
@@ -238,7 +239,8 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
     let g = GBuffer::new(&ctx, grid).unwrap();
     upload_gbuffer(&ctx, &g, &texels);
     let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
-    let out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None }, Vec3::ZERO, &plain_materials(&ctx));
+    let table = grid_table(&ctx, &space, None);
+    let out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table }, Vec3::ZERO, &plain_materials(&ctx));
     assert_finite_non_negative("rank-deficient fit", &out);
     let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
     let mut worst = 0f64;
@@ -373,7 +375,8 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             r.render_frame(&frame(camera, f)).unwrap();
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous }, origin, &r.scene.materials);
+            let table = grid_table(&ctx, r.space(), None);
+            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table }, origin, &r.scene.materials);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} history"), &read_image(&ctx, bmfr.noisy()));
@@ -408,6 +411,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
         let mut bmfr = Bmfr::new(&ctx, space.grid_size(), space.shader_variant(), BmfrSettings::default()).unwrap();
         let params = space.params();
+        let table = grid_table(&ctx, space.as_ref(), None);
         let materials = plain_materials(&ctx);
         let mut out = Vec::new();
         for f in 0..9u32 {
@@ -429,7 +433,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                 .collect();
             upload_gbuffer(&ctx, &g, &texels);
             let previous = (f > 0).then_some(params);
-            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous }, Vec3::new(camera_x, 0.0, 0.0), &materials);
+            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous, sampling_table: &table }, Vec3::new(camera_x, 0.0, 0.0), &materials);
         }
         let lengths: Vec<[f32; 4]> = read_image(&ctx, bmfr.noisy());
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
@@ -460,14 +464,14 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
     assert_clean(&ctx);
 }
 
-/// `fovea render --denoiser bmfr`: the report names the denoiser and times its passes; the
-/// screen-clipped VP layout is refused with a clear error.
+/// `fovea render --denoiser bmfr`: the report names the denoiser and times its passes, in
+/// Cartesian space and both Visual-Polar layouts.
 #[test]
 fn render_command_runs_bmfr_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
     let out = fovea_tests::artifacts_dir().join(format!("bmfr-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    for method in ["cartesian", "vp"] {
+    for method in ["cartesian", "vp", "vp-screen-clipped"] {
         run(&RenderArgs { method, denoiser: "bmfr", exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
         assert_eq!(report["denoiser"], "bmfr");
@@ -475,8 +479,4 @@ fn render_command_runs_bmfr_and_reports_it() {
             assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
         }
     }
-    let mut args = RenderArgs { method: "vp", denoiser: "bmfr", exr: false, ..fovea_tests::small_render_args("cornell-box", &out) };
-    args.profile.visual_polar.layout = fovea_renderer::sampling::VpLayout::ScreenClipped;
-    let err = format!("{:#}", run(&args).unwrap_err());
-    assert!(err.contains("--denoiser bmfr") && err.contains("paper"), "{err}");
 }

@@ -18,7 +18,7 @@ use fovea_renderer::vk::{Context, Image};
 use fovea_tests::denoise::{
     assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload,
 };
-use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
+use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
 
@@ -191,7 +191,8 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             r.render_frame(&frame(camera, f)).unwrap();
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous });
+            let table = grid_table(&ctx, r.space(), None);
+            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table });
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} moments"), &moments);
@@ -225,12 +226,13 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
         let mut svgf = Svgf::new(&ctx, space.grid_size(), space.shader_variant(), SvgfSettings::default()).unwrap();
         let params = space.params();
+        let table = grid_table(&ctx, space.as_ref(), None);
         let mut last = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             let previous = (f > 0).then_some(params);
-            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous });
+            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous, sampling_table: &table });
         }
         let (out, moments) = last;
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
@@ -374,7 +376,8 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
             inject_fireflies(&ctx, &r.view(0).gbuffer.color, f);
             let current = r.space().params();
             let jitter = TaaSettings::default().jitter(f);
-            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous }, jitter);
+            let table = grid_table(&ctx, r.space(), None);
+            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous, sampling_table: &table }, jitter);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f}"), &out);
             peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
@@ -396,13 +399,14 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
         let mut taa = Taa::new(&ctx, space.grid_size(), space.shader_variant(), TaaSettings::default()).unwrap();
         let params = space.params();
+        let table = grid_table(&ctx, space.as_ref(), None);
         let (mut out, mut current) = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             current = samples;
             // Samples at texel centres: the jitter is the centre.
-            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params) }, Vec2::splat(0.5));
+            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params), sampling_table: &table }, Vec2::splat(0.5));
         }
         let (mut uncovered, mut followed, mut stayed, mut blended) = (0, 0, 0, 0);
         for (i, s) in screens.iter().enumerate() {

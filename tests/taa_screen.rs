@@ -13,7 +13,7 @@ use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
-use fovea_tests::{assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
+use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
 
@@ -123,7 +123,8 @@ fn screen_taa_output_is_finite_and_non_negative_with_fireflies() {
         write_image(&ctx, &color, &hdr);
         inject_fireflies(&ctx, &color, f);
         let space = r.space().params();
-        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &r.view(0).gbuffer, space: &space, has_previous: f > 0, jitter: Vec2::splat(0.5) };
+        let columns = grid_table(&ctx, r.space(), None);
+        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &r.view(0).gbuffer, space: &space, columns: &columns, has_previous: f > 0, jitter: Vec2::splat(0.5) };
         let out = resolve(&ctx, &mut taa, &color, &input);
         assert_finite_non_negative(&format!("frame {f}"), &out);
         peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
@@ -151,6 +152,7 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
     let texels = (grid.x * grid.y) as usize;
     let uncovered = |x: u32, y: u32| vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).x > SCREEN.x as f32 * 0.5;
     let space = vp.sampling_params();
+    let columns = grid_table(&ctx, &vp, None);
     let mut out = Vec::new();
     let mut current: Vec<[f32; 4]> = Vec::new();
     let mut previous = Vec::new();
@@ -166,7 +168,7 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
             .map(|i| if unit_hash(i * 7 + f * 7919) < 0.5 { [1.0, 0.0, 0.0, 1.0] } else { [0.0, 0.0, 1.0, 1.0] })
             .collect();
         write_image(&ctx, &color, &current);
-        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &gbuffer, space: &space, has_previous: f > 0, jitter: Vec2::splat(0.5) };
+        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &gbuffer, space: &space, columns: &columns, has_previous: f > 0, jitter: Vec2::splat(0.5) };
         out = resolve(&ctx, &mut taa, &color, &input);
     }
     let (mut fresh, mut blended, mut new_pixels, mut wall_pixels) = (0, 0, 0, 0);

@@ -238,13 +238,12 @@ fn remap_reproduces_screen_positions() {
 /// at a Halton offset inside it, and the remap, told that offset, must put every position back
 /// on its pixel as well as for centred samples — while reading the same image as if centred is
 /// off by about the jitter times the texel footprint (the test would fail without the offset).
-/// The paper's layout only: TAA is refused with the screen-clipped one (`fovea render`).
+/// Both layouts: the screen-clipped one moves the lookup along its arc rows.
 #[test]
 fn remap_reads_jittered_samples_where_they_were_traced() {
     let ctx = gpu();
     let jitter = Vec2::new(0.85, 0.2);
-    for (name, gaze) in gazes() {
-        let layout = VpLayout::Paper;
+    for ((name, gaze), layout) in gazes().into_iter().flat_map(|g| LAYOUTS.map(|l| (g, l))) {
         let vp = space(gaze, layout);
         let texel = |x: u32, y: u32| {
             let p = vp.vp_to_screen(Vec2::new(x as f32, y as f32) + jitter);

@@ -497,7 +497,16 @@ impl Renderer {
         let s = &view.slots[slot];
         s.sampling.write(&[view.space.params()])?;
         view.space.write_sampling_table(&mut view.table_rows);
-        s.sampling_table.write(&view.table_rows)
+        let n = view.table_rows.len();
+        // Without a previous frame its half repeats this frame's (no pass reads it then).
+        match view.prev_sampling {
+            Some(_) if view.prev_table_rows.len() == n => view.table_rows.extend_from_slice(&view.prev_table_rows),
+            _ => view.table_rows.extend_from_within(..n),
+        }
+        s.sampling_table.write(&view.table_rows)?;
+        view.prev_table_rows.clear();
+        view.prev_table_rows.extend_from_slice(&view.table_rows[..n]);
+        Ok(())
     }
 
     fn readable_slot(&self, frame: u64) -> Result<usize> {
@@ -653,7 +662,7 @@ fn record_view(
     let s = &view.slots[slot];
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
-    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling };
+    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling, sampling_table: &s.sampling_table };
     if let Some(d) = &mut view.denoiser {
         d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
     }
@@ -688,6 +697,7 @@ fn record_view(
         frame_data: &s.frame_data,
         gbuffer: &view.gbuffer,
         space: &denoise_frame.current,
+        columns: &s.sampling_table,
         has_previous: denoise_frame.previous.is_some(),
         jitter,
     });

@@ -25,7 +25,8 @@ use std::sync::Arc;
 pub(crate) struct ViewSlot {
     pub frame_data: Buffer,
     pub sampling: Buffer,
-    /// The space's per-frame table (`SamplingSpace::sampling_table`).
+    /// The space's per-frame table (`SamplingSpace::sampling_table`), followed by the previous
+    /// frame's (the denoisers reproject through the previous frame's space).
     pub sampling_table: Buffer,
     pub ray_counters: Buffer,
     pub ldr_readback: Buffer,
@@ -41,7 +42,7 @@ impl ViewSlot {
         Ok(ViewSlot {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
-            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table())?,
+            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table().repeat(2))?,
             ray_counters: Buffer::new(
                 ctx,
                 "ray_counters",
@@ -108,8 +109,11 @@ pub struct View {
     /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
     pub(crate) prev_sampling: Option<SamplingParams>,
     pub(crate) slots: Vec<ViewSlot>,
-    /// Host staging of the sampling table, reused every frame (no per-frame allocation).
+    /// Host staging of the sampling table (this frame's, then the previous frame's), reused
+    /// every frame (no per-frame allocation).
     pub(crate) table_rows: Vec<[f32; 4]>,
+    /// The previous frame's table (`SamplingSpace::sampling_table` of `prev_sampling`).
+    pub(crate) prev_table_rows: Vec<[f32; 4]>,
 }
 
 impl View {
@@ -170,6 +174,7 @@ impl View {
             prev_sampling: None,
             slots,
             table_rows: Vec::new(),
+            prev_table_rows: Vec::new(),
             space,
         })
     }

@@ -39,15 +39,19 @@ ivec2 stratum_centre_texel(Grid g, ivec2 s) {
 }
 
 // The stratum `o` strata away from s (o.y in strata of s's column); false when it leaves the
-// strata grid (on x always; on y only in a space whose rows do not wrap, GRID_ROWS_WRAP).
+// strata grid (on x always; on y only where the rows of the stratum column's tallest grid column
+// do not wrap, grid_column_wraps). Across stratum columns the angle is kept as the share of the
+// column's rows: exact for full circles; on the screen-clipped layout's clipped arcs an
+// approximation of the neighbour (the gradient's edge-stopping weights the tap).
 bool strata_tap(Grid g, ivec2 s, ivec2 o, out ivec2 tap) {
     tap = s + o;
     if (tap.x < 0 || tap.x >= strata_size(g).x) return false;
     int n1 = strata_rows(g, tap.x);
-    if (!GRID_ROWS_WRAP) return tap.y >= 0 && tap.y < n1;
     // Keep the angle across stratum columns of different height.
     int n0 = o.x == 0 ? n1 : strata_rows(g, s.x);
-    tap.y = grid_wrap(int(floor((float(s.y) + 0.5 + float(o.y)) * float(n1) / float(n0))), n1);
+    tap.y = int(floor((float(s.y) + 0.5 + float(o.y)) * float(n1) / float(n0)));
+    if (!grid_column_wraps(g, min(STRATUM * tap.x + STRATUM - 1, g.size.x - 1))) return tap.y >= 0 && tap.y < n1;
+    tap.y = grid_wrap(tap.y, n1);
     return true;
 }
 

@@ -3,14 +3,11 @@
 #ifndef FOVEA_CARTESIAN_GRID_GLSL
 #define FOVEA_CARTESIAN_GRID_GLSL
 
-// Rows end at the grid like columns.
-const bool GRID_ROWS_WRAP = false;
-
 struct Grid {
     ivec2 size;
 };
 
-Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
+Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1, bool previous) {
     Grid g;
     g.size = ivec2(grid.xy);
     return g;
@@ -20,6 +17,13 @@ Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
 int grid_rows(Grid g, int col) {
     return g.size.y;
 }
+
+// Rows end at the grid like columns.
+bool grid_column_wraps(Grid g, int col) {
+    return false;
+}
+
+#include "../denoise/grid_column.glsl"
 
 // The texel `o` steps away from the sample texel `t`; false when that leaves the grid.
 bool grid_tap(Grid g, ivec2 t, ivec2 o, out ivec2 tap) {
@@ -55,6 +59,11 @@ void grid_bilinear(Grid g, vec2 p, out ivec2 taps[4], out vec4 w) {
     taps[2] = i0 + ivec2(1, 0);
     taps[3] = i0 + ivec2(1, 1);
     w = vec4((1.0 - t.x) * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * (1.0 - t.y), t.x * t.y);
+}
+
+// Row of continuous grid position p as a row of column `col` (rows are the same everywhere).
+float grid_row_in_column(Grid g, vec2 p, int col) {
+    return p.y;
 }
 
 #endif

@@ -7,7 +7,9 @@
 // file only looks them up.
 //
 // The includer provides the lookup from its own binding (the trace: the `sampling` buffer; the
-// passes back to the screen: a texel buffer):  VpArcs vp_column_arcs(uint col);
+// passes back to the screen: a texel buffer):  VpArcs vp_column_arcs(uint col). The table holds
+// this frame's columns, then the previous frame's (the denoisers reproject through those):
+// VpParams.arcs_base picks the frame.
 #ifndef FOVEA_SAMPLING_VISUAL_POLAR_CLIPPED_GLSL
 #define FOVEA_SAMPLING_VISUAL_POLAR_CLIPPED_GLSL
 
@@ -99,7 +101,7 @@ int vp_arcs_interval_of_row(VpArcs c, float y, float n) {
 vec2 vp_clipped_vp_to_screen(VpParams P, vec2 g) {
     uint col = vp_column_of(P, g.x);
     float n = float(vp_rows_in_column(P, col));
-    VpArcs arcs = vp_column_arcs(col);
+    VpArcs arcs = vp_column_arcs(P.arcs_base + col);
     float phi = vp_phi_of_arc(arcs, g.y / n * vp_arcs_total(arcs));
     float r = vp_r_of_u(P, g.x / float(P.grid.x));
     return P.gaze + r * vec2(cos(phi), sin(phi));
@@ -114,7 +116,7 @@ vec2 vp_clipped_screen_to_vp(VpParams P, vec2 s) {
     float x = vp_u_of_r(P, r) * float(P.grid.x);
     uint col = vp_column_of(P, x);
     float n = float(vp_rows_in_column(P, col));
-    VpArcs arcs = vp_column_arcs(col);
+    VpArcs arcs = vp_column_arcs(P.arcs_base + col);
     float y = vp_arc_row(arcs, vp_arc_of_phi(arcs, phi).x, n);
     // y = n is φ = 2π on a full circle (row 0) or a clipped arc's far end (its last row).
     if (y >= n) y = vp_arcs_wrap(arcs) ? 0.0 : uintBitsToFloat(floatBitsToUint(n) - 1u);

@@ -8,15 +8,12 @@
 
 #include "visual_polar_math.glsl"
 
-// Rows (φ) wrap around; columns (ρ) end at the grid.
-const bool GRID_ROWS_WRAP = true;
-
 struct Grid {
     ivec2 size;
     VpParams vp;
 };
 
-Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
+Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1, bool previous) {
     Grid g;
     g.size = ivec2(grid.xy);
     g.vp = vp_unpack(grid, gaze, shape0, shape1);
@@ -27,6 +24,13 @@ Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
 int grid_rows(Grid g, int col) {
     return int(vp_rows_in_column(g.vp, uint(col)));
 }
+
+// Rows (φ) wrap around; columns (ρ) end at the grid.
+bool grid_column_wraps(Grid g, int col) {
+    return true;
+}
+
+#include "../denoise/grid_column.glsl"
 
 // The texel `o` steps away from the sample texel `t` (o.y in φ steps of t's own column); false
 // when that leaves the grid (on ρ only).
@@ -82,6 +86,12 @@ void grid_bilinear(Grid g, vec2 p, out ivec2 taps[4], out vec4 w) {
         w[2 * i] = wc * (1.0 - wy);
         w[2 * i + 1] = wc * wy;
     }
+}
+
+// Row of continuous grid position p (rows of column floor(p.x)) at the same angle in column `col`.
+float grid_row_in_column(Grid g, vec2 p, int col) {
+    float from = float(grid_rows(g, clamp(int(floor(p.x)), 0, g.size.x - 1)));
+    return p.y * float(grid_rows(g, col)) / from;
 }
 
 #endif

@@ -65,6 +65,7 @@ struct VpParams {
     float lp_alpha;  // log-polar: kernel exponent α
     float lp_l;      // log-polar: L = ln of the extent (pixels)
     float lp_inner;  // log-polar: the law's column where the first log-polar column starts (composite: the gaze disc's edge; shape0.y)
+    uint arcs_base;  // screen-clipped layout: first column of this frame's arcs in the table (0; the previous frame's follow this frame's)
 };
 
 // Reddy's acuity V(e), cycles per degree.
@@ -168,6 +169,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.lp_alpha = shape1.z;
     p.lp_l = shape1.w;
     p.lp_inner = shape0.y;
+    p.arcs_base = 0u;
     return p;
 }
 

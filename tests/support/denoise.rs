@@ -142,7 +142,7 @@ pub fn seam_texels(vp: &VisualPolar, f: u32) -> Vec<Option<Texel>> {
 }
 
 /// RMS error against `seam_truth` of a filtered polar grid (`out`, green channel), over columns
-/// with at least 32 rows: the rows next to the φ = 0/2π seam, the rows at φ ≈ π, and the median
+/// with at least 32 rows whose circle wraps (all of them in the paper's layout): the rows next to the φ = 0/2π seam, the rows at φ ≈ π, and the median
 /// of 16 row bins.
 #[derive(Clone, Copy, Debug)]
 pub struct SeamErrors {
@@ -161,7 +161,9 @@ impl SeamErrors {
         let (mut seam, mut seam_n, mut opposite, mut opposite_n) = (0f64, 0, 0f64, 0);
         for x in 0..grid.x {
             let n = vp.rows_in_column(x);
-            if n < 32 {
+            // The screen-clipped layout's clipped columns have no seam: their rows end at the
+            // screen's border (`ColumnArcs::wraps`).
+            if n < 32 || !vp.column_arcs(x).wraps() {
                 continue;
             }
             for y in 0..n {
@@ -178,6 +180,7 @@ impl SeamErrors {
                 }
             }
         }
+        assert!(count.iter().all(|&c| c > 0), "no column with a seam and 32 rows");
         let bins: [f64; BINS] = std::array::from_fn(|b| (sum[b] / count[b] as f64).sqrt());
         let mut sorted = bins;
         sorted.sort_by(f64::total_cmp);

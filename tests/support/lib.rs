@@ -196,9 +196,21 @@ impl SpaceBuffers {
         SpaceBuffers {
             frame: Buffer::with_data(ctx, "frame", &[data], uniform).unwrap(),
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform).unwrap(),
-            table: Buffer::texels(ctx, "sampling_table", &space.sampling_table()).unwrap(),
+            table: grid_table(ctx, space, None),
         }
     }
+}
+
+/// A view's sampling table as the renderer keeps it: `current`'s, then `previous`'s (`current`'s
+/// again without one) — what the trace and `DenoiseFrame::sampling_table` read.
+pub fn grid_table(
+    ctx: &Arc<Context>,
+    current: &dyn fovea_renderer::sampling::SamplingSpace,
+    previous: Option<&dyn fovea_renderer::sampling::SamplingSpace>,
+) -> Buffer {
+    let mut rows = current.sampling_table();
+    rows.extend(previous.unwrap_or(current).sampling_table());
+    Buffer::texels(ctx, "sampling_table", &rows).unwrap()
 }
 
 /// One texel as the GPU's space sees it (passes/space_probe): its sample's screen position at

@@ -611,8 +611,13 @@ impl SamplingSpace for VisualPolar {
             _ => "vp",
         }
     }
+    /// The denoisers' and TAA's grid addressing: the paper's, or the screen-clipped layout's
+    /// (its per-column arcs, `shaders/sampling/visual_polar_clipped_grid.glsl`).
     fn shader_variant(&self) -> &'static str {
-        "visual_polar"
+        match self.params.layout {
+            VpLayout::Paper => "visual_polar",
+            VpLayout::ScreenClipped => "visual_polar_clipped",
+        }
     }
     /// `visual_polar`: specialised for the paper's layout and normalised axis; `log_polar`: the
     /// paper's layout with the radial law read at run time; otherwise the general kernel
@@ -677,14 +682,10 @@ impl SamplingSpace for VisualPolar {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         Some(self)
     }
+    /// Every layout runs the filters: the screen-clipped one addresses its grid through the
+    /// per-column arcs of this frame and the previous one (`DenoiseFrame::sampling_table`).
     fn capabilities(&self) -> super::SpaceCapabilities {
-        // The filters reproject and address the grid with the paper's mapping only (no
-        // per-column arc table in their kernels yet).
-        super::SpaceCapabilities {
-            way_back: super::WayBack::Remap,
-            temporal_filters: self.params.layout == VpLayout::Paper,
-            filters_note: "in its screen-clipped layout (use layout = \"paper\")",
-        }
+        super::SpaceCapabilities { way_back: super::WayBack::Remap, temporal_filters: true, filters_note: "" }
     }
 }
 

@@ -67,9 +67,7 @@ void main() {
         // back by the jitter (its y in rows of the column it lands in).
         vec2 off = push.p.params.zw - 0.5;
         float x = clamp(p.x - off.x, 0.0, float(g.size.x) - 1e-3);
-        float rows_from = float(grid_rows(prev, clamp(int(floor(p.x)), 0, g.size.x - 1)));
-        float rows_to = float(grid_rows(prev, int(floor(x))));
-        p = vec2(x, (p.y - off.y) * rows_to / rows_from);
+        p = vec2(x, grid_row_in_column(prev, vec2(p.x, p.y - off.y), int(floor(x))));
         // Disocclusion: this sample's surface is nowhere in the previous 3×3 around its position.
         // Not a per-tap test: at a geometric edge the jittered sample lands on either surface
         // from frame to frame, and the history there is meant to average both (anti-aliasing).

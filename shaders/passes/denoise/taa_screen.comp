@@ -13,9 +13,13 @@
 // depth the pixel starts afresh (disocclusion). Not a per-tap test: at a geometric edge the
 // nearest sample flips between the two surfaces from frame to frame, and the history there is
 // meant to average both.
+// Two variants, as the remap's: lavapipe executes both sides of every branch, so the paper's
+// layout gets a kernel without the screen-clipped mapping; `clipped` is the general kernel.
+//! variant paper:
+//! variant clipped: VP_LAYOUT_CLIPPED
 #include "../../common/layouts.glsl"
 #include "../../common/camera.glsl"
-#include "../../sampling/visual_polar_math.glsl"
+#include "../../sampling/visual_polar_clipped.glsl"
 #include "../../denoise/svgf.glsl"
 #include "../../denoise/taa.glsl"
 
@@ -28,6 +32,34 @@ layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;       /
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D prev_history;   // rgb colour, a depth (0: miss)
 layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D history;       // output = next history
 
+#if defined(VP_LAYOUT_CLIPPED)
+layout(set = 0, binding = 6) uniform samplerBuffer vp_columns;                // VisualPolar::column_table
+
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+}
+
+vec2 to_screen(VpParams P, vec2 g) {
+    return vp_layout_vp_to_screen(P, g);
+}
+
+vec2 to_grid(VpParams P, vec2 s) {
+    return vp_layout_screen_to_vp(P, s);
+}
+#else
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(vec4(0.0), vec4(VP_TAU));
+}
+
+vec2 to_screen(VpParams P, vec2 g) {
+    return vp_vp_to_screen(P, g);
+}
+
+vec2 to_grid(VpParams P, vec2 s) {
+    return vp_screen_to_vp(P, s);
+}
+#endif
+
 // Depth agreement for "the same surface": a relative slack plus the depth change over the
 // neighbourhood's spacing (the nearest sample may lie a texel away from the pixel).
 const float TAA_SCREEN_DEPTH_SLACK = 0.02;
@@ -38,8 +70,8 @@ const float TAA_SCREEN_DEPTH_GRADIENTS = 2.0;
 // this frame's jitter can move the remapped image.
 float texel_footprint(VpParams P, vec2 g) {
     float x = clamp(g.x, 0.5, float(P.grid.x) - 0.5);
-    float step_rho = length(vp_vp_to_screen(P, vec2(x + 0.5, g.y)) - vp_vp_to_screen(P, vec2(x - 0.5, g.y)));
-    float step_phi = length(vp_vp_to_screen(P, vec2(x, g.y + 0.5)) - vp_vp_to_screen(P, vec2(x, g.y - 0.5)));
+    float step_rho = length(to_screen(P, vec2(x + 0.5, g.y)) - to_screen(P, vec2(x - 0.5, g.y)));
+    float step_phi = length(to_screen(P, vec2(x, g.y + 0.5)) - to_screen(P, vec2(x, g.y - 0.5)));
     return max(max(step_rho, step_phi), 1.0);
 }
 
@@ -59,7 +91,7 @@ void main() {
     VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
     vec2 s = vec2(t) + 0.5;
     vec3 c = svgf_sanitize(imageLoad(color, t).rgb);
-    vec2 g = vp_screen_to_vp(P, s);
+    vec2 g = to_grid(P, s);
     ivec2 texel = nearest_texel(P, g);
     float depth = imageLoad(normal_depth, texel).w;
     float depth_step = imageLoad(position, texel).w;

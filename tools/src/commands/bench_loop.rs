@@ -161,7 +161,7 @@ impl LoopSetup {
     fn new(width: u32, height: u32) -> Result<LoopSetup> {
         let hmd = HmdDescription::resolve(HEADSET).with_context(|| format!("headset {HEADSET}"))?;
         let profile = RenderProfile::default();
-        let (denoiser, taa) = filters(METHOD, DENOISER, "off", &profile)?;
+        let (denoiser, taa) = filters(DENOISER, "off", &profile)?;
         let settings = RenderSettings { blur: profile.blur, denoiser, taa, ..Default::default() };
         let scene = crate::scenes::load(LOOP_SCENE)?;
         let Some(camera) = scene.default_camera() else { bail!("{LOOP_SCENE}: no camera") };

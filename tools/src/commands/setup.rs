@@ -90,7 +90,7 @@ impl Setup {
         }
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
-        let (denoiser, taa) = filters(args.method, args.denoiser, args.taa, &args.profile)?;
+        let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
         let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, width as f32 / height as f32)?;
         let start_pose = CameraPose::from_scene_camera(&camera, width, height);
@@ -277,9 +277,10 @@ pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMo
     }
 }
 
-/// `--denoiser` and `--taa` with their parameters from the profile, checked against the method
-/// (`fovea render`, `fovea view`'s live switching and `fovea xr` share it).
-pub fn filters(method: &str, denoiser: &str, taa: &str, profile: &RenderProfile) -> Result<(DenoiserSettings, TaaMode)> {
+/// `--denoiser` and `--taa` with their parameters from the profile (`fovea render`, `fovea view`'s
+/// live switching and `fovea xr` share it); whether the method's space runs them is checked by
+/// the renderer.
+pub fn filters(denoiser: &str, taa: &str, profile: &RenderProfile) -> Result<(DenoiserSettings, TaaMode)> {
     let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
         DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
@@ -287,15 +288,6 @@ pub fn filters(method: &str, denoiser: &str, taa: &str, profile: &RenderProfile)
         other => other,
     };
     let taa_mode = TaaMode::parse(taa).context("--taa")?.with_settings(profile.taa);
-    // TAA reprojects with the paper's mapping, like SVGF (the screen-space one finds depths in the
-    // VP G-buffer the same way).
-    if method == "vp" && profile.visual_polar.layout != VpLayout::Paper && taa_mode != TaaMode::Off {
-        bail!("--taa {taa} supports only the paper's Visual-Polar layout (--vp-layout paper)");
-    }
-    // SVGF and BMFR reproject and filter with the paper's mapping (no per-column arc table yet).
-    if method == "vp" && profile.visual_polar.layout != VpLayout::Paper && denoiser_settings != DenoiserSettings::None {
-        bail!("--denoiser {denoiser} supports only the paper's Visual-Polar layout (--vp-layout paper)");
-    }
     Ok((denoiser_settings, taa_mode))
 }
 

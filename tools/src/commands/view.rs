@@ -252,7 +252,7 @@ impl Viewer<'_> {
     fn rebuild_views(&mut self) -> Result<()> {
         let profile = &self.args.render.profile;
         let spaces = self.setup.eyes.list().iter().map(|&eye| space_for(&self.method, profile, &self.setup.hmd, eye, self.setup.screen())).collect::<Result<Vec<_>>>()?;
-        let (denoiser, taa) = super::setup::filters(&self.method, &self.denoiser, &self.taa, profile)?;
+        let (denoiser, taa) = super::setup::filters(&self.denoiser, &self.taa, profile)?;
         let settings = RenderSettings { denoiser, taa, ..self.renderer.settings };
         self.renderer.replace_views(spaces, settings)?;
         Ok(())

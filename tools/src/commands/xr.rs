@@ -86,7 +86,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     check_common(r)?;
-    let (denoiser, taa) = filters(r.method, r.denoiser, r.taa, &r.profile)?;
+    let (denoiser, taa) = filters(r.denoiser, r.taa, &r.profile)?;
     let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
     let eye = base.eye(fovea_hal::Eye::Left);
     // The runtime's size is known only later; the headset's recommended eye frames the scene.

@@ -67,10 +67,14 @@ impl DenoiserSettings {
 
 /// The sampling space of this frame and of the previous one (its gaze differs; `None` when there
 /// is no usable previous frame, which drops all history).
-#[derive(Clone, Copy, Debug)]
-pub struct DenoiseFrame {
+#[derive(Clone, Copy)]
+pub struct DenoiseFrame<'a> {
     pub current: SamplingParams,
     pub previous: Option<SamplingParams>,
+    /// The view's sampling table: this frame's (`SamplingSpace::sampling_table`) followed by the
+    /// previous frame's of the same length (the screen-clipped layout's kernels read both
+    /// frames' arcs from it).
+    pub sampling_table: &'a Buffer,
 }
 
 /// What a denoiser may need from the scene besides the G-buffer.

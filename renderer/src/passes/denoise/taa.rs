@@ -6,7 +6,7 @@
 
 use super::DenoiseFrame;
 use crate::error::{Error, Result};
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::TaaPush;
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
@@ -169,6 +169,7 @@ impl Taa {
             read_image("prev_surface", &self.surface[1 - cur]),
             write_image("history", &self.history[cur]),
             write_image("surface", &self.surface[cur]),
+            read_texels("grid_columns", frame.sampling_table),
         ];
         let (current, p) = (&frame.current, previous.as_ref().unwrap_or(&frame.current));
         let reset = if previous.is_none() { 1.0 } else { 0.0 };

@@ -8,11 +8,11 @@
 
 use super::taa::TaaSettings;
 use crate::error::Result;
-use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, TaaScreenPush};
-use crate::passes::push_bytes;
+use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::passes::trace::GBuffer;
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::{UVec2, Vec4};
 use std::sync::Arc;
@@ -21,7 +21,7 @@ use std::sync::Arc;
 /// resolved with), allocated once.
 pub struct ScreenTaa {
     pub settings: TaaSettings,
-    pipeline: std::sync::Arc<ComputePipeline>,
+    pipelines: VpLayoutPipelines,
     history: [Image; 2],
     frames: u64,
 }
@@ -34,6 +34,8 @@ pub struct ScreenTaaFrame<'a> {
     pub gbuffer: &'a GBuffer,
     /// This frame's space (its gaze).
     pub space: &'a SamplingParams,
+    /// Its sampling table (`VisualPolar::column_table`: the screen-clipped layout's arcs).
+    pub columns: &'a Buffer,
     /// False when no previous frame may be used (all history dropped).
     pub has_previous: bool,
     /// Where the tracer put this frame's samples inside their VP texel (`TaaSettings::jitter`).
@@ -46,7 +48,7 @@ impl ScreenTaa {
         let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(ScreenTaa {
             settings,
-            pipeline: ComputePipeline::shared(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
+            pipelines: VpLayoutPipelines::new(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
             history: [image("taa_screen.history0")?, image("taa_screen.history1")?],
             frames: 0,
         })
@@ -69,13 +71,14 @@ impl ScreenTaa {
             read_image("position", &frame.gbuffer.position),
             read_image("prev_history", &self.history[1 - cur]),
             write_image("history", &self.history[cur]),
+            read_texels("vp_columns", frame.columns),
         ];
         let push = TaaScreenPush {
             space: *frame.space,
             params: Vec4::new(self.settings.current_weight, if reset { 1.0 } else { 0.0 }, 0.0, 0.0),
         };
         let out = &self.history[cur];
-        rec.dispatch("taa_screen", &self.pipeline, &binds, push_bytes(&push), [out.width, out.height, 1])?;
+        rec.dispatch("taa_screen", self.pipelines.for_space(frame.space), &binds, push_bytes(&push), [out.width, out.height, 1])?;
         self.frames += 1;
         Ok(&self.history[cur])
     }

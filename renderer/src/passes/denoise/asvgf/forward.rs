@@ -3,7 +3,7 @@
 //! strata's gradient image the tracer writes.
 
 use crate::error::{Error, Result};
-use crate::graph::{read_buffer, read_image, write_buffer, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder};
 use crate::layouts::{AsvgfForwardPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
@@ -33,6 +33,7 @@ impl ForwardPass {
         samples: &Buffer,
         gradient: &Image,
         space: &SamplingParams,
+        table: &Buffer,
         project: bool,
     ) -> Result<()> {
         let visibility = g.visibility.as_ref().ok_or_else(|| Error::Invalid("A-SVGF needs a G-buffer with visibility".into()))?;
@@ -44,6 +45,7 @@ impl ForwardPass {
             read_image("visibility", visibility),
             write_buffer("gradient_samples", samples),
             write_image("gradient", gradient),
+            read_texels("grid_columns", table),
         ];
         let push = AsvgfForwardPush {
             space: *space,

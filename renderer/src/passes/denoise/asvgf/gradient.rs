@@ -3,11 +3,11 @@
 
 use super::AsvgfSettings;
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{AsvgfGradientPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{UVec4, Vec4};
 use std::sync::Arc;
 
@@ -31,9 +31,10 @@ impl GradientPass {
         dst: &Image,
         step: u32,
         space: &SamplingParams,
+        table: &Buffer,
         s: &AsvgfSettings,
     ) -> Result<()> {
-        let binds = [read_image("src", src), read_image("normal_depth", &g.normal_depth), read_image("position", &g.position), write_image("dst", dst)];
+        let binds = [read_image("src", src), read_image("normal_depth", &g.normal_depth), read_image("position", &g.position), write_image("dst", dst), read_texels("grid_columns", table)];
         let push = AsvgfGradientPush {
             space: *space,
             params: Vec4::new(s.gradient_sigma_depth, s.gradient_sigma_normal, 0.0, 0.0),

@@ -6,9 +6,9 @@
 //! (`gradient`), and SVGF's temporal accumulation uses α_i = (1 − λ)·α + λ with
 //! λ = |δ̂| / max(f_i, f_{i−1}) (its `*_adaptive` kernel variant); the rest is SVGF's.
 //!
-//! Visual-Polar: strata wrap on φ and end at the grid on ρ (`shaders/denoise/strata.glsl`); the
-//! projection goes world → this frame's screen → this frame's grid (this frame's gaze). Only the
-//! paper's layout: the tracer has no gradient variant of the screen-clipped one.
+//! Visual-Polar: strata wrap on φ (on full circles; the screen-clipped layout's clipped arcs end)
+//! and end at the grid on ρ (`shaders/denoise/strata.glsl`); the projection goes world → this
+//! frame's screen → this frame's grid (this frame's gaze).
 
 mod forward;
 mod gradient;
@@ -116,7 +116,7 @@ impl Asvgf {
     pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
         rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
         let project = self.frames > 0 && frame.previous.is_some();
-        self.forward.record(rec, g, frame_data, &self.samples, &self.raw, &frame.current, project)
+        self.forward.record(rec, g, frame_data, &self.samples, &self.raw, &frame.current, frame.sampling_table, project)
     }
 
     /// The tracer's gradient-variant inputs and outputs.
@@ -130,7 +130,7 @@ impl Asvgf {
         let mut src = &self.raw;
         for i in 0..s.gradient_iterations {
             let dst = &self.ping[(i % 2) as usize];
-            self.gradient.record(rec, g, src, dst, 1 << i, &frame.current, &s)?;
+            self.gradient.record(rec, g, src, dst, 1 << i, &frame.current, frame.sampling_table, &s)?;
             src = dst;
         }
         let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];

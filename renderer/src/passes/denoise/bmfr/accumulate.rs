@@ -3,7 +3,7 @@
 
 use super::{BmfrHistory, Reprojection};
 use crate::error::Result;
-use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
@@ -43,6 +43,7 @@ impl AccumulatePass {
         prev: usize,
         cur: usize,
         current: &SamplingParams,
+        table: &Buffer,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
@@ -59,6 +60,7 @@ impl AccumulatePass {
             write_image("noisy", &h.noisy[cur]),
             write_image("normal", &h.normal[cur]),
             write_image("features_position", &h.position[cur]),
+            read_texels("grid_columns", table),
         ];
         let push = temporal_push(current, r, alpha_floor);
         let size = [g.size.x, g.size.y, 1];

@@ -4,11 +4,11 @@
 use super::accumulate::temporal_push;
 use super::{BmfrHistory, Reprojection};
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use std::sync::Arc;
 
 pub struct AccumulateFilteredPass {
@@ -33,6 +33,7 @@ impl AccumulateFilteredPass {
         fitted: &Image,
         dst: &Image,
         current: &SamplingParams,
+        table: &Buffer,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
@@ -49,6 +50,7 @@ impl AccumulateFilteredPass {
             write_image("filtered", &h.filtered[cur]),
             write_image("dst", dst),
             read_image("features_position", &h.position[cur]),
+            read_texels("grid_columns", table),
         ];
         let push = temporal_push(current, r, alpha_floor);
         rec.dispatch("bmfr_accumulate_filtered", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])

@@ -4,10 +4,10 @@
 
 use super::{block_count, BmfrHistory};
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrBlockPush, SamplingParams, BMFR_FIT_LANES};
 use crate::passes::push_bytes;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{IVec2, IVec4, UVec2, Vec4};
 use std::sync::Arc;
 
@@ -39,6 +39,7 @@ impl FitPass {
         cur: usize,
         weights: &Image,
         space: &SamplingParams,
+        table: &Buffer,
         offset: IVec2,
         seed: u32,
         noise: f32,
@@ -48,6 +49,7 @@ impl FitPass {
             read_image("normal", &h.normal[cur]),
             read_image("features_position", &h.position[cur]),
             write_image("weights", weights),
+            read_texels("grid_columns", table),
         ];
         let push = block_push(space, offset, seed, noise);
         let blocks = block_count(UVec2::new(space.grid.x, space.grid.y));

@@ -203,11 +203,11 @@ impl Bmfr {
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous.as_ref() };
         let reprojection = Reprojection { previous, camera_shift: h.origin - camera_origin };
-        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, &reprojection, s.alpha_noisy)?;
+        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, frame.sampling_table, &reprojection, s.alpha_noisy)?;
         let seed = h.frames as u32;
-        self.fit.record(rec, h, cur, &self.weights, &frame.current, offset, seed, s.noise)?;
-        self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, offset)?;
-        self.accumulate_filtered.record(rec, g, h, prev, cur, &self.fitted, &self.output, &frame.current, &reprojection, s.alpha_filtered)?;
+        self.fit.record(rec, h, cur, &self.weights, &frame.current, frame.sampling_table, offset, seed, s.noise)?;
+        self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, frame.sampling_table, offset)?;
+        self.accumulate_filtered.record(rec, g, h, prev, cur, &self.fitted, &self.output, &frame.current, frame.sampling_table, &reprojection, s.alpha_filtered)?;
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)

@@ -3,10 +3,10 @@
 use super::fit::block_push;
 use super::BmfrHistory;
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrBlockPush, SamplingParams};
 use crate::passes::push_bytes;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::IVec2;
 use std::sync::Arc;
 
@@ -30,6 +30,7 @@ impl WeightedSumPass {
         weights: &Image,
         fitted: &Image,
         space: &SamplingParams,
+        table: &Buffer,
         offset: IVec2,
     ) -> Result<()> {
         let binds = [
@@ -38,6 +39,7 @@ impl WeightedSumPass {
             read_image("features_position", &h.position[cur]),
             read_image("weights", weights),
             write_image("fitted", fitted),
+            read_texels("grid_columns", table),
         ];
         let push = block_push(space, offset, 0, 0.0);
         rec.dispatch("bmfr_weighted_sum", &self.pipeline, &binds, push_bytes(&push), [fitted.width, fitted.height, 1])

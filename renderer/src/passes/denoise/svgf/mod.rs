@@ -193,13 +193,13 @@ impl Svgf {
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous };
-        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, previous.as_ref(), &s, gradient)?;
-        self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, &s)?;
+        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, frame.sampling_table, previous.as_ref(), &s, gradient)?;
+        self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, frame.sampling_table, &s)?;
         // Iteration 0 writes the colour history; then the two ping images alternate.
         let mut src = &self.ping[0];
         for i in 0..s.atrous_iterations {
             let dst = if i == 0 { &h.color } else { &self.ping[(i % 2) as usize] };
-            self.atrous.record(rec, g, src, dst, 1 << i, &frame.current, &s)?;
+            self.atrous.record(rec, g, src, dst, 1 << i, &frame.current, frame.sampling_table, &s)?;
             src = dst;
         }
         self.modulate.record(rec, "svgf_modulate", src, &g.albedo, &self.output)?;

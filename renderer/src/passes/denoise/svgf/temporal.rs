@@ -3,11 +3,11 @@
 
 use super::{SvgfHistory, SvgfSettings};
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfTemporalPush};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;
 
@@ -34,6 +34,7 @@ impl TemporalPass {
         cur: usize,
         accum: &Image,
         current: &SamplingParams,
+        table: &Buffer,
         previous: Option<&SamplingParams>,
         s: &SvgfSettings,
         gradient: Option<&Image>,
@@ -51,6 +52,7 @@ impl TemporalPass {
             write_image("accum", accum),
             write_image("moments", &h.moments[cur]),
             write_image("surface", &h.surface[cur]),
+            read_texels("grid_columns", table),
             read_image("gradient", gradient.unwrap_or(&g.radiance)),
         ];
         let binds = &binds[..if gradient.is_some() { binds.len() } else { binds.len() - 1 }];

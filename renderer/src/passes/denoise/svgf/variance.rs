@@ -3,11 +3,11 @@
 
 use super::SvgfSettings;
 use crate::error::Result;
-use crate::graph::{read_image, write_image, FrameRecorder};
+use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfVariancePush};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;
 
@@ -31,6 +31,7 @@ impl VariancePass {
         moments: &Image,
         dst: &Image,
         space: &SamplingParams,
+        table: &Buffer,
         s: &SvgfSettings,
     ) -> Result<()> {
         let binds = [
@@ -39,6 +40,7 @@ impl VariancePass {
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
             write_image("dst", dst),
+            read_texels("grid_columns", table),
         ];
         let push = SvgfVariancePush {
             space: *space,
