@@ -28,7 +28,7 @@ impl GpuEnvironment {
         let Some(map) = scene.environment_map() else { return Self::black(ctx) };
         let (map, halvings) = fit(map.into_owned(), max_texels);
         let Some(dist) = EnvironmentDistribution::new(&map) else { return Self::black(ctx) };
-        let buffer = Buffer::with_data(ctx, "environment", &gpu_texels(&map, &dist), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let buffer = Buffer::device_local(ctx, "environment", &gpu_texels(&map, &dist), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         Ok(GpuEnvironment { buffer, map: Some((map.width, map.height, map.rotation, map.intensity)), halvings })
     }
 

@@ -93,16 +93,16 @@ impl GpuScene {
 
         let tree_bytes = (trees.nodes.len() + trees.triangles.len()) * 16 + std::mem::size_of_val(trees.instances.as_slice());
         Ok(GpuScene {
-            bvh_nodes: Buffer::texels(ctx, "bvh_nodes", &trees.nodes)?,
-            bvh_triangles: Buffer::texels(ctx, "bvh_triangles", &trees.triangles)?,
-            instances: Buffer::with_data(ctx, "instances", &trees.instances, storage)?,
+            bvh_nodes: Buffer::device_texels(ctx, "bvh_nodes", &trees.nodes)?,
+            bvh_triangles: Buffer::device_texels(ctx, "bvh_triangles", &trees.triangles)?,
+            instances: Buffer::device_local(ctx, "instances", &trees.instances, storage)?,
             instancing_slots: trees.slots,
             instancing_stats: stats,
-            vertices: Buffer::with_data(ctx, "vertices", &vertices, storage)?,
-            triangles: Buffer::with_data(ctx, "triangles", &triangles, storage)?,
+            vertices: Buffer::device_local(ctx, "vertices", &vertices, storage)?,
+            triangles: Buffer::device_local(ctx, "triangles", &triangles, storage)?,
             materials: Buffer::with_data(ctx, "materials", &materials, storage)?,
-            textures: Buffer::with_data(ctx, "textures", &textures, storage)?,
-            texels: Buffer::with_data(ctx, "texels", &texels, storage)?,
+            textures: Buffer::device_local(ctx, "textures", &textures, storage)?,
+            texels: Buffer::device_local(ctx, "texels", &texels, storage)?,
             lights: Buffer::with_data(ctx, "lights", &lights, storage)?,
             light_count: lights.len() as u32,
             triangle_count: triangles.len() as u32,

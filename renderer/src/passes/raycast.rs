@@ -18,7 +18,7 @@ impl RaycastPass {
         Ok(RaycastPass { pipeline: ComputePipeline::shared(ctx, "passes/raycast", std::mem::size_of::<RaycastPush>() as u32)? })
     }
 
-    /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::host_texels`: texel
+    /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel
     /// reads are far cheaper than std430 reads on lavapipe); `hits` receives `count` HitGpu. `any_hit` stops at the first
     /// hit found (shadow rays).
     #[allow(clippy::too_many_arguments)]
@@ -70,25 +70,28 @@ impl RayCaster {
     }
 
     /// Traces `rays` (closest hit, or any hit for shadow rays); returns the hits and GPU ms.
+    /// Rays and hits live in device-local memory, copied in and out outside the timed pass: on a
+    /// discrete GPU the pass would otherwise time the bus, not the traversal.
     pub fn trace(&mut self, scene: &GpuScene, rays: &[crate::layouts::RayGpu], any_hit: bool) -> Result<(Vec<crate::layouts::HitGpu>, f64)> {
         use gpu_allocator::MemoryLocation;
-        let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
+        let usage = ash::vk::BufferUsageFlags::STORAGE_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_SRC;
         let ray_bytes = (std::mem::size_of_val(rays) as u64).max(16);
         let hit_bytes = (rays.len() * std::mem::size_of::<crate::layouts::HitGpu>()) as u64;
         if self.rays.as_ref().is_none_or(|b| b.size < ray_bytes) {
-            self.rays = Some(Buffer::host_texels(&self.ctx, "rays", ray_bytes)?);
-            self.hits = Some(Buffer::new(&self.ctx, "hits", hit_bytes.max(32), storage, MemoryLocation::GpuToCpu)?);
+            self.rays = Some(Buffer::device_texels(&self.ctx, "rays", bytemuck::cast_slice(rays))?);
+            self.hits = Some(Buffer::new(&self.ctx, "hits", hit_bytes.max(32), usage, MemoryLocation::GpuOnly)?);
+        } else {
+            self.rays.as_ref().unwrap().upload(rays)?;
         }
         let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());
-        ray_buf.write(rays)?;
         // The instance level's slots are the scene's; everything else in the frame stays default.
         self.frame.write(&[crate::layouts::FrameData { instancing: scene.instancing_slots, ..Default::default() }])?;
         self.recorder.begin()?;
         let name = if any_hit { "raycast_any" } else { "raycast_closest" };
         self.pass.record(&mut self.recorder, name, scene, &self.frame, ray_buf, hit_buf, rays.len() as u32, any_hit)?;
         let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
-        let mut hits: Vec<crate::layouts::HitGpu> = hit_buf.read()?;
-        hits.truncate(rays.len());
+        let mut hits = vec![crate::layouts::HitGpu::default(); rays.len()];
+        hit_buf.download(&mut hits)?;
         Ok((hits, ms))
     }
 }

@@ -346,6 +346,24 @@ impl Context {
         })
     }
 
+    /// Copies `bytes` from the start of `src` to the start of `dst` now and waits: a full
+    /// barrier on each side (set-up work; what ran before and what runs after see the data).
+    pub fn copy_now(&self, src: &super::Buffer, dst: &super::Buffer, bytes: u64) -> Result<()> {
+        if bytes > src.size || bytes > dst.size {
+            return Err(Error::Invalid(format!("copy of {bytes} bytes from '{}' ({} bytes) to '{}' ({} bytes)", src.name, src.size, dst.name, dst.size)));
+        }
+        self.one_shot(|device, cmd| unsafe {
+            let all = vk::PipelineStageFlags::ALL_COMMANDS;
+            let barrier = vk::MemoryBarrier::default()
+                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+                .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+            device.cmd_pipeline_barrier(cmd, all, all, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
+            device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes }]);
+            let after = barrier.dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE | vk::AccessFlags::HOST_READ);
+            device.cmd_pipeline_barrier(cmd, all, all | vk::PipelineStageFlags::HOST, vk::DependencyFlags::empty(), &[after], &[], &[]);
+        })
+    }
+
     pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         if let Some(du) = &self.debug_utils {
             let name = std::ffi::CString::new(name).unwrap_or_default();

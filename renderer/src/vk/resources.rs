@@ -86,14 +86,28 @@ impl Buffer {
     }
 
     /// An empty host-visible (CpuToGpu) RGBA32F texel buffer of `size` bytes, refilled with
-    /// `write` between submissions (ray lists read with `texelFetch`).
+    /// `write` between submissions (per-frame tables read with `texelFetch`).
     pub fn host_texels(ctx: &Arc<Context>, name: &str, size: u64) -> Result<Buffer> {
+        Self::texel_buffer(ctx, name, size, vk::BufferUsageFlags::empty(), MemoryLocation::CpuToGpu)
+    }
+
+    /// A device-local RGBA32F texel buffer holding `texels`, uploaded once (BVH nodes and
+    /// triangles: see `device_local`).
+    pub fn device_texels(ctx: &Arc<Context>, name: &str, texels: &[[f32; 4]]) -> Result<Buffer> {
+        let size = std::mem::size_of_val(texels) as u64;
+        let usage = vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC;
+        let buffer = Self::texel_buffer(ctx, name, size, usage, MemoryLocation::GpuOnly)?;
+        buffer.upload(texels)?;
+        Ok(buffer)
+    }
+
+    fn texel_buffer(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
         let size = size.max(16).next_multiple_of(16);
         let limit = ctx.info.max_texel_buffer_elements as u64;
         if size / 16 > limit {
             return Err(Error::Invalid(format!("{name}: {} texels exceed the device limit {limit}", size / 16)));
         }
-        let mut buffer = Buffer::new(ctx, name, size, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, MemoryLocation::CpuToGpu)?;
+        let mut buffer = Buffer::new(ctx, name, size, usage | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, location)?;
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.raw)
             .format(vk::Format::R32G32B32A32_SFLOAT)
@@ -101,6 +115,42 @@ impl Buffer {
             .range(vk::WHOLE_SIZE);
         buffer.texel_view = Some(unsafe { ctx.device.create_buffer_view(&info, None)? });
         Ok(buffer)
+    }
+
+    /// A device-local buffer holding `data`, uploaded once through a staging buffer: scene data
+    /// that every ray reads and the host never rewrites. On a discrete GPU host-visible memory
+    /// may sit across the bus (every BVH node fetch a PCIe read); on lavapipe both are system
+    /// memory and this costs one copy at load.
+    pub fn device_local<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+        let size = (std::mem::size_of_val(data) as u64).max(16);
+        let transfer = vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC;
+        let buffer = Buffer::new(ctx, name, size, usage | transfer, MemoryLocation::GpuOnly)?;
+        buffer.upload(data)?;
+        Ok(buffer)
+    }
+
+    /// Fills this device-local buffer from the host now and waits (set-up and benchmark inputs,
+    /// never inside a frame).
+    pub fn upload<T: bytemuck::Pod>(&self, data: &[T]) -> Result<()> {
+        let bytes = std::mem::size_of_val(data) as u64;
+        if bytes == 0 {
+            return Ok(());
+        }
+        let staging = Buffer::new(&self.ctx, &format!("{}.staging", self.name), bytes, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+        staging.write(data)?;
+        self.ctx.copy_now(&staging, self, bytes)
+    }
+
+    /// Reads the first `out.len()` elements of this device-local buffer back through a staging
+    /// buffer now (benchmark results, never inside a frame).
+    pub fn download<T: bytemuck::Pod>(&self, out: &mut [T]) -> Result<()> {
+        let bytes = std::mem::size_of_val(out) as u64;
+        if bytes == 0 {
+            return Ok(());
+        }
+        let staging = Buffer::new(&self.ctx, &format!("{}.readback", self.name), bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        self.ctx.copy_now(self, &staging, bytes)?;
+        staging.read_into(out)
     }
 
     /// The mapped pointer of a host-visible buffer.
