@@ -3,7 +3,7 @@
 //! sign and ratio of a light change), a light switched off reaches the output within a few frames
 //! where SVGF lags, noise reduction on a still camera comparable to SVGF's, no NaN/Inf/negative
 //! output with fireflies or an empty view; run-time emission scaling keeps the light table
-//! consistent; the screen-clipped VP layout is refused.
+//! consistent; a space without temporal filters refuses it, the screen-clipped VP layout runs it.
 
 use fovea_renderer::layouts::{AsvgfGradientSample, ASVGF_NO_LUMINANCE};
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
