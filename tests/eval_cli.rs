@@ -230,7 +230,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     let out = temp_dir("quality-all");
     let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     let methods = expand_methods(strings(&["all"]));
-    assert_eq!(methods, strings(fovea_tools::commands::render::METHODS));
+    assert_eq!(methods, strings(&fovea_tools::commands::methods::names()));
     let (denoisers, taa, cameras) = (strings(&["none", "svgf"]), strings(&["off"]), strings(&["still"]));
     let args = QualityArgs { frames: 2, eval_frames: 1, rings: 3, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
     run(&args).unwrap();

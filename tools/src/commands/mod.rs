@@ -7,6 +7,7 @@ pub mod gen_scene;
 pub mod headsets;
 pub mod info;
 pub mod method_table;
+pub mod methods;
 pub mod quality;
 pub mod reference;
 pub mod render;

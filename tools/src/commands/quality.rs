@@ -125,7 +125,7 @@ fn check_names(flag: &str, given: &[String], allowed: &[&str]) -> Result<()> {
 /// `--methods all` → every method of `fovea render`.
 pub fn expand_methods(methods: Vec<String>) -> Vec<String> {
     match methods.as_slice() {
-        [one] if one == "all" => render::METHODS.iter().map(|m| m.to_string()).collect(),
+        [one] if one == "all" => super::methods::names().iter().map(|m| m.to_string()).collect(),
         _ => methods,
     }
 }
@@ -139,7 +139,7 @@ fn filters_refusal(args: &QualityArgs, hmd: &fovea_hal::HmdDescription, method: 
 }
 
 pub fn run(args: &QualityArgs) -> Result<()> {
-    check_names("--methods", args.methods, render::METHODS)?;
+    check_names("--methods", args.methods, &super::methods::names())?;
     check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
     check_names("--taa", args.taa, TaaMode::NAMES)?;
     check_names("--cameras", args.cameras, CAMERAS)?;

@@ -1,6 +1,7 @@
 //! `fovea render`: N frames of the scene, written as PNG (and linear EXR), plus report.json with
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
+use super::methods::{ReportSection, VpVariant};
 use super::setup::{Eyes, Setup};
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use anyhow::Result;
@@ -49,7 +50,6 @@ pub struct RenderArgs<'a> {
     pub camera: &'a crate::look::CameraOptions,
 }
 
-pub use super::setup::METHODS;
 
 #[derive(Serialize)]
 struct Report {
@@ -227,6 +227,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let totals = out.totals;
     let passes: BTreeMap<String, f64> = out.pass_sums.into_iter().map(|(k, v)| (k, v / frames as f64)).collect();
     let rays = RayReport { primary: totals.primary_rays / n, shadow: totals.shadow_rays / n, continuation: totals.continuation_rays / n };
+    let method = super::methods::method(args.method)?;
     let report = Report {
         method: args.method.to_string(),
         denoiser: setup.denoiser.name().to_string(),
@@ -259,13 +260,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         seed: args.seed,
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
-        visual_polar: args.method.starts_with("vp").then(|| vp_report(&args.profile, args.method)),
-        log_polar: (args.method == "log-polar").then(|| {
+        visual_polar: match method.report {
+            ReportSection::VisualPolar(variant) => Some(vp_report(&args.profile, variant)),
+            _ => None,
+        },
+        log_polar: (method.report == ReportSection::LogPolar).then(|| {
             let p = &args.profile.log_polar;
             LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
         }),
-        composite_mode: (args.method == "composite").then(|| args.profile.composite_mode.name()),
-        blur_sigma_at_30: matches!(args.method, "vp" | "vp-screen-clipped" | "vp-headset" | "log-polar" | "linear-falloff" | "random-acuity" | "composite").then_some(args.profile.blur.sigma_at_30),
+        composite_mode: (method.report == ReportSection::Composite).then(|| args.profile.composite_mode.name()),
+        blur_sigma_at_30: method.blurs.then_some(args.profile.blur.sigma_at_30),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -340,12 +344,12 @@ impl FrameWriter<'_> {
     }
 }
 
-/// `method`: `vp` or one of its variants (`vp-screen-clipped`, `vp-headset`), which set the layout
-/// or the axis whatever the profile says.
-fn vp_report(profile: &RenderProfile, method: &str) -> VpReport {
+/// `variant`: the profile's Visual-Polar, or a variant that sets the layout or the axis whatever
+/// the profile says (`vp-screen-clipped`, `vp-headset`).
+fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
     use fovea_renderer::sampling::{InverseCdf, RadiusMode};
     let p = &profile.visual_polar;
-    let headset = method == "vp-headset" || profile.eccentricity == crate::render_profile::EccentricityMode::Headset;
+    let headset = variant == VpVariant::Headset || profile.eccentricity == crate::render_profile::EccentricityMode::Headset;
     VpReport {
         axis_scale: p.axis_scale,
         clip_fraction: p.clip_fraction,
@@ -360,7 +364,7 @@ fn vp_report(profile: &RenderProfile, method: &str) -> VpReport {
             RadiusMode::FarthestCorner => "corner".into(),
             RadiusMode::Fixed(r) => format!("{r}"),
         },
-        layout: if method == "vp-screen-clipped" { "screen-clipped".into() } else { crate::render_profile::layout_name(p.layout).into() },
+        layout: if variant == VpVariant::ScreenClipped { "screen-clipped".into() } else { crate::render_profile::layout_name(p.layout).into() },
         eccentricity: if headset { "headset".into() } else { crate::render_profile::eccentricity_name(profile.eccentricity).into() },
     }
 }

@@ -12,15 +12,12 @@ use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
-use fovea_renderer::sampling::{
-    BlockShape, Cartesian, Eccentricity, FalloffShape, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, VpLayout,
-    FALLOFF_BUDGET_OF_VP,
-};
+use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
 use glam::{Mat4, UVec2, Vec3};
 
-/// The sampling methods `--method` accepts.
-pub const METHODS: &[&str] = &["vp", "cartesian", "uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-headset"];
+pub use super::methods::{method, names as method_names};
+use super::methods::{ScreenNeeds, SpaceInputs};
 
 /// Which eyes a run renders (`--eyes`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -175,17 +172,16 @@ pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
 /// What the Visual-Polar mapping needs of the screen `method` renders: a screen and a grid of at
 /// least `MIN_VP_GRID` texels per axis and a fixed radius within `MAX_VP_RADIUS_DIAGONALS`
 /// diagonals. Cartesian takes any size from 1×1.
-pub fn check_space(method: &str, profile: &RenderProfile, screen: UVec2) -> Result<()> {
-    // The uniform budget is Visual-Polar's sample count: VP must be possible at this size.
-    if method == "log-polar" {
-        return check_log_polar(profile, screen);
-    }
-    if method == "composite" && (screen.x < 16 || screen.y < 16) {
-        bail!("--method composite: a {}×{} screen is too small for a gaze disc and a log-polar buffer (at least 16×16)", screen.x, screen.y);
-    }
-    // So are linear falloff's and pixel blocks' degrees, and random acuity's grid.
-    if !matches!(method, "vp" | "vp-screen-clipped" | "vp-headset" | "uniform-budget" | "linear-falloff" | "random-acuity" | "pixel-blocks") {
-        return Ok(());
+pub fn check_space(method_name: &str, profile: &RenderProfile, screen: UVec2) -> Result<()> {
+    match method(method_name)?.screen {
+        ScreenNeeds::Any => return Ok(()),
+        ScreenNeeds::LogPolarBuffer => return check_log_polar(profile, screen),
+        ScreenNeeds::CompositeDisc if screen.x < 16 || screen.y < 16 => {
+            bail!("--method {method_name}: a {}×{} screen is too small for a gaze disc and a log-polar buffer (at least 16×16)", screen.x, screen.y)
+        }
+        ScreenNeeds::CompositeDisc => return Ok(()),
+        // VP, and the methods sized by its sample count or placed on its eccentricity axis.
+        ScreenNeeds::VisualPolarGrid => {}
     }
     if screen.x < MIN_VP_GRID || screen.y < MIN_VP_GRID {
         bail!(
@@ -250,9 +246,7 @@ pub fn check_common(args: &RenderArgs) -> Result<()> {
     if !(args.scale > 0.0 && args.scale <= 4.0) {
         bail!("--scale {} must be in (0, 4]", args.scale);
     }
-    if !METHODS.contains(&args.method) {
-        bail!("--method {}: expected one of {}", args.method, METHODS.join(", "));
-    }
+    method(args.method)?;
     check_settings(args.max_depth, args.exposure)
 }
 
@@ -291,45 +285,12 @@ pub fn filters(denoiser: &str, taa: &str, profile: &RenderProfile) -> Result<(De
     Ok((denoiser_settings, taa_mode))
 }
 
-/// The sampling space of `method` for one eye of `hmd` (its FOV drives the headset ρ axis).
-pub fn space_for(method: &str, profile: &RenderProfile, hmd: &HmdDescription, eye: Eye, screen: UVec2) -> Result<Box<dyn SamplingSpace>> {
-    check_space(method, profile, screen)?;
-    // Built around the screen centre: every frame, the first included, re-centres it on its gaze.
-    let screen_centre = screen.as_vec2() * 0.5;
+/// The sampling space of `method_name` for one eye of `hmd` (its FOV drives the headset ρ axis).
+pub fn space_for(method_name: &str, profile: &RenderProfile, hmd: &HmdDescription, eye: Eye, screen: UVec2) -> Result<Box<dyn SamplingSpace>> {
+    check_space(method_name, profile, screen)?;
     let fov = crate::render_profile::fov_tangents(&hmd.eye(eye).fov);
-    let vp_params = profile.visual_polar_for(fov).with_context(|| format!("--headset {}", hmd.id))?;
-    Ok(match method {
-        "vp" => Box::new(VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space")?),
-        // Visual-Polar's variants as methods of their own (the method table's rows).
-        "vp-screen-clipped" => {
-            let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp_params };
-            Box::new(VisualPolar::new(screen, screen_centre, params).context("Visual-Polar space, screen-clipped layout")?)
-        }
-        "vp-headset" => {
-            let params = VisualPolarParams { eccentricity: Eccentricity::Headset(fov), layout: VpLayout::Paper, ..vp_params };
-            Box::new(VisualPolar::new(screen, screen_centre, params).with_context(|| format!("Visual-Polar space, headset axis of {}", hmd.id))?)
-        }
-        "cartesian" => Box::new(Cartesian::new(screen)),
-        // Meng's kernel log-polar buffer: the polar space with the log-polar radial law.
-        "log-polar" => Box::new(VisualPolar::new(screen, screen_centre, profile.log_polar_space()).context("log-polar space")?),
-        // Andersson & Hansson's gaze disc + log-polar; the eye's distance from its FOV.
-        "composite" => {
-            let viewing_distance = screen.x as f32 / (fov.right + fov.left).max(1e-3);
-            Box::new(VisualPolar::new(screen, screen_centre, profile.composite_space(viewing_distance)).context("composite space")?)
-        }
-        // Visual-Polar's sample count for this eye and profile, spent on a regular grid.
-        "uniform-budget" => {
-            let vp = VisualPolar::new(screen, screen_centre, vp_params).context("Visual-Polar space (the uniform budget's count)")?;
-            Box::new(UniformBudget::with_samples(screen, vp.sample_count())?)
-        }
-        // Weier et al.'s falloff on VP's eccentricity axis with 1.5× its samples (Koskela 2019).
-        "linear-falloff" => Box::new(LinearFalloff::new(screen, vp_params, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).context("linear falloff")?),
-        // VP's samples at random positions drawn from its density (Koskela et al. 2018).
-        "random-acuity" => Box::new(RandomAcuity::new(screen, screen_centre, vp_params).context("random acuity")?),
-        // Mohanto et al.'s pixel / 2×2 / 4×4 regions on VP's eccentricity axis, 4 / 2 / 1 samples.
-        "pixel-blocks" => Box::new(PixelBlocks::new(screen, vp_params, BlockShape::default()).context("pixel blocks")?),
-        other => bail!("--method {other}: expected one of {}", METHODS.join(", ")),
-    })
+    let vp = profile.visual_polar_for(fov).with_context(|| format!("--headset {}", hmd.id))?;
+    method(method_name)?.space(&SpaceInputs { profile, hmd, fov, vp, screen })
 }
 
 /// The eye's name in file names and reports.

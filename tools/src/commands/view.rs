@@ -5,7 +5,7 @@
 //! 0…N−1 exactly as `fovea render` does and saves the last presented image.
 
 use super::render::RenderArgs;
-use super::setup::{space_for, Setup, METHODS};
+use super::setup::{method_names, space_for, Setup};
 use crate::viewer::debug::{compose, DebugView};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -265,7 +265,7 @@ impl Viewer<'_> {
                 event_loop.exit();
                 return Ok(());
             }
-            Key::Character("m") => self.method = next(METHODS, &self.method),
+            Key::Character("m") => self.method = next(&method_names(), &self.method),
             Key::Character("d") => self.denoiser = next(DENOISERS, &self.denoiser),
             Key::Character("t") => self.taa = next(TAAS, &self.taa),
             Key::Character("f") => {
