@@ -10,6 +10,7 @@
 #define FOVEA_VISUAL_POLAR_CLIPPED_GRID_GLSL
 
 #include "visual_polar_clipped.glsl"
+#include "visual_polar_grid_common.glsl"
 
 // Above every binding of the kernels that include this file.
 layout(set = 0, binding = 31) uniform samplerBuffer grid_columns;
@@ -22,22 +23,10 @@ VpArcs vp_column_arcs(uint col) {
 // the circle at a neighbouring radius meets the border a little earlier or later.
 const float GRID_ARC_SLACK_ROWS = 0.5;
 
-struct Grid {
-    ivec2 size;
-    VpParams vp;
-};
-
 Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1, bool previous) {
-    Grid g;
-    g.size = ivec2(grid.xy);
-    g.vp = vp_unpack(grid, gaze, shape0, shape1);
+    Grid g = vp_grid_make(grid, gaze, shape0, shape1);
     g.vp.arcs_base = previous ? grid.x : 0u;
     return g;
-}
-
-// Rows of column `col` that hold samples (as in the paper's layout).
-int grid_rows(Grid g, int col) {
-    return int(vp_rows_in_column(g.vp, uint(col)));
 }
 
 VpArcs grid_arcs(Grid g, int col) {

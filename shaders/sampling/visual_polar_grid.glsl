@@ -6,23 +6,10 @@
 #ifndef FOVEA_VISUAL_POLAR_GRID_GLSL
 #define FOVEA_VISUAL_POLAR_GRID_GLSL
 
-#include "visual_polar_math.glsl"
-
-struct Grid {
-    ivec2 size;
-    VpParams vp;
-};
+#include "visual_polar_grid_common.glsl"
 
 Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1, bool previous) {
-    Grid g;
-    g.size = ivec2(grid.xy);
-    g.vp = vp_unpack(grid, gaze, shape0, shape1);
-    return g;
-}
-
-// Rows of column `col` that hold samples.
-int grid_rows(Grid g, int col) {
-    return int(vp_rows_in_column(g.vp, uint(col)));
+    return vp_grid_make(grid, gaze, shape0, shape1);
 }
 
 // Rows (φ) wrap around; columns (ρ) end at the grid.
