@@ -523,7 +523,7 @@ fn bench_vp_frames_follow_a_camera_path() {
     assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
     let comparators = vp["comparators"].as_array().unwrap();
     let methods: Vec<&str> = comparators.iter().map(|c| c["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["log-polar", "uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-headset"]);
+    assert_eq!(methods, ["log-polar", "uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset"]);
     for c in comparators {
         assert!(c["samples"].as_u64().unwrap() > 0 && c["frame_ms"].as_f64().unwrap() > 0.0 && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0, "{c}");
     }

@@ -45,6 +45,7 @@ fn spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
         ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(size.x as f32 / 2.0)))))),
         ("vp-headset", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp }).unwrap()))),
         ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp }).unwrap()))),
+        ("vp-screen-aware", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { layout: VpLayout::ScreenAware, ..vp }).unwrap()))),
         ("uniform-budget", Box::new(move || Box::new(UniformBudget::with_samples(size, 4000).unwrap()))),
         ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(size, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),
         ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(size, gaze, vp).unwrap()))),
@@ -255,9 +256,10 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The screen-clipped layout under a moving gaze, every grid filter: each frame the gaze moves
-/// (edge → corner → centre), so every column's on-screen arcs change and the history must be
-/// found through the previous frame's arcs (the second half of `DenoiseFrame::sampling_table`).
+/// The screen-clipped layout and the screen-aware axis under a moving gaze, every grid filter:
+/// each frame the gaze moves (edge → corner → centre), so every column's on-screen arcs (and the
+/// screen-aware axis' knots) change and the history must be found through the previous frame's
+/// (the second half of `DenoiseFrame::sampling_table`).
 /// One face-on plane, static camera, radiance a smooth screen pattern plus noise. Each filter must
 /// reduce the noise (≥ 1.15×), stay below a run whose previous-frame half repeats this frame's
 /// arcs — which reprojects the history to the wrong texels wherever a column is clipped (< 0.9×;
@@ -301,14 +303,21 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
     };
     let grid = space(VpLayout::ScreenClipped, 0).grid_size();
     assert_eq!(grid, space(VpLayout::Paper, 0).grid_size());
+    assert_eq!(grid, space(VpLayout::ScreenAware, 0).grid_size());
     let g = GBuffer::with_visibility(&ctx, grid).unwrap();
     upload(&ctx, g.visibility.as_ref().unwrap(), &vec![[0u32; 4]; (grid.x * grid.y) as usize]);
     let mut failures = Vec::new();
-    // (layout, the previous frame's own arcs in the table's second half)
-    let runs = [(VpLayout::ScreenClipped, true), (VpLayout::ScreenClipped, false), (VpLayout::Paper, true)];
+    // (layout, the previous frame's own arcs in the table's second half); the paper layout last.
+    let runs = [
+        (VpLayout::ScreenClipped, true),
+        (VpLayout::ScreenClipped, false),
+        (VpLayout::ScreenAware, true),
+        (VpLayout::ScreenAware, false),
+        (VpLayout::Paper, true),
+    ];
     for (filter, denoiser, taa) in filters().into_iter().filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_))) {
-        let mut errors = [0.0; 3];
-        let mut noise = 0.0;
+        let mut errors = [0.0; 5];
+        let mut noise = [0.0; 5];
         for (run, &(layout, previous_arcs)) in runs.iter().enumerate() {
             let mut f = GridFilter::new(&ctx, &denoiser, taa, &space(layout, 0));
             for frame in 0..FRAMES {
@@ -322,17 +331,18 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
                 if frame == FRAMES - 1 {
                     assert_finite_non_negative(&format!("{layout:?} + {filter}"), &out);
                     errors[run] = error(&vp, &|i| out[i][1]);
-                    if run == 0 {
-                        noise = error(&vp, &|i| input[i].as_ref().map_or(0.0, |t| t.radiance[1]));
-                    }
+                    noise[run] = error(&vp, &|i| input[i].as_ref().map_or(0.0, |t| t.radiance[1]));
                 }
             }
             assert_clean(&ctx);
         }
-        let [right, wrong, paper] = errors;
-        println!("screen-clipped + {filter}, moving gaze: noise {noise:.4} → {right:.4}; with this frame's arcs as the previous frame's {wrong:.4}; paper layout {paper:.4}");
-        if right > noise / 1.15 || right > 0.9 * wrong || right > 1.15 * paper {
-            failures.push(format!("screen-clipped + {filter}: {noise:.4} → {right:.4} (previous arcs ignored: {wrong:.4}, paper layout: {paper:.4})"));
+        let paper = errors[4];
+        for (k, name) in [(0, "screen-clipped"), (2, "screen-aware")] {
+            let (noise, right, wrong) = (noise[k], errors[k], errors[k + 1]);
+            println!("{name} + {filter}, moving gaze: noise {noise:.4} → {right:.4}; with this frame's arcs as the previous frame's {wrong:.4}; paper layout {paper:.4}");
+            if right > noise / 1.15 || right > 0.9 * wrong || right > 1.15 * paper {
+                failures.push(format!("{name} + {filter}: {noise:.4} → {right:.4} (previous arcs ignored: {wrong:.4}, paper layout: {paper:.4})"));
+            }
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

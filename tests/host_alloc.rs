@@ -73,12 +73,14 @@ fn render_loop_makes_no_host_allocations() {
     };
     let vp = || vp_with(VisualPolarParams::default());
     let clipped = VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
+    let screen_aware = VisualPolarParams { layout: VpLayout::ScreenAware, ..Default::default() };
     let fove0 = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
     let headset = VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..Default::default() };
-    let cases: [(&str, Box<dyn SamplingSpace>, &str, &str); 7] = [
+    let cases: [(&str, Box<dyn SamplingSpace>, &str, &str); 8] = [
         ("cartesian", Box::new(Cartesian::new(SCREEN)), "none", "off"),
         ("vp", vp(), "none", "off"),
         ("vp screen-clipped", vp_with(clipped), "none", "off"),
+        ("vp screen-aware + svgf", vp_with(screen_aware), "svgf", "off"),
         ("vp headset axis", vp_with(headset), "none", "off"),
         ("vp svgf + screen TAA", vp(), "svgf", "screen"),
         ("vp asvgf + grid TAA", vp(), "asvgf", "vp"),

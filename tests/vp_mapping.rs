@@ -216,6 +216,7 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
                 (InverseCdf::Exact, VpLayout::Paper),
                 (InverseCdf::Polynomial, VpLayout::ScreenClipped),
                 (InverseCdf::Exact, VpLayout::ScreenClipped),
+                (InverseCdf::Polynomial, VpLayout::ScreenAware),
             ] {
                 let params = VisualPolarParams { inverse_cdf, layout, ..Default::default() };
                 let vp = VisualPolar::new(screen, gaze, params).unwrap();
@@ -229,7 +230,7 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
                 println!("{line}");
                 let phi_ok = match layout {
                     VpLayout::Paper => r.grid_y < GRID_BOUND,
-                    VpLayout::ScreenClipped => r.grid_y_paper_rows < GRID_BOUND,
+                    VpLayout::ScreenClipped | VpLayout::ScreenAware => r.grid_y_paper_rows < GRID_BOUND,
                 };
                 if !(r.screen_px < SCREEN_BOUND_PX && r.grid_x < GRID_BOUND && phi_ok) {
                     failures.push(line);

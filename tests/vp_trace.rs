@@ -201,8 +201,9 @@ fn visual_polar_tracing_counts_samples_and_offscreen() {
     assert_clean(&ctx);
 }
 
-/// The screen-clipped layout: the paper's sample count, and off the screen only samples whose
-/// texel cell reaches past the border (no cell lies wholly off it), a small share.
+/// The screen-clipped layout and the screen-aware axis: the paper's sample count, and off the
+/// screen only samples whose texel cell reaches past the border (no cell lies wholly off it), a
+/// small share.
 #[test]
 fn screen_clipped_layout_keeps_samples_on_screen() {
     let ctx = gpu();
@@ -210,12 +211,14 @@ fn screen_clipped_layout_keeps_samples_on_screen() {
     let gazes = [("centre", SCREEN.as_vec2() * 0.5), ("edge", Vec2::new(3.0, 90.0)), ("corner", Vec2::new(2.0, 2.0))];
     for (name, gaze) in gazes {
         let (paper_share, _, paper_traced) = check_vp_frame(&ctx, &scene, name, gaze, VpLayout::Paper);
-        let (share, cpu, traced) = check_vp_frame(&ctx, &scene, name, gaze, VpLayout::ScreenClipped);
-        println!("gaze {name}: off-screen share paper {:.1} % → screen-clipped {:.2} %", 100.0 * paper_share, 100.0 * share);
-        assert_eq!(traced, paper_traced, "gaze {name}: the same budget");
-        assert_eq!(cpu.centres, 0, "gaze {name}: texel centres lie on their arcs, on the screen");
-        assert_eq!(cpu.cell_all, 0, "gaze {name}: a texel cell wholly off the screen");
-        assert!(share < 0.03, "gaze {name}: {:.2} % off the screen", 100.0 * share);
+        for layout in [VpLayout::ScreenClipped, VpLayout::ScreenAware] {
+            let (share, cpu, traced) = check_vp_frame(&ctx, &scene, name, gaze, layout);
+            println!("gaze {name}: off-screen share paper {:.1} % → {layout:?} {:.2} %", 100.0 * paper_share, 100.0 * share);
+            assert_eq!(traced, paper_traced, "gaze {name} {layout:?}: the same budget");
+            assert_eq!(cpu.centres, 0, "gaze {name} {layout:?}: texel centres lie on their arcs, on the screen");
+            assert_eq!(cpu.cell_all, 0, "gaze {name} {layout:?}: a texel cell wholly off the screen");
+            assert!(share < 0.03, "gaze {name} {layout:?}: {:.2} % off the screen", 100.0 * share);
+        }
     }
     assert_clean(&ctx);
 }

@@ -27,8 +27,8 @@ layout(set = 0, binding = 1, rgba32f) uniform readonly image2D vp_color; // the 
 layout(set = 0, binding = 2, rgba32f) uniform image2D mips;              // all levels, stacked
 layout(set = 0, binding = 3) uniform samplerBuffer vp_columns;           // VisualPolar::column_table
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(vp_columns, int(i));
 }
 
 void main() {

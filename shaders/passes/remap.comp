@@ -32,8 +32,8 @@ layout(set = 0, binding = 1, rgba32f) uniform readonly image2D mips;          //
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D screen_color;
 layout(set = 0, binding = 3) uniform samplerBuffer vp_columns;                // VisualPolar::column_table
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(vp_columns, int(i));
 }
 
 vec4 fetch(uint level, uint height, uint col, uint row) {
@@ -129,7 +129,8 @@ void main() {
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
     // Texel centres at integers; a jittered sample sits sample_offset texels beside its centre.
-    float x = clamp(vp_u_of_r(P, vp_axis_of_offset(P, d, r)) * float(P.grid.x) - 0.5 - push.p.sample_offset.x, 0.0, float(P.grid.x - 1u));
+    float u = VP_LAYOUT_MAY_CLIP ? vp_layout_u_of_r(P, vp_axis_of_offset(P, d, r)) : vp_u_of_r(P, vp_axis_of_offset(P, d, r));
+    float x = clamp(u * float(P.grid.x) - 0.5 - push.p.sample_offset.x, 0.0, float(P.grid.x - 1u));
     uint c0 = uint(x);
     uint c1 = min(c0 + 1u, P.grid.x - 1u);
     uint levels = max(push.p.config.x, 1u);

@@ -14,8 +14,8 @@ layout(std430, set = 0, binding = 1) readonly buffer PointBuffer { vec4 data[]; 
 layout(std430, set = 0, binding = 2) writeonly buffer OutBuffer { vec4 data[]; } mapped;
 layout(set = 0, binding = 3) uniform samplerBuffer vp_columns; // VisualPolar::column_table
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(vp_columns, int(i));
 }
 
 void main() {

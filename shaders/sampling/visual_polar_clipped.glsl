@@ -6,10 +6,11 @@
 // a per-column table (two RGBA32F texels per column: interval starts, cumulative ends), so this
 // file only looks them up.
 //
-// The includer provides the lookup from its own binding (the trace: the `sampling` buffer; the
-// passes back to the screen: a texel buffer):  VpArcs vp_column_arcs(uint col). The table holds
-// this frame's columns, then the previous frame's (the denoisers reproject through those):
-// VpParams.arcs_base picks the frame.
+// The includer provides the table from its own binding (the trace: `sampling_table`; the passes
+// back to the screen: a texel buffer):  vec4 vp_table_texel(uint i). A frame's table is its
+// columns' arcs (2 texels each), then the screen-aware ρ axis' knots (VP_AXIS_KNOT_TEXELS; Rust
+// visual_polar_screen_axis.rs); the view's table holds this frame's, then the previous frame's
+// (the denoisers reproject through those): VpParams.arcs_base picks the frame.
 #ifndef FOVEA_SAMPLING_VISUAL_POLAR_CLIPPED_GLSL
 #define FOVEA_SAMPLING_VISUAL_POLAR_CLIPPED_GLSL
 
@@ -22,7 +23,68 @@ struct VpArcs {
     vec4 end;    // cumulative arc length at each interval's end; end.w = A
 };
 
-VpArcs vp_column_arcs(uint col);
+vec4 vp_table_texel(uint i);
+
+// Rust AXIS_PIECES and AXIS_KNOT_TEXELS (pieces + 1 knots, 4 per texel, padded to whole columns).
+const uint VP_AXIS_PIECES = 128u;
+const int VP_AXIS_SEARCH_STEPS = 7; // log2(VP_AXIS_PIECES)
+const uint VP_AXIS_KNOT_TEXELS = 34u;
+
+// Column slots one frame's table takes: its columns' arcs and the knots (the previous frame's
+// table starts there).
+uint vp_table_frame_columns(uint grid_width) {
+    return grid_width + VP_AXIS_KNOT_TEXELS / 2u;
+}
+
+VpArcs vp_column_arcs(uint col) {
+    return VpArcs(vp_table_texel(2u * col), vp_table_texel(2u * col + 1u));
+}
+
+// Knot j of the screen-aware axis of P's frame: r (pixels) at w = 1 − √(1 − p) = j / VP_AXIS_PIECES.
+float vp_axis_knot(VpParams P, uint j) {
+    return vp_table_texel(2u * (P.arcs_base + P.grid.x) + j / 4u)[j % 4u];
+}
+
+// Rust ScreenAxis::r_of_p: r piecewise linear in w = 1 − √(1 − p), p the periphery fraction
+// (past p = 1: w = 1 + √(p − 1), r along the last piece).
+float vp_axis_r_of_p(VpParams P, float p) {
+    float q = 1.0 - p;
+    float w = 1.0 - (q < 0.0 ? -sqrt(-q) : sqrt(q));
+    float x = w * float(VP_AXIS_PIECES);
+    uint i = uint(clamp(floor(x), 0.0, float(VP_AXIS_PIECES - 1u)));
+    float t = x - float(i);
+    float a = vp_axis_knot(P, i);
+    float b = vp_axis_knot(P, i + 1u);
+    return a + (b - a) * t;
+}
+
+// Rust ScreenAxis::p_of_r: the piece holding r by halving, then linear inside it.
+float vp_axis_p_of_r(VpParams P, float r) {
+    uint lo = 0u;
+    uint hi = VP_AXIS_PIECES;
+    for (int s = 0; s < VP_AXIS_SEARCH_STEPS; ++s) {
+        uint mid = (lo + hi) / 2u;
+        if (vp_axis_knot(P, mid) <= r) lo = mid;
+        else hi = mid;
+    }
+    float a = vp_axis_knot(P, lo);
+    float b = vp_axis_knot(P, lo + 1u);
+    float t = b > a ? (r - a) / (b - a) : 0.0;
+    float v = 1.0 - (float(lo) + t) / float(VP_AXIS_PIECES);
+    return 1.0 - (v < 0.0 ? -(v * v) : v * v);
+}
+
+// The layout's ρ axis (Rust VisualPolar::r_of_u / u_of_r): the paper's, or past the fovea the
+// screen-aware axis' knots.
+float vp_layout_r_of_u(VpParams P, float u) {
+    if (P.screen_axis && u >= P.u_f) return vp_axis_r_of_p(P, (u - P.u_f) / (1.0 - P.u_f));
+    return vp_r_of_u(P, u);
+}
+
+float vp_layout_u_of_r(VpParams P, float r) {
+    if (P.screen_axis && r >= P.r_f) return P.u_f + vp_axis_p_of_r(P, r) * (1.0 - P.u_f);
+    return vp_u_of_r(P, r);
+}
 
 float vp_arcs_total(VpArcs c) {
     return c.end.w;
@@ -103,7 +165,7 @@ vec2 vp_clipped_vp_to_screen(VpParams P, vec2 g) {
     float n = float(vp_rows_in_column(P, col));
     VpArcs arcs = vp_column_arcs(P.arcs_base + col);
     float phi = vp_phi_of_arc(arcs, g.y / n * vp_arcs_total(arcs));
-    float r = vp_r_of_u(P, g.x / float(P.grid.x));
+    float r = vp_layout_r_of_u(P, g.x / float(P.grid.x));
     return P.gaze + r * vec2(cos(phi), sin(phi));
 }
 
@@ -113,7 +175,7 @@ vec2 vp_clipped_screen_to_vp(VpParams P, vec2 s) {
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;
     if (phi < 0.0) phi += VP_TAU;
-    float x = vp_u_of_r(P, r) * float(P.grid.x);
+    float x = vp_layout_u_of_r(P, r) * float(P.grid.x);
     uint col = vp_column_of(P, x);
     float n = float(vp_rows_in_column(P, col));
     VpArcs arcs = vp_column_arcs(P.arcs_base + col);

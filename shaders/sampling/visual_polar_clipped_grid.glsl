@@ -15,8 +15,8 @@
 // Above every binding of the kernels that include this file.
 layout(set = 0, binding = 31) uniform samplerBuffer grid_columns;
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(grid_columns, int(2u * col)), texelFetch(grid_columns, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(grid_columns, int(i));
 }
 
 // An angle off the other column's arcs by up to this many of its rows still lands on its end row:
@@ -25,7 +25,7 @@ const float GRID_ARC_SLACK_ROWS = 0.5;
 
 Grid grid_make(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1, bool previous) {
     Grid g = vp_grid_make(grid, gaze, shape0, shape1);
-    g.vp.arcs_base = previous ? grid.x : 0u;
+    g.vp.arcs_base = previous ? vp_table_frame_columns(grid.x) : 0u;
     return g;
 }
 

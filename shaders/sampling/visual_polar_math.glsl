@@ -56,7 +56,8 @@ struct VpParams {
     float e_max;     // where the CDF is normalised: 80 (headset: the farthest corner's true eccentricity)
     float cdf_max;   // cdf(e_max, k)
     bool exact;      // exact inverse CDF instead of the paper's quartic
-    bool clipped;    // screen-clipped layout: map with visual_polar_clipped.glsl (vp_layout_*)
+    bool clipped;    // rows on the on-screen arcs: map with visual_polar_clipped.glsl (vp_layout_*)
+    bool screen_axis; // screen-aware ρ axis: the periphery through the table's knots (visual_polar_clipped.glsl)
     bool headset;    // true-eccentricity axis through the FOV tangents
     vec2 gaze_tan;   // headset: the gaze in tangent space
     vec2 tan_scale;  // headset: tangent units per pixel
@@ -138,7 +139,7 @@ float vp_cdf_derivative(float d, float k) {
 }
 
 // Slots as packed by VisualPolar::sampling_params(): grid = (grid w, grid h, screen w, screen h),
-// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis, 8 log-polar
+// shape1.y = flags (1 exact inverse CDF, 2 screen-clipped layout, 4 headset axis, 16 screen-aware ρ axis, 8 log-polar
 // law: shape1.zw = (α, L)), and
 // - paper axis: gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
 //   shape1 = (cdf_max, flags, fovea° (unused here), 0);
@@ -157,6 +158,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.r_f = shape0.z;
     p.exact = (flags & 1u) != 0u;
     p.clipped = (flags & 2u) != 0u;
+    p.screen_axis = (flags & 16u) != 0u;
     p.headset = VP_MAY_USE_HEADSET_AXIS && (flags & 4u) != 0u;
     p.r_max = p.headset ? 1.0 : gaze.z;
     p.e_norm = p.headset ? 1.0 : shape0.w;

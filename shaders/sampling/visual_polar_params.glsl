@@ -5,11 +5,11 @@
 
 #include "visual_polar_clipped.glsl"
 
-// Per-column arcs of the layout (VisualPolar::column_table, two RGBA32F texels per column).
+// The layout's table (VisualPolar::column_table: per-column arcs, then the screen-aware axis' knots).
 layout(set = 0, binding = 18) uniform samplerBuffer sampling_table;
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(sampling_table, int(2u * col)), texelFetch(sampling_table, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(sampling_table, int(i));
 }
 
 VpParams sampling_vp_params() {

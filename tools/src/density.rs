@@ -228,7 +228,7 @@ pub fn density_plot(path: &Path, vp: &VisualPolar, rings: usize) -> Result<()> {
         // What the screen-clipped layout buys: the paper's layout at the same gaze.
         let paper = VisualPolar::new(screen, vp.gaze(), VisualPolarParams { layout: VpLayout::Paper, ..*vp.params() })?;
         let paper_map: Vec<f64> = samples_per_pixel(&paper).iter().map(|&c| c as f64).collect();
-        series[0].label = "Visual-Polar, screen-clipped (measured)".into();
+        series[0].label = format!("Visual-Polar, {} (measured)", crate::render_profile::layout_name(vp.params().layout));
         series.push(per_ring("Visual-Polar, paper's layout (measured)", &paper_map));
     }
     let title = format!("Sample density, {}×{}, gaze ({:.0}, {:.0})", screen.x, screen.y, vp.gaze().x, vp.gaze().y);
@@ -353,6 +353,40 @@ mod tests {
         assert!(whole[0].gain() > 3.5, "whole screen: gain {}", whole[0].gain());
         let total = |s: &VisualPolar| samples_per_pixel(s).iter().map(|&c| c as f64).sum::<f64>();
         assert_eq!(total(&clipped), clipped.sample_count() as f64, "every texel centre lands on the screen");
+    }
+
+    /// The screen-aware ρ axis against the screen-clipped layout, gaze in a corner of the FOVE eye:
+    /// samples per pixel / V(e) is flat beyond the fovea (the acuity target) instead of rising
+    /// again in the outermost rings, and the outermost rings give their samples back to the rest.
+    #[test]
+    fn screen_aware_density_follows_acuity() {
+        let (screen, gaze) = (UVec2::new(1280, 1440), Vec2::new(10.0, 10.0));
+        let space = |layout| VisualPolar::new(screen, gaze, VisualPolarParams { layout, ..Default::default() }).unwrap();
+        let (aware, clipped) = (space(VpLayout::ScreenAware), space(VpLayout::ScreenClipped));
+        assert_eq!(aware.sample_count(), clipped.sample_count());
+        let gains = ring_density_gain(&aware, &clipped, 16);
+        println!("eccentricity | pixels | screen-clipped spp | screen-aware spp | spp / V(e) (screen-aware, screen-clipped)");
+        let per_acuity = |g: &RingGain, d: f64| d / acuity(0.5 * (g.e_lo + g.e_hi));
+        for g in &gains[..gains.len() - 1] {
+            println!(
+                "{:>4.0}–{:<3.0}° | {:>7} | {:>9.3} | {:>9.3} | {:.5} {:.5}",
+                g.e_lo, g.e_hi, g.pixels, g.baseline, g.density, per_acuity(g, g.density), per_acuity(g, g.baseline)
+            );
+        }
+        // Rings beyond 10° (past the fovea and its edge ring), whole rings of the acuity target.
+        let periphery: Vec<&RingGain> = gains[..gains.len() - 1].iter().filter(|g| g.e_lo >= 10.0).collect();
+        let spread = |d: &dyn Fn(&RingGain) -> f64| {
+            let v: Vec<f64> = periphery.iter().map(|g| per_acuity(g, d(g))).collect();
+            v.iter().cloned().fold(0.0, f64::max) / v.iter().cloned().fold(f64::INFINITY, f64::min)
+        };
+        let (aware_spread, clipped_spread) = (spread(&|g| g.density), spread(&|g| g.baseline));
+        println!("spp / V(e) max/min beyond 10°: screen-aware {aware_spread:.2}, screen-clipped {clipped_spread:.2}");
+        assert!(aware_spread < 1.35, "screen-aware: spp / V(e) varies {aware_spread}× beyond 10°");
+        assert!(clipped_spread > 3.0, "the screen-clipped layout's outer rings were expected to rise: {clipped_spread}");
+        let outermost = periphery.last().unwrap();
+        assert!(outermost.gain() < 0.5, "75–80°: {} of the screen-clipped density", outermost.gain());
+        let total = |s: &VisualPolar| samples_per_pixel(s).iter().map(|&c| c as f64).sum::<f64>();
+        assert!(total(&aware) > 0.99 * aware.sample_count() as f64, "texel centres land on the screen");
     }
 
     #[test]

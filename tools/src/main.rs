@@ -180,7 +180,8 @@ struct RenderOpts {
     /// VP radius: corner (largest gaze-to-corner distance, default) or pixels.
     #[arg(long)]
     vp_radius: Option<String>,
-    /// VP layout: paper (default) or screen-clipped (each column's rows on its on-screen arcs).
+    /// VP layout: paper (default), screen-clipped (each column's rows on its on-screen arcs) or
+    /// screen-aware (screen-clipped rows, columns placed by the on-screen acuity mass).
     #[arg(long)]
     vp_layout: Option<String>,
     /// VP eccentricity axis: normalized (the paper's, 80 ↦ farthest corner; default) or headset

@@ -226,7 +226,8 @@ pub fn parse_layout(s: &str) -> Result<VpLayout> {
     match s {
         "paper" => Ok(VpLayout::Paper),
         "screen-clipped" => Ok(VpLayout::ScreenClipped),
-        other => bail!("'{other}' is not a Visual-Polar layout (paper | screen-clipped)"),
+        "screen-aware" => Ok(VpLayout::ScreenAware),
+        other => bail!("'{other}' is not a Visual-Polar layout (paper | screen-clipped | screen-aware)"),
     }
 }
 
@@ -235,6 +236,7 @@ pub fn layout_name(layout: VpLayout) -> &'static str {
     match layout {
         VpLayout::Paper => "paper",
         VpLayout::ScreenClipped => "screen-clipped",
+        VpLayout::ScreenAware => "screen-aware",
     }
 }
 

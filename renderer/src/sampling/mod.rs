@@ -14,6 +14,7 @@ mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
+mod visual_polar_screen_axis;
 
 pub use cartesian::Cartesian;
 pub use composite::{CompositeMode, CompositeParams};
@@ -25,6 +26,7 @@ pub use uniform_budget::UniformBudget;
 pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
+pub use visual_polar_screen_axis::{ScreenAxis, AXIS_KNOT_TEXELS, AXIS_PIECES};
 
 use crate::error::Result;
 use crate::layouts::SamplingParams;

@@ -17,7 +17,8 @@
 //!
 //! That is the paper's layout (`VpLayout::Paper`, the default). `VpLayout::ScreenClipped` keeps
 //! the grid and the row counts but lays each column's rows on the on-screen part of its circle
-//! only: `visual_polar_clipped.rs`.
+//! only: `visual_polar_clipped.rs`. `VpLayout::ScreenAware` adds a ρ axis placed by the on-screen
+//! acuity mass: `visual_polar_screen_axis.rs`.
 //!
 //! The ρ axis is the paper's normalised eccentricity by default (`Eccentricity::Normalized`).
 //! `Eccentricity::Headset` makes it the true eccentricity in degrees through the eye's FOV
@@ -33,6 +34,7 @@
 use super::composite::CompositeParams;
 use super::log_polar::{LogPolarLaw, LogPolarParams};
 use super::visual_polar_headset::{FovTangents, HeadsetAxis};
+use super::visual_polar_screen_axis::ScreenAxis;
 use super::acuity::*;
 use super::SamplingSpace;
 use crate::error::{Error, Result};
@@ -47,6 +49,7 @@ const FLAG_EXACT: u32 = 1;
 const FLAG_CLIPPED: u32 = 2;
 const FLAG_HEADSET: u32 = 4;
 const FLAG_LOG_POLAR: u32 = 8;
+const FLAG_SCREEN_AXIS: u32 = 16;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InverseCdf {
@@ -76,6 +79,17 @@ pub enum VpLayout {
     /// radius): same grid, same rows per column, the whole budget on the screen
     /// (`visual_polar_clipped.rs`).
     ScreenClipped,
+    /// The screen-clipped rows with the periphery's columns placed by the acuity mass on the
+    /// screen, so samples per pixel follow acuity everywhere on it
+    /// (`visual_polar_screen_axis.rs`).
+    ScreenAware,
+}
+
+impl VpLayout {
+    /// Whether rows are laid on the on-screen arcs only (both screen layouts).
+    pub fn clips(self) -> bool {
+        self != VpLayout::Paper
+    }
 }
 
 /// How a column's normalised position u maps to a distance from the gaze.
@@ -227,6 +241,8 @@ pub struct VisualPolar {
     r_corner_px: f32,
     /// The log-polar law (`RadialLaw::LogPolar`), for this gaze.
     log_polar: Option<LogPolarLaw>,
+    /// The periphery's ρ axis by on-screen acuity mass (`VpLayout::ScreenAware`), for this gaze.
+    screen_axis: Option<ScreenAxis>,
 }
 
 impl VisualPolar {
@@ -285,7 +301,7 @@ impl VisualPolar {
             }
             Some(axis) => (cdf(axis.e_max, k), 1.0, params.fovea_deg, 1.0),
         };
-        let vp = Self {
+        let mut vp = Self {
             screen,
             gaze,
             params,
@@ -305,7 +321,12 @@ impl VisualPolar {
             headset,
             r_corner_px,
             log_polar,
+            screen_axis: None,
         };
+        if params.layout == VpLayout::ScreenAware {
+            // No mass beyond the fovea on the screen (a screen inside the fovea): the paper's axis.
+            vp.screen_axis = ScreenAxis::new(gaze, screen, vp.r_f, vp.r_max, vp.e_norm / vp.r_max, params.density_exponent);
+        }
         if let Some(axis) = headset {
             if !axis.e_max.is_finite() || axis.e_max <= params.fovea_deg {
                 return Err(invalid(format!(
@@ -371,6 +392,12 @@ impl VisualPolar {
     /// The log-polar law, with `RadialLaw::LogPolar`.
     pub fn log_polar(&self) -> Option<&LogPolarLaw> {
         self.log_polar.as_ref()
+    }
+
+    /// The screen-aware ρ axis, with `VpLayout::ScreenAware` (unless no acuity mass lies on the
+    /// screen beyond the fovea).
+    pub fn screen_axis(&self) -> Option<&ScreenAxis> {
+        self.screen_axis.as_ref()
     }
 
     /// The tangent-space geometry, with `Eccentricity::Headset`.
@@ -443,6 +470,9 @@ impl VisualPolar {
         if u < self.u_f {
             return u / self.u_f * self.r_f;
         }
+        if let Some(axis) = &self.screen_axis {
+            return axis.r_of_p((u - self.u_f) / (1.0 - self.u_f));
+        }
         let e = if self.exact {
             // The tail fraction 1 − p straight from u (see `inverse_cdf_exact`).
             let q = (1.0 - u) / (1.0 - self.u_f) * (1.0 - self.p_f);
@@ -484,6 +514,9 @@ impl VisualPolar {
         if r < self.r_f {
             return r / self.r_f * self.u_f;
         }
+        if let Some(axis) = &self.screen_axis {
+            return self.u_f + axis.p_of_r(r) * (1.0 - self.u_f);
+        }
         let e = r / self.r_max * self.e_norm;
         if self.exact {
             // Through the tail, like r_of_u, so both directions stay well conditioned at e_max.
@@ -510,7 +543,7 @@ impl VisualPolar {
     pub fn screen_to_vp(&self, s: Vec2) -> Vec2 {
         match self.params.layout {
             VpLayout::Paper => self.paper_screen_to_vp(s),
-            VpLayout::ScreenClipped => self.clipped_screen_to_vp(s),
+            VpLayout::ScreenClipped | VpLayout::ScreenAware => self.clipped_screen_to_vp(s),
         }
     }
 
@@ -519,7 +552,7 @@ impl VisualPolar {
     pub fn vp_to_screen(&self, g: Vec2) -> Vec2 {
         match self.params.layout {
             VpLayout::Paper => self.paper_vp_to_screen(g),
-            VpLayout::ScreenClipped => self.clipped_vp_to_screen(g),
+            VpLayout::ScreenClipped | VpLayout::ScreenAware => self.clipped_vp_to_screen(g),
         }
     }
 
@@ -548,7 +581,8 @@ impl VisualPolar {
     /// The parameters as the GPU gets them (binding `sampling`; unpacked by `vp_unpack` in
     /// `visual_polar_math.glsl`, which derives r_max = e_norm = 1 for the headset axis):
     /// grid = (grid w, grid h, screen w, screen h), shape1.y = flags (1 exact inverse CDF,
-    /// 2 screen-clipped layout, 4 headset axis), and by axis
+    /// 2 rows on the on-screen arcs, 4 headset axis, 8 log-polar law, 16 the screen-aware ρ axis,
+    /// its knots in the sampling table), and by axis
     /// - paper (normalised): gaze = (x, y, r_max, k), shape0 = (u_f, p_f, r_f, e_norm),
     ///   shape1 = (cdf_max, flags, fovea° (informative), 0);
     /// - headset: gaze = (x, y, G.x, k), shape0 = (u_f, p_f, fovea°, G.y),
@@ -556,7 +590,8 @@ impl VisualPolar {
     ///   units per pixel; the GPU derives cdf_max = cdf(e_max, k) as `new` does).
     pub fn sampling_params(&self) -> SamplingParams {
         let flags = self.exact as u32 * FLAG_EXACT
-            + (self.params.layout == VpLayout::ScreenClipped) as u32 * FLAG_CLIPPED
+            + self.params.layout.clips() as u32 * FLAG_CLIPPED
+            + self.screen_axis.is_some() as u32 * FLAG_SCREEN_AXIS
             + self.headset.is_some() as u32 * FLAG_HEADSET
             + self.log_polar.is_some() as u32 * FLAG_LOG_POLAR;
         let grid = UVec4::new(self.grid.x, self.grid.y, self.screen.x, self.screen.y);
@@ -608,6 +643,7 @@ impl SamplingSpace for VisualPolar {
             (_, Some(_)) => "log-polar",
             _ if self.headset.is_some() => "vp-headset",
             _ if self.params.layout == VpLayout::ScreenClipped => "vp-screen-clipped",
+            _ if self.params.layout == VpLayout::ScreenAware => "vp-screen-aware",
             _ => "vp",
         }
     }
@@ -616,7 +652,7 @@ impl SamplingSpace for VisualPolar {
     fn shader_variant(&self) -> &'static str {
         match self.params.layout {
             VpLayout::Paper => "visual_polar",
-            VpLayout::ScreenClipped => "visual_polar_clipped",
+            VpLayout::ScreenClipped | VpLayout::ScreenAware => "visual_polar_clipped",
         }
     }
     /// `visual_polar`: specialised for the paper's layout and normalised axis; `log_polar`: the

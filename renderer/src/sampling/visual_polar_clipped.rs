@@ -11,6 +11,7 @@
 //! starting at φ = 0, which is exactly the paper's layout, φ wrapping.
 
 use super::visual_polar::{VisualPolar, VpLayout};
+use super::visual_polar_screen_axis::AXIS_KNOT_TEXELS;
 use glam::{UVec2, Vec2};
 use std::f32::consts::TAU;
 
@@ -220,15 +221,17 @@ impl VisualPolar {
     pub fn column_arcs(&self, col: u32) -> ColumnArcs {
         match self.params().layout {
             VpLayout::Paper => ColumnArcs::FULL,
-            VpLayout::ScreenClipped => {
+            VpLayout::ScreenClipped | VpLayout::ScreenAware => {
                 let u_c = (col as f32 + 0.5) / self.grid_size().x as f32;
                 on_screen_arcs(self.gaze(), self.r_of_u(u_c), self.screen())
             }
         }
     }
 
-    /// The per-column table the GPU reads, two RGBA32F texels per column (`ColumnArcs::texels`);
-    /// GLSL looks it up through `vp_column_arcs`. Recomputed whenever the gaze moves.
+    /// The per-column table the GPU reads: two RGBA32F texels per column (`ColumnArcs::texels`),
+    /// then the screen-aware axis' knots (`AXIS_KNOT_TEXELS` texels, zero in the other layouts);
+    /// GLSL looks them up through `vp_column_arcs` and `vp_axis_knot`. Recomputed whenever the
+    /// gaze moves.
     pub fn column_table(&self) -> Vec<[f32; 4]> {
         let mut table = Vec::new();
         self.write_column_table(&mut table);
@@ -239,6 +242,10 @@ impl VisualPolar {
     pub fn write_column_table(&self, out: &mut Vec<[f32; 4]>) {
         out.clear();
         out.extend((0..self.grid_size().x).flat_map(|c| self.column_arcs(c).texels()));
+        match self.screen_axis() {
+            Some(axis) => out.extend(axis.texels()),
+            None => out.extend([[0.0; 4]; AXIS_KNOT_TEXELS]),
+        }
     }
 
     /// Grid → screen in the screen-clipped layout (GLSL `vp_clipped_vp_to_screen`): row y of a
@@ -361,7 +368,8 @@ mod tests {
                 assert_eq!(vp.sample_count(), paper.sample_count());
                 assert!(crate::sampling::params_select_clipped_layout(&vp.sampling_params()));
                 assert!(!crate::sampling::params_select_clipped_layout(&paper.sampling_params()));
-                assert!(paper.column_table().chunks(2).all(|t| t[0] == [0.0; 4] && t[1] == [TAU; 4]));
+                let columns = 2 * paper.grid_size().x as usize;
+                assert!(paper.column_table()[..columns].chunks(2).all(|t| t[0] == [0.0; 4] && t[1] == [TAU; 4]));
                 let (grid, mut off, mut full_columns) = (vp.grid_size(), 0, 0);
                 for x in 0..grid.x {
                     let arcs = vp.column_arcs(x);

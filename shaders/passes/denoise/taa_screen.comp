@@ -35,8 +35,8 @@ layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D history;       /
 #if defined(VP_LAYOUT_CLIPPED)
 layout(set = 0, binding = 6) uniform samplerBuffer vp_columns;                // VisualPolar::column_table
 
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(texelFetch(vp_columns, int(2u * col)), texelFetch(vp_columns, int(2u * col + 1u)));
+vec4 vp_table_texel(uint i) {
+    return texelFetch(vp_columns, int(i));
 }
 
 vec2 to_screen(VpParams P, vec2 g) {
@@ -47,8 +47,9 @@ vec2 to_grid(VpParams P, vec2 s) {
     return vp_layout_screen_to_vp(P, s);
 }
 #else
-VpArcs vp_column_arcs(uint col) {
-    return VpArcs(vec4(0.0), vec4(VP_TAU));
+// The paper's layout: every column a full circle (starts 0, ends 2π), no knots.
+vec4 vp_table_texel(uint i) {
+    return (i & 1u) == 0u ? vec4(0.0) : vec4(VP_TAU);
 }
 
 vec2 to_screen(VpParams P, vec2 g) {

@@ -47,7 +47,7 @@ pub struct VpFrameReport {
     /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
     /// frames above, no denoiser, each with its paper's defaults (`comparator_spaces`):
     /// `log-polar`, `uniform-budget`, `linear-falloff` (samples: the expected count), `random-acuity`,
-    /// `pixel-blocks`, `composite`, and VP's variants (`vp-screen-clipped`, `vp-headset`: the FOVE 0's FOV).
+    /// `pixel-blocks`, `composite`, and VP's variants (`vp-screen-clipped`, `vp-screen-aware`, `vp-headset`: the FOVE 0's FOV).
     pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
@@ -162,8 +162,10 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<
         Box::new(PixelBlocks::new(screen, *vp.params(), BlockShape::default())?),
         // A 90° eye: the gaze disc's viewing distance is half the width.
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::default().params(screen.x as f32 / 2.0)), ..Default::default() })?),
-        // Visual-Polar's variants: the screen-clipped layout and the FOVE 0's headset axis.
+        // Visual-Polar's variants: the screen-clipped layout, the screen-aware axis and the FOVE 0's
+        // headset axis.
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..*vp.params() })?),
+        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenAware, ..*vp.params() })?),
         Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0_fov()?), ..*vp.params() })?),
     ])
 }

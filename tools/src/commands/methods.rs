@@ -30,6 +30,7 @@ pub enum ScreenNeeds {
 pub enum VpVariant {
     Profile,
     ScreenClipped,
+    ScreenAware,
     Headset,
 }
 
@@ -153,6 +154,13 @@ pub const METHODS: &[Method] = &[
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::ScreenClipped),
         build: |i| i.visual_polar(VisualPolarParams { layout: VpLayout::ScreenClipped, ..i.vp }, "Visual-Polar space, screen-clipped layout"),
+    },
+    Method {
+        name: "vp-screen-aware",
+        screen: ScreenNeeds::VisualPolarGrid,
+        blurs: true,
+        report: ReportSection::VisualPolar(VpVariant::ScreenAware),
+        build: |i| i.visual_polar(VisualPolarParams { layout: VpLayout::ScreenAware, ..i.vp }, "Visual-Polar space, screen-aware axis"),
     },
     Method {
         name: "vp-headset",

@@ -128,7 +128,7 @@ struct VpReport {
     density_exponent: f32,
     inverse_cdf: String,
     radius: String,
-    /// "paper" or "screen-clipped".
+    /// "paper", "screen-clipped" or "screen-aware".
     layout: String,
     /// The ρ axis: "normalized" (the paper's) or "headset" (true degrees through the eye's FOV).
     eccentricity: String,
@@ -345,7 +345,7 @@ impl FrameWriter<'_> {
 }
 
 /// `variant`: the profile's Visual-Polar, or a variant that sets the layout or the axis whatever
-/// the profile says (`vp-screen-clipped`, `vp-headset`).
+/// the profile says (`vp-screen-clipped`, `vp-screen-aware`, `vp-headset`).
 fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
     use fovea_renderer::sampling::{InverseCdf, RadiusMode};
     let p = &profile.visual_polar;
@@ -364,7 +364,11 @@ fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
             RadiusMode::FarthestCorner => "corner".into(),
             RadiusMode::Fixed(r) => format!("{r}"),
         },
-        layout: if variant == VpVariant::ScreenClipped { "screen-clipped".into() } else { crate::render_profile::layout_name(p.layout).into() },
+        layout: match variant {
+            VpVariant::ScreenClipped => "screen-clipped".into(),
+            VpVariant::ScreenAware => "screen-aware".into(),
+            _ => crate::render_profile::layout_name(p.layout).into(),
+        },
         eccentricity: if headset { "headset".into() } else { crate::render_profile::eccentricity_name(profile.eccentricity).into() },
     }
 }
