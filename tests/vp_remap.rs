@@ -9,6 +9,7 @@
 use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::blur::{BlurPass, BlurShape};
+use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
 use fovea_renderer::passes::remap::RemapPass;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
@@ -294,7 +295,7 @@ fn blur(ctx: &Arc<Context>, shape: &BlurShape, src: &[[f32; 4]]) -> Vec<[f32; 4]
     let pass = BlurPass::new(ctx).unwrap();
     let mut rec = FrameRecorder::new(ctx, 4).unwrap();
     rec.begin().unwrap();
-    pass.record(&mut rec, shape, &a, &b, &c).unwrap();
+    pass.record(&mut rec, shape, &a, &b, fovea_renderer::passes::blur::BlurTarget::Radiance(&c)).unwrap();
     rec.submit_and_wait().unwrap();
     read_image(ctx, &c)
 }
@@ -393,6 +394,38 @@ fn visual_polar_frame_matches_cartesian_on_average() {
     println!("mean radiance VP {vp_mean:?} vs Cartesian {cart_mean:?}");
     for c in 0..3 {
         assert!((vp_mean[c] / cart_mean[c] - 1.0).abs() < 0.04, "channel {c}: {} vs {}", vp_mean[c], cart_mean[c]);
+    }
+    assert_clean(&ctx);
+}
+
+/// Without a radiance read-back the blur's last axis writes the display image itself (pass
+/// `blur_v_tonemap`, no `blur_v` or `tonemap`): byte for byte the picture of the blur into
+/// radiance followed by the tonemap pass, at the centre and in a corner, with and without
+/// screen-space TAA.
+#[test]
+fn fused_blur_and_tonemap_match_the_separate_passes() {
+    let ctx = gpu();
+    let scene = fovea_tests::owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    for (gaze, taa) in [(SCREEN.as_vec2() * 0.5, TaaMode::Off), (Vec2::new(10.0, 90.0), TaaMode::Screen(Default::default()))] {
+        let render = |read_hdr: bool| {
+            let vp = VisualPolar::new(SCREEN, gaze, VisualPolarParams::default()).unwrap();
+            let settings = RenderSettings { taa, ..Default::default() };
+            let mut r = Renderer::new(&ctx, &scene, Box::new(vp), settings).unwrap();
+            let mut ldr = Vec::new();
+            for frame in 0..2 {
+                r.render_frame(&FrameInput::mono(camera, frame, Some(gaze)).with_hdr(read_hdr)).unwrap();
+            }
+            r.read_ldr(&mut ldr).unwrap();
+            let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
+            (ldr, names)
+        };
+        let ((fused, fused_passes), (separate, separate_passes)) = (render(false), render(true));
+        assert!(fused_passes.contains(&"blur_v_tonemap") && !fused_passes.contains(&"tonemap") && !fused_passes.contains(&"blur_v"), "{fused_passes:?}");
+        assert!(separate_passes.contains(&"blur_v") && separate_passes.contains(&"tonemap"), "{separate_passes:?}");
+        assert!(fused.iter().any(|&v| v > 0), "a black frame");
+        let differing = fused.iter().zip(&separate).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "gaze {gaze} {taa:?}: {differing} bytes differ");
     }
     assert_clean(&ctx);
 }

@@ -11,9 +11,9 @@ use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use crate::passes::tonemap::{LdrTarget, TonemapPass, ToneCurve};
+use crate::passes::tonemap::{LdrTarget, ToneCurve, TonemapPass, ToneTarget};
 use crate::sampling::SamplingSpace;
-use crate::to_screen::BlurSettings;
+use crate::to_screen::{BlurSettings, ScreenOut};
 use crate::passes::splat::SplatInputs;
 use crate::view::{BackPasses, View};
 use crate::scene::{Camera, Scene};
@@ -701,37 +701,47 @@ fn record_view(
         has_previous: denoise_frame.previous.is_some(),
         jitter,
     });
-    let screen_hdr = match (&mut view.back, view.space.visual_polar()) {
-        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref())?,
+    let display = ToneTarget {
+        ldr: match external {
+            Some((image, offset)) => LdrTarget::External { image, offset },
+            None => LdrTarget::Own(&view.ldr),
+        },
+        exposure: settings.exposure,
+        curve: settings.tone_curve,
+    };
+    // Unless the frame's radiance is read back, the remap's blur writes the display image itself
+    // (one full-screen pass fewer).
+    let fused = (!input.read_hdr).then_some(display);
+    let screen = match (&mut view.back, view.space.visual_polar()) {
+        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref(), fused)?,
         (BackPasses::Upscale(upscale, screen), _) => {
             upscale.record(rec, grid_hdr, screen)?;
-            screen
+            ScreenOut::Radiance(screen)
         }
-        (BackPasses::Fill(fill), _) => fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?,
+        (BackPasses::Fill(fill), _) => ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?),
         (BackPasses::BlockFill(fill, screen), _) => {
             fill.record(rec, &s.sampling, grid_hdr, screen)?;
-            screen
+            ScreenOut::Radiance(screen)
         }
         (BackPasses::Splat(splat, fill), _) => {
             let inputs = SplatInputs { frame_data: &s.frame_data, sampling: &s.sampling, sampling_table: &s.sampling_table };
             let sparse = splat.record(rec, &inputs, grid_hdr)?;
-            fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?
+            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?)
         }
-        _ => grid_hdr,
+        _ => ScreenOut::Radiance(grid_hdr),
     };
-    let (exposure, curve) = (settings.exposure, settings.tone_curve);
-    match external {
-        Some((image, offset)) => tonemap.record(rec, "tonemap", screen_hdr, LdrTarget::External { image, offset }, exposure, curve)?,
-        None => {
-            tonemap.record(rec, "tonemap", screen_hdr, LdrTarget::Own(&view.ldr), exposure, curve)?;
-            rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
+    if let ScreenOut::Radiance(screen_hdr) = screen {
+        tonemap.record(rec, "tonemap", screen_hdr, &display)?;
+        if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {
+            rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
         }
     }
-    if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {
-        rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+    if external.is_none() {
+        rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
     }
     if let (true, Some(b)) = (input.read_grid, &s.grid_readback) {
-        tonemap.record(rec, "tonemap_grid", grid_hdr, LdrTarget::Own(&view.grid_ldr), exposure, curve)?;
+        let grid_target = ToneTarget { ldr: LdrTarget::Own(&view.grid_ldr), ..display };
+        tonemap.record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
         rec.copy_image_to_buffer("readback_grid", &view.grid_ldr, b)?;
     }
     Ok(())

@@ -4,11 +4,12 @@
 
 use crate::error::Result;
 use crate::graph::FrameRecorder;
-use crate::passes::blur::{BlurPass, BlurShape};
+use crate::passes::blur::{BlurPass, BlurShape, BlurTarget};
 use crate::passes::denoise::taa::TaaSettings;
 use crate::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
 use crate::passes::mip_phi::{MipPhiPass, PhiMips};
 use crate::passes::remap::RemapPass;
+use crate::passes::tonemap::ToneTarget;
 use crate::sampling::VisualPolar;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
@@ -50,6 +51,13 @@ impl BlurSettings {
     }
 }
 
+/// What a way back leaves: radiance on the screen to tone-map, or the display image already
+/// written (the blur's last axis wrote it).
+pub enum ScreenOut<'a> {
+    Radiance(&'a Image),
+    Shown,
+}
+
 /// The foveated blur at the end of a way back, with its screen-sized scratch and output.
 pub struct FoveatedBlur {
     pass: BlurPass,
@@ -69,8 +77,27 @@ impl FoveatedBlur {
         if settings.sigma_at_30 <= 0.0 {
             return Ok(src);
         }
-        self.pass.record(rec, &settings.shape(axis), src, &self.scratch, &self.blurred)?;
+        self.pass.record(rec, &settings.shape(axis), src, &self.scratch, BlurTarget::Radiance(&self.blurred))?;
         Ok(&self.blurred)
+    }
+
+    /// As `record`, but with a `display` target the last axis writes the display image itself
+    /// (σ 0: `src` is left to tone-map as before).
+    pub fn record_to<'a>(
+        &'a self,
+        rec: &mut FrameRecorder,
+        settings: &BlurSettings,
+        axis: &VisualPolar,
+        src: &'a Image,
+        display: Option<ToneTarget>,
+    ) -> Result<ScreenOut<'a>> {
+        match display {
+            Some(target) if settings.sigma_at_30 > 0.0 => {
+                self.pass.record(rec, &settings.shape(axis), src, &self.scratch, BlurTarget::Display(target))?;
+                Ok(ScreenOut::Shown)
+            }
+            _ => self.record(rec, settings, axis, src).map(ScreenOut::Radiance),
+        }
     }
 }
 
@@ -101,8 +128,9 @@ impl ToScreen {
 
     /// Records mips, remap, the screen-space TAA (when this was built with one; `taa` then
     /// carries the frame's jitter and G-buffer) and (unless σ is 0) the blur; returns the screen
-    /// image to show. `columns` is a texel buffer holding `vp.column_table()` (the renderer's
-    /// `sampling_table`).
+    /// radiance to show, or, given a `display` target, writes it there from the blur's last axis.
+    /// `columns` is a texel buffer holding `vp.column_table()` (the renderer's `sampling_table`).
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
         rec: &mut FrameRecorder,
@@ -111,7 +139,8 @@ impl ToScreen {
         vp_color: &Image,
         blur: &BlurSettings,
         taa: Option<&ScreenTaaFrame>,
-    ) -> Result<&Image> {
+        display: Option<ToneTarget>,
+    ) -> Result<ScreenOut<'_>> {
         let params = vp.sampling_params();
         self.mip_phi.record(rec, &params, columns, vp_color, &self.mips)?;
         // Samples jittered for the screen-space TAA are read where they were traced.
@@ -124,6 +153,6 @@ impl ToScreen {
             (Some(resolver), Some(frame)) => resolver.record(rec, &self.remapped, frame)?,
             _ => &self.remapped,
         };
-        self.blur.record(rec, blur, vp, resolved)
+        self.blur.record_to(rec, blur, vp, resolved, display)
     }
 }

@@ -222,6 +222,7 @@ struct RemapPush {
 struct BlurPush {
     vec4 shape;                 // xy gaze (pixels), z fovea radius (pixels), w σ per pixel beyond it
     uvec4 config;               // x axis (0 horizontal, 1 vertical), y max kernel radius, zw unused
+    TonemapPush tone;           // the `ldr` variants (last axis writing the display image): exposure, operator, target offset
 };
 
 // Push constants of the Visual-Polar mapping probe (device test of Rust vs GLSL).

@@ -2,7 +2,14 @@
 // Foveated blur (visual-polar.md §7), one separable axis per dispatch: a Gaussian whose σ is 0
 // inside the fovea and grows linearly with the distance from the gaze beyond it, so periphery
 // aliasing from the coarse VP grid is removed without blurring what the eye resolves.
-#include "../common/layouts.glsl"
+// The `ldr` variants are the last axis writing the display image (tone curve and sRGB encoding of
+// common/tone.glsl, at the target offset) instead of radiance, saving the tonemap's full-screen
+// pass when nothing reads the blurred radiance; `ldr_external` writes an image the engine does
+// not own, as the tonemap's `external` variant does.
+//! variant hdr:
+//! variant ldr: BLUR_TONEMAP
+//! variant ldr_external: BLUR_TONEMAP EXTERNAL_TARGET
+#include "../common/tone.glsl"
 
 // 64 pixels of one row per workgroup: with 8×8 tiles the vertical pass's taps (up to ±26 rows)
 // from 8 rows at once fell into the same CPU cache sets (row pitch 20 KiB at 1280 px) and it ran
@@ -11,11 +18,26 @@
 layout(local_size_x = 64, local_size_y = 1) in;
 layout(push_constant) uniform Push { BlurPush p; } push;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D src;
+#if defined(EXTERNAL_TARGET)
+layout(set = 0, binding = 1) uniform writeonly image2D dst;
+#elif defined(BLUR_TONEMAP)
+layout(set = 0, binding = 1, rgba8) uniform writeonly image2D dst;
+#else
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D dst;
+#endif
+
+void store(ivec2 t, vec4 radiance) {
+#if defined(BLUR_TONEMAP)
+    ivec2 target = t + ivec2(push.p.tone.config.yz);
+    if (all(lessThan(target, imageSize(dst)))) imageStore(dst, target, tone_map(radiance.rgb, push.p.tone));
+#else
+    imageStore(dst, t, radiance);
+#endif
+}
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    ivec2 size = imageSize(dst);
+    ivec2 size = imageSize(src);
     if (any(greaterThanEqual(t, size))) return;
     vec4 shape = push.p.shape;
     float sigma = shape.w * max(length(vec2(t) + 0.5 - shape.xy) - shape.z, 0.0);
@@ -29,7 +51,7 @@ void main() {
     int taps = int(min(ceil(2.5 * sigma / spacing_px), floor(float(push.p.config.y) / spacing_px)));
     vec4 centre = imageLoad(src, t);
     if (taps < 1) {
-        imageStore(dst, t, centre);
+        store(t, centre);
         return;
     }
     ivec2 step_px = spacing * (push.p.config.x == 0u ? ivec2(1, 0) : ivec2(0, 1));
@@ -49,5 +71,5 @@ void main() {
         sum += w * (a + b);
         weight += 2.0 * w;
     }
-    imageStore(dst, t, sum / weight);
+    store(t, sum / weight);
 }

@@ -26,6 +26,46 @@ pub enum LdrTarget<'a> {
     External { image: &'a ExternalImage, offset: UVec2 },
 }
 
+/// The display image of a frame and how radiance becomes its pixels: what the tonemap pass
+/// writes, or the foveated blur's last axis when it writes the display image itself.
+#[derive(Clone, Copy)]
+pub struct ToneTarget<'a> {
+    pub ldr: LdrTarget<'a>,
+    pub exposure: f32,
+    pub curve: ToneCurve,
+}
+
+impl ToneTarget<'_> {
+    /// The push constants of the tone mapping (`common/tone.glsl`).
+    pub fn push(&self) -> TonemapPush {
+        let op = match self.curve {
+            ToneCurve::Clamp => TONEMAP_CLAMP,
+            ToneCurve::Aces => TONEMAP_ACES,
+        };
+        let offset = match self.ldr {
+            LdrTarget::Own(_) => UVec2::ZERO,
+            LdrTarget::External { offset, .. } => offset,
+        };
+        TonemapPush { params: Vec4::new(self.exposure, 0.0, 0.0, 0.0), config: UVec4::new(op, offset.x, offset.y, 0) }
+    }
+
+    /// The target's binding, named `name`.
+    pub fn bind(&self, name: &'static str) -> Bind<'_> {
+        match self.ldr {
+            LdrTarget::Own(image) => write_image(name, image),
+            LdrTarget::External { image, .. } => write_external(name, image),
+        }
+    }
+}
+
+/// The error for an external target on a device that cannot write storage images without a
+/// format.
+pub(crate) fn no_external_targets() -> crate::Error {
+    crate::Error::Invalid(
+        "this device cannot write storage images without a format (shaderStorageImageWriteWithoutFormat): no external targets".into(),
+    )
+}
+
 pub struct TonemapPass {
     own: Arc<ComputePipeline>,
     /// Built only when the device can write storage images without a format (external targets).
@@ -43,22 +83,12 @@ impl TonemapPass {
     }
 
     /// `pass` names the dispatch in the timing report (the frame and the debug grid view differ).
-    pub fn record(&self, rec: &mut FrameRecorder, pass: &'static str, hdr: &Image, ldr: LdrTarget, exposure: f32, curve: ToneCurve) -> Result<()> {
-        let op = match curve {
-            ToneCurve::Clamp => TONEMAP_CLAMP,
-            ToneCurve::Aces => TONEMAP_ACES,
+    pub fn record(&self, rec: &mut FrameRecorder, pass: &'static str, hdr: &Image, target: &ToneTarget) -> Result<()> {
+        let pipeline: &ComputePipeline = match target.ldr {
+            LdrTarget::Own(_) => &self.own,
+            LdrTarget::External { .. } => self.external.as_ref().ok_or_else(no_external_targets)?,
         };
-        let (pipeline, target, offset): (&ComputePipeline, Bind, UVec2) = match ldr {
-            LdrTarget::Own(image) => (&self.own, write_image("ldr", image), UVec2::ZERO),
-            LdrTarget::External { image, offset } => {
-                let pipeline = self.external.as_ref().ok_or_else(|| crate::Error::Invalid(
-                    "this device cannot write storage images without a format (shaderStorageImageWriteWithoutFormat): no external targets".into(),
-                ))?;
-                (pipeline, write_external("ldr", image), offset)
-            }
-        };
-        let binds = [read_image("hdr", hdr), target];
-        let push = TonemapPush { params: Vec4::new(exposure, 0.0, 0.0, 0.0), config: UVec4::new(op, offset.x, offset.y, 0) };
-        rec.dispatch(pass, pipeline, &binds, push_bytes(&push), [hdr.width, hdr.height, 1])
+        let binds = [read_image("hdr", hdr), target.bind("ldr")];
+        rec.dispatch(pass, pipeline, &binds, push_bytes(&target.push()), [hdr.width, hdr.height, 1])
     }
 }

@@ -31,7 +31,7 @@ pub const AXIS_PIECES: usize = 128;
 const SEARCH_STEPS: u32 = AXIS_PIECES.trailing_zeros();
 /// Texels the knots take in the sampling table: AXIS_PIECES + 1 floats, 4 per texel, padded to an
 /// even count so the previous frame's table starts on a column (2 texels) boundary.
-pub const AXIS_KNOT_TEXELS: usize = ((AXIS_PIECES + 1).div_ceil(4) + 1) / 2 * 2;
+pub const AXIS_KNOT_TEXELS: usize = (AXIS_PIECES + 1).div_ceil(4).next_multiple_of(2);
 /// Trapezoid steps of the mass integral: A(r) has kinks where the circle meets a corner; at 1024
 /// steps the knots move < 0.05 px against 8192 steps on a 1280×1440 screen.
 const MASS_STEPS: usize = 1024;

@@ -18,7 +18,10 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// Passes that take the VP image back to the screen.
-const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v"];
+/// The VP frame's way back; without a radiance read-back (the bench has none) the blur's last
+/// axis writes the display image (`blur_v_tonemap`), so the share includes the tone mapping that
+/// Cartesian's frame spends in `tonemap`.
+const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v", "blur_v_tonemap"];
 
 #[derive(Serialize)]
 pub struct VpFrameReport {
@@ -286,7 +289,7 @@ pub fn measure(
         coherence_gain: shuffled_ms / ordered_ms,
     };
     println!(
-        "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); mips+remap+blur {:.1} % of the VP frame; \
+        "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); way back (mips+remap+blur, and the tone mapping it writes) {:.1} % of the VP frame; \
          primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×)",
         grid.x,
         grid.y,
