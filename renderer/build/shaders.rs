@@ -5,7 +5,9 @@
 //! compiled as `path.NAME` with those macros defined. `//! variants per space[ SUFFIX: DEFINES]`
 //! stands for one such line per sampling space of `shaders/sampling/spaces.txt` (`NAME: DEFINES`),
 //! named `SPACE SUFFIX` with the space's and the line's defines, so a new space is one line there,
-//! not one in every kernel.
+//! not one in every kernel. `//! variants per trace space[ SUFFIX: DEFINES]` does the same over the
+//! trace kernel's sampling variants of `shaders/sampling/trace_spaces.txt`, and `//! variants per
+//! gradient trace space SUFFIX: DEFINES` over those of its lines tagged `gradients`.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -13,17 +15,49 @@ use std::path::{Path, PathBuf};
 /// Macro definitions of one variant: (name, optional value).
 type Defines = Vec<(String, Option<String>)>;
 
+/// The lists variant directives expand over.
+struct SpaceLists {
+    /// `spaces.txt`: the grid addressings of the per-space kernels.
+    grid: Vec<(String, Defines)>,
+    /// `trace_spaces.txt`: the tracer's sampling variants, and which can trace gradient samples.
+    trace: Vec<(String, Defines)>,
+    gradient_trace: Vec<(String, Defines)>,
+}
+
+fn read_list(root: &Path, file: &str) -> Result<Vec<(String, Vec<String>, Defines)>, String> {
+    let path = root.join(file);
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let list: Vec<_> = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .filter_map(|l| {
+            let (head, defs) = l.split_once(':')?;
+            let mut words = head.split_whitespace();
+            let name = words.next()?.to_string();
+            Some((name, words.map(str::to_string).collect(), parse_defines(defs)))
+        })
+        .collect();
+    if list.is_empty() {
+        return Err(format!("{}: no sampling space listed", path.display()));
+    }
+    Ok(list)
+}
+
+impl SpaceLists {
+    fn read(root: &Path) -> Result<SpaceLists, String> {
+        let untagged = |list: Vec<(String, Vec<String>, Defines)>| list.into_iter().map(|(n, _, d)| (n, d)).collect::<Vec<_>>();
+        let trace = read_list(root, "sampling/trace_spaces.txt")?;
+        let gradient_trace = untagged(trace.iter().filter(|(_, tags, _)| tags.iter().any(|t| t == "gradients")).cloned().collect());
+        Ok(SpaceLists { grid: untagged(read_list(root, "sampling/spaces.txt")?), trace: untagged(trace), gradient_trace })
+    }
+}
+
 pub fn compile_all(root: &Path, out_dir: &Path, generated: &[(String, String)]) -> Result<(), String> {
     let compiler = shaderc::Compiler::new().map_err(|e| format!("shaderc: {e}"))?;
     let spv_dir = out_dir.join("spv");
     std::fs::create_dir_all(&spv_dir).map_err(|e| e.to_string())?;
 
-    let spaces_file = root.join("sampling/spaces.txt");
-    let spaces_text = std::fs::read_to_string(&spaces_file).map_err(|e| format!("{}: {e}", spaces_file.display()))?;
-    let spaces = parse_variant_list(spaces_text.lines().filter(|l| !l.trim_start().starts_with('#')));
-    if spaces.is_empty() {
-        return Err(format!("{}: no sampling space listed", spaces_file.display()));
-    }
+    let spaces = SpaceLists::read(root)?;
     let mut jobs: Vec<(String, PathBuf, String, Defines)> = Vec::new();
     for path in find_shaders(root) {
         let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -116,16 +150,27 @@ fn options<'a>(root: &Path, defines: &[(String, Option<String>)]) -> Result<shad
     Ok(options)
 }
 
-/// The variants a shader declares, `variants per space` lines expanded over `spaces`.
-fn parse_variants(source: &str, spaces: &[(String, Defines)]) -> Vec<(String, Defines)> {
+/// The variants a shader declares, `variants per …` lines expanded over their list.
+fn parse_variants(source: &str, spaces: &SpaceLists) -> Vec<(String, Defines)> {
     let mut variants = parse_variant_list(source.lines().filter_map(|l| l.trim().strip_prefix("//! variant ")));
-    for line in source.lines().filter_map(|l| l.trim().strip_prefix("//! variants per space")) {
-        let (suffix, extra) = match line.split_once(':') {
-            Some((suffix, defs)) => (suffix.trim(), parse_defines(defs)),
-            None => (line.trim(), Vec::new()),
-        };
-        for (space, defines) in spaces {
-            variants.push((format!("{space}{suffix}"), defines.iter().chain(&extra).cloned().collect()));
+    let directives = [
+        ("//! variants per space", &spaces.grid),
+        ("//! variants per trace space", &spaces.trace),
+        ("//! variants per gradient trace space", &spaces.gradient_trace),
+    ];
+    for (directive, list) in directives {
+        for line in source.lines().filter_map(|l| l.trim().strip_prefix(directive)) {
+            // A directive ends at a space or a colon, not inside a longer word.
+            if !(line.is_empty() || line.starts_with(' ') || line.starts_with(':')) {
+                continue;
+            }
+            let (suffix, extra) = match line.split_once(':') {
+                Some((suffix, defs)) => (suffix.trim(), parse_defines(defs)),
+                None => (line.trim(), Vec::new()),
+            };
+            for (space, defines) in list {
+                variants.push((format!("{space}{suffix}"), defines.iter().chain(&extra).cloned().collect()));
+            }
         }
     }
     variants

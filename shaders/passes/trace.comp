@@ -6,18 +6,9 @@
 // of last frame's samples chose (asvgf_forward.comp) re-shades that frame's surface with that
 // frame's random state, and every texel writes the visibility (barycentrics, random state) the
 // next projection reads. Plain rendering keeps the variants without them and pays nothing.
-//! variant cartesian: SAMPLING_CARTESIAN
-//! variant visual_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
-//! variant visual_polar_clipped: SAMPLING_VISUAL_POLAR
-//! variant cartesian_gradients: SAMPLING_CARTESIAN TRACE_GRADIENTS
-//! variant visual_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
-//! variant visual_polar_clipped_gradients: SAMPLING_VISUAL_POLAR TRACE_GRADIENTS
-//! variant log_polar: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY
-//! variant log_polar_gradients: SAMPLING_VISUAL_POLAR VP_LAYOUT_PAPER_ONLY TRACE_GRADIENTS
-//! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
-//! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY VP_NORMALIZED_AXIS_ONLY
-//! variant random_acuity_headset: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
-//! variant pixel_blocks: SAMPLING_PIXEL_BLOCKS
+// Its variants are the sampling spaces of shaders/sampling/trace_spaces.txt.
+//! variants per trace space
+//! variants per gradient trace space _gradients: TRACE_GRADIENTS
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
