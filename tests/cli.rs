@@ -316,6 +316,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         loop_frames,
         camera_path: None,
         out: &out,
+        dump_rays: false,
         device: None,
         validation: true,
     };
@@ -515,6 +516,7 @@ fn bench_vp_frames_follow_a_camera_path() {
         loop_frames: 2,
         camera_path: Some(&keys),
         out: &out,
+        dump_rays: true,
         device: None,
         validation: true,
     };
@@ -534,4 +536,9 @@ fn bench_vp_frames_follow_a_camera_path() {
     let rays = &report["rays"][0];
     assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
     assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");
+    // --dump-rays: the Cornell box's 36 triangles and the rays of every pose, 32 bytes each.
+    let size = |kind: &str| std::fs::metadata(out.join(format!("rays_cornell-box-32x36.{kind}.bin"))).unwrap().len();
+    assert_eq!(size("triangles"), 36 * 9 * 4);
+    assert_eq!(size("primary"), fovea_tools::commands::bench::PATH_RAY_POSES as u64 * 32 * 36 * 32);
+    assert!(size("indirect") > 0 && size("indirect") % 32 == 0);
 }

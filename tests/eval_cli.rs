@@ -260,6 +260,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         loop_frames: 2,
         camera_path: None,
         out: &bench_out,
+        dump_rays: false,
         device: None,
         validation: true,
     })

@@ -388,6 +388,10 @@ enum Command {
         camera_path: Option<PathBuf>,
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
+        /// Also write each scene's triangles and each `--sizes` size's primary and indirect rays
+        /// into OUT as rays_*.bin (for `scripts/embree-rays`: Embree timing the same rays).
+        #[arg(long)]
+        dump_rays: bool,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -649,7 +653,7 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, device } => {
+        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, dump_rays, device } => {
             let camera_path = camera_path.map(|f| fovea_tools::camera_keys::CameraKeys::load(&f)).transpose().context("--camera-path")?;
             let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
             if builders.is_empty() {
@@ -670,6 +674,7 @@ fn run() -> Result<()> {
                 loop_frames,
                 camera_path: camera_path.as_ref(),
                 out: &out,
+                dump_rays,
                 device: device.device.as_deref(),
                 validation: device.validation,
             })

@@ -179,6 +179,7 @@ fn is_fovea_file(name: &str) -> bool {
         || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))
+        || (name.starts_with("rays_") && name.ends_with(".bin"))
 }
 
 /// A temporary of [`write_atomic`] (left behind only by a killed process).

@@ -41,6 +41,10 @@ pub struct BenchArgs<'a> {
     /// (`--camera-path FILE`; none: the still camera).
     pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
     pub out: &'a Path,
+    /// Also write each scene's world-space triangles and each size's primary and indirect rays
+    /// into `out` (`--dump-rays`, files `rays_*.bin`), for a CPU tracer to time the very same rays
+    /// (`scripts/embree-rays`).
+    pub dump_rays: bool,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
@@ -185,6 +189,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             // the same rays (hits may differ in the last bit between trees).
             let (hits, _) = caster.trace(&variants[0].2, &primary, false)?;
             let (shadow, indirect) = secondary_rays(&scene, &placed, &primary, &hits);
+            if args.dump_rays {
+                dump_rays(args.out, name, (w, h), &placed, &primary, &indirect)?;
+            }
             for &(v, pass) in &order {
                 let (builder, bvh, gpu) = &variants[v];
                 let (primary_hits, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;
@@ -301,6 +308,20 @@ fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
         }
     }
     rays
+}
+
+/// `DIR/rays_SCENE-WxH.{triangles,primary,indirect}.bin`: little-endian f32, 9 per triangle
+/// (three world-space vertices), 8 per ray (origin, t_min, direction, t_max).
+fn dump_rays(dir: &Path, scene: &str, (w, h): (u32, u32), tris: &[[Vec3; 3]], primary: &[RayGpu], indirect: &[RayGpu]) -> Result<()> {
+    let stem = Path::new(scene).file_stem().map_or(scene.into(), |s| s.to_string_lossy());
+    let write = |kind: &str, floats: &[f32]| {
+        let path = dir.join(format!("rays_{stem}-{w}x{h}.{kind}.bin"));
+        crate::output::write_atomic(&path, |f| Ok(std::io::Write::write_all(f, bytemuck::cast_slice(floats))?))
+    };
+    let tri_floats: Vec<f32> = tris.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())).collect();
+    write("triangles", &tri_floats)?;
+    write("primary", bytemuck::cast_slice(primary))?;
+    write("indirect", bytemuck::cast_slice(indirect))
 }
 
 /// A small deterministic hash → [0, 1) for the CPU-side ray generation.
