@@ -7,7 +7,7 @@
 //! (`RenderProfile::visual_polar_for`).
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{CompositeMode, Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
@@ -23,8 +23,11 @@ pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     /// `[log_polar]`: `--method log-polar` (Meng et al. 2018; σ, α, the extent L comes from).
     pub log_polar: LogPolarParams,
-    /// `--composite-mode`: `--method composite`'s mode (Andersson & Hansson 2020).
+    /// `--composite-mode` / `[composite] mode`: `--method composite`'s mode (Andersson & Hansson 2020).
     pub composite_mode: CompositeMode,
+    /// `[composite] sigma`: the log-polar buffer's σ instead of the mode's (its budget knob: the
+    /// buffer holds ≈ W·H/σ² samples), e.g. to compare at another method's sample count.
+    pub composite_sigma: Option<f32>,
     /// The ρ axis (`[visual_polar] eccentricity`); `visual_polar.eccentricity` stays Normalized
     /// until `visual_polar_for` adds the headset's FOV.
     pub eccentricity: EccentricityMode,
@@ -47,6 +50,7 @@ pub struct RenderProfile {
 struct ProfileFile {
     visual_polar: Option<VpSection>,
     log_polar: Option<LogPolarSection>,
+    composite: Option<CompositeSection>,
     blur: Option<BlurSection>,
     svgf: Option<SvgfSection>,
     bmfr: Option<BmfrSection>,
@@ -139,6 +143,13 @@ struct LogPolarSection {
     sigma: Option<f32>,
     alpha: Option<f32>,
     extent: Option<String>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct CompositeSection {
+    mode: Option<String>,
+    sigma: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -303,6 +314,15 @@ impl RenderProfile {
             }
             p.validate().with_context(|| at("log_polar"))?;
         }
+        if let Some(c) = file.composite {
+            if let Some(mode) = c.mode {
+                profile.composite_mode = CompositeMode::parse(&mode)
+                    .with_context(|| format!("{}.mode: '{mode}', expected one of {}", at("composite"), CompositeMode::NAMES.join(", ")))?;
+            }
+            profile.composite_sigma = c.sigma;
+            // A stand-in viewing distance: σ's range does not depend on it.
+            profile.composite_params(1000.0).validate().with_context(|| format!("{}.sigma", at("composite")))?;
+        }
         if let Some(blur) = file.blur {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
         }
@@ -450,7 +470,13 @@ impl RenderProfile {
     /// The polar-space parameters of `--method composite` for an eye `viewing_distance_px` from
     /// the image (its gaze disc is d · tan a_G).
     pub fn composite_space(&self, viewing_distance_px: f32) -> VisualPolarParams {
-        VisualPolarParams { radial: RadialLaw::Composite(self.composite_mode.params(viewing_distance_px)), ..Default::default() }
+        VisualPolarParams { radial: RadialLaw::Composite(self.composite_params(viewing_distance_px)), ..Default::default() }
+    }
+
+    /// The mode's parameters with the profile's σ, if it sets one.
+    fn composite_params(&self, viewing_distance_px: f32) -> CompositeParams {
+        let mode = self.composite_mode.params(viewing_distance_px);
+        CompositeParams { sigma: self.composite_sigma.unwrap_or(mode.sigma), ..mode }
     }
 
     /// The combinations the headset axis refuses, checked with a stand-in FOV (the real one is
@@ -477,6 +503,17 @@ mod tests {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         RenderProfile::load(&path)
+    }
+
+    /// `[composite]`: the mode and σ (the buffer's budget knob) reach `--method composite`'s space.
+    #[test]
+    fn composite_section_sets_mode_and_sigma() {
+        let p = load_str("composite.toml", "[composite]\nmode = \"kernel\"\nsigma = 1.66\n").unwrap();
+        assert_eq!(p.composite_mode, CompositeMode::Kernel);
+        let RadialLaw::Composite(c) = p.composite_space(160.0).radial else { panic!("not composite") };
+        assert_eq!((c.mode, c.sigma, c.alpha), (CompositeMode::Kernel, 1.66, CompositeMode::Kernel.params(160.0).alpha));
+        let RadialLaw::Composite(c) = RenderProfile::default().composite_space(160.0).radial else { panic!("not composite") };
+        assert_eq!(c, CompositeMode::Composite.params(160.0), "without the section: the mode's own σ");
     }
 
     #[test]
@@ -551,6 +588,9 @@ gradient_sigma_normal = 64
             ("ecc_type.toml", "[visual_polar]\neccentricity = 2\n", "eccentricity"),
             ("ecc_clip.toml", "[visual_polar]\neccentricity = \"headset\"\nlayout = \"screen-clipped\"\n", "eccentricity"),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
+            ("composite_sigma.toml", "[composite]\nsigma = 0\n", "[composite].sigma"),
+            ("composite_mode.toml", "[composite]\nmode = \"fovea\"\n", "[composite].mode"),
+            ("composite_key.toml", "[composite]\nalpha = 2\n", "alpha"),
             ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
