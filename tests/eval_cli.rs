@@ -270,7 +270,9 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
     let pictures = docs.join("docs").join("methods");
     let bench_report = [bench_out.join("report.json")];
-    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures };
+    // The committed equal-samples report of the README's claim (VP against composite at σ = 1.66).
+    let equal = [std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/methods/quality-equal-samples-composite.json")];
+    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures, equal_samples: &equal };
     fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
     let text = std::fs::read_to_string(&readme).unwrap();
     assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n") && !text.contains("old"), "{text}");
@@ -280,6 +282,12 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         assert!(text.contains(&format!("![{m}](docs/methods/{m}.png)")), "{m}");
     }
     assert!(text.contains("| pixel-blocks + svgf | refused:") && text.contains("faster traversal per sample for Visual-Polar than random acuity"), "{text}");
+    assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
+    // A report of many methods is no equal-samples pair: named, and the README left as it was.
+    let many = [out.join("quality.json")];
+    let err = format!("{:#}", fovea_tools::commands::method_table::run(&fovea_tools::commands::method_table::MethodTableArgs { equal_samples: &many, ..table_args(&readme) }).unwrap_err());
+    assert!(err.contains("quality.json") && err.contains("exactly one other method"), "{err}");
+    assert_eq!(std::fs::read_to_string(&readme).unwrap(), text);
     let bare = docs.join("BARE.md");
     std::fs::write(&bare, "no markers").unwrap();
     let err = format!("{:#}", fovea_tools::commands::method_table::run(&table_args(&bare)).unwrap_err());

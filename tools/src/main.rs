@@ -479,6 +479,10 @@ enum Command {
         /// Folder for the picture row's images.
         #[arg(long, default_value = "docs/methods")]
         pictures: PathBuf,
+        /// `fovea quality` reports (quality.json), comma-separated, each of `vp` and one other
+        /// method at VP's sample count (a profile's budget knob): one claim line each.
+        #[arg(long, value_delimiter = ',')]
+        equal_samples: Vec<PathBuf>,
     },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
     Eval {
@@ -737,9 +741,13 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::MethodTable { quality, bench, readme, pictures } => {
-            commands::method_table::run(&commands::method_table::MethodTableArgs { quality: &quality, bench: &bench, readme: &readme, pictures: &pictures })
-        }
+        Command::MethodTable { quality, bench, readme, pictures, equal_samples } => commands::method_table::run(&commands::method_table::MethodTableArgs {
+            quality: &quality,
+            bench: &bench,
+            readme: &readme,
+            pictures: &pictures,
+            equal_samples: &equal_samples,
+        }),
         Command::Eval { reference, test, gaze, rings, out, headset, ppd } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,

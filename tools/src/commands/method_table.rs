@@ -9,7 +9,7 @@ use crate::flip::{flip_image, flip_map};
 use crate::output::{read_exr, tonemap_preview, write_png, write_text};
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -105,6 +105,8 @@ pub struct MethodTableArgs<'a> {
     pub readme: &'a Path,
     /// Where the picture row's images go (relative to the README's folder in the links).
     pub pictures: &'a Path,
+    /// `fovea quality` reports of `vp` and one other method at VP's sample count: a claim each.
+    pub equal_samples: &'a [std::path::PathBuf],
 }
 
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
@@ -141,6 +143,10 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
     let scenes: Vec<(String, BTreeMap<String, Cost>)> =
         benches.iter().flat_map(|b| &b.visual_polar).map(|v| (format!("{} {}×{}", scene_name(&v.scene), v.width, v.height), self::costs(v))).collect();
     write_claims(&mut table, &quality, &costs, &scenes);
+    for path in args.equal_samples {
+        write_equal_samples_claim(&mut table, path, &read(path)?)?;
+    }
+    table.push('\n');
     let updated = format!("{}{BEGIN}\n{table}{}", &readme[..begin], &readme[end..]);
     write_text(args.readme, &updated)?;
     println!("{table}");
@@ -285,5 +291,45 @@ fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, sce
             pb.frame_ms / c.frame_ms
         );
     }
-    s.push('\n');
+}
+
+/// The paper a comparator at equal samples stands for.
+fn paper_of(method: &str) -> &'static str {
+    match method {
+        "log-polar" => "Meng et al. 2018",
+        "composite" => "Andersson & Hansson 2020",
+        "linear-falloff" => "Weier et al. 2016",
+        "random-acuity" => "Koskela et al. 2018",
+        "pixel-blocks" => "Mohanto et al. 2023",
+        _ => "a comparator",
+    }
+}
+
+/// One claim line from a quality report of `vp` and one other method at (about) VP's sample
+/// count: FLIP per band for every denoiser both ran, still camera.
+fn write_equal_samples_claim(s: &mut String, path: &Path, q: &Quality) -> Result<()> {
+    fn still_runs<'q>(q: &'q Quality, method: &'q str) -> impl Iterator<Item = &'q Run> + 'q {
+        q.runs.iter().filter(move |r| r.camera == "still" && r.method == method && r.taa == "off")
+    }
+    let still = |m| still_runs(q, m);
+    let others: BTreeSet<&str> = q.runs.iter().map(|r| r.method.as_str()).filter(|&m| m != "vp").collect();
+    let others: Vec<&str> = others.into_iter().collect();
+    let (Some(vp), [other]) = (still("vp").next(), others.as_slice()) else {
+        bail!("{}: an equal-samples report needs still runs of vp and exactly one other method", path.display())
+    };
+    let other = *other;
+    let Some(theirs) = still(other).next() else { bail!("{}: no still run of {other}", path.display()) };
+    let figures: Vec<String> = still("vp")
+        .filter_map(|v| still(other).find(|o| o.denoiser == v.denoiser).map(|o| format!("{} {} vs {}", v.denoiser, bands(v, |g| g.flip), bands(o, |g| g.flip))))
+        .collect();
+    let _ = writeln!(
+        s,
+        "- Visual-Polar vs {other} ({}) at equal samples ({} vs {}, `{}`): FLIP {}.",
+        paper_of(other),
+        vp.samples_traced,
+        theirs.samples_traced,
+        path.display(),
+        figures.join("; ")
+    );
+    Ok(())
 }
