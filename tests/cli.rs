@@ -533,6 +533,12 @@ fn bench_vp_frames_follow_a_camera_path() {
     }
     // Random acuity traces Visual-Polar's samples.
     assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
+    // VP's rays against the screen's through the same pass: the per-sample overhead measured apart.
+    let f = |key: &str| vp[key].as_f64().unwrap_or_else(|| panic!("{key} in {vp}"));
+    assert!(f("screen_mrays_per_s") > 0.0 && f("screen_shuffled_mrays_per_s") > 0.0, "{vp}");
+    let ordered = f("screen_mrays_per_s") / f("vp_order_mrays_per_s");
+    let shuffled = f("screen_shuffled_mrays_per_s") / f("shuffled_mrays_per_s");
+    assert!((f("vp_ray_cost_ordered") / ordered - 1.0).abs() < 1e-9 && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9, "{vp}");
     let rays = &report["rays"][0];
     assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
     assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");

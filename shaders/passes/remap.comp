@@ -121,9 +121,6 @@ void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, imageSize(screen_color)))) return;
     VpParams P = vp_unpack(push.p.space.grid, push.p.space.gaze, push.p.space.shape0, push.p.space.shape1);
-#if defined(VP_POLYNOMIAL_CDF_ONLY)
-    P.exact = false; // the exact CDF would cost every pixel of the default frame under a mask
-#endif
     vec2 d = vec2(t) + 0.5 - P.gaze;
     float r = length(d);
     float phi = r > 0.0 ? atan(d.y, d.x) : 0.0;

@@ -63,8 +63,20 @@ float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
 #endif
 }
 
+// This invocation's texel: the workgroup's tile walked as 4×2 blocks, so that each run of 8
+// consecutive invocations (one 256-bit vector on llvmpipe) covers a 4×2 block instead of a row of
+// 8 texels. In Visual-Polar space a row runs out along ρ, and 8 columns of the periphery spread
+// far across the screen; the block keeps a vector's paths closer (VP trace 2–3 % faster on
+// lavapipe, Cartesian ≈ 1 %). A GPU's 32-lane warp still covers an 8×4 block, as before.
+ivec2 swizzled_texel() {
+    const uint blocks_across = WORKGROUP_2D / 4u;
+    uint block = gl_LocalInvocationIndex / 8u, lane = gl_LocalInvocationIndex % 8u;
+    uvec2 within = uvec2(lane % 4u + 4u * (block % blocks_across), lane / 4u + 2u * (block / blocks_across));
+    return ivec2(gl_WorkGroupID.xy * gl_WorkGroupSize.xy + within);
+}
+
 void main() {
-    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 texel = swizzled_texel();
     if (any(greaterThanEqual(texel, ivec2(sampling.data.grid.xy)))) return;
     // The cameras through a column index lavapipe cannot fold (push constant config.y, always 0):
     // it specialises kernels on foldable uniform values, which recompiled this one on every head

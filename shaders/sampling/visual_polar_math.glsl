@@ -42,6 +42,13 @@ const bool VP_MAY_USE_LOG_POLAR = false;
 const bool VP_MAY_USE_HEADSET_AXIS = true;
 const bool VP_MAY_USE_LOG_POLAR = true;
 #endif
+// Kernels for the paper's quartic inverse CDF define VP_POLYNOMIAL_CDF_ONLY: the exact inverse's
+// Newton steps would otherwise run under a mask for every peripheral sample of the default frame.
+#if defined(VP_POLYNOMIAL_CDF_ONLY)
+const bool VP_MAY_USE_EXACT_CDF = false;
+#else
+const bool VP_MAY_USE_EXACT_CDF = true;
+#endif
 
 struct VpParams {
     uvec2 grid;      // VP grid size in texels
@@ -156,7 +163,7 @@ VpParams vp_unpack(uvec4 grid, vec4 gaze, vec4 shape0, vec4 shape1) {
     p.u_f = shape0.x;
     p.p_f = shape0.y;
     p.r_f = shape0.z;
-    p.exact = (flags & 1u) != 0u;
+    p.exact = VP_MAY_USE_EXACT_CDF && (flags & 1u) != 0u;
     p.clipped = (flags & 2u) != 0u;
     p.screen_axis = (flags & 16u) != 0u;
     p.headset = VP_MAY_USE_HEADSET_AXIS && (flags & 4u) != 0u;

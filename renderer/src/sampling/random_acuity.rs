@@ -69,11 +69,13 @@ impl SamplingSpace for RandomAcuity {
     fn shader_variant(&self) -> &'static str {
         "random_acuity"
     }
-    /// As Visual-Polar's: specialised for the normalised axis unless the headset's is used.
+    /// As Visual-Polar's: specialised for the normalised axis unless the headset's is used, and
+    /// for the quartic inverse CDF unless the exact one is.
     fn trace_variant(&self) -> &'static str {
-        match self.vp.headset() {
-            None => "random_acuity",
-            Some(_) => "random_acuity_headset",
+        match (self.vp.headset(), self.vp.exact_inverse_cdf()) {
+            (None, false) => "random_acuity_polynomial",
+            (None, true) => "random_acuity",
+            (Some(_), _) => "random_acuity_headset",
         }
     }
     fn grid_size(&self) -> UVec2 {

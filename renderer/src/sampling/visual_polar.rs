@@ -404,6 +404,10 @@ impl VisualPolar {
     pub fn headset(&self) -> Option<&HeadsetAxis> {
         self.headset.as_ref()
     }
+    /// Whether the radial axis runs through the exact inverse CDF (not the paper's quartic).
+    pub fn exact_inverse_cdf(&self) -> bool {
+        self.exact
+    }
     /// True eccentricity (degrees) of a screen position, with `Eccentricity::Headset`.
     pub fn true_eccentricity(&self, s: Vec2) -> Option<f32> {
         self.headset.map(|axis| axis.eccentricity(s - self.gaze))
@@ -655,12 +659,14 @@ impl SamplingSpace for VisualPolar {
             VpLayout::ScreenClipped | VpLayout::ScreenAware => "visual_polar_clipped",
         }
     }
-    /// `visual_polar`: specialised for the paper's layout and normalised axis; `log_polar`: the
+    /// `visual_polar_polynomial`: specialised for the paper's layout, normalised axis and quartic
+    /// inverse CDF (the default), `visual_polar` the same with the exact inverse; `log_polar`: the
     /// paper's layout with the radial law read at run time; otherwise the general kernel
     /// (`visual_polar_clipped`: either layout, either axis).
     fn trace_variant(&self) -> &'static str {
         match (self.params.layout, self.headset.is_some()) {
             _ if self.log_polar.is_some() => "log_polar",
+            (VpLayout::Paper, false) if !self.exact => "visual_polar_polynomial",
             (VpLayout::Paper, false) => "visual_polar",
             _ => "visual_polar_clipped",
         }

@@ -294,7 +294,7 @@ fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) 
     (0..PATH_RAY_POSES).map(|i| keys.pose(first + (last - first) * i as f64 / (PATH_RAY_POSES - 1) as f64, still)).collect()
 }
 
-fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
+pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
     let origin = pose.world_from_view.w_axis.truncate();
     let t = pose.fov_tan;
     let mut rays = Vec::with_capacity((w * h) as usize);

@@ -56,6 +56,14 @@ pub struct VpFrameReport {
     pub vp_order_mrays_per_s: f64,
     pub shuffled_mrays_per_s: f64,
     pub coherence_gain: f64,
+    /// Primary rays through the screen's pixel centres, same pose and pass: Mrays/s in row
+    /// order and shuffled. Where VP's per-sample trace overhead comes from: its rays' cost
+    /// against a screen ray's, shuffled both (`vp_ray_cost_shuffled`: where the samples sit,
+    /// order aside) and in each one's own order (`vp_ray_cost_ordered`: where and in what order).
+    pub screen_mrays_per_s: f64,
+    pub screen_shuffled_mrays_per_s: f64,
+    pub vp_ray_cost_shuffled: f64,
+    pub vp_ray_cost_ordered: f64,
 }
 
 /// The denoisers measured, each with its defaults; a denoiser's passes are named `<name>_*`.
@@ -264,7 +272,11 @@ pub fn measure(
     let (_, ordered_ms) = super::bench::timed_trace(caster, &gpu, &rays, false)?;
     let shuffled = shuffle(rays.clone());
     let (_, shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffled, false)?;
+    let screen_rays = super::bench::primary_rays(&pose, w, h);
+    let (_, screen_ms) = super::bench::timed_trace(caster, &gpu, &screen_rays, false)?;
+    let (_, screen_shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffle(screen_rays.clone()), false)?;
     let rate = |ms: f64| rays.len() as f64 / (ms * 1e-3) * 1e-6;
+    let screen_rate = |ms: f64| screen_rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let grid = vp.grid_size();
     let report = VpFrameReport {
         scene: scene_name.to_string(),
@@ -287,10 +299,14 @@ pub fn measure(
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
         coherence_gain: shuffled_ms / ordered_ms,
+        screen_mrays_per_s: screen_rate(screen_ms),
+        screen_shuffled_mrays_per_s: screen_rate(screen_shuffled_ms),
+        vp_ray_cost_shuffled: screen_rate(screen_shuffled_ms) / rate(shuffled_ms),
+        vp_ray_cost_ordered: screen_rate(screen_ms) / rate(ordered_ms),
     };
     println!(
         "{scene_name} {w}×{h} VP {}×{}: frame {:.1} ms vs Cartesian {:.1} ms = {:.3} (trace {:.3}); way back (mips+remap+blur, and the tone mapping it writes) {:.1} % of the VP frame; \
-         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×)",
+         primary rays VP-ordered {:.2} vs shuffled {:.2} Mrays/s ({:.2}×); screen rays {:.2} / shuffled {:.2} Mrays/s: a VP ray costs {:.2}× a screen ray ({:.2}× both shuffled)",
         grid.x,
         grid.y,
         report.vp_frame_ms,
@@ -301,6 +317,10 @@ pub fn measure(
         report.vp_order_mrays_per_s,
         report.shuffled_mrays_per_s,
         report.coherence_gain,
+        report.screen_mrays_per_s,
+        report.screen_shuffled_mrays_per_s,
+        report.vp_ray_cost_ordered,
+        report.vp_ray_cost_shuffled,
     );
     for m in &report.comparators {
         println!(
