@@ -53,11 +53,15 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     assert_eq!(report["method"], "vp");
     assert_eq!(report["vp_width"], vp.grid_size().x);
     assert_eq!(report["vp_height"], vp.grid_size().y);
-    assert_eq!(report["samples_traced"], vp.sample_count());
     assert_eq!(report["screen_pixels"], 40 * 36);
-    // Gaze in a corner: most of the r_max circle is off the screen (≈ 76 % at full size).
-    let offscreen = report["samples_offscreen"].as_u64().unwrap();
-    assert!(offscreen > vp.sample_count() / 2 && offscreen < vp.sample_count(), "{offscreen}");
+    // Gaze in a corner: most of the r_max circle is off the screen (≈ 76 % at full size); the
+    // samples far off it are culled, those the way back reads are traced and counted.
+    let count = |key: &str| report[key].as_u64().unwrap();
+    // Per-frame means, each rounded down: their sum may fall one short.
+    assert!((count("samples_traced") + count("samples_culled")).abs_diff(vp.sample_count()) <= 1, "{report}");
+    assert_eq!(report["offscreen_samples"], "cull");
+    let (offscreen, culled) = (count("samples_offscreen"), count("samples_culled"));
+    assert!(offscreen > 0 && culled > 0 && offscreen + culled > vp.sample_count() / 2, "{report}");
     assert_eq!(report["visual_polar"]["clip_fraction"], 0.12);
     for pass in ["trace", "mip_phi", "remap", "blur_h", "blur_v", "tonemap"] {
         assert!(report["passes"][pass].as_f64().unwrap() > 0.0, "pass {pass} missing");
@@ -311,6 +315,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         flatten: false,
         sizes: &[],
         vp_sizes: &[],
+        vp_gaze: fovea_tools::commands::bench::CENTRED_GAZE,
         frames: 1,
         loop_size: Some((64, 72)),
         loop_frames,
@@ -511,6 +516,7 @@ fn bench_vp_frames_follow_a_camera_path() {
         flatten: false,
         sizes: &[(32, 36)],
         vp_sizes: &[(64, 72)],
+        vp_gaze: glam::Vec2::new(0.1, 0.05),
         frames: 2,
         loop_size: None,
         loop_frames: 2,
@@ -533,12 +539,27 @@ fn bench_vp_frames_follow_a_camera_path() {
     }
     // Random acuity traces Visual-Polar's samples.
     assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
+    // --vp-gaze near the top-left corner: most of VP's circle lies off the screen, and the samples
+    // far off it are culled; with every sample traced (the paper's way) all of them are.
+    assert_eq!(vp["gaze"][0].as_f64(), Some(6.4), "{vp}");
+    let (samples, traced) = (vp["vp_samples"].as_u64().unwrap(), vp["vp_samples_traced"].as_u64().unwrap());
+    // (At 64×72 the culling margin, three footprints and three pixels, keeps a large share.)
+    assert!(traced < samples * 3 / 4, "{vp}");
+    assert_eq!(vp["vp_offscreen_traced"]["samples_traced"].as_u64(), Some(samples), "{vp}");
+    assert!(vp["vp_offscreen_traced"]["frame_ratio"].as_f64().unwrap() > 0.0, "{vp}");
     // VP's rays against the screen's through the same pass: the per-sample overhead measured apart.
     let f = |key: &str| vp[key].as_f64().unwrap_or_else(|| panic!("{key} in {vp}"));
     assert!(f("screen_mrays_per_s") > 0.0 && f("screen_shuffled_mrays_per_s") > 0.0, "{vp}");
     let ordered = f("screen_mrays_per_s") / f("vp_order_mrays_per_s");
     let shuffled = f("screen_shuffled_mrays_per_s") / f("shuffled_mrays_per_s");
     assert!((f("vp_ray_cost_ordered") / ordered - 1.0).abs() < 1e-9 && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9, "{vp}");
+    // Each denoiser's whole frames hold its own passes and the rest of the frame (issue 17's
+    // target with a denoiser).
+    for d in vp["denoisers"].as_array().unwrap() {
+        let g = |key: &str| d[key].as_f64().unwrap_or_else(|| panic!("{key} in {d}"));
+        assert!(g("vp_frame_ms") > g("vp_ms") && g("cartesian_frame_ms") > g("cartesian_ms"), "{d}");
+        assert!((g("frame_ratio") * g("cartesian_frame_ms") / g("vp_frame_ms") - 1.0).abs() < 1e-9, "{d}");
+    }
     let rays = &report["rays"][0];
     assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
     assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");

@@ -6,7 +6,7 @@
 
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::fill::FillPass;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
 use fovea_renderer::sampling::{FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
@@ -223,7 +223,7 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
-    let settings = RenderSettings::default();
+    let settings = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
     let gaze = Vec2::new(40.0, 30.0);
     let host = random_acuity(SCREEN, gaze);
     let mut r = Renderer::new(&ctx, &scene, Box::new(random_acuity(SCREEN, SCREEN.as_vec2() * 0.5)), settings).unwrap();

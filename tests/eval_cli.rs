@@ -255,6 +255,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         flatten: false,
         sizes: &[],
         vp_sizes: &[(64, 72)],
+        vp_gaze: fovea_tools::commands::bench::CENTRED_GAZE,
         frames: 1,
         loop_size: None,
         loop_frames: 2,

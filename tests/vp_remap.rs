@@ -357,8 +357,8 @@ fn frame_means(ctx: &Arc<Context>, space: Box<dyn SamplingSpace>, gaze: Option<V
     let (mut sum, mut hdr, mut offscreen) = ([0f64; 3], Vec::new(), 0);
     for frame in 0..frames {
         let stats = r.render_frame(&FrameInput::mono(camera, frame, gaze).with_hdr(true).with_grid(true)).unwrap();
-        assert_eq!(stats.samples_traced, r.space().sample_count());
-        offscreen += stats.samples_offscreen;
+        assert_eq!(stats.samples_traced + stats.samples_culled, r.space().sample_count());
+        offscreen += stats.samples_offscreen + stats.samples_culled; // traced there or culled
         r.read_hdr(&mut hdr).unwrap();
         assert!(hdr.iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "NaN/Inf/negative pixel");
         let m = fovea_tests::mean_rgb(&hdr);

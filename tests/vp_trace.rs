@@ -1,6 +1,7 @@
 //! The tracer fed by the Visual-Polar sampling space (issue 4, pipeline step 1): one traced sample
 //! per kept VP texel, nothing traced in the clipped fovea triangle, off-screen samples traced and
-//! counted (`FrameStats::samples_offscreen`, ray counter slot 3). The screen-clipped layout traces
+//! counted (`FrameStats::samples_offscreen`, ray counter slot 3) when they are traced as in the
+//! paper (`OffscreenSamples::Trace`); culled by default, with the picture unchanged. The screen-clipped layout traces
 //! the same number of samples and keeps them on the screen: only jittered samples of texels whose
 //! cell reaches past the border (the cell spans a column's width in radius, its arcs are those of
 //! the centre radius) may leave it.
@@ -14,7 +15,7 @@
 //! - jitter-independently: between the texels whose whole cell is off-screen and the texels
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
-use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, RenderSettings, Renderer};
+use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, OffscreenSamples, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
@@ -97,7 +98,7 @@ fn cornell() -> Scene {
 }
 
 fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (Renderer, FrameStats) {
-    let settings = RenderSettings::default();
+    let settings = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, space, settings).unwrap();
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     let stats = r.render_frame(&FrameInput::mono(camera, FRAME_INDEX, None)).unwrap();
@@ -248,5 +249,74 @@ fn cartesian_has_no_offscreen_samples() {
     let (_r, stats) = render(&ctx, &scene, Box::new(Cartesian::new(SCREEN)));
     assert_eq!(stats.samples_traced, (SCREEN.x * SCREEN.y) as u64);
     assert_eq!(stats.samples_offscreen, 0);
+    assert_clean(&ctx);
+}
+
+/// Off-screen culling (`OffscreenSamples::Cull`, the default): the spaces that place samples off
+/// the screen (the paper's VP layout, log-polar with L from the diagonal, composite, random
+/// acuity) trace only those the way back reads, so without a filter the picture is byte for byte
+/// the one with every sample traced, gaze centred and in a corner; the skipped samples are
+/// counted, none on a layout that keeps its samples on the screen. With SVGF the filter sees
+/// culled texels as misses (no weight): the picture moves by well under one LDR level on average.
+#[test]
+fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
+    use fovea_renderer::passes::denoise::DenoiserSettings;
+    use fovea_renderer::sampling::{CompositeMode, LogPolarExtent, LogPolarParams, RadialLaw, RandomAcuity};
+    let ctx = gpu();
+    let scene = cornell();
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    let frames = |space: Box<dyn SamplingSpace>, gaze: Vec2, settings: RenderSettings| {
+        let mut r = Renderer::new(&ctx, &scene, space, settings).unwrap();
+        let (mut pictures, mut stats) = (Vec::new(), Vec::new());
+        for f in 0..2 {
+            stats.push(r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap());
+            let mut ldr = Vec::new();
+            r.read_ldr(&mut ldr).unwrap();
+            pictures.push(ldr);
+        }
+        (pictures, stats)
+    };
+    let cull = RenderSettings::default();
+    let trace = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..cull };
+    assert_eq!(cull.offscreen_samples, OffscreenSamples::Cull);
+    let corner = Vec2::new(2.0, 2.0);
+    for gaze in [SCREEN.as_vec2() * 0.5, corner] {
+        let polar = move |radial| VisualPolar::new(SCREEN, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+        type Make = Box<dyn Fn() -> Box<dyn SamplingSpace>>;
+        let spaces: [(&str, Make, bool); 6] = [
+            ("vp", Box::new(move || Box::new(polar(RadialLaw::Acuity))), true),
+            ("log-polar diagonal", Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams { extent: LogPolarExtent::Diagonal, ..Default::default() })))), true),
+            ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(SCREEN.x as f32 / 2.0))))), true),
+            ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(SCREEN, gaze, VisualPolarParams::default()).unwrap())), true),
+            ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(SCREEN, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() }).unwrap())), false),
+            ("cartesian", Box::new(|| Box::new(Cartesian::new(SCREEN))), false),
+        ];
+        for (name, make, places_offscreen) in spaces {
+            let samples = make().sample_count();
+            let (all, all_stats) = frames(make(), gaze, trace);
+            let (culled, culled_stats) = frames(make(), gaze, cull);
+            for (f, (a, c)) in all_stats.iter().zip(&culled_stats).enumerate() {
+                println!("{name} gaze {gaze} frame {f}: traced {} of {samples} ({} off the screen); culled {} ({} traced off the screen)", a.samples_traced, a.samples_offscreen, c.samples_culled, c.samples_offscreen);
+                assert_eq!(a.samples_culled, 0, "{name}: trace culls nothing");
+                assert_eq!(c.samples_traced + c.samples_culled, a.samples_traced, "{name} frame {f}: every sample traced or culled");
+                assert!(c.samples_culled <= a.samples_offscreen, "{name} frame {f}: only off-screen samples are culled");
+                if places_offscreen && gaze == corner {
+                    assert!(c.samples_culled > a.samples_traced / 2, "{name} frame {f}: a corner gaze culls most of the circle");
+                }
+                if !places_offscreen {
+                    assert_eq!(c.samples_culled, 0, "{name}: its samples are on the screen");
+                }
+            }
+            assert!(all == culled, "{name} gaze {gaze}: culling changed the picture");
+        }
+    }
+    // A filter: culled texels are misses to it.
+    let vp = VisualPolar::new(SCREEN, corner, VisualPolarParams::default()).unwrap();
+    let svgf = DenoiserSettings::parse("svgf").unwrap();
+    let (all, _) = frames(Box::new(vp), corner, RenderSettings { denoiser: svgf, ..trace });
+    let (culled, _) = frames(Box::new(vp), corner, RenderSettings { denoiser: svgf, ..cull });
+    let mean_diff = all[1].iter().zip(&culled[1]).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / all[1].len() as f64;
+    println!("SVGF, corner gaze: culling moves the picture by {mean_diff:.4} LDR levels on average");
+    assert!(mean_diff < 0.05, "SVGF: culling moved the picture by {mean_diff} levels on average");
     assert_clean(&ctx);
 }

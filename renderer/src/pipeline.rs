@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::frames::FrameRing;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
-use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD};
+use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_CULL_OFFSCREEN, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
@@ -70,6 +70,9 @@ pub struct RenderSettings {
     /// focus (sunlight through a diffuse-then-glossy path: fireflies) is spread out. Biased, like
     /// every such filter; 0 turns it off (the unbiased estimator), 1 is the default.
     pub path_regularisation: f32,
+    /// Whether samples far off the screen are traced (only the paper's Visual-Polar layout and
+    /// the random/log-polar spaces place any there).
+    pub offscreen_samples: OffscreenSamples,
 }
 
 /// `RenderSettings::environment_sampling`.
@@ -97,12 +100,45 @@ impl Default for RenderSettings {
             environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
             path_regularisation: DEFAULT_PATH_REGULARISATION,
+            offscreen_samples: OffscreenSamples::default(),
         }
     }
 }
 
 /// `RenderSettings::path_regularisation` unless the user sets it.
 pub const DEFAULT_PATH_REGULARISATION: f32 = 1.0;
+
+/// What the tracer does with a sample whose screen position lies off the screen
+/// (`RenderSettings::offscreen_samples`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum OffscreenSamples {
+    /// Samples farther off the screen than the way back and the filters read (three footprints
+    /// and three pixels, trace.comp) hold no sample, like clipped texels: the picture is the
+    /// same, the paper layout's off-screen work is not done (`FrameStats::samples_culled`).
+    #[default]
+    Cull,
+    /// Every sample is traced, as in the paper (Koskela et al. 2019).
+    Trace,
+}
+
+impl OffscreenSamples {
+    pub const NAMES: &'static str = "cull, trace";
+
+    pub fn parse(name: &str) -> Result<OffscreenSamples> {
+        match name {
+            "cull" => Ok(OffscreenSamples::Cull),
+            "trace" => Ok(OffscreenSamples::Trace),
+            other => Err(Error::Invalid(format!("off-screen samples '{other}' is not one of {}", Self::NAMES))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OffscreenSamples::Cull => "cull",
+            OffscreenSamples::Trace => "trace",
+        }
+    }
+}
 
 /// How texture lookups choose a mip level (`RenderSettings::texture_lod`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -220,6 +256,8 @@ pub struct FrameStats {
     /// Traced samples whose screen position lies off the screen (Visual-Polar covers the r_max
     /// circle; always 0 for Cartesian).
     pub samples_offscreen: u64,
+    /// Samples not traced because they lay far off the screen (`OffscreenSamples::Cull`).
+    pub samples_culled: u64,
 }
 
 impl FrameStats {
@@ -490,7 +528,8 @@ impl Renderer {
         let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
         let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 }
             | if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 }
-            | if self.settings.texture_lod == TextureLod::RayCones { FRAME_FLAG_TEXTURE_LOD } else { 0 };
+            | if self.settings.texture_lod == TextureLod::RayCones { FRAME_FLAG_TEXTURE_LOD } else { 0 }
+            | if self.settings.offscreen_samples == OffscreenSamples::Cull { FRAME_FLAG_CULL_OFFSCREEN } else { 0 };
         self.write_frame_data(v, slot, &view_input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;

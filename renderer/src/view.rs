@@ -65,6 +65,7 @@ impl ViewSlot {
             shadow_rays: counters[1] as u64,
             continuation_rays: counters[2] as u64,
             samples_offscreen: counters[3] as u64,
+            samples_culled: counters[4] as u64,
         })
     }
 }

@@ -36,6 +36,9 @@ const uint FRAME_FLAG_ALPHA_MASK = 4u;
 // footprint on the screen); without the flag every lookup reads mip level 0 (point sampling,
 // what references use: jittered samples then converge to the box-filtered pixel).
 const uint FRAME_FLAG_TEXTURE_LOD = 8u;
+// Samples whose screen position lies farther off the screen than the way back and the filters
+// read (trace.comp, OFFSCREEN_CULL_*) are not traced: they hold no sample, like clipped texels.
+const uint FRAME_FLAG_CULL_OFFSCREEN = 16u;
 
 // Salts of unit_hash (random.glsl) for the sparse spaces' choices, apart from the paths' streams:
 // whether linear falloff keeps a pixel, where a random-acuity sample lies.

@@ -34,7 +34,8 @@ layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;  
 layout(set = 0, binding = 15, rg32ui) uniform writeonly uimage2D out_ids;          // triangle + 1 (0: miss), material | mesh << 16
 layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;         // previous-frame screen position (−1: none)
 // Exact ray counts for the report: [0] primary, [1] shadow, [2] continuation rays,
-// [3] traced samples whose screen position is off the screen.
+// [3] traced samples whose screen position is off the screen, [4] samples culled off the screen
+// (FRAME_FLAG_CULL_OFFSCREEN: not traced).
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
 #if defined(TRACE_GRADIENTS)
 // From 21: binding 18 is the VP sampling table (sampling/visual_polar.glsl).
@@ -61,6 +62,21 @@ float texel_footprint(ivec2 texel, vec2 jitter, vec2 screen) {
     }
     return size > 0.0 ? size : 1.0;
 #endif
+}
+
+// How far off the screen a sample may lie and still be traced (FRAME_FLAG_CULL_OFFSCREEN): the
+// remap reads the two columns around a pixel (one footprint) and, along φ, rows within two
+// pixels of it (bilinear at the level and the level above, a level's row being about a pixel
+// there); TAA's 3×3 box one footprint more. Beyond that a sample never reaches the screen.
+const float OFFSCREEN_CULL_FOOTPRINTS = 3.0;
+const float OFFSCREEN_CULL_PIXELS = 3.0;
+
+bool far_off_screen(ivec2 texel, vec2 jitter, vec2 screen) {
+    vec2 size = frame.data.screen.xy;
+    vec2 outside = max(max(-screen, screen - size), vec2(0.0));
+    if (all(equal(outside, vec2(0.0)))) return false;
+    float margin = OFFSCREEN_CULL_FOOTPRINTS * texel_footprint(texel, jitter, screen) + OFFSCREEN_CULL_PIXELS;
+    return max(outside.x, outside.y) > margin;
 }
 
 // This invocation's texel: the workgroup's tile walked as 4×2 blocks, so that each run of 8
@@ -92,6 +108,11 @@ void main() {
 #if defined(SAMPLING_SAMPLES_PER_TEXEL)
     traced = traced && push.p.config.x < sample_count_in_texel(texel);
 #endif
+    bool culled = traced && (frame.data.frame.w & FRAME_FLAG_CULL_OFFSCREEN) != 0u && far_off_screen(texel, jitter, screen);
+    if (culled) {
+        atomicAdd(ray_counters.data[4], 1u);
+        traced = false;
+    }
     if (!traced) {
         imageStore(out_color, texel, vec4(0.0));
         imageStore(out_radiance, texel, vec4(0.0));

@@ -58,6 +58,12 @@ struct SceneFlags {
     /// footprint on the screen; the default) or off (every lookup reads level 0).
     #[arg(long)]
     texture_lod: Option<String>,
+    /// Samples far off the screen: cull (the default: a sample farther off than the way back
+    /// and the filters read, three footprints and three pixels, is not traced; the picture is the
+    /// same) or trace (every sample, as in the paper; only the paper's Visual-Polar layout, the
+    /// log-polar and composite buffers and random acuity place samples there).
+    #[arg(long)]
+    offscreen_samples: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
     /// vertices' glossy lobes are widened so sunlight focused through them stops making
     /// fireflies; biased, 0 = off (the unbiased estimator).
@@ -236,6 +242,7 @@ impl RenderOpts {
             environment: self.look.environment()?,
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
+            offscreen_samples: self.look.offscreen_samples.clone(),
         })
     }
 }
@@ -371,6 +378,10 @@ enum Command {
         /// Screen sizes WxH of the Visual-Polar vs Cartesian comparison ("" skips it).
         #[arg(long, value_delimiter = ',', default_value = "640x720,1280x1440")]
         vp_sizes: Vec<String>,
+        /// Gaze of the Visual-Polar vs Cartesian frames as FX,FY, fractions of the screen in
+        /// [0, 1] (0,0: the top-left corner; default 0.5,0.5: the centre).
+        #[arg(long, default_value = "0.5,0.5")]
+        vp_gaze: String,
         /// Whole frames rendered per size for the per-pass timings.
         #[arg(long, default_value_t = 2)]
         frames: u32,
@@ -657,7 +668,7 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, frames, loop_size, loop_frames, camera_path, out, dump_rays, device } => {
+        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, vp_gaze, frames, loop_size, loop_frames, camera_path, out, dump_rays, device } => {
             let camera_path = camera_path.map(|f| fovea_tools::camera_keys::CameraKeys::load(&f)).transpose().context("--camera-path")?;
             let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
             if builders.is_empty() {
@@ -673,6 +684,7 @@ fn run() -> Result<()> {
                 flatten,
                 sizes: &sizes,
                 vp_sizes: &vp_sizes,
+                vp_gaze: parse_gaze_fraction(&vp_gaze).context("--vp-gaze")?,
                 frames,
                 loop_size,
                 loop_frames,
@@ -716,6 +728,7 @@ fn run() -> Result<()> {
                 environment: look.environment()?,
                 texture_lod: look.texture_lod.clone(),
                 path_regularisation: look.path_regularisation,
+                offscreen_samples: look.offscreen_samples.clone(),
                 ..Default::default()
             })?;
             let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();
@@ -766,4 +779,18 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
         _ => anyhow::bail!("size '{s}' is not WIDTHxHEIGHT (e.g. 320x360)"),
     }
+}
+
+/// `--vp-gaze FX,FY`: two fractions of the screen, each in [0, 1].
+fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
+    let parts: Vec<&str> = spec.split(',').map(str::trim).collect();
+    let [x, y] = parts[..] else { bail!("'{spec}' is not FX,FY (two fractions of the screen)") };
+    let fraction = |s: &str| -> Result<f32> {
+        let v: f32 = s.parse().with_context(|| format!("'{s}' is not a number"))?;
+        if !(0.0..=1.0).contains(&v) {
+            bail!("{v} is not a fraction of the screen in [0, 1]");
+        }
+        Ok(v)
+    };
+    Ok(glam::Vec2::new(fraction(x)?, fraction(y)?))
 }

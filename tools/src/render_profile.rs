@@ -12,7 +12,7 @@ use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
-use fovea_renderer::pipeline::{TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::pipeline::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
 use fovea_renderer::to_screen::BlurSettings;
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
@@ -43,6 +43,8 @@ pub struct RenderProfile {
     pub texture_lod: TextureLod,
     /// `[path] regularisation` (`RenderSettings::path_regularisation`); `None`: the engine's default.
     pub path_regularisation: Option<f32>,
+    /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
+    pub offscreen_samples: OffscreenSamples,
 }
 
 #[derive(Deserialize, Default)]
@@ -59,6 +61,13 @@ struct ProfileFile {
     environment: Option<EnvironmentSection>,
     textures: Option<TexturesSection>,
     path: Option<PathSection>,
+    trace: Option<TraceSection>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TraceSection {
+    offscreen: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -180,6 +189,8 @@ pub struct ProfileOverrides {
     pub texture_lod: Option<String>,
     /// `--path-regularisation`.
     pub path_regularisation: Option<f32>,
+    /// `--offscreen-samples`.
+    pub offscreen_samples: Option<String>,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -379,6 +390,9 @@ impl RenderProfile {
         if let Some(lod) = file.textures.and_then(|t| t.lod) {
             profile.texture_lod = TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
+        if let Some(mode) = file.trace.and_then(|t| t.offscreen) {
+            profile.offscreen_samples = OffscreenSamples::parse(&mode).with_context(|| format!("{}.offscreen", at("trace")))?;
+        }
         if let Some(strength) = file.path.and_then(|p| p.regularisation) {
             profile.path_regularisation = Some(check_path_regularisation(Some(strength), &format!("{}.regularisation", at("path")))?);
         }
@@ -422,6 +436,9 @@ impl RenderProfile {
         }
         if let Some(strength) = o.path_regularisation {
             self.path_regularisation = Some(check_path_regularisation(Some(strength), "--path-regularisation")?);
+        }
+        if let Some(mode) = &o.offscreen_samples {
+            self.offscreen_samples = OffscreenSamples::parse(mode).context("--offscreen-samples")?;
         }
         Ok(self)
     }
@@ -534,6 +551,7 @@ mod tests {
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
+        assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
         assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None, ..Default::default() });
@@ -610,6 +628,8 @@ gradient_sigma_normal = 64
             ("reg_nan.toml", "[path]\nregularisation = nan\n", "[path].regularisation"),
             ("reg_big.toml", "[path]\nregularisation = 101\n", "[path].regularisation"),
             ("reg_key.toml", "[path]\nfilter = 1\n", "filter"),
+            ("offscreen.toml", "[trace]\noffscreen = \"skip\"\n", "[trace].offscreen"),
+            ("offscreen_key.toml", "[trace]\ndepth = 1\n", "depth"),
         ];
         for (name, text, key) in cases {
             let err = format!("{:#}", load_str(name, text).unwrap_err());
@@ -638,6 +658,13 @@ gradient_sigma_normal = 64
         let bad = ProfileOverrides { texture_lod: Some("on".into()), ..Default::default() };
         let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
         assert!(err.contains("--texture-lod") && err.contains("cones, off"), "{err}");
+        let p = load_str("offscreen.toml", "[trace]\noffscreen = \"trace\"\n").unwrap();
+        assert_eq!(p.offscreen_samples, OffscreenSamples::Trace);
+        let o = ProfileOverrides { offscreen_samples: Some("cull".into()), ..Default::default() };
+        assert_eq!(p.override_with(&o).unwrap().offscreen_samples, OffscreenSamples::Cull);
+        let bad = ProfileOverrides { offscreen_samples: Some("skip".into()), ..Default::default() };
+        let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
+        assert!(err.contains("--offscreen-samples") && err.contains("cull, trace"), "{err}");
         let p = load_str("reg_off.toml", "[path]\nregularisation = 0\n").unwrap();
         assert_eq!(p.path_regularisation(), 0.0);
         let o = ProfileOverrides { path_regularisation: Some(2.5), ..Default::default() };

@@ -75,8 +75,8 @@ pub struct TracePass {
 }
 
 /// Counters the trace kernel fills (one u32 each): primary, shadow and continuation rays, and
-/// traced samples whose screen position lies off the screen.
-pub const RAY_COUNTERS: usize = 4;
+/// traced samples whose screen position lies off the screen, samples culled off the screen.
+pub const RAY_COUNTERS: usize = 5;
 
 impl TracePass {
     pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {

@@ -21,6 +21,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
+/// `BenchArgs::vp_gaze` by default: the screen's centre.
+pub const CENTRED_GAZE: glam::Vec2 = glam::Vec2::splat(0.5);
+
 pub struct BenchArgs<'a> {
     pub scenes: &'a [String],
     /// BVH builders to compare (the first also serves the frame and VP figures); with more than
@@ -32,6 +35,9 @@ pub struct BenchArgs<'a> {
     pub sizes: &'a [(u32, u32)],
     /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
     pub vp_sizes: &'a [(u32, u32)],
+    /// Where the gaze rests in the VP vs Cartesian frames, as a fraction of the screen per axis
+    /// (`--vp-gaze`; `CENTRED_GAZE` by default, issue 17's targets).
+    pub vp_gaze: glam::Vec2,
     pub frames: u32,
     /// Per-eye size of the real-time loop section (`None`: skip it); its scene is the Cornell box.
     pub loop_size: Option<(u32, u32)>,
@@ -249,7 +255,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let (_, bvh, _) = &variants[0];
         for &size in args.vp_sizes {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
-            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, args.camera_path, size, args.frames)?);
+            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, args.camera_path, size, args.vp_gaze, args.frames)?);
         }
     }
     if let Some(size) = args.loop_size {

@@ -9,7 +9,7 @@ use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
     BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FovTangents, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
@@ -31,6 +31,12 @@ pub struct VpFrameReport {
     pub vp_width: u32,
     pub vp_height: u32,
     pub vp_samples: u64,
+    /// Of `vp_samples`, those traced in the last timed frame: samples far off the screen are
+    /// culled (`OffscreenSamples::Cull`, the default).
+    pub vp_samples_traced: u64,
+    /// The same VP frames with every off-screen sample traced, as in the paper
+    /// (`--offscreen-samples trace`), in the same interleaved run.
+    pub vp_offscreen_traced: MethodCost,
     pub gaze: [f32; 2],
     /// `still`, or `keys`: the frames followed `--camera-path FILE` (frame i at i / 70 Hz).
     pub camera_motion: &'static str,
@@ -93,6 +99,11 @@ pub struct DenoiserCost {
     pub cartesian_ms: f64,
     pub vp_ms: f64,
     pub ratio: f64,
+    /// Whole frames with this denoiser (every pass of the frame, as `vp_frame_ms` without one).
+    pub cartesian_frame_ms: f64,
+    pub vp_frame_ms: f64,
+    /// VP / Cartesian whole frame with this denoiser: issue 17's target with a denoiser.
+    pub frame_ratio: f64,
     pub cartesian_history_bytes: u64,
     pub vp_history_bytes: u64,
 }
@@ -102,7 +113,10 @@ pub struct DenoiserCost {
 pub struct MethodCost {
     pub method: &'static str,
     pub grid: [u32; 2],
+    /// The space's samples per frame (linear falloff: its expected count).
     pub samples: u64,
+    /// Samples the GPU traced (off-screen culling and linear falloff's killed pixels excluded).
+    pub samples_traced: u64,
     pub passes_ms: BTreeMap<String, f64>,
     pub frame_ms: f64,
     /// Its frame / the Cartesian frame.
@@ -111,6 +125,9 @@ pub struct MethodCost {
     pub trace_ratio: f64,
 }
 
+/// `VpFrameReport::vp_offscreen_traced`'s method name.
+const VP_OFFSCREEN_TRACED: &str = "vp-offscreen-traced";
+
 /// Display rate of `--camera-path` keyframes in the bench (no headset there): the FOVE 0's 70 Hz,
 /// the default headset of `fovea render`, so a path times the same in both.
 pub const CAMERA_PATH_HZ: f64 = 70.0;
@@ -118,22 +135,32 @@ pub const CAMERA_PATH_HZ: f64 = 70.0;
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
 pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<BTreeMap<String, f64>> {
     let mut medians = interleaved_pass_medians(&mut [(renderer, gaze)], &|_| camera, frames)?;
-    Ok(medians.remove(0))
+    Ok(medians.remove(0).passes)
+}
+
+/// One renderer's figures from `interleaved_pass_medians`.
+#[derive(Debug)]
+pub struct FrameMedians {
+    pub passes: BTreeMap<String, f64>,
+    /// Samples its last timed frame traced (the GPU's count: culled off-screen samples and
+    /// killed linear-falloff pixels excluded).
+    pub samples_traced: u64,
 }
 
 /// `pass_medians` of several renderers (each with its gaze) whose frames alternate: a drift of
 /// the machine's speed during the run (up to ±25 % within an hour on these CPU machines) then
 /// hits every side alike, and the ratios between them stay fair. `camera` gives frame i's camera
 /// (every renderer sees the same one).
-pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: &dyn Fn(u32) -> CameraPose, frames: u32) -> Result<Vec<BTreeMap<String, f64>>> {
+pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: &dyn Fn(u32) -> CameraPose, frames: u32) -> Result<Vec<FrameMedians>> {
     let input = |frame_index, gaze| FrameInput::mono(camera(frame_index), frame_index, gaze);
     for (renderer, gaze) in renderers.iter_mut() {
         renderer.render_frame(&input(0, *gaze))?;
     }
     let mut samples: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); renderers.len()];
+    let mut traced = vec![0u64; renderers.len()];
     for frame in 0..frames.max(1) {
-        for ((renderer, gaze), samples) in renderers.iter_mut().zip(&mut samples) {
-            renderer.render_frame(&input(frame + 1, *gaze))?;
+        for (((renderer, gaze), samples), traced) in renderers.iter_mut().zip(&mut samples).zip(&mut traced) {
+            *traced = renderer.render_frame(&input(frame + 1, *gaze))?.samples_traced;
             // A pass recorded several times in one frame (one mip level each) counts as one.
             let mut frame_sums: BTreeMap<&str, f64> = BTreeMap::new();
             for t in renderer.timings() {
@@ -146,14 +173,16 @@ pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)],
     }
     Ok(samples
         .into_iter()
-        .map(|passes| {
-            passes
+        .zip(traced)
+        .map(|(passes, samples_traced)| FrameMedians {
+            passes: passes
                 .into_iter()
                 .map(|(name, mut v)| {
                     v.sort_by(f64::total_cmp);
                     (name, v[v.len() / 2])
                 })
-                .collect()
+                .collect(),
+            samples_traced,
         })
         .collect())
 }
@@ -201,20 +230,22 @@ pub fn measure(
     camera: &fovea_renderer::scene::Camera,
     camera_path: Option<&CameraKeys>,
     (w, h): (u32, u32),
+    gaze_fraction: Vec2,
     frames: u32,
 ) -> Result<VpFrameReport> {
     let screen = UVec2::new(w, h);
-    let gaze = screen.as_vec2() * 0.5;
+    let gaze = screen.as_vec2() * gaze_fraction;
     let pose = CameraPose::from_scene_camera(camera, w, h);
     let camera_at = |frame: u32| camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose));
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
     // One renderer per space (Cartesian first, gaze-less) with these settings, their frames
     // interleaved: each one's pass medians and denoiser history bytes (the renderers are dropped
     // before the next measurement).
-    let measure = |settings: RenderSettings, foveated: Vec<Box<dyn SamplingSpace>>| -> Result<Vec<(BTreeMap<String, f64>, u64)>> {
+    // A foveated space may come with its own settings (VP with every off-screen sample traced).
+    let measure = |settings: RenderSettings, foveated: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)>| -> Result<Vec<(FrameMedians, u64)>> {
         let mut renderers = vec![(Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?, None)];
-        for space in foveated {
-            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, space, settings)?, Some(gaze)));
+        for (space, own) in foveated {
+            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, space, own.unwrap_or(settings))?, Some(gaze)));
         }
         let history: Vec<u64> = renderers.iter().map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes())).collect();
         let mut timed: Vec<(&mut Renderer, Option<Vec2>)> = renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
@@ -222,22 +253,25 @@ pub fn measure(
     };
     // Without a denoiser the comparators join the same interleaved run.
     let comparator_spaces = comparator_spaces(screen, gaze, &vp)?;
-    let described: Vec<(&'static str, [u32; 2], u64)> = comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())).collect();
-    let mut spaces: Vec<Box<dyn SamplingSpace>> = vec![Box::new(vp)];
-    spaces.extend(comparator_spaces);
-    let mut plain = measure(RenderSettings::default(), spaces)?.into_iter().map(|(passes, _)| passes);
-    let cartesian_passes_ms = plain.next().expect("the Cartesian medians");
-    let vp_passes_ms = plain.next().expect("the Visual-Polar medians");
+    let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![(VP_OFFSCREEN_TRACED, vp.grid_size().to_array(), vp.sample_count())];
+    described.extend(comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())));
+    let traced_everywhere = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
+    let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> = vec![(Box::new(vp), None), (Box::new(vp), Some(traced_everywhere))];
+    spaces.extend(comparator_spaces.into_iter().map(|s| (s, None)));
+    let mut plain = measure(RenderSettings::default(), spaces)?.into_iter().map(|(medians, _)| medians);
+    let cartesian_passes_ms = plain.next().expect("the Cartesian medians").passes;
+    let FrameMedians { passes: vp_passes_ms, samples_traced: vp_samples_traced } = plain.next().expect("the Visual-Polar medians");
     let cartesian_frame_ms = frame_ms(&cartesian_passes_ms);
-    let comparators: Vec<MethodCost> = described
+    let mut comparators: Vec<MethodCost> = described
         .into_iter()
         .zip(plain)
-        .map(|((method, grid, samples), passes_ms)| {
+        .map(|((method, grid, samples), FrameMedians { passes: passes_ms, samples_traced })| {
             let frame = frame_ms(&passes_ms);
             MethodCost {
                 method,
                 grid,
                 samples,
+                samples_traced,
                 frame_ratio: frame / cartesian_frame_ms,
                 trace_ratio: passes_ms["trace"] / cartesian_passes_ms["trace"],
                 passes_ms,
@@ -245,11 +279,14 @@ pub fn measure(
             }
         })
         .collect();
+    let vp_offscreen_traced = comparators.remove(0);
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
         let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)]: [_; 2] =
-            measure(RenderSettings { denoiser, ..Default::default() }, vec![Box::new(vp)])?.try_into().expect("one median map per renderer");
+            measure(RenderSettings { denoiser, ..Default::default() }, vec![(Box::new(vp), None)])?.try_into().expect("one median map per renderer");
+        let (cart_all, vp_all) = (cart_all.passes, vp_all.passes);
+        let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cart_all), frame_ms(&vp_all));
         let (cartesian_passes_ms, vp_passes_ms) = (denoiser_passes(cart_all, &prefixes), denoiser_passes(vp_all, &prefixes));
         let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
@@ -260,6 +297,9 @@ pub fn measure(
             cartesian_ms,
             vp_ms,
             ratio: vp_ms / cartesian_ms,
+            cartesian_frame_ms,
+            vp_frame_ms,
+            frame_ratio: vp_frame_ms / cartesian_frame_ms,
             cartesian_history_bytes,
             vp_history_bytes,
         });
@@ -286,6 +326,8 @@ pub fn measure(
         vp_width: grid.x,
         vp_height: grid.y,
         vp_samples: vp.sample_count(),
+        vp_samples_traced,
+        vp_offscreen_traced,
         gaze: gaze.to_array(),
         trace_ratio: vp_passes_ms["trace"] / cartesian_passes_ms["trace"],
         frame_ratio: vp_frame_ms / cartesian_frame_ms,
@@ -322,10 +364,11 @@ pub fn measure(
         report.vp_ray_cost_ordered,
         report.vp_ray_cost_shuffled,
     );
-    for m in &report.comparators {
+    println!("  VP traced {} of its {} samples (the rest lay far off the screen)", report.vp_samples_traced, report.vp_samples);
+    for m in std::iter::once(&report.vp_offscreen_traced).chain(&report.comparators) {
         println!(
-            "  {} {}×{} ({} samples vs VP's {}): frame {:.1} ms = {:.3} of Cartesian (trace {:.3})",
-            m.method, m.grid[0], m.grid[1], m.samples, report.vp_samples, m.frame_ms, m.frame_ratio, m.trace_ratio
+            "  {} {}×{} ({} samples, {} traced, vs VP's {}): frame {:.1} ms = {:.3} of Cartesian (trace {:.3})",
+            m.method, m.grid[0], m.grid[1], m.samples, m.samples_traced, report.vp_samples, m.frame_ms, m.frame_ratio, m.trace_ratio
         );
     }
     let mib = |b: u64| b as f64 / (1 << 20) as f64;
@@ -336,12 +379,13 @@ pub fn measure(
             .map(|(pass, vp_ms)| format!("{pass} {vp_ms:.2} vs {:.2}", d.cartesian_passes_ms.get(pass).copied().unwrap_or(f64::NAN)))
             .collect();
         println!(
-            "  {}: {:.1} ms VP vs {:.1} ms Cartesian = {:.3} ({}), history {:.1} vs {:.1} MiB",
+            "  {}: {:.1} ms VP vs {:.1} ms Cartesian = {:.3} ({}); whole frame {:.3}, history {:.1} vs {:.1} MiB",
             d.name,
             d.vp_ms,
             d.cartesian_ms,
             d.ratio,
             passes.join(", "),
+            d.frame_ratio,
             mib(d.vp_history_bytes),
             mib(d.cartesian_history_bytes)
         );

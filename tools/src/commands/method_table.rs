@@ -74,6 +74,8 @@ struct BenchSize {
     width: u32,
     height: u32,
     vp_samples: u64,
+    /// Reports before off-screen culling have none: every sample was traced.
+    vp_samples_traced: Option<u64>,
     cartesian_passes_ms: BTreeMap<String, f64>,
     vp_passes_ms: BTreeMap<String, f64>,
     cartesian_frame_ms: f64,
@@ -85,11 +87,12 @@ struct BenchSize {
 struct BenchMethod {
     method: String,
     samples: u64,
+    samples_traced: Option<u64>,
     passes_ms: BTreeMap<String, f64>,
     frame_ms: f64,
 }
 
-/// One method's cost in the bench run: samples, frame ms, trace ms.
+/// One method's cost in the bench run: samples traced, frame ms, trace ms.
 struct Cost {
     samples: u64,
     frame_ms: f64,
@@ -158,10 +161,10 @@ fn costs(size: &BenchSize) -> BTreeMap<String, Cost> {
     let screen = size.width as u64 * size.height as u64;
     let mut out = BTreeMap::from([
         ("cartesian".to_string(), Cost { samples: screen, frame_ms: size.cartesian_frame_ms, trace_ms: trace(&size.cartesian_passes_ms) }),
-        ("vp".to_string(), Cost { samples: size.vp_samples, frame_ms: size.vp_frame_ms, trace_ms: trace(&size.vp_passes_ms) }),
+        ("vp".to_string(), Cost { samples: size.vp_samples_traced.unwrap_or(size.vp_samples), frame_ms: size.vp_frame_ms, trace_ms: trace(&size.vp_passes_ms) }),
     ]);
     for m in &size.comparators {
-        out.insert(m.method.clone(), Cost { samples: m.samples, frame_ms: m.frame_ms, trace_ms: trace(&m.passes_ms) });
+        out.insert(m.method.clone(), Cost { samples: m.samples_traced.unwrap_or(m.samples), frame_ms: m.frame_ms, trace_ms: trace(&m.passes_ms) });
     }
     out
 }

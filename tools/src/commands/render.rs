@@ -63,6 +63,8 @@ struct Report {
     texture_lod: &'static str,
     /// Path regularisation strength (0 = off, the unbiased estimator).
     path_regularisation: f32,
+    /// `cull` (samples far off the screen not traced) or `trace`.
+    offscreen_samples: &'static str,
     scene: String,
     headset: String,
     /// "left", "right" or "both".
@@ -92,6 +94,8 @@ struct Report {
     samples_traced: u64,
     /// Traced samples per frame (mean) whose screen position is off the screen.
     samples_offscreen: u64,
+    /// Samples per frame (mean) not traced because they lay far off the screen (`--offscreen-samples cull`).
+    samples_culled: u64,
     screen_pixels: u64,
     /// Rays traced in one frame of one eye (mean): primary + shadow + continuation.
     rays_traced: u64,
@@ -234,6 +238,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         taa: setup.taa.name().to_string(),
         texture_lod: args.profile.texture_lod.name(),
         path_regularisation: args.profile.path_regularisation(),
+        offscreen_samples: args.profile.offscreen_samples.name(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         eyes: eyes.name().to_string(),
@@ -253,6 +258,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frames,
         samples_traced: totals.samples_traced / n,
         samples_offscreen: totals.samples_offscreen / n,
+        samples_culled: totals.samples_culled / n,
         screen_pixels,
         rays_traced: rays.primary + rays.shadow + rays.continuation,
         rays,
@@ -322,6 +328,7 @@ impl FrameWriter<'_> {
             let stats = renderer.frame_stats(frame, view)?;
             self.totals.samples_traced += stats.samples_traced;
             self.totals.samples_offscreen += stats.samples_offscreen;
+            self.totals.samples_culled += stats.samples_culled;
             self.totals.primary_rays += stats.primary_rays;
             self.totals.shadow_rays += stats.shadow_rays;
             self.totals.continuation_rays += stats.continuation_rays;

@@ -267,6 +267,7 @@ pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMo
         taa,
         texture_lod: args.profile.texture_lod,
         path_regularisation: args.profile.path_regularisation(),
+        offscreen_samples: args.profile.offscreen_samples,
         ..Default::default()
     }
 }

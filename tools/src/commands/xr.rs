@@ -318,6 +318,7 @@ impl<'a> XrRun<'a> {
             let total = &mut self.tally.stats;
             total.samples_traced += s.samples_traced;
             total.samples_offscreen += s.samples_offscreen;
+            total.samples_culled += s.samples_culled;
             total.primary_rays += s.primary_rays;
             total.shadow_rays += s.shadow_rays;
             total.continuation_rays += s.continuation_rays;

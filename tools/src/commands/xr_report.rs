@@ -121,6 +121,7 @@ pub struct XrReport {
     /// Per eye and rendered frame.
     samples_traced: u64,
     samples_offscreen: u64,
+    samples_culled: u64,
     rays_traced: u64,
     /// Pass → mean GPU ms per rendered frame (both eyes' passes summed).
     passes: BTreeMap<String, f64>,
@@ -191,6 +192,7 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
         gaze_recorded: i.recorded,
         samples_traced: t.stats.samples_traced / eye_frames,
         samples_offscreen: t.stats.samples_offscreen / eye_frames,
+        samples_culled: t.stats.samples_culled / eye_frames,
         rays_traced: t.stats.rays_traced() / eye_frames,
         frame_gpu_ms: passes.values().sum(),
         passes,
