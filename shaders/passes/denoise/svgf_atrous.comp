@@ -2,7 +2,7 @@
 // One SVGF à-trous iteration (Schied et al. 2017, §4.3): a 5×5 B3-spline kernel with taps
 // `config.x` texels apart, stopped at edges by depth (relative to the gradient), normal and
 // luminance (relative to σ_l·√(3×3-Gaussian variance)); the variance is filtered with the squared
-// weights. Texels without a sample are never read and get zeros.
+// weights. Texels without a sample are never read and get zeros; misses keep their value.
 //! variants per space
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
@@ -27,6 +27,13 @@ void main() {
         return;
     }
     vec4 centre = imageLoad(src, t);
+    vec4 centre_normal_depth = imageLoad(normal_depth, t);
+    if (all(equal(centre_normal_depth.xyz, vec3(0.0)))) {
+        // A miss (or a sample culled off the screen): no tap passes the normal test, the texel
+        // keeps its value. Skipping the 34 taps matters where whole runs are misses (sky, culled).
+        imageStore(dst, t, centre);
+        return;
+    }
 
     // The luminance edge-stop uses a 3×3 Gaussian of the variance: single-texel estimates are noisy.
     int rows_here = grid_rows(g, t.x);
@@ -45,7 +52,7 @@ void main() {
     }
     float phi_l = push.p.params.x * sqrt(max(var / var_w, 0.0) + 1e-10);
 
-    SvgfSurface s = svgf_surface(imageLoad(normal_depth, t), imageLoad(position, t).w, uvec2(0u));
+    SvgfSurface s = svgf_surface(centre_normal_depth, imageLoad(position, t).w, uvec2(0u));
     float l = svgf_luminance(centre.rgb);
     int step = int(push.p.config.x);
     float w0 = B3[0] * B3[0];

@@ -29,13 +29,17 @@ void main() {
         imageStore(dst, t, centre);
         return;
     }
-    SvgfSurface s = svgf_surface(imageLoad(normal_depth, t), imageLoad(position, t).w, uvec2(0u));
+    vec4 centre_normal_depth = imageLoad(normal_depth, t);
+    // A miss (or a culled sample): no neighbour passes the normal test, so the sums below would
+    // hold the centre alone; skipped for whole runs of sky or culled texels.
+    bool alone = all(equal(centre_normal_depth.xyz, vec3(0.0)));
+    SvgfSurface s = svgf_surface(centre_normal_depth, imageLoad(position, t).w, uvec2(0u));
     float l = svgf_luminance(centre.rgb);
     vec3 sum_c = centre.rgb;
     vec2 sum_m = cm.xy;
     float sum_w = 1.0;
     int rows_here = grid_rows(g, t.x);
-    for (int dx = -3; dx <= 3; ++dx) {
+    for (int dx = -3; dx <= 3 && !alone; ++dx) {
         GridColumn col;
         if (!grid_column(g, t, rows_here, dx, col)) continue;
         for (int dy = -3; dy <= 3; ++dy) {
