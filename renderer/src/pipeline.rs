@@ -70,8 +70,8 @@ pub struct RenderSettings {
     /// focus (sunlight through a diffuse-then-glossy path: fireflies) is spread out. Biased, like
     /// every such filter; 0 turns it off (the unbiased estimator), 1 is the default.
     pub path_regularisation: f32,
-    /// Whether samples far off the screen are traced (only the paper's Visual-Polar layout and
-    /// the random/log-polar spaces place any there).
+    /// Whether samples far off the screen are traced (only the paper's Visual-Polar layout, the
+    /// log-polar and composite buffers and random acuity place any there).
     pub offscreen_samples: OffscreenSamples,
 }
 
