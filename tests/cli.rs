@@ -533,12 +533,19 @@ fn bench_vp_frames_follow_a_camera_path() {
     assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
     let comparators = vp["comparators"].as_array().unwrap();
     let methods: Vec<&str> = comparators.iter().map(|c| c["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["log-polar", "uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset"]);
+    assert_eq!(
+        methods,
+        ["uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset", "fixed-foveation"]
+    );
     for c in comparators {
         assert!(c["samples"].as_u64().unwrap() > 0 && c["frame_ms"].as_f64().unwrap() > 0.0 && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0, "{c}");
     }
     // Random acuity traces Visual-Polar's samples.
     assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
+    // Fixed foveation: VP's samples, but around the lens centre, so far fewer of them lie off the
+    // screen than VP's around the gaze near the corner below.
+    assert_eq!(comparators[9]["samples"], vp["vp_samples"]);
+    assert!(comparators[9]["samples_traced"].as_u64() > vp["vp_samples_traced"].as_u64(), "{}", comparators[9]);
     // --vp-gaze near the top-left corner: most of VP's circle lies off the screen, and the samples
     // far off it are culled; with every sample traced (the paper's way) all of them are.
     assert_eq!(vp["gaze"][0].as_f64(), Some(6.4), "{vp}");

@@ -271,3 +271,39 @@ fn composite_runs_the_filters_and_the_cli_reports_it() {
     assert_eq!(report["composite_mode"], "kernel");
     assert!(report["passes"]["remap"].as_f64().is_some(), "{}", report["passes"]);
 }
+
+/// Fixed foveation: with the eye near a corner it renders byte for byte what Visual-Polar renders
+/// with the eye on the lens centre, SVGF included (its filters run in the lens-centred grid), and
+/// `fovea render --method fixed-foveation` records where the eye looked.
+#[test]
+fn fixed_foveation_keeps_the_fovea_on_the_lens_wherever_the_eye_looks() {
+    use fovea_renderer::sampling::FixedFoveation;
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
+    let lens = SCREEN.as_vec2() * 0.5;
+    for denoiser in ["none", "svgf"] {
+        let settings = RenderSettings { denoiser: DenoiserSettings::parse(denoiser).unwrap(), ..Default::default() };
+        let fixed = FixedFoveation::new(SCREEN, lens, VisualPolarParams::default()).unwrap();
+        let mut fixed = Renderer::new(&ctx, &scene, Box::new(fixed), settings).unwrap();
+        let mut vp = Renderer::new(&ctx, &scene, Box::new(VisualPolar::new(SCREEN, lens, VisualPolarParams::default()).unwrap()), settings).unwrap();
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for f in 0..3 {
+            let eye = Vec2::new(6.0 + 3.0 * f as f32, 8.0);
+            fixed.render_frame(&FrameInput::mono(camera, f, Some(eye))).unwrap();
+            vp.render_frame(&FrameInput::mono(camera, f, Some(lens))).unwrap();
+            assert_eq!(fixed.space().gaze(), eye);
+            fixed.read_ldr(&mut a).unwrap();
+            vp.read_ldr(&mut b).unwrap();
+            assert!(a == b, "{denoiser} frame {f}: fixed foveation moved with the eye");
+        }
+    }
+    assert_clean(&ctx);
+
+    let report = fovea_tests::render_report("fixed-foveation", Default::default());
+    assert_eq!(report["method"], "fixed-foveation");
+    assert!(report["visual_polar"].is_object() && report["passes"]["remap"].as_f64().is_some(), "{report}");
+    // The simulated eye is off the lens centre (32, 36): its gaze, not the samples' centre.
+    let gaze = &report["gaze"][0];
+    assert!(gaze.is_array() && *gaze != serde_json::json!([32.0, 36.0]), "{gaze}");
+}

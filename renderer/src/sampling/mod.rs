@@ -5,6 +5,7 @@
 mod acuity;
 mod cartesian;
 mod composite;
+mod fixed_foveation;
 mod linear_falloff;
 mod log_polar;
 mod pixel_blocks;
@@ -18,6 +19,7 @@ mod visual_polar_screen_axis;
 
 pub use cartesian::Cartesian;
 pub use composite::{CompositeMode, CompositeParams};
+pub use fixed_foveation::FixedFoveation;
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use pixel_blocks::{BlockShape, PixelBlocks, BLOCK_LEVELS};

@@ -10,9 +10,7 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
-use fovea_renderer::sampling::{
-    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FovTangents, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
-};
+use fovea_renderer::sampling::{Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -53,10 +51,9 @@ pub struct VpFrameReport {
     pub to_screen_share: f64,
     /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
     pub denoisers: Vec<DenoiserCost>,
-    /// The comparator methods (issue 14) in the same interleaved run as the VP and Cartesian
-    /// frames above, no denoiser, each with its paper's defaults (`comparator_spaces`):
-    /// `log-polar`, `uniform-budget`, `linear-falloff` (samples: the expected count), `random-acuity`,
-    /// `pixel-blocks`, `composite`, and VP's variants (`vp-screen-clipped`, `vp-screen-aware`, `vp-headset`: the FOVE 0's FOV).
+    /// Every other method of `--method` (issue 14's comparators, VP's variants, fixed foveation)
+    /// in the same interleaved run as the VP and Cartesian frames above, no denoiser, each with
+    /// its paper's defaults (`comparator_spaces`; `linear-falloff`'s samples: the expected count).
     pub comparators: Vec<MethodCost>,
     /// Primary rays of the VP samples: Mrays/s in VP order and shuffled, and their ratio.
     pub vp_order_mrays_per_s: f64,
@@ -187,27 +184,22 @@ pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)],
         .collect())
 }
 
-/// The comparator methods of issue 14 with their papers' defaults, around `gaze`: log-polar
-/// (Meng et al. 2018), the uniform budget, linear falloff (1.5× VP's samples) and random acuity
-/// (VP's samples at random positions), pixel blocks (Mohanto et al. 2023, 4 / 2 / 1 samples) and
-/// composite (Andersson & Hansson 2020, their composite mode), each one measured beside `vp`.
-fn comparator_spaces(screen: UVec2, gaze: Vec2, vp: &VisualPolar) -> Result<Vec<Box<dyn SamplingSpace>>> {
-    let log_polar = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(LogPolarParams::default()), ..Default::default() })?;
-    let falloff = LinearFalloff::new(screen, *vp.params(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP)?;
-    Ok(vec![
-        Box::new(log_polar),
-        Box::new(UniformBudget::with_samples(screen, vp.sample_count())?),
-        Box::new(falloff),
-        Box::new(RandomAcuity::new(screen, gaze, *vp.params())?),
-        Box::new(PixelBlocks::new(screen, *vp.params(), BlockShape::default())?),
-        // A 90° eye: the gaze disc's viewing distance is half the width.
-        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::Composite(CompositeMode::default().params(screen.x as f32 / 2.0)), ..Default::default() })?),
-        // Visual-Polar's variants: the screen-clipped layout, the screen-aware axis and the FOVE 0's
-        // headset axis.
-        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..*vp.params() })?),
-        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { layout: VpLayout::ScreenAware, ..*vp.params() })?),
-        Box::new(VisualPolar::new(screen, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0_fov()?), ..*vp.params() })?),
-    ])
+/// Methods the bench measures itself (the VP and Cartesian frames every ratio divides).
+const MEASURED_APART: &[&str] = &["vp", "cartesian"];
+
+/// Every other method of the registry (`methods::METHODS`: the comparators of issue 14 with
+/// their papers' defaults, VP's variants, fixed foveation), as `fovea render` builds it with the
+/// default profile for the FOVE 0's left eye, around `gaze`; each one measured beside `vp`.
+fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSpace>>> {
+    let (profile, hmd) = (crate::render_profile::RenderProfile::default(), fovea_hal::HmdDescription::resolve("fove0")?);
+    let names = super::methods::names().into_iter().filter(|n| !MEASURED_APART.contains(n));
+    names
+        .map(|name| {
+            let mut space = super::setup::space_for(name, &profile, &hmd, fovea_hal::Eye::Left, screen)?;
+            space.set_gaze(gaze)?;
+            Ok(space)
+        })
+        .collect()
 }
 
 /// The FOVE 0 left eye's FOV from its headset profile, for the headset-axis variant.
@@ -252,7 +244,7 @@ pub fn measure(
         Ok(interleaved_pass_medians(&mut timed, &camera_at, frames)?.into_iter().zip(history).collect())
     };
     // Without a denoiser the comparators join the same interleaved run.
-    let comparator_spaces = comparator_spaces(screen, gaze, &vp)?;
+    let comparator_spaces = comparator_spaces(screen, gaze)?;
     let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![(VP_OFFSCREEN_TRACED, vp.grid_size().to_array(), vp.sample_count())];
     described.extend(comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())));
     let traced_everywhere = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
@@ -431,4 +423,26 @@ fn shuffle(mut rays: Vec<RayGpu>) -> Vec<RayGpu> {
         rays.swap(i, (state % (i as u64 + 1)) as usize);
     }
     rays
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The comparators come from the registry as `fovea render` builds them, around the bench's
+    /// gaze, and the bench's own VP frame is the registry's `vp` with the default profile.
+    #[test]
+    fn comparators_are_the_registry_around_the_gaze() {
+        let screen = UVec2::new(320, 360);
+        let gaze = Vec2::new(100.0, 120.0);
+        let spaces = comparator_spaces(screen, gaze).unwrap();
+        let names: Vec<_> = spaces.iter().map(|s| s.name()).collect();
+        let expected: Vec<_> = super::super::methods::names().into_iter().filter(|n| !MEASURED_APART.contains(n)).collect();
+        assert_eq!(names, expected);
+        assert!(spaces.iter().all(|s| s.gaze() == gaze), "{names:?}");
+        let (profile, hmd) = (crate::render_profile::RenderProfile::default(), fovea_hal::HmdDescription::resolve("fove0").unwrap());
+        let registry_vp = super::super::setup::space_for("vp", &profile, &hmd, fovea_hal::Eye::Left, screen).unwrap();
+        let bench_vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+        assert_eq!(registry_vp.params(), bench_vp.sampling_params());
+    }
 }

@@ -7,7 +7,7 @@ use crate::render_profile::RenderProfile;
 use anyhow::{anyhow, Context, Result};
 use fovea_hal::HmdDescription;
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, Eccentricity, FalloffShape, FovTangents, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar,
+    BlockShape, Cartesian, Eccentricity, FalloffShape, FixedFoveation, FovTangents, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar,
     VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
 use glam::{UVec2, Vec2};
@@ -171,6 +171,14 @@ pub const METHODS: &[Method] = &[
             let params = VisualPolarParams { eccentricity: Eccentricity::Headset(i.fov), layout: VpLayout::Paper, ..i.vp };
             i.visual_polar(params, &format!("Visual-Polar space, headset axis of {}", i.hmd.id))
         },
+    },
+    // Visual-Polar held on the lens centre (fixed foveated rendering): what eye tracking buys.
+    Method {
+        name: "fixed-foveation",
+        screen: ScreenNeeds::VisualPolarGrid,
+        blurs: true,
+        report: ReportSection::VisualPolar(VpVariant::Profile),
+        build: |i| Ok(Box::new(FixedFoveation::new(i.screen, FixedFoveation::lens_centre(i.screen, i.fov), i.vp).context("fixed foveation")?)),
     },
 ];
 
