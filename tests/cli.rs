@@ -535,7 +535,7 @@ fn bench_vp_frames_follow_a_camera_path() {
     let methods: Vec<&str> = comparators.iter().map(|c| c["method"].as_str().unwrap()).collect();
     assert_eq!(
         methods,
-        ["uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset", "fixed-foveation"]
+        ["uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset", "fixed-foveation", "vrs-tiles"]
     );
     for c in comparators {
         assert!(c["samples"].as_u64().unwrap() > 0 && c["frame_ms"].as_f64().unwrap() > 0.0 && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0, "{c}");

@@ -307,3 +307,32 @@ fn fixed_foveation_keeps_the_fovea_on_the_lens_wherever_the_eye_looks() {
     let gaze = &report["gaze"][0];
     assert!(gaze.is_array() && *gaze != serde_json::json!([32.0, 36.0]), "{gaze}");
 }
+
+/// Variable-rate tiles: the GPU traces exactly the block pixels the Rust rule names (Rust = GLSL)
+/// for gazes across the screen, the fill leaves no hole and converges to one sample per pixel's
+/// image, the filters are refused, and `fovea render --method vrs-tiles` reports it end to end.
+#[test]
+fn vrs_tiles_trace_one_pixel_per_block_and_converge_like_one_sample_per_pixel() {
+    use fovea_renderer::sampling::VrsTiles;
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
+    let centre = SCREEN.as_vec2() * 0.5;
+    let tiles = || VrsTiles::new(SCREEN, centre, VisualPolarParams::default()).unwrap();
+    let mut r = Renderer::new(&ctx, &scene, Box::new(tiles()), RenderSettings::default()).unwrap();
+    for (f, gaze) in [centre, Vec2::new(3.3, 70.1), Vec2::new(47.5, 16.0), Vec2::new(-20.0, 10.0)].into_iter().enumerate() {
+        let mut host = tiles();
+        host.set_gaze(gaze).unwrap();
+        let stats = r.render_frame(&FrameInput::mono(camera, f as u32, Some(gaze))).unwrap();
+        assert_eq!(stats.samples_traced, host.sample_count(), "gaze {gaze}");
+        // 16-pixel tiles on a 64×72 screen: some coarse tiles, never all fine.
+        assert!(host.sample_count() < (SCREEN.x * SCREEN.y) as u64 * 9 / 10, "gaze {gaze}: {} samples", host.sample_count());
+    }
+    fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, Vec2::new(20.0, 50.0), 16, no_holes);
+    fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(tiles()));
+    assert_clean(&ctx);
+
+    let report = fovea_tests::render_report("vrs-tiles", Default::default());
+    assert_eq!(report["method"], "vrs-tiles");
+    assert!(report["passes"]["fill_push"].as_f64().is_some() && report["passes"]["blur_v"].as_f64().is_some(), "{}", report["passes"]);
+}

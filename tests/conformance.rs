@@ -15,8 +15,8 @@ use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, Deno
 use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
-    VisualPolar, VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
+    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
+    VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
@@ -50,6 +50,9 @@ fn spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
         ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(size, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),
         ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(size, gaze, vp).unwrap()))),
         ("pixel-blocks", Box::new(move || Box::new(PixelBlocks::new(size, vp, BlockShape::default()).unwrap()))),
+        ("vrs-tiles", Box::new(move || Box::new(VrsTiles::new(size, gaze, vp).unwrap()))),
+        // The lens centre a quarter of the way in: the filters run on a grid centred off the gaze.
+        ("fixed-foveation", Box::new(move || Box::new(FixedFoveation::new(size, size.as_vec2() * 0.25, vp).unwrap()))),
     ]
 }
 

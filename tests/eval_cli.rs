@@ -236,7 +236,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     run(&args).unwrap();
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
     let refused: Vec<&str> = report["refused"].as_array().unwrap().iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(refused, ["uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks"]);
+    assert_eq!(refused, ["uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks", "vrs-tiles"]);
     assert!(report["refused"].as_array().unwrap().iter().all(|r| r["denoiser"] == "svgf" && r["reason"].as_str().unwrap().contains("supports no denoiser")));
     let runs = report["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2 * methods.len() - refused.len(), "{runs:?}");

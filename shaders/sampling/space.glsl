@@ -23,6 +23,8 @@ layout(std140, set = 0, binding = 9) uniform SamplingBuffer { SamplingParams dat
 #include "random_acuity.glsl"
 #elif defined(SAMPLING_PIXEL_BLOCKS)
 #include "pixel_blocks.glsl"
+#elif defined(SAMPLING_VRS_TILES)
+#include "vrs_tiles.glsl"
 #else
 #error "no sampling space selected"
 #endif

@@ -16,6 +16,7 @@ mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 mod visual_polar_screen_axis;
+mod vrs_tiles;
 
 pub use cartesian::Cartesian;
 pub use composite::{CompositeMode, CompositeParams};
@@ -29,6 +30,7 @@ pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout,
 pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
 pub use visual_polar_screen_axis::{ScreenAxis, AXIS_KNOT_TEXELS, AXIS_PIECES};
+pub use vrs_tiles::{VrsTiles, VRS_TILE};
 
 use crate::error::Result;
 use crate::layouts::SamplingParams;

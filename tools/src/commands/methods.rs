@@ -7,7 +7,7 @@ use crate::render_profile::RenderProfile;
 use anyhow::{anyhow, Context, Result};
 use fovea_hal::HmdDescription;
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, Eccentricity, FalloffShape, FixedFoveation, FovTangents, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar,
+    BlockShape, Cartesian, Eccentricity, FalloffShape, FixedFoveation, FovTangents, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VrsTiles,
     VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
 };
 use glam::{UVec2, Vec2};
@@ -179,6 +179,14 @@ pub const METHODS: &[Method] = &[
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::Profile),
         build: |i| Ok(Box::new(FixedFoveation::new(i.screen, FixedFoveation::lens_centre(i.screen, i.fov), i.vp).context("fixed foveation")?)),
+    },
+    // Variable-rate-shading foveation: 16×16 tiles at 1×1, 2×2 or 4×4, never sparser than VP.
+    Method {
+        name: "vrs-tiles",
+        screen: ScreenNeeds::VisualPolarGrid,
+        blurs: true,
+        report: ReportSection::None,
+        build: |i| Ok(Box::new(VrsTiles::new(i.screen, i.centre(), i.vp).context("vrs tiles")?)),
     },
 ];
 
