@@ -143,7 +143,7 @@ impl View {
             WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa)?),
             WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
-            WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.shader_variant(), screen)?, FillToScreen::new(ctx, screen)?),
+            WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.trace_variant(), screen)?, FillToScreen::new(ctx, screen)?),
             WayBack::BlockFill => BackPasses::BlockFill(BlockFillPass::new(ctx, space.shader_variant())?, Image::new(ctx, "block_filled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;

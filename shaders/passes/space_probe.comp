@@ -4,9 +4,7 @@
 // it with the space's Rust twin texel by texel (tests/comparators.rs, tests/pixel_blocks.rs).
 // out[i] = (screen x, y, 1 if the texel holds a sample else 0, samples it traces per frame),
 // i = y · width + x.
-//! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
-//! variant linear_falloff: SAMPLING_LINEAR_FALLOFF
-//! variant pixel_blocks: SAMPLING_PIXEL_BLOCKS
+//! variants per trace space
 #include "../common/layouts.glsl"
 #include "../sampling/space.glsl"
 

@@ -1,11 +1,14 @@
 #version 460
-// Splat (the way back of spaces whose samples lie anywhere on the screen: random acuity): each
-// grid texel's sample added to the screen pixel its position falls in, then every pixel's mean.
+// Splat (the way back of spaces whose samples lie anywhere on the screen: random acuity, the
+// packed variable-rate tiles): each grid texel's sample added to the screen pixel its position
+// falls in, then every pixel's mean.
 // Scatter (config.x = 0, one lane per grid texel): the sample's position recomputed by the space
 // (the same draw as the trace), its radiance added in fixed point (SPLAT_FIXED_POINT) with integer
 // atomics — float atomics are an extension — and a count. Resolve (config.x = 1, one lane per
 // pixel): the mean, alpha 1 where a sample landed, 0 elsewhere (the push-pull fill's input).
-//! variant random_acuity: SAMPLING_RANDOM_ACUITY VP_LAYOUT_PAPER_ONLY
+// One variant per trace variant: the splat recomputes each sample's position with the very
+// mapping the trace used (renderer::passes::splat takes the space's trace_variant).
+//! variants per trace space
 #include "../common/layouts.glsl"
 #include "../sampling/space.glsl"
 

@@ -224,7 +224,7 @@ pub struct ProbedTexel {
 pub fn probe(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace, frame: u32, seed: u32) -> Vec<ProbedTexel> {
     use fovea_renderer::graph::{read_buffer, read_texels, write_buffer};
     let grid = space.grid_size();
-    let pipeline = fovea_renderer::vk::ComputePipeline::new(ctx, &format!("passes/space_probe.{}", space.shader_variant()), 0).unwrap();
+    let pipeline = fovea_renderer::vk::ComputePipeline::new(ctx, &format!("passes/space_probe.{}", space.trace_variant()), 0).unwrap();
     let buffers = SpaceBuffers::new(ctx, space, frame, seed);
     let out = Buffer::new(ctx, "probe_out", grid.x as u64 * grid.y as u64 * 16, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();

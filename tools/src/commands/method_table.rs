@@ -287,6 +287,26 @@ fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, sce
             let _ = writeln!(s, "- Visual-Polar vs {other} ({paper}), no denoiser: FLIP {vp} with {nv} samples vs {o} with {no} (each at its paper's budget, not equal samples).");
         }
     }
+    // What eye tracking buys: the same samples held on the lens centre, every denoiser both ran.
+    let still_with = |m: &str, d: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m && r.denoiser == d && r.taa == "off");
+    let tracked: Vec<String> = q
+        .runs
+        .iter()
+        .filter(|v| v.camera == "still" && v.method == "vp" && v.taa == "off")
+        .filter_map(|v| still_with("fixed-foveation", &v.denoiser).map(|f| format!("{} {} vs {}", v.denoiser, bands(v, |g| g.flip), bands(f, |g| g.flip))))
+        .collect();
+    if !tracked.is_empty() {
+        let _ = writeln!(s, "- Eye tracking: Visual-Polar around the gaze vs the same samples held on the lens centre (`fixed-foveation`), over the quality run's gaze: FLIP {}.", tracked.join("; "));
+    }
+    if let (Some(t), Some(v), Some(tf), Some(vf)) = (costs.get("vrs-tiles"), costs.get("vp"), flip("vrs-tiles"), flip("vp")) {
+        let _ = writeln!(
+            s,
+            "- Variable-rate tiles (VP's density quantised to 1×1 / 2×2 / 4×4 blocks in 16×16 tiles, never sparser than VP): {} samples = {:.2}× VP's, frame {:.2}× VP's, FLIP {tf} vs VP's {vf}.",
+            t.samples,
+            t.samples as f64 / v.samples.max(1) as f64,
+            t.frame_ms / v.frame_ms
+        );
+    }
     if let (Some(pb), Some(c), Some(pf), Some(cf)) = (costs.get("pixel-blocks"), costs.get("cartesian"), flip("pixel-blocks"), flip("cartesian")) {
         let _ = writeln!(
             s,
