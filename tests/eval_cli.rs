@@ -283,7 +283,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         assert!(text.contains(&format!("![{m}](docs/methods/{m}.png)")), "{m}");
     }
     assert!(text.contains("| pixel-blocks + svgf | refused:") && text.contains("faster traversal per sample for Visual-Polar than random acuity"), "{text}");
-    assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
+    assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034, gaze `sim:1`") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
     // A report of many methods is no equal-samples pair: named, and the README left as it was.
     let many = [out.join("quality.json")];
     let err = format!("{:#}", fovea_tools::commands::method_table::run(&fovea_tools::commands::method_table::MethodTableArgs { equal_samples: &many, ..table_args(&readme) }).unwrap_err());
