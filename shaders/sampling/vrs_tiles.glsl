@@ -1,5 +1,5 @@
 // Variable-rate tiles (the foveation eye-tracked headsets ship through variable-rate shading),
-// packed so no lane idles: the screen in VRS_TILE-pixel tiles, each traced at one sample per
+// packed so no lane idles: the screen in shape0.x-pixel tiles, each traced at one sample per
 // pixel, per 2×2 or per 4×4 block — rate 1 for tiles nearer the gaze than gaze.z, 2 nearer than
 // gaze.w, else 4 (by the tile's point nearest the gaze; the radii where Visual-Polar's density
 // falls to 1/4 and 1/16, from the Rust side). The grid is the screen padded to whole tiles, read
@@ -10,12 +10,15 @@
 #ifndef FOVEA_SAMPLING_VRS_TILES_GLSL
 #define FOVEA_SAMPLING_VRS_TILES_GLSL
 
-const int VRS_TILE_PIXELS = 16;
+// Pixels per tile side: sampling::VRS_TILE, passed in shape0.x (one source of truth).
+int vrs_tile_pixels() {
+    return int(sampling.data.shape0.x);
+}
 
 // Tile columns [x, y) of tile row `row` whose nearest point lies closer than `r` to the gaze.
 ivec2 vrs_columns_within(int row, float r) {
     vec2 g = sampling.data.gaze.xy;
-    float t = float(VRS_TILE_PIXELS);
+    float t = float(vrs_tile_pixels());
     float dy = max(0.0, max(float(row) * t - g.y, g.y - float(row + 1) * t));
     if (dy >= r) return ivec2(0);
     float w = sqrt(r * r - dy * dy);
@@ -33,7 +36,8 @@ bool vrs_pixel(ivec2 texel, out ivec2 pixel) {
     if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, grid))) return false;
     int tiles_x = int(sampling.data.shape0.y);
     int k = ((texel.y / 8) * (grid.x / 8) + texel.x / 8) * 64 + (texel.y % 8) * 8 + texel.x % 8;
-    int capacity = tiles_x * VRS_TILE_PIXELS * VRS_TILE_PIXELS;
+    int tile = vrs_tile_pixels();
+    int capacity = tiles_x * tile * tile;
     int row = k / capacity;
     k -= row * capacity;
     ivec2 fine = vrs_columns_within(row, sampling.data.gaze.z);
@@ -44,7 +48,7 @@ bool vrs_pixel(ivec2 texel, out ivec2 pixel) {
                              ivec3(0, mid.x, 4), ivec3(mid.y, tiles_x - mid.y, 4));
     for (int i = 0; i < 5; ++i) {
         int rate = runs[i].z;
-        int per_side = VRS_TILE_PIXELS / rate;
+        int per_side = tile / rate;
         int per_tile = per_side * per_side;
         if (k < runs[i].y * per_tile) {
             int column = runs[i].x + k / per_tile;
@@ -52,7 +56,7 @@ bool vrs_pixel(ivec2 texel, out ivec2 pixel) {
             int patches = per_side / 4;
             int group = s / 16, q = s % 16;
             ivec2 block = ivec2((group % patches) * 4 + q % 4, (group / patches) * 4 + q / 4);
-            ivec2 origin = ivec2(column, row) * VRS_TILE_PIXELS + block * rate;
+            ivec2 origin = ivec2(column, row) * tile + block * rate;
             if (any(greaterThanEqual(origin, screen))) return false;
             pixel = min(origin + rate / 2, screen - 1);
             return true;

@@ -88,7 +88,7 @@ impl VrsTiles {
     /// The screen pixel of grid texel `texel`'s sample (GLSL `vrs_pixel`); `None` where the
     /// texel holds none.
     pub fn pixel(&self, texel: IVec2) -> Option<IVec2> {
-        let grid = self.axis_grid().as_ivec2();
+        let grid = self.padded_grid().as_ivec2();
         let screen = self.axis.screen().as_ivec2();
         if texel.cmplt(IVec2::ZERO).any() || texel.cmpge(grid).any() {
             return None;
@@ -118,7 +118,7 @@ impl VrsTiles {
     }
 
     /// The screen padded to whole tiles.
-    fn axis_grid(&self) -> UVec2 {
+    fn padded_grid(&self) -> UVec2 {
         self.tiles().as_uvec2() * VRS_TILE
     }
 
@@ -163,7 +163,7 @@ impl SamplingSpace for VrsTiles {
         "vrs_tiles"
     }
     fn grid_size(&self) -> UVec2 {
-        self.axis_grid()
+        self.padded_grid()
     }
     fn screen_size(&self) -> UVec2 {
         self.axis.screen()
@@ -186,7 +186,7 @@ impl SamplingSpace for VrsTiles {
     /// grid = (padded grid, screen), gaze = (x, y, rate-2 radius, rate-4 radius),
     /// shape0 = (tile side, tiles across, tiles down, 0).
     fn params(&self) -> SamplingParams {
-        let (s, g, grid, tiles) = (self.axis.screen(), self.axis.gaze(), self.axis_grid(), self.tiles());
+        let (s, g, grid, tiles) = (self.axis.screen(), self.axis.gaze(), self.padded_grid(), self.tiles());
         SamplingParams {
             grid: UVec4::new(grid.x, grid.y, s.x, s.y),
             gaze: Vec4::new(g.x, g.y, self.coarse_from[0], self.coarse_from[1]),
