@@ -28,7 +28,7 @@ const SPACES: [&str; 2] = ["cartesian", "vp"];
 
 /// The blur is off: the comparisons measure sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, denoiser, ..Default::default() }
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
 }
 
 fn asvgf() -> DenoiserSettings {

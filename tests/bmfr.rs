@@ -37,7 +37,7 @@ fn same_space(space: &dyn SamplingSpace) -> Box<dyn SamplingSpace> {
 
 /// The blur is off: the VP comparison measures sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, denoiser, ..Default::default() }
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
 }
 
 fn with_bmfr() -> DenoiserSettings {

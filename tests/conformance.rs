@@ -69,7 +69,7 @@ fn filters() -> Vec<(&'static str, DenoiserSettings, TaaMode)> {
 
 /// The blur is off: the suite measures sampling and filtering only.
 fn settings(denoiser: DenoiserSettings, taa: TaaMode) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, denoiser, taa, ..Default::default() }
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, taa, ..Default::default() }
 }
 
 /// The mean of `frames` raw frames of a space at `camera` (after its way back), and the last.

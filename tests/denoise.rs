@@ -31,7 +31,7 @@ fn spaces(screen: UVec2) -> [(&'static str, Box<dyn SamplingSpace>); 2] {
 
 /// The blur is off: the VP comparison measures sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, denoiser, ..Default::default() }
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
 }
 
 fn with_svgf() -> DenoiserSettings {

@@ -25,7 +25,7 @@ fn vp_space() -> VisualPolar {
 
 /// The blur is off: the comparison measures sampling and TAA only.
 fn settings(taa: TaaMode) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0 }, taa, ..Default::default() }
+    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, taa, ..Default::default() }
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {

@@ -5,6 +5,7 @@
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::passes::blur::{BlurPass, BlurShape, BlurTarget};
+use crate::passes::blur_grid::GridBlurPass;
 use crate::passes::denoise::taa::TaaSettings;
 use crate::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
 use crate::passes::mip_phi::{MipPhiPass, PhiMips};
@@ -23,16 +24,38 @@ const SIGMA_REFERENCE_DEG: f32 = 30.0;
 /// Pixels of the screen the paper's σ was chosen for.
 const FOVE_EYE_PIXELS: f32 = 1280.0 * 1440.0;
 
+/// Where the foveated blur runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BlurSpace {
+    /// On the remapped screen image, one pass per screen axis (the paper's).
+    #[default]
+    Screen,
+    /// In the Visual-Polar grid before the remap, along φ and ρ (`passes::blur_grid`): no
+    /// full-screen blur pass. Spaces it cannot serve (screen-clipped layouts, the headset axis)
+    /// and screen-space TAA, which must see the unblurred remap, keep the screen blur.
+    Grid,
+}
+
+impl BlurSpace {
+    pub fn name(self) -> &'static str {
+        match self {
+            BlurSpace::Screen => "screen",
+            BlurSpace::Grid => "grid",
+        }
+    }
+}
+
 /// Foveated-blur settings; σ scales with resolution (per unit of screen length).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BlurSettings {
     /// σ in pixels at 30° for a 1280×1440 screen (0 turns the blur off).
     pub sigma_at_30: f32,
+    pub space: BlurSpace,
 }
 
 impl Default for BlurSettings {
     fn default() -> Self {
-        BlurSettings { sigma_at_30: FOVE_SIGMA_AT_30 }
+        BlurSettings { sigma_at_30: FOVE_SIGMA_AT_30, space: BlurSpace::default() }
     }
 }
 
@@ -101,6 +124,13 @@ impl FoveatedBlur {
     }
 }
 
+/// The grid blur's pass and its two grid-sized images.
+struct GridBlur {
+    pass: GridBlurPass,
+    scratch: Image,
+    blurred: Image,
+}
+
 pub struct ToScreen {
     mip_phi: MipPhiPass,
     remap: RemapPass,
@@ -110,13 +140,24 @@ pub struct ToScreen {
     blur: FoveatedBlur,
     /// TAA between the remap and the blur (`--taa screen`).
     pub taa: Option<ScreenTaa>,
+    /// Built for `BlurSpace::Grid` (and no screen-space TAA).
+    grid_blur: Option<GridBlur>,
 }
 
 impl ToScreen {
-    /// `taa`: resolve in screen space after the remap with these settings.
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2, taa: Option<TaaSettings>) -> Result<ToScreen> {
+    /// `taa`: resolve in screen space after the remap with these settings; `blur`: where the
+    /// foveated blur runs (the grid only without screen-space TAA).
+    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2, taa: Option<TaaSettings>, blur: BlurSpace) -> Result<ToScreen> {
         let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
+        let grid_image = |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
+        let grid_blur = match (blur, taa) {
+            (BlurSpace::Grid, None) => {
+                Some(GridBlur { pass: GridBlurPass::new(ctx)?, scratch: grid_image("grid.blur_scratch")?, blurred: grid_image("grid.blurred")? })
+            }
+            _ => None,
+        };
         Ok(ToScreen {
+            grid_blur,
             mip_phi: MipPhiPass::new(ctx)?,
             remap: RemapPass::new(ctx)?,
             blur: FoveatedBlur::new(ctx, screen)?,
@@ -142,6 +183,19 @@ impl ToScreen {
         display: Option<ToneTarget>,
     ) -> Result<ScreenOut<'_>> {
         let params = vp.sampling_params();
+        // The blur in the grid where it can stand in for the screen's (then the remap's output
+        // is the picture).
+        let grid_blur = match &self.grid_blur {
+            Some(g) if blur.sigma_at_30 > 0.0 && GridBlurPass::supports(vp) => Some(g),
+            _ => None,
+        };
+        let vp_color = match grid_blur {
+            Some(g) => {
+                g.pass.record(rec, &params, &blur.shape(vp), vp_color, &g.scratch, &g.blurred)?;
+                &g.blurred
+            }
+            None => vp_color,
+        };
         self.mip_phi.record(rec, &params, columns, vp_color, &self.mips)?;
         // Samples jittered for the screen-space TAA are read where they were traced.
         let sample_offset = match (&self.taa, taa) {
@@ -153,6 +207,9 @@ impl ToScreen {
             (Some(resolver), Some(frame)) => resolver.record(rec, &self.remapped, frame)?,
             _ => &self.remapped,
         };
+        if grid_blur.is_some() {
+            return Ok(ScreenOut::Radiance(resolved));
+        }
         self.blur.record_to(rec, blur, vp, resolved, display)
     }
 }

@@ -140,7 +140,7 @@ impl View {
         };
         let back = match caps.way_back {
             WayBack::Direct => BackPasses::Direct,
-            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa)?),
+            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa, settings.blur.space)?),
             WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
             WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.trace_variant(), screen)?, FillToScreen::new(ctx, screen)?),

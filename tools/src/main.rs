@@ -205,6 +205,10 @@ struct RenderOpts {
     /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
     #[arg(long)]
     blur_sigma: Option<f32>,
+    /// Where the foveated blur runs: screen (after the remap, the paper's) | grid (in the VP grid
+    /// before the remap, no full-screen blur pass; the paper layout without screen-space TAA).
+    #[arg(long)]
+    blur_space: Option<String>,
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
@@ -239,6 +243,7 @@ impl RenderOpts {
             log_polar_extent: self.log_polar_extent.clone(),
             composite_mode: self.composite_mode.clone(),
             blur_sigma: self.blur_sigma,
+            blur_space: self.blur_space.clone(),
             environment: self.look.environment()?,
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
@@ -254,6 +259,8 @@ struct DefaultRender {
     opts: RenderOpts,
 }
 
+// Parsed once per run: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Render frames to PNG (and EXR) with a timing report.
@@ -468,6 +475,9 @@ enum Command {
         /// Foveated blur σ at 30° (0 turns it off).
         #[arg(long)]
         blur_sigma: Option<f32>,
+        /// Where the foveated blur runs: screen | grid (see `fovea render --blur-space`).
+        #[arg(long)]
+        blur_space: Option<String>,
         #[arg(long, default_value = "out/quality")]
         out: PathBuf,
         #[command(flatten)]
@@ -715,6 +725,7 @@ fn run() -> Result<()> {
             seed,
             profile,
             blur_sigma,
+            blur_space,
             out,
             look,
             device,
@@ -725,6 +736,7 @@ fn run() -> Result<()> {
             };
             let profile = base.override_with(&ProfileOverrides {
                 blur_sigma,
+                blur_space,
                 environment: look.environment()?,
                 texture_lod: look.texture_lod.clone(),
                 path_regularisation: look.path_regularisation,

@@ -13,7 +13,7 @@ use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::pipeline::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
-use fovea_renderer::to_screen::BlurSettings;
+use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
 use std::path::Path;
@@ -165,6 +165,7 @@ struct CompositeSection {
 #[serde(deny_unknown_fields)]
 struct BlurSection {
     sigma_at_30: Option<f32>,
+    space: Option<String>,
 }
 
 /// Optional single-value overrides (the `fovea render` flags).
@@ -183,6 +184,7 @@ pub struct ProfileOverrides {
     /// `--composite-mode`.
     pub composite_mode: Option<String>,
     pub blur_sigma: Option<f32>,
+    pub blur_space: Option<String>,
     /// `--sun`, `--sun-intensity`, `--sky-intensity`.
     pub environment: EnvironmentOptions,
     /// `--texture-lod`.
@@ -336,6 +338,9 @@ impl RenderProfile {
         }
         if let Some(blur) = file.blur {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
+            if let Some(space) = &blur.space {
+                profile.blur.space = parse_blur_space(space).with_context(|| format!("{}.space", at("blur")))?;
+            }
         }
         check_blur(&profile.blur).with_context(|| format!("{}.sigma_at_30", at("blur")))?;
         if let Some(f) = file.svgf {
@@ -428,6 +433,9 @@ impl RenderProfile {
                 .with_context(|| format!("--composite-mode {mode}: expected one of {}", CompositeMode::NAMES.join(", ")))?;
         }
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
+        if let Some(space) = &o.blur_space {
+            self.blur.space = parse_blur_space(space).context("--blur-space")?;
+        }
         check_blur(&self.blur).context("--blur-sigma")?;
         o.environment.validate(&EnvironmentNames::flags())?;
         self.environment = self.environment.overridden(&o.environment);
@@ -500,6 +508,14 @@ impl RenderProfile {
     /// only known to the command).
     fn check_eccentricity(&self) -> Result<()> {
         self.visual_polar_for(FovTangents { left: 1.0, right: 1.0, up: 1.0, down: 1.0 }).map(|_| ())
+    }
+}
+
+fn parse_blur_space(name: &str) -> Result<BlurSpace> {
+    match name {
+        "screen" => Ok(BlurSpace::Screen),
+        "grid" => Ok(BlurSpace::Grid),
+        _ => bail!("'{name}', expected screen or grid"),
     }
 }
 
@@ -606,6 +622,7 @@ gradient_sigma_normal = 64
             ("ecc_type.toml", "[visual_polar]\neccentricity = 2\n", "eccentricity"),
             ("ecc_clip.toml", "[visual_polar]\neccentricity = \"headset\"\nlayout = \"screen-clipped\"\n", "eccentricity"),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
+            ("blur_space.toml", "[blur]\nspace = \"pyramid\"\n", "[blur].space"),
             ("composite_sigma.toml", "[composite]\nsigma = 0\n", "[composite].sigma"),
             ("composite_mode.toml", "[composite]\nmode = \"fovea\"\n", "[composite].mode"),
             ("composite_key.toml", "[composite]\nalpha = 2\n", "alpha"),

@@ -4,6 +4,7 @@
 pub mod accumulate;
 pub mod block_fill;
 pub mod blur;
+pub mod blur_grid;
 pub mod denoise;
 pub mod fill;
 pub mod mip_phi;
@@ -25,9 +26,14 @@ pub(crate) struct VpLayoutPipelines {
 impl VpLayoutPipelines {
     /// `shader` without the variant suffix (e.g. `passes/remap`).
     pub fn new(ctx: &std::sync::Arc<crate::vk::Context>, shader: &str, push_size: u32) -> crate::error::Result<Self> {
+        Self::with_prefix(ctx, &format!("{shader}."), push_size)
+    }
+
+    /// Variants `{prefix}paper` and `{prefix}clipped` (e.g. `passes/blur_grid.phi_`).
+    pub fn with_prefix(ctx: &std::sync::Arc<crate::vk::Context>, prefix: &str, push_size: u32) -> crate::error::Result<Self> {
         Ok(VpLayoutPipelines {
-            paper: crate::vk::ComputePipeline::shared(ctx, &format!("{shader}.paper"), push_size)?,
-            clipped: crate::vk::ComputePipeline::shared(ctx, &format!("{shader}.clipped"), push_size)?,
+            paper: crate::vk::ComputePipeline::shared(ctx, &format!("{prefix}paper"), push_size)?,
+            clipped: crate::vk::ComputePipeline::shared(ctx, &format!("{prefix}clipped"), push_size)?,
         })
     }
 

@@ -97,5 +97,6 @@ void main() {
         vec3 hy = clip_toward_mean(lo, hi, mean, rgb_to_ycocg(max(hist / hist_weight, vec3(0.0))));
         result = taa_blend(cy, hy, push.p.params.x);
     }
-    imageStore(history, t, vec4(result, 1.0));
+    // Alpha: whether this frame traced the sample (0: culled off the screen), for the grid blur.
+    imageStore(history, t, vec4(result, imageLoad(color, t).a));
 }

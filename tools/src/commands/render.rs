@@ -114,6 +114,9 @@ struct Report {
     composite_mode: Option<&'static str>,
     /// Foveated blur σ at 30° for a 1280×1440 eye (the methods with the foveated blur; 0 = off).
     blur_sigma_at_30: Option<f32>,
+    /// Where that blur was asked to run: screen | grid (`--blur-space`; the grid where the space
+    /// allows it, see the passes in `passes`: `blur_grid_*` or `blur_h`/`blur_v*`).
+    blur_space: Option<&'static str>,
     /// Pass name → mean GPU milliseconds per frame (both eyes' passes summed in a stereo run).
     passes: BTreeMap<String, f64>,
     /// Sum of the pass means.
@@ -276,6 +279,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }),
         composite_mode: (method.report == ReportSection::Composite).then(|| args.profile.composite_mode.name()),
         blur_sigma_at_30: method.blurs.then_some(args.profile.blur.sigma_at_30),
+        blur_space: method.blurs.then_some(args.profile.blur.space.name()),
         frame_gpu_ms: passes.values().sum(),
         passes,
         wall_seconds: started.elapsed().as_secs_f64(),
