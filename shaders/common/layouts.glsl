@@ -228,11 +228,11 @@ struct BlurPush {
     TonemapPush tone;           // the `ldr` variants (last axis writing the display image): exposure, operator, target offset
 };
 
-// Push constants of the foveated blur in the Visual-Polar grid (one pass per axis).
+// Push constants of the foveated blur in the Visual-Polar grid (one pass per axis; the axis is
+// the kernel variant, phi_* or rho_*).
 struct GridBlurPush {
     SamplingParams space;       // VisualPolar::sampling_params (the paper's layout)
     vec4 shape;                 // as BlurPush.shape: xy gaze, z blur start (pixels), w σ per pixel beyond it
-    uvec4 config;               // unused (the axis is the kernel variant: phi_* or rho_*)
 };
 
 // Push constants of the Visual-Polar mapping probe (device test of Rust vs GLSL).

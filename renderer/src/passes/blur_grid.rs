@@ -10,7 +10,7 @@ use crate::graph::{read_image, write_image, FrameRecorder};
 use crate::layouts::{GridBlurPush, SamplingParams};
 use crate::sampling::{VisualPolar, VpLayout};
 use crate::vk::{Context, Image};
-use glam::{UVec4, Vec4};
+use glam::Vec4;
 use std::sync::Arc;
 
 pub struct GridBlurPass {
@@ -38,7 +38,6 @@ impl GridBlurPass {
         let push = GridBlurPush {
             space: *vp,
             shape: Vec4::new(shape.gaze.x, shape.gaze.y, shape.fovea_radius, shape.sigma_slope),
-            config: UVec4::ZERO,
         };
         let size = [src.width, src.height, 1];
         let binds = [read_image("src", src), write_image("dst", scratch)];
