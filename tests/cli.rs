@@ -554,6 +554,12 @@ fn bench_vp_frames_follow_a_camera_path() {
     assert!(traced < samples * 3 / 4, "{vp}");
     assert_eq!(vp["vp_offscreen_traced"]["samples_traced"].as_u64(), Some(samples), "{vp}");
     assert!(vp["vp_offscreen_traced"]["frame_ratio"].as_f64().unwrap() > 0.0, "{vp}");
+    // The blur in the grid: its two passes and the tonemap instead of the screen blur's.
+    let grid_blur = &vp["vp_grid_blur"]["passes_ms"];
+    assert!(["blur_grid_phi", "blur_grid_rho", "tonemap"].iter().all(|p| grid_blur[*p].as_f64().unwrap_or(0.0) > 0.0), "{grid_blur}");
+    assert!(grid_blur.get("blur_h").is_none() && grid_blur.get("blur_v_tonemap").is_none(), "{grid_blur}");
+    let share = vp["grid_blur_to_screen_share"].as_f64().unwrap();
+    assert!(share > 0.0 && share < 1.0, "{vp}");
     // VP's rays against the screen's through the same pass: the per-sample overhead measured apart.
     let f = |key: &str| vp[key].as_f64().unwrap_or_else(|| panic!("{key} in {vp}"));
     assert!(f("screen_mrays_per_s") > 0.0 && f("screen_shuffled_mrays_per_s") > 0.0, "{vp}");

@@ -11,6 +11,7 @@ use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams};
+use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -19,7 +20,9 @@ use std::collections::BTreeMap;
 /// The VP frame's way back; without a radiance read-back (the bench has none) the blur's last
 /// axis writes the display image (`blur_v_tonemap`), so the share includes the tone mapping that
 /// Cartesian's frame spends in `tonemap`.
-const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v", "blur_v_tonemap"];
+/// With `--blur-space grid` the blur runs in the grid before the remap and the tonemap pass
+/// writes the display image.
+const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v", "blur_v_tonemap", "blur_grid_phi", "blur_grid_rho", "tonemap"];
 
 #[derive(Serialize)]
 pub struct VpFrameReport {
@@ -35,6 +38,10 @@ pub struct VpFrameReport {
     /// The same VP frames with every off-screen sample traced, as in the paper
     /// (`--offscreen-samples trace`), in the same interleaved run.
     pub vp_offscreen_traced: MethodCost,
+    /// The same VP frames with the foveated blur in the grid (`--blur-space grid`), in the same
+    /// interleaved run, and its way back's share of its frame (against `to_screen_share`).
+    pub vp_grid_blur: MethodCost,
+    pub grid_blur_to_screen_share: f64,
     pub gaze: [f32; 2],
     /// `still`, or `keys`: the frames followed `--camera-path FILE` (frame i at i / 70 Hz).
     pub camera_motion: &'static str,
@@ -124,6 +131,8 @@ pub struct MethodCost {
 
 /// `VpFrameReport::vp_offscreen_traced`'s method name.
 const VP_OFFSCREEN_TRACED: &str = "vp-offscreen-traced";
+/// `VpFrameReport::vp_grid_blur`'s method name.
+const VP_GRID_BLUR: &str = "vp-grid-blur";
 
 /// Display rate of `--camera-path` keyframes in the bench (no headset there): the FOVE 0's 70 Hz,
 /// the default headset of `fovea render`, so a path times the same in both.
@@ -245,10 +254,13 @@ pub fn measure(
     };
     // Without a denoiser the comparators join the same interleaved run.
     let comparator_spaces = comparator_spaces(screen, gaze)?;
-    let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![(VP_OFFSCREEN_TRACED, vp.grid_size().to_array(), vp.sample_count())];
+    let described_vp = |name| (name, vp.grid_size().to_array(), vp.sample_count());
+    let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![described_vp(VP_OFFSCREEN_TRACED), described_vp(VP_GRID_BLUR)];
     described.extend(comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())));
     let traced_everywhere = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
-    let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> = vec![(Box::new(vp), None), (Box::new(vp), Some(traced_everywhere))];
+    let blur_in_grid = RenderSettings { blur: BlurSettings { space: BlurSpace::Grid, ..Default::default() }, ..Default::default() };
+    let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> =
+        vec![(Box::new(vp), None), (Box::new(vp), Some(traced_everywhere)), (Box::new(vp), Some(blur_in_grid))];
     spaces.extend(comparator_spaces.into_iter().map(|s| (s, None)));
     let mut plain = measure(RenderSettings::default(), spaces)?.into_iter().map(|(medians, _)| medians);
     let cartesian_passes_ms = plain.next().expect("the Cartesian medians").passes;
@@ -272,6 +284,7 @@ pub fn measure(
         })
         .collect();
     let vp_offscreen_traced = comparators.remove(0);
+    let vp_grid_blur = comparators.remove(0);
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
@@ -297,7 +310,8 @@ pub fn measure(
         });
     }
     let vp_frame_ms = frame_ms(&vp_passes_ms);
-    let to_screen: f64 = TO_SCREEN_PASSES.iter().filter_map(|p| vp_passes_ms.get(*p)).sum();
+    let to_screen = |passes: &BTreeMap<String, f64>| -> f64 { TO_SCREEN_PASSES.iter().filter_map(|p| passes.get(*p)).sum() };
+    let grid_blur_to_screen_share = to_screen(&vp_grid_blur.passes_ms) / vp_grid_blur.frame_ms;
 
     let rays = vp_primary_rays(&vp, &pose);
     let gpu = make_scene()?;
@@ -320,10 +334,12 @@ pub fn measure(
         vp_samples: vp.sample_count(),
         vp_samples_traced,
         vp_offscreen_traced,
+        vp_grid_blur,
+        grid_blur_to_screen_share,
         gaze: gaze.to_array(),
         trace_ratio: vp_passes_ms["trace"] / cartesian_passes_ms["trace"],
         frame_ratio: vp_frame_ms / cartesian_frame_ms,
-        to_screen_share: to_screen / vp_frame_ms,
+        to_screen_share: to_screen(&vp_passes_ms) / vp_frame_ms,
         cartesian_passes_ms,
         vp_passes_ms,
         cartesian_frame_ms,
@@ -357,7 +373,8 @@ pub fn measure(
         report.vp_ray_cost_shuffled,
     );
     println!("  VP traced {} of its {} samples (the rest lay far off the screen)", report.vp_samples_traced, report.vp_samples);
-    for m in std::iter::once(&report.vp_offscreen_traced).chain(&report.comparators) {
+    println!("  way back with the blur in the grid: {:.1} % of that frame", 100.0 * report.grid_blur_to_screen_share);
+    for m in [&report.vp_offscreen_traced, &report.vp_grid_blur].into_iter().chain(&report.comparators) {
         println!(
             "  {} {}×{} ({} samples, {} traced, vs VP's {}): frame {:.1} ms = {:.3} of Cartesian (trace {:.3})",
             m.method, m.grid[0], m.grid[1], m.samples, m.samples_traced, report.vp_samples, m.frame_ms, m.frame_ratio, m.trace_ratio
