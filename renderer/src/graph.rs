@@ -17,7 +17,7 @@ use crate::vk::{Buffer, ComputePipeline, Context, Image, ResourceId};
 use ash::vk;
 use std::sync::Arc;
 
-const MAX_BINDINGS: usize = 24;
+const MAX_BINDINGS: usize = 32;
 
 #[derive(Clone, Copy)]
 pub enum Resource<'a> {

@@ -12,6 +12,7 @@ use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
 use crate::passes::tonemap::{LdrTarget, ToneCurve, TonemapPass, ToneTarget};
+use crate::passes::trace::TileList;
 use crate::sampling::SamplingSpace;
 use crate::to_screen::{BlurSettings, ScreenOut};
 use crate::passes::splat::SplatInputs;
@@ -522,6 +523,7 @@ impl Renderer {
 
     /// Host-side work of one view before recording: gaze, this slot's uniforms and table.
     fn prepare_view(&mut self, v: usize, slot: usize, view_input: &ViewInput, input: &FrameInput) -> Result<()> {
+        let cull = self.settings.offscreen_samples == OffscreenSamples::Cull;
         if let Some(gaze) = view_input.gaze {
             self.views[v].space.set_gaze(gaze)?;
         }
@@ -545,7 +547,7 @@ impl Renderer {
         s.sampling_table.write(&view.table_rows)?;
         view.prev_table_rows.clear();
         view.prev_table_rows.extend_from_slice(&view.table_rows[..n]);
-        Ok(())
+        view.write_trace_tiles(slot, cull)
     }
 
     fn readable_slot(&self, frame: u64) -> Result<usize> {
@@ -635,11 +637,13 @@ impl Renderer {
             let alpha = if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 };
             self.write_frame_data(0, slot, camera, 0, max_depth, FRAME_FLAG_REFERENCE | alpha, Vec2::ZERO)?;
             self.views[0].slots[slot].sampling.write(&[self.views[0].space.params()])?;
+            self.views[0].write_trace_tiles(slot, false)?;
             let (_, rec) = self.ring.begin_next()?;
             let view = &self.views[0];
             let (s, accum) = (&view.slots[slot], view.accum.as_ref().expect("made above"));
+            let tiles = TileList::new(&s.trace_tiles, &view.tiles);
             for i in done..done + batch {
-                view.trace.record(rec, &self.scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, i, None)?;
+                view.trace.record(rec, &self.scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, i, None)?;
                 self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {
@@ -673,7 +677,7 @@ fn build_views(ctx: &Arc<Context>, spaces: Vec<Box<dyn SamplingSpace>>, settings
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
 fn max_passes(views: &[View]) -> u32 {
     let frame: u32 = views.iter().map(View::max_passes).sum();
-    frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 1) + 2
+    frame.max(3 * REFERENCE_SAMPLES_PER_SUBMIT + 1) + 2
 }
 
 fn read_optional<T: bytemuck::Pod>(buffer: &Option<Buffer>, flag: &str, out: &mut Vec<T>) -> Result<()> {
@@ -707,14 +711,15 @@ fn record_view(
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
-    trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, 0, gradients)?;
+    let tiles = TileList::new(&s.trace_tiles, &view.tiles);
+    trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, 0, gradients)?;
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
     let traced = match &view.sample_mean {
         Some(mean) => {
             accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
             for k in 1..view.space.samples_per_texel() {
-                trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, k, None)?;
+                trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, k, None)?;
                 accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
             }
             mean

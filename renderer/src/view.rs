@@ -13,7 +13,7 @@ use crate::passes::splat::SplatPass;
 use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::fill_to_screen::FillToScreen;
-use crate::sampling::{SamplingSpace, WayBack};
+use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
 use crate::to_screen::ToScreen;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
@@ -29,6 +29,8 @@ pub(crate) struct ViewSlot {
     /// frame's (the denoisers reproject through the previous frame's space).
     pub sampling_table: Buffer,
     pub ray_counters: Buffer,
+    /// This frame's trace tiles (`SamplingSpace::trace_tiles`): live, then idle.
+    pub trace_tiles: Buffer,
     pub ldr_readback: Buffer,
     /// Made on the first frame that asks for it (`FrameInput::read_hdr` / `read_grid`): a viewer
     /// never pays for screen-sized HDR copies.
@@ -39,6 +41,7 @@ pub(crate) struct ViewSlot {
 impl ViewSlot {
     fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace) -> Result<ViewSlot> {
         let screen = space.screen_size();
+        let grid = space.grid_size();
         Ok(ViewSlot {
             frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
@@ -50,6 +53,7 @@ impl ViewSlot {
                 vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )?,
+            trace_tiles: Buffer::with_data(ctx, "trace_tiles", &vec![0u32; tile_count(grid).element_product() as usize], vk::BufferUsageFlags::STORAGE_BUFFER)?,
             ldr_readback: readback(ctx, "ldr_readback", screen.x as u64 * screen.y as u64 * 4)?,
             hdr_readback: None,
             grid_readback: None,
@@ -115,6 +119,8 @@ pub struct View {
     pub(crate) table_rows: Vec<[f32; 4]>,
     /// The previous frame's table (`SamplingSpace::sampling_table` of `prev_sampling`).
     pub(crate) prev_table_rows: Vec<[f32; 4]>,
+    /// The last frame's trace tiles, as written to its slot's `trace_tiles`.
+    pub(crate) tiles: TraceTiles,
 }
 
 impl View {
@@ -176,14 +182,23 @@ impl View {
             slots,
             table_rows: Vec::new(),
             prev_table_rows: Vec::new(),
+            tiles: TraceTiles::default(),
             space,
         })
     }
 
+    /// Writes this frame's trace tiles into `slot` (`cull`: samples far off the screen are not
+    /// traced), for the trace's recording (`TileList::new`).
+    pub(crate) fn write_trace_tiles(&mut self, slot: usize, cull: bool) -> Result<()> {
+        self.space.trace_tiles(cull, &mut self.tiles);
+        self.slots[slot].trace_tiles.write(self.tiles.packed())
+    }
+
     /// Passes one frame of this view records at most (sizes the timestamp pool).
     pub(crate) fn max_passes(&self) -> u32 {
-        let extra_samples = 2 * self.space.samples_per_texel();
-        25 + extra_samples + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
+        // Per traced sample: the idle tiles' clear, the trace, the accumulation.
+        let extra_samples = 3 * self.space.samples_per_texel();
+        26 + extra_samples + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
             BackPasses::Fill(f) => f.passes(),
             BackPasses::Splat(s, f) => s.passes() + f.passes(),
             _ => 0,

@@ -159,6 +159,11 @@ struct TracePush {
     uvec4 config;               // x sample index within the frame (reference accumulation), y 0 (the cameras' column base, see trace.comp), zw unused
 };
 
+// Push constants of the trace's clearing kernel (passes/trace_clear.comp).
+struct TraceClearPush {
+    uvec4 config;               // x first idle tile in the tile list, y samples culled in the idle tiles (added to ray counter 4), zw unused
+};
+
 // Push constants of the accumulate pass.
 struct AccumulatePush {
     uvec4 config;               // x number of samples already in the accumulator, y 1: untraced samples (alpha 0) leave the mean as it is

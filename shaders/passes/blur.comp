@@ -10,6 +10,7 @@
 //! variant ldr: BLUR_TONEMAP
 //! variant ldr_external: BLUR_TONEMAP EXTERNAL_TARGET
 #include "../common/tone.glsl"
+#include "../common/gaussian.glsl"
 
 // 64 pixels of one row per workgroup: with 8×8 tiles the vertical pass's taps (up to ±26 rows)
 // from 8 rows at once fell into the same CPU cache sets (row pitch 20 KiB at 1280 px) and it ran
@@ -55,17 +56,11 @@ void main() {
         return;
     }
     ivec2 step_px = spacing * (push.p.config.x == 0u ? ivec2(1, 0) : ivec2(0, 1));
-    // w(i) = exp(−(i·spacing)²/2σ²) by recurrence: w(i+1) = w(i)·q·c^i, q = exp(−spacing²/2σ²), c = q².
-    float s = sigma / spacing_px;
-    float q = exp(-0.5 / (s * s));
-    float c = q * q;
-    float w = 1.0;
-    float ratio = q;
+    GaussianTaps gauss = gaussian_taps(sigma / spacing_px);
     vec4 sum = centre;
     float weight = 1.0;
     for (int i = 1; i <= taps; ++i) {
-        w *= ratio;
-        ratio *= c;
+        float w = gaussian_next(gauss);
         vec4 a = imageLoad(src, clamp(t + i * step_px, ivec2(0), size - 1));
         vec4 b = imageLoad(src, clamp(t - i * step_px, ivec2(0), size - 1));
         sum += w * (a + b);

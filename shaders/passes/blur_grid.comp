@@ -17,6 +17,7 @@
 //! variant rho_clipped:
 #include "../common/layouts.glsl"
 #include "../sampling/visual_polar_math.glsl"
+#include "../common/gaussian.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { GridBlurPush p; } push;
@@ -90,17 +91,11 @@ void main() {
         return;
     }
     int step = int(spacing);
-    // w(i) = exp(−(i·spacing)²/2σ²) by recurrence: w(i+1) = w(i)·q·c^i, q = exp(−spacing²/2σ²), c = q².
-    float s = sigma / spacing;
-    float q = exp(-0.5 / (s * s));
-    float c = q * q;
-    float w = 1.0;
-    float ratio = q;
+    GaussianTaps gauss = gaussian_taps(sigma / spacing);
     vec4 sum = centre;
     float weight = centre.a;
     for (int i = 1; i <= taps; ++i) {
-        w *= ratio;
-        ratio *= c;
+        float w = gaussian_next(gauss);
         vec4 a = tap(P, t, rows, i * step);
         vec4 b = tap(P, t, rows, -i * step);
         sum += w * (a + b);

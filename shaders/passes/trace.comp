@@ -37,6 +37,8 @@ layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;      
 // [3] traced samples whose screen position is off the screen, [4] samples culled off the screen
 // (FRAME_FLAG_CULL_OFFSCREEN: not traced).
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
+// This frame's live tiles (SamplingSpace::trace_tiles), x | y << 16 in tiles: one workgroup each.
+layout(std430, set = 0, binding = 26) readonly buffer TraceTiles { uint data[]; } trace_tiles;
 #if defined(TRACE_GRADIENTS)
 // From 21: binding 18 is the VP sampling table (sampling/visual_polar.glsl).
 layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
@@ -79,7 +81,9 @@ bool far_off_screen(ivec2 texel, vec2 jitter, vec2 screen) {
     return max(outside.x, outside.y) > margin;
 }
 
-// This invocation's texel: the workgroup's tile walked as 4×2 blocks, so that each run of 8
+// This invocation's texel: the workgroup's tile (from the list of live tiles: lavapipe runs
+// masked-off lanes at nearly full cost, so tiles without a sample to trace are not dispatched)
+// walked as 4×2 blocks, so that each run of 8
 // consecutive invocations (one 256-bit vector on llvmpipe) covers a 4×2 block instead of a row of
 // 8 texels. In Visual-Polar space a row runs out along ρ, and 8 columns of the periphery spread
 // far across the screen; the block keeps a vector's paths closer (VP trace 2–3 % faster on
@@ -88,7 +92,8 @@ ivec2 swizzled_texel() {
     const uint blocks_across = WORKGROUP_2D / 4u;
     uint block = gl_LocalInvocationIndex / 8u, lane = gl_LocalInvocationIndex % 8u;
     uvec2 within = uvec2(lane % 4u + 4u * (block % blocks_across), lane / 4u + 2u * (block / blocks_across));
-    return ivec2(gl_WorkGroupID.xy * gl_WorkGroupSize.xy + within);
+    uint tile = trace_tiles.data[gl_WorkGroupID.x];
+    return ivec2(uvec2(tile & 0xffffu, tile >> 16u) * gl_WorkGroupSize.xy + within);
 }
 
 void main() {

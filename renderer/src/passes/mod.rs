@@ -13,6 +13,7 @@ pub mod remap;
 pub mod splat;
 pub mod tonemap;
 pub mod trace;
+pub mod trace_clear;
 pub mod upscale;
 
 /// One Visual-Polar kernel compiled for each layout (`//! variant paper` / `clipped`): lavapipe

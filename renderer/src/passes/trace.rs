@@ -5,7 +5,9 @@ use super::push_bytes;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, write_image, FrameRecorder};
-use crate::layouts::TracePush;
+use super::trace_clear::TraceClearPass;
+use crate::layouts::{TracePush, WORKGROUP_2D};
+use crate::sampling::TraceTiles;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
@@ -70,8 +72,26 @@ pub struct GradientTargets<'a> {
     pub gradient: &'a Image,
 }
 
+/// This frame's trace tiles on the GPU (`SamplingSpace::trace_tiles`): `live` tiles then `idle`
+/// ones in `buffer`, and the samples the idle tiles hold (all culled).
+#[derive(Clone, Copy)]
+pub struct TileList<'a> {
+    pub buffer: &'a Buffer,
+    pub live: u32,
+    pub idle: u32,
+    pub culled_samples: u32,
+}
+
+impl<'a> TileList<'a> {
+    /// `tiles` as written into `buffer`.
+    pub fn new(buffer: &'a Buffer, tiles: &TraceTiles) -> TileList<'a> {
+        TileList { buffer, live: tiles.live.len() as u32, idle: tiles.idle.len() as u32, culled_samples: tiles.culled_samples }
+    }
+}
+
 pub struct TracePass {
     pipeline: std::sync::Arc<ComputePipeline>,
+    clear: TraceClearPass,
 }
 
 /// Counters the trace kernel fills (one u32 each): primary, shadow and continuation rays, and
@@ -81,13 +101,14 @@ pub const RAY_COUNTERS: usize = 5;
 impl TracePass {
     pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {
         let shader = format!("passes/trace.{sampling_variant}");
-        Ok(TracePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TracePush>() as u32)? })
+        Ok(TracePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TracePush>() as u32)?, clear: TraceClearPass::new(ctx)? })
     }
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
     /// frame (reference accumulation); real-time frames use 0. `sampling_table` holds the space's
     /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs). `gradients`: A-SVGF's,
-    /// for the `*_gradients` variants (which also write `out.visibility`).
+    /// for the `*_gradients` variants (which also write `out.visibility`). Only `tiles`' live tiles
+    /// are traced; its idle ones are cleared to "not traced".
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -98,9 +119,11 @@ impl TracePass {
         sampling_table: &Buffer,
         ray_counters: &Buffer,
         out: &GBuffer,
+        tiles: &TileList,
         sample_index: u32,
         gradients: Option<GradientTargets>,
     ) -> Result<()> {
+        self.clear.record(rec, tiles, ray_counters, out)?;
         let s = scene.binds();
         // A fixed array sliced to what this kernel binds: no host allocation per frame.
         let gradient_binds = match (gradients, &out.visibility) {
@@ -123,11 +146,15 @@ impl TracePass {
             write_image("out_position", &out.position),
             write_image("out_ids", &out.ids),
             write_image("out_motion", &out.motion),
+            read_buffer("trace_tiles", tiles.buffer),
             extra[0], extra[1], extra[2],
         ];
         let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
-        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [out.size.x, out.size.y, 1])
+        if tiles.live == 0 {
+            return Ok(());
+        }
+        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [tiles.live * WORKGROUP_2D, WORKGROUP_2D, 1])
     }
 }

@@ -8,6 +8,7 @@ mod composite;
 mod fixed_foveation;
 mod linear_falloff;
 mod log_polar;
+mod trace_tiles;
 mod pixel_blocks;
 pub mod random;
 mod random_acuity;
@@ -22,6 +23,7 @@ pub use cartesian::Cartesian;
 pub use composite::{CompositeMode, CompositeParams};
 pub use fixed_foveation::FixedFoveation;
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
+pub use trace_tiles::{tile_count, TraceTiles, TRACE_TILE};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use pixel_blocks::{BlockShape, PixelBlocks, BLOCK_LEVELS};
 pub use random_acuity::RandomAcuity;
@@ -125,6 +127,13 @@ pub trait SamplingSpace {
     /// k tracing where k < the texel's count, and the results are averaged per texel).
     fn samples_per_texel(&self) -> u32 {
         1
+    }
+    /// This frame's trace tiles (`trace_tiles.rs`): the live ones run the tracer, the idle ones
+    /// hold no sample it would trace (`cull`: samples far off the screen are culled) and are only
+    /// cleared. Default: every tile live.
+    fn trace_tiles(&self, cull: bool, tiles: &mut TraceTiles) {
+        let _ = cull;
+        tiles.fill_live(self.grid_size());
     }
     /// The space's capabilities (default: a screen-sized grid every filter supports).
     fn capabilities(&self) -> SpaceCapabilities {

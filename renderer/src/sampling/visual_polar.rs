@@ -724,6 +724,10 @@ impl SamplingSpace for VisualPolar {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         Some(self)
     }
+    /// The fovea's clipped tiles and, in the paper's layout, tiles far off the screen are idle.
+    fn trace_tiles(&self, cull: bool, tiles: &mut super::TraceTiles) {
+        super::trace_tiles::visual_polar_tiles(self, cull, tiles);
+    }
     /// Every layout runs the filters: the screen-clipped one addresses its grid through the
     /// per-column arcs of this frame and the previous one (`DenoiseFrame::sampling_table`).
     fn capabilities(&self) -> super::SpaceCapabilities {
