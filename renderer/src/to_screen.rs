@@ -146,7 +146,8 @@ pub struct ToScreen {
 
 impl ToScreen {
     /// `taa`: resolve in screen space after the remap with these settings; `blur`: where the
-    /// foveated blur runs (the grid only without screen-space TAA).
+    /// foveated blur runs (the grid only without screen-space TAA; the caller asks for the grid
+    /// only for a space `GridBlurPass::supports`).
     pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2, taa: Option<TaaSettings>, blur: BlurSpace) -> Result<ToScreen> {
         let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
         let grid_image = |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
@@ -183,12 +184,9 @@ impl ToScreen {
         display: Option<ToneTarget>,
     ) -> Result<ScreenOut<'_>> {
         let params = vp.sampling_params();
-        // The blur in the grid where it can stand in for the screen's (then the remap's output
-        // is the picture).
-        let grid_blur = match &self.grid_blur {
-            Some(g) if blur.sigma_at_30 > 0.0 && GridBlurPass::supports(vp) => Some(g),
-            _ => None,
-        };
+        // The blur in the grid where this was built for it (the view checked once that its
+        // space can take it); then the remap's output is the picture.
+        let grid_blur = self.grid_blur.as_ref().filter(|_| blur.sigma_at_30 > 0.0);
         let vp_color = match grid_blur {
             Some(g) => {
                 g.pass.record(rec, &params, &blur.shape(vp), vp_color, &g.scratch, &g.blurred)?;

@@ -14,7 +14,8 @@ use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::fill_to_screen::FillToScreen;
 use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
-use crate::to_screen::ToScreen;
+use crate::passes::blur_grid::GridBlurPass;
+use crate::to_screen::{BlurSpace, ToScreen};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -71,6 +72,16 @@ impl ViewSlot {
             samples_offscreen: counters[3] as u64,
             samples_culled: counters[4] as u64,
         })
+    }
+}
+
+/// Where this view's foveated blur runs: the grid only where the space's grid can take it
+/// (`GridBlurPass::supports`, fixed for a view), the screen otherwise, so the grid blur's images
+/// are made only for a view that uses them.
+fn blur_space(asked: BlurSpace, space: &dyn SamplingSpace) -> BlurSpace {
+    match asked {
+        BlurSpace::Grid if !space.visual_polar().is_some_and(GridBlurPass::supports) => BlurSpace::Screen,
+        other => other,
     }
 }
 
@@ -146,7 +157,7 @@ impl View {
         };
         let back = match caps.way_back {
             WayBack::Direct => BackPasses::Direct,
-            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa, settings.blur.space)?),
+            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa, blur_space(settings.blur.space, space.as_ref()))?),
             WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
             WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.trace_variant(), screen)?, FillToScreen::new(ctx, screen)?),
