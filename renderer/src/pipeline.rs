@@ -677,7 +677,8 @@ fn build_views(ctx: &Arc<Context>, spaces: Vec<Box<dyn SamplingSpace>>, settings
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
 fn max_passes(views: &[View]) -> u32 {
     let frame: u32 = views.iter().map(View::max_passes).sum();
-    frame.max(3 * REFERENCE_SAMPLES_PER_SUBMIT + 1) + 2
+    // A reference batch: trace and accumulate per sample, the idle tiles' clear, the copy.
+    frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 2) + 2
 }
 
 fn read_optional<T: bytemuck::Pod>(buffer: &Option<Buffer>, flag: &str, out: &mut Vec<T>) -> Result<()> {

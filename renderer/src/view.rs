@@ -207,8 +207,8 @@ impl View {
 
     /// Passes one frame of this view records at most (sizes the timestamp pool).
     pub(crate) fn max_passes(&self) -> u32 {
-        // Per traced sample: the idle tiles' clear, the trace, the accumulation.
-        let extra_samples = 3 * self.space.samples_per_texel();
+        let extra_samples = 2 * self.space.samples_per_texel();
+        // 26: the idle tiles' clear is one of them.
         26 + extra_samples + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
             BackPasses::Fill(f) => f.passes(),
             BackPasses::Splat(s, f) => s.passes() + f.passes(),

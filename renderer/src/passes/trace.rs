@@ -4,7 +4,7 @@
 use super::push_bytes;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
-use crate::graph::{read_buffer, read_texels, write_buffer, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_texels, write_buffer, write_image, Bind, FrameRecorder};
 use super::trace_clear::TraceClearPass;
 use crate::layouts::{TracePush, WORKGROUP_2D};
 use crate::sampling::TraceTiles;
@@ -51,6 +51,19 @@ impl GBuffer {
             motion: image("gbuffer.motion", vk::Format::R32G32_SFLOAT)?,
             visibility: None,
         })
+    }
+
+    /// The images every sample writes, bound by their kernels' names (trace.comp, trace_clear.comp).
+    pub fn write_binds(&self) -> [Bind<'_>; 7] {
+        [
+            write_image("out_color", &self.color),
+            write_image("out_radiance", &self.radiance),
+            write_image("out_albedo", &self.albedo),
+            write_image("out_normal_depth", &self.normal_depth),
+            write_image("out_position", &self.position),
+            write_image("out_ids", &self.ids),
+            write_image("out_motion", &self.motion),
+        ]
     }
 
     /// A G-buffer with the visibility image the A-SVGF gradient samples are projected from.
@@ -123,7 +136,14 @@ impl TracePass {
         sample_index: u32,
         gradients: Option<GradientTargets>,
     ) -> Result<()> {
-        self.clear.record(rec, tiles, ray_counters, out)?;
+        // The idle tiles hold the same not-traced values for every sample of a frame (or of a
+        // reference): cleared, and their culled samples counted, with the first.
+        if sample_index == 0 {
+            self.clear.record(rec, tiles, ray_counters, out)?;
+        }
+        if tiles.live == 0 {
+            return Ok(());
+        }
         let s = scene.binds();
         // A fixed array sliced to what this kernel binds: no host allocation per frame.
         let gradient_binds = match (gradients, &out.visibility) {
@@ -133,28 +153,20 @@ impl TracePass {
             _ => None,
         };
         let extra = gradient_binds.unwrap_or([s[0]; 3]);
+        let g = out.write_binds();
         let binds = [
             s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], s[9],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
             read_texels("sampling_table", sampling_table),
             write_buffer("ray_counters", ray_counters),
-            write_image("out_color", &out.color),
-            write_image("out_radiance", &out.radiance),
-            write_image("out_albedo", &out.albedo),
-            write_image("out_normal_depth", &out.normal_depth),
-            write_image("out_position", &out.position),
-            write_image("out_ids", &out.ids),
-            write_image("out_motion", &out.motion),
+            g[0], g[1], g[2], g[3], g[4], g[5], g[6],
             read_buffer("trace_tiles", tiles.buffer),
             extra[0], extra[1], extra[2],
         ];
         let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
-        if tiles.live == 0 {
-            return Ok(());
-        }
         rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [tiles.live * WORKGROUP_2D, WORKGROUP_2D, 1])
     }
 }

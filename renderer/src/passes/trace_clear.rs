@@ -33,14 +33,9 @@ impl TraceClearPass {
         }
         let push = TraceClearPush { config: UVec4::new(tiles.live, tiles.culled_samples, 0, 0) };
         // A fixed array (no host allocation per frame): the plain kernel binds all but the last.
+        let g = out.write_binds();
         let binds = [
-            write_image("out_color", &out.color),
-            write_image("out_radiance", &out.radiance),
-            write_image("out_albedo", &out.albedo),
-            write_image("out_normal_depth", &out.normal_depth),
-            write_image("out_position", &out.position),
-            write_image("out_ids", &out.ids),
-            write_image("out_motion", &out.motion),
+            g[0], g[1], g[2], g[3], g[4], g[5], g[6],
             read_buffer("trace_tiles", tiles.buffer),
             write_buffer("ray_counters", ray_counters),
             write_image("out_visibility", out.visibility.as_ref().unwrap_or(&out.color)),
