@@ -156,7 +156,8 @@ fn fit_matches_a_cpu_least_squares_solve() {
         let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
         assert_eq!(bmfr.next_block_offset().to_array(), offset);
         let table = grid_table(&ctx, space.as_ref(), None);
-        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table }, Vec3::ZERO, &plain_materials(&ctx));
+        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
+        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table, tiles: tiles.list() }, Vec3::ZERO, &plain_materials(&ctx));
         let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
         let mut blocks: Vec<(i32, i32)> = blocks_of.iter().flatten().copied().collect();
@@ -240,7 +241,8 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
     upload_gbuffer(&ctx, &g, &texels);
     let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
     let table = grid_table(&ctx, &space, None);
-    let out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table }, Vec3::ZERO, &plain_materials(&ctx));
+    let tiles = fovea_tests::grid_tiles(&ctx, &space);
+    let out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table, tiles: tiles.list() }, Vec3::ZERO, &plain_materials(&ctx));
     assert_finite_non_negative("rank-deficient fit", &out);
     let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
     let mut worst = 0f64;
@@ -376,7 +378,8 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
             let table = grid_table(&ctx, r.space(), None);
-            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table }, origin, &r.scene.materials);
+            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() }, origin, &r.scene.materials);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} history"), &read_image(&ctx, bmfr.noisy()));
@@ -412,6 +415,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
         let mut bmfr = Bmfr::new(&ctx, space.grid_size(), space.shader_variant(), BmfrSettings::default()).unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
+        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
         let materials = plain_materials(&ctx);
         let mut out = Vec::new();
         for f in 0..9u32 {
@@ -433,7 +437,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                 .collect();
             upload_gbuffer(&ctx, &g, &texels);
             let previous = (f > 0).then_some(params);
-            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous, sampling_table: &table }, Vec3::new(camera_x, 0.0, 0.0), &materials);
+            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous, sampling_table: &table, tiles: tiles.list() }, Vec3::new(camera_x, 0.0, 0.0), &materials);
         }
         let lengths: Vec<[f32; 4]> = read_image(&ctx, bmfr.noisy());
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);

@@ -245,7 +245,7 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
             let mut out = Vec::new();
             for frame in 0..8u32 {
                 upload_gbuffer(&ctx, &g, &seam_texels(&vp, frame));
-                out = f.run(&ctx, &g, &DenoiseFrame { current: params, previous: (frame > 0).then_some(params), sampling_table: &buffers.table }, &buffers, &materials);
+                out = f.run(&ctx, &g, &DenoiseFrame { current: params, previous: (frame > 0).then_some(params), sampling_table: &buffers.table, tiles: buffers.tiles.list() }, &buffers, &materials);
             }
             assert_finite_non_negative(&format!("{space_name} + {filter} at the seam"), &out);
             let e = SeamErrors::of(&vp, &out);
@@ -329,7 +329,7 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
                 upload_gbuffer(&ctx, &g, &input);
                 let buffers = SpaceBuffers::new(&ctx, &vp, frame, 1);
                 let table = fovea_tests::grid_table(&ctx, &vp, previous_arcs.then_some(&prev as &dyn SamplingSpace));
-                let frame_in = DenoiseFrame { current: vp.sampling_params(), previous: (frame > 0).then(|| prev.sampling_params()), sampling_table: &table };
+                let frame_in = DenoiseFrame { current: vp.sampling_params(), previous: (frame > 0).then(|| prev.sampling_params()), sampling_table: &table, tiles: buffers.tiles.list() };
                 let out = f.run(&ctx, &g, &frame_in, &buffers, &materials);
                 if frame == FRAMES - 1 {
                     assert_finite_non_negative(&format!("{layout:?} + {filter}"), &out);

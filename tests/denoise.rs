@@ -10,7 +10,7 @@ use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
 use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
+use fovea_renderer::passes::trace::{GBuffer, OwnedTileList};
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
@@ -192,7 +192,8 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
             let table = grid_table(&ctx, r.space(), None);
-            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table });
+            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() });
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} moments"), &moments);
@@ -227,12 +228,13 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let mut svgf = Svgf::new(&ctx, space.grid_size(), space.shader_variant(), SvgfSettings::default()).unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
+        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
         let mut last = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             let previous = (f > 0).then_some(params);
-            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous, sampling_table: &table });
+            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous, sampling_table: &table, tiles: tiles.list() });
         }
         let (out, moments) = last;
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
@@ -262,6 +264,50 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
 }
 
 /// `fovea render --denoiser svgf`: the report names the denoiser and times its passes.
+/// SVGF's kernels run over the trace's live tiles only (lavapipe runs masked-off lanes at nearly
+/// full cost) and its idle pass writes the history of the idle ones: the output and every image a
+/// later frame reads must be those of the whole grid, bit for bit, while the gaze moves towards a
+/// corner (tiles turn idle and live). G-buffers from the renderer with culling on, each denoised by
+/// one SVGF with the space's tile list and by another with every tile holding a sample live.
+#[test]
+fn svgf_over_the_live_tiles_equals_svgf_over_the_whole_grid() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let size = UVec2::new(128, 144);
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let vp = VisualPolar::new(size, size.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    let (grid, variant) = (vp.grid_size(), vp.shader_variant());
+    let mut r = Renderer::new(&ctx, &scene, Box::new(vp), settings(DenoiserSettings::None)).unwrap();
+    let mut over_tiles = Svgf::new(&ctx, grid, variant, SvgfSettings::default()).unwrap();
+    let mut over_grid = Svgf::new(&ctx, grid, variant, SvgfSettings::default()).unwrap();
+    let bits = |image: &Image| read_image::<[u32; 4]>(&ctx, image);
+    let mut previous = None;
+    let mut idle_seen = Vec::new();
+    for f in 0..6u32 {
+        // Off the centre from the start: at this size only an off-centre gaze culls whole tiles.
+        let gaze = size.as_vec2() * (0.3 - 0.04 * f as f32);
+        r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
+        let current = r.space().params();
+        let table = grid_table(&ctx, r.space(), None);
+        let culled = OwnedTileList::new(&ctx, r.space(), true).unwrap();
+        let whole = fovea_tests::grid_tiles(&ctx, r.space());
+        assert!(culled.tiles.idle.len() > whole.tiles.idle.len(), "frame {f}: no tile culled, nothing tested");
+        idle_seen.push(culled.tiles.idle.clone());
+        for (svgf, tiles) in [(&mut over_tiles, &culled), (&mut over_grid, &whole)] {
+            denoise(&ctx, svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() });
+        }
+        previous = Some(current);
+        let cur = (f % 2) as usize;
+        let images = |s: &Svgf| [bits(&s.output), bits(&s.history.color), bits(&s.history.moments[cur]), bits(&s.history.surface[cur])];
+        for (name, (a, b)) in ["output", "colour history", "moments", "surfaces"].iter().zip(images(&over_tiles).iter().zip(images(&over_grid).iter())) {
+            let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
+            assert_eq!(differing, 0, "frame {f}: {name} differs in {differing} texels");
+        }
+    }
+    assert!(idle_seen.windows(2).any(|w| w[0] != w[1]), "the idle tiles never changed with the gaze");
+    assert_clean(&ctx);
+}
+
 #[test]
 fn render_command_runs_svgf_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
@@ -377,7 +423,8 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
             let current = r.space().params();
             let jitter = TaaSettings::default().jitter(f);
             let table = grid_table(&ctx, r.space(), None);
-            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous, sampling_table: &table }, jitter);
+            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() }, jitter);
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f}"), &out);
             peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
@@ -400,13 +447,14 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
         let mut taa = Taa::new(&ctx, space.grid_size(), space.shader_variant(), TaaSettings::default()).unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
+        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
         let (mut out, mut current) = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             current = samples;
             // Samples at texel centres: the jitter is the centre.
-            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params), sampling_table: &table }, Vec2::splat(0.5));
+            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params), sampling_table: &table, tiles: tiles.list() }, Vec2::splat(0.5));
         }
         let (mut uncovered, mut followed, mut stayed, mut blended) = (0, 0, 0, 0);
         for (i, s) in screens.iter().enumerate() {

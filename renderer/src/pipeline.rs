@@ -706,13 +706,13 @@ fn record_view(
     let s = &view.slots[slot];
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
-    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling, sampling_table: &s.sampling_table };
+    let tiles = TileList::new(&s.trace_tiles, &view.tiles);
+    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling, sampling_table: &s.sampling_table, tiles };
     if let Some(d) = &mut view.denoiser {
         d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
-    let tiles = TileList::new(&s.trace_tiles, &view.tiles);
     trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, 0, gradients)?;
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).

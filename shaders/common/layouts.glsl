@@ -273,6 +273,12 @@ struct SvgfAtrousPush {
     uvec4 config;               // x tap spacing (2^iteration texels), yzw unused
 };
 
+// Push constants of SVGF's state in the trace's idle tiles (svgf_idle.comp).
+struct SvgfIdlePush {
+    SamplingParams space;
+    uvec4 config;               // x first idle tile in the tile list, yzw unused
+};
+
 // Push constants of TAA in the sampling grid (Karis 2014), 128 bytes like SvgfTemporalPush.
 struct TaaPush {
     SamplingParams space;       // this frame's space

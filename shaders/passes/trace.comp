@@ -37,8 +37,9 @@ layout(set = 0, binding = 16, rg32f) uniform writeonly image2D out_motion;      
 // [3] traced samples whose screen position is off the screen, [4] samples culled off the screen
 // (FRAME_FLAG_CULL_OFFSCREEN: not traced).
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
-// This frame's live tiles (SamplingSpace::trace_tiles), x | y << 16 in tiles: one workgroup each.
-layout(std430, set = 0, binding = 26) readonly buffer TraceTiles { uint data[]; } trace_tiles;
+// This frame's live tiles (SamplingSpace::trace_tiles): one workgroup each.
+#define TILE_LIST_BINDING 26
+#include "../common/tiles.glsl"
 #if defined(TRACE_GRADIENTS)
 // From 21: binding 18 is the VP sampling table (sampling/visual_polar.glsl).
 layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
@@ -92,8 +93,7 @@ ivec2 swizzled_texel() {
     const uint blocks_across = WORKGROUP_2D / 4u;
     uint block = gl_LocalInvocationIndex / 8u, lane = gl_LocalInvocationIndex % 8u;
     uvec2 within = uvec2(lane % 4u + 4u * (block % blocks_across), lane / 4u + 2u * (block / blocks_across));
-    uint tile = trace_tiles.data[gl_WorkGroupID.x];
-    return ivec2(uvec2(tile & 0xffffu, tile >> 16u) * gl_WorkGroupSize.xy + within);
+    return ivec2(tile_list_origin(0u) + within);
 }
 
 void main() {

@@ -21,12 +21,12 @@ layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_co
 #if defined(TRACE_GRADIENTS)
 layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility;
 #endif
-layout(std430, set = 0, binding = 26) readonly buffer TraceTiles { uint data[]; } trace_tiles;
+#define TILE_LIST_BINDING 26
+#include "../common/tiles.glsl"
 
 void main() {
     if (gl_WorkGroupID.x == 0u && gl_LocalInvocationIndex == 0u) atomicAdd(ray_counters.data[4], push.p.config.y);
-    uint tile = trace_tiles.data[push.p.config.x + gl_WorkGroupID.x];
-    ivec2 texel = ivec2(uvec2(tile & 0xffffu, tile >> 16u) * gl_WorkGroupSize.xy + gl_LocalInvocationID.xy);
+    ivec2 texel = tile_list_texel(push.p.config.x);
     if (any(greaterThanEqual(texel, imageSize(out_color)))) return;
     imageStore(out_color, texel, vec4(0.0));
     imageStore(out_radiance, texel, vec4(0.0));

@@ -187,6 +187,8 @@ pub struct SpaceBuffers {
     pub frame: Buffer,
     pub sampling: Buffer,
     pub table: Buffer,
+    /// Every tile holding a sample (`grid_tiles`).
+    pub tiles: fovea_renderer::passes::trace::OwnedTileList,
 }
 
 impl SpaceBuffers {
@@ -197,6 +199,7 @@ impl SpaceBuffers {
             frame: Buffer::with_data(ctx, "frame", &[data], uniform).unwrap(),
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform).unwrap(),
             table: grid_table(ctx, space, None),
+            tiles: grid_tiles(ctx, space),
         }
     }
 }
@@ -211,6 +214,12 @@ pub fn grid_table(
     let mut rows = current.sampling_table();
     rows.extend(previous.unwrap_or(current).sampling_table());
     Buffer::texels(ctx, "sampling_table", &rows).unwrap()
+}
+
+/// `space`'s tile list without culling: every tile where a texel holds a sample is live, as a
+/// synthetic G-buffer may place a sample in any of them (`DenoiseFrame::tiles`).
+pub fn grid_tiles(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace) -> fovea_renderer::passes::trace::OwnedTileList {
+    fovea_renderer::passes::trace::OwnedTileList::new(ctx, space, false).unwrap()
 }
 
 /// One texel as the GPU's space sees it (passes/space_probe): its sample's screen position at

@@ -7,7 +7,7 @@ use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, write_image, Bind, FrameRecorder};
 use super::trace_clear::TraceClearPass;
 use crate::layouts::{TracePush, WORKGROUP_2D};
-use crate::sampling::TraceTiles;
+use crate::sampling::{SamplingSpace, TraceTiles};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
@@ -100,6 +100,37 @@ impl<'a> TileList<'a> {
     pub fn new(buffer: &'a Buffer, tiles: &TraceTiles) -> TileList<'a> {
         TileList { buffer, live: tiles.live.len() as u32, idle: tiles.idle.len() as u32, culled_samples: tiles.culled_samples }
     }
+
+    /// The threads of a dispatch over the live tiles (one workgroup each; shaders/common/tiles.glsl).
+    pub fn live_threads(&self) -> [u32; 3] {
+        [self.live * WORKGROUP_2D, WORKGROUP_2D, 1]
+    }
+
+    /// The threads of a dispatch over the idle tiles (the list's entries from `live` on).
+    pub fn idle_threads(&self) -> [u32; 3] {
+        [self.idle * WORKGROUP_2D, WORKGROUP_2D, 1]
+    }
+}
+
+/// A space's tile list with a buffer of its own, for running the grid's passes outside a view
+/// (tests, tools); a view keeps one per frame slot.
+pub struct OwnedTileList {
+    pub buffer: Buffer,
+    pub tiles: TraceTiles,
+}
+
+impl OwnedTileList {
+    /// `space`'s tiles for its current gaze (`cull`: samples far off the screen are not traced).
+    pub fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace, cull: bool) -> Result<OwnedTileList> {
+        let mut tiles = TraceTiles::default();
+        space.trace_tiles(cull, &mut tiles);
+        let buffer = Buffer::with_data(ctx, "tiles", tiles.packed(), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        Ok(OwnedTileList { buffer, tiles })
+    }
+
+    pub fn list(&self) -> TileList<'_> {
+        TileList::new(&self.buffer, &self.tiles)
+    }
 }
 
 pub struct TracePass {
@@ -161,12 +192,12 @@ impl TracePass {
             read_texels("sampling_table", sampling_table),
             write_buffer("ray_counters", ray_counters),
             g[0], g[1], g[2], g[3], g[4], g[5], g[6],
-            read_buffer("trace_tiles", tiles.buffer),
+            read_buffer("tiles", tiles.buffer),
             extra[0], extra[1], extra[2],
         ];
         let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
-        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), [tiles.live * WORKGROUP_2D, WORKGROUP_2D, 1])
+        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), tiles.live_threads())
     }
 }

@@ -5,7 +5,7 @@
 use super::push_bytes;
 use crate::error::Result;
 use crate::graph::{read_buffer, write_buffer, write_image, FrameRecorder};
-use crate::layouts::{TraceClearPush, WORKGROUP_2D};
+use crate::layouts::TraceClearPush;
 use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context};
 use glam::UVec4;
@@ -36,7 +36,7 @@ impl TraceClearPass {
         let g = out.write_binds();
         let binds = [
             g[0], g[1], g[2], g[3], g[4], g[5], g[6],
-            read_buffer("trace_tiles", tiles.buffer),
+            read_buffer("tiles", tiles.buffer),
             write_buffer("ray_counters", ray_counters),
             write_image("out_visibility", out.visibility.as_ref().unwrap_or(&out.color)),
         ];
@@ -44,6 +44,6 @@ impl TraceClearPass {
             Some(_) => (&self.gradients, &binds[..]),
             None => (&self.plain, &binds[..binds.len() - 1]),
         };
-        rec.dispatch("trace_clear", pipeline, binds, push_bytes(&push), [tiles.idle * WORKGROUP_2D, WORKGROUP_2D, 1])
+        rec.dispatch("trace_clear", pipeline, binds, push_bytes(&push), tiles.idle_threads())
     }
 }

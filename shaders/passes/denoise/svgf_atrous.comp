@@ -7,6 +7,9 @@
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"
+// The live tiles of the trace (SvgfIdlePass writes what later frames read of the idle ones).
+#define TILE_LIST_BINDING 30
+#include "../../common/tiles.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { SvgfAtrousPush p; } push;
@@ -19,7 +22,7 @@ const float B3[3] = float[3](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 const float GAUSS3[2] = float[2](1.0 / 2.0, 1.0 / 4.0);
 
 void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 t = tile_list_texel(0u);
     Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {

@@ -13,6 +13,9 @@
 #include "../../common/layouts.glsl"
 #include "../../denoise/grid.glsl"
 #include "../../denoise/svgf.glsl"
+// The live tiles of the trace (SvgfIdlePass writes what later frames read of the idle ones).
+#define TILE_LIST_BINDING 30
+#include "../../common/tiles.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { SvgfTemporalPush p; } push;
@@ -47,7 +50,7 @@ void take(Grid prev, SvgfSurface s, ivec2 tap, float w) {
 }
 
 void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 t = tile_list_texel(0u);
     Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {

@@ -16,7 +16,7 @@ use bmfr::{Bmfr, BmfrSettings};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
-use crate::passes::trace::{GBuffer, GradientTargets};
+use crate::passes::trace::{GBuffer, GradientTargets, TileList};
 use crate::vk::{Buffer, Context, Image};
 use asvgf::{Asvgf, AsvgfSettings};
 use glam::{UVec2, Vec3};
@@ -75,6 +75,9 @@ pub struct DenoiseFrame<'a> {
     /// previous frame's of the same length (the screen-clipped layout's kernels read both
     /// frames' arcs from it).
     pub sampling_table: &'a Buffer,
+    /// The trace's tiles this frame: filters that work per texel run over the live ones (the
+    /// idle ones hold no traced sample) and write what later frames read of the idle ones.
+    pub tiles: TileList<'a>,
 }
 
 /// What a denoiser may need from the scene besides the G-buffer.

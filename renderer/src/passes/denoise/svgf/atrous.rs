@@ -3,10 +3,10 @@
 
 use super::SvgfSettings;
 use crate::error::Result;
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfAtrousPush};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{UVec4, Vec4};
 use std::sync::Arc;
@@ -21,7 +21,7 @@ impl AtrousPass {
         Ok(AtrousPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfAtrousPush>() as u32)? })
     }
 
-    /// `src` → `dst` (both colour, variance), taps `step` texels apart.
+    /// `src` → `dst` (both colour, variance) in the live tiles, taps `step` texels apart.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -32,6 +32,7 @@ impl AtrousPass {
         step: u32,
         space: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         s: &SvgfSettings,
     ) -> Result<()> {
         let binds = [
@@ -40,12 +41,13 @@ impl AtrousPass {
             read_image("position", &g.position),
             write_image("dst", dst),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
         ];
         let push = SvgfAtrousPush {
             space: *space,
             params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, 0.0),
             config: UVec4::new(step, 0, 0, 0),
         };
-        rec.dispatch("svgf_atrous", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+        rec.dispatch("svgf_atrous", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
     }
 }

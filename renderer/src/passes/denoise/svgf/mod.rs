@@ -8,6 +8,7 @@
 //! with the previous frame's space (gaze) and takes bilinear taps in each column's own rows.
 
 mod atrous;
+mod idle;
 mod temporal;
 mod variance;
 
@@ -19,6 +20,7 @@ use crate::passes::trace::GBuffer;
 use crate::vk::{Context, Image};
 use ash::vk;
 use atrous::AtrousPass;
+use idle::IdlePass;
 use glam::UVec2;
 use std::sync::Arc;
 use temporal::TemporalPass;
@@ -130,6 +132,7 @@ pub struct Svgf {
     temporal: TemporalPass,
     variance: VariancePass,
     atrous: AtrousPass,
+    idle: IdlePass,
     modulate: ModulatePass,
     pub history: SvgfHistory,
     /// Temporal output: accumulated colour, variance.
@@ -159,6 +162,7 @@ impl Svgf {
             temporal: TemporalPass::new(ctx, temporal_variant)?,
             variance: VariancePass::new(ctx, variant)?,
             atrous: AtrousPass::new(ctx, variant)?,
+            idle: IdlePass::new(ctx, variant)?,
             modulate: ModulatePass::new(ctx)?,
             history: SvgfHistory::new(ctx, grid)?,
             accum: image("svgf.accum")?,
@@ -168,7 +172,7 @@ impl Svgf {
     }
 
     pub fn max_passes(&self) -> u32 {
-        3 + self.settings.atrous_iterations
+        4 + self.settings.atrous_iterations
     }
 
     /// Moments and history length (x m1, y m2, z frames) written by the last recorded frame.
@@ -177,6 +181,8 @@ impl Svgf {
     }
 
     /// Records one frame: temporal → variance → à-trous iterations → modulate; returns `output`.
+    /// All but the modulation run over `frame.tiles`' live tiles; the idle pass fills in the
+    /// history a later frame reads of the idle ones.
     /// History is dropped on the first frame and whenever `frame.previous` is `None`.
     pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
         self.record_with(rec, g, frame, None)
@@ -193,13 +199,15 @@ impl Svgf {
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous };
-        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, frame.sampling_table, previous.as_ref(), &s, gradient)?;
-        self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, frame.sampling_table, &s)?;
+        let (table, tiles) = (frame.sampling_table, &frame.tiles);
+        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, table, tiles, previous.as_ref(), &s, gradient)?;
+        self.idle.record(rec, h, cur, &frame.current, table, tiles)?;
+        self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, table, tiles, &s)?;
         // Iteration 0 writes the colour history; then the two ping images alternate.
         let mut src = &self.ping[0];
         for i in 0..s.atrous_iterations {
             let dst = if i == 0 { &h.color } else { &self.ping[(i % 2) as usize] };
-            self.atrous.record(rec, g, src, dst, 1 << i, &frame.current, frame.sampling_table, &s)?;
+            self.atrous.record(rec, g, src, dst, 1 << i, &frame.current, table, tiles, &s)?;
             src = dst;
         }
         self.modulate.record(rec, "svgf_modulate", src, &g.albedo, &self.output)?;

@@ -3,10 +3,10 @@
 
 use super::{SvgfHistory, SvgfSettings};
 use crate::error::Result;
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfTemporalPush};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;
@@ -21,7 +21,7 @@ impl TemporalPass {
         Ok(TemporalPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfTemporalPush>() as u32)? })
     }
 
-    /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance). `previous`:
+    /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance) in the live tiles. `previous`:
     /// the previous frame's space, `None` to start every history afresh. `gradient`: A-SVGF's
     /// reconstructed gradient per stratum, for the `*_adaptive` kernel variants.
     #[allow(clippy::too_many_arguments)]
@@ -35,6 +35,7 @@ impl TemporalPass {
         accum: &Image,
         current: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         previous: Option<&SamplingParams>,
         s: &SvgfSettings,
         gradient: Option<&Image>,
@@ -53,6 +54,7 @@ impl TemporalPass {
             write_image("moments", &h.moments[cur]),
             write_image("surface", &h.surface[cur]),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
             read_image("gradient", gradient.unwrap_or(&g.radiance)),
         ];
         let binds = &binds[..if gradient.is_some() { binds.len() } else { binds.len() - 1 }];
@@ -64,6 +66,6 @@ impl TemporalPass {
             prev: p.frame(),
             params: Vec4::new(s.alpha_color, s.alpha_moments, s.max_history as f32, reset),
         };
-        rec.dispatch("svgf_temporal", &self.pipeline, binds, push_bytes(&push), [accum.width, accum.height, 1])
+        rec.dispatch("svgf_temporal", &self.pipeline, binds, push_bytes(&push), tiles.live_threads())
     }
 }

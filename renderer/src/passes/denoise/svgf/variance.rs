@@ -3,10 +3,10 @@
 
 use super::SvgfSettings;
 use crate::error::Result;
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfVariancePush};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;
@@ -21,7 +21,7 @@ impl VariancePass {
         Ok(VariancePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfVariancePush>() as u32)? })
     }
 
-    /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance).
+    /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance), live tiles.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -32,6 +32,7 @@ impl VariancePass {
         dst: &Image,
         space: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         s: &SvgfSettings,
     ) -> Result<()> {
         let binds = [
@@ -41,11 +42,12 @@ impl VariancePass {
             read_image("position", &g.position),
             write_image("dst", dst),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
         ];
         let push = SvgfVariancePush {
             space: *space,
             params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, s.variance_history as f32),
         };
-        rec.dispatch("svgf_variance", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+        rec.dispatch("svgf_variance", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
     }
 }
