@@ -14,7 +14,7 @@ use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPola
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
 use fovea_tests::denoise::{
-    assert_finite_non_negative, plain_materials, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
+    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
     Texel,
 };
 use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
@@ -483,4 +483,36 @@ fn render_command_runs_bmfr_and_reports_it() {
             assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
         }
     }
+}
+
+/// BMFR's per-texel kernels run over the trace's live tiles only and its idle pass writes the idle
+/// ones before the fit reads whole blocks: the output, the fitted colour and every history image
+/// must be those of the whole grid, bit for bit, while the gaze moves (tiles turn idle and live).
+#[test]
+fn bmfr_over_the_live_tiles_equals_bmfr_over_the_whole_grid() {
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let origin = CameraPose::from_scene_camera(&scene.cameras[0], 128, 144).world_from_view.w_axis.truncate();
+    let mut pair: Option<[Bmfr; 2]> = None;
+    denoise_over_culled_tiles(&ctx, 6, |f, r, over_tiles, over_grid| {
+        let new = || Bmfr::new(&ctx, r.space().grid_size(), r.space().shader_variant(), BmfrSettings::default()).unwrap();
+        let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
+        denoise(&ctx, a, &r.view(0).gbuffer, over_tiles, origin, &r.scene.materials);
+        denoise(&ctx, b, &r.view(0).gbuffer, over_grid, origin, &r.scene.materials);
+        let cur = (f % 2) as usize;
+        let (ha, hb) = (&a.history, &b.history);
+        assert_bit_equal(
+            &ctx,
+            &format!("frame {f}"),
+            &[
+                ("output", &a.output, &b.output),
+                ("fitted", &a.fitted, &b.fitted),
+                ("noisy history", &ha.noisy[cur], &hb.noisy[cur]),
+                ("normal history", &ha.normal[cur], &hb.normal[cur]),
+                ("position history", &ha.position[cur], &hb.position[cur]),
+                ("filtered history", &ha.filtered[cur], &hb.filtered[cur]),
+            ],
+        );
+    });
+    assert_clean(&ctx);
 }

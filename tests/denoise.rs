@@ -10,13 +10,13 @@ use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
 use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::{GBuffer, OwnedTileList};
+use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};
 use fovea_tests::denoise::{
-    assert_finite_non_negative, rmse_where, surface_interiors, texel_screens, upload,
+    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, rmse_where, surface_interiors, texel_screens, upload,
 };
 use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
 use glam::{Mat4, UVec2, Vec2};
@@ -263,7 +263,6 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
     assert_clean(&ctx);
 }
 
-/// `fovea render --denoiser svgf`: the report names the denoiser and times its passes.
 /// SVGF's kernels run over the trace's live tiles only (lavapipe runs masked-off lanes at nearly
 /// full cost) and its idle pass writes the history of the idle ones: the output and every image a
 /// later frame reads must be those of the whole grid, bit for bit, while the gaze moves towards a
@@ -272,42 +271,28 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
 #[test]
 fn svgf_over_the_live_tiles_equals_svgf_over_the_whole_grid() {
     let ctx = gpu();
-    let scene = owned_scene("cornell-box");
-    let size = UVec2::new(128, 144);
-    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
-    let vp = VisualPolar::new(size, size.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
-    let (grid, variant) = (vp.grid_size(), vp.shader_variant());
-    let mut r = Renderer::new(&ctx, &scene, Box::new(vp), settings(DenoiserSettings::None)).unwrap();
-    let mut over_tiles = Svgf::new(&ctx, grid, variant, SvgfSettings::default()).unwrap();
-    let mut over_grid = Svgf::new(&ctx, grid, variant, SvgfSettings::default()).unwrap();
-    let bits = |image: &Image| read_image::<[u32; 4]>(&ctx, image);
-    let mut previous = None;
-    let mut idle_seen = Vec::new();
-    for f in 0..6u32 {
-        // Off the centre from the start: at this size only an off-centre gaze culls whole tiles.
-        let gaze = size.as_vec2() * (0.3 - 0.04 * f as f32);
-        r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
-        let current = r.space().params();
-        let table = grid_table(&ctx, r.space(), None);
-        let culled = OwnedTileList::new(&ctx, r.space(), true).unwrap();
-        let whole = fovea_tests::grid_tiles(&ctx, r.space());
-        assert!(culled.tiles.idle.len() > whole.tiles.idle.len(), "frame {f}: no tile culled, nothing tested");
-        idle_seen.push(culled.tiles.idle.clone());
-        for (svgf, tiles) in [(&mut over_tiles, &culled), (&mut over_grid, &whole)] {
-            denoise(&ctx, svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() });
-        }
-        previous = Some(current);
+    let mut pair: Option<[Svgf; 2]> = None;
+    denoise_over_culled_tiles(&ctx, 6, |f, r, over_tiles, over_grid| {
+        let new = || Svgf::new(&ctx, r.space().grid_size(), r.space().shader_variant(), SvgfSettings::default()).unwrap();
+        let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
+        denoise(&ctx, a, &r.view(0).gbuffer, over_tiles);
+        denoise(&ctx, b, &r.view(0).gbuffer, over_grid);
         let cur = (f % 2) as usize;
-        let images = |s: &Svgf| [bits(&s.output), bits(&s.history.color), bits(&s.history.moments[cur]), bits(&s.history.surface[cur])];
-        for (name, (a, b)) in ["output", "colour history", "moments", "surfaces"].iter().zip(images(&over_tiles).iter().zip(images(&over_grid).iter())) {
-            let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
-            assert_eq!(differing, 0, "frame {f}: {name} differs in {differing} texels");
-        }
-    }
-    assert!(idle_seen.windows(2).any(|w| w[0] != w[1]), "the idle tiles never changed with the gaze");
+        assert_bit_equal(
+            &ctx,
+            &format!("frame {f}"),
+            &[
+                ("output", &a.output, &b.output),
+                ("colour history", &a.history.color, &b.history.color),
+                ("moments", &a.history.moments[cur], &b.history.moments[cur]),
+                ("surfaces", &a.history.surface[cur], &b.history.surface[cur]),
+            ],
+        );
+    });
     assert_clean(&ctx);
 }
 
+/// `fovea render --denoiser svgf`: the report names the denoiser and times its passes.
 #[test]
 fn render_command_runs_svgf_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};

@@ -323,6 +323,12 @@ struct BmfrBlockPush {
     vec4 params;                // x stochastic regularisation amplitude, yzw unused
 };
 
+// Push constants of BMFR's state in the trace's idle tiles (bmfr_idle.comp).
+struct BmfrIdlePush {
+    SamplingParams space;
+    uvec4 config;               // x first idle tile in the tile list, yzw unused
+};
+
 // ---- A-SVGF (Schied et al. 2018): gradient samples, one per ASVGF_STRATUM × ASVGF_STRATUM
 // stratum of the sampling grid, reconstructed at that 1/3 resolution into the temporal α of SVGF.
 const uint ASVGF_STRATUM = 3u;

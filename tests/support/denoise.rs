@@ -3,10 +3,12 @@
 
 use ash::vk;
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::sampling::{SamplingSpace, VisualPolar};
+use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
+use fovea_renderer::passes::trace::{GBuffer, OwnedTileList};
+use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Buffer, Context, Image};
-use glam::Vec2;
+use glam::{UVec2, Vec2};
 use std::sync::Arc;
 
 /// Any plain-old-data texels into an image of the matching format.
@@ -196,5 +198,45 @@ impl SeamErrors {
     /// seam's (tenth/eleventh session).
     pub fn like_elsewhere(&self) -> bool {
         self.seam <= 3.0 * self.opposite && self.seam <= 1.25 * self.median
+    }
+}
+
+/// Visual-Polar frames of the Cornell box at 128×144 with the gaze walking from 0.3 to 0.1 of the
+/// screen (off the centre: at this size only then are whole tiles culled). Each frame goes to
+/// `each(frame, renderer, over the culled tiles, over every tile)`: the same frame for a denoiser
+/// over the view's tile list and one over the whole grid. Asserts that tiles were culled and that
+/// the culled set moved with the gaze, so that the comparison tests something.
+pub fn denoise_over_culled_tiles(ctx: &Arc<Context>, frames: u32, mut each: impl FnMut(u32, &Renderer, &DenoiseFrame, &DenoiseFrame)) {
+    let scene = crate::owned_scene("cornell-box");
+    let size = UVec2::new(128, 144);
+    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let vp = VisualPolar::new(size, size.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    let settings = RenderSettings { denoiser: DenoiserSettings::None, ..Default::default() };
+    let mut r = Renderer::new(ctx, &scene, Box::new(vp), settings).unwrap();
+    let mut previous = None;
+    let mut idle_seen = Vec::new();
+    for f in 0..frames {
+        let gaze = size.as_vec2() * (0.3 - 0.2 * f as f32 / frames.max(2) as f32);
+        r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
+        let current = r.space().params();
+        let table = crate::grid_table(ctx, r.space(), None);
+        let culled = OwnedTileList::new(ctx, r.space(), true).unwrap();
+        let whole = crate::grid_tiles(ctx, r.space());
+        assert!(culled.tiles.idle.len() > whole.tiles.idle.len(), "frame {f}: no tile culled, nothing tested");
+        idle_seen.push(culled.tiles.idle.clone());
+        let over_culled = DenoiseFrame { current, previous, sampling_table: &table, tiles: culled.list() };
+        let over_every_tile = DenoiseFrame { tiles: whole.list(), ..over_culled };
+        each(f, &r, &over_culled, &over_every_tile);
+        previous = Some(current);
+    }
+    assert!(idle_seen.windows(2).any(|w| w[0] != w[1]), "the idle tiles never changed with the gaze");
+}
+
+/// Asserts that each named pair of images holds the same bits.
+pub fn assert_bit_equal(ctx: &Arc<Context>, what: &str, pairs: &[(&str, &Image, &Image)]) {
+    for (name, a, b) in pairs {
+        let (a, b) = (crate::read_image::<[u32; 4]>(ctx, a), crate::read_image::<[u32; 4]>(ctx, b));
+        let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
+        assert_eq!(differing, 0, "{what}: {name} differs in {differing} texels");
     }
 }

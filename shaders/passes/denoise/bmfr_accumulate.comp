@@ -6,6 +6,10 @@
 //! variants per space
 #include "../../common/layouts.glsl"
 
+// The live tiles of the trace (bmfr_idle.comp writes the idle ones).
+#define TILE_LIST_BINDING 30
+#include "../../common/tiles.glsl"
+
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { BmfrTemporalPush p; } push;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D radiance;       // demodulated
@@ -42,7 +46,7 @@ float footprint(Grid g, ivec2 t, vec3 p) {
 }
 
 void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 t = tile_list_texel(0u);
     Grid g = grid_make(push.p.space);
     if (any(greaterThanEqual(t, g.size))) return;
     if (!grid_holds_sample(g, t)) {

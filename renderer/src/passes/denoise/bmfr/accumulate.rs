@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context};
 use std::sync::Arc;
 
@@ -32,7 +32,7 @@ impl AccumulatePass {
         Ok(AccumulatePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
     }
 
-    /// Reads history half `prev`, writes half `cur` (noisy, normal, position).
+    /// Reads history half `prev`, writes half `cur` (noisy, normal, position) in the live tiles.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -44,6 +44,7 @@ impl AccumulatePass {
         cur: usize,
         current: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
@@ -61,9 +62,9 @@ impl AccumulatePass {
             write_image("normal", &h.normal[cur]),
             write_image("features_position", &h.position[cur]),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
         ];
         let push = temporal_push(current, r, alpha_floor);
-        let size = [g.size.x, g.size.y, 1];
-        rec.dispatch("bmfr_accumulate", &self.pipeline, &binds, push_bytes(&push), size)
+        rec.dispatch("bmfr_accumulate", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
     }
 }

@@ -4,10 +4,10 @@
 use super::accumulate::temporal_push;
 use super::{BmfrHistory, Reprojection};
 use crate::error::Result;
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
+use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use std::sync::Arc;
 
@@ -21,7 +21,7 @@ impl AccumulateFilteredPass {
         Ok(AccumulateFilteredPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
     }
 
-    /// `fitted` + history half `prev` → history half `cur` and `dst` (re-modulated).
+    /// `fitted` + history half `prev` → history half `cur` and `dst` (re-modulated), live tiles.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -34,6 +34,7 @@ impl AccumulateFilteredPass {
         dst: &Image,
         current: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
@@ -51,8 +52,9 @@ impl AccumulateFilteredPass {
             write_image("dst", dst),
             read_image("features_position", &h.position[cur]),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
         ];
         let push = temporal_push(current, r, alpha_floor);
-        rec.dispatch("bmfr_accumulate_filtered", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+        rec.dispatch("bmfr_accumulate_filtered", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
     }
 }

@@ -18,6 +18,7 @@
 mod accumulate;
 mod accumulate_filtered;
 mod fit;
+mod idle;
 mod weighted_sum;
 
 use super::{DenoiseFrame, DenoiseScene};
@@ -31,6 +32,7 @@ use accumulate_filtered::AccumulateFilteredPass;
 use ash::vk;
 use fit::FitPass;
 use glam::{IVec2, UVec2, Vec3};
+use idle::{IdlePass, IdleTargets};
 use std::sync::Arc;
 use weighted_sum::WeightedSumPass;
 
@@ -150,6 +152,7 @@ pub struct Bmfr {
     fit: FitPass,
     weighted_sum: WeightedSumPass,
     accumulate_filtered: AccumulateFilteredPass,
+    idle: IdlePass,
     pub history: BmfrHistory,
     /// Per block: BMFR_WEIGHT_TEXELS texels (10 × rgb weights, position offset, position scale).
     pub weights: Image,
@@ -171,6 +174,7 @@ impl Bmfr {
             fit: FitPass::new(ctx, variant)?,
             weighted_sum: WeightedSumPass::new(ctx, variant)?,
             accumulate_filtered: AccumulateFilteredPass::new(ctx, variant)?,
+            idle: IdlePass::new(ctx, variant)?,
             history: BmfrHistory::new(ctx, grid)?,
             weights: Image::new(ctx, "bmfr.weights", blocks.x * BMFR_WEIGHT_TEXELS, blocks.y, rgba32)?,
             fitted: Image::new(ctx, "bmfr.fitted", grid.x, grid.y, rgba32)?,
@@ -179,7 +183,7 @@ impl Bmfr {
     }
 
     pub fn max_passes(&self) -> u32 {
-        4
+        5
     }
 
     /// The block-grid offset the next recorded frame uses.
@@ -193,7 +197,8 @@ impl Bmfr {
     }
 
     /// Records one frame: accumulate → fit → weighted sum → accumulate the fit and re-modulate;
-    /// returns `output`. History is dropped on the first frame and whenever `frame.previous` is
+    /// returns `output`. The per-texel passes run over `frame.tiles`' live tiles; the idle pass
+    /// writes the idle ones before the fit reads whole blocks. History is dropped on the first frame and whenever `frame.previous` is
     /// `None`.
     pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
         let camera_origin = scene.camera_origin;
@@ -203,11 +208,14 @@ impl Bmfr {
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous.as_ref() };
         let reprojection = Reprojection { previous, camera_shift: h.origin - camera_origin };
-        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, frame.sampling_table, &reprojection, s.alpha_noisy)?;
+        let (table, tiles) = (frame.sampling_table, &frame.tiles);
+        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, table, tiles, &reprojection, s.alpha_noisy)?;
+        let idle = IdleTargets { history: h, cur, fitted: &self.fitted, output: &self.output };
+        self.idle.record(rec, &idle, &frame.current, table, tiles)?;
         let seed = h.frames as u32;
-        self.fit.record(rec, h, cur, &self.weights, &frame.current, frame.sampling_table, offset, seed, s.noise)?;
-        self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, frame.sampling_table, offset)?;
-        self.accumulate_filtered.record(rec, g, h, prev, cur, &self.fitted, &self.output, &frame.current, frame.sampling_table, &reprojection, s.alpha_filtered)?;
+        self.fit.record(rec, h, cur, &self.weights, &frame.current, table, offset, seed, s.noise)?;
+        self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, table, tiles, offset)?;
+        self.accumulate_filtered.record(rec, g, h, prev, cur, &self.fitted, &self.output, &frame.current, table, tiles, &reprojection, s.alpha_filtered)?;
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)

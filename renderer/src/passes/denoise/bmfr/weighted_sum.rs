@@ -3,9 +3,10 @@
 use super::fit::block_push;
 use super::BmfrHistory;
 use crate::error::Result;
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
+use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrBlockPush, SamplingParams};
 use crate::passes::push_bytes;
+use crate::passes::trace::TileList;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::IVec2;
 use std::sync::Arc;
@@ -20,7 +21,7 @@ impl WeightedSumPass {
         Ok(WeightedSumPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
     }
 
-    /// Features of history half `cur` and the blocks' `weights` → `fitted`.
+    /// Features of history half `cur` and the blocks' `weights` → `fitted`, live tiles.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -31,6 +32,7 @@ impl WeightedSumPass {
         fitted: &Image,
         space: &SamplingParams,
         table: &Buffer,
+        tiles: &TileList,
         offset: IVec2,
     ) -> Result<()> {
         let binds = [
@@ -40,8 +42,9 @@ impl WeightedSumPass {
             read_image("weights", weights),
             write_image("fitted", fitted),
             read_texels("grid_columns", table),
+            read_buffer("tiles", tiles.buffer),
         ];
         let push = block_push(space, offset, 0, 0.0);
-        rec.dispatch("bmfr_weighted_sum", &self.pipeline, &binds, push_bytes(&push), [fitted.width, fitted.height, 1])
+        rec.dispatch("bmfr_weighted_sum", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
     }
 }
