@@ -24,12 +24,21 @@ fn cornell_with_blended_block(alpha: f32) -> Scene {
 
 fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
     let mut scene = owned_scene("cornell-box");
-    let block = scene.mesh_names.iter().position(|n| n == "block").expect("the block mesh") as u32;
+    let block = scene
+        .mesh_names
+        .iter()
+        .position(|n| n == "block")
+        .expect("the block mesh") as u32;
     match alpha {
         Some(a) => {
             // The two blocks are one instanced mesh: its triangles are in `instancing.meshes`.
             let instanced = scene.instancing.meshes.iter().flat_map(|m| &m.triangles);
-            let tri = *scene.triangles.iter().chain(instanced).find(|t| t.mesh == block).unwrap();
+            let tri = *scene
+                .triangles
+                .iter()
+                .chain(instanced)
+                .find(|t| t.mesh == block)
+                .unwrap();
             let mut material = scene.materials[tri.material as usize].clone();
             material.base_color.w = a;
             if blend {
@@ -39,8 +48,17 @@ fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
             }
             scene.materials.push(material);
             let index = scene.materials.len() as u32 - 1;
-            let instanced = scene.instancing.meshes.iter_mut().flat_map(|m| &mut m.triangles);
-            scene.triangles.iter_mut().chain(instanced).filter(|t| t.mesh == block).for_each(|t| t.material = index);
+            let instanced = scene
+                .instancing
+                .meshes
+                .iter_mut()
+                .flat_map(|m| &mut m.triangles);
+            scene
+                .triangles
+                .iter_mut()
+                .chain(instanced)
+                .filter(|t| t.mesh == block)
+                .for_each(|t| t.material = index);
         }
         None => {
             scene = scene.flattened();
@@ -53,7 +71,13 @@ fn cornell_with(alpha: Option<f32>, blend: bool) -> Scene {
 fn reference(scene: &Scene, spp: u32) -> Vec<[f32; 4]> {
     let ctx = gpu();
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SIZE.x, SIZE.y);
-    let mut renderer = Renderer::new(&ctx, scene, Box::new(Cartesian::new(SIZE)), RenderSettings::default()).unwrap();
+    let mut renderer = Renderer::new(
+        &ctx,
+        scene,
+        Box::new(Cartesian::new(SIZE)),
+        RenderSettings::default(),
+    )
+    .unwrap();
     let image = renderer.render_reference(&camera, spp, 3, |_| {}).unwrap();
     drop(renderer);
     assert_clean(&ctx);
@@ -62,23 +86,47 @@ fn reference(scene: &Scene, spp: u32) -> Vec<[f32; 4]> {
 
 #[test]
 fn a_transparent_cut_out_is_no_hit_and_an_opaque_one_is_the_opaque_surface() {
-    let (transparent, removed, opaque) = (reference(&cornell_with_block(Some(0.0)), 64), reference(&cornell_with_block(None), 64), reference(&owned_scene("cornell-box"), 64));
+    let (transparent, removed, opaque) = (
+        reference(&cornell_with_block(Some(0.0)), 64),
+        reference(&cornell_with_block(None), 64),
+        reference(&owned_scene("cornell-box"), 64),
+    );
     let (gone, there) = (rmse(&transparent, &removed), rmse(&transparent, &opaque));
     // Both sides converge to the same picture (noise only), far from the one with the block.
-    assert!(gone < there / 4.0, "masked-out block vs no block {gone}, vs the opaque block {there}");
+    assert!(
+        gone < there / 4.0,
+        "masked-out block vs no block {gone}, vs the opaque block {there}"
+    );
     let masked_opaque = reference(&cornell_with_block(Some(1.0)), 4);
-    assert_eq!(masked_opaque, reference(&owned_scene("cornell-box"), 4), "alpha 1 through the mask is the opaque block, bit for bit");
+    assert_eq!(
+        masked_opaque,
+        reference(&owned_scene("cornell-box"), 4),
+        "alpha 1 through the mask is the opaque block, bit for bit"
+    );
 }
 
 #[test]
 fn blended_alpha_is_stochastic_transparency() {
-    let (removed, opaque) = (reference(&cornell_with_block(None), 64), reference(&owned_scene("cornell-box"), 64));
+    let (removed, opaque) = (
+        reference(&cornell_with_block(None), 64),
+        reference(&owned_scene("cornell-box"), 64),
+    );
     let gone = reference(&cornell_with_blended_block(0.0), 64);
-    assert!(rmse(&gone, &removed) < rmse(&gone, &opaque) / 4.0, "alpha 0 blends to no block");
-    assert_eq!(reference(&cornell_with_blended_block(1.0), 4), reference(&owned_scene("cornell-box"), 4), "alpha 1 is opaque, bit for bit");
+    assert!(
+        rmse(&gone, &removed) < rmse(&gone, &opaque) / 4.0,
+        "alpha 0 blends to no block"
+    );
+    assert_eq!(
+        reference(&cornell_with_blended_block(1.0), 4),
+        reference(&owned_scene("cornell-box"), 4),
+        "alpha 1 is opaque, bit for bit"
+    );
     let half = reference(&cornell_with_blended_block(0.5), 64);
     let apart = rmse(&removed, &opaque);
-    assert!(rmse(&half, &removed) < apart && rmse(&half, &opaque) < apart, "alpha 0.5 lies between no block and the opaque one");
+    assert!(
+        rmse(&half, &removed) < apart && rmse(&half, &opaque) < apart,
+        "alpha 0.5 lies between no block and the opaque one"
+    );
 }
 
 /// The loader reads alphaMode MASK and its cutoff (Sponza's foliage and chains, when present).
@@ -89,6 +137,13 @@ fn sponza_s_masked_materials_are_read() {
         return;
     };
     let scene = Scene::load(&path).unwrap();
-    let masked: Vec<f32> = scene.materials.iter().filter_map(|m| m.alpha_cutoff).collect();
-    assert!(!masked.is_empty() && masked.iter().all(|c| (0.0..=1.0).contains(c)), "{masked:?}");
+    let masked: Vec<f32> = scene
+        .materials
+        .iter()
+        .filter_map(|m| m.alpha_cutoff)
+        .collect();
+    assert!(
+        !masked.is_empty() && masked.iter().all(|c| (0.0..=1.0).contains(c)),
+        "{masked:?}"
+    );
 }

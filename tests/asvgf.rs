@@ -10,9 +10,13 @@ use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{
+    Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
+};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_tests::{assert_clean, gpu, light_material, mean_rgb, owned_scene, read_image, rmse, save_preview};
+use fovea_tests::{
+    assert_clean, gpu, light_material, mean_rgb, owned_scene, read_image, rmse, save_preview,
+};
 use glam::{Mat4, UVec2};
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
@@ -20,7 +24,9 @@ const SCREEN: UVec2 = UVec2::new(64, 72);
 fn space(name: &str, screen: UVec2) -> Box<dyn SamplingSpace> {
     match name {
         "cartesian" => Box::new(Cartesian::new(screen)),
-        _ => Box::new(VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap()),
+        _ => Box::new(
+            VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap(),
+        ),
     }
 }
 
@@ -28,7 +34,14 @@ const SPACES: [&str; 2] = ["cartesian", "vp"];
 
 /// The blur is off: the comparisons measure sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
+    RenderSettings {
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
+        denoiser,
+        ..Default::default()
+    }
 }
 
 fn asvgf() -> DenoiserSettings {
@@ -53,7 +66,9 @@ fn mean_luminance(pixels: &[[f32; 4]]) -> f64 {
 
 /// Gradient samples the tracer re-shaded last frame: (last luminance, this frame's).
 fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
-    let Some(Denoiser::Asvgf(a)) = r.denoiser() else { panic!("A-SVGF expected") };
+    let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+        panic!("A-SVGF expected")
+    };
     let samples: Vec<AsvgfGradientSample> = a.read_samples().unwrap();
     let claimed = samples.iter().filter(|s| s.surface.x != 0).count();
     let pairs = samples
@@ -77,16 +92,32 @@ fn gradient_samples_reshade_last_frames_path() {
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     for name in SPACES {
         let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(asvgf())).unwrap();
-        let Some(Denoiser::Asvgf(a)) = r.denoiser() else { panic!() };
+        let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+            panic!()
+        };
         let strata = a.strata();
         r.render_frame(&frame(camera, 0)).unwrap();
-        assert_eq!(reshaded(&r).1, 0, "{name}: no gradient samples without a previous frame");
+        assert_eq!(
+            reshaded(&r).1,
+            0,
+            "{name}: no gradient samples without a previous frame"
+        );
 
         let check_ratio = |r: &Renderer, f: u32, expected: f32| {
             let (pairs, claimed) = reshaded(r);
-            let lit: Vec<(f32, f32)> = pairs.iter().copied().filter(|(prev, _)| *prev > 1e-3).collect();
-            let off = lit.iter().filter(|(prev, cur)| (cur / prev - expected).abs() > 1e-3 * expected).count();
-            let worst = lit.iter().map(|(prev, cur)| (cur / prev - expected).abs()).fold(0f32, f32::max);
+            let lit: Vec<(f32, f32)> = pairs
+                .iter()
+                .copied()
+                .filter(|(prev, _)| *prev > 1e-3)
+                .collect();
+            let off = lit
+                .iter()
+                .filter(|(prev, cur)| (cur / prev - expected).abs() > 1e-3 * expected)
+                .count();
+            let worst = lit
+                .iter()
+                .map(|(prev, cur)| (cur / prev - expected).abs())
+                .fold(0f32, f32::max);
             println!(
                 "{name} frame {f}: {claimed} of {} strata claimed, {} re-shaded ({} lit); f_i/f_(i-1) = {expected} ± {worst:.2e}, {off} beyond 1e-3",
                 strata.x * strata.y,
@@ -94,19 +125,49 @@ fn gradient_samples_reshade_last_frames_path() {
                 lit.len()
             );
             // Most strata of the box (the grid is all box but VP's texels beyond the screen).
-            assert!(lit.len() * 2 > (strata.x * strata.y) as usize, "{name} frame {f}: only {} lit gradient samples", lit.len());
+            assert!(
+                lit.len() * 2 > (strata.x * strata.y) as usize,
+                "{name} frame {f}: only {} lit gradient samples",
+                lit.len()
+            );
             // Rounding in the re-derived view ray may send a rare continuation elsewhere.
-            assert!(off * 100 <= lit.len(), "{name} frame {f}: {off} of {} gradient samples off the ratio {expected}", lit.len());
-            let sign = lit.iter().filter(|(prev, cur)| (cur - prev).signum() == (expected - 1.0).signum() || expected == 1.0).count();
-            assert!(sign * 100 >= lit.len() * 99, "{name} frame {f}: δ has the wrong sign in {} samples", lit.len() - sign);
+            assert!(
+                off * 100 <= lit.len(),
+                "{name} frame {f}: {off} of {} gradient samples off the ratio {expected}",
+                lit.len()
+            );
+            let sign = lit
+                .iter()
+                .filter(|(prev, cur)| {
+                    (cur - prev).signum() == (expected - 1.0).signum() || expected == 1.0
+                })
+                .count();
+            assert!(
+                sign * 100 >= lit.len() * 99,
+                "{name} frame {f}: δ has the wrong sign in {} samples",
+                lit.len() - sign
+            );
             // The reconstruction averages δ and max f alike: λ = |δ̂| / max f̂ is the ratio's.
-            let Some(Denoiser::Asvgf(a)) = r.denoiser() else { panic!() };
+            let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+                panic!()
+            };
             let gradient: Vec<[f32; 4]> = read_image(&ctx, a.gradient());
             let lambda = (expected - 1.0).abs() / expected.max(1.0);
-            let confident: Vec<f32> = gradient.iter().filter(|g| g[2] > 0.0 && g[1] > 1e-3).map(|g| g[0].abs() / g[1]).collect();
-            let off = confident.iter().filter(|l| (*l - lambda).abs() > 1e-3).count();
+            let confident: Vec<f32> = gradient
+                .iter()
+                .filter(|g| g[2] > 0.0 && g[1] > 1e-3)
+                .map(|g| g[0].abs() / g[1])
+                .collect();
+            let off = confident
+                .iter()
+                .filter(|l| (*l - lambda).abs() > 1e-3)
+                .count();
             println!("{name} frame {f}: λ = {lambda} expected, {off} of {} reconstructed strata off by > 1e-3", confident.len());
-            assert!(confident.len() * 2 > (strata.x * strata.y) as usize && off * 100 <= confident.len(), "{name} frame {f}: λ off in {off} strata");
+            assert!(
+                confident.len() * 2 > (strata.x * strata.y) as usize
+                    && off * 100 <= confident.len(),
+                "{name} frame {f}: λ off in {off} strata"
+            );
         };
         r.render_frame(&frame(camera, 1)).unwrap();
         check_ratio(&r, 1, 1.0);
@@ -121,8 +182,19 @@ fn gradient_samples_reshade_last_frames_path() {
         // Lambertian, so the same path (seen from a slightly different direction) still gives the
         // same radiance.
         for f in 4..7 {
-            let shift = Mat4::from_translation(glam::Vec3::new(0.01 * (f - 3) as f32, 0.005 * (f - 3) as f32, 0.0));
-            r.render_frame(&frame(CameraPose { world_from_view: shift * camera.world_from_view, ..camera }, f)).unwrap();
+            let shift = Mat4::from_translation(glam::Vec3::new(
+                0.01 * (f - 3) as f32,
+                0.005 * (f - 3) as f32,
+                0.0,
+            ));
+            r.render_frame(&frame(
+                CameraPose {
+                    world_from_view: shift * camera.world_from_view,
+                    ..camera
+                },
+                f,
+            ))
+            .unwrap();
         }
         check_ratio(&r, 6, 1.0);
         assert_clean(&ctx);
@@ -132,7 +204,10 @@ fn gradient_samples_reshade_last_frames_path() {
 /// Frames after the switch (the first frame rendered without the light is 1) until the mean
 /// luminance has covered 90 % of the step to its new level; `None` if it never does.
 fn lag(after: &[f64], before: f64, level: f64) -> Option<usize> {
-    after.iter().position(|l| (l - level).abs() <= 0.1 * (before - level).abs()).map(|i| i + 1)
+    after
+        .iter()
+        .position(|l| (l - level).abs() <= 0.1 * (before - level).abs())
+        .map(|i| i + 1)
 }
 
 /// Still camera, the ceiling light switched off after 10 frames: the mean screen luminance of
@@ -148,7 +223,8 @@ fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
     for name in SPACES {
         let mut lags = Vec::new();
         for (label, denoiser) in [("svgf", svgf()), ("asvgf", asvgf())] {
-            let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(denoiser)).unwrap();
+            let mut r =
+                Renderer::new(&ctx, &scene, space(name, SCREEN), settings(denoiser)).unwrap();
             let mut hdr = Vec::new();
             let mut levels = Vec::new();
             for f in 0..on + off {
@@ -162,13 +238,23 @@ fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
             let before = levels[on as usize - 1];
             let after = &levels[on as usize..];
             let frames = lag(after, before, 0.0);
-            let trace: Vec<String> = after.iter().take(12).map(|l| format!("{:.3}", l / before)).collect();
-            println!("{name} {label}: lag {frames:?} frames (10 % of the step); level / before: {}", trace.join(" "));
+            let trace: Vec<String> = after
+                .iter()
+                .take(12)
+                .map(|l| format!("{:.3}", l / before))
+                .collect();
+            println!(
+                "{name} {label}: lag {frames:?} frames (10 % of the step); level / before: {}",
+                trace.join(" ")
+            );
             lags.push(frames.unwrap_or(off as usize + 1));
         }
         let (svgf_lag, asvgf_lag) = (lags[0], lags[1]);
         assert!(asvgf_lag <= 3, "{name}: A-SVGF needs {asvgf_lag} frames");
-        assert!(svgf_lag >= asvgf_lag + 4, "{name}: SVGF lags {svgf_lag} frames, A-SVGF {asvgf_lag}: not clearly faster");
+        assert!(
+            svgf_lag >= asvgf_lag + 4,
+            "{name}: SVGF lags {svgf_lag} frames, A-SVGF {asvgf_lag}: not clearly faster"
+        );
     }
     assert_clean(&ctx);
 }
@@ -179,12 +265,16 @@ fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
 /// several (aliasing, not noise), and the light's rim (17× the walls) would outweigh the rest.
 fn smooth_pixels(reference: &[[f32; 4]], size: UVec2) -> Vec<bool> {
     let (w, h) = (size.x as i32, size.y as i32);
-    let lum = |x: i32, y: i32| luminance(&reference[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize]);
+    let lum = |x: i32, y: i32| {
+        luminance(&reference[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize])
+    };
     (0..w * h)
         .map(|i| {
             let (x, y) = (i % w, i / w);
             let c = lum(x, y);
-            let near = |r: i32, keep: &dyn Fn(f64) -> bool| (-r..=r).all(|dy| (-r..=r).all(|dx| keep(lum(x + dx, y + dy))));
+            let near = |r: i32, keep: &dyn Fn(f64) -> bool| {
+                (-r..=r).all(|dy| (-r..=r).all(|dx| keep(lum(x + dx, y + dy))))
+            };
             c > 0.0 && near(2, &|l| l < 1.5) && near(1, &|l| (l - c).abs() <= 0.3 * c)
         })
         .collect()
@@ -192,7 +282,13 @@ fn smooth_pixels(reference: &[[f32; 4]], size: UVec2) -> Vec<bool> {
 
 /// RMSE over the pixels `keep` marks.
 fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: &[bool]) -> f64 {
-    let pick = |v: &[[f32; 4]]| v.iter().zip(keep).filter(|(_, k)| **k).map(|(p, _)| *p).collect::<Vec<_>>();
+    let pick = |v: &[[f32; 4]]| {
+        v.iter()
+            .zip(keep)
+            .filter(|(_, k)| **k)
+            .map(|(p, _)| *p)
+            .collect::<Vec<_>>()
+    };
     rmse(&pick(a), &pick(b))
 }
 
@@ -206,8 +302,16 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
     let scene = owned_scene("cornell-box");
     let size = UVec2::new(96, 108);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
-    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 128, 3, |_| {}).unwrap();
+    let mut reference_renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(size)),
+        settings(DenoiserSettings::None),
+    )
+    .unwrap();
+    let reference = reference_renderer
+        .render_reference(&camera, 128, 3, |_| {})
+        .unwrap();
     drop(reference_renderer);
     let smooth = smooth_pixels(&reference, size);
     // Around the gaze (3 fovea radii; the fovea alone holds too few pixels at this size for a
@@ -216,13 +320,27 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
     let gaze = size.as_vec2() * 0.5;
     let r_centre = 3.0 * space("vp", size).visual_polar().unwrap().r_fovea();
     let centre: Vec<bool> = (0..size.x * size.y)
-        .map(|i| smooth[i as usize] && (glam::Vec2::new((i % size.x) as f32 + 0.5, (i / size.x) as f32 + 0.5) - gaze).length() < r_centre)
+        .map(|i| {
+            smooth[i as usize]
+                && (glam::Vec2::new((i % size.x) as f32 + 0.5, (i / size.x) as f32 + 0.5) - gaze)
+                    .length()
+                    < r_centre
+        })
         .collect();
     let count = |m: &[bool]| m.iter().filter(|k| **k).count();
-    println!("{} of {} pixels away from edges, {} of them within {r_centre:.1} px of the gaze", count(&smooth), smooth.len(), count(&centre));
+    println!(
+        "{} of {} pixels away from edges, {} of them within {r_centre:.1} px of the gaze",
+        count(&smooth),
+        smooth.len(),
+        count(&centre)
+    );
     for name in SPACES {
         let mut errors = Vec::new();
-        for (label, denoiser, frames) in [("raw", DenoiserSettings::None, 1), ("svgf", svgf(), 16), ("asvgf", asvgf(), 16)] {
+        for (label, denoiser, frames) in [
+            ("raw", DenoiserSettings::None, 1),
+            ("svgf", svgf(), 16),
+            ("asvgf", asvgf(), 16),
+        ] {
             let mut r = Renderer::new(&ctx, &scene, space(name, size), settings(denoiser)).unwrap();
             let mut hdr = Vec::new();
             for f in 0..frames {
@@ -230,17 +348,27 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
             }
             r.read_hdr(&mut hdr).unwrap();
             save_preview(&format!("asvgf_{name}_{label}.png"), size.x, size.y, &hdr);
-            errors.push([rmse_where(&hdr, &reference, &smooth), rmse_where(&hdr, &reference, &centre)]);
+            errors.push([
+                rmse_where(&hdr, &reference, &smooth),
+                rmse_where(&hdr, &reference, &centre),
+            ]);
         }
         for (region, k) in [("whole frame", 0), ("centre", 1)] {
-            let (svgf_factor, asvgf_factor) = (errors[0][k] / errors[1][k], errors[0][k] / errors[2][k]);
+            let (svgf_factor, asvgf_factor) =
+                (errors[0][k] / errors[1][k], errors[0][k] / errors[2][k]);
             println!(
                 "{name} {region}: RMSE raw {:.4}, SVGF {:.4} ({svgf_factor:.2}×), A-SVGF {:.4} ({asvgf_factor:.2}×) after 16 frames",
                 errors[0][k], errors[1][k], errors[2][k]
             );
-            assert!(asvgf_factor >= 0.8 * svgf_factor, "{name} {region}: A-SVGF {asvgf_factor:.2}× vs SVGF {svgf_factor:.2}×");
+            assert!(
+                asvgf_factor >= 0.8 * svgf_factor,
+                "{name} {region}: A-SVGF {asvgf_factor:.2}× vs SVGF {svgf_factor:.2}×"
+            );
             if name == "cartesian" || region == "centre" {
-                assert!(asvgf_factor >= 3.0, "{name} {region}: A-SVGF reduces the RMSE only {asvgf_factor:.2}×");
+                assert!(
+                    asvgf_factor >= 3.0,
+                    "{name} {region}: A-SVGF reduces the RMSE only {asvgf_factor:.2}×"
+                );
             }
         }
     }
@@ -249,7 +377,10 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
 
 fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
     for (i, p) in pixels.iter().enumerate() {
-        assert!(p.iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: texel {i} = {p:?}");
+        assert!(
+            p.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{what}: texel {i} = {p:?}"
+        );
     }
 }
 
@@ -263,12 +394,16 @@ fn asvgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
     let scene = owned_scene("cornell-box");
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let away = CameraPose { world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..camera };
+    let away = CameraPose {
+        world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI),
+        ..camera
+    };
     for name in SPACES {
         let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(asvgf())).unwrap();
         let mut hdr = Vec::new();
         for f in 0..6 {
-            r.set_emission_scale(&scene, light, if f == 2 || f == 3 { 1e30 } else { 1.0 }).unwrap();
+            r.set_emission_scale(&scene, light, if f == 2 || f == 3 { 1e30 } else { 1.0 })
+                .unwrap();
             r.render_frame(&frame(camera, f)).unwrap();
             r.read_hdr(&mut hdr).unwrap();
             assert_finite_non_negative(&format!("{name} frame {f}"), &hdr);
@@ -276,7 +411,10 @@ fn asvgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
         for f in 6..9 {
             r.render_frame(&frame(away, f)).unwrap();
             r.read_hdr(&mut hdr).unwrap();
-            assert!(hdr.iter().all(|p| p[..3] == [0.0; 3]), "{name}: the empty view is not black (frame {f})");
+            assert!(
+                hdr.iter().all(|p| p[..3] == [0.0; 3]),
+                "{name}: the empty view is not black (frame {f})"
+            );
         }
         assert_clean(&ctx);
     }
@@ -291,7 +429,13 @@ fn emission_scale_switches_a_light_consistently() {
     let scene = owned_scene("cornell-box");
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let mut r = Renderer::new(&ctx, &scene, space("cartesian", SCREEN), settings(DenoiserSettings::None)).unwrap();
+    let mut r = Renderer::new(
+        &ctx,
+        &scene,
+        space("cartesian", SCREEN),
+        settings(DenoiserSettings::None),
+    )
+    .unwrap();
     let render = |r: &mut Renderer| {
         let mut hdr = Vec::new();
         r.render_frame(&frame(camera, 5)).unwrap();
@@ -306,12 +450,22 @@ fn emission_scale_switches_a_light_consistently() {
     r.set_emission_scale(&scene, light, 0.25).unwrap();
     let dimmed = render(&mut r);
     let ratio = mean_luminance(&dimmed) / mean_luminance(&lit);
-    assert!((ratio - 0.25).abs() < 1e-4, "a quarter of the emission gives {ratio} of the light");
+    assert!(
+        (ratio - 0.25).abs() < 1e-4,
+        "a quarter of the emission gives {ratio} of the light"
+    );
     r.set_emission_scale(&scene, light, 1.0).unwrap();
     assert_eq!(r.scene.light_count, lit_light_count);
     assert_eq!(render(&mut r), lit, "back on, the frame differs");
-    for (material, scale) in [(scene.materials.len(), 1.0), (light, -1.0), (light, f32::NAN)] {
-        let err = r.set_emission_scale(&scene, material, scale).unwrap_err().to_string();
+    for (material, scale) in [
+        (scene.materials.len(), 1.0),
+        (light, -1.0),
+        (light, f32::NAN),
+    ] {
+        let err = r
+            .set_emission_scale(&scene, material, scale)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("emission scale"), "{err}");
     }
     assert_clean(&ctx);
@@ -327,23 +481,63 @@ fn the_renderer_refuses_filters_a_space_cannot_run() {
     use fovea_renderer::sampling::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
-    let falloff = || Box::new(LinearFalloff::new(SCREEN, VisualPolarParams::default(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap());
+    let falloff = || {
+        Box::new(
+            LinearFalloff::new(
+                SCREEN,
+                VisualPolarParams::default(),
+                FalloffShape::default(),
+                FALLOFF_BUDGET_OF_VP,
+            )
+            .unwrap(),
+        )
+    };
     let clipped = || {
-        let params = VisualPolarParams { layout: VpLayout::ScreenClipped, ..VisualPolarParams::default() };
+        let params = VisualPolarParams {
+            layout: VpLayout::ScreenClipped,
+            ..VisualPolarParams::default()
+        };
         Box::new(VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap())
     };
     assert!(!falloff().capabilities().temporal_filters);
-    assert!(clipped().capabilities().temporal_filters && clipped().capabilities().way_back == fovea_renderer::sampling::WayBack::Remap);
+    assert!(
+        clipped().capabilities().temporal_filters
+            && clipped().capabilities().way_back == fovea_renderer::sampling::WayBack::Remap
+    );
     let cases = [
-        ("svgf", settings(DenoiserSettings::Svgf(SvgfSettings::default()))),
+        (
+            "svgf",
+            settings(DenoiserSettings::Svgf(SvgfSettings::default())),
+        ),
         ("asvgf", settings(asvgf())),
-        ("bmfr", settings(DenoiserSettings::Bmfr(BmfrSettings::default()))),
-        ("vp", RenderSettings { taa: TaaMode::SamplingGrid(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
-        ("screen", RenderSettings { taa: TaaMode::Screen(TaaSettings::default()), ..settings(DenoiserSettings::None) }),
+        (
+            "bmfr",
+            settings(DenoiserSettings::Bmfr(BmfrSettings::default())),
+        ),
+        (
+            "vp",
+            RenderSettings {
+                taa: TaaMode::SamplingGrid(TaaSettings::default()),
+                ..settings(DenoiserSettings::None)
+            },
+        ),
+        (
+            "screen",
+            RenderSettings {
+                taa: TaaMode::Screen(TaaSettings::default()),
+                ..settings(DenoiserSettings::None)
+            },
+        ),
     ];
     for (name, s) in cases {
-        let err = Renderer::new(&ctx, &scene, falloff(), s).err().unwrap_or_else(|| panic!("{name} accepted")).to_string();
-        assert!(err.contains(name) && err.contains("linear-falloff") && err.contains("killed"), "{err}");
+        let err = Renderer::new(&ctx, &scene, falloff(), s)
+            .err()
+            .unwrap_or_else(|| panic!("{name} accepted"))
+            .to_string();
+        assert!(
+            err.contains(name) && err.contains("linear-falloff") && err.contains("killed"),
+            "{err}"
+        );
         if let Err(e) = Renderer::new(&ctx, &scene, clipped(), s) {
             panic!("{name} refused on the screen-clipped layout: {e}");
         }
@@ -360,11 +554,30 @@ fn render_command_runs_asvgf_and_reports_it() {
     let out = fovea_tests::artifacts_dir().join(format!("asvgf-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     for method in ["cartesian", "vp", "vp-screen-clipped"] {
-        run(&RenderArgs { method, denoiser: "asvgf", frames: 3, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        run(&RenderArgs {
+            method,
+            denoiser: "asvgf",
+            frames: 3,
+            exr: false,
+            ..fovea_tests::small_render_args("cornell-box", &out)
+        })
+        .unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
         assert_eq!(report["denoiser"], "asvgf");
-        for pass in ["asvgf_clear", "asvgf_forward", "asvgf_gradient", "svgf_temporal", "svgf_atrous", "svgf_modulate"] {
-            assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
+        for pass in [
+            "asvgf_clear",
+            "asvgf_forward",
+            "asvgf_gradient",
+            "svgf_temporal",
+            "svgf_atrous",
+            "svgf_modulate",
+        ] {
+            assert!(
+                report["passes"].get(pass).is_some(),
+                "{method}: pass {pass} missing"
+            );
         }
     }
 }

@@ -14,18 +14,25 @@ use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPola
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
 use fovea_tests::denoise::{
-    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials, rmse_where, surface_interiors, texel_screens, upload_gbuffer,
-    Texel,
+    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials,
+    rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,
 };
-use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash};
+use fovea_tests::{
+    assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash,
+};
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
 
 fn spaces(screen: UVec2) -> [(&'static str, Box<dyn SamplingSpace>); 2] {
-    let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
-    [("cartesian", Box::new(Cartesian::new(screen))), ("vp", Box::new(vp))]
+    let vp =
+        VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    [
+        ("cartesian", Box::new(Cartesian::new(screen))),
+        ("vp", Box::new(vp)),
+    ]
 }
 
 fn same_space(space: &dyn SamplingSpace) -> Box<dyn SamplingSpace> {
@@ -37,7 +44,14 @@ fn same_space(space: &dyn SamplingSpace) -> Box<dyn SamplingSpace> {
 
 /// The blur is off: the VP comparison measures sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
+    RenderSettings {
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
+        denoiser,
+        ..Default::default()
+    }
 }
 
 fn with_bmfr() -> DenoiserSettings {
@@ -49,10 +63,26 @@ fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
 }
 
 /// Runs one BMFR frame; returns its output (re-modulated).
-fn denoise(ctx: &Arc<Context>, bmfr: &mut Bmfr, g: &GBuffer, frame: &DenoiseFrame, origin: Vec3, materials: &Buffer) -> Vec<[f32; 4]> {
+fn denoise(
+    ctx: &Arc<Context>,
+    bmfr: &mut Bmfr,
+    g: &GBuffer,
+    frame: &DenoiseFrame,
+    origin: Vec3,
+    materials: &Buffer,
+) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 8).unwrap();
     rec.begin().unwrap();
-    bmfr.record(&mut rec, g, frame, &DenoiseScene { camera_origin: origin, materials }).unwrap();
+    bmfr.record(
+        &mut rec,
+        g,
+        frame,
+        &DenoiseScene {
+            camera_origin: origin,
+            materials,
+        },
+    )
+    .unwrap();
     rec.submit_and_wait().unwrap();
     read_image(ctx, &bmfr.output)
 }
@@ -70,7 +100,9 @@ fn cpu_least_squares(rows: &[([f64; 10], f64)]) -> [f64; 10] {
         }
     }
     for k in 0..10 {
-        let p = (k..10).max_by(|&x, &y| a[x][k].abs().total_cmp(&a[y][k].abs())).unwrap();
+        let p = (k..10)
+            .max_by(|&x, &y| a[x][k].abs().total_cmp(&a[y][k].abs()))
+            .unwrap();
         a.swap(k, p);
         let pivot_row = a[k];
         for row in a.iter_mut().skip(k + 1) {
@@ -96,7 +128,11 @@ fn cpu_blocks(space: &dyn SamplingSpace, offset: [i32; 2]) -> Vec<Option<(i32, i
     let grid = space.grid_size();
     let side = BMFR_BLOCK as i32;
     let shift = [16 - offset[0], 16 - offset[1]];
-    let rows = |c: i32| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(c as u32)) as i32;
+    let rows = |c: i32| {
+        space
+            .visual_polar()
+            .map_or(grid.y, |v| v.rows_in_column(c as u32)) as i32
+    };
     (0..grid.x * grid.y)
         .map(|i| {
             let (x, y) = ((i % grid.x) as i32, (i / grid.x) as i32);
@@ -126,10 +162,22 @@ fn cpu_blocks(space: &dyn SamplingSpace, offset: [i32; 2]) -> Vec<Option<(i32, i
 #[test]
 fn fit_matches_a_cpu_least_squares_solve() {
     let ctx = gpu();
-    let vp = VisualPolar::new(UVec2::new(128, 144), Vec2::new(64.0, 72.0), VisualPolarParams::default()).unwrap();
-    let spaces: [(&str, Box<dyn SamplingSpace>); 2] = [("cartesian", Box::new(Cartesian::new(SCREEN))), ("vp", Box::new(vp))];
+    let vp = VisualPolar::new(
+        UVec2::new(128, 144),
+        Vec2::new(64.0, 72.0),
+        VisualPolarParams::default(),
+    )
+    .unwrap();
+    let spaces: [(&str, Box<dyn SamplingSpace>); 2] = [
+        ("cartesian", Box::new(Cartesian::new(SCREEN))),
+        ("vp", Box::new(vp)),
+    ];
     let lattice = |v: f32| (v * 256.0).round() / 256.0;
-    let truth = [[2.0, 0.3, -0.2, 0.1, 0.4, 0.2, 0.05, -0.1, 0.3, 0.02], [1.5, -0.1, 0.2, 0.3, -0.3, 0.1, 0.02, 0.2, -0.2, 0.01], [2.5, 0.2, 0.1, -0.3, 0.1, -0.2, 0.04, 0.1, 0.1, 0.03]];
+    let truth = [
+        [2.0, 0.3, -0.2, 0.1, 0.4, 0.2, 0.05, -0.1, 0.3, 0.02],
+        [1.5, -0.1, 0.2, 0.3, -0.3, 0.1, 0.02, 0.2, -0.2, 0.01],
+        [2.5, 0.2, 0.1, -0.3, 0.1, -0.2, 0.04, 0.1, 0.1, 0.03],
+    ];
     for (name, space) in spaces {
         let grid = space.grid_size();
         let offset = BLOCK_OFFSETS[0];
@@ -138,26 +186,61 @@ fn fit_matches_a_cpu_least_squares_solve() {
             .map(|i| {
                 blocks_of[i as usize]?;
                 let h = |k: u32| unit_hash(i * 11 + k);
-                let normal = [lattice(2.0 * h(1) - 1.0), lattice(2.0 * h(2) - 1.0), lattice(h(3))];
+                let normal = [
+                    lattice(2.0 * h(1) - 1.0),
+                    lattice(2.0 * h(2) - 1.0),
+                    lattice(h(3)),
+                ];
                 let position = [4.0 * h(4) - 2.0, 0.8 * h(5) - 0.4, -5.0 + 0.9 * h(6)];
                 let mut radiance = [0f32; 3];
                 for (c, r) in radiance.iter_mut().enumerate() {
                     // Features before the per-block scaling; any linear combination of them is one
                     // of the scaled features too.
                     let f = features(normal, position, [0.0; 3], [1.0; 3]);
-                    *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>() + 0.1 * (unit_hash(i * 11 + 7 + c as u32) - 0.5);
-                    assert!(*r > 0.0, "test colours must be positive (the output is clamped)");
+                    *r = (0..10).map(|k| truth[c][k] * f[k] as f32).sum::<f32>()
+                        + 0.1 * (unit_hash(i * 11 + 7 + c as u32) - 0.5);
+                    assert!(
+                        *r > 0.0,
+                        "test colours must be positive (the output is clamped)"
+                    );
                 }
-                Some(Texel { radiance, normal, position, mesh: 1, motion: Vec2::splat(-1.0) })
+                Some(Texel {
+                    radiance,
+                    normal,
+                    position,
+                    mesh: 1,
+                    motion: Vec2::splat(-1.0),
+                })
             })
             .collect();
         let g = GBuffer::new(&ctx, grid).unwrap();
         upload_gbuffer(&ctx, &g, &texels);
-        let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
+        let mut bmfr = Bmfr::new(
+            &ctx,
+            grid,
+            space.shader_variant(),
+            BmfrSettings {
+                noise: 0.0,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         assert_eq!(bmfr.next_block_offset().to_array(), offset);
         let table = grid_table(&ctx, space.as_ref(), None);
         let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
-        denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table, tiles: tiles.list() }, Vec3::ZERO, &plain_materials(&ctx));
+        denoise(
+            &ctx,
+            &mut bmfr,
+            &g,
+            &DenoiseFrame {
+                current: space.params(),
+                previous: None,
+                sampling_table: &table,
+                tiles: tiles.list(),
+            },
+            Vec3::ZERO,
+            &plain_materials(&ctx),
+        );
         let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
         let mut blocks: Vec<(i32, i32)> = blocks_of.iter().flatten().copied().collect();
@@ -165,13 +248,21 @@ fn fit_matches_a_cpu_least_squares_solve() {
         blocks.dedup();
         let (mut worst, mut worst_rel, mut checked, mut seam_blocks) = (0f64, 0f64, 0usize, 0);
         for block in &blocks {
-            let members: Vec<usize> = (0..texels.len()).filter(|&i| blocks_of[i] == Some(*block)).collect();
+            let members: Vec<usize> = (0..texels.len())
+                .filter(|&i| blocks_of[i] == Some(*block))
+                .collect();
             if members.len() < 40 {
                 continue;
             }
-            let rows_of = |i: usize| space.visual_polar().map_or(grid.y, |v| v.rows_in_column(i as u32 % grid.x));
+            let rows_of = |i: usize| {
+                space
+                    .visual_polar()
+                    .map_or(grid.y, |v| v.rows_in_column(i as u32 % grid.x))
+            };
             let row = |i: usize| i as u32 / grid.x;
-            if members.iter().any(|&i| row(i) == 0) && members.iter().any(|&i| row(i) + 1 == rows_of(i)) {
+            if members.iter().any(|&i| row(i) == 0)
+                && members.iter().any(|&i| row(i) + 1 == rows_of(i))
+            {
                 seam_blocks += 1;
             }
             checked += members.len();
@@ -188,8 +279,15 @@ fn fit_matches_a_cpu_least_squares_solve() {
             let scale = [0, 1, 2].map(|a| if wide(a) { 1.0 / (hi[a] - lo[a]) } else { 1.0 });
             #[allow(clippy::needless_range_loop)] // c picks a channel of two different arrays
             for c in 0..3 {
-                let rows: Vec<([f64; 10], f64)> =
-                    member_texels.iter().map(|t| (features(t.normal, t.position, offset, scale), t.radiance[c] as f64)).collect();
+                let rows: Vec<([f64; 10], f64)> = member_texels
+                    .iter()
+                    .map(|t| {
+                        (
+                            features(t.normal, t.position, offset, scale),
+                            t.radiance[c] as f64,
+                        )
+                    })
+                    .collect();
                 let w = cpu_least_squares(&rows);
                 for (&i, (f, _)) in members.iter().zip(&rows) {
                     let expected: f64 = (0..10).map(|k| w[k] * f[k]).sum();
@@ -210,8 +308,14 @@ fn fit_matches_a_cpu_least_squares_solve() {
         // of the colour (~2.5, ulp 2.4e-7) times a small factor; 3e-6 is measured, 1e-4 leaves
         // ~30×, while a wrong block, wrong scaling, a missing row or a dropped feature shows errors
         // of the added noise's size (±0.05).
-        assert!(worst < 1e-4, "{name}: fitted colours differ by up to {worst}");
-        assert!(checked as f64 >= 0.9 * valid as f64, "{name}: only {checked} of {valid} texels in blocks of ≥ 40");
+        assert!(
+            worst < 1e-4,
+            "{name}: fitted colours differ by up to {worst}"
+        );
+        assert!(
+            checked as f64 >= 0.9 * valid as f64,
+            "{name}: only {checked} of {valid} texels in blocks of ≥ 40"
+        );
         if name == "vp" {
             assert!(seam_blocks > 0, "no block crosses the φ seam");
         }
@@ -233,16 +337,44 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
     let texels: Vec<Option<Texel>> = (0..grid.x * grid.y)
         .map(|i| {
             let (x, y) = ((i % grid.x) as f32 / 64.0, (i / grid.x) as f32 / 64.0);
-            let v = 0.5 + 0.3 * x - 0.2 * y + 0.4 * x * x + 0.1 * y * y + 0.05 * (unit_hash(i) - 0.5);
-            Some(Texel { radiance: [v, 2.0 * v, 0.5 * v], normal: [0.0, 0.0, 1.0], position: [x, y, -5.0], mesh: 1, motion: Vec2::splat(-1.0) })
+            let v =
+                0.5 + 0.3 * x - 0.2 * y + 0.4 * x * x + 0.1 * y * y + 0.05 * (unit_hash(i) - 0.5);
+            Some(Texel {
+                radiance: [v, 2.0 * v, 0.5 * v],
+                normal: [0.0, 0.0, 1.0],
+                position: [x, y, -5.0],
+                mesh: 1,
+                motion: Vec2::splat(-1.0),
+            })
         })
         .collect();
     let g = GBuffer::new(&ctx, grid).unwrap();
     upload_gbuffer(&ctx, &g, &texels);
-    let mut bmfr = Bmfr::new(&ctx, grid, space.shader_variant(), BmfrSettings { noise: 0.0, ..Default::default() }).unwrap();
+    let mut bmfr = Bmfr::new(
+        &ctx,
+        grid,
+        space.shader_variant(),
+        BmfrSettings {
+            noise: 0.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let table = grid_table(&ctx, &space, None);
     let tiles = fovea_tests::grid_tiles(&ctx, &space);
-    let out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: space.params(), previous: None, sampling_table: &table, tiles: tiles.list() }, Vec3::ZERO, &plain_materials(&ctx));
+    let out = denoise(
+        &ctx,
+        &mut bmfr,
+        &g,
+        &DenoiseFrame {
+            current: space.params(),
+            previous: None,
+            sampling_table: &table,
+            tiles: tiles.list(),
+        },
+        Vec3::ZERO,
+        &plain_materials(&ctx),
+    );
     assert_finite_non_negative("rank-deficient fit", &out);
     let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
     let mut worst = 0f64;
@@ -250,7 +382,9 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
     blocks.sort();
     blocks.dedup();
     for block in blocks {
-        let members: Vec<usize> = (0..texels.len()).filter(|&i| blocks_of[i] == Some(block)).collect();
+        let members: Vec<usize> = (0..texels.len())
+            .filter(|&i| blocks_of[i] == Some(block))
+            .collect();
         // Positions span < 1 per block: no scaling.
         let five = |t: &Texel| {
             let (x, y) = (t.position[0] as f64, t.position[1] as f64);
@@ -262,7 +396,15 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
         // (their rows are an identity block outside the data).
         #[allow(clippy::needless_range_loop)] // c picks a channel of two different arrays
         for c in 0..3 {
-            let mut rows: Vec<([f64; 10], f64)> = members.iter().map(|&i| (five(&texels[i].unwrap()), texels[i].unwrap().radiance[c] as f64)).collect();
+            let mut rows: Vec<([f64; 10], f64)> = members
+                .iter()
+                .map(|&i| {
+                    (
+                        five(&texels[i].unwrap()),
+                        texels[i].unwrap().radiance[c] as f64,
+                    )
+                })
+                .collect();
             for k in 5..10 {
                 let mut f = [0f64; 10];
                 f[k] = 1.0;
@@ -285,7 +427,18 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
 /// The 10 features, positions scaled as (p − offset)·scale.
 fn features(n: [f32; 3], p: [f32; 3], offset: [f32; 3], scale: [f32; 3]) -> [f64; 10] {
     let s = [0, 1, 2].map(|a| ((p[a] - offset[a]) * scale[a]) as f64);
-    [1.0, n[0] as f64, n[1] as f64, n[2] as f64, s[0], s[1], s[2], s[0] * s[0], s[1] * s[1], s[2] * s[2]]
+    [
+        1.0,
+        n[0] as f64,
+        n[1] as f64,
+        n[2] as f64,
+        s[0],
+        s[1],
+        s[2],
+        s[0] * s[0],
+        s[1] * s[1],
+        s[2] * s[2],
+    ]
 }
 
 /// Still camera on the Cornell box at 128×144: 16 BMFR frames against the raw 1-sample frame, both
@@ -297,18 +450,35 @@ fn bmfr_reduces_noise_in_both_spaces() {
     let scene = owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
-    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    let mut reference_renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(size)),
+        settings(DenoiserSettings::None),
+    )
+    .unwrap();
+    let reference = reference_renderer
+        .render_reference(&camera, 256, 3, |_| {})
+        .unwrap();
     drop(reference_renderer);
 
     for (name, space) in spaces(size) {
         let gaze = space.gaze();
-        let r_fovea = space.visual_polar().map_or(size.x as f32 * 0.1, |v| v.r_fovea());
+        let r_fovea = space
+            .visual_polar()
+            .map_or(size.x as f32 * 0.1, |v| v.r_fovea());
         let r_max = (gaze.max(size.as_vec2() - gaze)).length();
-        let radius = |i: usize| (Vec2::new((i as u32 % size.x) as f32 + 0.5, (i as u32 / size.x) as f32 + 0.5) - gaze).length();
+        let radius = |i: usize| {
+            (Vec2::new(
+                (i as u32 % size.x) as f32 + 0.5,
+                (i as u32 / size.x) as f32 + 0.5,
+            ) - gaze)
+                .length()
+        };
         let again = same_space(space.as_ref());
 
-        let mut raw_renderer = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut raw_renderer =
+            Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
         let mut raw = Vec::new();
         raw_renderer.render_frame(&frame(camera, 0)).unwrap();
         raw_renderer.read_hdr(&mut raw).unwrap();
@@ -326,13 +496,22 @@ fn bmfr_reduces_noise_in_both_spaces() {
         save_preview(&format!("bmfr_{name}.png"), size.x, size.y, &denoised);
 
         let factor = |keep: &dyn Fn(usize) -> bool| {
-            let (a, b) = (rmse_where(&raw, &reference, keep), rmse_where(&denoised, &reference, keep));
+            let (a, b) = (
+                rmse_where(&raw, &reference, keep),
+                rmse_where(&denoised, &reference, keep),
+            );
             (a, b, a / b)
         };
         let (a, b, whole) = factor(&|i| interior[i]);
         let (_, _, fovea) = factor(&|i| interior[i] && radius(i) < r_fovea);
         let (ea, eb, with_edges) = factor(&|_| true);
-        let ring_edges = [0.0, r_fovea, r_fovea + (r_max - r_fovea) / 3.0, r_fovea + 2.0 * (r_max - r_fovea) / 3.0, r_max + 1.0];
+        let ring_edges = [
+            0.0,
+            r_fovea,
+            r_fovea + (r_max - r_fovea) / 3.0,
+            r_fovea + 2.0 * (r_max - r_fovea) / 3.0,
+            r_max + 1.0,
+        ];
         let rings: Vec<String> = ring_edges
             .windows(2)
             .map(|e| {
@@ -340,17 +519,33 @@ fn bmfr_reduces_noise_in_both_spaces() {
                 format!("[{:.0}, {:.0}) px {f:.1}×", e[0], e[1].min(r_max))
             })
             .collect();
-        let ms: f64 = r.timings().iter().filter(|t| t.name.starts_with("bmfr_")).map(|t| t.ms).sum();
+        let ms: f64 = r
+            .timings()
+            .iter()
+            .filter(|t| t.name.starts_with("bmfr_"))
+            .map(|t| t.ms)
+            .sum();
         println!(
             "{name}: surface interiors RMSE {a:.4} → {b:.4}: {whole:.2}× whole frame, {fovea:.2}× fovea (r < {r_fovea:.1} px); \
              rings {}; with edges {ea:.4} → {eb:.4} ({with_edges:.2}×); bmfr passes {ms:.1} ms",
             rings.join(", ")
         );
-        assert!(whole >= 4.0, "{name}: whole-frame RMSE fell only {whole:.2}×");
+        assert!(
+            whole >= 4.0,
+            "{name}: whole-frame RMSE fell only {whole:.2}×"
+        );
         assert!(fovea >= 4.0, "{name}: fovea RMSE fell only {fovea:.2}×");
         let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
-        for pass in ["bmfr_accumulate", "bmfr_fit", "bmfr_weighted_sum", "bmfr_accumulate_filtered"] {
-            assert!(names.contains(&pass), "{name}: pass {pass} missing from {names:?}");
+        for pass in [
+            "bmfr_accumulate",
+            "bmfr_fit",
+            "bmfr_weighted_sum",
+            "bmfr_accumulate_filtered",
+        ] {
+            assert!(
+                names.contains(&pass),
+                "{name}: pass {pass} missing from {names:?}"
+            );
         }
     }
     assert_clean(&ctx);
@@ -364,7 +559,10 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     let origin = camera.world_from_view.w_axis.truncate();
-    let away = CameraPose { world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..camera };
+    let away = CameraPose {
+        world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI),
+        ..camera
+    };
     for (name, space) in spaces(SCREEN) {
         let grid = space.grid_size();
         let variant = space.shader_variant();
@@ -379,11 +577,30 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             let current = r.space().params();
             let table = grid_table(&ctx, r.space(), None);
             let tiles = fovea_tests::grid_tiles(&ctx, r.space());
-            let out = denoise(&ctx, &mut bmfr, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() }, origin, &r.scene.materials);
+            let out = denoise(
+                &ctx,
+                &mut bmfr,
+                &r.view(0).gbuffer,
+                &DenoiseFrame {
+                    current,
+                    previous,
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+                origin,
+                &r.scene.materials,
+            );
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
-            assert_finite_non_negative(&format!("{name} frame {f} history"), &read_image(&ctx, bmfr.noisy()));
-            peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+            assert_finite_non_negative(
+                &format!("{name} frame {f} history"),
+                &read_image(&ctx, bmfr.noisy()),
+            );
+            peak = peak.max(
+                out.iter()
+                    .flat_map(|p| p[..3].iter().copied())
+                    .fold(0.0, f32::max),
+            );
         }
         println!("{name}: brightest output with fireflies {peak:.1}");
 
@@ -392,7 +609,10 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
         for f in 0..3 {
             r.render_frame(&frame(away, f)).unwrap();
             r.read_hdr(&mut hdr).unwrap();
-            assert!(hdr.iter().all(|p| p[..3] == [0.0; 3]), "{name}: the empty view is not black (frame {f})");
+            assert!(
+                hdr.iter().all(|p| p[..3] == [0.0; 3]),
+                "{name}: the empty view is not black (frame {f})"
+            );
         }
     }
     assert_clean(&ctx);
@@ -412,7 +632,13 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
     for (name, space) in spaces(SCREEN) {
         let screens = texel_screens(space.as_ref());
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
-        let mut bmfr = Bmfr::new(&ctx, space.grid_size(), space.shader_variant(), BmfrSettings::default()).unwrap();
+        let mut bmfr = Bmfr::new(
+            &ctx,
+            space.grid_size(),
+            space.shader_variant(),
+            BmfrSettings::default(),
+        )
+        .unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
         let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
@@ -427,43 +653,89 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
                     let s = (*s)?;
                     // The occluder's screen edge: world x = 0 at depth 2.
                     let edge = centre.x + focal * (0.0 - camera_x) / 2.0;
-                    let (depth, level, mesh) = if s.x < edge { (2.0, occluder, 2) } else { (10.0, background, 1) };
-                    let rel = Vec3::new((s.x - centre.x) / focal * depth, (s.y - centre.y) / focal * depth, -depth);
+                    let (depth, level, mesh) = if s.x < edge {
+                        (2.0, occluder, 2)
+                    } else {
+                        (10.0, background, 1)
+                    };
+                    let rel = Vec3::new(
+                        (s.x - centre.x) / focal * depth,
+                        (s.y - centre.y) / focal * depth,
+                        -depth,
+                    );
                     let world_x = camera_x + rel.x;
-                    let motion = Vec2::new(centre.x + focal * (world_x - prev_camera_x) / depth, s.y);
+                    let motion =
+                        Vec2::new(centre.x + focal * (world_x - prev_camera_x) / depth, s.y);
                     let v = level * (0.5 + unit_hash(i as u32 * 31 + f * 7919));
-                    Some(Texel { radiance: [v; 3], normal: [0.0, 0.0, 1.0], position: rel.to_array(), mesh, motion })
+                    Some(Texel {
+                        radiance: [v; 3],
+                        normal: [0.0, 0.0, 1.0],
+                        position: rel.to_array(),
+                        mesh,
+                        motion,
+                    })
                 })
                 .collect();
             upload_gbuffer(&ctx, &g, &texels);
             let previous = (f > 0).then_some(params);
-            out = denoise(&ctx, &mut bmfr, &g, &DenoiseFrame { current: params, previous, sampling_table: &table, tiles: tiles.list() }, Vec3::new(camera_x, 0.0, 0.0), &materials);
+            out = denoise(
+                &ctx,
+                &mut bmfr,
+                &g,
+                &DenoiseFrame {
+                    current: params,
+                    previous,
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+                Vec3::new(camera_x, 0.0, 0.0),
+                &materials,
+            );
         }
         let lengths: Vec<[f32; 4]> = read_image(&ctx, bmfr.noisy());
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
         for (i, s) in screens.iter().enumerate() {
-            let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
+            let Some(s) =
+                s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all())
+            else {
+                continue;
+            };
             // Margins of a few pixels keep bilinear footprints across the edges (and coarse
             // peripheral VP texels) out of the checked sets. Lengths blend over bilinear taps:
             // compared to 1e-3.
             let (len, lum) = (lengths[i][3], out[i][1]);
             if s.x > 18.0 && s.x < 27.0 {
                 uncovered += 1;
-                assert_eq!(len, 1.0, "{name}: uncovered texel {i} at {s} kept a history");
-                assert!(lum < 1.0, "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)");
+                assert_eq!(
+                    len, 1.0,
+                    "{name}: uncovered texel {i} at {s} kept a history"
+                );
+                assert!(
+                    lum < 1.0,
+                    "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)"
+                );
             } else if s.x > 2.0 && s.x < 14.0 {
                 followed += 1;
-                assert!((len - 9.0).abs() < 1e-3, "{name}: the occluder's history at {s} did not follow the camera ({len})");
+                assert!(
+                    (len - 9.0).abs() < 1e-3,
+                    "{name}: the occluder's history at {s} did not follow the camera ({len})"
+                );
                 assert!(lum > 2.0, "{name}: occluder texel {i} at {s} shows {lum}");
             } else if s.x > 34.0 && s.x < 60.0 {
                 // (Beyond 60.8 px the background was off the screen last frame.)
                 stayed += 1;
-                assert!((len - 9.0).abs() < 1e-3, "{name}: background at {s} lost its history ({len})");
+                assert!(
+                    (len - 9.0).abs() < 1e-3,
+                    "{name}: background at {s} lost its history ({len})"
+                );
                 assert!(lum < 1.0, "{name}: background texel {i} at {s} shows {lum}");
             }
         }
         println!("{name}: {uncovered} uncovered, {followed} occluder and {stayed} background texels checked");
-        assert!(uncovered > 20 && followed > 20 && stayed > 20, "{name}: too few texels checked");
+        assert!(
+            uncovered > 20 && followed > 20 && stayed > 20,
+            "{name}: too few texels checked"
+        );
     }
     assert_clean(&ctx);
 }
@@ -476,11 +748,27 @@ fn render_command_runs_bmfr_and_reports_it() {
     let out = fovea_tests::artifacts_dir().join(format!("bmfr-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     for method in ["cartesian", "vp", "vp-screen-clipped"] {
-        run(&RenderArgs { method, denoiser: "bmfr", exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        run(&RenderArgs {
+            method,
+            denoiser: "bmfr",
+            exr: false,
+            ..fovea_tests::small_render_args("cornell-box", &out)
+        })
+        .unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
         assert_eq!(report["denoiser"], "bmfr");
-        for pass in ["bmfr_accumulate", "bmfr_fit", "bmfr_weighted_sum", "bmfr_accumulate_filtered"] {
-            assert!(report["passes"].get(pass).is_some(), "{method}: pass {pass} missing");
+        for pass in [
+            "bmfr_accumulate",
+            "bmfr_fit",
+            "bmfr_weighted_sum",
+            "bmfr_accumulate_filtered",
+        ] {
+            assert!(
+                report["passes"].get(pass).is_some(),
+                "{method}: pass {pass} missing"
+            );
         }
     }
 }
@@ -492,13 +780,38 @@ fn render_command_runs_bmfr_and_reports_it() {
 fn bmfr_over_the_live_tiles_equals_bmfr_over_the_whole_grid() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
-    let origin = CameraPose::from_scene_camera(&scene.cameras[0], 128, 144).world_from_view.w_axis.truncate();
+    let origin = CameraPose::from_scene_camera(&scene.cameras[0], 128, 144)
+        .world_from_view
+        .w_axis
+        .truncate();
     let mut pair: Option<[Bmfr; 2]> = None;
     denoise_over_culled_tiles(&ctx, 6, |f, r, over_tiles, over_grid| {
-        let new = || Bmfr::new(&ctx, r.space().grid_size(), r.space().shader_variant(), BmfrSettings::default()).unwrap();
+        let new = || {
+            Bmfr::new(
+                &ctx,
+                r.space().grid_size(),
+                r.space().shader_variant(),
+                BmfrSettings::default(),
+            )
+            .unwrap()
+        };
         let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
-        denoise(&ctx, a, &r.view(0).gbuffer, over_tiles, origin, &r.scene.materials);
-        denoise(&ctx, b, &r.view(0).gbuffer, over_grid, origin, &r.scene.materials);
+        denoise(
+            &ctx,
+            a,
+            &r.view(0).gbuffer,
+            over_tiles,
+            origin,
+            &r.scene.materials,
+        );
+        denoise(
+            &ctx,
+            b,
+            &r.view(0).gbuffer,
+            over_grid,
+            origin,
+            &r.scene.materials,
+        );
         let cur = (f % 2) as usize;
         let (ha, hb) = (&a.history, &b.history);
         assert_bit_equal(

@@ -14,7 +14,10 @@ use glam::{Vec2, Vec3, Vec4};
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 40) as f32) / (1u64 << 24) as f32
     }
     fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
@@ -31,14 +34,27 @@ impl Lcg {
 }
 
 fn scene_from_triangles(tris: &[[Vec3; 3]]) -> Scene {
-    let mut scene = Scene { materials: vec![Material::default()], mesh_names: vec!["mesh".into()], ..Default::default() };
+    let mut scene = Scene {
+        materials: vec![Material::default()],
+        mesh_names: vec!["mesh".into()],
+        ..Default::default()
+    };
     for t in tris {
         let base = scene.vertices.len() as u32;
         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         for p in t {
-            scene.vertices.push(Vertex { position: *p, normal: n, uv: Vec2::ZERO, tangent: Vec4::X });
+            scene.vertices.push(Vertex {
+                position: *p,
+                normal: n,
+                uv: Vec2::ZERO,
+                tangent: Vec4::X,
+            });
         }
-        scene.triangles.push(Triangle { indices: [base, base + 1, base + 2], material: 0, mesh: 0 });
+        scene.triangles.push(Triangle {
+            indices: [base, base + 1, base + 2],
+            material: 0,
+            mesh: 0,
+        });
     }
     scene
 }
@@ -47,7 +63,13 @@ fn sphere(rings: u32, segments: u32, radius: f32, centre: Vec3) -> Vec<[Vec3; 3]
     let p = |r: u32, s: u32| {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-        centre + radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        centre
+            + radius
+                * Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                )
     };
     let mut tris = Vec::new();
     for r in 0..rings {
@@ -64,7 +86,11 @@ fn soup(rng: &mut Lcg, count: usize) -> Vec<[Vec3; 3]> {
     (0..count)
         .map(|_| {
             let c = rng.in_box(Vec3::splat(-2.0), Vec3::splat(2.0));
-            [c + rng.direction() * 0.3, c + rng.direction() * 0.3, c + rng.direction() * 0.3]
+            [
+                c + rng.direction() * 0.3,
+                c + rng.direction() * 0.3,
+                c + rng.direction() * 0.3,
+            ]
         })
         .collect()
 }
@@ -75,7 +101,12 @@ fn grid(n: u32) -> Vec<[Vec3; 3]> {
     for i in 0..n {
         for j in 0..n {
             let (x, y) = (i as f32 - n as f32 / 2.0, j as f32 - n as f32 / 2.0);
-            let q = [Vec3::new(x, y, 0.0), Vec3::new(x + 1.0, y, 0.0), Vec3::new(x + 1.0, y + 1.0, 0.0), Vec3::new(x, y + 1.0, 0.0)];
+            let q = [
+                Vec3::new(x, y, 0.0),
+                Vec3::new(x + 1.0, y, 0.0),
+                Vec3::new(x + 1.0, y + 1.0, 0.0),
+                Vec3::new(x, y + 1.0, 0.0),
+            ];
             tris.push([q[0], q[1], q[2]]);
             tris.push([q[0], q[2], q[3]]);
         }
@@ -97,58 +128,117 @@ fn bunny() -> Option<Vec<[Vec3; 3]>> {
             break;
         }
     }
-    let pts: Vec<Vec3> = lines.by_ref().take(vertices).map(|l| {
-        let v: Vec<f32> = l.split_whitespace().take(3).filter_map(|x| x.parse().ok()).collect();
-        Vec3::new(v[0], v[1], v[2]) * 10.0
-    }).collect();
-    Some(lines.take(faces).map(|l| {
-        let i: Vec<usize> = l.split_whitespace().skip(1).take(3).filter_map(|x| x.parse().ok()).collect();
-        [pts[i[0]], pts[i[1]], pts[i[2]]]
-    }).collect())
+    let pts: Vec<Vec3> = lines
+        .by_ref()
+        .take(vertices)
+        .map(|l| {
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .take(3)
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            Vec3::new(v[0], v[1], v[2]) * 10.0
+        })
+        .collect();
+    Some(
+        lines
+            .take(faces)
+            .map(|l| {
+                let i: Vec<usize> = l
+                    .split_whitespace()
+                    .skip(1)
+                    .take(3)
+                    .filter_map(|x| x.parse().ok())
+                    .collect();
+                [pts[i[0]], pts[i[1]], pts[i[2]]]
+            })
+            .collect(),
+    )
 }
 
 /// Both builders' trees: the binned one (one leaf per triangle) and the SBVH (triangles split
 /// across leaves, leaf boxes holding only their clipped parts).
 fn check_mesh(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool) {
-    for builder in [BvhBuilder::BINNED, BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED }] {
-        check_mesh_with(&format!("{name} ({})", builder.name()), tris, rays, any_hit, builder);
+    for builder in [
+        BvhBuilder::BINNED,
+        BvhBuilder {
+            spatial_budget: Some(0.5),
+            ..BvhBuilder::BINNED
+        },
+    ] {
+        check_mesh_with(
+            &format!("{name} ({})", builder.name()),
+            tris,
+            rays,
+            any_hit,
+            builder,
+        );
     }
 }
 
-fn check_mesh_with(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool, builder: BvhBuilder) {
+fn check_mesh_with(
+    name: &str,
+    tris: &[[Vec3; 3]],
+    rays: &[Ray],
+    any_hit: bool,
+    builder: BvhBuilder,
+) {
     let ctx = gpu();
     let scene = scene_from_triangles(tris);
     let positions = scene.triangle_positions();
     let bvh = Bvh::build_with(&positions, builder);
     let gpu_scene = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh).unwrap();
     let mut caster = RayCaster::new(&ctx).unwrap();
-    let gpu_rays: Vec<RayGpu> =
-        rays.iter().map(|r| RayGpu { origin_tmin: r.origin.extend(0.0), direction_tmax: r.dir.extend(1e30) }).collect();
+    let gpu_rays: Vec<RayGpu> = rays
+        .iter()
+        .map(|r| RayGpu {
+            origin_tmin: r.origin.extend(0.0),
+            direction_tmax: r.dir.extend(1e30),
+        })
+        .collect();
     let (hits, _) = caster.trace(&gpu_scene, &gpu_rays, any_hit).unwrap();
     let mut hit_count = 0;
     for (i, (ray, gpu_hit)) in rays.iter().zip(&hits).enumerate() {
         let cpu = brute_force(tris, ray, 1e30, false);
         let gpu_t = gpu_hit.t_u_v.x;
         match cpu {
-            None => assert!(gpu_t < 0.0, "{name} ray {i}: GPU hit {gpu_t} where the CPU sees nothing"),
+            None => assert!(
+                gpu_t < 0.0,
+                "{name} ray {i}: GPU hit {gpu_t} where the CPU sees nothing"
+            ),
             Some(h) => {
                 hit_count += 1;
-                assert!(gpu_t >= 0.0, "{name} ray {i}: GPU missed a hit at t = {}", h.t);
+                assert!(
+                    gpu_t >= 0.0,
+                    "{name} ray {i}: GPU missed a hit at t = {}",
+                    h.t
+                );
                 if any_hit {
                     continue; // any hit along the ray is a correct shadow answer
                 }
                 let tolerance = 1e-5 * h.t.max(1.0);
-                assert!((gpu_t - h.t).abs() <= tolerance, "{name} ray {i}: t {gpu_t} vs CPU {}", h.t);
+                assert!(
+                    (gpu_t - h.t).abs() <= tolerance,
+                    "{name} ray {i}: t {gpu_t} vs CPU {}",
+                    h.t
+                );
                 let id = gpu_hit.triangle.x;
                 if id != h.triangle {
                     // Equal distances may pick either triangle: the GPU's must be hit at that t too.
                     let other = brute_force(&tris[id as usize..id as usize + 1], ray, 1e30, false);
-                    assert!(other.is_some_and(|o| (o.t - h.t).abs() <= tolerance), "{name} ray {i}: triangle {id} vs CPU {}", h.triangle);
+                    assert!(
+                        other.is_some_and(|o| (o.t - h.t).abs() <= tolerance),
+                        "{name} ray {i}: triangle {id} vs CPU {}",
+                        h.triangle
+                    );
                 }
             }
         }
     }
-    assert!(hit_count > rays.len() / 10, "{name}: too few hits ({hit_count}) for a meaningful test");
+    assert!(
+        hit_count > rays.len() / 10,
+        "{name}: too few hits ({hit_count}) for a meaningful test"
+    );
     assert_clean(&ctx);
 }
 
@@ -157,7 +247,10 @@ fn random_rays(rng: &mut Lcg, count: usize, origin_box: f32, aim_box: f32) -> Ve
         .map(|_| {
             let origin = rng.in_box(Vec3::splat(-origin_box), Vec3::splat(origin_box));
             let target = rng.in_box(Vec3::splat(-aim_box), Vec3::splat(aim_box));
-            Ray { origin, dir: (target - origin).normalize() }
+            Ray {
+                origin,
+                dir: (target - origin).normalize(),
+            }
         })
         .collect()
 }
@@ -188,7 +281,10 @@ fn gpu_traversal_is_watertight_on_shared_edges_and_vertices() {
             let target = Vec3::new(i as f32 * 0.5 - 4.0, j as f32 * 0.5 - 4.0, 0.0);
             for origin in [target + Vec3::Z * 3.0, target + Vec3::new(0.7, -0.4, 2.0)] {
                 if target.x.abs() < 4.0 && target.y.abs() < 4.0 {
-                    rays.push(Ray { origin, dir: (target - origin).normalize() });
+                    rays.push(Ray {
+                        origin,
+                        dir: (target - origin).normalize(),
+                    });
                 }
             }
         }

@@ -19,11 +19,27 @@ fn render_args<'a>(scene: &'a str, out: &'a Path) -> RenderArgs<'a> {
 fn render_writes_frames_and_a_report_with_exact_counts() {
     let out = temp_dir("render");
     render(&render_args("cornell-box", &out)).unwrap();
-    for f in ["frame_0000.png", "frame_0001.png", "frame_0000.exr", "frame_0001.exr", "report.json"] {
+    for f in [
+        "frame_0000.png",
+        "frame_0001.png",
+        "frame_0000.exr",
+        "frame_0001.exr",
+        "report.json",
+    ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    for key in ["method", "width", "height", "frames", "samples_traced", "screen_pixels", "rays_traced", "passes"] {
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    for key in [
+        "method",
+        "width",
+        "height",
+        "frames",
+        "samples_traced",
+        "screen_pixels",
+        "rays_traced",
+        "passes",
+    ] {
         assert!(report.get(key).is_some(), "report.json lacks '{key}'");
     }
     assert_eq!(report["samples_traced"], 40 * 36);
@@ -48,8 +64,14 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     args.camera_path = Default::default();
     args.debug_views = true;
     render(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    let vp = VisualPolar::new(glam::UVec2::new(40, 36), glam::Vec2::new(2.0, 3.0), VisualPolarParams::default()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let vp = VisualPolar::new(
+        glam::UVec2::new(40, 36),
+        glam::Vec2::new(2.0, 3.0),
+        VisualPolarParams::default(),
+    )
+    .unwrap();
     assert_eq!(report["method"], "vp");
     assert_eq!(report["vp_width"], vp.grid_size().x);
     assert_eq!(report["vp_height"], vp.grid_size().y);
@@ -58,19 +80,37 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     // samples far off it are culled, those the way back reads are traced and counted.
     let count = |key: &str| report[key].as_u64().unwrap();
     // Per-frame means, each rounded down: their sum may fall one short.
-    assert!((count("samples_traced") + count("samples_culled")).abs_diff(vp.sample_count()) <= 1, "{report}");
+    assert!(
+        (count("samples_traced") + count("samples_culled")).abs_diff(vp.sample_count()) <= 1,
+        "{report}"
+    );
     assert_eq!(report["offscreen_samples"], "cull");
     let (offscreen, culled) = (count("samples_offscreen"), count("samples_culled"));
-    assert!(offscreen > 0 && culled > 0 && offscreen + culled > vp.sample_count() / 2, "{report}");
+    assert!(
+        offscreen > 0 && culled > 0 && offscreen + culled > vp.sample_count() / 2,
+        "{report}"
+    );
     assert_eq!(report["visual_polar"]["clip_fraction"], 0.12);
     for pass in ["trace", "mip_phi", "remap", "blur_h", "blur_v", "tonemap"] {
-        assert!(report["passes"][pass].as_f64().unwrap() > 0.0, "pass {pass} missing");
+        assert!(
+            report["passes"][pass].as_f64().unwrap() > 0.0,
+            "pass {pass} missing"
+        );
     }
-    for f in ["debug_grid_0000.png", "debug_density_0001.png", "debug_overlay_0001.png", "debug_density_plot.png", "frame_0001.exr"] {
+    for f in [
+        "debug_grid_0000.png",
+        "debug_density_0001.png",
+        "debug_overlay_0001.png",
+        "debug_density_plot.png",
+        "frame_0001.exr",
+    ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
     let grid = image::open(out.join("debug_grid_0000.png")).unwrap();
-    assert_eq!((grid.width(), grid.height()), (vp.grid_size().x, vp.grid_size().y));
+    assert_eq!(
+        (grid.width(), grid.height()),
+        (vp.grid_size().x, vp.grid_size().y)
+    );
 }
 
 /// `--vp-eccentricity headset` through every VP pass (trace, SVGF, TAA, φ-mips, remap, blur)
@@ -81,7 +121,10 @@ fn headset_eccentricity_runs_every_vp_pass() {
     use fovea_tools::render_profile::EccentricityMode;
     let mean_of = |out: &Path| {
         let img = image::open(out.join("frame_0002.png")).unwrap().to_rgb8();
-        img.pixels().map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>() / 3.0).sum::<f64>() / img.pixels().len() as f64
+        img.pixels()
+            .map(|p| p.0.iter().map(|&c| c as f64).sum::<f64>() / 3.0)
+            .sum::<f64>()
+            / img.pixels().len() as f64
     };
     let mut means = Vec::new();
     for mode in [EccentricityMode::Normalized, EccentricityMode::Headset] {
@@ -95,18 +138,42 @@ fn headset_eccentricity_runs_every_vp_pass() {
         args.taa = "vp";
         args.profile.eccentricity = mode;
         render(&args).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
         let name = fovea_tools::render_profile::eccentricity_name(mode);
         assert_eq!(report["visual_polar"]["eccentricity"], name);
-        let inverse = if mode == EccentricityMode::Headset { "exact" } else { "polynomial" };
+        let inverse = if mode == EccentricityMode::Headset {
+            "exact"
+        } else {
+            "polynomial"
+        };
         assert_eq!(report["visual_polar"]["inverse_cdf"], inverse);
-        for pass in ["trace", "svgf_temporal", "svgf_atrous", "taa", "mip_phi", "remap", "blur_h", "tonemap"] {
-            assert!(report["passes"][pass].as_f64().unwrap_or(0.0) > 0.0, "{name}: pass {pass} missing");
+        for pass in [
+            "trace",
+            "svgf_temporal",
+            "svgf_atrous",
+            "taa",
+            "mip_phi",
+            "remap",
+            "blur_h",
+            "tonemap",
+        ] {
+            assert!(
+                report["passes"][pass].as_f64().unwrap_or(0.0) > 0.0,
+                "{name}: pass {pass} missing"
+            );
         }
         means.push(mean_of(&out));
     }
-    println!("mean 8-bit value: normalized {:.1}, headset {:.1}", means[0], means[1]);
-    assert!(means[1] > 5.0 && (means[1] / means[0] - 1.0).abs() < 0.15, "frame means {means:?}");
+    println!(
+        "mean 8-bit value: normalized {:.1}, headset {:.1}",
+        means[0], means[1]
+    );
+    assert!(
+        means[1] > 5.0 && (means[1] / means[0] - 1.0).abs() < 0.15,
+        "frame means {means:?}"
+    );
 }
 
 #[test]
@@ -114,9 +181,14 @@ fn output_folders_with_user_files_are_refused() {
     let out = temp_dir("userfile");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let err = render(&render_args("cornell-box", &out)).unwrap_err().to_string();
+    let err = render(&render_args("cornell-box", &out))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("notes.txt"), "{err}");
-    assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
 
     let exr = out.join("notes.txt");
     let args = ReferenceArgs {
@@ -145,12 +217,22 @@ fn bad_scene_input_is_named_in_the_error() {
     let dir = temp_dir("badscene");
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("out");
-    let err = format!("{:#}", render(&render_args("no/such/scene.gltf", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        render(&render_args("no/such/scene.gltf", &out)).unwrap_err()
+    );
     assert!(err.contains("no/such/scene.gltf"), "{err}");
 
     let malformed = dir.join("malformed.gltf");
-    std::fs::write(&malformed, "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ ").unwrap();
-    let err = format!("{:#}", render(&render_args(malformed.to_str().unwrap(), &out)).unwrap_err());
+    std::fs::write(
+        &malformed,
+        "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ ",
+    )
+    .unwrap();
+    let err = format!(
+        "{:#}",
+        render(&render_args(malformed.to_str().unwrap(), &out)).unwrap_err()
+    );
     assert!(err.contains("malformed.gltf"), "{err}");
 
     let draco = dir.join("draco.gltf");
@@ -159,10 +241,19 @@ fn bad_scene_input_is_named_in_the_error() {
         r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"]}"#,
     )
     .unwrap();
-    let err = format!("{:#}", render(&render_args(draco.to_str().unwrap(), &out)).unwrap_err());
-    assert!(err.contains("draco.gltf") && err.contains("KHR_draco_mesh_compression"), "{err}");
+    let err = format!(
+        "{:#}",
+        render(&render_args(draco.to_str().unwrap(), &out)).unwrap_err()
+    );
+    assert!(
+        err.contains("draco.gltf") && err.contains("KHR_draco_mesh_compression"),
+        "{err}"
+    );
 
-    let err = format!("{:#}", render(&render_args("no-such-builtin", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        render(&render_args("no-such-builtin", &out)).unwrap_err()
+    );
     assert!(err.contains("no-such-builtin"), "{err}");
 }
 
@@ -182,16 +273,26 @@ fn bad_headset_and_gaze_arguments_are_named() {
     let err = format!("{:#}", render(&args).unwrap_err());
     assert!(err.contains("magic"), "{err}");
     // Not a file name and not a silent fallback to the centre.
-    for (gaze, needle) in [("NaN,5", "finite pixel coordinates"), ("1e30,5", "(1e30, 5.0) lies outside the 40×36 render image"), ("41,5", "outside")] {
+    for (gaze, needle) in [
+        ("NaN,5", "finite pixel coordinates"),
+        ("1e30,5", "(1e30, 5.0) lies outside the 40×36 render image"),
+        ("41,5", "outside"),
+    ] {
         let mut args = render_args("cornell-box", &out);
         args.gaze = gaze;
         let err = format!("{:#}", render(&args).unwrap_err());
-        assert!(err.contains(gaze) && err.contains(needle) && !err.contains("cannot read"), "{err}");
+        assert!(
+            err.contains(gaze) && err.contains(needle) && !err.contains("cannot read"),
+            "{err}"
+        );
     }
     let mut args = render_args("cornell-box", &out);
     args.gaze = "/dev/zero";
     let err = format!("{:#}", render(&args).unwrap_err());
-    assert!(err.contains("/dev/zero") && err.contains("not a regular file"), "{err}");
+    assert!(
+        err.contains("/dev/zero") && err.contains("not a regular file"),
+        "{err}"
+    );
 }
 
 /// Runs `f` on a thread; fails the test when it takes longer than `seconds` (a write that opened a
@@ -201,7 +302,8 @@ fn within_seconds<T: Send + 'static>(seconds: u64, f: impl FnOnce() -> T + Send 
     std::thread::spawn(move || {
         let _ = tx.send(f());
     });
-    rx.recv_timeout(std::time::Duration::from_secs(seconds)).expect("the command blocked")
+    rx.recv_timeout(std::time::Duration::from_secs(seconds))
+        .expect("the command blocked")
 }
 
 #[test]
@@ -211,10 +313,22 @@ fn a_symbolic_link_in_the_output_folder_is_refused() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(dir.join("victim.txt"), "keep me").unwrap();
     std::os::unix::fs::symlink(dir.join("victim.txt"), out.join("frame_0000.png")).unwrap();
-    let err = format!("{:#}", render(&render_args("cornell-box", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        render(&render_args("cornell-box", &out)).unwrap_err()
+    );
     assert!(err.contains("symbolic link 'frame_0000.png'"), "{err}");
-    assert_eq!(std::fs::read_to_string(dir.join("victim.txt")).unwrap(), "keep me");
-    assert!(std::fs::symlink_metadata(out.join("frame_0000.png")).unwrap().file_type().is_symlink(), "the link is left alone");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("victim.txt")).unwrap(),
+        "keep me"
+    );
+    assert!(
+        std::fs::symlink_metadata(out.join("frame_0000.png"))
+            .unwrap()
+            .file_type()
+            .is_symlink(),
+        "the link is left alone"
+    );
 }
 
 /// Two renders started together into one folder: the lock lets exactly one write there; the
@@ -236,13 +350,25 @@ fn two_concurrent_renders_into_one_folder_are_refused() {
         .collect();
     let results: Vec<Result<(), String>> = runs.into_iter().map(|t| t.join().unwrap()).collect();
     let refused: Vec<&String> = results.iter().filter_map(|r| r.as_ref().err()).collect();
-    assert_eq!(refused.len(), 1, "exactly one run may write into the folder: {results:?}");
-    assert!(refused[0].contains("in use by another fovea run"), "{}", refused[0]);
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(
+        refused.len(),
+        1,
+        "exactly one run may write into the folder: {results:?}"
+    );
+    assert!(
+        refused[0].contains("in use by another fovea run"),
+        "{}",
+        refused[0]
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["frames"], 8);
 
     let held = fovea_tools::output::prepare_output_dir(&out).unwrap();
-    let err = format!("{:#}", render(&render_args("cornell-box", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        render(&render_args("cornell-box", &out)).unwrap_err()
+    );
     assert!(err.contains("in use by another fovea run"), "{err}");
     drop(held);
     render(&render_args("cornell-box", &out)).unwrap();
@@ -259,11 +385,26 @@ fn a_rerun_removes_the_earlier_runs_stale_frames() {
     let mut args = render_args("cornell-box", &out);
     args.exr = false;
     render(&args).unwrap();
-    let mut names: Vec<String> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     names.sort();
-    assert_eq!(names, vec![".fovea.lock", "frame_0000.png", "frame_0001.png", "report.json"]);
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-    assert_eq!((report["frames"].as_u64(), report["interrupted"].as_bool()), (Some(2), Some(false)));
+    assert_eq!(
+        names,
+        vec![
+            ".fovea.lock",
+            "frame_0000.png",
+            "frame_0001.png",
+            "report.json"
+        ]
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(
+        (report["frames"].as_u64(), report["interrupted"].as_bool()),
+        (Some(2), Some(false))
+    );
 }
 
 /// `fovea reference --force` replaces only regular files: a FIFO or a link as `--out` is refused
@@ -273,7 +414,11 @@ fn reference_force_refuses_non_regular_targets() {
     let dir = temp_dir("force");
     std::fs::create_dir_all(&dir).unwrap();
     let fifo = dir.join("pipe.exr");
-    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     std::fs::write(dir.join("victim.exr"), "old").unwrap();
     let link = dir.join("link.exr");
     std::os::unix::fs::symlink(dir.join("victim.exr"), &link).unwrap();
@@ -297,9 +442,15 @@ fn reference_force_refuses_non_regular_targets() {
             };
             format!("{:#}", reference(&args).unwrap_err())
         });
-        assert!(err.contains(kind) && err.contains("only writes or replaces regular files"), "{err}");
+        assert!(
+            err.contains(kind) && err.contains("only writes or replaces regular files"),
+            "{err}"
+        );
     }
-    assert_eq!(std::fs::read_to_string(dir.join("victim.exr")).unwrap(), "old");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("victim.exr")).unwrap(),
+        "old"
+    );
 }
 
 /// `fovea bench`'s real-time loop section alone (no scenes, no ray or VP sizes) at 64×72 with 3
@@ -328,48 +479,116 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     let err = bench(&args(1)).unwrap_err().to_string();
     assert!(err.contains("--loop-frames"), "{err}");
     bench(&args(3)).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     for part in ["bvh", "rays", "visual_polar"] {
-        assert_eq!(report[part].as_array().map(Vec::len), Some(0), "{part} was not skipped");
+        assert_eq!(
+            report[part].as_array().map(Vec::len),
+            Some(0),
+            "{part} was not skipped"
+        );
     }
     let l = &report["loop"];
-    assert_eq!((l["width"].as_u64(), l["height"].as_u64(), l["frames"].as_u64()), (Some(64), Some(72), Some(3)));
+    assert_eq!(
+        (
+            l["width"].as_u64(),
+            l["height"].as_u64(),
+            l["frames"].as_u64()
+        ),
+        (Some(64), Some(72), Some(3))
+    );
     assert_eq!(l["repeats"], 2);
     // (run, frames in flight, renderers = scene uploads, drains in 2 × 3 timed frames): one slot
     // waits for the newest frame every time; two slots never do.
-    for (name, in_flight, renderers, drains) in [("stereo_in_flight_1", 1, 1, 6), ("stereo_in_flight_2", 2, 1, 0), ("two_mono_in_flight_2", 2, 2, 0)] {
+    for (name, in_flight, renderers, drains) in [
+        ("stereo_in_flight_1", 1, 1, 6),
+        ("stereo_in_flight_2", 2, 1, 0),
+        ("two_mono_in_flight_2", 2, 2, 0),
+    ] {
         let run = &l[name];
         assert_eq!(run["timed_frames"], 6, "{name}");
-        let f = |key: &str| run[key].as_f64().unwrap_or_else(|| panic!("{name}.{key} missing"));
+        let f = |key: &str| {
+            run[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{name}.{key} missing"))
+        };
         assert_eq!(run["frames_in_flight"], in_flight, "{name}");
         assert_eq!(run["renderers"], renderers, "{name}");
         assert_eq!(run["views_per_renderer"], 2 / renderers, "{name}");
-        assert_eq!(f("submits_per_frame"), renderers as f64, "{name}: one submit per renderer and frame");
-        assert_eq!(f("fence_waits_per_frame"), renderers as f64, "{name}: one slot freed per renderer and frame");
+        assert_eq!(
+            f("submits_per_frame"),
+            renderers as f64,
+            "{name}: one submit per renderer and frame"
+        );
+        assert_eq!(
+            f("fence_waits_per_frame"),
+            renderers as f64,
+            "{name}: one slot freed per renderer and frame"
+        );
         assert_eq!(run["drain_waits"], drains, "{name}");
-        for key in ["frames_per_second", "wall_ms_per_frame", "gpu_ms_per_frame", "host_ms_per_frame", "process_cpu_ms_per_frame"] {
-            assert!(f(key).is_finite() && f(key) > 0.0, "{name}.{key} = {}", f(key));
+        for key in [
+            "frames_per_second",
+            "wall_ms_per_frame",
+            "gpu_ms_per_frame",
+            "host_ms_per_frame",
+            "process_cpu_ms_per_frame",
+        ] {
+            assert!(
+                f(key).is_finite() && f(key) > 0.0,
+                "{name}.{key} = {}",
+                f(key)
+            );
         }
-        assert!(f("others_cpu_ms_per_frame") >= 0.0 && f("steal_ms_per_frame") >= 0.0, "{name}");
-        assert!((f("frames_per_second") * f("wall_ms_per_frame") / 1e3 - 1.0).abs() < 1e-9, "{name}");
+        assert!(
+            f("others_cpu_ms_per_frame") >= 0.0 && f("steal_ms_per_frame") >= 0.0,
+            "{name}"
+        );
+        assert!(
+            (f("frames_per_second") * f("wall_ms_per_frame") / 1e3 - 1.0).abs() < 1e-9,
+            "{name}"
+        );
         let passes = run["passes_ms"].as_object().unwrap();
         // No radiance is read back in the loop: the blur's last axis writes the display image.
-        assert!(["trace", "svgf_temporal", "remap", "blur_v_tonemap"].iter().all(|p| passes.contains_key(*p)), "{name}: passes {:?}", passes.keys());
-        assert!(!passes.contains_key("tonemap"), "{name}: a separate tonemap pass");
+        assert!(
+            ["trace", "svgf_temporal", "remap", "blur_v_tonemap"]
+                .iter()
+                .all(|p| passes.contains_key(*p)),
+            "{name}: passes {:?}",
+            passes.keys()
+        );
+        assert!(
+            !passes.contains_key("tonemap"),
+            "{name}: a separate tonemap pass"
+        );
         let sum: f64 = passes.values().map(|v| v.as_f64().unwrap()).sum();
-        assert!((sum - f("gpu_ms_per_frame")).abs() < 1e-9 * sum.max(1.0), "{name}");
+        assert!(
+            (sum - f("gpu_ms_per_frame")).abs() < 1e-9 * sum.max(1.0),
+            "{name}"
+        );
     }
     let bytes = |name: &str, key: &str| l[name][key].as_i64().unwrap();
     // One scene shared by both eyes: stereo = scene + 2 views, two mono = 2 × (scene + view), so
     // two mono renders hold at least one more scene upload.
-    let (stereo, mono) = (bytes("stereo_in_flight_2", "gpu_bytes"), bytes("two_mono_in_flight_2", "gpu_bytes"));
+    let (stereo, mono) = (
+        bytes("stereo_in_flight_2", "gpu_bytes"),
+        bytes("two_mono_in_flight_2", "gpu_bytes"),
+    );
     let scene = bytes("stereo_in_flight_2", "scene_bytes");
     assert!(scene > 0 && bytes("two_mono_in_flight_2", "scene_bytes") == 2 * scene);
-    assert!(stereo < mono && mono - stereo >= scene && stereo > mono / 2, "stereo {stereo} B, two mono {mono} B, scene {scene} B");
+    assert!(
+        stereo < mono && mono - stereo >= scene && stereo > mono / 2,
+        "stereo {stereo} B, two mono {mono} B, scene {scene} B"
+    );
     let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-9;
-    assert!(close(l["stereo_vs_two_mono_bytes"].as_f64().unwrap(), stereo as f64 / mono as f64));
+    assert!(close(
+        l["stereo_vs_two_mono_bytes"].as_f64().unwrap(),
+        stereo as f64 / mono as f64
+    ));
     let fps = |name: &str| l[name]["frames_per_second"].as_f64().unwrap();
-    assert!(close(l["in_flight_2_vs_1_fps"].as_f64().unwrap(), fps("stereo_in_flight_2") / fps("stereo_in_flight_1")));
+    assert!(close(
+        l["in_flight_2_vs_1_fps"].as_f64().unwrap(),
+        fps("stereo_in_flight_2") / fps("stereo_in_flight_1")
+    ));
 }
 
 /// Values that used to render a black, flat or meaningless frame without a word are refused
@@ -379,7 +598,10 @@ fn meaningless_values_are_refused_with_the_flag_named() {
     let out = temp_dir("values");
     let refused = |args: &RenderArgs, needles: &[&str]| {
         let err = format!("{:#}", render(args).unwrap_err());
-        assert!(needles.iter().all(|n| err.contains(n)), "{needles:?}: {err}");
+        assert!(
+            needles.iter().all(|n| err.contains(n)),
+            "{needles:?}: {err}"
+        );
     };
     for exposure in [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e-30, 1e30] {
         let mut args = render_args("cornell-box", &out);
@@ -393,35 +615,72 @@ fn meaningless_values_are_refused_with_the_flag_named() {
     }
     // Visual-Polar: a 2×2 grid at least (3×3 screens at the default --vp-scale 2/3) and 2 pixels
     // per screen axis; Cartesian renders any size.
-    for (w, h, needle) in [(1, 1, "no periphery"), (2, 2, "1×1 Visual-Polar grid"), (2, 40, "1×27 Visual-Polar grid"), (40, 1, "no periphery")] {
+    for (w, h, needle) in [
+        (1, 1, "no periphery"),
+        (2, 2, "1×1 Visual-Polar grid"),
+        (2, 40, "1×27 Visual-Polar grid"),
+        (40, 1, "no periphery"),
+    ] {
         let mut args = render_args("cornell-box", &out);
         (args.method, args.width, args.height) = ("vp", Some(w), Some(h));
-        refused(&args, &[needle, "--width/--height", "--scale", "--method cartesian"]);
+        refused(
+            &args,
+            &[needle, "--width/--height", "--scale", "--method cartesian"],
+        );
     }
     let mut args = render_args("cornell-box", &out);
     args.method = "vp";
     args.profile.visual_polar.axis_scale = 0.04; // --vp-scale 0.04: 40×36 → a 2×1 grid
-    refused(&args, &["2×1 Visual-Polar grid", "--vp-scale 0.04", "at least 38×38"]);
+    refused(
+        &args,
+        &["2×1 Visual-Polar grid", "--vp-scale 0.04", "at least 38×38"],
+    );
     // A fixed radius within 10 screen diagonals (40×36: 538 px); a profile's value alike.
     let mut args = render_args("cornell-box", &out);
     args.method = "vp";
     args.profile.visual_polar.radius_mode = fovea_renderer::sampling::RadiusMode::Fixed(600.0);
-    refused(&args, &["--vp-radius", "visual_polar.radius", "600 px", "538 px"]);
+    refused(
+        &args,
+        &["--vp-radius", "visual_polar.radius", "600 px", "538 px"],
+    );
     assert!(!out.exists(), "nothing is written for a refused run");
 
     let out = temp_dir("values-ok");
     let mut args = render_args("cornell-box", &out);
-    (args.method, args.width, args.height, args.frames, args.exr) = ("vp", Some(3), Some(3), 1, false);
+    (args.method, args.width, args.height, args.frames, args.exr) =
+        ("vp", Some(3), Some(3), 1, false);
     args.profile.visual_polar.radius_mode = fovea_renderer::sampling::RadiusMode::Fixed(42.0);
     (args.max_depth, args.exposure) = (64, 1e4);
     render(&args).unwrap();
     let mut args = render_args("cornell-box", &out);
-    (args.width, args.height, args.frames, args.exr, args.max_depth, args.exposure) = (Some(1), Some(1), 1, false, 1, 1e-4);
+    (
+        args.width,
+        args.height,
+        args.frames,
+        args.exr,
+        args.max_depth,
+        args.exposure,
+    ) = (Some(1), Some(1), 1, false, 1, 1e-4);
     render(&args).unwrap();
 
     for max_depth in [0, 65] {
         let exr = out.join("ref.exr");
-        let args = ReferenceArgs { scene: "cornell-box", width: 8, height: 8, spp: 1, max_depth, seed: 1, out: &exr, force: false, preview: false, device: None, validation: true, camera: &fovea_tools::look::NO_CAMERA_FLAGS, environment: Default::default(), path_regularisation: 1.0 };
+        let args = ReferenceArgs {
+            scene: "cornell-box",
+            width: 8,
+            height: 8,
+            spp: 1,
+            max_depth,
+            seed: 1,
+            out: &exr,
+            force: false,
+            preview: false,
+            device: None,
+            validation: true,
+            camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+            environment: Default::default(),
+            path_regularisation: 1.0,
+        };
         let err = format!("{:#}", reference(&args).unwrap_err());
         assert!(err.contains("--max-depth"), "{err}");
     }
@@ -440,21 +699,50 @@ fn gaze_outside_the_view_is_reported_as_centre() {
     let _ = std::fs::remove_file(&trace);
     let mut writer = TraceWriter::create(&hmd, &trace, false).unwrap();
     // Live ahead, behind the eye, 71.6° left (the FOVE 0 sees ±45°), live ahead again.
-    let directions = [Vec3::NEG_Z, Vec3::Z, Vec3::new(-3.0, 0.0, -1.0).normalize(), Vec3::new(0.1, 0.0, -1.0).normalize()];
+    let directions = [
+        Vec3::NEG_Z,
+        Vec3::Z,
+        Vec3::new(-3.0, 0.0, -1.0).normalize(),
+        Vec3::new(0.1, 0.0, -1.0).normalize(),
+    ];
     for (k, d) in directions.iter().enumerate() {
-        writer.write(&GazeSample::looking(fovea_tools::gaze::frame_time(1e9 / hmd.refresh_hz as f64, k as u32), k as u64, *d));
+        writer.write(&GazeSample::looking(
+            fovea_tools::gaze::frame_time(1e9 / hmd.refresh_hz as f64, k as u32),
+            k as u64,
+            *d,
+        ));
     }
     writer.finish().unwrap();
-    for (method, eyes) in [("cartesian", fovea_tools::commands::setup::Eyes::Left), ("vp", fovea_tools::commands::setup::Eyes::Both)] {
+    for (method, eyes) in [
+        ("cartesian", fovea_tools::commands::setup::Eyes::Left),
+        ("vp", fovea_tools::commands::setup::Eyes::Both),
+    ] {
         let mut args = render_args("cornell-box", &out);
-        (args.method, args.eyes, args.frames, args.exr, args.camera_path) = (method, eyes, 4, false, Default::default());
+        (
+            args.method,
+            args.eyes,
+            args.frames,
+            args.exr,
+            args.camera_path,
+        ) = (method, eyes, 4, false, Default::default());
         args.gaze = trace.to_str().unwrap();
         render(&args).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
-        let counts = ["gaze_live", "gaze_held", "gaze_centre", "gaze_outside_view"].map(|k| report[k].as_u64());
-        assert_eq!(counts, [Some(2), Some(0), Some(2), Some(2)], "{method}: {report}");
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        let counts = ["gaze_live", "gaze_held", "gaze_centre", "gaze_outside_view"]
+            .map(|k| report[k].as_u64());
+        assert_eq!(
+            counts,
+            [Some(2), Some(0), Some(2), Some(2)],
+            "{method}: {report}"
+        );
         for frame in [1, 2] {
-            assert_eq!(report["gaze"][frame], serde_json::json!([20.0, 18.0]), "{method}: frame {frame} at the image centre");
+            assert_eq!(
+                report["gaze"][frame],
+                serde_json::json!([20.0, 18.0]),
+                "{method}: frame {frame} at the image centre"
+            );
         }
     }
 }
@@ -473,30 +761,73 @@ fn camera_path_files_drive_the_camera() {
     let moving = dir.join("moving.toml");
     // The headset's 70 Hz: frame 1 is shown 1/70 s in, a third of the way to the second key.
     std::fs::write(&moving, format!("{keys}[[key]]\ntime = 0.04\nposition = [-0.6, 1.3, 3.0]\nlook = [0.0, 1.0, 0.0]\nfov = 50\n")).unwrap();
-    let frames = |out: &Path| (0..2).map(|i| std::fs::read(out.join(format!("frame_{i:04}.png"))).unwrap()).collect::<Vec<_>>();
+    let frames = |out: &Path| {
+        (0..2)
+            .map(|i| std::fs::read(out.join(format!("frame_{i:04}.png"))).unwrap())
+            .collect::<Vec<_>>()
+    };
 
-    let free = fovea_tools::look::CameraOptions { position: Some("0.2,1.0,3.4".into()), look: Some("0,1,0".into()), fov: Some(50.0), camera: None };
+    let free = fovea_tools::look::CameraOptions {
+        position: Some("0.2,1.0,3.4".into()),
+        look: Some("0,1,0".into()),
+        fov: Some(50.0),
+        camera: None,
+    };
     let out_free = dir.join("free");
-    let args = RenderArgs { camera: &free, camera_path: CameraMotion::Still, ..render_args("cornell-box", &out_free) };
+    let args = RenderArgs {
+        camera: &free,
+        camera_path: CameraMotion::Still,
+        ..render_args("cornell-box", &out_free)
+    };
     render(&args).unwrap();
     let out_still = dir.join("still");
-    let args = RenderArgs { camera_path: CameraMotion::from_flag(Some(still.to_str().unwrap())).unwrap(), ..render_args("cornell-box", &out_still) };
+    let args = RenderArgs {
+        camera_path: CameraMotion::from_flag(Some(still.to_str().unwrap())).unwrap(),
+        ..render_args("cornell-box", &out_still)
+    };
     render(&args).unwrap();
-    assert_eq!(frames(&out_free), frames(&out_still), "a path standing at the free camera's point renders the free camera's frames");
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out_still.join("report.json")).unwrap()).unwrap();
-    assert_eq!((report["camera_path"].as_bool(), report["camera_motion"].as_str()), (Some(true), Some("keys")));
+    assert_eq!(
+        frames(&out_free),
+        frames(&out_still),
+        "a path standing at the free camera's point renders the free camera's frames"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_still.join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        (
+            report["camera_path"].as_bool(),
+            report["camera_motion"].as_str()
+        ),
+        (Some(true), Some("keys"))
+    );
 
     let out_moving = dir.join("moving");
-    let args = RenderArgs { camera_path: CameraMotion::from_flag(Some(moving.to_str().unwrap())).unwrap(), ..render_args("cornell-box", &out_moving) };
+    let args = RenderArgs {
+        camera_path: CameraMotion::from_flag(Some(moving.to_str().unwrap())).unwrap(),
+        ..render_args("cornell-box", &out_moving)
+    };
     render(&args).unwrap();
     let (moved, held) = (frames(&out_moving), frames(&out_still));
     assert_eq!(moved[0], held[0], "both paths start at the same key");
-    assert_ne!(moved[1], held[1], "the moving path's second frame sees the scene from elsewhere");
+    assert_ne!(
+        moved[1], held[1],
+        "the moving path's second frame sees the scene from elsewhere"
+    );
 
-    assert_eq!(CameraMotion::from_flag(Some("orbit")).unwrap(), CameraMotion::Orbit);
+    assert_eq!(
+        CameraMotion::from_flag(Some("orbit")).unwrap(),
+        CameraMotion::Orbit
+    );
     assert_eq!(CameraMotion::from_flag(None).unwrap(), CameraMotion::Still);
-    let err = format!("{:#}", CameraMotion::from_flag(Some(dir.join("absent.toml").to_str().unwrap())).unwrap_err());
-    assert!(err.contains("--camera-path") && err.contains("absent.toml"), "{err}");
+    let err = format!(
+        "{:#}",
+        CameraMotion::from_flag(Some(dir.join("absent.toml").to_str().unwrap())).unwrap_err()
+    );
+    assert!(
+        err.contains("--camera-path") && err.contains("absent.toml"),
+        "{err}"
+    );
 }
 
 /// `fovea bench --camera-path FILE`: the VP vs Cartesian frames follow the keyframes and the ray
@@ -507,7 +838,12 @@ fn bench_vp_frames_follow_a_camera_path() {
     use fovea_tools::commands::bench::{run as bench, BenchArgs};
     use glam::Vec3;
     let out = temp_dir("bench-camera-path");
-    let key = |time, x| Key { time, position: Vec3::new(x, 1.0, 3.4), look: Vec3::new(0.0, 1.0, 0.0), fov: None };
+    let key = |time, x| Key {
+        time,
+        position: Vec3::new(x, 1.0, 3.4),
+        look: Vec3::new(0.0, 1.0, 0.0),
+        fov: None,
+    };
     let keys = CameraKeys::new(vec![key(0.0, -0.3), key(0.05, 0.3)]).unwrap();
     let scenes = ["cornell-box".to_string()];
     let args = BenchArgs {
@@ -527,58 +863,132 @@ fn bench_vp_frames_follow_a_camera_path() {
         validation: true,
     };
     bench(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let vp = &report["visual_polar"][0];
     assert_eq!(vp["camera_motion"], "keys");
-    assert!(vp["vp_frame_ms"].as_f64().unwrap() > 0.0 && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0, "{vp}");
+    assert!(
+        vp["vp_frame_ms"].as_f64().unwrap() > 0.0
+            && vp["cartesian_frame_ms"].as_f64().unwrap() > 0.0,
+        "{vp}"
+    );
     let comparators = vp["comparators"].as_array().unwrap();
-    let methods: Vec<&str> = comparators.iter().map(|c| c["method"].as_str().unwrap()).collect();
+    let methods: Vec<&str> = comparators
+        .iter()
+        .map(|c| c["method"].as_str().unwrap())
+        .collect();
     assert_eq!(
         methods,
-        ["uniform-budget", "log-polar", "linear-falloff", "random-acuity", "pixel-blocks", "composite", "vp-screen-clipped", "vp-screen-aware", "vp-headset", "fixed-foveation", "vrs-tiles"]
+        [
+            "uniform-budget",
+            "log-polar",
+            "linear-falloff",
+            "random-acuity",
+            "pixel-blocks",
+            "composite",
+            "vp-screen-clipped",
+            "vp-screen-aware",
+            "vp-headset",
+            "fixed-foveation",
+            "vrs-tiles"
+        ]
     );
     for c in comparators {
-        assert!(c["samples"].as_u64().unwrap() > 0 && c["frame_ms"].as_f64().unwrap() > 0.0 && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0, "{c}");
+        assert!(
+            c["samples"].as_u64().unwrap() > 0
+                && c["frame_ms"].as_f64().unwrap() > 0.0
+                && c["passes_ms"]["trace"].as_f64().unwrap() > 0.0,
+            "{c}"
+        );
     }
     // Random acuity traces Visual-Polar's samples.
     assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
     // Fixed foveation: VP's samples, but around the lens centre, so far fewer of them lie off the
     // screen than VP's around the gaze near the corner below.
     assert_eq!(comparators[9]["samples"], vp["vp_samples"]);
-    assert!(comparators[9]["samples_traced"].as_u64() > vp["vp_samples_traced"].as_u64(), "{}", comparators[9]);
+    assert!(
+        comparators[9]["samples_traced"].as_u64() > vp["vp_samples_traced"].as_u64(),
+        "{}",
+        comparators[9]
+    );
     // --vp-gaze near the top-left corner: most of VP's circle lies off the screen, and the samples
     // far off it are culled; with every sample traced (the paper's way) all of them are.
     assert_eq!(vp["gaze"][0].as_f64(), Some(6.4), "{vp}");
-    let (samples, traced) = (vp["vp_samples"].as_u64().unwrap(), vp["vp_samples_traced"].as_u64().unwrap());
+    let (samples, traced) = (
+        vp["vp_samples"].as_u64().unwrap(),
+        vp["vp_samples_traced"].as_u64().unwrap(),
+    );
     // (At 64×72 the culling margin, three footprints and three pixels, keeps a large share.)
     assert!(traced < samples * 3 / 4, "{vp}");
-    assert_eq!(vp["vp_offscreen_traced"]["samples_traced"].as_u64(), Some(samples), "{vp}");
-    assert!(vp["vp_offscreen_traced"]["frame_ratio"].as_f64().unwrap() > 0.0, "{vp}");
+    assert_eq!(
+        vp["vp_offscreen_traced"]["samples_traced"].as_u64(),
+        Some(samples),
+        "{vp}"
+    );
+    assert!(
+        vp["vp_offscreen_traced"]["frame_ratio"].as_f64().unwrap() > 0.0,
+        "{vp}"
+    );
     // The blur in the grid: its two passes and the tonemap instead of the screen blur's.
     let grid_blur = &vp["vp_grid_blur"]["passes_ms"];
-    assert!(["blur_grid_phi", "blur_grid_rho", "tonemap"].iter().all(|p| grid_blur[*p].as_f64().unwrap_or(0.0) > 0.0), "{grid_blur}");
-    assert!(grid_blur.get("blur_h").is_none() && grid_blur.get("blur_v_tonemap").is_none(), "{grid_blur}");
+    assert!(
+        ["blur_grid_phi", "blur_grid_rho", "tonemap"]
+            .iter()
+            .all(|p| grid_blur[*p].as_f64().unwrap_or(0.0) > 0.0),
+        "{grid_blur}"
+    );
+    assert!(
+        grid_blur.get("blur_h").is_none() && grid_blur.get("blur_v_tonemap").is_none(),
+        "{grid_blur}"
+    );
     let share = vp["grid_blur_to_screen_share"].as_f64().unwrap();
     assert!(share > 0.0 && share < 1.0, "{vp}");
     // VP's rays against the screen's through the same pass: the per-sample overhead measured apart.
     let f = |key: &str| vp[key].as_f64().unwrap_or_else(|| panic!("{key} in {vp}"));
-    assert!(f("screen_mrays_per_s") > 0.0 && f("screen_shuffled_mrays_per_s") > 0.0, "{vp}");
+    assert!(
+        f("screen_mrays_per_s") > 0.0 && f("screen_shuffled_mrays_per_s") > 0.0,
+        "{vp}"
+    );
     let ordered = f("screen_mrays_per_s") / f("vp_order_mrays_per_s");
     let shuffled = f("screen_shuffled_mrays_per_s") / f("shuffled_mrays_per_s");
-    assert!((f("vp_ray_cost_ordered") / ordered - 1.0).abs() < 1e-9 && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9, "{vp}");
+    assert!(
+        (f("vp_ray_cost_ordered") / ordered - 1.0).abs() < 1e-9
+            && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9,
+        "{vp}"
+    );
     // Each denoiser's whole frames hold its own passes and the rest of the frame (issue 17's
     // target with a denoiser).
     for d in vp["denoisers"].as_array().unwrap() {
         let g = |key: &str| d[key].as_f64().unwrap_or_else(|| panic!("{key} in {d}"));
-        assert!(g("vp_frame_ms") > g("vp_ms") && g("cartesian_frame_ms") > g("cartesian_ms"), "{d}");
-        assert!((g("frame_ratio") * g("cartesian_frame_ms") / g("vp_frame_ms") - 1.0).abs() < 1e-9, "{d}");
+        assert!(
+            g("vp_frame_ms") > g("vp_ms") && g("cartesian_frame_ms") > g("cartesian_ms"),
+            "{d}"
+        );
+        assert!(
+            (g("frame_ratio") * g("cartesian_frame_ms") / g("vp_frame_ms") - 1.0).abs() < 1e-9,
+            "{d}"
+        );
     }
     let rays = &report["rays"][0];
-    assert_eq!(rays["ray_poses"].as_u64(), Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64), "{rays}");
-    assert!(rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0, "{rays}");
+    assert_eq!(
+        rays["ray_poses"].as_u64(),
+        Some(fovea_tools::commands::bench::PATH_RAY_POSES as u64),
+        "{rays}"
+    );
+    assert!(
+        rays["primary_mrays_per_s"].as_f64().unwrap() > 0.0,
+        "{rays}"
+    );
     // --dump-rays: the Cornell box's 36 triangles and the rays of every pose, 32 bytes each.
-    let size = |kind: &str| std::fs::metadata(out.join(format!("rays_cornell-box-32x36.{kind}.bin"))).unwrap().len();
+    let size = |kind: &str| {
+        std::fs::metadata(out.join(format!("rays_cornell-box-32x36.{kind}.bin")))
+            .unwrap()
+            .len()
+    };
     assert_eq!(size("triangles"), 36 * 9 * 4);
-    assert_eq!(size("primary"), fovea_tools::commands::bench::PATH_RAY_POSES as u64 * 32 * 36 * 32);
+    assert_eq!(
+        size("primary"),
+        fovea_tools::commands::bench::PATH_RAY_POSES as u64 * 32 * 36 * 32
+    );
     assert!(size("indirect") > 0 && size("indirect") % 32 == 0);
 }

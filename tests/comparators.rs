@@ -4,12 +4,17 @@
 //! keeps the traced pixels, it converges to the image one sample per pixel gives, it refuses the
 //! filters it cannot run, and `fovea render --method NAME` reports it end to end.
 
+use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::fill::FillPass;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
-use fovea_renderer::sampling::{FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams, FALLOFF_BUDGET_OF_VP};
-use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
+use fovea_renderer::pipeline::{
+    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
+};
+use fovea_renderer::sampling::{
+    FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams,
+    FALLOFF_BUDGET_OF_VP,
+};
 use fovea_renderer::vk::Image;
 use fovea_tests::{assert_clean, gpu, owned_scene, probe};
 use glam::{UVec2, Vec2};
@@ -17,13 +22,23 @@ use glam::{UVec2, Vec2};
 const SCREEN: UVec2 = UVec2::new(64, 72);
 
 fn falloff() -> LinearFalloff {
-    LinearFalloff::new(SCREEN, VisualPolarParams::default(), FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()
+    LinearFalloff::new(
+        SCREEN,
+        VisualPolarParams::default(),
+        FalloffShape::default(),
+        FALLOFF_BUDGET_OF_VP,
+    )
+    .unwrap()
 }
 
 /// No frame may hold a hole or a non-finite pixel.
 fn no_holes(f: u32, hdr: &[[f32; 4]]) {
     assert_eq!(hdr.len(), (SCREEN.x * SCREEN.y) as usize);
-    assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] > 0.0), "frame {f}: a hole or a non-finite pixel");
+    assert!(
+        hdr.iter()
+            .all(|p| p.iter().all(|c| c.is_finite()) && p[3] > 0.0),
+        "frame {f}: a hole or a non-finite pixel"
+    );
 }
 
 #[test]
@@ -37,12 +52,21 @@ fn linear_falloff_traces_the_pixels_its_rule_keeps_and_converges_like_one_sample
     host.set_gaze(gaze).unwrap();
     let mut r = Renderer::new(&ctx, &scene, Box::new(falloff()), settings).unwrap();
     for f in 0..3 {
-        let stats = r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
-        assert_eq!(stats.samples_traced, host.traced_count(f, settings.seed), "frame {f}");
+        let stats = r
+            .render_frame(&FrameInput::mono(camera, f, Some(gaze)))
+            .unwrap();
+        assert_eq!(
+            stats.samples_traced,
+            host.traced_count(f, settings.seed),
+            "frame {f}"
+        );
         assert_eq!(stats.samples_offscreen, 0);
     }
     let expected = host.sample_count() as f64;
-    assert!(expected < (SCREEN.x * SCREEN.y) as f64 * 0.9, "{expected}: the periphery is thinned");
+    assert!(
+        expected < (SCREEN.x * SCREEN.y) as f64 * 0.9,
+        "{expected}: the periphery is thinned"
+    );
     fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, no_holes);
     assert_clean(&ctx);
 }
@@ -55,8 +79,18 @@ fn push_pull_keeps_the_samples_and_fills_the_holes_smoothly() {
     let size = UVec2::new(61, 47);
     let truth = |x: u32, y: u32| [x as f32 / 60.0, y as f32 / 46.0, 0.5, 1.0];
     let keep = |x: u32, y: u32| fovea_tests::unit_hash(x * 7919 + y * 104_729) < 0.2;
-    let sparse: Vec<[f32; 4]> = (0..size.y).flat_map(|y| (0..size.x).map(move |x| (x, y))).map(|(x, y)| if keep(x, y) { truth(x, y) } else { [0.0; 4] }).collect();
-    let input = Image::new(&ctx, "sparse", size.x, size.y, ash::vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let sparse: Vec<[f32; 4]> = (0..size.y)
+        .flat_map(|y| (0..size.x).map(move |x| (x, y)))
+        .map(|(x, y)| if keep(x, y) { truth(x, y) } else { [0.0; 4] })
+        .collect();
+    let input = Image::new(
+        &ctx,
+        "sparse",
+        size.x,
+        size.y,
+        ash::vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     fovea_tests::write_image(&ctx, &input, &sparse);
     let fill = FillPass::new(&ctx, size).unwrap();
     let out = {
@@ -95,7 +129,12 @@ fn linear_falloff_refuses_the_filters_and_the_cli_reports_it() {
 
     let report = fovea_tests::render_report("linear-falloff", Default::default());
     assert_eq!(report["method"], "linear-falloff");
-    assert!(report["passes"]["fill_push"].as_f64().is_some() && report["passes"]["blur_v"].as_f64().is_some(), "{}", report["passes"]);
+    assert!(
+        report["passes"]["fill_push"].as_f64().is_some()
+            && report["passes"]["blur_v"].as_f64().is_some(),
+        "{}",
+        report["passes"]
+    );
     let traced = report["samples_traced"].as_u64().unwrap();
     assert!(traced > 0 && traced < 64 * 72, "{report}");
 }
@@ -115,18 +154,28 @@ fn random_acuity_draws_agree_between_rust_and_glsl() {
         for gaze in [s * 0.5, Vec2::new(0.1, 0.2) * s, Vec2::new(0.97, 0.9) * s] {
             let space = random_acuity(screen, gaze);
             for frame in [0, 7] {
-                let gpu: Vec<Option<Vec2>> = probe(&ctx, &space, frame, 11).iter().map(|p| p.position).collect();
+                let gpu: Vec<Option<Vec2>> = probe(&ctx, &space, frame, 11)
+                    .iter()
+                    .map(|p| p.position)
+                    .collect();
                 let g = space.grid_size();
                 let mut worst: f32 = 0.0;
                 for (i, got) in gpu.iter().enumerate() {
                     let t = UVec2::new(i as u32 % g.x, i as u32 / g.x);
                     let want = space.screen_position(t, frame, 11);
-                    assert_eq!(got.is_some(), want.is_some(), "{screen} gaze {gaze} frame {frame} texel {t}");
+                    assert_eq!(
+                        got.is_some(),
+                        want.is_some(),
+                        "{screen} gaze {gaze} frame {frame} texel {t}"
+                    );
                     if let (Some(a), Some(b)) = (got, want) {
                         worst = worst.max((*a - b).length() / (1.0 + (b - gaze).length() * 1e-3));
                     }
                 }
-                assert!(worst < 2e-3, "{screen} gaze {gaze} frame {frame}: worst {worst} px");
+                assert!(
+                    worst < 2e-3,
+                    "{screen} gaze {gaze} frame {frame}: worst {worst} px"
+                );
             }
         }
     }
@@ -145,13 +194,20 @@ fn random_acuity_samples_follow_visual_polars_density_per_ring() {
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default()).unwrap();
     let r_max = vp.r_max();
     let rings = 8;
-    let ring = |p: Vec2| (((p - gaze).length() / r_max).sqrt() * rings as f32).min(rings as f32 - 1.0) as usize;
+    let ring = |p: Vec2| {
+        (((p - gaze).length() / r_max).sqrt() * rings as f32).min(rings as f32 - 1.0) as usize
+    };
     let (mut drawn, mut expected) = (vec![0u64; rings], vec![0u64; rings]);
     let g = vp.grid_size();
     for y in 0..g.y {
         for x in 0..g.x {
             let t = UVec2::new(x, y);
-            for sub in [Vec2::new(0.25, 0.25), Vec2::new(0.75, 0.25), Vec2::new(0.25, 0.75), Vec2::new(0.75, 0.75)] {
+            for sub in [
+                Vec2::new(0.25, 0.25),
+                Vec2::new(0.75, 0.25),
+                Vec2::new(0.25, 0.75),
+                Vec2::new(0.75, 0.75),
+            ] {
                 if let Some(p) = vp.grid_to_screen(t.as_vec2() + sub) {
                     expected[ring(p)] += 2;
                 }
@@ -167,7 +223,12 @@ fn random_acuity_samples_follow_visual_polars_density_per_ring() {
     for i in 0..rings {
         if expected[i] >= 2000 {
             let ratio = drawn[i] as f64 / expected[i] as f64;
-            assert!((ratio - 1.0).abs() < 0.03, "ring {i}: {} drawn vs {} VP samples", drawn[i], expected[i]);
+            assert!(
+                (ratio - 1.0).abs() < 0.03,
+                "ring {i}: {} drawn vs {} VP samples",
+                drawn[i],
+                expected[i]
+            );
         }
     }
     assert_eq!(drawn.iter().sum::<u64>(), 8 * vp.sample_count());
@@ -182,36 +243,62 @@ fn the_splat_puts_every_sample_in_its_pixel() {
     let space = random_acuity(screen, gaze);
     let grid = space.grid_size();
     let value = [0.25, 0.5, 2.0, 1.0];
-    let color = Image::new(&ctx, "grid_color", grid.x, grid.y, ash::vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let color = Image::new(
+        &ctx,
+        "grid_color",
+        grid.x,
+        grid.y,
+        ash::vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     fovea_tests::write_image(&ctx, &color, &vec![value; (grid.x * grid.y) as usize]);
     let buffers = fovea_tests::SpaceBuffers::new(&ctx, &space, 5, 2);
     let splat = SplatPass::new(&ctx, space.trace_variant(), screen).unwrap();
     let mut rec = FrameRecorder::new(&ctx, splat.passes() + 1).unwrap();
     rec.begin().unwrap();
-    let inputs = SplatInputs { frame_data: &buffers.frame, sampling: &buffers.sampling, sampling_table: &buffers.table };
+    let inputs = SplatInputs {
+        frame_data: &buffers.frame,
+        sampling: &buffers.sampling,
+        sampling_table: &buffers.table,
+    };
     let sparse = splat.record(&mut rec, &inputs, &color).unwrap();
     rec.submit_and_wait().unwrap();
     let out: Vec<[f32; 4]> = fovea_tests::read_image(&ctx, sparse);
     let mut hit = vec![false; (screen.x * screen.y) as usize];
     for y in 0..grid.y {
         for x in 0..grid.x {
-            let Some(p) = space.screen_position(UVec2::new(x, y), 5, 2) else { continue };
+            let Some(p) = space.screen_position(UVec2::new(x, y), 5, 2) else {
+                continue;
+            };
             if p.cmpge(Vec2::ZERO).all() && p.cmplt(screen.as_vec2()).all() {
                 hit[(p.y as u32 * screen.x + p.x as u32) as usize] = true;
             }
         }
     }
     let covered = hit.iter().filter(|&&h| h).count();
-    assert!(covered > 500 && covered < hit.len(), "{covered}: the fovea is dense, the periphery holes");
+    assert!(
+        covered > 500 && covered < hit.len(),
+        "{covered}: the fovea is dense, the periphery holes"
+    );
     for (i, (px, &h)) in out.iter().zip(&hit).enumerate() {
         // Within a pixel's width of a sample, the host and the GPU may put it on either side.
         let want = if h { value } else { [0.0; 4] };
         let near = |dx: i32, dy: i32| {
-            let (x, y) = ((i as u32 % screen.x) as i32 + dx, (i as u32 / screen.x) as i32 + dy);
-            x >= 0 && y >= 0 && x < screen.x as i32 && y < screen.y as i32 && hit[(y as u32 * screen.x + x as u32) as usize] != h
+            let (x, y) = (
+                (i as u32 % screen.x) as i32 + dx,
+                (i as u32 / screen.x) as i32 + dy,
+            );
+            x >= 0
+                && y >= 0
+                && x < screen.x as i32
+                && y < screen.y as i32
+                && hit[(y as u32 * screen.x + x as u32) as usize] != h
         };
         if *px != want {
-            assert!((-1..=1).any(|dx| (-1..=1).any(|dy| near(dx, dy))), "pixel {i}: {px:?}, want {want:?}");
+            assert!(
+                (-1..=1).any(|dx| (-1..=1).any(|dy| near(dx, dy))),
+                "pixel {i}: {px:?}, want {want:?}"
+            );
         }
         assert!(*px == value || *px == [0.0; 4], "pixel {i}: {px:?}");
     }
@@ -223,14 +310,33 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
-    let settings = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
+    let settings = RenderSettings {
+        offscreen_samples: OffscreenSamples::Trace,
+        ..Default::default()
+    };
     let gaze = Vec2::new(40.0, 30.0);
     let host = random_acuity(SCREEN, gaze);
-    let mut r = Renderer::new(&ctx, &scene, Box::new(random_acuity(SCREEN, SCREEN.as_vec2() * 0.5)), settings).unwrap();
+    let mut r = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(random_acuity(SCREEN, SCREEN.as_vec2() * 0.5)),
+        settings,
+    )
+    .unwrap();
     for f in 0..3 {
-        let stats = r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
-        assert_eq!(stats.samples_traced, host.traced_count(f, settings.seed), "frame {f}");
-        assert_eq!(stats.samples_traced, host.sample_count(), "frame {f}: every kept texel drew");
+        let stats = r
+            .render_frame(&FrameInput::mono(camera, f, Some(gaze)))
+            .unwrap();
+        assert_eq!(
+            stats.samples_traced,
+            host.traced_count(f, settings.seed),
+            "frame {f}"
+        );
+        assert_eq!(
+            stats.samples_traced,
+            host.sample_count(),
+            "frame {f}: every kept texel drew"
+        );
     }
     fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, no_holes);
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(host));
@@ -239,7 +345,11 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
     let report = fovea_tests::render_report("random-acuity", Default::default());
     assert_eq!(report["method"], "random-acuity");
     for pass in ["splat_scatter", "splat_resolve", "fill_push", "blur_v"] {
-        assert!(report["passes"][pass].as_f64().is_some(), "{pass}: {}", report["passes"]);
+        assert!(
+            report["passes"][pass].as_f64().is_some(),
+            "{pass}: {}",
+            report["passes"]
+        );
     }
 }
 
@@ -254,22 +364,44 @@ fn composite_runs_the_filters_and_the_cli_reports_it() {
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
     let radial = RadialLaw::Composite(CompositeMode::Composite.params(SCREEN.x as f32 / 2.0));
-    let space = VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, VisualPolarParams { radial, ..Default::default() }).unwrap();
+    let space = VisualPolar::new(
+        SCREEN,
+        SCREEN.as_vec2() * 0.5,
+        VisualPolarParams {
+            radial,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(space.u_fovea() > 0.0, "the gaze disc");
     for denoiser in ["svgf", "asvgf", "bmfr"] {
-        let settings = RenderSettings { denoiser: DenoiserSettings::parse(denoiser).unwrap(), taa: TaaMode::parse("vp").unwrap(), ..Default::default() };
+        let settings = RenderSettings {
+            denoiser: DenoiserSettings::parse(denoiser).unwrap(),
+            taa: TaaMode::parse("vp").unwrap(),
+            ..Default::default()
+        };
         let mut r = Renderer::new(&ctx, &scene, Box::new(space), settings).unwrap();
         fovea_tests::mean_over_frames(&mut r, camera, Some(Vec2::new(25.0, 40.0)), 3, |f, hdr| {
-            assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite())), "{denoiser} frame {f}");
+            assert!(
+                hdr.iter().all(|p| p.iter().all(|c| c.is_finite())),
+                "{denoiser} frame {f}"
+            );
         });
     }
     assert_clean(&ctx);
 
-    let profile = fovea_tools::render_profile::RenderProfile { composite_mode: CompositeMode::Kernel, ..Default::default() };
+    let profile = fovea_tools::render_profile::RenderProfile {
+        composite_mode: CompositeMode::Kernel,
+        ..Default::default()
+    };
     let report = fovea_tests::render_report("composite", profile);
     assert_eq!(report["method"], "composite");
     assert_eq!(report["composite_mode"], "kernel");
-    assert!(report["passes"]["remap"].as_f64().is_some(), "{}", report["passes"]);
+    assert!(
+        report["passes"]["remap"].as_f64().is_some(),
+        "{}",
+        report["passes"]
+    );
 }
 
 /// Fixed foveation: with the eye near a corner it renders byte for byte what Visual-Polar renders
@@ -283,29 +415,50 @@ fn fixed_foveation_keeps_the_fovea_on_the_lens_wherever_the_eye_looks() {
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
     let lens = SCREEN.as_vec2() * 0.5;
     for denoiser in ["none", "svgf"] {
-        let settings = RenderSettings { denoiser: DenoiserSettings::parse(denoiser).unwrap(), ..Default::default() };
+        let settings = RenderSettings {
+            denoiser: DenoiserSettings::parse(denoiser).unwrap(),
+            ..Default::default()
+        };
         let fixed = FixedFoveation::new(SCREEN, lens, VisualPolarParams::default()).unwrap();
         let mut fixed = Renderer::new(&ctx, &scene, Box::new(fixed), settings).unwrap();
-        let mut vp = Renderer::new(&ctx, &scene, Box::new(VisualPolar::new(SCREEN, lens, VisualPolarParams::default()).unwrap()), settings).unwrap();
+        let mut vp = Renderer::new(
+            &ctx,
+            &scene,
+            Box::new(VisualPolar::new(SCREEN, lens, VisualPolarParams::default()).unwrap()),
+            settings,
+        )
+        .unwrap();
         let (mut a, mut b) = (Vec::new(), Vec::new());
         for f in 0..3 {
             let eye = Vec2::new(6.0 + 3.0 * f as f32, 8.0);
-            fixed.render_frame(&FrameInput::mono(camera, f, Some(eye))).unwrap();
-            vp.render_frame(&FrameInput::mono(camera, f, Some(lens))).unwrap();
+            fixed
+                .render_frame(&FrameInput::mono(camera, f, Some(eye)))
+                .unwrap();
+            vp.render_frame(&FrameInput::mono(camera, f, Some(lens)))
+                .unwrap();
             assert_eq!(fixed.space().gaze(), eye);
             fixed.read_ldr(&mut a).unwrap();
             vp.read_ldr(&mut b).unwrap();
-            assert!(a == b, "{denoiser} frame {f}: fixed foveation moved with the eye");
+            assert!(
+                a == b,
+                "{denoiser} frame {f}: fixed foveation moved with the eye"
+            );
         }
     }
     assert_clean(&ctx);
 
     let report = fovea_tests::render_report("fixed-foveation", Default::default());
     assert_eq!(report["method"], "fixed-foveation");
-    assert!(report["visual_polar"].is_object() && report["passes"]["remap"].as_f64().is_some(), "{report}");
+    assert!(
+        report["visual_polar"].is_object() && report["passes"]["remap"].as_f64().is_some(),
+        "{report}"
+    );
     // The simulated eye is off the lens centre (32, 36): its gaze, not the samples' centre.
     let gaze = &report["gaze"][0];
-    assert!(gaze.is_array() && *gaze != serde_json::json!([32.0, 36.0]), "{gaze}");
+    assert!(
+        gaze.is_array() && *gaze != serde_json::json!([32.0, 36.0]),
+        "{gaze}"
+    );
 }
 
 /// Variable-rate tiles: every packed texel's pixel on the GPU is the Rust rule's (Rust = GLSL, two
@@ -318,7 +471,12 @@ fn vrs_tiles_trace_the_rust_rules_pixels_and_converge_like_one_sample_per_pixel(
     let ctx = gpu();
     for screen in [SCREEN, UVec2::new(320, 360)] {
         let s = screen.as_vec2();
-        for gaze in [s * 0.5, Vec2::new(3.3, s.y - 2.1), Vec2::new(0.74, 0.22) * s, Vec2::new(-20.0, 10.0)] {
+        for gaze in [
+            s * 0.5,
+            Vec2::new(3.3, s.y - 2.1),
+            Vec2::new(0.74, 0.22) * s,
+            Vec2::new(-20.0, 10.0),
+        ] {
             let space = VrsTiles::new(screen, gaze, VisualPolarParams::default()).unwrap();
             let g = space.grid_size();
             for (i, got) in probe(&ctx, &space, 0, 1).iter().enumerate() {
@@ -331,16 +489,44 @@ fn vrs_tiles_trace_the_rust_rules_pixels_and_converge_like_one_sample_per_pixel(
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SCREEN.x, SCREEN.y);
     let tiles = |gaze| VrsTiles::new(SCREEN, gaze, VisualPolarParams::default()).unwrap();
-    let mut r = Renderer::new(&ctx, &scene, Box::new(tiles(SCREEN.as_vec2() * 0.5)), RenderSettings::default()).unwrap();
-    for (f, gaze) in [Vec2::new(20.0, 50.0), Vec2::new(60.0, 5.0)].into_iter().enumerate() {
-        let stats = r.render_frame(&FrameInput::mono(camera, f as u32, Some(gaze))).unwrap();
-        assert_eq!(stats.samples_traced, tiles(gaze).sample_count(), "gaze {gaze}");
+    let mut r = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(tiles(SCREEN.as_vec2() * 0.5)),
+        RenderSettings::default(),
+    )
+    .unwrap();
+    for (f, gaze) in [Vec2::new(20.0, 50.0), Vec2::new(60.0, 5.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let stats = r
+            .render_frame(&FrameInput::mono(camera, f as u32, Some(gaze)))
+            .unwrap();
+        assert_eq!(
+            stats.samples_traced,
+            tiles(gaze).sample_count(),
+            "gaze {gaze}"
+        );
     }
-    fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, Vec2::new(20.0, 50.0), 16, no_holes);
+    fovea_tests::assert_mean_like_cartesian(
+        &ctx,
+        &scene,
+        &mut r,
+        camera,
+        Vec2::new(20.0, 50.0),
+        16,
+        no_holes,
+    );
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(tiles(SCREEN.as_vec2() * 0.5)));
     assert_clean(&ctx);
 
     let report = fovea_tests::render_report("vrs-tiles", Default::default());
     assert_eq!(report["method"], "vrs-tiles");
-    assert!(report["passes"]["splat_scatter"].as_f64().is_some() && report["passes"]["blur_v"].as_f64().is_some(), "{}", report["passes"]);
+    assert!(
+        report["passes"]["splat_scatter"].as_f64().is_some()
+            && report["passes"]["blur_v"].as_f64().is_some(),
+        "{}",
+        report["passes"]
+    );
 }

@@ -8,19 +8,23 @@
 //! does not refuses every filter by name. Adding a space means adding it to `spaces()`, not
 //! copying these tests.
 
-use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::taa::Taa;
+use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
 use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation, LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace, UniformBudget,
-    VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
+    BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation,
+    LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace,
+    UniformBudget, VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::denoise::{assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer, SeamErrors};
+use fovea_tests::denoise::{
+    assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer,
+    SeamErrors,
+};
 use fovea_tests::{assert_clean, gpu, light_material, owned_scene, read_image, SpaceBuffers};
 use glam::{Mat4, UVec2, Vec3};
 use std::sync::Arc;
@@ -37,31 +41,139 @@ fn spaces(size: UVec2) -> Vec<(&'static str, MakeSpace)> {
     let gaze = size.as_vec2() * 0.5;
     let vp = VisualPolarParams::default();
     let fove0 = fovea_tools::commands::bench_vp::fove0_fov().unwrap();
-    let polar = move |radial| VisualPolar::new(size, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+    let polar = move |radial| {
+        VisualPolar::new(
+            size,
+            gaze,
+            VisualPolarParams {
+                radial,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
     vec![
-        ("cartesian", Box::new(move || Box::new(Cartesian::new(size)))),
-        ("vp", Box::new(move || Box::new(VisualPolar::new(size, gaze, vp).unwrap()))),
-        ("log-polar", Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams::default()))))),
-        ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(size.x as f32 / 2.0)))))),
-        ("vp-headset", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..vp }).unwrap()))),
-        ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..vp }).unwrap()))),
-        ("vp-screen-aware", Box::new(move || Box::new(VisualPolar::new(size, gaze, VisualPolarParams { layout: VpLayout::ScreenAware, ..vp }).unwrap()))),
-        ("uniform-budget", Box::new(move || Box::new(UniformBudget::with_samples(size, 4000).unwrap()))),
-        ("linear-falloff", Box::new(move || Box::new(LinearFalloff::new(size, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap()))),
-        ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(size, gaze, vp).unwrap()))),
-        ("pixel-blocks", Box::new(move || Box::new(PixelBlocks::new(size, vp, BlockShape::default()).unwrap()))),
-        ("vrs-tiles", Box::new(move || Box::new(VrsTiles::new(size, gaze, vp).unwrap()))),
+        (
+            "cartesian",
+            Box::new(move || Box::new(Cartesian::new(size))),
+        ),
+        (
+            "vp",
+            Box::new(move || Box::new(VisualPolar::new(size, gaze, vp).unwrap())),
+        ),
+        (
+            "log-polar",
+            Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams::default())))),
+        ),
+        (
+            "composite",
+            Box::new(move || {
+                Box::new(polar(RadialLaw::Composite(
+                    CompositeMode::Composite.params(size.x as f32 / 2.0),
+                )))
+            }),
+        ),
+        (
+            "vp-headset",
+            Box::new(move || {
+                Box::new(
+                    VisualPolar::new(
+                        size,
+                        gaze,
+                        VisualPolarParams {
+                            eccentricity: Eccentricity::Headset(fove0),
+                            ..vp
+                        },
+                    )
+                    .unwrap(),
+                )
+            }),
+        ),
+        (
+            "vp-screen-clipped",
+            Box::new(move || {
+                Box::new(
+                    VisualPolar::new(
+                        size,
+                        gaze,
+                        VisualPolarParams {
+                            layout: VpLayout::ScreenClipped,
+                            ..vp
+                        },
+                    )
+                    .unwrap(),
+                )
+            }),
+        ),
+        (
+            "vp-screen-aware",
+            Box::new(move || {
+                Box::new(
+                    VisualPolar::new(
+                        size,
+                        gaze,
+                        VisualPolarParams {
+                            layout: VpLayout::ScreenAware,
+                            ..vp
+                        },
+                    )
+                    .unwrap(),
+                )
+            }),
+        ),
+        (
+            "uniform-budget",
+            Box::new(move || Box::new(UniformBudget::with_samples(size, 4000).unwrap())),
+        ),
+        (
+            "linear-falloff",
+            Box::new(move || {
+                Box::new(
+                    LinearFalloff::new(size, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP)
+                        .unwrap(),
+                )
+            }),
+        ),
+        (
+            "random-acuity",
+            Box::new(move || Box::new(RandomAcuity::new(size, gaze, vp).unwrap())),
+        ),
+        (
+            "pixel-blocks",
+            Box::new(move || Box::new(PixelBlocks::new(size, vp, BlockShape::default()).unwrap())),
+        ),
+        (
+            "vrs-tiles",
+            Box::new(move || Box::new(VrsTiles::new(size, gaze, vp).unwrap())),
+        ),
         // The lens centre a quarter of the way in: the filters run on a grid centred off the gaze.
-        ("fixed-foveation", Box::new(move || Box::new(FixedFoveation::new(size, size.as_vec2() * 0.25, vp).unwrap()))),
+        (
+            "fixed-foveation",
+            Box::new(move || {
+                Box::new(FixedFoveation::new(size, size.as_vec2() * 0.25, vp).unwrap())
+            }),
+        ),
     ]
 }
 
 fn filters() -> Vec<(&'static str, DenoiserSettings, TaaMode)> {
     let taa = TaaSettings::default();
     vec![
-        ("svgf", DenoiserSettings::parse("svgf").unwrap(), TaaMode::Off),
-        ("asvgf", DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off),
-        ("bmfr", DenoiserSettings::parse("bmfr").unwrap(), TaaMode::Off),
+        (
+            "svgf",
+            DenoiserSettings::parse("svgf").unwrap(),
+            TaaMode::Off,
+        ),
+        (
+            "asvgf",
+            DenoiserSettings::parse("asvgf").unwrap(),
+            TaaMode::Off,
+        ),
+        (
+            "bmfr",
+            DenoiserSettings::parse("bmfr").unwrap(),
+            TaaMode::Off,
+        ),
         ("taa-vp", DenoiserSettings::None, TaaMode::SamplingGrid(taa)),
         ("taa-screen", DenoiserSettings::None, TaaMode::Screen(taa)),
     ]
@@ -69,14 +181,28 @@ fn filters() -> Vec<(&'static str, DenoiserSettings, TaaMode)> {
 
 /// The blur is off: the suite measures sampling and filtering only.
 fn settings(denoiser: DenoiserSettings, taa: TaaMode) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, taa, ..Default::default() }
+    RenderSettings {
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
+        denoiser,
+        taa,
+        ..Default::default()
+    }
 }
 
 /// The mean of `frames` raw frames of a space at `camera` (after its way back), and the last.
-fn converged(renderer: &mut Renderer, camera: CameraPose, frames: u32) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+fn converged(
+    renderer: &mut Renderer,
+    camera: CameraPose,
+    frames: u32,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let (mut raw, mut mean) = (Vec::new(), vec![[0.0f32; 4]; (SIZE.x * SIZE.y) as usize]);
     for f in (0..frames).rev() {
-        renderer.render_frame(&FrameInput::mono(camera, f, Some(SIZE.as_vec2() * 0.5)).with_hdr(true)).unwrap();
+        renderer
+            .render_frame(&FrameInput::mono(camera, f, Some(SIZE.as_vec2() * 0.5)).with_hdr(true))
+            .unwrap();
         renderer.read_hdr(&mut raw).unwrap();
         for (m, p) in mean.iter_mut().zip(&raw) {
             (0..4).for_each(|c| m[c] += p[c] / frames as f32);
@@ -95,7 +221,13 @@ fn smooth_interior(converged: &[[f32; 4]]) -> Vec<bool> {
         .map(|i| {
             let (x, y, l) = (i % w, i / w, luma(&converged[i as usize]));
             let inside = x > 0 && y > 0 && x + 1 < w && y + 1 < h && l < 1.0;
-            inside && (-1..=1).all(|dy| (-1..=1).all(|dx| (luma(&converged[((y + dy) * w + x + dx) as usize]) - l).abs() <= 0.1 * l.max(0.05)))
+            inside
+                && (-1..=1).all(|dy| {
+                    (-1..=1).all(|dx| {
+                        (luma(&converged[((y + dy) * w + x + dx) as usize]) - l).abs()
+                            <= 0.1 * l.max(0.05)
+                    })
+                })
         })
         .collect()
 }
@@ -105,19 +237,34 @@ fn smooth_interior(converged: &[[f32; 4]]) -> Vec<bool> {
 /// frames, so the filter sees the jump both ways — every output pixel finite and non-negative;
 /// then the camera turned out of the box: two frames exactly black (no history ghosts into
 /// an empty view).
-fn blow_up_the_light_and_look_away(r: &mut Renderer, scene: &fovea_scene::Scene, (camera, away): (CameraPose, CameraPose), first: u32, what: &str) {
+fn blow_up_the_light_and_look_away(
+    r: &mut Renderer,
+    scene: &fovea_scene::Scene,
+    (camera, away): (CameraPose, CameraPose),
+    first: u32,
+    what: &str,
+) {
     let light = light_material(scene);
     let mut out = Vec::new();
     for (k, scale) in [1e30, 1e30, 1.0, 1.0].into_iter().enumerate() {
         r.set_emission_scale(scene, light, scale).unwrap();
-        r.render_frame(&FrameInput::mono(camera, first + k as u32, Some(SIZE.as_vec2() * 0.5)).with_hdr(true)).unwrap();
+        r.render_frame(
+            &FrameInput::mono(camera, first + k as u32, Some(SIZE.as_vec2() * 0.5)).with_hdr(true),
+        )
+        .unwrap();
         r.read_hdr(&mut out).unwrap();
         assert_finite_non_negative(&format!("{what}, light ×{scale:e}, frame {k}"), &out);
     }
     for k in 4..6 {
-        r.render_frame(&FrameInput::mono(away, first + k, Some(SIZE.as_vec2() * 0.5)).with_hdr(true)).unwrap();
+        r.render_frame(
+            &FrameInput::mono(away, first + k, Some(SIZE.as_vec2() * 0.5)).with_hdr(true),
+        )
+        .unwrap();
         r.read_hdr(&mut out).unwrap();
-        assert!(out.iter().all(|p| p[..3] == [0.0; 3]), "{what}: the empty view is not black (frame {k})");
+        assert!(
+            out.iter().all(|p| p[..3] == [0.0; 3]),
+            "{what}: the empty view is not black (frame {k})"
+        );
     }
 }
 
@@ -136,49 +283,90 @@ fn every_filter_on_every_space_that_supports_it() {
     let scene = owned_scene("cornell-box");
     let start = CameraPose::from_scene_camera(&scene.cameras[0], SIZE.x, SIZE.y);
     let centre = scene.bounds().center();
-    let turn = Mat4::from_translation(centre) * Mat4::from_rotation_y(20f32.to_radians()) * Mat4::from_translation(-centre);
-    let jumped = CameraPose { world_from_view: turn * start.world_from_view, fov_tan: start.fov_tan };
+    let turn = Mat4::from_translation(centre)
+        * Mat4::from_rotation_y(20f32.to_radians())
+        * Mat4::from_translation(-centre);
+    let jumped = CameraPose {
+        world_from_view: turn * start.world_from_view,
+        fov_tan: start.fov_tan,
+    };
     // Turned around, the camera looks out of the box's open side into nothing.
-    let away = CameraPose { world_from_view: start.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..start };
+    let away = CameraPose {
+        world_from_view: start.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI),
+        ..start
+    };
     let gaze = Some(SIZE.as_vec2() * 0.5);
     let mut failures = Vec::new();
     for (space_name, make) in spaces(SIZE) {
         if !make().capabilities().temporal_filters {
             for (filter, denoiser, taa) in filters() {
-                let err = Renderer::new(&ctx, &scene, make(), settings(denoiser, taa)).err().map(|e| e.to_string()).unwrap_or_default();
-                assert!(err.contains(space_name) && err.contains("supports no denoiser"), "{space_name} + {filter}: {err}");
+                let err = Renderer::new(&ctx, &scene, make(), settings(denoiser, taa))
+                    .err()
+                    .map(|e| e.to_string())
+                    .unwrap_or_default();
+                assert!(
+                    err.contains(space_name) && err.contains("supports no denoiser"),
+                    "{space_name} + {filter}: {err}"
+                );
             }
             continue;
         }
-        let mut raw_renderer = Renderer::new(&ctx, &scene, make(), settings(DenoiserSettings::None, TaaMode::Off)).unwrap();
+        let mut raw_renderer = Renderer::new(
+            &ctx,
+            &scene,
+            make(),
+            settings(DenoiserSettings::None, TaaMode::Off),
+        )
+        .unwrap();
         let (reference, raw) = converged(&mut raw_renderer, start, CONVERGED_FRAMES);
-        let (jumped_reference, jumped_raw) = converged(&mut raw_renderer, jumped, CONVERGED_FRAMES / 2);
+        let (jumped_reference, jumped_raw) =
+            converged(&mut raw_renderer, jumped, CONVERGED_FRAMES / 2);
         drop(raw_renderer);
-        let (interior, jumped_interior) = (smooth_interior(&reference), smooth_interior(&jumped_reference));
+        let (interior, jumped_interior) = (
+            smooth_interior(&reference),
+            smooth_interior(&jumped_reference),
+        );
         for (filter, denoiser, taa) in filters() {
             let mut r = Renderer::new(&ctx, &scene, make(), settings(denoiser, taa)).unwrap();
             let mut out = Vec::new();
             for f in 0..FILTERED_FRAMES {
-                r.render_frame(&FrameInput::mono(start, f, gaze).with_hdr(true)).unwrap();
+                r.render_frame(&FrameInput::mono(start, f, gaze).with_hdr(true))
+                    .unwrap();
             }
             r.read_hdr(&mut out).unwrap();
             assert_finite_non_negative(&format!("{space_name} + {filter}"), &out);
-            let (before, after) = (rmse_where(&raw, &reference, |i| interior[i]), rmse_where(&out, &reference, |i| interior[i]));
-            r.render_frame(&FrameInput::mono(jumped, FILTERED_FRAMES, gaze).with_hdr(true)).unwrap();
+            let (before, after) = (
+                rmse_where(&raw, &reference, |i| interior[i]),
+                rmse_where(&out, &reference, |i| interior[i]),
+            );
+            r.render_frame(&FrameInput::mono(jumped, FILTERED_FRAMES, gaze).with_hdr(true))
+                .unwrap();
             r.read_hdr(&mut out).unwrap();
             assert_finite_non_negative(&format!("{space_name} + {filter} after the jump"), &out);
-            let (raw_jump, filtered_jump) = (rmse_where(&jumped_raw, &jumped_reference, |i| jumped_interior[i]), rmse_where(&out, &jumped_reference, |i| jumped_interior[i]));
+            let (raw_jump, filtered_jump) = (
+                rmse_where(&jumped_raw, &jumped_reference, |i| jumped_interior[i]),
+                rmse_where(&out, &jumped_reference, |i| jumped_interior[i]),
+            );
             println!(
                 "{space_name} + {filter}: noise {before:.4} → {after:.4} ({:.2}×); after the jump {filtered_jump:.4} vs raw {raw_jump:.4}",
                 before / after
             );
             if before / after < 1.15 {
-                failures.push(format!("{space_name} + {filter}: RMSE fell only {:.2}× ({before:.4} → {after:.4})", before / after));
+                failures.push(format!(
+                    "{space_name} + {filter}: RMSE fell only {:.2}× ({before:.4} → {after:.4})",
+                    before / after
+                ));
             }
             if filtered_jump > 1.5 * raw_jump {
                 failures.push(format!("{space_name} + {filter}: the first frame after the jump {filtered_jump:.4} vs raw {raw_jump:.4}"));
             }
-            blow_up_the_light_and_look_away(&mut r, &scene, (jumped, away), FILTERED_FRAMES + 1, &format!("{space_name} + {filter}"));
+            blow_up_the_light_and_look_away(
+                &mut r,
+                &scene,
+                (jumped, away),
+                FILTERED_FRAMES + 1,
+                &format!("{space_name} + {filter}"),
+            );
             assert_clean(&ctx);
         }
     }
@@ -193,24 +381,50 @@ enum GridFilter {
 }
 
 impl GridFilter {
-    fn new(ctx: &Arc<Context>, denoiser: &DenoiserSettings, taa: TaaMode, space: &dyn SamplingSpace) -> GridFilter {
+    fn new(
+        ctx: &Arc<Context>,
+        denoiser: &DenoiserSettings,
+        taa: TaaMode,
+        space: &dyn SamplingSpace,
+    ) -> GridFilter {
         let (grid, variant) = (space.grid_size(), space.shader_variant());
         match (Denoiser::new(ctx, denoiser, grid, variant).unwrap(), taa) {
             (Some(d), _) => GridFilter::Denoiser(Box::new(d)),
-            (None, TaaMode::SamplingGrid(s)) => GridFilter::Taa(Box::new(Taa::new(ctx, grid, variant, s).unwrap())),
+            (None, TaaMode::SamplingGrid(s)) => {
+                GridFilter::Taa(Box::new(Taa::new(ctx, grid, variant, s).unwrap()))
+            }
             (None, other) => panic!("no grid filter for TAA {other:?}"),
         }
     }
 
-    fn run(&mut self, ctx: &Arc<Context>, g: &GBuffer, frame: &DenoiseFrame, buffers: &SpaceBuffers, materials: &Buffer) -> Vec<[f32; 4]> {
+    fn run(
+        &mut self,
+        ctx: &Arc<Context>,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+        buffers: &SpaceBuffers,
+        materials: &Buffer,
+    ) -> Vec<[f32; 4]> {
         let mut rec = FrameRecorder::new(ctx, 32).unwrap();
         rec.begin().unwrap();
         let out: &Image = match self {
             GridFilter::Denoiser(d) => {
-                d.record_before_trace(&mut rec, g, frame, &buffers.frame).unwrap();
-                d.record(&mut rec, g, frame, &DenoiseScene { camera_origin: Vec3::ZERO, materials }).unwrap()
+                d.record_before_trace(&mut rec, g, frame, &buffers.frame)
+                    .unwrap();
+                d.record(
+                    &mut rec,
+                    g,
+                    frame,
+                    &DenoiseScene {
+                        camera_origin: Vec3::ZERO,
+                        materials,
+                    },
+                )
+                .unwrap()
             }
-            GridFilter::Taa(t) => t.record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5)).unwrap(),
+            GridFilter::Taa(t) => t
+                .record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5))
+                .unwrap(),
         };
         rec.submit_and_wait().unwrap();
         read_image(ctx, out)
@@ -232,26 +446,52 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
     for (space_name, make) in spaces(SEAM_SIZE) {
         let space = make();
         // The polar spaces that run the filters have a seam.
-        let Some(&vp) = space.visual_polar().filter(|_| space.capabilities().temporal_filters) else { continue };
+        let Some(&vp) = space
+            .visual_polar()
+            .filter(|_| space.capabilities().temporal_filters)
+        else {
+            continue;
+        };
         let grid = space.grid_size();
         // A-SVGF projects its gradient samples from last frame's visibility: none here (zero),
         // so it filters like SVGF with the adaptive α.
         let g = GBuffer::with_visibility(&ctx, grid).unwrap();
-        upload(&ctx, g.visibility.as_ref().unwrap(), &vec![[0u32; 4]; (grid.x * grid.y) as usize]);
+        upload(
+            &ctx,
+            g.visibility.as_ref().unwrap(),
+            &vec![[0u32; 4]; (grid.x * grid.y) as usize],
+        );
         let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
         let params = space.params();
-        for (filter, denoiser, taa) in filters().into_iter().filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_))) {
+        for (filter, denoiser, taa) in filters()
+            .into_iter()
+            .filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_)))
+        {
             let mut f = GridFilter::new(&ctx, &denoiser, taa, space.as_ref());
             let mut out = Vec::new();
             for frame in 0..8u32 {
                 upload_gbuffer(&ctx, &g, &seam_texels(&vp, frame));
-                out = f.run(&ctx, &g, &DenoiseFrame { current: params, previous: (frame > 0).then_some(params), sampling_table: &buffers.table, tiles: buffers.tiles.list() }, &buffers, &materials);
+                out = f.run(
+                    &ctx,
+                    &g,
+                    &DenoiseFrame {
+                        current: params,
+                        previous: (frame > 0).then_some(params),
+                        sampling_table: &buffers.table,
+                        tiles: buffers.tiles.list(),
+                    },
+                    &buffers,
+                    &materials,
+                );
             }
             assert_finite_non_negative(&format!("{space_name} + {filter} at the seam"), &out);
             let e = SeamErrors::of(&vp, &out);
             println!("{space_name} + {filter}: seam rows RMSE {:.4}, at φ ≈ π {:.4}, median row bin {:.4}; per bin {:.4?}", e.seam, e.opposite, e.median, e.bins);
             if !e.like_elsewhere() {
-                failures.push(format!("{space_name} + {filter}: seam {:.4} vs {:.4} at φ ≈ π, median {:.4}", e.seam, e.opposite, e.median));
+                failures.push(format!(
+                    "{space_name} + {filter}: seam {:.4} vs {:.4} at φ ≈ π, median {:.4}",
+                    e.seam, e.opposite, e.median
+                ));
             }
             assert_clean(&ctx);
         }
@@ -276,12 +516,26 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
     let ctx = gpu();
     let materials = plain_materials(&ctx);
     let gaze = |f: u32| {
-        let path = [glam::Vec2::new(12.0, 70.0), glam::Vec2::new(110.0, 130.0), glam::Vec2::new(64.0, 72.0)];
+        let path = [
+            glam::Vec2::new(12.0, 70.0),
+            glam::Vec2::new(110.0, 130.0),
+            glam::Vec2::new(64.0, 72.0),
+        ];
         let t = f as f32 / (FRAMES - 1) as f32 * 2.0;
         let (i, u) = ((t.floor() as usize).min(1), t - t.floor().min(1.0));
         path[i].lerp(path[i + 1], u)
     };
-    let space = |layout: VpLayout, f: u32| VisualPolar::new(CLIP_SIZE, gaze(f), VisualPolarParams { layout, ..Default::default() }).unwrap();
+    let space = |layout: VpLayout, f: u32| {
+        VisualPolar::new(
+            CLIP_SIZE,
+            gaze(f),
+            VisualPolarParams {
+                layout,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
     // About one period across the screen: BMFR's per-block fit of position features follows it
     // (a pattern of a few pixels' period is fitted worse than the noise in either layout).
     let truth = |s: glam::Vec2| 0.5 + 0.3 * (s.x / 27.0).sin() * (s.y / 33.0).cos();
@@ -293,22 +547,37 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
             .map(|(i, s)| {
                 s.map(|s| {
                     let p = (s - centre) / 64.0 * 5.0;
-                    let v = truth(s) + 0.2 * (fovea_tests::unit_hash(i as u32 * 31 + f * 7919) - 0.5);
-                    fovea_tests::denoise::Texel { radiance: [v; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }
+                    let v =
+                        truth(s) + 0.2 * (fovea_tests::unit_hash(i as u32 * 31 + f * 7919) - 0.5);
+                    fovea_tests::denoise::Texel {
+                        radiance: [v; 3],
+                        normal: [0.0, 0.0, 1.0],
+                        position: [p.x, p.y, -5.0],
+                        mesh: 1,
+                        motion: s,
+                    }
                 })
             })
             .collect()
     };
     let error = |vp: &VisualPolar, values: &dyn Fn(usize) -> f32| {
         let screens = fovea_tests::denoise::texel_screens(vp);
-        let e: Vec<f64> = screens.iter().enumerate().filter_map(|(i, s)| s.map(|s| (values(i) - truth(s)) as f64)).collect();
+        let e: Vec<f64> = screens
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.map(|s| (values(i) - truth(s)) as f64))
+            .collect();
         (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
     };
     let grid = space(VpLayout::ScreenClipped, 0).grid_size();
     assert_eq!(grid, space(VpLayout::Paper, 0).grid_size());
     assert_eq!(grid, space(VpLayout::ScreenAware, 0).grid_size());
     let g = GBuffer::with_visibility(&ctx, grid).unwrap();
-    upload(&ctx, g.visibility.as_ref().unwrap(), &vec![[0u32; 4]; (grid.x * grid.y) as usize]);
+    upload(
+        &ctx,
+        g.visibility.as_ref().unwrap(),
+        &vec![[0u32; 4]; (grid.x * grid.y) as usize],
+    );
     let mut failures = Vec::new();
     // (layout, the previous frame's own arcs in the table's second half); the paper layout last.
     let runs = [
@@ -318,7 +587,10 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
         (VpLayout::ScreenAware, false),
         (VpLayout::Paper, true),
     ];
-    for (filter, denoiser, taa) in filters().into_iter().filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_))) {
+    for (filter, denoiser, taa) in filters()
+        .into_iter()
+        .filter(|(_, _, taa)| !matches!(taa, TaaMode::Screen(_)))
+    {
         let mut errors = [0.0; 5];
         let mut noise = [0.0; 5];
         for (run, &(layout, previous_arcs)) in runs.iter().enumerate() {
@@ -328,8 +600,17 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
                 let input = texels(&vp, frame);
                 upload_gbuffer(&ctx, &g, &input);
                 let buffers = SpaceBuffers::new(&ctx, &vp, frame, 1);
-                let table = fovea_tests::grid_table(&ctx, &vp, previous_arcs.then_some(&prev as &dyn SamplingSpace));
-                let frame_in = DenoiseFrame { current: vp.sampling_params(), previous: (frame > 0).then(|| prev.sampling_params()), sampling_table: &table, tiles: buffers.tiles.list() };
+                let table = fovea_tests::grid_table(
+                    &ctx,
+                    &vp,
+                    previous_arcs.then_some(&prev as &dyn SamplingSpace),
+                );
+                let frame_in = DenoiseFrame {
+                    current: vp.sampling_params(),
+                    previous: (frame > 0).then(|| prev.sampling_params()),
+                    sampling_table: &table,
+                    tiles: buffers.tiles.list(),
+                };
                 let out = f.run(&ctx, &g, &frame_in, &buffers, &materials);
                 if frame == FRAMES - 1 {
                     assert_finite_non_negative(&format!("{layout:?} + {filter}"), &out);

@@ -16,22 +16,37 @@ use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPola
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};
 use fovea_tests::denoise::{
-    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, rmse_where, surface_interiors, texel_screens, upload,
+    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, rmse_where,
+    surface_interiors, texel_screens, upload,
 };
-use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
+use fovea_tests::{
+    assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image,
+};
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
 
 const SCREEN: UVec2 = UVec2::new(64, 72);
 
 fn spaces(screen: UVec2) -> [(&'static str, Box<dyn SamplingSpace>); 2] {
-    let vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
-    [("cartesian", Box::new(Cartesian::new(screen))), ("vp", Box::new(vp))]
+    let vp =
+        VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+    [
+        ("cartesian", Box::new(Cartesian::new(screen))),
+        ("vp", Box::new(vp)),
+    ]
 }
 
 /// The blur is off: the VP comparison measures sampling + denoising only.
 fn settings(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, denoiser, ..Default::default() }
+    RenderSettings {
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
+        denoiser,
+        ..Default::default()
+    }
 }
 
 fn with_svgf() -> DenoiserSettings {
@@ -53,8 +68,16 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
     let scene = owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
-    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    let mut reference_renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(size)),
+        settings(DenoiserSettings::None),
+    )
+    .unwrap();
+    let reference = reference_renderer
+        .render_reference(&camera, 256, 3, |_| {})
+        .unwrap();
     drop(reference_renderer);
     save_preview("denoise_reference.png", size.x, size.y, &reference);
 
@@ -63,10 +86,23 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
         let vp = space.visual_polar().copied();
         let r_fovea = vp.map_or(size.x as f32 * 0.1, |v| v.r_fovea());
         let r_max = (gaze.max(size.as_vec2() - gaze)).length();
-        let radius = |i: usize| (Vec2::new((i as u32 % size.x) as f32 + 0.5, (i as u32 / size.x) as f32 + 0.5) - gaze).length();
-        let ring_edges = [0.0, r_fovea, r_fovea + (r_max - r_fovea) / 3.0, r_fovea + 2.0 * (r_max - r_fovea) / 3.0, r_max + 1.0];
+        let radius = |i: usize| {
+            (Vec2::new(
+                (i as u32 % size.x) as f32 + 0.5,
+                (i as u32 / size.x) as f32 + 0.5,
+            ) - gaze)
+                .length()
+        };
+        let ring_edges = [
+            0.0,
+            r_fovea,
+            r_fovea + (r_max - r_fovea) / 3.0,
+            r_fovea + 2.0 * (r_max - r_fovea) / 3.0,
+            r_max + 1.0,
+        ];
 
-        let mut raw_renderer = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let mut raw_renderer =
+            Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
         let mut raw = Vec::new();
         raw_renderer.render_frame(&frame(camera, 0)).unwrap();
         raw_renderer.read_hdr(&mut raw).unwrap();
@@ -85,10 +121,18 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
         assert_finite_non_negative(name, &denoised);
         let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         save_preview(&format!("denoise_{name}_raw.png"), size.x, size.y, &raw);
-        save_preview(&format!("denoise_{name}_svgf.png"), size.x, size.y, &denoised);
+        save_preview(
+            &format!("denoise_{name}_svgf.png"),
+            size.x,
+            size.y,
+            &denoised,
+        );
 
         let factor = |keep: &dyn Fn(usize) -> bool| {
-            let (a, b) = (rmse_where(&raw, &reference, keep), rmse_where(&denoised, &reference, keep));
+            let (a, b) = (
+                rmse_where(&raw, &reference, keep),
+                rmse_where(&denoised, &reference, keep),
+            );
             (a, b, a / b)
         };
         let (a, b, whole) = factor(&|i| interior[i]);
@@ -98,7 +142,11 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
             .windows(2)
             .map(|e| {
                 let (a, b, f) = factor(&|i| interior[i] && radius(i) >= e[0] && radius(i) < e[1]);
-                format!("[{:.0}, {:.0}) px {a:.4} → {b:.4} ({f:.1}×)", e[0], e[1].min(r_max))
+                format!(
+                    "[{:.0}, {:.0}) px {a:.4} → {b:.4} ({f:.1}×)",
+                    e[0],
+                    e[1].min(r_max)
+                )
             })
             .collect();
         println!(
@@ -106,11 +154,22 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
              rings {}; with edges {ea:.4} → {eb:.4} ({with_edges:.2}×)",
             rings.join(", ")
         );
-        assert!(whole >= 4.0, "{name}: whole-frame RMSE fell only {whole:.2}×");
+        assert!(
+            whole >= 4.0,
+            "{name}: whole-frame RMSE fell only {whole:.2}×"
+        );
         assert!(fovea >= 4.0, "{name}: fovea RMSE fell only {fovea:.2}×");
         let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
-        for pass in ["svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_modulate"] {
-            assert!(names.contains(&pass), "{name}: pass {pass} missing from {names:?}");
+        for pass in [
+            "svgf_temporal",
+            "svgf_variance",
+            "svgf_atrous",
+            "svgf_modulate",
+        ] {
+            assert!(
+                names.contains(&pass),
+                "{name}: pass {pass} missing from {names:?}"
+            );
         }
     }
     assert_clean(&ctx);
@@ -131,22 +190,73 @@ const HALF_ONE: u16 = 0x3c00;
 
 /// Fills the G-buffer like the tracer would: `None` = a texel without a sample.
 fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, samples: &[Option<Sample>]) {
-    let grey = |s: &Option<Sample>| s.map_or([0.0; 4], |s| [s.radiance, s.radiance, s.radiance, 1.0]);
+    let grey =
+        |s: &Option<Sample>| s.map_or([0.0; 4], |s| [s.radiance, s.radiance, s.radiance, 1.0]);
     let colour: Vec<[f32; 4]> = samples.iter().map(grey).collect();
     write_image(ctx, &g.color, &colour);
     write_image(ctx, &g.radiance, &colour);
-    upload(ctx, &g.albedo, &samples.iter().map(|s| if s.is_some() { [HALF_ONE; 4] } else { [0u16; 4] }).collect::<Vec<_>>());
-    write_image(ctx, &g.normal_depth, &samples.iter().map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, 1.0, s.depth])).collect::<Vec<_>>());
-    write_image(ctx, &g.position, &samples.iter().map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, -s.depth, 0.01])).collect::<Vec<_>>());
-    upload(ctx, &g.ids, &samples.iter().map(|s| s.map_or([0u32; 2], |s| [1, s.mesh << 16])).collect::<Vec<_>>());
-    upload(ctx, &g.motion, &samples.iter().map(|s| s.map_or([-1.0f32; 2], |s| s.motion.to_array())).collect::<Vec<_>>());
+    upload(
+        ctx,
+        &g.albedo,
+        &samples
+            .iter()
+            .map(|s| {
+                if s.is_some() {
+                    [HALF_ONE; 4]
+                } else {
+                    [0u16; 4]
+                }
+            })
+            .collect::<Vec<_>>(),
+    );
+    write_image(
+        ctx,
+        &g.normal_depth,
+        &samples
+            .iter()
+            .map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, 1.0, s.depth]))
+            .collect::<Vec<_>>(),
+    );
+    write_image(
+        ctx,
+        &g.position,
+        &samples
+            .iter()
+            .map(|s| s.map_or([0.0; 4], |s| [0.0, 0.0, -s.depth, 0.01]))
+            .collect::<Vec<_>>(),
+    );
+    upload(
+        ctx,
+        &g.ids,
+        &samples
+            .iter()
+            .map(|s| s.map_or([0u32; 2], |s| [1, s.mesh << 16]))
+            .collect::<Vec<_>>(),
+    );
+    upload(
+        ctx,
+        &g.motion,
+        &samples
+            .iter()
+            .map(|s| s.map_or([-1.0f32; 2], |s| s.motion.to_array()))
+            .collect::<Vec<_>>(),
+    );
 }
 
 /// Frame `f` of the moving-occluder scene: frames 0–7 the occluder (mesh 2, depth 2) covers
 /// x < 32 (VP samples beyond the screen too); frame 8 it covers x in [16, 48), moved by 16 px,
 /// over the static background (mesh 1, depth 10). Radiance with per-frame noise.
-fn occluder_scene(screens: &[Option<Vec2>], f: u32, background: f32, occluder: f32) -> Vec<Option<Sample>> {
-    let (covered, shift) = if f < 8 { (-1e4..32.0, 0.0) } else { (16.0..48.0, 16.0) };
+fn occluder_scene(
+    screens: &[Option<Vec2>],
+    f: u32,
+    background: f32,
+    occluder: f32,
+) -> Vec<Option<Sample>> {
+    let (covered, shift) = if f < 8 {
+        (-1e4..32.0, 0.0)
+    } else {
+        (16.0..48.0, 16.0)
+    };
     screens
         .iter()
         .enumerate()
@@ -154,21 +264,39 @@ fn occluder_scene(screens: &[Option<Vec2>], f: u32, background: f32, occluder: f
             let s = (*s)?;
             let noise = 0.5 + unit_hash(i as u32 * 31 + f * 7919);
             Some(if covered.contains(&s.x) {
-                Sample { radiance: occluder * noise, depth: 2.0, mesh: 2, motion: s - Vec2::new(shift, 0.0) }
+                Sample {
+                    radiance: occluder * noise,
+                    depth: 2.0,
+                    mesh: 2,
+                    motion: s - Vec2::new(shift, 0.0),
+                }
             } else {
-                Sample { radiance: background * noise, depth: 10.0, mesh: 1, motion: s }
+                Sample {
+                    radiance: background * noise,
+                    depth: 10.0,
+                    mesh: 1,
+                    motion: s,
+                }
             })
         })
         .collect()
 }
 
 /// Runs one SVGF frame; returns its output (re-modulated) and moments (z = history length).
-fn denoise(ctx: &Arc<Context>, svgf: &mut Svgf, g: &GBuffer, frame: &DenoiseFrame) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+fn denoise(
+    ctx: &Arc<Context>,
+    svgf: &mut Svgf,
+    g: &GBuffer,
+    frame: &DenoiseFrame,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut rec = FrameRecorder::new(ctx, 16).unwrap();
     rec.begin().unwrap();
     svgf.record(&mut rec, g, frame).unwrap();
     rec.submit_and_wait().unwrap();
-    (read_image(ctx, &svgf.output), read_image(ctx, svgf.moments()))
+    (
+        read_image(ctx, &svgf.output),
+        read_image(ctx, svgf.moments()),
+    )
 }
 
 /// Fireflies (huge, infinite and NaN radiance injected into a traced Cornell frame) and an empty
@@ -179,7 +307,10 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     // Turned around, the camera looks out of the box's open side into nothing.
-    let away = CameraPose { world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI), ..camera };
+    let away = CameraPose {
+        world_from_view: camera.world_from_view * Mat4::from_rotation_y(std::f32::consts::PI),
+        ..camera
+    };
     for (name, space) in spaces(SCREEN) {
         let grid = space.grid_size();
         let variant = space.shader_variant();
@@ -193,23 +324,46 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             let current = r.space().params();
             let table = grid_table(&ctx, r.space(), None);
             let tiles = fovea_tests::grid_tiles(&ctx, r.space());
-            let (out, moments) = denoise(&ctx, &mut svgf, &r.view(0).gbuffer, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() });
+            let (out, moments) = denoise(
+                &ctx,
+                &mut svgf,
+                &r.view(0).gbuffer,
+                &DenoiseFrame {
+                    current,
+                    previous,
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+            );
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
             assert_finite_non_negative(&format!("{name} frame {f} moments"), &moments);
-            peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+            peak = peak.max(
+                out.iter()
+                    .flat_map(|p| p[..3].iter().copied())
+                    .fold(0.0, f32::max),
+            );
         }
         println!("{name}: brightest output with fireflies {peak:.1}");
 
-        let mut r = Renderer::new(&ctx, &scene, r.space().visual_polar().map_or_else(
-            || Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>,
-            |v| Box::new(*v),
-        ), settings(with_svgf())).unwrap();
+        let mut r = Renderer::new(
+            &ctx,
+            &scene,
+            r.space().visual_polar().map_or_else(
+                || Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>,
+                |v| Box::new(*v),
+            ),
+            settings(with_svgf()),
+        )
+        .unwrap();
         let mut hdr = Vec::new();
         for f in 0..3 {
             r.render_frame(&frame(away, f)).unwrap();
             r.read_hdr(&mut hdr).unwrap();
-            assert!(hdr.iter().all(|p| p[..3] == [0.0; 3]), "{name}: the empty view is not black (frame {f})");
+            assert!(
+                hdr.iter().all(|p| p[..3] == [0.0; 3]),
+                "{name}: the empty view is not black (frame {f})"
+            );
         }
         assert_clean(&ctx);
     }
@@ -225,7 +379,13 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
     for (name, space) in spaces(SCREEN) {
         let screens = texel_screens(space.as_ref());
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
-        let mut svgf = Svgf::new(&ctx, space.grid_size(), space.shader_variant(), SvgfSettings::default()).unwrap();
+        let mut svgf = Svgf::new(
+            &ctx,
+            space.grid_size(),
+            space.shader_variant(),
+            SvgfSettings::default(),
+        )
+        .unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
         let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
@@ -234,31 +394,60 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             let previous = (f > 0).then_some(params);
-            last = denoise(&ctx, &mut svgf, &g, &DenoiseFrame { current: params, previous, sampling_table: &table, tiles: tiles.list() });
+            last = denoise(
+                &ctx,
+                &mut svgf,
+                &g,
+                &DenoiseFrame {
+                    current: params,
+                    previous,
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+            );
         }
         let (out, moments) = last;
         let (mut uncovered, mut followed, mut stayed) = (0, 0, 0);
         for (i, s) in screens.iter().enumerate() {
             // VP samples beyond the screen edge may have had no sample last frame (outside r_max).
-            let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
+            let Some(s) =
+                s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all())
+            else {
+                continue;
+            };
             // Margins of a few pixels keep the 3×3 fallback's legitimate same-surface
             // neighbours (and coarse peripheral VP texels) out of the checked sets.
             let (len, lum) = (moments[i][2], out[i][1]);
             if s.x < 14.0 {
                 uncovered += 1;
-                assert_eq!(len, 1.0, "{name}: uncovered texel {i} at {s} kept a history");
-                assert!(lum < 1.0, "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)");
+                assert_eq!(
+                    len, 1.0,
+                    "{name}: uncovered texel {i} at {s} kept a history"
+                );
+                assert!(
+                    lum < 1.0,
+                    "{name}: uncovered texel {i} at {s} shows {lum} (occluder colour)"
+                );
             } else if s.x > 18.0 && s.x < 46.0 {
                 followed += 1;
-                assert_eq!(len, 9.0, "{name}: the occluder's history at {s} did not follow its motion");
+                assert_eq!(
+                    len, 9.0,
+                    "{name}: the occluder's history at {s} did not follow its motion"
+                );
                 assert!(lum > 2.0, "{name}: occluder texel {i} at {s} shows {lum}");
             } else if s.x > 50.0 {
                 stayed += 1;
-                assert_eq!(len, 9.0, "{name}: static background at {s} lost its history");
+                assert_eq!(
+                    len, 9.0,
+                    "{name}: static background at {s} lost its history"
+                );
             }
         }
         println!("{name}: {uncovered} uncovered, {followed} moved-occluder and {stayed} static texels checked");
-        assert!(uncovered > 20 && followed > 5 && stayed > 20, "{name}: too few texels checked");
+        assert!(
+            uncovered > 20 && followed > 5 && stayed > 20,
+            "{name}: too few texels checked"
+        );
     }
     assert_clean(&ctx);
 }
@@ -273,7 +462,15 @@ fn svgf_over_the_live_tiles_equals_svgf_over_the_whole_grid() {
     let ctx = gpu();
     let mut pair: Option<[Svgf; 2]> = None;
     denoise_over_culled_tiles(&ctx, 6, |f, r, over_tiles, over_grid| {
-        let new = || Svgf::new(&ctx, r.space().grid_size(), r.space().shader_variant(), SvgfSettings::default()).unwrap();
+        let new = || {
+            Svgf::new(
+                &ctx,
+                r.space().grid_size(),
+                r.space().shader_variant(),
+                SvgfSettings::default(),
+            )
+            .unwrap()
+        };
         let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
         denoise(&ctx, a, &r.view(0).gbuffer, over_tiles);
         denoise(&ctx, b, &r.view(0).gbuffer, over_grid);
@@ -299,23 +496,49 @@ fn render_command_runs_svgf_and_reports_it() {
     let out = fovea_tests::artifacts_dir().join(format!("denoise-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     for (method, denoiser) in [("cartesian", "svgf"), ("vp", "svgf"), ("vp", "none")] {
-        run(&RenderArgs { method, denoiser, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) }).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        run(&RenderArgs {
+            method,
+            denoiser,
+            exr: false,
+            ..fovea_tests::small_render_args("cornell-box", &out)
+        })
+        .unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
         assert_eq!(report["denoiser"], denoiser);
-        for pass in ["svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_modulate"] {
-            assert_eq!(report["passes"].get(pass).is_some(), denoiser == "svgf", "{method}/{denoiser}: pass {pass}");
+        for pass in [
+            "svgf_temporal",
+            "svgf_variance",
+            "svgf_atrous",
+            "svgf_modulate",
+        ] {
+            assert_eq!(
+                report["passes"].get(pass).is_some(),
+                denoiser == "svgf",
+                "{method}/{denoiser}: pass {pass}"
+            );
         }
     }
     assert!(DenoiserSettings::parse("nlm").is_err());
 }
 
-
 fn with_taa(denoiser: DenoiserSettings) -> RenderSettings {
-    RenderSettings { taa: TaaMode::SamplingGrid(TaaSettings::default()), ..settings(denoiser) }
+    RenderSettings {
+        taa: TaaMode::SamplingGrid(TaaSettings::default()),
+        ..settings(denoiser)
+    }
 }
 
 /// Runs one TAA frame on `color`; returns its output.
-fn resolve(ctx: &Arc<Context>, taa: &mut Taa, g: &GBuffer, color: &Image, frame: &DenoiseFrame, jitter: Vec2) -> Vec<[f32; 4]> {
+fn resolve(
+    ctx: &Arc<Context>,
+    taa: &mut Taa,
+    g: &GBuffer,
+    color: &Image,
+    frame: &DenoiseFrame,
+    jitter: Vec2,
+) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 4).unwrap();
     rec.begin().unwrap();
     let out = taa.record(&mut rec, g, color, frame, jitter).unwrap();
@@ -334,13 +557,27 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
     let scene = owned_scene("cornell-box");
     let size = SCREEN;
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
-    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings(DenoiserSettings::None)).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    let mut reference_renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(size)),
+        settings(DenoiserSettings::None),
+    )
+    .unwrap();
+    let reference = reference_renderer
+        .render_reference(&camera, 256, 3, |_| {})
+        .unwrap();
     drop(reference_renderer);
     for (name, space) in spaces(size) {
         let vp = space.visual_polar().copied();
-        let again = || -> Box<dyn SamplingSpace> { vp.map_or_else(|| Box::new(Cartesian::new(size)) as Box<dyn SamplingSpace>, |v| Box::new(v)) };
-        let mut raw_renderer = Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
+        let again = || -> Box<dyn SamplingSpace> {
+            vp.map_or_else(
+                || Box::new(Cartesian::new(size)) as Box<dyn SamplingSpace>,
+                |v| Box::new(v),
+            )
+        };
+        let mut raw_renderer =
+            Renderer::new(&ctx, &scene, space, settings(DenoiserSettings::None)).unwrap();
         let mut raw = Vec::new();
         raw_renderer.render_frame(&frame(camera, 0)).unwrap();
         raw_renderer.read_hdr(&mut raw).unwrap();
@@ -353,8 +590,16 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
         }
         r.read_hdr(&mut resolved).unwrap();
         assert_finite_non_negative(name, &resolved);
-        assert!(r.timings().iter().any(|t| t.name == "taa"), "{name}: no taa pass timed");
-        let taa_ms: f64 = r.timings().iter().filter(|t| t.name == "taa").map(|t| t.ms).sum();
+        assert!(
+            r.timings().iter().any(|t| t.name == "taa"),
+            "{name}: no taa pass timed"
+        );
+        let taa_ms: f64 = r
+            .timings()
+            .iter()
+            .filter(|t| t.name == "taa")
+            .map(|t| t.ms)
+            .sum();
         let interior = surface_interiors(&ctx, &r.view(0).gbuffer, r.space());
         save_preview(&format!("taa_{name}_raw.png"), size.x, size.y, &raw);
         save_preview(&format!("taa_{name}.png"), size.x, size.y, &resolved);
@@ -365,10 +610,15 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
         let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
         let lit: Vec<bool> = reference.iter().map(|p| luminance(p) > 1.0).collect();
         let factor = |keep: &dyn Fn(usize) -> bool| {
-            let (a, b) = (rmse_where(&raw, &reference, keep), rmse_where(&resolved, &reference, keep));
+            let (a, b) = (
+                rmse_where(&raw, &reference, keep),
+                rmse_where(&resolved, &reference, keep),
+            );
             (a, b, a / b)
         };
-        let edge_count = (0..interior.len()).filter(|&i| !interior[i] && !lit[i]).count();
+        let edge_count = (0..interior.len())
+            .filter(|&i| !interior[i] && !lit[i])
+            .count();
         let (wa, wb, whole) = factor(&|i| !lit[i]);
         let (ia, ib, inner) = factor(&|i| interior[i] && !lit[i]);
         let (ea, eb, edges) = factor(&|i| !interior[i] && !lit[i]);
@@ -381,9 +631,18 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
             size.x, size.y
         );
         assert!(whole >= 2.5, "{name}: RMSE fell only {whole:.2}×");
-        assert!(inner >= 2.5, "{name}: surface-interior RMSE fell only {inner:.2}×");
-        assert!(edges >= 2.0, "{name}: geometric-edge RMSE fell only {edges:.2}×");
-        assert!(edge_count > 100, "{name}: too few edge pixels ({edge_count})");
+        assert!(
+            inner >= 2.5,
+            "{name}: surface-interior RMSE fell only {inner:.2}×"
+        );
+        assert!(
+            edges >= 2.0,
+            "{name}: geometric-edge RMSE fell only {edges:.2}×"
+        );
+        assert!(
+            edge_count > 100,
+            "{name}: too few edge pixels ({edge_count})"
+        );
     }
     assert_clean(&ctx);
 }
@@ -409,10 +668,26 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
             let jitter = TaaSettings::default().jitter(f);
             let table = grid_table(&ctx, r.space(), None);
             let tiles = fovea_tests::grid_tiles(&ctx, r.space());
-            let out = resolve(&ctx, &mut taa, &r.view(0).gbuffer, &r.view(0).gbuffer.color, &DenoiseFrame { current, previous, sampling_table: &table, tiles: tiles.list() }, jitter);
+            let out = resolve(
+                &ctx,
+                &mut taa,
+                &r.view(0).gbuffer,
+                &r.view(0).gbuffer.color,
+                &DenoiseFrame {
+                    current,
+                    previous,
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+                jitter,
+            );
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f}"), &out);
-            peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+            peak = peak.max(
+                out.iter()
+                    .flat_map(|p| p[..3].iter().copied())
+                    .fold(0.0, f32::max),
+            );
         }
         println!("{name}: brightest TAA output with fireflies {peak:.1}");
     }
@@ -429,7 +704,13 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
     for (name, space) in spaces(SCREEN) {
         let screens = texel_screens(space.as_ref());
         let g = GBuffer::new(&ctx, space.grid_size()).unwrap();
-        let mut taa = Taa::new(&ctx, space.grid_size(), space.shader_variant(), TaaSettings::default()).unwrap();
+        let mut taa = Taa::new(
+            &ctx,
+            space.grid_size(),
+            space.shader_variant(),
+            TaaSettings::default(),
+        )
+        .unwrap();
         let params = space.params();
         let table = grid_table(&ctx, space.as_ref(), None);
         let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
@@ -439,15 +720,34 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
             upload_gbuffer(&ctx, &g, &samples);
             current = samples;
             // Samples at texel centres: the jitter is the centre.
-            out = resolve(&ctx, &mut taa, &g, &g.color, &DenoiseFrame { current: params, previous: (f > 0).then_some(params), sampling_table: &table, tiles: tiles.list() }, Vec2::splat(0.5));
+            out = resolve(
+                &ctx,
+                &mut taa,
+                &g,
+                &g.color,
+                &DenoiseFrame {
+                    current: params,
+                    previous: (f > 0).then_some(params),
+                    sampling_table: &table,
+                    tiles: tiles.list(),
+                },
+                Vec2::splat(0.5),
+            );
         }
         let (mut uncovered, mut followed, mut stayed, mut blended) = (0, 0, 0, 0);
         for (i, s) in screens.iter().enumerate() {
-            let Some(s) = s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all()) else { continue };
+            let Some(s) =
+                s.filter(|s| s.cmpge(Vec2::ZERO).all() && s.cmplt(SCREEN.as_vec2()).all())
+            else {
+                continue;
+            };
             let (got, now) = (out[i][1], current[i].unwrap().radiance);
             if s.x < 14.0 {
                 uncovered += 1;
-                assert!((got - now).abs() <= 1e-5 * now, "{name}: uncovered texel {i} at {s} shows {got}, this frame's sample is {now}");
+                assert!(
+                    (got - now).abs() <= 1e-5 * now,
+                    "{name}: uncovered texel {i} at {s} shows {got}, this frame's sample is {now}"
+                );
             } else if s.x > 18.0 && s.x < 46.0 {
                 followed += 1;
                 assert!(got > 2.0, "{name}: occluder texel {i} at {s} shows {got}");
@@ -459,8 +759,15 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
             }
         }
         println!("{name}: {uncovered} uncovered (reset), {followed} moved-occluder and {stayed} static texels ({blended} blended)");
-        assert!(uncovered > 20 && followed > 5 && stayed > 20, "{name}: too few texels checked");
-        assert!(blended as f32 >= 0.95 * (followed + stayed) as f32, "{name}: only {blended} of {} texels kept a history", followed + stayed);
+        assert!(
+            uncovered > 20 && followed > 5 && stayed > 20,
+            "{name}: too few texels checked"
+        );
+        assert!(
+            blended as f32 >= 0.95 * (followed + stayed) as f32,
+            "{name}: only {blended} of {} texels kept a history",
+            followed + stayed
+        );
     }
     assert_clean(&ctx);
 }
@@ -475,11 +782,20 @@ fn taa_makes_the_tracer_use_the_frames_halton_offset() {
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     for (name, space) in spaces(SCREEN) {
         let vp = space.visual_polar().copied();
-        let again = || -> Box<dyn SamplingSpace> { vp.map_or_else(|| Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>, |v| Box::new(v)) };
+        let again = || -> Box<dyn SamplingSpace> {
+            vp.map_or_else(
+                || Box::new(Cartesian::new(SCREEN)) as Box<dyn SamplingSpace>,
+                |v| Box::new(v),
+            )
+        };
         let grid = space.grid_size();
         drop(space);
         for taa_on in [true, false] {
-            let s = if taa_on { with_taa(DenoiserSettings::None) } else { settings(DenoiserSettings::None) };
+            let s = if taa_on {
+                with_taa(DenoiserSettings::None)
+            } else {
+                settings(DenoiserSettings::None)
+            };
             let mut r = Renderer::new(&ctx, &scene, again(), s).unwrap();
             for f in [0u32, 1, 5, 17] {
                 r.render_frame(&frame(camera, f)).unwrap();
@@ -489,8 +805,16 @@ fn taa_makes_the_tracer_use_the_frames_halton_offset() {
                 for y in 0..grid.y {
                     for x in 0..grid.x {
                         let m = Vec2::from(motion[(y * grid.x + x) as usize]);
-                        let Some(expected) = r.space().grid_to_screen(Vec2::new(x as f32, y as f32) + jitter) else { continue };
-                        if m == Vec2::splat(-1.0) || !(expected.cmpge(Vec2::ZERO).all() && expected.cmplt(SCREEN.as_vec2()).all()) {
+                        let Some(expected) = r
+                            .space()
+                            .grid_to_screen(Vec2::new(x as f32, y as f32) + jitter)
+                        else {
+                            continue;
+                        };
+                        if m == Vec2::splat(-1.0)
+                            || !(expected.cmpge(Vec2::ZERO).all()
+                                && expected.cmplt(SCREEN.as_vec2()).all())
+                        {
                             continue;
                         }
                         let e = (m - expected).length();
@@ -503,7 +827,11 @@ fn taa_makes_the_tracer_use_the_frames_halton_offset() {
                 if taa_on {
                     assert!(worst < 0.02, "{name} frame {f}: a sample lies {worst} px from the Halton offset {jitter}");
                 } else {
-                    assert!(off as f32 > 0.5 * checked as f32, "{name} frame {f}: random jitter matches Halton at {} of {checked}", checked - off);
+                    assert!(
+                        off as f32 > 0.5 * checked as f32,
+                        "{name} frame {f}: random jitter matches Halton at {} of {checked}",
+                        checked - off
+                    );
                 }
                 if f == 5 {
                     println!("{name} taa {taa_on}: frame {f} jitter {jitter}, {checked} texels, worst {worst:.5} px, {off} off by > 0.05 px");
@@ -522,7 +850,13 @@ fn render_command_runs_taa_and_reports_it() {
     use fovea_tools::commands::render::{run, RenderArgs};
     let out = fovea_tests::artifacts_dir().join(format!("taa-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let args = |method, denoiser, taa| RenderArgs { method, denoiser, taa, exr: false, ..fovea_tests::small_render_args("cornell-box", &out) };
+    let args = |method, denoiser, taa| RenderArgs {
+        method,
+        denoiser,
+        taa,
+        exr: false,
+        ..fovea_tests::small_render_args("cornell-box", &out)
+    };
     let runs = [
         ("cartesian", "none", "vp", Some("taa")),
         ("cartesian", "none", "screen", Some("taa")),
@@ -532,10 +866,16 @@ fn render_command_runs_taa_and_reports_it() {
     ];
     for (method, denoiser, taa, pass) in runs {
         run(&args(method, denoiser, taa)).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
         assert_eq!(report["taa"], taa);
         for name in ["taa", "taa_screen"] {
-            assert_eq!(report["passes"].get(name).is_some(), pass == Some(name), "{method}/{denoiser}/{taa}: {name}");
+            assert_eq!(
+                report["passes"].get(name).is_some(),
+                pass == Some(name),
+                "{method}/{denoiser}/{taa}: {name}"
+            );
         }
     }
     let err = format!("{:#}", run(&args("vp", "none", "temporal")).unwrap_err());

@@ -28,7 +28,15 @@ fn image(w: u32, h: u32) -> Vec<[f32; 4]> {
 }
 
 fn args<'a>(reference: &'a Path, test: &'a Path, gaze: &'a str, out: &'a Path) -> EvalArgs<'a> {
-    EvalArgs { reference, test, gaze, rings: 10, out, headset: None, ppd: None }
+    EvalArgs {
+        reference,
+        test,
+        gaze,
+        rings: 10,
+        out,
+        headset: None,
+        ppd: None,
+    }
 }
 
 fn read_json(dir: &Path) -> serde_json::Value {
@@ -44,21 +52,42 @@ fn identical_frames_score_perfectly() {
     eval(&args(&reference, &reference, "32,36", &out)).unwrap();
     assert!(out.join("eval.png").exists());
     let json = read_json(&out);
-    assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(W as u64), Some(H as u64)));
+    assert_eq!(
+        (json["width"].as_u64(), json["height"].as_u64()),
+        (Some(W as u64), Some(H as u64))
+    );
     assert_eq!(json["frame"]["rmse"], 0.0);
     assert_eq!(json["frame"]["ssim"], 1.0);
     assert_eq!(json["frame"]["psnr"], fovea_tools::metrics::PSNR_CAP_DB);
     assert_eq!(json["frame"]["pixels"], W * H);
     let rings = json["rings"].as_array().unwrap();
     assert_eq!(rings.len(), 10);
-    assert_eq!(rings.iter().map(|r| r["pixels"].as_u64().unwrap()).sum::<u64>(), (W * H) as u64);
+    assert_eq!(
+        rings
+            .iter()
+            .map(|r| r["pixels"].as_u64().unwrap())
+            .sum::<u64>(),
+        (W * H) as u64
+    );
     let r_max = json["r_max_px"].as_f64().unwrap();
     assert!((r_max - (32f64.powi(2) + 36f64.powi(2)).sqrt()).abs() < 1e-9);
     for r in rings {
-        for key in ["ring", "r_inner_px", "r_outer_px", "ecc_inner", "ecc_outer", "rmse", "psnr", "ssim"] {
+        for key in [
+            "ring",
+            "r_inner_px",
+            "r_outer_px",
+            "ecc_inner",
+            "ecc_outer",
+            "rmse",
+            "psnr",
+            "ssim",
+        ] {
             assert!(r.get(key).is_some(), "ring lacks '{key}'");
         }
-        assert_eq!((&r["rmse"], &r["ssim"]), (&serde_json::json!(0.0), &serde_json::json!(1.0)));
+        assert_eq!(
+            (&r["rmse"], &r["ssim"]),
+            (&serde_json::json!(0.0), &serde_json::json!(1.0))
+        );
     }
     assert_eq!(rings[9]["ecc_outer"], 80.0);
     // Running again into the same folder replaces only fovea's own files.
@@ -76,7 +105,10 @@ fn peripheral_error_shows_only_in_outer_rings() {
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let (dx, dy) = ((i as u32 % W) as f32 + 0.5 - 32.0, (i as u32 / W) as f32 + 0.5 - 36.0);
+            let (dx, dy) = (
+                (i as u32 % W) as f32 + 0.5 - 32.0,
+                (i as u32 / W) as f32 + 0.5 - 36.0,
+            );
             if dx.hypot(dy) > 30.0 {
                 [p[0] + 0.25, p[1] + 0.25, p[2] + 0.25, 1.0]
             } else {
@@ -98,7 +130,10 @@ fn peripheral_error_shows_only_in_outer_rings() {
     for r in &rings[7..] {
         let rmse = r["rmse"].as_f64().unwrap();
         assert!((rmse - 0.25).abs() < 1e-6, "outer ring {r}");
-        assert!(r["psnr"].as_f64().unwrap() < 13.0 && r["ssim"].as_f64().unwrap() < 1.0, "outer ring {r}");
+        assert!(
+            r["psnr"].as_f64().unwrap() < 13.0 && r["ssim"].as_f64().unwrap() < 1.0,
+            "outer ring {r}"
+        );
     }
     assert!(json["frame"]["rmse"].as_f64().unwrap() > 0.0);
 }
@@ -119,16 +154,28 @@ fn bad_inputs_are_named_in_the_error() {
 
     let small = dir.join("small.exr");
     write_exr(&small, 32, 36, &image(32, 36)).unwrap();
-    let err = format!("{:#}", eval(&args(&good, &small, "16,18", &out)).unwrap_err());
-    assert!(err.contains("small.exr") && err.contains("32×36") && err.contains("64×72"), "{err}");
+    let err = format!(
+        "{:#}",
+        eval(&args(&good, &small, "16,18", &out)).unwrap_err()
+    );
+    assert!(
+        err.contains("small.exr") && err.contains("32×36") && err.contains("64×72"),
+        "{err}"
+    );
 
     let missing = dir.join("missing.exr");
-    let err = format!("{:#}", eval(&args(&missing, &good, "32,36", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        eval(&args(&missing, &good, "32,36", &out)).unwrap_err()
+    );
     assert!(err.contains("missing.exr"), "{err}");
 
     let not_exr = dir.join("notes.exr");
     std::fs::write(&not_exr, "not an image").unwrap();
-    let err = format!("{:#}", eval(&args(&good, &not_exr, "32,36", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        eval(&args(&good, &not_exr, "32,36", &out)).unwrap_err()
+    );
     assert!(err.contains("notes.exr"), "{err}");
 
     for gaze in ["100,10", "10,-1", "nan,3", "inf,3", "12"] {
@@ -137,27 +184,63 @@ fn bad_inputs_are_named_in_the_error() {
     }
     // --rings: 1..=1000, and at most the half-diagonal (48.2 px for 64×72) so that no ring is
     // narrower than a pixel. 10⁸ rings used to abort on allocation, 10⁶ wrote a 256 MB eval.json.
-    for (rings, needle) in [(0, "1..=1000"), (1001, "1..=1000"), (1_000_000, "1..=1000"), (100_000_000, "1..=1000"), (49, "at most 48 rings")] {
-        let err = format!("{:#}", eval(&EvalArgs { rings, ..args(&good, &good, "32,36", &out) }).unwrap_err());
-        assert!(err.contains(&format!("--rings {rings}")) && err.contains(needle), "{rings}: {err}");
+    for (rings, needle) in [
+        (0, "1..=1000"),
+        (1001, "1..=1000"),
+        (1_000_000, "1..=1000"),
+        (100_000_000, "1..=1000"),
+        (49, "at most 48 rings"),
+    ] {
+        let err = format!(
+            "{:#}",
+            eval(&EvalArgs {
+                rings,
+                ..args(&good, &good, "32,36", &out)
+            })
+            .unwrap_err()
+        );
+        assert!(
+            err.contains(&format!("--rings {rings}")) && err.contains(needle),
+            "{rings}: {err}"
+        );
     }
     // Nothing was written for failed runs.
     assert!(!out.exists());
-    eval(&EvalArgs { rings: 48, ..args(&good, &good, "0,0", &out) }).unwrap();
-    assert!(read_json(&out)["rings"].as_array().unwrap().iter().all(|r| r["pixels"].as_u64().unwrap() > 0), "every ring holds pixels");
+    eval(&EvalArgs {
+        rings: 48,
+        ..args(&good, &good, "0,0", &out)
+    })
+    .unwrap();
+    assert!(
+        read_json(&out)["rings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|r| r["pixels"].as_u64().unwrap() > 0),
+        "every ring holds pixels"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 
     // A folder holding the user's files is refused and left alone.
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("mine.txt"), "mine").unwrap();
-    let err = format!("{:#}", eval(&args(&good, &good, "32,36", &out)).unwrap_err());
+    let err = format!(
+        "{:#}",
+        eval(&args(&good, &good, "32,36", &out)).unwrap_err()
+    );
     assert!(err.contains("mine.txt"), "{err}");
-    assert_eq!(std::fs::read_to_string(out.join("mine.txt")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(out.join("mine.txt")).unwrap(),
+        "mine"
+    );
 }
 
 /// `fovea quality` of the Cornell box at 40×36 for `[methods, denoisers, taa, cameras]`: 3 frames,
 /// the last 2 evaluated against 4-spp references, 4 rings, validation on.
-fn quality_args<'a>([methods, denoisers, taa, cameras]: [&'a [String]; 4], out: &'a std::path::Path) -> fovea_tools::commands::quality::QualityArgs<'a> {
+fn quality_args<'a>(
+    [methods, denoisers, taa, cameras]: [&'a [String]; 4],
+    out: &'a std::path::Path,
+) -> fovea_tools::commands::quality::QualityArgs<'a> {
     fovea_tools::commands::quality::QualityArgs {
         scene: "cornell-box",
         width: 40,
@@ -189,12 +272,21 @@ fn quality_command_measures_every_combination() {
     use fovea_tools::commands::quality::{run, QualityArgs};
     let out = temp_dir("quality");
     let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-    let (methods, denoisers, taa, cameras) = (strings(&["vp", "cartesian"]), strings(&["none"]), strings(&["off", "screen"]), strings(&["still", "moving"]));
-    let args = |d| QualityArgs { denoisers: d, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
+    let (methods, denoisers, taa, cameras) = (
+        strings(&["vp", "cartesian"]),
+        strings(&["none"]),
+        strings(&["off", "screen"]),
+        strings(&["still", "moving"]),
+    );
+    let args = |d| QualityArgs {
+        denoisers: d,
+        ..quality_args([&methods, &denoisers, &taa, &cameras], &out)
+    };
     for _ in 0..2 {
         run(&args(&denoisers)).unwrap();
     }
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
     let runs = report["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2 * 2 * 2, "{runs:?}");
     for r in runs {
@@ -203,16 +295,38 @@ fn quality_command_measures_every_combination() {
         let rmse = r["frame_rmse"].as_f64().unwrap();
         assert!(rmse.is_finite() && rmse > 0.0, "{r}");
         // FLIP and flicker (1 spp without a denoiser: every frame differs from the last).
-        let (flip, flicker) = (r["frame_flip"].as_f64().unwrap(), r["frame_flicker"].as_f64().unwrap());
-        assert!(flip > 0.0 && flip < 1.0 && flicker > 0.0 && flicker < 1.0, "{r}");
-        assert!(r["rings"].as_array().unwrap().iter().all(|ring| ring["flip"].is_number() && ring["flicker"].is_number()), "{r}");
+        let (flip, flicker) = (
+            r["frame_flip"].as_f64().unwrap(),
+            r["frame_flicker"].as_f64().unwrap(),
+        );
+        assert!(
+            flip > 0.0 && flip < 1.0 && flicker > 0.0 && flicker < 1.0,
+            "{r}"
+        );
+        assert!(
+            r["rings"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|ring| ring["flip"].is_number() && ring["flicker"].is_number()),
+            "{r}"
+        );
     }
     // A still camera needs one reference; a moving one a reference per evaluated frame.
-    for name in ["reference_still_0000.exr", "reference_moving_0001.exr", "reference_moving_0002.exr"] {
+    for name in [
+        "reference_still_0000.exr",
+        "reference_moving_0001.exr",
+        "reference_moving_0002.exr",
+    ] {
         assert!(out.join(name).is_file(), "{name} missing");
     }
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
-    assert!(table.contains("**moving camera**") && table.contains("| vp + none, screen |") && table.contains("Temporal flicker"), "{table}");
+    assert!(
+        table.contains("**moving camera**")
+            && table.contains("| vp + none, screen |")
+            && table.contains("Temporal flicker"),
+        "{table}"
+    );
     let bad = strings(&["nlm"]);
     let err = format!("{:#}", run(&args(&bad)).unwrap_err());
     assert!(err.contains("--denoisers nlm"), "{err}");
@@ -231,20 +345,60 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     let methods = expand_methods(strings(&["all"]));
     assert_eq!(methods, strings(&fovea_tools::commands::methods::names()));
-    let (denoisers, taa, cameras) = (strings(&["none", "svgf"]), strings(&["off"]), strings(&["still"]));
-    let args = QualityArgs { frames: 2, eval_frames: 1, rings: 3, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
+    let (denoisers, taa, cameras) = (
+        strings(&["none", "svgf"]),
+        strings(&["off"]),
+        strings(&["still"]),
+    );
+    let args = QualityArgs {
+        frames: 2,
+        eval_frames: 1,
+        rings: 3,
+        ..quality_args([&methods, &denoisers, &taa, &cameras], &out)
+    };
     run(&args).unwrap();
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
-    let refused: Vec<&str> = report["refused"].as_array().unwrap().iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(refused, ["uniform-budget", "linear-falloff", "random-acuity", "pixel-blocks", "vrs-tiles"]);
-    assert!(report["refused"].as_array().unwrap().iter().all(|r| r["denoiser"] == "svgf" && r["reason"].as_str().unwrap().contains("supports no denoiser")));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
+    let refused: Vec<&str> = report["refused"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["method"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        refused,
+        [
+            "uniform-budget",
+            "linear-falloff",
+            "random-acuity",
+            "pixel-blocks",
+            "vrs-tiles"
+        ]
+    );
+    assert!(report["refused"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["denoiser"] == "svgf"
+            && r["reason"]
+                .as_str()
+                .unwrap()
+                .contains("supports no denoiser")));
     let runs = report["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2 * methods.len() - refused.len(), "{runs:?}");
     for m in &methods {
-        assert!(runs.iter().any(|r| r["method"] == m.as_str() && r["denoiser"] == "none" && r["frame_flip"].as_f64().unwrap() > 0.0), "{m}");
+        assert!(
+            runs.iter().any(|r| r["method"] == m.as_str()
+                && r["denoiser"] == "none"
+                && r["frame_flip"].as_f64().unwrap() > 0.0),
+            "{m}"
+        );
     }
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
-    assert!(table.contains("| random-acuity + svgf, off | refused: random-acuity supports no denoiser"), "{table}");
+    assert!(
+        table.contains("| random-acuity + svgf, off | refused: random-acuity supports no denoiser"),
+        "{table}"
+    );
 
     // The method table from this run and a bench report, into a README between its markers.
     let bench_out = out.join("bench");
@@ -272,27 +426,63 @@ fn quality_methods_all_lists_what_a_method_refuses() {
     let pictures = docs.join("docs").join("methods");
     let bench_report = [bench_out.join("report.json")];
     // The committed equal-samples report of the README's claim (VP against composite at σ = 1.66).
-    let equal = [std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/methods/quality-equal-samples-composite.json")];
-    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs { quality: &out, bench: &bench_report, readme, pictures: &pictures, equal_samples: &equal };
+    let equal = [std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../docs/methods/quality-equal-samples-composite.json")];
+    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs {
+        quality: &out,
+        bench: &bench_report,
+        readme,
+        pictures: &pictures,
+        equal_samples: &equal,
+    };
     fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
     let text = std::fs::read_to_string(&readme).unwrap();
     assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n") && !text.contains("old"), "{text}");
     for m in &methods {
         assert!(text.contains(&format!("| {m} + none | ")), "{m}: {text}");
-        assert!(pictures.join(format!("{m}.png")).is_file() && pictures.join(format!("{m}_flip.png")).is_file(), "{m}");
-        assert!(text.contains(&format!("![{m}](docs/methods/{m}.png)")), "{m}");
+        assert!(
+            pictures.join(format!("{m}.png")).is_file()
+                && pictures.join(format!("{m}_flip.png")).is_file(),
+            "{m}"
+        );
+        assert!(
+            text.contains(&format!("![{m}](docs/methods/{m}.png)")),
+            "{m}"
+        );
     }
-    assert!(text.contains("| pixel-blocks + svgf | refused:") && text.contains("faster traversal per sample for Visual-Polar than random acuity"), "{text}");
+    assert!(
+        text.contains("| pixel-blocks + svgf | refused:")
+            && text.contains("faster traversal per sample for Visual-Polar than random acuity"),
+        "{text}"
+    );
     assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034, gaze `sim:1`") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
     // A report of many methods is no equal-samples pair: named, and the README left as it was.
     let many = [out.join("quality.json")];
-    let err = format!("{:#}", fovea_tools::commands::method_table::run(&fovea_tools::commands::method_table::MethodTableArgs { equal_samples: &many, ..table_args(&readme) }).unwrap_err());
-    assert!(err.contains("quality.json") && err.contains("exactly one other method"), "{err}");
+    let err = format!(
+        "{:#}",
+        fovea_tools::commands::method_table::run(
+            &fovea_tools::commands::method_table::MethodTableArgs {
+                equal_samples: &many,
+                ..table_args(&readme)
+            }
+        )
+        .unwrap_err()
+    );
+    assert!(
+        err.contains("quality.json") && err.contains("exactly one other method"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_to_string(&readme).unwrap(), text);
     let bare = docs.join("BARE.md");
     std::fs::write(&bare, "no markers").unwrap();
-    let err = format!("{:#}", fovea_tools::commands::method_table::run(&table_args(&bare)).unwrap_err());
-    assert!(err.contains("BARE.md") && err.contains("method-table:begin"), "{err}");
+    let err = format!(
+        "{:#}",
+        fovea_tools::commands::method_table::run(&table_args(&bare)).unwrap_err()
+    );
+    assert!(
+        err.contains("BARE.md") && err.contains("method-table:begin"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_to_string(&bare).unwrap(), "no markers");
 }
 
@@ -303,12 +493,23 @@ fn quality_rings_are_bounded_before_rendering() {
     use fovea_tools::commands::quality::{run, QualityArgs};
     let out = temp_dir("quality-rings").join("out");
     let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-    let (methods, denoisers, taa, cameras) = (names(&["vp"]), names(&["none"]), names(&["off"]), names(&["still"]));
+    let (methods, denoisers, taa, cameras) = (
+        names(&["vp"]),
+        names(&["none"]),
+        names(&["off"]),
+        names(&["still"]),
+    );
     // 40×36: half-diagonal 26.9 px.
     for (rings, needle) in [(1001, "1..=1000"), (27, "at most 26 rings")] {
-        let args = QualityArgs { rings, ..quality_args([&methods, &denoisers, &taa, &cameras], &out) };
+        let args = QualityArgs {
+            rings,
+            ..quality_args([&methods, &denoisers, &taa, &cameras], &out)
+        };
         let err = format!("{:#}", run(&args).unwrap_err());
-        assert!(err.contains(&format!("--rings {rings}")) && err.contains(needle), "{err}");
+        assert!(
+            err.contains(&format!("--rings {rings}")) && err.contains(needle),
+            "{err}"
+        );
     }
     assert!(!out.exists());
 }
@@ -331,32 +532,63 @@ fn true_eccentricity_rings_through_a_headset() {
         .enumerate()
         .map(|(i, p)| {
             let px = glam::Vec2::new((i as u32 % W) as f32 + 0.5, (i as u32 / W) as f32 + 0.5);
-            if axis.eccentricity(px - gaze) > 30.0 { [p[0] + 0.5, p[1], p[2], 1.0] } else { *p }
+            if axis.eccentricity(px - gaze) > 30.0 {
+                [p[0] + 0.5, p[1], p[2], 1.0]
+            } else {
+                *p
+            }
         })
         .collect();
     let test = dir.join("test.exr");
     write_exr(&test, W, H, &noisy).unwrap();
     let out = dir.join("out");
-    eval(&EvalArgs { headset: Some("fove0"), ..args(&reference, &test, "32,36", &out) }).unwrap();
+    eval(&EvalArgs {
+        headset: Some("fove0"),
+        ..args(&reference, &test, "32,36", &out)
+    })
+    .unwrap();
     let json = read_json(&out);
     let t = &json["true_eccentricity"];
     assert_eq!(t["headset"], "fove0");
     let e_max = t["e_max_deg"].as_f64().unwrap();
-    assert!((e_max - axis.e_max as f64).abs() < 1e-9 && e_max > 50.0, "e_max {e_max}");
+    assert!(
+        (e_max - axis.e_max as f64).abs() < 1e-9 && e_max > 50.0,
+        "e_max {e_max}"
+    );
     let rings = t["rings"].as_array().unwrap();
-    assert_eq!(rings.iter().map(|r| r["pixels"].as_u64().unwrap()).sum::<u64>(), (W * H) as u64);
+    assert_eq!(
+        rings
+            .iter()
+            .map(|r| r["pixels"].as_u64().unwrap())
+            .sum::<u64>(),
+        (W * H) as u64
+    );
     for r in rings {
-        let (inner, outer, rmse) = (r["inner"].as_f64().unwrap(), r["outer"].as_f64().unwrap(), r["rmse"].as_f64());
+        let (inner, outer, rmse) = (
+            r["inner"].as_f64().unwrap(),
+            r["outer"].as_f64().unwrap(),
+            r["rmse"].as_f64(),
+        );
         if outer <= 30.0 {
             assert_eq!(rmse, Some(0.0), "ring {inner}–{outer}° should be clean");
         } else if inner >= 30.0 {
-            assert!(rmse.unwrap() > 0.1, "ring {inner}–{outer}° should show the error");
+            assert!(
+                rmse.unwrap() > 0.1,
+                "ring {inner}–{outer}° should show the error"
+            );
         }
     }
     // Without --headset the field is absent; a bad headset is named.
     eval(&args(&reference, &test, "32,36", &out)).unwrap();
     assert!(read_json(&out).get("true_eccentricity").is_none());
-    let err = format!("{:#}", eval(&EvalArgs { headset: Some("nope"), ..args(&reference, &test, "32,36", &out) }).unwrap_err());
+    let err = format!(
+        "{:#}",
+        eval(&EvalArgs {
+            headset: Some("nope"),
+            ..args(&reference, &test, "32,36", &out)
+        })
+        .unwrap_err()
+    );
     assert!(err.contains("--headset nope"), "{err}");
 }
 
@@ -366,10 +598,14 @@ fn true_eccentricity_rings_through_a_headset() {
 fn flip_whole_frame_and_per_ring_for_exr_and_png() {
     let dir = temp_dir("flip");
     let (reference, test) = (dir.join("ref.exr"), dir.join("test.exr"));
-    let noisy: Vec<[f32; 4]> = image(W, H).iter().enumerate().map(|(i, p)| {
-        let n = if (i * 7919) % 13 < 6 { 0.25 } else { -0.2 };
-        [p[0] + n, p[1] + n, p[2] + n, 1.0]
-    }).collect();
+    let noisy: Vec<[f32; 4]> = image(W, H)
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let n = if (i * 7919) % 13 < 6 { 0.25 } else { -0.2 };
+            [p[0] + n, p[1] + n, p[2] + n, 1.0]
+        })
+        .collect();
     write_exr(&reference, W, H, &image(W, H)).unwrap();
     write_exr(&test, W, H, &noisy).unwrap();
     let out = dir.join("exr");
@@ -381,29 +617,64 @@ fn flip_whole_frame_and_per_ring_for_exr_and_png() {
     assert!((ppd - 64.0 / 90.0).abs() < 1e-3, "{ppd}");
     let flip = j["frame"]["flip"].as_f64().unwrap();
     assert!(flip > 0.05 && flip < 1.0, "{flip}");
-    assert!(j["rings"].as_array().unwrap().iter().all(|r| r["flip"].as_f64().is_some_and(|f| f > 0.0)));
+    assert!(j["rings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["flip"].as_f64().is_some_and(|f| f > 0.0)));
 
     // The same pictures as PNGs (tonemapped like the EXRs were): the same FLIP; identical → 0.
     let png = |name: &str, texels: &[[f32; 4]]| {
         let path = dir.join(name);
-        fovea_tools::output::write_png(&path, W, H, &fovea_tools::output::tonemap_preview(texels, 1.0)).unwrap();
+        fovea_tools::output::write_png(
+            &path,
+            W,
+            H,
+            &fovea_tools::output::tonemap_preview(texels, 1.0),
+        )
+        .unwrap();
         path
     };
     let (reference_png, test_png) = (png("ref.png", &image(W, H)), png("test.png", &noisy));
     let out_png = dir.join("png");
-    eval(&EvalArgs { ppd: Some(ppd as f32), ..args(&reference_png, &test_png, "32,36", &out_png) }).unwrap();
+    eval(&EvalArgs {
+        ppd: Some(ppd as f32),
+        ..args(&reference_png, &test_png, "32,36", &out_png)
+    })
+    .unwrap();
     let p = read_json(&out_png);
     assert_eq!(p["inputs"], "png");
-    assert!((p["frame"]["flip"].as_f64().unwrap() - flip).abs() < 1e-6, "PNG {} vs EXR {flip}", p["frame"]["flip"]);
+    assert!(
+        (p["frame"]["flip"].as_f64().unwrap() - flip).abs() < 1e-6,
+        "PNG {} vs EXR {flip}",
+        p["frame"]["flip"]
+    );
     let same = dir.join("same");
-    eval(&EvalArgs { ppd: Some(30.0), ..args(&reference_png, &reference_png, "center", &same) }).unwrap();
+    eval(&EvalArgs {
+        ppd: Some(30.0),
+        ..args(&reference_png, &reference_png, "center", &same)
+    })
+    .unwrap();
     let s = read_json(&same);
-    assert_eq!((s["frame"]["flip"].as_f64(), s["flip_ppd"].as_f64()), (Some(0.0), Some(30.0)));
+    assert_eq!(
+        (s["frame"]["flip"].as_f64(), s["flip_ppd"].as_f64()),
+        (Some(0.0), Some(30.0))
+    );
 
     // Mixed kinds and a bad --ppd are refused.
-    let mixed = format!("{:#}", eval(&args(&reference, &test_png, "32,36", &dir.join("mixed"))).unwrap_err());
+    let mixed = format!(
+        "{:#}",
+        eval(&args(&reference, &test_png, "32,36", &dir.join("mixed"))).unwrap_err()
+    );
     assert!(mixed.contains("both"), "{mixed}");
-    let bad = format!("{:#}", eval(&EvalArgs { ppd: Some(f32::NAN), ..args(&reference_png, &test_png, "32,36", &dir.join("bad")) }).unwrap_err());
+    let bad = format!(
+        "{:#}",
+        eval(&EvalArgs {
+            ppd: Some(f32::NAN),
+            ..args(&reference_png, &test_png, "32,36", &dir.join("bad"))
+        })
+        .unwrap_err()
+    );
     assert!(bad.contains("--ppd"), "{bad}");
 }
 
@@ -427,9 +698,16 @@ fn flip_matches_nvidias_tool_on_a_known_pair() {
     let dir = temp_dir("flip-nvidia");
     for (k, (test, ppd, expected)) in cases.into_iter().enumerate() {
         let out = dir.join(k.to_string());
-        eval(&EvalArgs { ppd: Some(ppd), ..args(&reference, &data.join(test), "center", &out) }).unwrap();
+        eval(&EvalArgs {
+            ppd: Some(ppd),
+            ..args(&reference, &data.join(test), "center", &out)
+        })
+        .unwrap();
         let flip = read_json(&out)["frame"]["flip"].as_f64().unwrap();
         println!("{test} at {ppd} ppd: fovea eval {flip:.7}, NVIDIA's flip {expected:.7}");
-        assert!((flip - expected).abs() < 2e-6, "{test} at {ppd} ppd: {flip} vs NVIDIA's {expected}");
+        assert!(
+            (flip - expected).abs() < 2e-6,
+            "{test} at {ppd} ppd: {flip} vs NVIDIA's {expected}"
+        );
     }
 }

@@ -7,7 +7,9 @@
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{
+    Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
+};
 use fovea_tests::{assert_clean, gpu};
 use glam::{UVec2, Vec2};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -72,15 +74,29 @@ fn render_loop_makes_no_host_allocations() {
         Box::new(VisualPolar::new(SCREEN, SCREEN.as_vec2() * 0.5, params).unwrap())
     };
     let vp = || vp_with(VisualPolarParams::default());
-    let clipped = VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
-    let screen_aware = VisualPolarParams { layout: VpLayout::ScreenAware, ..Default::default() };
+    let clipped = VisualPolarParams {
+        layout: VpLayout::ScreenClipped,
+        ..Default::default()
+    };
+    let screen_aware = VisualPolarParams {
+        layout: VpLayout::ScreenAware,
+        ..Default::default()
+    };
     let fove0 = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
-    let headset = VisualPolarParams { eccentricity: Eccentricity::Headset(fove0), ..Default::default() };
+    let headset = VisualPolarParams {
+        eccentricity: Eccentricity::Headset(fove0),
+        ..Default::default()
+    };
     let cases: [(&str, Box<dyn SamplingSpace>, &str, &str); 8] = [
         ("cartesian", Box::new(Cartesian::new(SCREEN)), "none", "off"),
         ("vp", vp(), "none", "off"),
         ("vp screen-clipped", vp_with(clipped), "none", "off"),
-        ("vp screen-aware + svgf", vp_with(screen_aware), "svgf", "off"),
+        (
+            "vp screen-aware + svgf",
+            vp_with(screen_aware),
+            "svgf",
+            "off",
+        ),
         ("vp headset axis", vp_with(headset), "none", "off"),
         ("vp svgf + screen TAA", vp(), "svgf", "screen"),
         ("vp asvgf + grid TAA", vp(), "asvgf", "vp"),
@@ -98,7 +114,8 @@ fn render_loop_makes_no_host_allocations() {
         let mut counts = Vec::new();
         for frame in 0..WARM_UP_FRAMES + COUNTED_FRAMES {
             // The gaze moves every frame, as it does on a headset.
-            let gaze = SCREEN.as_vec2() * Vec2::new(0.3 + 0.1 * frame as f32, 0.6 - 0.05 * frame as f32);
+            let gaze =
+                SCREEN.as_vec2() * Vec2::new(0.3 + 0.1 * frame as f32, 0.6 - 0.05 * frame as f32);
             let input = FrameInput::mono(camera, frame, Some(gaze));
             let n = allocations_during(|| {
                 renderer.render_frame(&input).unwrap();
@@ -111,6 +128,10 @@ fn render_loop_makes_no_host_allocations() {
             failures.push(format!("{name}: {counts:?}"));
         }
     }
-    assert!(failures.is_empty(), "the render loop allocates on the host:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "the render loop allocates on the host:\n{}",
+        failures.join("\n")
+    );
     assert_clean(&ctx);
 }

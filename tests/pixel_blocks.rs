@@ -11,7 +11,8 @@ use fovea_tests::{assert_clean, gpu, owned_scene, probe, SpaceBuffers};
 use glam::{IVec2, UVec2, Vec2};
 
 fn blocks(screen: UVec2, gaze: Vec2) -> PixelBlocks {
-    let mut s = PixelBlocks::new(screen, VisualPolarParams::default(), BlockShape::default()).unwrap();
+    let mut s =
+        PixelBlocks::new(screen, VisualPolarParams::default(), BlockShape::default()).unwrap();
     s.set_gaze(gaze).unwrap();
     s
 }
@@ -32,7 +33,10 @@ fn host_position(s: &PixelBlocks, texel: IVec2) -> Option<Vec2> {
 #[test]
 fn pixel_blocks_units_agree_between_rust_and_glsl_and_frames_trace_exactly_their_samples() {
     let ctx = gpu();
-    for (screen, gaze) in [(UVec2::new(64, 72), Vec2::new(20.0, 50.0)), (UVec2::new(322, 361), Vec2::new(300.0, 40.5))] {
+    for (screen, gaze) in [
+        (UVec2::new(64, 72), Vec2::new(20.0, 50.0)),
+        (UVec2::new(322, 361), Vec2::new(300.0, 40.5)),
+    ] {
         let s = blocks(screen, gaze);
         let g = s.grid_size();
         for (i, got) in probe(&ctx, &s, 0, 1).iter().enumerate() {
@@ -46,9 +50,17 @@ fn pixel_blocks_units_agree_between_rust_and_glsl_and_frames_trace_exactly_their
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), screen.x, screen.y);
     let gaze = Vec2::new(40.0, 30.0);
     let host = blocks(screen, gaze);
-    let mut r = Renderer::new(&ctx, &scene, Box::new(blocks(screen, screen.as_vec2() * 0.5)), RenderSettings::default()).unwrap();
+    let mut r = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(blocks(screen, screen.as_vec2() * 0.5)),
+        RenderSettings::default(),
+    )
+    .unwrap();
     for f in 0..2 {
-        let stats = r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
+        let stats = r
+            .render_frame(&FrameInput::mono(camera, f, Some(gaze)))
+            .unwrap();
         assert_eq!(stats.samples_traced, host.sample_count(), "frame {f}");
     }
     assert_clean(&ctx);
@@ -67,18 +79,35 @@ fn the_block_fill_reproduces_a_linear_image() {
     let atlas: Vec<[f32; 4]> = (0..g.y as i32)
         .flat_map(|y| (0..g.x as i32).map(move |x| IVec2::new(x, y)))
         .map(|t| match s.unit(t) {
-            Some((level, block)) if s.traced(level, block) => truth((block.as_vec2() + 0.5) * (1 << level) as f32),
+            Some((level, block)) if s.traced(level, block) => {
+                truth((block.as_vec2() + 0.5) * (1 << level) as f32)
+            }
             _ => [0.0; 4],
         })
         .collect();
-    let grid = Image::new(&ctx, "atlas", g.x, g.y, ash::vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let grid = Image::new(
+        &ctx,
+        "atlas",
+        g.x,
+        g.y,
+        ash::vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     fovea_tests::write_image(&ctx, &grid, &atlas);
-    let out = Image::new(&ctx, "filled", screen.x, screen.y, ash::vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let out = Image::new(
+        &ctx,
+        "filled",
+        screen.x,
+        screen.y,
+        ash::vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     let fill = BlockFillPass::new(&ctx, s.shader_variant()).unwrap();
     let buffers = SpaceBuffers::new(&ctx, &s, 0, 1);
     let mut rec = fovea_renderer::graph::FrameRecorder::new(&ctx, 2).unwrap();
     rec.begin().unwrap();
-    fill.record(&mut rec, &buffers.sampling, &grid, &out).unwrap();
+    fill.record(&mut rec, &buffers.sampling, &grid, &out)
+        .unwrap();
     rec.submit_and_wait().unwrap();
     let got: Vec<[f32; 4]> = fovea_tests::read_image(&ctx, &out);
     let mut checked = [0u32; 3];
@@ -89,12 +118,17 @@ fn the_block_fill_reproduces_a_linear_image() {
             let b = (1 << level) as f32;
             let i0 = (p / b - 0.5).floor().as_ivec2();
             // Beyond the first and last block centres the fill clamps (holds the edge value).
-            if level > 0 && (i0.cmplt(IVec2::ZERO).any() || (i0 + 1).cmpge(s.level_size(level)).any()) {
+            if level > 0
+                && (i0.cmplt(IVec2::ZERO).any() || (i0 + 1).cmpge(s.level_size(level)).any())
+            {
                 continue;
             }
             let (have, want) = (got[(y * screen.x + x) as usize], truth(p));
             for c in 0..4 {
-                assert!((have[c] - want[c]).abs() < 1e-5, "pixel {p} level {level}: {have:?} vs {want:?}");
+                assert!(
+                    (have[c] - want[c]).abs() < 1e-5,
+                    "pixel {p} level {level}: {have:?} vs {want:?}"
+                );
             }
             checked[level] += 1;
         }
@@ -110,8 +144,20 @@ fn pixel_blocks_converge_like_one_sample_per_pixel_and_refuse_the_filters() {
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), screen.x, screen.y);
     let gaze = Vec2::new(30.0, 40.0);
-    let check = |f: u32, hdr: &[[f32; 4]]| assert!(hdr.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[3] == 1.0), "frame {f}");
-    let mut r = Renderer::new(&ctx, &scene, Box::new(blocks(screen, gaze)), RenderSettings::default()).unwrap();
+    let check = |f: u32, hdr: &[[f32; 4]]| {
+        assert!(
+            hdr.iter()
+                .all(|p| p.iter().all(|c| c.is_finite()) && p[3] == 1.0),
+            "frame {f}"
+        )
+    };
+    let mut r = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(blocks(screen, gaze)),
+        RenderSettings::default(),
+    )
+    .unwrap();
     fovea_tests::assert_mean_like_cartesian(&ctx, &scene, &mut r, camera, gaze, 16, check);
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(blocks(screen, gaze)));
     assert_clean(&ctx);
@@ -119,6 +165,10 @@ fn pixel_blocks_converge_like_one_sample_per_pixel_and_refuse_the_filters() {
     let report = fovea_tests::render_report("pixel-blocks", Default::default());
     assert_eq!(report["method"], "pixel-blocks");
     for pass in ["block_fill", "accumulate", "trace"] {
-        assert!(report["passes"][pass].as_f64().is_some(), "{pass}: {}", report["passes"]);
+        assert!(
+            report["passes"][pass].as_f64().is_some(),
+            "{pass}: {}",
+            report["passes"]
+        );
     }
 }

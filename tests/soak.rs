@@ -20,8 +20,16 @@ const RSS_SLACK_BYTES: i64 = 2 << 20;
 /// This process' resident set (`VmRSS` of /proc/self/status, in bytes).
 fn rss_bytes() -> i64 {
     let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
-    let kb = status.lines().find_map(|l| l.strip_prefix("VmRSS:")).expect("VmRSS line");
-    kb.trim().trim_end_matches("kB").trim().parse::<i64>().expect("VmRSS in kB") * 1024
+    let kb = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .expect("VmRSS line");
+    kb.trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse::<i64>()
+        .expect("VmRSS in kB")
+        * 1024
 }
 
 #[derive(Debug, PartialEq)]
@@ -36,14 +44,26 @@ fn a_thousand_frames_hold_gpu_and_host_memory_flat_without_validation_messages()
     let ctx = gpu();
     let out = fovea_tests::artifacts_dir().join("soak-unused");
     let mut args = fovea_tests::small_render_args("cornell-box", &out);
-    (args.method, args.denoiser, args.width, args.height, args.gaze) = ("vp", "svgf", Some(64), Some(72), "sim:1");
-    (args.frames, args.exr, args.camera_path) = (FRAMES, false, fovea_tools::camera_path::CameraMotion::Orbit);
+    (
+        args.method,
+        args.denoiser,
+        args.width,
+        args.height,
+        args.gaze,
+    ) = ("vp", "svgf", Some(64), Some(72), "sim:1");
+    (args.frames, args.exr, args.camera_path) =
+        (FRAMES, false, fovea_tools::camera_path::CameraMotion::Orbit);
     let mut setup = Setup::new(&args, FRAMES).unwrap();
     let spaces = setup.spaces(args.method, &args.profile).unwrap();
     let scene = GpuScene::upload(&ctx, &setup.scene).unwrap();
-    let mut renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, args.frames_in_flight).unwrap();
+    let mut renderer =
+        Renderer::with_views(&ctx, scene, spaces, setup.settings, args.frames_in_flight).unwrap();
 
-    let memory = || Memory { gpu_bytes: ctx.allocated_bytes(), allocations: ctx.live_allocations(), rss: rss_bytes() };
+    let memory = || Memory {
+        gpu_bytes: ctx.allocated_bytes(),
+        allocations: ctx.live_allocations(),
+        rss: rss_bytes(),
+    };
     let (mut ldr, mut retired, mut samples, mut lit) = (Vec::new(), 0u64, 0u64, 0u64);
     let mut at_checkpoint = None;
     let started = Instant::now();
@@ -70,10 +90,25 @@ fn a_thousand_frames_hold_gpu_and_host_memory_flat_without_validation_messages()
         seconds * 1e3 / FRAMES as f64
     );
     assert_clean(&ctx);
-    assert_eq!(retired, (FRAMES - 2) as u64, "every frame but the two in flight was retired in the loop");
+    assert_eq!(
+        retired,
+        (FRAMES - 2) as u64,
+        "every frame but the two in flight was retired in the loop"
+    );
     assert_eq!(lit, retired, "every frame shows the lit Cornell box");
-    assert!(samples > 1000 * retired, "{samples} samples over {retired} frames");
-    assert_eq!((at_end.gpu_bytes, at_end.allocations), (before.gpu_bytes, before.allocations), "GPU memory grew between frame {CHECKPOINT} and {FRAMES}");
+    assert!(
+        samples > 1000 * retired,
+        "{samples} samples over {retired} frames"
+    );
+    assert_eq!(
+        (at_end.gpu_bytes, at_end.allocations),
+        (before.gpu_bytes, before.allocations),
+        "GPU memory grew between frame {CHECKPOINT} and {FRAMES}"
+    );
     let grown = at_end.rss - before.rss;
-    assert!(grown <= RSS_SLACK_BYTES, "resident memory grew by {} KiB between frame {CHECKPOINT} and {FRAMES}", grown / 1024);
+    assert!(
+        grown <= RSS_SLACK_BYTES,
+        "resident memory grew by {} KiB between frame {CHECKPOINT} and {FRAMES}",
+        grown / 1024
+    );
 }

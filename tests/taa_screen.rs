@@ -3,6 +3,7 @@
 //! the disocclusion reset. The remap's placement of jittered samples is tested in vp_remap.rs.
 
 use ash::vk;
+use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::FrameData;
 use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
@@ -10,10 +11,12 @@ use fovea_renderer::passes::trace::GBuffer;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
-use fovea_tests::{assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview, unit_hash, write_image};
+use fovea_tests::{
+    assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image,
+};
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
 
@@ -25,7 +28,14 @@ fn vp_space() -> VisualPolar {
 
 /// The blur is off: the comparison measures sampling and TAA only.
 fn settings(taa: TaaMode) -> RenderSettings {
-    RenderSettings { blur: BlurSettings { sigma_at_30: 0.0, ..Default::default() }, taa, ..Default::default() }
+    RenderSettings {
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
+        taa,
+        ..Default::default()
+    }
 }
 
 fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
@@ -44,8 +54,16 @@ fn screen_taa_reduces_error_beside_grid_taa() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let mut reference_renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(SCREEN)), settings(TaaMode::Off)).unwrap();
-    let reference = reference_renderer.render_reference(&camera, 256, 3, |_| {}).unwrap();
+    let mut reference_renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(SCREEN)),
+        settings(TaaMode::Off),
+    )
+    .unwrap();
+    let reference = reference_renderer
+        .render_reference(&camera, 256, 3, |_| {})
+        .unwrap();
     drop(reference_renderer);
     let lit: Vec<bool> = reference.iter().map(|p| luminance(p) > 1.0).collect();
     let run = |taa: TaaMode, frames: u32| {
@@ -55,19 +73,32 @@ fn screen_taa_reduces_error_beside_grid_taa() {
         }
         let mut out = Vec::new();
         r.read_hdr(&mut out).unwrap();
-        let ms: f64 = r.timings().iter().filter(|t| t.name.starts_with("taa")).map(|t| t.ms).sum();
+        let ms: f64 = r
+            .timings()
+            .iter()
+            .filter(|t| t.name.starts_with("taa"))
+            .map(|t| t.ms)
+            .sum();
         let passes: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
         (out, ms, passes.join(" "), r.taa_history_bytes())
     };
     let (raw, ..) = run(TaaMode::Off, 1);
-    let (screen, screen_ms, screen_passes, screen_bytes) = run(TaaMode::Screen(TaaSettings::default()), 16);
+    let (screen, screen_ms, screen_passes, screen_bytes) =
+        run(TaaMode::Screen(TaaSettings::default()), 16);
     let (grid, grid_ms, _, grid_bytes) = run(TaaMode::SamplingGrid(TaaSettings::default()), 16);
-    assert!(screen_passes.contains("taa_screen") && !screen_passes.contains("taa "), "passes: {screen_passes}");
+    assert!(
+        screen_passes.contains("taa_screen") && !screen_passes.contains("taa "),
+        "passes: {screen_passes}"
+    );
     assert_finite_non_negative("screen taa", &screen);
     save_preview("taa_screen_vp.png", SCREEN.x, SCREEN.y, &screen);
     save_preview("taa_screen_vp_raw.png", SCREEN.x, SCREEN.y, &raw);
     let unlit = |i: usize| !lit[i];
-    let (e_raw, e_screen, e_grid) = (rmse_where(&raw, &reference, unlit), rmse_where(&screen, &reference, unlit), rmse_where(&grid, &reference, unlit));
+    let (e_raw, e_screen, e_grid) = (
+        rmse_where(&raw, &reference, unlit),
+        rmse_where(&screen, &reference, unlit),
+        rmse_where(&grid, &reference, unlit),
+    );
     println!(
         "VP {}×{}, RMSE without the light's pixels: raw 1 frame {e_raw:.4}; 16 frames TAA after the remap {e_screen:.4} \
          ({:.2}×, {screen_ms:.3} ms, history {screen_bytes} B); 16 frames TAA in the VP grid {e_grid:.4} ({:.2}×, \
@@ -77,7 +108,11 @@ fn screen_taa_reduces_error_beside_grid_taa() {
         e_raw / e_screen,
         e_raw / e_grid
     );
-    assert!(e_raw / e_screen >= 2.0, "screen-space TAA cut the error only {:.2}×", e_raw / e_screen);
+    assert!(
+        e_raw / e_screen >= 2.0,
+        "screen-space TAA cut the error only {:.2}×",
+        e_raw / e_screen
+    );
     assert_clean(&ctx);
 }
 
@@ -96,7 +131,12 @@ fn still_frame_data(ctx: &Arc<Context>, camera: &CameraPose) -> Buffer {
     Buffer::with_data(ctx, "frame", &[data], vk::BufferUsageFlags::UNIFORM_BUFFER).unwrap()
 }
 
-fn resolve(ctx: &Arc<Context>, taa: &mut ScreenTaa, color: &Image, frame: &ScreenTaaFrame) -> Vec<[f32; 4]> {
+fn resolve(
+    ctx: &Arc<Context>,
+    taa: &mut ScreenTaa,
+    color: &Image,
+    frame: &ScreenTaaFrame,
+) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
     let out = taa.record(&mut rec, color, frame).unwrap();
@@ -114,7 +154,14 @@ fn screen_taa_output_is_finite_and_non_negative_with_fireflies() {
     let mut r = Renderer::new(&ctx, &scene, Box::new(vp_space()), settings(TaaMode::Off)).unwrap();
     let mut taa = ScreenTaa::new(&ctx, SCREEN, TaaSettings::default()).unwrap();
     let frame_data = still_frame_data(&ctx, &camera);
-    let color = Image::new(&ctx, "remapped", SCREEN.x, SCREEN.y, vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let color = Image::new(
+        &ctx,
+        "remapped",
+        SCREEN.x,
+        SCREEN.y,
+        vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     let mut peak = 0f32;
     for f in 0..6 {
         r.render_frame(&frame(camera, f)).unwrap();
@@ -124,10 +171,21 @@ fn screen_taa_output_is_finite_and_non_negative_with_fireflies() {
         inject_fireflies(&ctx, &color, f);
         let space = r.space().params();
         let columns = grid_table(&ctx, r.space(), None);
-        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &r.view(0).gbuffer, space: &space, columns: &columns, has_previous: f > 0, jitter: Vec2::splat(0.5) };
+        let input = ScreenTaaFrame {
+            frame_data: &frame_data,
+            gbuffer: &r.view(0).gbuffer,
+            space: &space,
+            columns: &columns,
+            has_previous: f > 0,
+            jitter: Vec2::splat(0.5),
+        };
         let out = resolve(&ctx, &mut taa, &color, &input);
         assert_finite_non_negative(&format!("frame {f}"), &out);
-        peak = peak.max(out.iter().flat_map(|p| p[..3].iter().copied()).fold(0.0, f32::max));
+        peak = peak.max(
+            out.iter()
+                .flat_map(|p| p[..3].iter().copied())
+                .fold(0.0, f32::max),
+        );
     }
     println!("brightest screen-TAA output with fireflies {peak:.1}");
     assert_clean(&ctx);
@@ -148,9 +206,18 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
     let gbuffer = GBuffer::new(&ctx, grid).unwrap();
     let frame_data = still_frame_data(&ctx, &camera);
     let mut taa = ScreenTaa::new(&ctx, SCREEN, TaaSettings::default()).unwrap();
-    let color = Image::new(&ctx, "remapped", SCREEN.x, SCREEN.y, vk::Format::R32G32B32A32_SFLOAT).unwrap();
+    let color = Image::new(
+        &ctx,
+        "remapped",
+        SCREEN.x,
+        SCREEN.y,
+        vk::Format::R32G32B32A32_SFLOAT,
+    )
+    .unwrap();
     let texels = (grid.x * grid.y) as usize;
-    let uncovered = |x: u32, y: u32| vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).x > SCREEN.x as f32 * 0.5;
+    let uncovered = |x: u32, y: u32| {
+        vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).x > SCREEN.x as f32 * 0.5
+    };
     let space = vp.sampling_params();
     let columns = grid_table(&ctx, &vp, None);
     let mut out = Vec::new();
@@ -158,17 +225,36 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
     let mut previous = Vec::new();
     for f in 0..2u32 {
         let depth = |x, y| if f == 1 && uncovered(x, y) { 5.0 } else { 1.0 };
-        let normal_depth: Vec<[f32; 4]> = (0..texels).map(|i| [0.0, 0.0, 1.0, depth(i as u32 % grid.x, i as u32 / grid.x)]).collect();
+        let normal_depth: Vec<[f32; 4]> = (0..texels)
+            .map(|i| [0.0, 0.0, 1.0, depth(i as u32 % grid.x, i as u32 / grid.x)])
+            .collect();
         write_image(&ctx, &gbuffer.normal_depth, &normal_depth);
-        write_image(&ctx, &gbuffer.position, &vec![[0.0, 0.0, 0.0, 0.01]; texels]);
+        write_image(
+            &ctx,
+            &gbuffer.position,
+            &vec![[0.0, 0.0, 0.0, 0.01]; texels],
+        );
         // Red or blue at random, drawn afresh each frame: the history often differs from this
         // frame's colour, and any neighbourhood holds both.
         previous = std::mem::take(&mut current);
         current = (0..SCREEN.x * SCREEN.y)
-            .map(|i| if unit_hash(i * 7 + f * 7919) < 0.5 { [1.0, 0.0, 0.0, 1.0] } else { [0.0, 0.0, 1.0, 1.0] })
+            .map(|i| {
+                if unit_hash(i * 7 + f * 7919) < 0.5 {
+                    [1.0, 0.0, 0.0, 1.0]
+                } else {
+                    [0.0, 0.0, 1.0, 1.0]
+                }
+            })
             .collect();
         write_image(&ctx, &color, &current);
-        let input = ScreenTaaFrame { frame_data: &frame_data, gbuffer: &gbuffer, space: &space, columns: &columns, has_previous: f > 0, jitter: Vec2::splat(0.5) };
+        let input = ScreenTaaFrame {
+            frame_data: &frame_data,
+            gbuffer: &gbuffer,
+            space: &space,
+            columns: &columns,
+            has_previous: f > 0,
+            jitter: Vec2::splat(0.5),
+        };
         out = resolve(&ctx, &mut taa, &color, &input);
     }
     let (mut fresh, mut blended, mut new_pixels, mut wall_pixels) = (0, 0, 0, 0);
@@ -191,8 +277,17 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
         }
     }
     println!("uncovered: {fresh} of {new_pixels} pixels fresh; wall, colour changed: {blended} of {wall_pixels} blended with history");
-    assert!(new_pixels > 500 && wall_pixels > 250, "{new_pixels} / {wall_pixels}");
-    assert_eq!(fresh, new_pixels, "uncovered pixels kept history from the wall");
-    assert!(blended as f32 > 0.95 * wall_pixels as f32, "the wall's history was dropped: {blended} of {wall_pixels}");
+    assert!(
+        new_pixels > 500 && wall_pixels > 250,
+        "{new_pixels} / {wall_pixels}"
+    );
+    assert_eq!(
+        fresh, new_pixels,
+        "uncovered pixels kept history from the wall"
+    );
+    assert!(
+        blended as f32 > 0.95 * wall_pixels as f32,
+        "the wall's history was dropped: {blended} of {wall_pixels}"
+    );
     assert_clean(&ctx);
 }

@@ -29,7 +29,10 @@
 
 use fovea_renderer::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use fovea_renderer::layouts::VpProbePush;
-use fovea_renderer::sampling::{Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::sampling::{
+    Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, VisualPolar,
+    VisualPolarParams, VpLayout,
+};
 use fovea_renderer::vk::{Buffer, ComputePipeline};
 use fovea_tests::{assert_clean, gpu};
 use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
@@ -75,12 +78,19 @@ fn grid_points(vp: &VisualPolar, rng: &mut Rng, n: usize) -> Vec<Vec2> {
         Vec2::new(vp.u_fovea() * g.x as f32, 0.25),
     ];
     while out.len() < n {
-        let col = if out.len() % 2 == 0 { rng.below(g.x) } else { rng.below(fovea_cols) };
+        let col = if out.len() % 2 == 0 {
+            rng.below(g.x)
+        } else {
+            rng.below(fovea_cols)
+        };
         let rows = vp.rows_in_column(col);
         let row = rng.below(rows);
         assert!(vp.is_valid_texel(IVec2::new(col as i32, row as i32)));
         // Jitter in [0, 1), kept strictly inside the texel so floor(x) stays the column.
-        let p = Vec2::new(col as f32 + rng.f().min(0.999), row as f32 + rng.f().min(0.999));
+        let p = Vec2::new(
+            col as f32 + rng.f().min(0.999),
+            row as f32 + rng.f().min(0.999),
+        );
         if vp.headset().is_some() {
             let (s, q) = (vp.screen().as_vec2(), vp.vp_to_screen(p));
             if q.x < -s.x || q.y < -s.y || q.x > 2.0 * s.x || q.y > 2.0 * s.y {
@@ -96,7 +106,12 @@ fn grid_points(vp: &VisualPolar, rng: &mut Rng, n: usize) -> Vec<Vec2> {
 fn screen_points(vp: &VisualPolar, rng: &mut Rng, n: usize) -> Vec<Vec2> {
     let s = vp.screen().as_vec2();
     let gaze = vp.gaze();
-    let mut out = vec![gaze, Vec2::ZERO, s - Vec2::splat(0.5), gaze + Vec2::new(vp.r_fovea(), 0.0)];
+    let mut out = vec![
+        gaze,
+        Vec2::ZERO,
+        s - Vec2::splat(0.5),
+        gaze + Vec2::new(vp.r_fovea(), 0.0),
+    ];
     out.retain(|p| p.x >= 0.0 && p.y >= 0.0 && p.x < s.x && p.y < s.y);
     while out.len() < n {
         let p = if out.len() % 2 == 0 {
@@ -136,14 +151,27 @@ fn run_case(
     let mut rng = Rng(seed);
     let grid_in = grid_points(vp, &mut rng, POINTS);
     let screen_in = screen_points(vp, &mut rng, POINTS);
-    let input: Vec<Vec4> = grid_in.iter().zip(&screen_in).map(|(g, s)| Vec4::new(g.x, g.y, s.x, s.y)).collect();
+    let input: Vec<Vec4> = grid_in
+        .iter()
+        .zip(&screen_in)
+        .map(|(g, s)| Vec4::new(g.x, g.y, s.x, s.y))
+        .collect();
 
     let storage = ash::vk::BufferUsageFlags::STORAGE_BUFFER;
     let params = Buffer::with_data(ctx, "vp_params", &[vp.sampling_params()], storage).unwrap();
     let points = Buffer::with_data(ctx, "vp_points", &input, storage).unwrap();
     let columns = Buffer::texels(ctx, "vp_columns", &vp.column_table()).unwrap();
-    let mapped = Buffer::new(ctx, "vp_mapped", (POINTS * 16) as u64, storage, gpu_allocator::MemoryLocation::GpuToCpu).unwrap();
-    let push = VpProbePush { config: UVec4::new(POINTS as u32, 0, 0, 0) };
+    let mapped = Buffer::new(
+        ctx,
+        "vp_mapped",
+        (POINTS * 16) as u64,
+        storage,
+        gpu_allocator::MemoryLocation::GpuToCpu,
+    )
+    .unwrap();
+    let push = VpProbePush {
+        config: UVec4::new(POINTS as u32, 0, 0, 0),
+    };
     recorder.begin().unwrap();
     let binds = [
         read_buffer("sampling", &params),
@@ -151,11 +179,27 @@ fn run_case(
         write_buffer("mapped", &mapped),
         read_texels("vp_columns", &columns),
     ];
-    recorder.dispatch("vp_mapping_probe", pipeline, &binds, bytemuck::bytes_of(&push), [POINTS as u32, 1, 1]).unwrap();
+    recorder
+        .dispatch(
+            "vp_mapping_probe",
+            pipeline,
+            &binds,
+            bytemuck::bytes_of(&push),
+            [POINTS as u32, 1, 1],
+        )
+        .unwrap();
     recorder.submit_and_wait().unwrap();
     let got: Vec<Vec4> = mapped.read().unwrap();
 
-    let mut res = CaseResult { screen_px: 0.0, screen_px_on_screen: 0.0, screen_relative_off_screen: 0.0, grid_x: 0.0, grid_y: 0.0, grid_arc_px: 0.0, grid_y_paper_rows: 0.0 };
+    let mut res = CaseResult {
+        screen_px: 0.0,
+        screen_px_on_screen: 0.0,
+        screen_relative_off_screen: 0.0,
+        grid_x: 0.0,
+        grid_y: 0.0,
+        grid_arc_px: 0.0,
+        grid_y_paper_rows: 0.0,
+    };
     let mut worst = (Vec2::ZERO, Vec2::ZERO);
     for (i, o) in got[..POINTS].iter().enumerate() {
         // Grid → screen.
@@ -165,7 +209,9 @@ fn run_case(
         if want.x >= 0.0 && want.y >= 0.0 && want.x < size.x && want.y < size.y {
             res.screen_px_on_screen = res.screen_px_on_screen.max(e);
         } else {
-            res.screen_relative_off_screen = res.screen_relative_off_screen.max(e / (want - vp.gaze()).length());
+            res.screen_relative_off_screen = res
+                .screen_relative_off_screen
+                .max(e / (want - vp.gaze()).length());
         }
         if e > res.screen_px {
             res.screen_px = e;
@@ -180,7 +226,10 @@ fn run_case(
         let phi_of = |g: Vec2| {
             let col = vp.column_of(g.x);
             let arcs = vp.column_arcs(col);
-            (arcs.phi_of_arc(g.y / vp.rows_in_column(col) as f32 * arcs.total()), arcs.total())
+            (
+                arcs.phi_of_arc(g.y / vp.rows_in_column(col) as f32 * arcs.total()),
+                arcs.total(),
+            )
         };
         let ((phi_cpu, total_cpu), (phi_gpu, _)) = (phi_of(want), phi_of(gpu));
         let mut dphi = (phi_gpu - phi_cpu).rem_euclid(TAU);
@@ -196,20 +245,32 @@ fn run_case(
         res.grid_y = res.grid_y.max(ey);
         res.grid_arc_px = res.grid_arc_px.max(arc);
     }
-    println!("    worst grid input {:?}, worst screen input {:?}", worst.0, worst.1);
+    println!(
+        "    worst grid input {:?}, worst screen input {:?}",
+        worst.0, worst.1
+    );
     res
 }
 
 #[test]
 fn rust_and_glsl_visual_polar_mappings_agree() {
     let ctx = gpu();
-    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        "passes/vp_mapping_probe",
+        std::mem::size_of::<VpProbePush>() as u32,
+    )
+    .unwrap();
     let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
     let mut failures = Vec::new();
     let mut seed = 1u64;
     for screen in [UVec2::new(1280, 1440), UVec2::new(640, 720)] {
         let s = screen.as_vec2();
-        let gazes = [("centre", s * 0.5), ("edge", Vec2::new(0.02, 0.45) * s), ("corner", Vec2::new(0.97, 0.985) * s)];
+        let gazes = [
+            ("centre", s * 0.5),
+            ("edge", Vec2::new(0.02, 0.45) * s),
+            ("corner", Vec2::new(0.97, 0.985) * s),
+        ];
         for (gaze_name, gaze) in gazes {
             for (inverse_cdf, layout) in [
                 (InverseCdf::Polynomial, VpLayout::Paper),
@@ -218,7 +279,11 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
                 (InverseCdf::Exact, VpLayout::ScreenClipped),
                 (InverseCdf::Polynomial, VpLayout::ScreenAware),
             ] {
-                let params = VisualPolarParams { inverse_cdf, layout, ..Default::default() };
+                let params = VisualPolarParams {
+                    inverse_cdf,
+                    layout,
+                    ..Default::default()
+                };
                 let vp = VisualPolar::new(screen, gaze, params).unwrap();
                 seed += 1;
                 let r = run_case(&ctx, &pipeline, &mut recorder, &vp, seed);
@@ -230,7 +295,9 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
                 println!("{line}");
                 let phi_ok = match layout {
                     VpLayout::Paper => r.grid_y < GRID_BOUND,
-                    VpLayout::ScreenClipped | VpLayout::ScreenAware => r.grid_y_paper_rows < GRID_BOUND,
+                    VpLayout::ScreenClipped | VpLayout::ScreenAware => {
+                        r.grid_y_paper_rows < GRID_BOUND
+                    }
                 };
                 if !(r.screen_px < SCREEN_BOUND_PX && r.grid_x < GRID_BOUND && phi_ok) {
                     failures.push(line);
@@ -238,7 +305,11 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
             }
         }
     }
-    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "Rust and GLSL disagree:\n{}",
+        failures.join("\n")
+    );
     assert_clean(&ctx);
 }
 
@@ -248,20 +319,38 @@ fn rust_and_glsl_visual_polar_mappings_agree() {
 #[test]
 fn rust_and_glsl_headset_mappings_agree() {
     let ctx = gpu();
-    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        "passes/vp_mapping_probe",
+        std::mem::size_of::<VpProbePush>() as u32,
+    )
+    .unwrap();
     let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
     let mut failures = Vec::new();
     let mut seed = 100u64;
     let headsets = [
-        ("fove0", FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4)),
-        ("pimax_crystal", FovTangents::from_angles_deg(-51.7, 41.7, -51.9, 51.9)),
+        (
+            "fove0",
+            FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4),
+        ),
+        (
+            "pimax_crystal",
+            FovTangents::from_angles_deg(-51.7, 41.7, -51.9, 51.9),
+        ),
     ];
     for (headset, fov) in headsets {
         for screen in [UVec2::new(1280, 1440), UVec2::new(320, 360)] {
             let s = screen.as_vec2();
-            let gazes = [("centre", s * 0.5), ("edge", Vec2::new(0.02, 0.45) * s), ("corner", Vec2::new(0.97, 0.985) * s)];
+            let gazes = [
+                ("centre", s * 0.5),
+                ("edge", Vec2::new(0.02, 0.45) * s),
+                ("corner", Vec2::new(0.97, 0.985) * s),
+            ];
             for (gaze_name, gaze) in gazes {
-                let params = VisualPolarParams { eccentricity: Eccentricity::Headset(fov), ..Default::default() };
+                let params = VisualPolarParams {
+                    eccentricity: Eccentricity::Headset(fov),
+                    ..Default::default()
+                };
                 let vp = VisualPolar::new(screen, gaze, params).unwrap();
                 seed += 1;
                 let r = run_case(&ctx, &pipeline, &mut recorder, &vp, seed);
@@ -271,15 +360,19 @@ fn rust_and_glsl_headset_mappings_agree() {
                     screen.x, screen.y, r.screen_px, r.screen_px_on_screen, r.screen_relative_off_screen, r.grid_x, r.grid_y
                 );
                 println!("{line}");
-                let screen_ok =
-                    r.screen_px_on_screen < SCREEN_BOUND_PX && r.screen_relative_off_screen < RELATIVE_BOUND_HEADSET_OFF_SCREEN;
+                let screen_ok = r.screen_px_on_screen < SCREEN_BOUND_PX
+                    && r.screen_relative_off_screen < RELATIVE_BOUND_HEADSET_OFF_SCREEN;
                 if !(screen_ok && r.grid_x < GRID_BOUND && r.grid_y < GRID_BOUND) {
                     failures.push(line);
                 }
             }
         }
     }
-    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "Rust and GLSL disagree:\n{}",
+        failures.join("\n")
+    );
     assert_clean(&ctx);
 }
 
@@ -287,7 +380,14 @@ fn rust_and_glsl_headset_mappings_agree() {
 /// and returned when Rust and GLSL disagree beyond the bounds. Rows span 2π however many there are,
 /// so the driver's atan error in rows grows with the grid's height: the row bound is `GRID_BOUND`
 /// up to 800 rows and scales beyond (composite's tallest grid has 1688).
-fn polar_law_case(ctx: &std::sync::Arc<fovea_renderer::vk::Context>, pipeline: &ComputePipeline, recorder: &mut FrameRecorder, vp: &VisualPolar, seed: u64, label: &str) -> Option<String> {
+fn polar_law_case(
+    ctx: &std::sync::Arc<fovea_renderer::vk::Context>,
+    pipeline: &ComputePipeline,
+    recorder: &mut FrameRecorder,
+    vp: &VisualPolar,
+    seed: u64,
+    label: &str,
+) -> Option<String> {
     let r = run_case(ctx, pipeline, recorder, vp, seed);
     let line = format!(
         "{label}: grid→screen {:.2e} px on screen ({:.2e} of the distance off it), screen→grid x {:.2e} / y {:.2e} texels",
@@ -305,23 +405,57 @@ fn polar_law_case(ctx: &std::sync::Arc<fovea_renderer::vk::Context>, pipeline: &
 fn rust_and_glsl_composite_mappings_agree() {
     use fovea_renderer::sampling::CompositeMode;
     let ctx = gpu();
-    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        "passes/vp_mapping_probe",
+        std::mem::size_of::<VpProbePush>() as u32,
+    )
+    .unwrap();
     let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
     let mut failures = Vec::new();
     let mut seed = 300u64;
     for screen in [UVec2::new(1280, 1440), UVec2::new(320, 360)] {
         let s = screen.as_vec2();
         for (gaze_name, gaze) in [("centre", s * 0.5), ("corner", Vec2::new(0.97, 0.985) * s)] {
-            for mode in [CompositeMode::Fov, CompositeMode::Kernel, CompositeMode::Composite, CompositeMode::CompositeKernel] {
+            for mode in [
+                CompositeMode::Fov,
+                CompositeMode::Kernel,
+                CompositeMode::Composite,
+                CompositeMode::CompositeKernel,
+            ] {
                 let radial = RadialLaw::Composite(mode.params(s.x / 2.0));
-                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+                let vp = VisualPolar::new(
+                    screen,
+                    gaze,
+                    VisualPolarParams {
+                        radial,
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
                 seed += 1;
-                let label = format!("composite {}x{} gaze {gaze_name} {}", screen.x, screen.y, mode.name());
-                failures.extend(polar_law_case(&ctx, &pipeline, &mut recorder, &vp, seed, &label));
+                let label = format!(
+                    "composite {}x{} gaze {gaze_name} {}",
+                    screen.x,
+                    screen.y,
+                    mode.name()
+                );
+                failures.extend(polar_law_case(
+                    &ctx,
+                    &pipeline,
+                    &mut recorder,
+                    &vp,
+                    seed,
+                    &label,
+                ));
             }
         }
     }
-    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "Rust and GLSL disagree:\n{}",
+        failures.join("\n")
+    );
     assert_clean(&ctx);
 }
 
@@ -331,23 +465,62 @@ fn rust_and_glsl_composite_mappings_agree() {
 #[test]
 fn rust_and_glsl_log_polar_mappings_agree() {
     let ctx = gpu();
-    let pipeline = ComputePipeline::new(&ctx, "passes/vp_mapping_probe", std::mem::size_of::<VpProbePush>() as u32).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        "passes/vp_mapping_probe",
+        std::mem::size_of::<VpProbePush>() as u32,
+    )
+    .unwrap();
     let mut recorder = FrameRecorder::new(&ctx, 4).unwrap();
     let mut failures = Vec::new();
     let mut seed = 200u64;
     for screen in [UVec2::new(1280, 1440), UVec2::new(320, 360)] {
         let s = screen.as_vec2();
-        let gazes = [("centre", s * 0.5), ("edge", Vec2::new(0.02, 0.45) * s), ("corner", Vec2::new(0.97, 0.985) * s)];
+        let gazes = [
+            ("centre", s * 0.5),
+            ("edge", Vec2::new(0.02, 0.45) * s),
+            ("corner", Vec2::new(0.97, 0.985) * s),
+        ];
         for (gaze_name, gaze) in gazes {
-            for (alpha, extent) in [(4.0, LogPolarExtent::FarthestCorner), (4.0, LogPolarExtent::Diagonal), (1.0, LogPolarExtent::FarthestCorner)] {
-                let lp = LogPolarParams { alpha, extent, ..Default::default() };
-                let vp = VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(lp), ..Default::default() }).unwrap();
+            for (alpha, extent) in [
+                (4.0, LogPolarExtent::FarthestCorner),
+                (4.0, LogPolarExtent::Diagonal),
+                (1.0, LogPolarExtent::FarthestCorner),
+            ] {
+                let lp = LogPolarParams {
+                    alpha,
+                    extent,
+                    ..Default::default()
+                };
+                let vp = VisualPolar::new(
+                    screen,
+                    gaze,
+                    VisualPolarParams {
+                        radial: RadialLaw::LogPolar(lp),
+                        ..Default::default()
+                    },
+                )
+                .unwrap();
                 seed += 1;
-                let label = format!("log-polar {}x{} gaze {gaze_name} α {alpha} {extent:?}", screen.x, screen.y);
-                failures.extend(polar_law_case(&ctx, &pipeline, &mut recorder, &vp, seed, &label));
+                let label = format!(
+                    "log-polar {}x{} gaze {gaze_name} α {alpha} {extent:?}",
+                    screen.x, screen.y
+                );
+                failures.extend(polar_law_case(
+                    &ctx,
+                    &pipeline,
+                    &mut recorder,
+                    &vp,
+                    seed,
+                    &label,
+                ));
             }
         }
     }
-    assert!(failures.is_empty(), "Rust and GLSL disagree:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "Rust and GLSL disagree:\n{}",
+        failures.join("\n")
+    );
     assert_clean(&ctx);
 }

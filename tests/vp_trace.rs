@@ -15,11 +15,15 @@
 //! - jitter-independently: between the texels whose whole cell is off-screen and the texels
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
-use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, OffscreenSamples, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
+use fovea_renderer::pipeline::{
+    CameraPose, FrameInput, FrameStats, OffscreenSamples, RenderSettings, Renderer,
+};
+use fovea_renderer::sampling::random::{pcg_hash, rng_seed};
+use fovea_renderer::sampling::{
+    Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
+};
 use fovea_renderer::vk::Context;
 use fovea_scene::Scene;
-use fovea_renderer::sampling::random::{pcg_hash, rng_seed};
 use fovea_tests::{assert_clean, gpu, read_image};
 use glam::{IVec2, UVec2, Vec2};
 use std::sync::Arc;
@@ -69,7 +73,13 @@ struct CpuCounts {
 
 fn cpu_counts(vp: &VisualPolar, seed: u32) -> CpuCounts {
     let g = vp.grid_size();
-    let mut c = CpuCounts { replay: 0, replay_ambiguous: 0, centres: 0, cell_all: 0, cell_any: 0 };
+    let mut c = CpuCounts {
+        replay: 0,
+        replay_ambiguous: 0,
+        centres: 0,
+        cell_all: 0,
+        cell_any: 0,
+    };
     for x in 0..g.x {
         for y in 0..vp.rows_in_column(x) {
             assert!(vp.is_valid_texel(IVec2::new(x as i32, y as i32)));
@@ -81,7 +91,9 @@ fn cpu_counts(vp: &VisualPolar, seed: u32) -> CpuCounts {
             let (mut all, mut any) = (true, false);
             for i in 0..9 {
                 for j in 0..9 {
-                    let o = offscreen(vp.vp_to_screen(t + Vec2::new(i as f32, j as f32) * (0.9999 / 8.0)));
+                    let o = offscreen(
+                        vp.vp_to_screen(t + Vec2::new(i as f32, j as f32) * (0.9999 / 8.0)),
+                    );
                     all &= o;
                     any |= o;
                 }
@@ -97,18 +109,42 @@ fn cornell() -> Scene {
     fovea_tests::owned_scene("cornell-box")
 }
 
-fn render(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>) -> (Renderer, FrameStats) {
-    let settings = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
+fn render(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    space: Box<dyn SamplingSpace>,
+) -> (Renderer, FrameStats) {
+    let settings = RenderSettings {
+        offscreen_samples: OffscreenSamples::Trace,
+        ..Default::default()
+    };
     let mut r = Renderer::new(ctx, scene, space, settings).unwrap();
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    let stats = r.render_frame(&FrameInput::mono(camera, FRAME_INDEX, None)).unwrap();
+    let stats = r
+        .render_frame(&FrameInput::mono(camera, FRAME_INDEX, None))
+        .unwrap();
     (r, stats)
 }
 
 /// Renders one VP frame and checks counts and the G-buffer; returns the off-screen share and the
 /// CPU counts.
-fn check_vp_frame(ctx: &Arc<Context>, scene: &Scene, gaze_name: &str, gaze: Vec2, layout: VpLayout) -> (f64, CpuCounts, u64) {
-    check_vp_frame_with(ctx, scene, gaze_name, gaze, VisualPolarParams { layout, ..Default::default() })
+fn check_vp_frame(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    gaze_name: &str,
+    gaze: Vec2,
+    layout: VpLayout,
+) -> (f64, CpuCounts, u64) {
+    check_vp_frame_with(
+        ctx,
+        scene,
+        gaze_name,
+        gaze,
+        VisualPolarParams {
+            layout,
+            ..Default::default()
+        },
+    )
 }
 
 fn check_vp_frame_with(
@@ -142,7 +178,10 @@ fn check_vp_frame_with(
         cpu.cell_all,
         cpu.cell_any,
     );
-    assert_eq!(stats.samples_traced, samples, "one traced sample per kept texel");
+    assert_eq!(
+        stats.samples_traced, samples,
+        "one traced sample per kept texel"
+    );
     assert_eq!(stats.primary_rays, samples);
     assert!(
         cpu.cell_all <= stats.samples_offscreen && stats.samples_offscreen <= cpu.cell_any,
@@ -178,9 +217,16 @@ fn check_vp_frame_with(
             }
             clipped += 1;
             assert_eq!(color[i], [0.0; 4], "colour at clipped texel ({x}, {y})");
-            assert_eq!(normal_depth[i], [0.0; 4], "normal/depth at clipped texel ({x}, {y})");
+            assert_eq!(
+                normal_depth[i], [0.0; 4],
+                "normal/depth at clipped texel ({x}, {y})"
+            );
             assert_eq!(ids[i], [0, 0], "ids at clipped texel ({x}, {y})");
-            assert_eq!(motion[i], [-1.0, -1.0], "motion at clipped texel ({x}, {y})");
+            assert_eq!(
+                motion[i],
+                [-1.0, -1.0],
+                "motion at clipped texel ({x}, {y})"
+            );
         }
     }
     assert_eq!(clipped, g.x as u64 * g.y as u64 - samples);
@@ -196,9 +242,19 @@ fn check_vp_frame_with(
 fn visual_polar_tracing_counts_samples_and_offscreen() {
     let ctx = gpu();
     let scene = cornell();
-    let (centre, _, _) = check_vp_frame(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5, VpLayout::Paper);
-    let (corner, _, _) = check_vp_frame(&ctx, &scene, "corner", Vec2::new(2.0, 2.0), VpLayout::Paper);
-    assert!(centre < 0.3 && 0.3 < corner, "off-screen share: centre {centre:.3}, corner {corner:.3}");
+    let (centre, _, _) = check_vp_frame(
+        &ctx,
+        &scene,
+        "centre",
+        SCREEN.as_vec2() * 0.5,
+        VpLayout::Paper,
+    );
+    let (corner, _, _) =
+        check_vp_frame(&ctx, &scene, "corner", Vec2::new(2.0, 2.0), VpLayout::Paper);
+    assert!(
+        centre < 0.3 && 0.3 < corner,
+        "off-screen share: centre {centre:.3}, corner {corner:.3}"
+    );
     assert_clean(&ctx);
 }
 
@@ -209,16 +265,38 @@ fn visual_polar_tracing_counts_samples_and_offscreen() {
 fn screen_clipped_layout_keeps_samples_on_screen() {
     let ctx = gpu();
     let scene = cornell();
-    let gazes = [("centre", SCREEN.as_vec2() * 0.5), ("edge", Vec2::new(3.0, 90.0)), ("corner", Vec2::new(2.0, 2.0))];
+    let gazes = [
+        ("centre", SCREEN.as_vec2() * 0.5),
+        ("edge", Vec2::new(3.0, 90.0)),
+        ("corner", Vec2::new(2.0, 2.0)),
+    ];
     for (name, gaze) in gazes {
-        let (paper_share, _, paper_traced) = check_vp_frame(&ctx, &scene, name, gaze, VpLayout::Paper);
+        let (paper_share, _, paper_traced) =
+            check_vp_frame(&ctx, &scene, name, gaze, VpLayout::Paper);
         for layout in [VpLayout::ScreenClipped, VpLayout::ScreenAware] {
             let (share, cpu, traced) = check_vp_frame(&ctx, &scene, name, gaze, layout);
-            println!("gaze {name}: off-screen share paper {:.1} % → {layout:?} {:.2} %", 100.0 * paper_share, 100.0 * share);
-            assert_eq!(traced, paper_traced, "gaze {name} {layout:?}: the same budget");
-            assert_eq!(cpu.centres, 0, "gaze {name} {layout:?}: texel centres lie on their arcs, on the screen");
-            assert_eq!(cpu.cell_all, 0, "gaze {name} {layout:?}: a texel cell wholly off the screen");
-            assert!(share < 0.03, "gaze {name} {layout:?}: {:.2} % off the screen", 100.0 * share);
+            println!(
+                "gaze {name}: off-screen share paper {:.1} % → {layout:?} {:.2} %",
+                100.0 * paper_share,
+                100.0 * share
+            );
+            assert_eq!(
+                traced, paper_traced,
+                "gaze {name} {layout:?}: the same budget"
+            );
+            assert_eq!(
+                cpu.centres, 0,
+                "gaze {name} {layout:?}: texel centres lie on their arcs, on the screen"
+            );
+            assert_eq!(
+                cpu.cell_all, 0,
+                "gaze {name} {layout:?}: a texel cell wholly off the screen"
+            );
+            assert!(
+                share < 0.03,
+                "gaze {name} {layout:?}: {:.2} % off the screen",
+                100.0 * share
+            );
         }
     }
     assert_clean(&ctx);
@@ -235,9 +313,13 @@ fn headset_axis_tracing_counts_samples_and_offscreen() {
         eccentricity: Eccentricity::Headset(FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4)),
         ..Default::default()
     };
-    let (centre, _, _) = check_vp_frame_with(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5, params);
+    let (centre, _, _) =
+        check_vp_frame_with(&ctx, &scene, "centre", SCREEN.as_vec2() * 0.5, params);
     let (corner, _, _) = check_vp_frame_with(&ctx, &scene, "corner", Vec2::new(2.0, 2.0), params);
-    assert!(centre < 0.3 && 0.3 < corner, "off-screen share: centre {centre:.3}, corner {corner:.3}");
+    assert!(
+        centre < 0.3 && 0.3 < corner,
+        "off-screen share: centre {centre:.3}, corner {corner:.3}"
+    );
     assert_clean(&ctx);
 }
 
@@ -261,7 +343,9 @@ fn cartesian_has_no_offscreen_samples() {
 #[test]
 fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
     use fovea_renderer::passes::denoise::DenoiserSettings;
-    use fovea_renderer::sampling::{CompositeMode, LogPolarExtent, LogPolarParams, RadialLaw, RandomAcuity};
+    use fovea_renderer::sampling::{
+        CompositeMode, LogPolarExtent, LogPolarParams, RadialLaw, RandomAcuity,
+    };
     let ctx = gpu();
     let scene = cornell();
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
@@ -269,7 +353,10 @@ fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
         let mut r = Renderer::new(&ctx, &scene, space, settings).unwrap();
         let (mut pictures, mut stats) = (Vec::new(), Vec::new());
         for f in 0..2 {
-            stats.push(r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap());
+            stats.push(
+                r.render_frame(&FrameInput::mono(camera, f, Some(gaze)))
+                    .unwrap(),
+            );
             let mut ldr = Vec::new();
             r.read_ldr(&mut ldr).unwrap();
             pictures.push(ldr);
@@ -277,19 +364,79 @@ fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
         (pictures, stats)
     };
     let cull = RenderSettings::default();
-    let trace = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..cull };
+    let trace = RenderSettings {
+        offscreen_samples: OffscreenSamples::Trace,
+        ..cull
+    };
     assert_eq!(cull.offscreen_samples, OffscreenSamples::Cull);
     let corner = Vec2::new(2.0, 2.0);
     for gaze in [SCREEN.as_vec2() * 0.5, corner] {
-        let polar = move |radial| VisualPolar::new(SCREEN, gaze, VisualPolarParams { radial, ..Default::default() }).unwrap();
+        let polar = move |radial| {
+            VisualPolar::new(
+                SCREEN,
+                gaze,
+                VisualPolarParams {
+                    radial,
+                    ..Default::default()
+                },
+            )
+            .unwrap()
+        };
         type Make = Box<dyn Fn() -> Box<dyn SamplingSpace>>;
         let spaces: [(&str, Make, bool); 6] = [
-            ("vp", Box::new(move || Box::new(polar(RadialLaw::Acuity))), true),
-            ("log-polar diagonal", Box::new(move || Box::new(polar(RadialLaw::LogPolar(LogPolarParams { extent: LogPolarExtent::Diagonal, ..Default::default() })))), true),
-            ("composite", Box::new(move || Box::new(polar(RadialLaw::Composite(CompositeMode::Composite.params(SCREEN.x as f32 / 2.0))))), true),
-            ("random-acuity", Box::new(move || Box::new(RandomAcuity::new(SCREEN, gaze, VisualPolarParams::default()).unwrap())), true),
-            ("vp-screen-clipped", Box::new(move || Box::new(VisualPolar::new(SCREEN, gaze, VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() }).unwrap())), false),
-            ("cartesian", Box::new(|| Box::new(Cartesian::new(SCREEN))), false),
+            (
+                "vp",
+                Box::new(move || Box::new(polar(RadialLaw::Acuity))),
+                true,
+            ),
+            (
+                "log-polar diagonal",
+                Box::new(move || {
+                    Box::new(polar(RadialLaw::LogPolar(LogPolarParams {
+                        extent: LogPolarExtent::Diagonal,
+                        ..Default::default()
+                    })))
+                }),
+                true,
+            ),
+            (
+                "composite",
+                Box::new(move || {
+                    Box::new(polar(RadialLaw::Composite(
+                        CompositeMode::Composite.params(SCREEN.x as f32 / 2.0),
+                    )))
+                }),
+                true,
+            ),
+            (
+                "random-acuity",
+                Box::new(move || {
+                    Box::new(RandomAcuity::new(SCREEN, gaze, VisualPolarParams::default()).unwrap())
+                }),
+                true,
+            ),
+            (
+                "vp-screen-clipped",
+                Box::new(move || {
+                    Box::new(
+                        VisualPolar::new(
+                            SCREEN,
+                            gaze,
+                            VisualPolarParams {
+                                layout: VpLayout::ScreenClipped,
+                                ..Default::default()
+                            },
+                        )
+                        .unwrap(),
+                    )
+                }),
+                false,
+            ),
+            (
+                "cartesian",
+                Box::new(|| Box::new(Cartesian::new(SCREEN))),
+                false,
+            ),
         ];
         for (name, make, places_offscreen) in spaces {
             let samples = make().sample_count();
@@ -298,25 +445,62 @@ fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
             for (f, (a, c)) in all_stats.iter().zip(&culled_stats).enumerate() {
                 println!("{name} gaze {gaze} frame {f}: traced {} of {samples} ({} off the screen); culled {} ({} traced off the screen)", a.samples_traced, a.samples_offscreen, c.samples_culled, c.samples_offscreen);
                 assert_eq!(a.samples_culled, 0, "{name}: trace culls nothing");
-                assert_eq!(c.samples_traced + c.samples_culled, a.samples_traced, "{name} frame {f}: every sample traced or culled");
-                assert!(c.samples_culled <= a.samples_offscreen, "{name} frame {f}: only off-screen samples are culled");
+                assert_eq!(
+                    c.samples_traced + c.samples_culled,
+                    a.samples_traced,
+                    "{name} frame {f}: every sample traced or culled"
+                );
+                assert!(
+                    c.samples_culled <= a.samples_offscreen,
+                    "{name} frame {f}: only off-screen samples are culled"
+                );
                 if places_offscreen && gaze == corner {
-                    assert!(c.samples_culled > a.samples_traced / 2, "{name} frame {f}: a corner gaze culls most of the circle");
+                    assert!(
+                        c.samples_culled > a.samples_traced / 2,
+                        "{name} frame {f}: a corner gaze culls most of the circle"
+                    );
                 }
                 if !places_offscreen {
                     assert_eq!(c.samples_culled, 0, "{name}: its samples are on the screen");
                 }
             }
-            assert!(all == culled, "{name} gaze {gaze}: culling changed the picture");
+            assert!(
+                all == culled,
+                "{name} gaze {gaze}: culling changed the picture"
+            );
         }
     }
     // A filter: culled texels are misses to it.
     let vp = VisualPolar::new(SCREEN, corner, VisualPolarParams::default()).unwrap();
     let svgf = DenoiserSettings::parse("svgf").unwrap();
-    let (all, _) = frames(Box::new(vp), corner, RenderSettings { denoiser: svgf, ..trace });
-    let (culled, _) = frames(Box::new(vp), corner, RenderSettings { denoiser: svgf, ..cull });
-    let mean_diff = all[1].iter().zip(&culled[1]).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / all[1].len() as f64;
-    println!("SVGF, corner gaze: culling moves the picture by {mean_diff:.4} LDR levels on average");
-    assert!(mean_diff < 0.05, "SVGF: culling moved the picture by {mean_diff} levels on average");
+    let (all, _) = frames(
+        Box::new(vp),
+        corner,
+        RenderSettings {
+            denoiser: svgf,
+            ..trace
+        },
+    );
+    let (culled, _) = frames(
+        Box::new(vp),
+        corner,
+        RenderSettings {
+            denoiser: svgf,
+            ..cull
+        },
+    );
+    let mean_diff = all[1]
+        .iter()
+        .zip(&culled[1])
+        .map(|(a, b)| a.abs_diff(*b) as f64)
+        .sum::<f64>()
+        / all[1].len() as f64;
+    println!(
+        "SVGF, corner gaze: culling moves the picture by {mean_diff:.4} LDR levels on average"
+    );
+    assert!(
+        mean_diff < 0.05,
+        "SVGF: culling moved the picture by {mean_diff} levels on average"
+    );
     assert_clean(&ctx);
 }

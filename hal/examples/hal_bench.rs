@@ -23,12 +23,20 @@ fn main() {
         black_box(sim.sample_at(f * 11_111_111));
     }
     let per = start.elapsed().as_nanos() as f64 / frames as f64;
-    println!("simulator sample_at per frame (generates ~1.3 ticks): {per:.0} ns (target < 1000 ns)");
+    println!(
+        "simulator sample_at per frame (generates ~1.3 ticks): {per:.0} ns (target < 1000 ns)"
+    );
 
     // Playback query: binary search + interpolation in a one-hour 120 Hz trace.
     let mut src = SimulatedFove::fove0(3);
     let samples: Vec<_> = (0..432_000).map(|_| src.step().sample).collect();
-    let mut play = Playback::new(Trace { header: TraceHeader::new("fove0", 120.0), samples }, HmdDescription::fove0());
+    let mut play = Playback::new(
+        Trace {
+            header: TraceHeader::new("fove0", 120.0),
+            samples,
+        },
+        HmdDescription::fove0(),
+    );
     let queries = 2_000_000i64;
     let start = Instant::now();
     for q in 0..queries {

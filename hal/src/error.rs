@@ -18,13 +18,23 @@ pub enum HalError {
 
     /// A key parsed but its value is out of range or inconsistent.
     #[error("{file}: key `{key}`: {reason}")]
-    InvalidValue { file: PathBuf, key: String, reason: String },
+    InvalidValue {
+        file: PathBuf,
+        key: String,
+        reason: String,
+    },
 
     /// A trace or import file problem at a specific line (1-based).
     #[error("{file}:{line}: {reason}")]
-    Trace { file: PathBuf, line: usize, reason: String },
+    Trace {
+        file: PathBuf,
+        line: usize,
+        reason: String,
+    },
 
-    #[error("unknown headset `{name}`: not a file and not a built-in profile (built-in: {available})")]
+    #[error(
+        "unknown headset `{name}`: not a file and not a built-in profile (built-in: {available})"
+    )]
     UnknownHeadset { name: String, available: String },
 
     #[error("{file}: already exists; refusing to overwrite (ask for overwrite explicitly)")]
@@ -38,16 +48,26 @@ pub enum HalError {
 
     /// Device backend failures (no runtime, no eye tracker, runtime call failed).
     #[error("{backend}: {reason}")]
-    Backend { backend: &'static str, reason: String },
+    Backend {
+        backend: &'static str,
+        reason: String,
+    },
 }
 
 impl HalError {
     pub(crate) fn io(file: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        HalError::Io { file: file.into(), source }
+        HalError::Io {
+            file: file.into(),
+            source,
+        }
     }
 
     pub(crate) fn trace(file: impl Into<PathBuf>, line: usize, reason: impl Into<String>) -> Self {
-        HalError::Trace { file: file.into(), line, reason: reason.into() }
+        HalError::Trace {
+            file: file.into(),
+            line,
+            reason: reason.into(),
+        }
     }
 
     pub(crate) fn invalid(
@@ -55,6 +75,10 @@ impl HalError {
         key: impl Into<String>,
         reason: impl Into<String>,
     ) -> Self {
-        HalError::InvalidValue { file: file.into(), key: key.into(), reason: reason.into() }
+        HalError::InvalidValue {
+            file: file.into(),
+            key: key.into(),
+            reason: reason.into(),
+        }
     }
 }

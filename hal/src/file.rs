@@ -23,24 +23,49 @@ pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, HalError
     let file = open_nonblocking(path).map_err(|e| HalError::io(path, e))?;
     let meta = file.metadata().map_err(|e| HalError::io(path, e))?;
     if !meta.is_file() {
-        return Err(refuse(path, format!("it is {}, not a regular file", file_kind(&meta.file_type()))));
+        return Err(refuse(
+            path,
+            format!("it is {}, not a regular file", file_kind(&meta.file_type())),
+        ));
     }
     if meta.len() > limit {
-        return Err(refuse(path, format!("{} bytes is more than the {limit}-byte limit for {what}", meta.len())));
+        return Err(refuse(
+            path,
+            format!(
+                "{} bytes is more than the {limit}-byte limit for {what}",
+                meta.len()
+            ),
+        ));
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     // One byte past the limit tells a file that grew while being read from one that fits.
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| HalError::io(path, e))?;
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| HalError::io(path, e))?;
     if bytes.len() as u64 > limit {
-        return Err(refuse(path, format!("it grew past the {limit}-byte limit for {what} while being read")));
+        return Err(refuse(
+            path,
+            format!("it grew past the {limit}-byte limit for {what} while being read"),
+        ));
     }
-    String::from_utf8(bytes).map_err(|e| refuse(path, format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to())))
+    String::from_utf8(bytes).map_err(|e| {
+        refuse(
+            path,
+            format!(
+                "not UTF-8 text (invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })
 }
 
 #[cfg(unix)]
 fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
     use std::os::unix::fs::OpenOptionsExt;
-    std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC).open(path)
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC)
+        .open(path)
 }
 
 #[cfg(not(unix))]

@@ -96,7 +96,10 @@ pub struct GazeRay {
 }
 
 impl GazeRay {
-    pub const FORWARD: GazeRay = GazeRay { origin: Vec3::ZERO, direction: Vec3::NEG_Z };
+    pub const FORWARD: GazeRay = GazeRay {
+        origin: Vec3::ZERO,
+        direction: Vec3::NEG_Z,
+    };
 }
 
 impl Default for GazeRay {
@@ -151,7 +154,10 @@ impl GazeSample {
             time: t,
             time_kind: SampleTimeKind::Measured,
             sequence,
-            gaze: GazeRay { origin: Vec3::ZERO, direction: direction.normalize_or(Vec3::NEG_Z) },
+            gaze: GazeRay {
+                origin: Vec3::ZERO,
+                direction: direction.normalize_or(Vec3::NEG_Z),
+            },
             eyes: None,
             valid: true,
             tracked: true,
@@ -172,7 +178,8 @@ impl GazeSample {
             && self.time_kind == other.time_kind
             && self.sequence == other.sequence
             && ray_bits(&self.gaze) == ray_bits(&other.gaze)
-            && self.eyes.map(|e| e.map(|r| ray_bits(&r))) == other.eyes.map(|e| e.map(|r| ray_bits(&r)))
+            && self.eyes.map(|e| e.map(|r| ray_bits(&r)))
+                == other.eyes.map(|e| e.map(|r| ray_bits(&r)))
             && self.valid == other.valid
             && self.tracked == other.tracked
             && self.eye_state == other.eye_state

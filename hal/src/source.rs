@@ -91,27 +91,45 @@ impl Default for InvalidGazePolicy {
 
 impl InvalidGazePolicy {
     pub fn new(hold_ms: f32) -> Self {
-        InvalidGazePolicy { hold_ms, centre: Vec3::NEG_Z, last_valid: None }
+        InvalidGazePolicy {
+            hold_ms,
+            centre: Vec3::NEG_Z,
+            last_valid: None,
+        }
     }
 
     /// Decide the gaze for a frame rendered at `now`. Time is passed explicitly because an invalid
     /// sample's own time may be unknown (0) or stale.
     pub fn resolve(&mut self, sample: &GazeSample, now: XrTime) -> ResolvedGaze {
-        let usable = sample.valid && sample.gaze.direction.is_finite() && sample.gaze.direction.length_squared() > 0.0;
+        let usable = sample.valid
+            && sample.gaze.direction.is_finite()
+            && sample.gaze.direction.length_squared() > 0.0;
         if usable {
             let dir = sample.gaze.direction.normalize();
             // Samples of unknown time are treated as current so the hold window stays meaningful.
             let t = if sample.time == 0 { now } else { sample.time };
             self.last_valid = Some((t, dir));
-            return ResolvedGaze { direction: dir, source: GazeOrigin::Live, age_ns: now.saturating_sub(t).max(0) };
+            return ResolvedGaze {
+                direction: dir,
+                source: GazeOrigin::Live,
+                age_ns: now.saturating_sub(t).max(0),
+            };
         }
         if let Some((t, dir)) = self.last_valid {
             let age = now.saturating_sub(t).max(0);
             if (age as f64) <= self.hold_ms as f64 * NANOS_PER_MILLI {
-                return ResolvedGaze { direction: dir, source: GazeOrigin::Held, age_ns: age };
+                return ResolvedGaze {
+                    direction: dir,
+                    source: GazeOrigin::Held,
+                    age_ns: age,
+                };
             }
         }
-        ResolvedGaze { direction: self.centre, source: GazeOrigin::Centre, age_ns: 0 }
+        ResolvedGaze {
+            direction: self.centre,
+            source: GazeOrigin::Centre,
+            age_ns: 0,
+        }
     }
 
     pub fn reset(&mut self) {
@@ -128,7 +146,11 @@ pub struct FixedGaze {
 
 impl FixedGaze {
     pub fn new(hmd: HmdDescription, direction: Vec3) -> Self {
-        FixedGaze { hmd, direction: direction.normalize_or(Vec3::NEG_Z), now: 0 }
+        FixedGaze {
+            hmd,
+            direction: direction.normalize_or(Vec3::NEG_Z),
+            now: 0,
+        }
     }
 }
 

@@ -15,8 +15,13 @@ pub enum GazeSpec {
     /// Straight ahead.
     Center,
     /// A fixed pixel position in the left eye's image (x right, y down).
-    Fixed { x: f32, y: f32 },
-    Simulated { seed: u64 },
+    Fixed {
+        x: f32,
+        y: f32,
+    },
+    Simulated {
+        seed: u64,
+    },
     Trace(PathBuf),
     /// A GazeBase-style dataset CSV (`n` ms, `x`/`y` degrees, optional `val`), imported on open.
     GazeBase(PathBuf),
@@ -26,19 +31,28 @@ impl FromStr for GazeSpec {
     type Err = HalError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let err = |reason: &str| HalError::GazeSpec { input: s.to_string(), reason: reason.to_string() };
+        let err = |reason: &str| HalError::GazeSpec {
+            input: s.to_string(),
+            reason: reason.to_string(),
+        };
         let t = s.trim();
         if t.is_empty() {
-            return Err(err("empty; expected center, X,Y, sim[:seed] or a trace file path"));
+            return Err(err(
+                "empty; expected center, X,Y, sim[:seed] or a trace file path",
+            ));
         }
         if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
             return Ok(GazeSpec::Center);
         }
         if t == "sim" {
-            return Ok(GazeSpec::Simulated { seed: SimConfig::default().seed });
+            return Ok(GazeSpec::Simulated {
+                seed: SimConfig::default().seed,
+            });
         }
         if let Some(seed) = t.strip_prefix("sim:") {
-            let seed = seed.parse().map_err(|_| err("the seed after `sim:` must be a non-negative integer"))?;
+            let seed = seed
+                .parse()
+                .map_err(|_| err("the seed after `sim:` must be a non-negative integer"))?;
             return Ok(GazeSpec::Simulated { seed });
         }
         if let Some(path) = t.strip_prefix("gazebase:") {
@@ -51,12 +65,19 @@ impl FromStr for GazeSpec {
         // `inf,0`), with a comma, is meant as pixel coordinates, never as a trace file name.
         if let Some((x, y)) = t.split_once(',') {
             let number = |v: &str| v.trim().parse::<f32>().ok();
-            let numeric_start = t.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+' || c == '.');
+            let numeric_start =
+                t.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+' || c == '.');
             if numeric_start || (number(x).is_some() && number(y).is_some()) {
                 return match (number(x), number(y)) {
-                    (Some(x), Some(y)) if x.is_finite() && y.is_finite() => Ok(GazeSpec::Fixed { x, y }),
-                    (Some(x), Some(y)) => Err(err(&format!("X,Y must be finite pixel coordinates; got {x} and {y}"))),
-                    _ => Err(err("expected X,Y as two finite pixel coordinates, e.g. 640,720")),
+                    (Some(x), Some(y)) if x.is_finite() && y.is_finite() => {
+                        Ok(GazeSpec::Fixed { x, y })
+                    }
+                    (Some(x), Some(y)) => Err(err(&format!(
+                        "X,Y must be finite pixel coordinates; got {x} and {y}"
+                    ))),
+                    _ => Err(err(
+                        "expected X,Y as two finite pixel coordinates, e.g. 640,720",
+                    )),
                 };
             }
         }
@@ -78,16 +99,24 @@ impl GazeSpec {
                 if !((-1.0..=w + 1.0).contains(x) && (-1.0..=h + 1.0).contains(y)) {
                     return Err(HalError::GazeSpec {
                         input: format!("{x:?},{y:?}"),
-                        reason: format!("outside the {w}×{h} left-eye image of headset `{}`", hmd.id),
+                        reason: format!(
+                            "outside the {w}×{h} left-eye image of headset `{}`",
+                            hmd.id
+                        ),
                     });
                 }
                 let dir = hmd.pixel_to_direction(Eye::Left, Vec2::new(*x, *y));
                 Box::new(FixedGaze::new(hmd, dir))
             }
-            GazeSpec::Simulated { seed } => Box::new(SimulatedFove::new(hmd, SimConfig::seeded(*seed))?),
+            GazeSpec::Simulated { seed } => {
+                Box::new(SimulatedFove::new(hmd, SimConfig::seeded(*seed))?)
+            }
             GazeSpec::Trace(path) => Box::new(Playback::open(path, hmd)?),
             GazeSpec::GazeBase(path) => {
-                let trace = crate::trace::import::import_gazebase(path, &crate::trace::import::DegreesImport::default())?;
+                let trace = crate::trace::import::import_gazebase(
+                    path,
+                    &crate::trace::import::DegreesImport::default(),
+                )?;
                 // Dataset times start anywhere: frame 0 shows the first sample.
                 Box::new(Playback::new(trace, hmd).aligned_to_first_frame())
             }

@@ -16,12 +16,17 @@ fn within_seconds<T: Send + 'static>(seconds: u64, f: impl FnOnce() -> T + Send 
     std::thread::spawn(move || {
         let _ = tx.send(f());
     });
-    rx.recv_timeout(Duration::from_secs(seconds)).expect("reading blocked")
+    rx.recv_timeout(Duration::from_secs(seconds))
+        .expect("reading blocked")
 }
 
 fn mkfifo(dir: &Path, name: &str) -> PathBuf {
     let path = dir.join(name);
-    assert!(std::process::Command::new("mkfifo").arg(&path).status().unwrap().success());
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&path)
+        .status()
+        .unwrap()
+        .success());
     path
 }
 
@@ -35,13 +40,23 @@ fn message(result: Result<impl Sized, HalError>) -> String {
 #[test]
 fn devices_and_fifos_are_refused_without_reading_or_blocking() {
     let dir = tempfile::tempdir().unwrap();
-    let msg = within_seconds(10, || message(Playback::open(Path::new("/dev/zero"), HmdDescription::fove0())));
-    assert!(msg.contains("/dev/zero") && msg.contains("a device, not a regular file"), "{msg}");
+    let msg = within_seconds(10, || {
+        message(Playback::open(
+            Path::new("/dev/zero"),
+            HmdDescription::fove0(),
+        ))
+    });
+    assert!(
+        msg.contains("/dev/zero") && msg.contains("a device, not a regular file"),
+        "{msg}"
+    );
     let fifo = mkfifo(dir.path(), "gaze.csv");
     let msg = within_seconds(10, move || message(Trace::load(&fifo)));
     assert!(msg.contains("gaze.csv") && msg.contains("FIFO"), "{msg}");
     let fifo = mkfifo(dir.path(), "gazebase.csv");
-    let msg = within_seconds(10, move || message(import_gazebase(&fifo, &DegreesImport::default())));
+    let msg = within_seconds(10, move || {
+        message(import_gazebase(&fifo, &DegreesImport::default()))
+    });
     assert!(msg.contains("FIFO"), "{msg}");
     let fifo = mkfifo(dir.path(), "headset.toml");
     let msg = within_seconds(10, move || message(HmdDescription::load(&fifo)));
@@ -59,11 +74,23 @@ fn files_over_the_documented_size_are_refused_before_reading() {
     let dir = tempfile::tempdir().unwrap();
     // Sparse: no disk space, but the size is what a real oversized file reports.
     let big = dir.path().join("big.csv");
-    std::fs::File::create(&big).unwrap().set_len(MAX_TRACE_BYTES + 1).unwrap();
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(MAX_TRACE_BYTES + 1)
+        .unwrap();
     let msg = message(Trace::load(&big));
-    assert!(msg.contains("big.csv") && msg.contains(&format!("more than the {MAX_TRACE_BYTES}-byte limit for a gaze trace")), "{msg}");
+    assert!(
+        msg.contains("big.csv")
+            && msg.contains(&format!(
+                "more than the {MAX_TRACE_BYTES}-byte limit for a gaze trace"
+            )),
+        "{msg}"
+    );
     let toml = dir.path().join("big.toml");
-    std::fs::File::create(&toml).unwrap().set_len(MAX_PROFILE_BYTES + 1).unwrap();
+    std::fs::File::create(&toml)
+        .unwrap()
+        .set_len(MAX_PROFILE_BYTES + 1)
+        .unwrap();
     assert!(message(HmdDescription::load(&toml)).contains("limit for a headset profile"));
     let bad = dir.path().join("latin1.csv");
     std::fs::write(&bad, b"# fovea-gaze-trace 1\n\xe9\n").unwrap();
@@ -79,22 +106,58 @@ fn a_utf8_byte_order_mark_is_accepted() {
     assert_eq!(with_bom, Trace::parse(TRACE, &path).unwrap());
     let csv = dir.path().join("gazebase.csv");
     std::fs::write(&csv, "\u{FEFF}n,x,y\n0,0,0\n4,1,0\n8,2,0\n").unwrap();
-    assert_eq!(import_gazebase(&csv, &DegreesImport::default()).unwrap().samples.len(), 3);
+    assert_eq!(
+        import_gazebase(&csv, &DegreesImport::default())
+            .unwrap()
+            .samples
+            .len(),
+        3
+    );
     // A BOM in the middle is still content, and still wrong.
     assert!(Trace::parse(&format!("{TRACE}\u{FEFF}20000000,1,0,0,-1\n"), &path).is_err());
 }
 
 #[test]
 fn gaze_coordinates_must_be_finite_and_on_the_image() {
-    for input in ["NaN,5", "nan,5", "5,NaN", "inf,5", "-inf,5", "1e39,5", "infinity,0"] {
+    for input in [
+        "NaN,5",
+        "nan,5",
+        "5,NaN",
+        "inf,5",
+        "-inf,5",
+        "1e39,5",
+        "infinity,0",
+    ] {
         let msg = message(input.parse::<GazeSpec>());
-        assert!(msg.contains(input) && msg.contains("finite pixel coordinates"), "{input}: {msg}");
-        assert!(!msg.contains("cannot read"), "{input} must not be taken for a file: {msg}");
+        assert!(
+            msg.contains(input) && msg.contains("finite pixel coordinates"),
+            "{input}: {msg}"
+        );
+        assert!(
+            !msg.contains("cannot read"),
+            "{input} must not be taken for a file: {msg}"
+        );
     }
     let far: GazeSpec = "1e30,5".parse().unwrap();
     assert_eq!(far, GazeSpec::Fixed { x: 1e30, y: 5.0 });
     let msg = message(far.open(HmdDescription::fove0()));
-    assert!(msg.contains("outside the 1280×1440 left-eye image of headset `fove0`"), "{msg}");
-    assert!(message("-5,10".parse::<GazeSpec>().unwrap().open(HmdDescription::fove0())).contains("outside"));
-    assert!("1280,1440".parse::<GazeSpec>().unwrap().open(HmdDescription::fove0()).is_ok(), "the far corner is on the image");
+    assert!(
+        msg.contains("outside the 1280×1440 left-eye image of headset `fove0`"),
+        "{msg}"
+    );
+    assert!(message(
+        "-5,10"
+            .parse::<GazeSpec>()
+            .unwrap()
+            .open(HmdDescription::fove0())
+    )
+    .contains("outside"));
+    assert!(
+        "1280,1440"
+            .parse::<GazeSpec>()
+            .unwrap()
+            .open(HmdDescription::fove0())
+            .is_ok(),
+        "the far corner is on the image"
+    );
 }

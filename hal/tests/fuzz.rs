@@ -1,19 +1,32 @@
 //! No-panic property tests over the trace parser, the importers and the TOML loaders
 //! (a cargo-fuzz substitute that runs in the ordinary test suite).
 
-use fovea_hal::trace::import::{import_gazebase_text, import_normalized_text, DegreesImport, NormalizedImport};
+use fovea_hal::trace::import::{
+    import_gazebase_text, import_normalized_text, DegreesImport, NormalizedImport,
+};
 use fovea_hal::{Fov, GazeSpec, HmdDescription, SimConfig, Trace};
 use proptest::prelude::*;
 use std::path::Path;
 
-const TRACE_HEAD: &str = "# fovea-gaze-trace 1\n# device: x\n# rate_hz: 120\n# coordinates: openxr-view\n";
+const TRACE_HEAD: &str =
+    "# fovea-gaze-trace 1\n# device: x\n# rate_hz: 120\n# coordinates: openxr-view\n";
 
 fn fragment() -> impl Strategy<Value = String> {
     prop_oneof![
-        Just("0".to_string()), Just("1".to_string()), Just("-1".to_string()), Just("NaN".to_string()),
-        Just("inf".to_string()), Just("".to_string()), Just("open".to_string()), Just("measured".to_string()),
-        Just("9223372036854775807".to_string()), Just("-0".to_string()), Just("1e39".to_string()),
-        "[ -~]{0,6}", any::<f32>().prop_map(|f| f.to_string()), any::<i64>().prop_map(|i| i.to_string()),
+        Just("0".to_string()),
+        Just("1".to_string()),
+        Just("-1".to_string()),
+        Just("NaN".to_string()),
+        Just("inf".to_string()),
+        Just("".to_string()),
+        Just("open".to_string()),
+        Just("measured".to_string()),
+        Just("9223372036854775807".to_string()),
+        Just("-0".to_string()),
+        Just("1e39".to_string()),
+        "[ -~]{0,6}",
+        any::<f32>().prop_map(|f| f.to_string()),
+        any::<i64>().prop_map(|i| i.to_string()),
     ]
 }
 
@@ -22,7 +35,10 @@ fn row() -> impl Strategy<Value = String> {
 }
 
 fn columns() -> impl Strategy<Value = String> {
-    let names = fovea_hal::trace::COLUMNS.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let names = fovea_hal::trace::COLUMNS
+        .iter()
+        .map(|s| s.to_string())
+        .collect::<Vec<_>>();
     prop::sample::subsequence(names, 0..=27).prop_map(|v| v.join(","))
 }
 

@@ -43,7 +43,11 @@ fn every_builtin_profile_parses_and_fove0_is_first() {
     let all = HmdDescription::list_builtin();
     assert_eq!(all.len(), names.len());
     for h in &all {
-        assert!(h.capabilities.eye_gaze, "{} is an eye-tracked headset", h.id);
+        assert!(
+            h.capabilities.eye_gaze,
+            "{} is an eye-tracked headset",
+            h.id
+        );
         assert!((h.ipd_m() - 0.063).abs() < 1e-6);
     }
 }
@@ -51,7 +55,10 @@ fn every_builtin_profile_parses_and_fove0_is_first() {
 #[test]
 fn fove0_matches_hal_md() {
     let h = HmdDescription::fove0();
-    assert_eq!((h.eyes[0].recommended_width, h.eyes[0].recommended_height), (1280, 1440));
+    assert_eq!(
+        (h.eyes[0].recommended_width, h.eyes[0].recommended_height),
+        (1280, 1440)
+    );
     assert_eq!(h.refresh_hz, 70.0);
     assert_eq!(h.tracker.rate_hz, 120.0);
     assert_eq!(h.tracker.latency_ms, 20.0);
@@ -62,18 +69,29 @@ fn fove0_matches_hal_md() {
 
 #[test]
 fn resolve_accepts_names_and_paths_and_lists_builtins_on_unknown() {
-    assert_eq!(HmdDescription::resolve("varjo_aero").unwrap().id, "varjo_aero");
+    assert_eq!(
+        HmdDescription::resolve("varjo_aero").unwrap().id,
+        "varjo_aero"
+    );
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/headsets/psvr2.toml");
     assert_eq!(HmdDescription::resolve(path).unwrap().id, "psvr2");
-    let e = HmdDescription::resolve("no_such_headset").unwrap_err().to_string();
+    let e = HmdDescription::resolve("no_such_headset")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no_such_headset") && e.contains("fove0"), "{e}");
 }
 
 #[test]
 fn config_files_on_disk_equal_compiled_in_copies() {
     for name in builtin_names() {
-        let path = format!("{}/../config/headsets/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-        assert_eq!(HmdDescription::load(Path::new(&path)).unwrap(), HmdDescription::builtin(name).unwrap());
+        let path = format!(
+            "{}/../config/headsets/{name}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        assert_eq!(
+            HmdDescription::load(Path::new(&path)).unwrap(),
+            HmdDescription::builtin(name).unwrap()
+        );
     }
 }
 
@@ -85,12 +103,18 @@ fn good_profile_parses() {
 
 #[test]
 fn unknown_key_is_rejected() {
-    expect_err(&GOOD.replace("refresh_hz = 90.0", "refresh_hz = 90.0\nrefresh_rate = 90"), &["refresh_rate"]);
+    expect_err(
+        &GOOD.replace("refresh_hz = 90.0", "refresh_hz = 90.0\nrefresh_rate = 90"),
+        &["refresh_rate"],
+    );
 }
 
 #[test]
 fn unknown_nested_key_is_rejected() {
-    expect_err(&GOOD.replace("rate_hz = 120.0", "rate_hz = 120.0\nsmoothing = 1"), &["smoothing"]);
+    expect_err(
+        &GOOD.replace("rate_hz = 120.0", "rate_hz = 120.0\nsmoothing = 1"),
+        &["smoothing"],
+    );
 }
 
 #[test]
@@ -100,29 +124,50 @@ fn missing_key_is_rejected() {
 
 #[test]
 fn fov_of_180_degrees_or_more_is_rejected() {
-    expect_err(&GOOD.replace("left = -50.0", "left = -95.0"), &["left_eye.fov_deg.left", "-90"]);
-    expect_err(&GOOD.replace("up = 45.0 }\noffset_m = [-", "up = 90.0 }\noffset_m = [-"), &["left_eye.fov_deg.up"]);
+    expect_err(
+        &GOOD.replace("left = -50.0", "left = -95.0"),
+        &["left_eye.fov_deg.left", "-90"],
+    );
+    expect_err(
+        &GOOD.replace("up = 45.0 }\noffset_m = [-", "up = 90.0 }\noffset_m = [-"),
+        &["left_eye.fov_deg.up"],
+    );
 }
 
 #[test]
 fn inverted_fov_is_rejected() {
-    expect_err(&GOOD.replace("right = 40.0", "right = -60.0"), &["left_eye.fov_deg.right"]);
+    expect_err(
+        &GOOD.replace("right = 40.0", "right = -60.0"),
+        &["left_eye.fov_deg.right"],
+    );
 }
 
 #[test]
 fn negative_rate_is_rejected() {
-    expect_err(&GOOD.replace("rate_hz = 120.0", "rate_hz = -120.0"), &["tracker.rate_hz"]);
-    expect_err(&GOOD.replace("refresh_hz = 90.0", "refresh_hz = 0.0"), &["refresh_hz"]);
+    expect_err(
+        &GOOD.replace("rate_hz = 120.0", "rate_hz = -120.0"),
+        &["tracker.rate_hz"],
+    );
+    expect_err(
+        &GOOD.replace("refresh_hz = 90.0", "refresh_hz = 0.0"),
+        &["refresh_hz"],
+    );
 }
 
 #[test]
 fn zero_resolution_is_rejected() {
-    expect_err(&GOOD.replacen("recommended_width = 1000", "recommended_width = 0", 1), &["left_eye.recommended_width"]);
+    expect_err(
+        &GOOD.replacen("recommended_width = 1000", "recommended_width = 0", 1),
+        &["left_eye.recommended_width"],
+    );
 }
 
 #[test]
 fn negative_resolution_is_a_type_error_with_line() {
-    expect_err(&GOOD.replacen("recommended_height = 1000", "recommended_height = -5", 1), &["line", "-5"]);
+    expect_err(
+        &GOOD.replacen("recommended_height = 1000", "recommended_height = -5", 1),
+        &["line", "-5"],
+    );
 }
 
 #[test]
@@ -132,7 +177,10 @@ fn syntax_error_names_line() {
 
 #[test]
 fn nan_value_is_rejected() {
-    expect_err(&GOOD.replace("accuracy_deg = 1.0", "accuracy_deg = nan"), &["tracker.accuracy_deg"]);
+    expect_err(
+        &GOOD.replace("accuracy_deg = 1.0", "accuracy_deg = nan"),
+        &["tracker.accuracy_deg"],
+    );
 }
 
 /// Pixel → direction → pixel and direction → pixel → direction for every profile and both eyes,
@@ -166,8 +214,16 @@ fn fov_edges_map_to_image_edges() {
             let f = v.fov;
             let left_edge = Vec3::new(f.angle_left.tan(), 0.0, -1.0);
             let top_edge = Vec3::new(0.0, f.angle_up.tan(), -1.0);
-            assert!((v.direction_to_pixel(left_edge).unwrap().x + 0.5).abs() < 1e-2, "{}", h.id);
-            assert!((v.direction_to_pixel(top_edge).unwrap().y + 0.5).abs() < 1e-2, "{}", h.id);
+            assert!(
+                (v.direction_to_pixel(left_edge).unwrap().x + 0.5).abs() < 1e-2,
+                "{}",
+                h.id
+            );
+            assert!(
+                (v.direction_to_pixel(top_edge).unwrap().y + 0.5).abs() < 1e-2,
+                "{}",
+                h.id
+            );
         }
     }
 }
@@ -182,7 +238,11 @@ fn eccentricity_is_zero_at_gaze_and_matches_angles() {
         // Straight ahead vs. a point 20° right: the forward pixel has eccentricity 20°.
         let right20 = Vec3::new(20f32.to_radians().sin(), 0.0, -20f32.to_radians().cos());
         let fwd = v.forward_pixel();
-        assert!((h.eccentricity_deg(Eye::Right, fwd, right20) - 20.0).abs() < 0.01, "{}", h.id);
+        assert!(
+            (h.eccentricity_deg(Eye::Right, fwd, right20) - 20.0).abs() < 0.01,
+            "{}",
+            h.id
+        );
     }
 }
 
@@ -191,7 +251,9 @@ fn directions_behind_the_viewer_have_no_pixel() {
     let h = HmdDescription::fove0();
     assert!(h.direction_to_pixel(Eye::Left, Vec3::Z).is_none());
     assert!(h.direction_to_pixel(Eye::Left, Vec3::X).is_none());
-    assert!(h.direction_to_pixel(Eye::Left, Vec3::new(f32::NAN, 0.0, -1.0)).is_none());
+    assert!(h
+        .direction_to_pixel(Eye::Left, Vec3::new(f32::NAN, 0.0, -1.0))
+        .is_none());
 }
 
 #[test]

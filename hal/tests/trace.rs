@@ -1,5 +1,10 @@
-use fovea_hal::trace::import::{import_gazebase_text, import_normalized_text, DegreesImport, NormalizedImport};
-use fovea_hal::{Fov, GazeSample, GazeSource, HalError, HmdDescription, Playback, Recorder, SampleTimeKind, SimulatedFove, Trace};
+use fovea_hal::trace::import::{
+    import_gazebase_text, import_normalized_text, DegreesImport, NormalizedImport,
+};
+use fovea_hal::{
+    Fov, GazeSample, GazeSource, HalError, HmdDescription, Playback, Recorder, SampleTimeKind,
+    SimulatedFove, Trace,
+};
 use glam::Vec3;
 use std::path::Path;
 
@@ -12,7 +17,10 @@ fn parse(body: &str) -> Result<Trace, HalError> {
 /// The error names the file and the line (header is 5 lines, so data starts at line 6).
 fn expect_err(body: &str, line: usize, needle: &str) {
     let e = parse(body).expect_err("must be rejected").to_string();
-    assert!(e.starts_with(&format!("t.csv:{line}: ")), "wrong file/line in `{e}`");
+    assert!(
+        e.starts_with(&format!("t.csv:{line}: ")),
+        "wrong file/line in `{e}`"
+    );
     assert!(e.contains(needle), "`{e}` should mention `{needle}`");
 }
 
@@ -28,10 +36,16 @@ fn minimal_trace_parses_with_defaults() {
 
 #[test]
 fn example_trace_in_config_parses_and_plays() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/gaze/example_trace.csv");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../config/gaze/example_trace.csv"
+    );
     let mut p = Playback::open(Path::new(path), HmdDescription::fove0()).unwrap();
     assert!(p.trace().samples.len() >= 20);
-    assert!(p.trace().samples.iter().any(|s| !s.valid), "the example shows a blink");
+    assert!(
+        p.trace().samples.iter().any(|s| !s.valid),
+        "the example shows a blink"
+    );
     p.begin_frame(50_000_000).unwrap();
     assert!(p.sample_at(50_000_000).time <= 50_000_000);
 }
@@ -64,7 +78,11 @@ fn out_of_order_time_is_rejected() {
 
 #[test]
 fn duplicate_time_is_rejected() {
-    expect_err("10,1,0,0,-1\n10,1,0,0,-1\n", 7, "duplicate time stamp 10 (also on line 6)");
+    expect_err(
+        "10,1,0,0,-1\n10,1,0,0,-1\n",
+        7,
+        "duplicate time stamp 10 (also on line 6)",
+    );
 }
 
 #[test]
@@ -81,26 +99,37 @@ fn wrong_field_count_is_rejected() {
 #[test]
 fn unknown_column_is_rejected() {
     let text = HEAD.replace("dir_z\n", "dir_z,pupil_mm\n") + "0,1,0,0,-1,3\n";
-    let e = Trace::parse(&text, Path::new("t.csv")).unwrap_err().to_string();
-    assert!(e.starts_with("t.csv:5: ") && e.contains("unknown column `pupil_mm`"), "{e}");
+    let e = Trace::parse(&text, Path::new("t.csv"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("t.csv:5: ") && e.contains("unknown column `pupil_mm`"),
+        "{e}"
+    );
 }
 
 #[test]
 fn missing_required_column_is_rejected() {
     let text = HEAD.replace(",dir_z\n", "\n") + "0,1,0,0\n";
-    let e = Trace::parse(&text, Path::new("t.csv")).unwrap_err().to_string();
+    let e = Trace::parse(&text, Path::new("t.csv"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("t.csv:5:") && e.contains("dir_z"), "{e}");
 }
 
 #[test]
 fn wrong_version_is_rejected() {
-    let e = Trace::parse(&HEAD.replace("trace 1", "trace 2"), Path::new("t.csv")).unwrap_err().to_string();
+    let e = Trace::parse(&HEAD.replace("trace 1", "trace 2"), Path::new("t.csv"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("t.csv:1: ") && e.contains("version 2"), "{e}");
 }
 
 #[test]
 fn empty_file_is_rejected() {
-    let e = Trace::parse("", Path::new("t.csv")).unwrap_err().to_string();
+    let e = Trace::parse("", Path::new("t.csv"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("t.csv:1: ") && e.contains("empty"), "{e}");
 }
 
@@ -110,15 +139,23 @@ fn header_without_samples_is_rejected() {
 }
 
 fn expect_err_full(text: &str, needle: &str) {
-    let e = Trace::parse(text, Path::new("t.csv")).unwrap_err().to_string();
+    let e = Trace::parse(text, Path::new("t.csv"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("t.csv:") && e.contains(needle), "{e}");
 }
 
 #[test]
 fn unknown_or_missing_metadata_is_rejected() {
-    expect_err_full(&HEAD.replace("# device: fove0\n", "# device: fove0\n# colour: red\n"), "unknown metadata key `colour`");
+    expect_err_full(
+        &HEAD.replace("# device: fove0\n", "# device: fove0\n# colour: red\n"),
+        "unknown metadata key `colour`",
+    );
     expect_err_full(&HEAD.replace("# rate_hz: 100\n", ""), "rate_hz");
-    expect_err_full(&HEAD.replace("openxr-view", "unity-left-handed"), "coordinates");
+    expect_err_full(
+        &HEAD.replace("openxr-view", "unity-left-handed"),
+        "coordinates",
+    );
 }
 
 #[test]
@@ -207,7 +244,10 @@ fn record_then_play_back_is_bit_exact() {
             seen.push(s);
         }
     }
-    assert!(seen.iter().any(|s| !s.valid), "a blink should have been recorded");
+    assert!(
+        seen.iter().any(|s| !s.valid),
+        "a blink should have been recorded"
+    );
     assert_eq!(rec.samples_written(), seen.len());
     rec.finish().unwrap();
     let trace = Trace::load(&path).unwrap();
@@ -227,7 +267,10 @@ fn recorder_refuses_to_overwrite_unless_asked() {
     let dir = temp();
     let path = dir.path().join("rec.csv");
     std::fs::write(&path, "precious").unwrap();
-    let e = Recorder::create(SimulatedFove::fove0(1), &path, false).err().unwrap().to_string();
+    let e = Recorder::create(SimulatedFove::fove0(1), &path, false)
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("rec.csv") && e.contains("already exists"), "{e}");
     let mut rec = Recorder::create(SimulatedFove::fove0(1), &path, true).unwrap();
     rec.sample_at(100_000_000);
@@ -255,7 +298,10 @@ fn trace_save_refuses_to_overwrite() {
     let path = dir.path().join("t.csv");
     let t = parse("0,1,0,0,-1\n").unwrap();
     t.save(&path, false).unwrap();
-    assert!(matches!(t.save(&path, false), Err(HalError::AlreadyExists { .. })));
+    assert!(matches!(
+        t.save(&path, false),
+        Err(HalError::AlreadyExists { .. })
+    ));
     t.save(&path, true).unwrap();
 }
 
@@ -270,7 +316,11 @@ fn gazebase_import_converts_degrees_and_flags() {
     assert!(!t.samples[2].valid && !t.samples[3].valid);
     // Imported traces are ordinary traces: they survive the text format.
     let again = Trace::parse(&t.to_text(), Path::new("g2.csv")).unwrap();
-    assert!(again.samples.iter().zip(&t.samples).all(|(a, b)| a.bit_eq(b)));
+    assert!(again
+        .samples
+        .iter()
+        .zip(&t.samples)
+        .all(|(a, b)| a.bit_eq(b)));
 }
 
 #[test]
@@ -286,11 +336,17 @@ fn gazebase_vr_binocular_columns_become_per_eye_rays() {
 #[test]
 fn gazebase_import_errors_name_file_and_line() {
     let opts = DegreesImport::default();
-    let e = import_gazebase_text("n,x,y\n0,0,0\n0,1,1\n", Path::new("g.csv"), &opts).unwrap_err().to_string();
+    let e = import_gazebase_text("n,x,y\n0,0,0\n0,1,1\n", Path::new("g.csv"), &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("g.csv:3:") && e.contains("duplicate"), "{e}");
-    let e = import_gazebase_text("n,x\n0,0\n", Path::new("g.csv"), &opts).unwrap_err().to_string();
+    let e = import_gazebase_text("n,x\n0,0\n", Path::new("g.csv"), &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("g.csv:1:") && e.contains("`y`"), "{e}");
-    let e = import_gazebase_text("n,x,y\n0,abc,0\n", Path::new("g.csv"), &opts).unwrap_err().to_string();
+    let e = import_gazebase_text("n,x,y\n0,abc,0\n", Path::new("g.csv"), &opts)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("g.csv:2:") && e.contains("abc"), "{e}");
 }
 
@@ -298,11 +354,19 @@ fn gazebase_import_errors_name_file_and_line() {
 fn normalized_import_uses_the_recording_fov() {
     let fov = Fov::from_degrees(-45.0, 45.0, -45.0, 45.0);
     let text = "time_ms,x,y\n0,0.5,0.5\n40,0,0\n80,1,1\n";
-    let t = import_normalized_text(text, Path::new("e.csv"), &NormalizedImport::new("ehtask", fov)).unwrap();
+    let t = import_normalized_text(
+        text,
+        Path::new("e.csv"),
+        &NormalizedImport::new("ehtask", fov),
+    )
+    .unwrap();
     assert!((t.samples[0].gaze.direction - Vec3::NEG_Z).length() < 1e-6);
     // Bottom-left origin: (0,0) is down-left at 45°/45° tangents.
     let d = t.samples[1].gaze.direction;
-    assert!((d - Vec3::new(-1.0, -1.0, -1.0).normalize()).length() < 1e-5, "{d}");
+    assert!(
+        (d - Vec3::new(-1.0, -1.0, -1.0).normalize()).length() < 1e-5,
+        "{d}"
+    );
     assert_eq!(t.header.rate_hz, 25.0);
     assert_eq!(t.header.fov_deg, Some([-45.0, 45.0, -45.0, 45.0]));
 }

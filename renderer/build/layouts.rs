@@ -28,7 +28,11 @@ impl Field {
             rust: ty.rust.to_string(),
             words: ty.words,
             align: ty.align,
-            word_access: ty.components.iter().map(|c| (c.to_string(), ty.scalar)).collect(),
+            word_access: ty
+                .components
+                .iter()
+                .map(|c| (c.to_string(), ty.scalar))
+                .collect(),
         }
     }
 
@@ -37,7 +41,11 @@ impl Field {
         let word_access = inner
             .fields
             .iter()
-            .flat_map(|f| f.word_access.iter().map(move |(access, scalar)| (format!(".{}{access}", f.name), *scalar)))
+            .flat_map(|f| {
+                f.word_access
+                    .iter()
+                    .map(move |(access, scalar)| (format!(".{}{access}", f.name), *scalar))
+            })
             .collect::<Vec<_>>();
         Field {
             name: name.to_string(),
@@ -83,16 +91,86 @@ const MAT4: &[&str] = &[
 ];
 
 static TYPES: &[FieldType] = &[
-    FieldType { glsl: "float", rust: "f32", words: 1, align: 4, scalar: 'f', components: &[""] },
-    FieldType { glsl: "uint", rust: "u32", words: 1, align: 4, scalar: 'u', components: &[""] },
-    FieldType { glsl: "int", rust: "i32", words: 1, align: 4, scalar: 'i', components: &[""] },
-    FieldType { glsl: "vec2", rust: "glam::Vec2", words: 2, align: 8, scalar: 'f', components: &[".x", ".y"] },
-    FieldType { glsl: "uvec2", rust: "glam::UVec2", words: 2, align: 8, scalar: 'u', components: &[".x", ".y"] },
-    FieldType { glsl: "ivec2", rust: "glam::IVec2", words: 2, align: 8, scalar: 'i', components: &[".x", ".y"] },
-    FieldType { glsl: "vec4", rust: "glam::Vec4", words: 4, align: 16, scalar: 'f', components: VEC4 },
-    FieldType { glsl: "uvec4", rust: "glam::UVec4", words: 4, align: 16, scalar: 'u', components: VEC4 },
-    FieldType { glsl: "ivec4", rust: "glam::IVec4", words: 4, align: 16, scalar: 'i', components: VEC4 },
-    FieldType { glsl: "mat4", rust: "glam::Mat4", words: 16, align: 16, scalar: 'f', components: MAT4 },
+    FieldType {
+        glsl: "float",
+        rust: "f32",
+        words: 1,
+        align: 4,
+        scalar: 'f',
+        components: &[""],
+    },
+    FieldType {
+        glsl: "uint",
+        rust: "u32",
+        words: 1,
+        align: 4,
+        scalar: 'u',
+        components: &[""],
+    },
+    FieldType {
+        glsl: "int",
+        rust: "i32",
+        words: 1,
+        align: 4,
+        scalar: 'i',
+        components: &[""],
+    },
+    FieldType {
+        glsl: "vec2",
+        rust: "glam::Vec2",
+        words: 2,
+        align: 8,
+        scalar: 'f',
+        components: &[".x", ".y"],
+    },
+    FieldType {
+        glsl: "uvec2",
+        rust: "glam::UVec2",
+        words: 2,
+        align: 8,
+        scalar: 'u',
+        components: &[".x", ".y"],
+    },
+    FieldType {
+        glsl: "ivec2",
+        rust: "glam::IVec2",
+        words: 2,
+        align: 8,
+        scalar: 'i',
+        components: &[".x", ".y"],
+    },
+    FieldType {
+        glsl: "vec4",
+        rust: "glam::Vec4",
+        words: 4,
+        align: 16,
+        scalar: 'f',
+        components: VEC4,
+    },
+    FieldType {
+        glsl: "uvec4",
+        rust: "glam::UVec4",
+        words: 4,
+        align: 16,
+        scalar: 'u',
+        components: VEC4,
+    },
+    FieldType {
+        glsl: "ivec4",
+        rust: "glam::IVec4",
+        words: 4,
+        align: 16,
+        scalar: 'i',
+        components: VEC4,
+    },
+    FieldType {
+        glsl: "mat4",
+        rust: "glam::Mat4",
+        words: 16,
+        align: 16,
+        scalar: 'f',
+        components: MAT4,
+    },
 ];
 
 pub fn parse(path: &Path) -> Result<Header, String> {
@@ -108,13 +186,20 @@ pub fn parse(path: &Path) -> Result<Header, String> {
         }
         if let Some(rest) = line.strip_prefix("struct ") {
             let name = rest.trim_end_matches('{').trim().to_string();
-            current = Some(Struct { name, fields: Vec::new() });
+            current = Some(Struct {
+                name,
+                fields: Vec::new(),
+            });
         } else if line == "};" {
-            let s = current.take().ok_or_else(|| format!("{}: '}};' outside a struct", at()))?;
+            let s = current
+                .take()
+                .ok_or_else(|| format!("{}: '}};' outside a struct", at()))?;
             check_layout(&s).map_err(|e| format!("{}: struct {}: {e}", at(), s.name))?;
             structs.push(s);
         } else if let Some(rest) = line.strip_prefix("const ") {
-            let (decl, value) = rest.split_once('=').ok_or_else(|| format!("{}: constant without value", at()))?;
+            let (decl, value) = rest
+                .split_once('=')
+                .ok_or_else(|| format!("{}: constant without value", at()))?;
             let mut parts = decl.split_whitespace();
             let (ty, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
             let ty = match ty {
@@ -123,8 +208,17 @@ pub fn parse(path: &Path) -> Result<Header, String> {
                 "float" => "f32",
                 _ => return Err(format!("{}: constant type '{ty}' not supported", at())),
             };
-            let value = value.trim().trim_end_matches(';').trim().trim_end_matches('u').to_string();
-            constants.push(Constant { ty, name: name.to_string(), value });
+            let value = value
+                .trim()
+                .trim_end_matches(';')
+                .trim()
+                .trim_end_matches('u')
+                .to_string();
+            constants.push(Constant {
+                ty,
+                name: name.to_string(),
+                value,
+            });
         } else if let Some(s) = current.as_mut() {
             let decl = line.trim_end_matches(';');
             let mut parts = decl.split_whitespace();
@@ -162,13 +256,16 @@ fn check_layout(s: &Struct) -> Result<(), String> {
         align = align.max(f.align);
     }
     if offset % align != 0 {
-        return Err(format!("size {offset} is not a multiple of its alignment {align}: pad explicitly"));
+        return Err(format!(
+            "size {offset} is not a multiple of its alignment {align}: pad explicitly"
+        ));
     }
     Ok(())
 }
 
 pub fn rust_source(header: &Header) -> String {
-    let mut out = String::from("// Generated by build.rs from shaders/common/layouts.glsl. Do not edit.\n\n");
+    let mut out =
+        String::from("// Generated by build.rs from shaders/common/layouts.glsl. Do not edit.\n\n");
     for c in &header.constants {
         writeln!(out, "pub const {}: {} = {};", c.name, c.ty, c.value).unwrap();
     }
@@ -180,10 +277,17 @@ pub fn rust_source(header: &Header) -> String {
         }
         writeln!(out, "}}").unwrap();
     }
-    out.push_str("\n/// Every shared struct with each field's Rust offset, for the on-device layout test.\n");
+    out.push_str(
+        "\n/// Every shared struct with each field's Rust offset, for the on-device layout test.\n",
+    );
     out.push_str("pub static STRUCT_LAYOUTS: &[StructLayout] = &[\n");
     for s in &header.structs {
-        writeln!(out, "    StructLayout {{ name: \"{0}\", size: core::mem::size_of::<{0}>(), fields: &[", s.name).unwrap();
+        writeln!(
+            out,
+            "    StructLayout {{ name: \"{0}\", size: core::mem::size_of::<{0}>(), fields: &[",
+            s.name
+        )
+        .unwrap();
         for f in &s.fields {
             writeln!(
                 out,

@@ -5,7 +5,8 @@
 //! build script included, which is why this is a crate of its own.
 
 fn main() {
-    let dir = std::env::var("FOVEA_GLSLANG_LIB_DIR").unwrap_or_else(|_| "/usr/lib/x86_64-linux-gnu".into());
+    let dir = std::env::var("FOVEA_GLSLANG_LIB_DIR")
+        .unwrap_or_else(|_| "/usr/lib/x86_64-linux-gnu".into());
     println!("cargo:rerun-if-env-changed=FOVEA_GLSLANG_LIB_DIR");
     println!("cargo:rustc-link-search=native={dir}");
     for lib in [
@@ -18,7 +19,10 @@ fn main() {
         "SPIRV-Tools-opt",
         "SPIRV-Tools",
     ] {
-        if !std::path::Path::new(&dir).join(format!("lib{lib}.a")).exists() {
+        if !std::path::Path::new(&dir)
+            .join(format!("lib{lib}.a"))
+            .exists()
+        {
             panic!("{dir}/lib{lib}.a is missing: install libshaderc-dev glslang-dev spirv-tools (see .ci/setup)");
         }
         println!("cargo:rustc-link-lib=static={lib}");

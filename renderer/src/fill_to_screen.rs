@@ -18,7 +18,10 @@ pub struct FillToScreen {
 
 impl FillToScreen {
     pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FillToScreen> {
-        Ok(FillToScreen { fill: FillPass::new(ctx, screen)?, blur: FoveatedBlur::new(ctx, screen)? })
+        Ok(FillToScreen {
+            fill: FillPass::new(ctx, screen)?,
+            blur: FoveatedBlur::new(ctx, screen)?,
+        })
     }
 
     pub fn passes(&self) -> u32 {
@@ -26,7 +29,13 @@ impl FillToScreen {
     }
 
     /// `sparse`: the traced colour (alpha 1 where traced); returns the image to show.
-    pub fn record<'a>(&'a self, rec: &mut FrameRecorder, space: &dyn SamplingSpace, sparse: &'a Image, blur: &BlurSettings) -> Result<&'a Image> {
+    pub fn record<'a>(
+        &'a self,
+        rec: &mut FrameRecorder,
+        space: &dyn SamplingSpace,
+        sparse: &'a Image,
+        blur: &BlurSettings,
+    ) -> Result<&'a Image> {
         let filled = self.fill.record(rec, sparse)?;
         match space.blur_axis() {
             Some(axis) => self.blur.record(rec, blur, axis, filled),

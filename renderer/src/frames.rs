@@ -32,7 +32,9 @@ impl FrameRing {
     pub fn new(ctx: &Arc<Context>, slots: usize, max_passes: u32) -> Result<FrameRing> {
         let slots = slots.max(1);
         Ok(FrameRing {
-            recorders: (0..slots).map(|_| FrameRecorder::new(ctx, max_passes)).collect::<Result<_>>()?,
+            recorders: (0..slots)
+                .map(|_| FrameRecorder::new(ctx, max_passes))
+                .collect::<Result<_>>()?,
             frame_in_slot: vec![None; slots],
             next_frame: 0,
             completed_below: 0,
@@ -63,7 +65,9 @@ impl FrameRing {
     /// and returns that frame, whose results stay readable until the next `begin_next`.
     pub fn retire_next(&mut self) -> Result<Option<u64>> {
         let slot = self.next_slot();
-        let Some(frame) = self.frame_in_slot[slot] else { return Ok(None) };
+        let Some(frame) = self.frame_in_slot[slot] else {
+            return Ok(None);
+        };
         self.wait_slot(slot, frame)?;
         Ok(Some(frame))
     }
@@ -98,7 +102,8 @@ impl FrameRing {
 
     /// Whether `frame` has completed and its slot still holds its results.
     pub fn is_readable(&self, frame: u64) -> bool {
-        self.slot_of(frame).is_some_and(|slot| !self.recorders[slot].in_flight())
+        self.slot_of(frame)
+            .is_some_and(|slot| !self.recorders[slot].in_flight())
     }
 
     pub fn recorder(&self, slot: usize) -> &FrameRecorder {
@@ -150,7 +155,11 @@ impl FrameRing {
 
     fn release_up_to(&mut self, completed_below: u64) {
         self.completed_below = self.completed_below.max(completed_below);
-        while self.deferred.front().is_some_and(|(frame, _)| *frame <= self.completed_below) {
+        while self
+            .deferred
+            .front()
+            .is_some_and(|(frame, _)| *frame <= self.completed_below)
+        {
             self.deferred.pop_front();
         }
     }

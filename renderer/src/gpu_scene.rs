@@ -8,8 +8,9 @@ use crate::environment::GpuEnvironment;
 use crate::error::{Error, Result};
 use crate::graph::{read_buffer, read_texels, Bind};
 use crate::layouts::{
-    InstanceGpu, LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL, LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT,
-    LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
+    InstanceGpu, LightGpu, MaterialGpu, TriangleGpu, VertexGpu, LIGHT_KIND_DIRECTIONAL,
+    LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT, LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE,
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
 use crate::scene::bvh::instanced::{InstancingStats, SceneBvh};
 use crate::scene::bvh::wide::{Bvh4, Bvh4Node};
@@ -75,9 +76,19 @@ impl GpuScene {
 
     /// `positions` and `bvh`: the flattened triangles ([`Scene::flat_positions`]) and the world
     /// tree over them; instanced meshes get [`BvhBuilder::DEFAULT`] trees.
-    pub fn upload_with_bvh(ctx: &Arc<Context>, scene: &Scene, positions: &[[glam::Vec3; 3]], bvh: &Bvh) -> Result<GpuScene> {
+    pub fn upload_with_bvh(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        positions: &[[glam::Vec3; 3]],
+        bvh: &Bvh,
+    ) -> Result<GpuScene> {
         // The GPU traverses the 4-wide trees collapsed from the binary ones (same leaves).
-        let levels = SceneBvh::with_world(scene, positions.to_vec(), Bvh4::from_binary(bvh), BvhBuilder::DEFAULT);
+        let levels = SceneBvh::with_world(
+            scene,
+            positions.to_vec(),
+            Bvh4::from_binary(bvh),
+            BvhBuilder::DEFAULT,
+        );
         let depth = levels.world.depth();
         check_stacks(scene, &levels)?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -86,12 +97,18 @@ impl GpuScene {
         let stats = InstancingStats::of(scene, &levels);
         let emission_scale = vec![1.0; scene.materials.len()];
         let packed = texture_pack::pack(scene, ctx.info.max_storage_buffer_range as usize / 4);
-        let materials: Vec<MaterialGpu> = scene.materials.iter().zip(&packed.material_slots).map(|(m, t)| material_gpu(m, t, 1.0)).collect();
+        let materials: Vec<MaterialGpu> = scene
+            .materials
+            .iter()
+            .zip(&packed.material_slots)
+            .map(|(m, t)| material_gpu(m, t, 1.0))
+            .collect();
         let (textures, texels) = (packed.infos, packed.texels);
         let lights = light_entries(scene, &emission_scale);
         let environment = GpuEnvironment::upload(ctx, scene)?;
 
-        let tree_bytes = (trees.nodes.len() + trees.triangles.len()) * 16 + std::mem::size_of_val(trees.instances.as_slice());
+        let tree_bytes = (trees.nodes.len() + trees.triangles.len()) * 16
+            + std::mem::size_of_val(trees.instances.as_slice());
         Ok(GpuScene {
             bvh_nodes: Buffer::device_texels(ctx, "bvh_nodes", &trees.nodes)?,
             bvh_triangles: Buffer::device_texels(ctx, "bvh_triangles", &trees.triangles)?,
@@ -113,7 +130,10 @@ impl GpuScene {
             bounds: scene.bounds(),
             environment_slots: environment.frame_slots(&lights),
             environment,
-            alpha_masked: scene.materials.iter().any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
+            alpha_masked: scene
+                .materials
+                .iter()
+                .any(|m| m.alpha_cutoff.is_some() || m.alpha_blend),
             bvh_depth: depth,
             bvh_bytes: tree_bytes,
             emission_scale,
@@ -124,8 +144,16 @@ impl GpuScene {
     /// uploaded from; 0 switches its lights off) and rebuilds the light-sampling table so that
     /// next-event estimation picks lights by their new power. For lights switched during a
     /// sequence (tests, scripted sequences); takes effect from the next frame recorded.
-    pub fn set_emission_scale(&mut self, ctx: &Arc<Context>, scene: &Scene, material: usize, scale: f32) -> Result<()> {
-        if material >= self.emission_scale.len() || scene.materials.len() != self.emission_scale.len() {
+    pub fn set_emission_scale(
+        &mut self,
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        material: usize,
+        scale: f32,
+    ) -> Result<()> {
+        if material >= self.emission_scale.len()
+            || scene.materials.len() != self.emission_scale.len()
+        {
             return Err(Error::Invalid(format!(
                 "emission scale: material {material} does not exist ({} materials uploaded, {} in the scene given)",
                 self.emission_scale.len(),
@@ -133,15 +161,23 @@ impl GpuScene {
             )));
         }
         if !scale.is_finite() || scale < 0.0 {
-            return Err(Error::Invalid(format!("emission scale of material {material} must be finite and ≥ 0, got {scale}")));
+            return Err(Error::Invalid(format!(
+                "emission scale of material {material} must be finite and ≥ 0, got {scale}"
+            )));
         }
         self.emission_scale[material] = scale;
-        let materials: Vec<MaterialGpu> =
-            scene.materials.iter().zip(&self.material_textures).zip(&self.emission_scale).map(|((m, t), s)| material_gpu(m, t, *s)).collect();
+        let materials: Vec<MaterialGpu> = scene
+            .materials
+            .iter()
+            .zip(&self.material_textures)
+            .zip(&self.emission_scale)
+            .map(|((m, t), s)| material_gpu(m, t, *s))
+            .collect();
         self.materials.write(&materials)?;
         let lights = light_entries(scene, &self.emission_scale);
         if std::mem::size_of_val(lights.as_slice()) as u64 > self.lights.size {
-            self.lights = Buffer::with_data(ctx, "lights", &lights, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+            self.lights =
+                Buffer::with_data(ctx, "lights", &lights, vk::BufferUsageFlags::STORAGE_BUFFER)?;
         } else {
             self.lights.write(&lights)?;
         }
@@ -175,28 +211,50 @@ impl GpuScene {
 
 /// Vertices and triangles: the flattened ones, then each instanced mesh's (object space).
 fn geometry(scene: &Scene) -> Result<(Vec<VertexGpu>, Vec<TriangleGpu>)> {
-    let vertex = |v: &crate::scene::Vertex| VertexGpu { position_u: v.position.extend(v.uv.x), normal_v: v.normal.extend(v.uv.y), tangent: v.tangent };
+    let vertex = |v: &crate::scene::Vertex| VertexGpu {
+        position_u: v.position.extend(v.uv.x),
+        normal_v: v.normal.extend(v.uv.y),
+        tangent: v.tangent,
+    };
     let mut vertices: Vec<VertexGpu> = scene.vertices.iter().map(vertex).collect();
     let mut triangles = Vec::with_capacity(scene.unique_triangle_count());
-    let meshes = scene.instancing.meshes.iter().map(|m| (&m.vertices, &m.triangles));
-    for (k, (verts, tris)) in std::iter::once((&scene.vertices, &scene.triangles)).chain(meshes).enumerate() {
+    let meshes = scene
+        .instancing
+        .meshes
+        .iter()
+        .map(|m| (&m.vertices, &m.triangles));
+    for (k, (verts, tris)) in std::iter::once((&scene.vertices, &scene.triangles))
+        .chain(meshes)
+        .enumerate()
+    {
         let base = if k == 0 { 0 } else { vertices.len() as u32 };
         if k > 0 {
             vertices.extend(verts.iter().map(vertex));
         }
         for t in tris {
             if t.material > 0xffff || t.mesh > 0xffff {
-                return Err(Error::Invalid(format!("{}: more than 65536 materials or meshes", scene.source.display())));
+                return Err(Error::Invalid(format!(
+                    "{}: more than 65536 materials or meshes",
+                    scene.source.display()
+                )));
             }
             let [a, b, c] = t.indices.map(|i| i + base);
-            triangles.push(TriangleGpu { vertices: UVec4::new(a, b, c, t.material | (t.mesh << 16)) });
+            triangles.push(TriangleGpu {
+                vertices: UVec4::new(a, b, c, t.material | (t.mesh << 16)),
+            });
         }
     }
     Ok((vertices, triangles))
 }
 
 fn check_stacks(scene: &Scene, levels: &SceneBvh) -> Result<()> {
-    let deepest = levels.meshes.iter().map(Bvh4::max_stack).chain([levels.world.max_stack()]).max().unwrap_or(0);
+    let deepest = levels
+        .meshes
+        .iter()
+        .map(Bvh4::max_stack)
+        .chain([levels.world.max_stack()])
+        .max()
+        .unwrap_or(0);
     let top = levels.top_max_stack();
     if deepest > MAX_BVH_STACK || top > MAX_TOP_STACK {
         return Err(Error::Invalid(format!(
@@ -233,7 +291,10 @@ fn rebased(tree: &Bvh4, node_base: u32, leaf_base: u32) -> Bvh4 {
             n
         })
         .collect();
-    Bvh4 { nodes, tri_order: tree.tri_order.clone() }
+    Bvh4 {
+        nodes,
+        tri_order: tree.tri_order.clone(),
+    }
 }
 
 fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
@@ -253,7 +314,13 @@ fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
     let top_leaves = triangles.len() as u32;
     if !levels.instances.is_empty() {
         nodes.extend(rebased(&levels.top, top_root, 0).node_texels());
-        triangles.extend(levels.top.tri_order.iter().map(|&k| [f32::from_bits(k), 0.0, 0.0, 0.0]));
+        triangles.extend(
+            levels
+                .top
+                .tri_order
+                .iter()
+                .map(|&k| [f32::from_bits(k), 0.0, 0.0, 0.0]),
+        );
     }
     let mut instances: Vec<InstanceGpu> = levels
         .instances
@@ -269,18 +336,37 @@ fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
                 world_from_object0: w.row(0),
                 world_from_object1: w.row(1),
                 world_from_object2: w.row(2),
-                mesh: UVec4::new(inst.first_id, roots[inst.mesh as usize], mesh_first[inst.mesh as usize], inst.mirrors() as u32),
+                mesh: UVec4::new(
+                    inst.first_id,
+                    roots[inst.mesh as usize],
+                    mesh_first[inst.mesh as usize],
+                    inst.mirrors() as u32,
+                ),
             }
         })
         .collect();
-    let slots = UVec4::new(instances.len() as u32, scene.triangles.len() as u32, top_root, top_leaves);
+    let slots = UVec4::new(
+        instances.len() as u32,
+        scene.triangles.len() as u32,
+        top_root,
+        top_leaves,
+    );
     if instances.is_empty() {
         instances.push(InstanceGpu::default()); // a buffer cannot be empty; instancing.x = 0 skips it
     }
-    PackedTrees { nodes, triangles, instances, slots }
+    PackedTrees {
+        nodes,
+        triangles,
+        instances,
+        slots,
+    }
 }
 
-fn material_gpu(m: &crate::scene::Material, textures: &[Option<u32>; TextureSlot::COUNT], emission_scale: f32) -> MaterialGpu {
+fn material_gpu(
+    m: &crate::scene::Material,
+    textures: &[Option<u32>; TextureSlot::COUNT],
+    emission_scale: f32,
+) -> MaterialGpu {
     let texture_index = |slot: TextureSlot| textures[slot as usize].unwrap_or(NO_TEXTURE);
     MaterialGpu {
         base_color: m.base_color,
@@ -296,9 +382,19 @@ fn material_gpu(m: &crate::scene::Material, textures: &[Option<u32>; TextureSlot
         textures2: UVec4::new(
             texture_index(TextureSlot::Specular),
             texture_index(TextureSlot::SpecularColor),
-            if m.double_sided { MATERIAL_DOUBLE_SIDED } else { 0 }
-                | if m.alpha_cutoff.is_some() { MATERIAL_ALPHA_MASK } else { 0 }
-                | if m.alpha_blend { MATERIAL_ALPHA_BLEND } else { 0 },
+            if m.double_sided {
+                MATERIAL_DOUBLE_SIDED
+            } else {
+                0
+            } | if m.alpha_cutoff.is_some() {
+                MATERIAL_ALPHA_MASK
+            } else {
+                0
+            } | if m.alpha_blend {
+                MATERIAL_ALPHA_BLEND
+            } else {
+                0
+            },
             m.alpha_cutoff.unwrap_or(0.0).to_bits(),
         ),
     }
@@ -320,18 +416,32 @@ fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {
                 gpu.kind_index.x = LIGHT_KIND_ENVIRONMENT;
             } else if entry.kind != LightKind::EmissiveTriangle {
                 match &scene.punctual_lights[entry.index as usize] {
-                    PunctualLight::Point { position, intensity, range } => {
+                    PunctualLight::Point {
+                        position,
+                        intensity,
+                        range,
+                    } => {
                         gpu.kind_index.x = LIGHT_KIND_POINT;
                         gpu.position = position.extend(range.unwrap_or(0.0));
                         gpu.intensity = intensity.extend(1.0);
                     }
-                    PunctualLight::Spot { position, direction, intensity, range, inner_cone, outer_cone } => {
+                    PunctualLight::Spot {
+                        position,
+                        direction,
+                        intensity,
+                        range,
+                        inner_cone,
+                        outer_cone,
+                    } => {
                         gpu.kind_index.x = LIGHT_KIND_SPOT;
                         gpu.position = position.extend(range.unwrap_or(0.0));
                         gpu.direction = direction.extend(outer_cone.cos());
                         gpu.intensity = intensity.extend(inner_cone.cos());
                     }
-                    PunctualLight::Directional { direction, illuminance } => {
+                    PunctualLight::Directional {
+                        direction,
+                        illuminance,
+                    } => {
                         gpu.kind_index.x = LIGHT_KIND_DIRECTIONAL;
                         gpu.direction = direction.extend(0.0);
                         gpu.intensity = illuminance.extend(0.0);

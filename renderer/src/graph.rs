@@ -70,22 +70,46 @@ pub struct Bind<'a> {
 }
 
 pub fn read_buffer<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
-    Bind { name, resource: Resource::Buffer(b), write: false }
+    Bind {
+        name,
+        resource: Resource::Buffer(b),
+        write: false,
+    }
 }
 pub fn write_buffer<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
-    Bind { name, resource: Resource::Buffer(b), write: true }
+    Bind {
+        name,
+        resource: Resource::Buffer(b),
+        write: true,
+    }
 }
 pub fn read_texels<'a>(name: &'static str, b: &'a Buffer) -> Bind<'a> {
-    Bind { name, resource: Resource::Texels(b), write: false }
+    Bind {
+        name,
+        resource: Resource::Texels(b),
+        write: false,
+    }
 }
 pub fn read_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
-    Bind { name, resource: Resource::Image(i), write: false }
+    Bind {
+        name,
+        resource: Resource::Image(i),
+        write: false,
+    }
 }
 pub fn write_image<'a>(name: &'static str, i: &'a Image) -> Bind<'a> {
-    Bind { name, resource: Resource::Image(i), write: true }
+    Bind {
+        name,
+        resource: Resource::Image(i),
+        write: true,
+    }
 }
 pub fn write_external<'a>(name: &'static str, e: &'a ExternalImage) -> Bind<'a> {
-    Bind { name, resource: Resource::External(e), write: true }
+    Bind {
+        name,
+        resource: Resource::External(e),
+        write: true,
+    }
 }
 
 /// GPU time of one pass of a completed frame.
@@ -128,7 +152,10 @@ impl FrameRecorder {
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc)? }[0];
-        let fence = unsafe { ctx.device.create_fence(&vk::FenceCreateInfo::default(), None)? };
+        let fence = unsafe {
+            ctx.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)?
+        };
         let query_info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
             .query_count(max_passes * 2);
@@ -155,15 +182,29 @@ impl FrameRecorder {
         let device = &self.ctx.device;
         unsafe {
             device.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())?;
-            let info = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            let info = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             device.begin_command_buffer(self.cmd, &info)?;
             device.cmd_reset_query_pool(self.cmd, self.queries, 0, self.max_passes * 2);
             // Orders this frame after every earlier submission (frames in flight share history
             // images; a barrier's first scope covers all commands before it in submission order).
-            let all = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE;
+            let all = vk::AccessFlags::SHADER_READ
+                | vk::AccessFlags::SHADER_WRITE
+                | vk::AccessFlags::TRANSFER_READ
+                | vk::AccessFlags::TRANSFER_WRITE;
             let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
-            let barrier = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(all);
-            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
+            let barrier = vk::MemoryBarrier::default()
+                .src_access_mask(all)
+                .dst_access_mask(all);
+            device.cmd_pipeline_barrier(
+                self.cmd,
+                stages,
+                stages,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            );
         }
         self.passes.clear();
         self.view = 0;
@@ -186,17 +227,35 @@ impl FrameRecorder {
     /// Moves an external image from its arrival layout to GENERAL before the passes write it.
     pub fn acquire_external(&mut self, image: &ExternalImage) {
         self.barrier_for([(image.id, true)].into_iter());
-        let barrier = image_transition(image.raw, image.layout_before, vk::ImageLayout::GENERAL, vk::AccessFlags::empty(), vk::AccessFlags::SHADER_WRITE);
+        let barrier = image_transition(
+            image.raw,
+            image.layout_before,
+            vk::ImageLayout::GENERAL,
+            vk::AccessFlags::empty(),
+            vk::AccessFlags::SHADER_WRITE,
+        );
         let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
         unsafe {
-            self.ctx.device.cmd_pipeline_barrier(self.cmd, stages, vk::PipelineStageFlags::COMPUTE_SHADER, vk::DependencyFlags::empty(), &[], &[], &[barrier]);
+            self.ctx.device.cmd_pipeline_barrier(
+                self.cmd,
+                stages,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            );
         }
         self.written_since_barrier.push(image.id);
     }
 
     /// Moves an external image to the layout it must leave in (PRESENT_SRC_KHR), after copying
     /// it into `copy_to` when given (a screenshot of exactly what is presented).
-    pub fn release_external(&mut self, image: &ExternalImage, copy_to: Option<&Buffer>) -> Result<()> {
+    pub fn release_external(
+        &mut self,
+        image: &ExternalImage,
+        copy_to: Option<&Buffer>,
+    ) -> Result<()> {
         let ctx = self.ctx.clone();
         let device = &ctx.device;
         let compute = vk::PipelineStageFlags::COMPUTE_SHADER;
@@ -206,17 +265,49 @@ impl FrameRecorder {
         let mut src_stage = compute;
         if let Some(buffer) = copy_to {
             if buffer.size < image.bytes() {
-                return Err(Error::Binding { pass: "screenshot".into(), reason: format!("buffer '{}' too small for the external image", buffer.name) });
+                return Err(Error::Binding {
+                    pass: "screenshot".into(),
+                    reason: format!("buffer '{}' too small for the external image", buffer.name),
+                });
             }
             self.barrier_for([(buffer.id, true)].into_iter());
             let index = self.open_pass("screenshot")?;
-            let to_src = image_transition(image.raw, from, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, src_access, vk::AccessFlags::TRANSFER_READ);
+            let to_src = image_transition(
+                image.raw,
+                from,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                src_access,
+                vk::AccessFlags::TRANSFER_READ,
+            );
             let region = vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
-                .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
+                .image_subresource(vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                })
+                .image_extent(vk::Extent3D {
+                    width: image.width,
+                    height: image.height,
+                    depth: 1,
+                });
             unsafe {
-                device.cmd_pipeline_barrier(self.cmd, compute, transfer, vk::DependencyFlags::empty(), &[], &[], &[to_src]);
-                device.cmd_copy_image_to_buffer(self.cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &[region]);
+                device.cmd_pipeline_barrier(
+                    self.cmd,
+                    compute,
+                    transfer,
+                    vk::DependencyFlags::empty(),
+                    &[],
+                    &[],
+                    &[to_src],
+                );
+                device.cmd_copy_image_to_buffer(
+                    self.cmd,
+                    image.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    buffer.raw,
+                    &[region],
+                );
             }
             self.close_pass(index);
             from = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
@@ -224,9 +315,23 @@ impl FrameRecorder {
             src_stage = transfer;
         }
         // Presentation waits on a semaphore, which makes these writes visible: no dst access.
-        let to_final = image_transition(image.raw, from, image.layout_after, src_access, vk::AccessFlags::empty());
+        let to_final = image_transition(
+            image.raw,
+            from,
+            image.layout_after,
+            src_access,
+            vk::AccessFlags::empty(),
+        );
         unsafe {
-            device.cmd_pipeline_barrier(self.cmd, src_stage, vk::PipelineStageFlags::BOTTOM_OF_PIPE, vk::DependencyFlags::empty(), &[], &[], &[to_final]);
+            device.cmd_pipeline_barrier(
+                self.cmd,
+                src_stage,
+                vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[to_final],
+            );
         }
         Ok(())
     }
@@ -242,7 +347,12 @@ impl FrameRecorder {
     ) -> Result<()> {
         self.check_bindings(pass, pipeline, binds, push)?;
         let used = |b: &&Bind| pipeline.bindings.iter().any(|x| x.name == b.name);
-        self.barrier_for(binds.iter().filter(used).map(|b| (b.resource.id(), b.write)));
+        self.barrier_for(
+            binds
+                .iter()
+                .filter(used)
+                .map(|b| (b.resource.id(), b.write)),
+        );
         let index = self.open_pass(pass)?;
         let device = &self.ctx.device;
 
@@ -252,7 +362,11 @@ impl FrameRecorder {
         for (i, b) in binds.iter().enumerate() {
             match b.resource {
                 Resource::Buffer(buf) => {
-                    buffer_infos[i] = vk::DescriptorBufferInfo { buffer: buf.raw, offset: 0, range: vk::WHOLE_SIZE }
+                    buffer_infos[i] = vk::DescriptorBufferInfo {
+                        buffer: buf.raw,
+                        offset: 0,
+                        range: vk::WHOLE_SIZE,
+                    }
                 }
                 Resource::Texels(buf) => views[i] = buf.texel_view.unwrap_or_default(),
                 Resource::Image(img) => {
@@ -274,12 +388,18 @@ impl FrameRecorder {
         let mut writes = [vk::WriteDescriptorSet::default(); MAX_BINDINGS];
         let mut count = 0;
         for (i, b) in binds.iter().enumerate() {
-            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else { continue };
-            let w = vk::WriteDescriptorSet::default().dst_binding(info.binding).descriptor_type(info.ty);
+            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else {
+                continue;
+            };
+            let w = vk::WriteDescriptorSet::default()
+                .dst_binding(info.binding)
+                .descriptor_type(info.ty);
             writes[count] = match b.resource {
                 Resource::Buffer(_) => w.buffer_info(std::slice::from_ref(&buffer_infos[i])),
                 Resource::Texels(_) => w.texel_buffer_view(std::slice::from_ref(&views[i])),
-                Resource::Image(_) | Resource::External(_) => w.image_info(std::slice::from_ref(&image_infos[i])),
+                Resource::Image(_) | Resource::External(_) => {
+                    w.image_info(std::slice::from_ref(&image_infos[i]))
+                }
             };
             count += 1;
         }
@@ -294,7 +414,13 @@ impl FrameRecorder {
                 &writes[..count],
             );
             if !push.is_empty() {
-                device.cmd_push_constants(self.cmd, pipeline.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+                device.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    push,
+                );
             }
             device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
         }
@@ -306,24 +432,50 @@ impl FrameRecorder {
     pub fn fill_buffer(&mut self, pass: &'static str, buffer: &Buffer, value: u32) -> Result<()> {
         self.barrier_for([(buffer.id, true)].into_iter());
         let index = self.open_pass(pass)?;
-        unsafe { self.ctx.device.cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value) };
+        unsafe {
+            self.ctx
+                .device
+                .cmd_fill_buffer(self.cmd, buffer.raw, 0, vk::WHOLE_SIZE, value)
+        };
         self.close_pass(index);
         Ok(())
     }
 
     /// Copies an image into a host-visible buffer (tightly packed rows) for read-back.
-    pub fn copy_image_to_buffer(&mut self, pass: &'static str, image: &Image, buffer: &Buffer) -> Result<()> {
+    pub fn copy_image_to_buffer(
+        &mut self,
+        pass: &'static str,
+        image: &Image,
+        buffer: &Buffer,
+    ) -> Result<()> {
         self.copy_between(pass, image, buffer, false)
     }
 
     /// Fills an image from a buffer of tightly packed rows (test inputs, uploads).
-    pub fn copy_buffer_to_image(&mut self, pass: &'static str, buffer: &Buffer, image: &Image) -> Result<()> {
+    pub fn copy_buffer_to_image(
+        &mut self,
+        pass: &'static str,
+        buffer: &Buffer,
+        image: &Image,
+    ) -> Result<()> {
         self.copy_between(pass, image, buffer, true)
     }
 
-    fn copy_between(&mut self, pass: &'static str, image: &Image, buffer: &Buffer, to_image: bool) -> Result<()> {
+    fn copy_between(
+        &mut self,
+        pass: &'static str,
+        image: &Image,
+        buffer: &Buffer,
+        to_image: bool,
+    ) -> Result<()> {
         if buffer.size < image.width as u64 * image.height as u64 * image.texel_bytes() {
-            return Err(Error::Binding { pass: pass.into(), reason: format!("buffer '{}' too small for image '{}'", buffer.name, image.name) });
+            return Err(Error::Binding {
+                pass: pass.into(),
+                reason: format!(
+                    "buffer '{}' too small for image '{}'",
+                    buffer.name, image.name
+                ),
+            });
         }
         self.barrier_for([(image.id, to_image), (buffer.id, !to_image)].into_iter());
         let index = self.open_pass(pass)?;
@@ -334,28 +486,61 @@ impl FrameRecorder {
                 base_array_layer: 0,
                 layer_count: 1,
             })
-            .image_extent(vk::Extent3D { width: image.width, height: image.height, depth: 1 });
+            .image_extent(vk::Extent3D {
+                width: image.width,
+                height: image.height,
+                depth: 1,
+            });
         // Copies prefer the TRANSFER_*_OPTIMAL layouts (the validation layer warns otherwise):
         // switch for the copy and back to GENERAL, the layout every pass expects.
         let (layout, access) = if to_image {
-            (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::AccessFlags::TRANSFER_WRITE)
+            (
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::AccessFlags::TRANSFER_WRITE,
+            )
         } else {
-            (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::AccessFlags::TRANSFER_READ)
+            (
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::AccessFlags::TRANSFER_READ,
+            )
         };
         let transition = |from, to, src, dst| image_transition(image.raw, from, to, src, dst);
         let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
-        let any = vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
+        let any = vk::AccessFlags::SHADER_READ
+            | vk::AccessFlags::SHADER_WRITE
+            | vk::AccessFlags::TRANSFER_WRITE;
         let device = &self.ctx.device;
         unsafe {
             let enter = transition(vk::ImageLayout::GENERAL, layout, any, access);
-            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[enter]);
+            device.cmd_pipeline_barrier(
+                self.cmd,
+                stages,
+                stages,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[enter],
+            );
             if to_image {
                 device.cmd_copy_buffer_to_image(self.cmd, buffer.raw, image.raw, layout, &[region]);
             } else {
                 device.cmd_copy_image_to_buffer(self.cmd, image.raw, layout, buffer.raw, &[region]);
             }
-            let back = transition(layout, vk::ImageLayout::GENERAL, access, any | vk::AccessFlags::TRANSFER_READ);
-            device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[], &[], &[back]);
+            let back = transition(
+                layout,
+                vk::ImageLayout::GENERAL,
+                access,
+                any | vk::AccessFlags::TRANSFER_READ,
+            );
+            device.cmd_pipeline_barrier(
+                self.cmd,
+                stages,
+                stages,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[back],
+            );
         }
         self.close_pass(index);
         Ok(())
@@ -372,7 +557,9 @@ impl FrameRecorder {
     pub fn submit(&mut self, sync: SubmitSync) -> Result<()> {
         let device = &self.ctx.device;
         let all = vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE;
-        let to_host = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(vk::AccessFlags::HOST_READ);
+        let to_host = vk::MemoryBarrier::default()
+            .src_access_mask(all)
+            .dst_access_mask(vk::AccessFlags::HOST_READ);
         unsafe {
             device.cmd_pipeline_barrier(
                 self.cmd,
@@ -399,7 +586,9 @@ impl FrameRecorder {
             .wait_semaphores(&wait_semaphores[..waits])
             .wait_dst_stage_mask(&wait_stages[..waits])
             .signal_semaphores(sync.signal);
-        self.ctx.submit(&[submit], self.fence).map_err(|e| self.lost(e))?;
+        self.ctx
+            .submit(&[submit], self.fence)
+            .map_err(|e| self.lost(e))?;
         self.in_flight = true;
         Ok(())
     }
@@ -410,9 +599,14 @@ impl FrameRecorder {
             return Ok(());
         }
         let device = &self.ctx.device;
-        self.ctx.counters.fence_waits.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        self.ctx
+            .counters
+            .fence_waits
+            .fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         unsafe {
-            device.wait_for_fences(&[self.fence], true, u64::MAX).map_err(|e| self.lost(e))?;
+            device
+                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .map_err(|e| self.lost(e))?;
             device.reset_fences(&[self.fence])?;
         }
         self.in_flight = false;
@@ -431,7 +625,11 @@ impl FrameRecorder {
             let period_ms = self.ctx.info.timestamp_period_ns as f64 * 1e-6;
             for (i, &(name, view)) in self.passes.iter().enumerate().take(count / 2) {
                 let ticks = stamps[2 * i + 1].saturating_sub(stamps[2 * i]);
-                self.timings.push(PassTiming { name, view, ms: ticks as f64 * period_ms });
+                self.timings.push(PassTiming {
+                    name,
+                    view,
+                    ms: ticks as f64 * period_ms,
+                });
             }
         }
         Ok(())
@@ -439,7 +637,9 @@ impl FrameRecorder {
 
     fn lost(&self, e: vk::Result) -> Error {
         match e {
-            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { last_pass: self.passes.last().map_or("<none>", |p| p.0).to_string() },
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost {
+                last_pass: self.passes.last().map_or("<none>", |p| p.0).to_string(),
+            },
             other => Error::Vulkan(other),
         }
     }
@@ -448,13 +648,28 @@ impl FrameRecorder {
         &self.timings
     }
 
-    fn check_bindings(&self, pass: &str, pipeline: &ComputePipeline, binds: &[Bind], push: &[u8]) -> Result<()> {
-        let fail = |reason: String| Err(Error::Binding { pass: pass.to_string(), reason });
+    fn check_bindings(
+        &self,
+        pass: &str,
+        pipeline: &ComputePipeline,
+        binds: &[Bind],
+        push: &[u8],
+    ) -> Result<()> {
+        let fail = |reason: String| {
+            Err(Error::Binding {
+                pass: pass.to_string(),
+                reason,
+            })
+        };
         if !self.recording {
             return fail("recorded outside begin()/submit_and_wait()".into());
         }
         if push.len() as u32 != pipeline.push_size {
-            return fail(format!("{} push-constant bytes given, shader takes {}", push.len(), pipeline.push_size));
+            return fail(format!(
+                "{} push-constant bytes given, shader takes {}",
+                push.len(),
+                pipeline.push_size
+            ));
         }
         if binds.len() > MAX_BINDINGS {
             return fail(format!("more than {MAX_BINDINGS} bindings"));
@@ -462,20 +677,35 @@ impl FrameRecorder {
         for b in binds {
             // Names the shader does not declare are skipped: the optimiser drops unused
             // bindings, so a shared binding list (the scene's) may name more than a kernel uses.
-            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else { continue };
+            let Some(info) = pipeline.bindings.iter().find(|x| x.name == b.name) else {
+                continue;
+            };
             let ok = matches!(
                 (b.resource, info.ty),
-                (Resource::Buffer(_), vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER)
-                    | (Resource::Texels(_), vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
-                    | (Resource::Image(_) | Resource::External(_), vk::DescriptorType::STORAGE_IMAGE)
+                (
+                    Resource::Buffer(_),
+                    vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER
+                ) | (
+                    Resource::Texels(_),
+                    vk::DescriptorType::UNIFORM_TEXEL_BUFFER
+                ) | (
+                    Resource::Image(_) | Resource::External(_),
+                    vk::DescriptorType::STORAGE_IMAGE
+                )
             );
             if !ok {
-                return fail(format!("binding '{}' is a {:?} in the shader", b.name, info.ty));
+                return fail(format!(
+                    "binding '{}' is a {:?} in the shader",
+                    b.name, info.ty
+                ));
             }
         }
         for info in &pipeline.bindings {
             if binds.iter().filter(|b| b.name == info.name).count() != 1 {
-                return fail(format!("shader binding '{}' must be bound exactly once", info.name));
+                return fail(format!(
+                    "shader binding '{}' must be bound exactly once",
+                    info.name
+                ));
             }
         }
         Ok(())
@@ -483,17 +713,28 @@ impl FrameRecorder {
 
     fn barrier_for(&mut self, accesses: impl Iterator<Item = (ResourceId, bool)> + Clone) {
         let hazard = accesses.clone().any(|(id, write)| {
-            self.written_since_barrier.contains(&id) || (write && self.read_since_barrier.contains(&id))
+            self.written_since_barrier.contains(&id)
+                || (write && self.read_since_barrier.contains(&id))
         });
         if hazard {
             let all = vk::AccessFlags::SHADER_READ
                 | vk::AccessFlags::SHADER_WRITE
                 | vk::AccessFlags::TRANSFER_READ
                 | vk::AccessFlags::TRANSFER_WRITE;
-            let barrier = vk::MemoryBarrier::default().src_access_mask(all).dst_access_mask(all);
+            let barrier = vk::MemoryBarrier::default()
+                .src_access_mask(all)
+                .dst_access_mask(all);
             let stages = vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER;
             unsafe {
-                self.ctx.device.cmd_pipeline_barrier(self.cmd, stages, stages, vk::DependencyFlags::empty(), &[barrier], &[], &[])
+                self.ctx.device.cmd_pipeline_barrier(
+                    self.cmd,
+                    stages,
+                    stages,
+                    vk::DependencyFlags::empty(),
+                    &[barrier],
+                    &[],
+                    &[],
+                )
             };
             self.read_since_barrier.clear();
             self.written_since_barrier.clear();
@@ -510,7 +751,10 @@ impl FrameRecorder {
     fn open_pass(&mut self, pass: &'static str) -> Result<u32> {
         let index = self.passes.len() as u32;
         if index >= self.max_passes {
-            return Err(Error::Binding { pass: pass.into(), reason: format!("more than {} passes in one frame", self.max_passes) });
+            return Err(Error::Binding {
+                pass: pass.into(),
+                reason: format!("more than {} passes in one frame", self.max_passes),
+            });
         }
         self.passes.push((pass, self.view));
         unsafe {
@@ -522,14 +766,24 @@ impl FrameRecorder {
                     .label_name(std::ffi::CStr::from_bytes_until_nul(&name).unwrap_or(c"pass"));
                 du.cmd_begin_debug_utils_label(self.cmd, &label);
             }
-            self.ctx.device.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::COMPUTE_SHADER, self.queries, 2 * index);
+            self.ctx.device.cmd_write_timestamp(
+                self.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                self.queries,
+                2 * index,
+            );
         }
         Ok(index)
     }
 
     fn close_pass(&mut self, index: u32) {
         unsafe {
-            self.ctx.device.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::COMPUTE_SHADER, self.queries, 2 * index + 1);
+            self.ctx.device.cmd_write_timestamp(
+                self.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                self.queries,
+                2 * index + 1,
+            );
             if let Some(du) = &self.ctx.debug_utils {
                 du.cmd_end_debug_utils_label(self.cmd);
             }
@@ -560,7 +814,10 @@ impl Drop for FrameRecorder {
         unsafe {
             // Only this slot's frame can still use the command buffer and queries.
             if self.in_flight {
-                let _ = self.ctx.device.wait_for_fences(&[self.fence], true, u64::MAX);
+                let _ = self
+                    .ctx
+                    .device
+                    .wait_for_fences(&[self.fence], true, u64::MAX);
             }
             self.ctx.device.destroy_query_pool(self.queries, None);
             self.ctx.device.destroy_fence(self.fence, None);

@@ -23,6 +23,10 @@ include!(concat!(env!("OUT_DIR"), "/layouts.rs"));
 impl SamplingParams {
     /// The gaze-dependent slots, what a pass gets of the previous frame's space.
     pub fn frame(&self) -> SamplingFrame {
-        SamplingFrame { gaze: self.gaze, shape0: self.shape0, shape1: self.shape1 }
+        SamplingFrame {
+            gaze: self.gaze,
+            shape0: self.shape0,
+            shape1: self.shape1,
+        }
     }
 }

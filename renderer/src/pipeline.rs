@@ -3,21 +3,24 @@
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
-use crate::gpu_scene::GpuScene;
 use crate::frames::FrameRing;
+use crate::gpu_scene::GpuScene;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
-use crate::layouts::{FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_CULL_OFFSCREEN, FRAME_FLAG_HALTON_JITTER, FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD};
+use crate::layouts::{
+    FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_CULL_OFFSCREEN, FRAME_FLAG_HALTON_JITTER,
+    FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD,
+};
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use crate::passes::tonemap::{LdrTarget, ToneCurve, TonemapPass, ToneTarget};
+use crate::passes::splat::SplatInputs;
+use crate::passes::tonemap::{LdrTarget, ToneCurve, ToneTarget, TonemapPass};
 use crate::passes::trace::TileList;
 use crate::sampling::SamplingSpace;
-use crate::to_screen::{BlurSettings, ScreenOut};
-use crate::passes::splat::SplatInputs;
-use crate::view::{BackPasses, View};
 use crate::scene::{Camera, Scene};
+use crate::to_screen::{BlurSettings, ScreenOut};
+use crate::view::{BackPasses, View};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec4};
@@ -41,7 +44,10 @@ impl CameraPose {
     pub fn from_scene_camera(camera: &Camera, width: u32, height: u32) -> CameraPose {
         let ty = (camera.yfov * 0.5).tan();
         let tx = ty * width as f32 / height as f32;
-        CameraPose { world_from_view: camera.world_from_view, fov_tan: Vec4::new(-tx, tx, -ty, ty) }
+        CameraPose {
+            world_from_view: camera.world_from_view,
+            fov_tan: Vec4::new(-tx, tx, -ty, ty),
+        }
     }
 }
 
@@ -129,7 +135,10 @@ impl OffscreenSamples {
         match name {
             "cull" => Ok(OffscreenSamples::Cull),
             "trace" => Ok(OffscreenSamples::Trace),
-            other => Err(Error::Invalid(format!("off-screen samples '{other}' is not one of {}", Self::NAMES))),
+            other => Err(Error::Invalid(format!(
+                "off-screen samples '{other}' is not one of {}",
+                Self::NAMES
+            ))),
         }
     }
 
@@ -159,7 +168,10 @@ impl TextureLod {
         match name {
             "cones" => Ok(TextureLod::RayCones),
             "off" => Ok(TextureLod::Off),
-            other => Err(Error::Invalid(format!("texture LOD '{other}' is not one of {}", Self::NAMES))),
+            other => Err(Error::Invalid(format!(
+                "texture LOD '{other}' is not one of {}",
+                Self::NAMES
+            ))),
         }
     }
 
@@ -213,11 +225,20 @@ impl FrameInput {
     /// A frame of `views.len()` ≤ MAX_VIEWS views, in the renderer's view order.
     pub fn views(views: &[ViewInput], frame_index: u32) -> Result<FrameInput> {
         if views.is_empty() || views.len() > MAX_VIEWS {
-            return Err(Error::Invalid(format!("a frame has 1 to {MAX_VIEWS} views, not {}", views.len())));
+            return Err(Error::Invalid(format!(
+                "a frame has 1 to {MAX_VIEWS} views, not {}",
+                views.len()
+            )));
         }
         let mut all = [views[0]; MAX_VIEWS];
         all[..views.len()].copy_from_slice(views);
-        Ok(FrameInput { views: all, view_count: views.len(), frame_index, read_hdr: false, read_grid: false })
+        Ok(FrameInput {
+            views: all,
+            view_count: views.len(),
+            frame_index,
+            read_hdr: false,
+            read_grid: false,
+        })
     }
 
     pub fn with_hdr(mut self, read_hdr: bool) -> FrameInput {
@@ -284,12 +305,22 @@ pub struct Renderer {
 
 impl Renderer {
     /// A one-view renderer with one frame slot (each `render_frame` waits for its frame).
-    pub fn new(ctx: &Arc<Context>, scene: &Scene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        space: Box<dyn SamplingSpace>,
+        settings: RenderSettings,
+    ) -> Result<Renderer> {
         let gpu_scene = GpuScene::upload(ctx, scene)?;
         Renderer::with_gpu_scene(ctx, gpu_scene, space, settings)
     }
 
-    pub fn with_gpu_scene(ctx: &Arc<Context>, scene: GpuScene, space: Box<dyn SamplingSpace>, settings: RenderSettings) -> Result<Renderer> {
+    pub fn with_gpu_scene(
+        ctx: &Arc<Context>,
+        scene: GpuScene,
+        space: Box<dyn SamplingSpace>,
+        settings: RenderSettings,
+    ) -> Result<Renderer> {
         Renderer::with_views(ctx, scene, vec![space], settings, 1)
     }
 
@@ -303,10 +334,15 @@ impl Renderer {
         frames_in_flight: usize,
     ) -> Result<Renderer> {
         if settings.max_depth == 0 {
-            return Err(Error::Invalid("max depth must be at least 1 (1 = emission seen directly)".into()));
+            return Err(Error::Invalid(
+                "max depth must be at least 1 (1 = emission seen directly)".into(),
+            ));
         }
         if spaces.is_empty() || spaces.len() > MAX_VIEWS {
-            return Err(Error::Invalid(format!("a renderer has 1 to {MAX_VIEWS} views, not {}", spaces.len())));
+            return Err(Error::Invalid(format!(
+                "a renderer has 1 to {MAX_VIEWS} views, not {}",
+                spaces.len()
+            )));
         }
         if frames_in_flight == 0 {
             return Err(Error::Invalid("frames in flight must be at least 1".into()));
@@ -327,9 +363,16 @@ impl Renderer {
 
     /// Replaces every view (new spaces, a new denoiser or TAA, a resize) while frames are in
     /// flight: the old views are released once the frames that used them have completed.
-    pub fn replace_views(&mut self, spaces: Vec<Box<dyn SamplingSpace>>, settings: RenderSettings) -> Result<()> {
+    pub fn replace_views(
+        &mut self,
+        spaces: Vec<Box<dyn SamplingSpace>>,
+        settings: RenderSettings,
+    ) -> Result<()> {
         if spaces.is_empty() || spaces.len() > MAX_VIEWS {
-            return Err(Error::Invalid(format!("a renderer has 1 to {MAX_VIEWS} views, not {}", spaces.len())));
+            return Err(Error::Invalid(format!(
+                "a renderer has 1 to {MAX_VIEWS} views, not {}",
+                spaces.len()
+            )));
         }
         let views = build_views(&self.ctx, spaces, &settings, self.ring.slots())?;
         if max_passes(&views) > max_passes(&self.views) {
@@ -381,7 +424,8 @@ impl Renderer {
     /// an edit, not a per-frame call.
     pub fn set_emission_scale(&mut self, scene: &Scene, material: usize, scale: f32) -> Result<()> {
         self.ring.finish()?;
-        self.scene.set_emission_scale(&self.ctx, scene, material, scale)
+        self.scene
+            .set_emission_scale(&self.ctx, scene, material, scale)
     }
 
     /// The first view's denoiser and its state, when `settings.denoiser` names one.
@@ -413,12 +457,23 @@ impl Renderer {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn write_frame_data(&self, view: usize, slot: usize, camera: &CameraPose, frame_index: u32, max_depth: u32, flags: u32, jitter: Vec2) -> Result<()> {
+    fn write_frame_data(
+        &self,
+        view: usize,
+        slot: usize,
+        camera: &CameraPose,
+        frame_index: u32,
+        max_depth: u32,
+        flags: u32,
+        jitter: Vec2,
+    ) -> Result<()> {
         let v = &self.views[view];
         let screen = v.space.screen_size().as_vec2();
         let prev = v.prev_camera.unwrap_or(*camera);
         let seed = match self.settings.stereo_noise {
-            StereoNoise::Independent => self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9),
+            StereoNoise::Independent => {
+                self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9)
+            }
             StereoNoise::Shared => self.settings.seed,
         };
         let data = FrameData {
@@ -439,7 +494,9 @@ impl Renderer {
             // Selection probability 0 tells the shaders not to sample it (BRDF-only).
             environment: match self.settings.environment_sampling {
                 EnvironmentSampling::ImportanceMis => self.scene.environment_slots.0,
-                EnvironmentSampling::BrdfOnly => self.scene.environment_slots.0 * Vec4::new(1.0, 1.0, 1.0, 0.0),
+                EnvironmentSampling::BrdfOnly => {
+                    self.scene.environment_slots.0 * Vec4::new(1.0, 1.0, 1.0, 0.0)
+                }
             },
             environment_map: self.scene.environment_slots.1,
             path: Vec4::new(self.settings.path_regularisation, 0.0, 0.0, 0.0),
@@ -489,7 +546,11 @@ impl Renderer {
     pub fn submit(&mut self, input: &FrameInput, target: Option<&FrameTarget>) -> Result<u64> {
         let inputs = input.view_inputs();
         if inputs.len() != self.views.len() {
-            return Err(Error::Invalid(format!("the frame has {} views, the renderer {}", inputs.len(), self.views.len())));
+            return Err(Error::Invalid(format!(
+                "the frame has {} views, the renderer {}",
+                inputs.len(),
+                self.views.len()
+            )));
         }
         let retired = self.ring.retire_next()?;
         self.last_waited = retired.max(self.last_waited);
@@ -504,7 +565,17 @@ impl Renderer {
         for (v, view_input) in inputs.iter().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
-            record_view(rec, &mut self.views[v], slot, &self.scene, (&self.tonemap, &self.accumulate), &self.settings, view_input, input, external)?;
+            record_view(
+                rec,
+                &mut self.views[v],
+                slot,
+                &self.scene,
+                (&self.tonemap, &self.accumulate),
+                &self.settings,
+                view_input,
+                input,
+                external,
+            )?;
         }
         let sync = match target {
             Some(t) => {
@@ -522,17 +593,48 @@ impl Renderer {
     }
 
     /// Host-side work of one view before recording: gaze, this slot's uniforms and table.
-    fn prepare_view(&mut self, v: usize, slot: usize, view_input: &ViewInput, input: &FrameInput) -> Result<()> {
+    fn prepare_view(
+        &mut self,
+        v: usize,
+        slot: usize,
+        view_input: &ViewInput,
+        input: &FrameInput,
+    ) -> Result<()> {
         let cull = self.settings.offscreen_samples == OffscreenSamples::Cull;
         if let Some(gaze) = view_input.gaze {
             self.views[v].space.set_gaze(gaze)?;
         }
-        let jitter = self.settings.taa.settings().map(|t| t.jitter(input.frame_index));
-        let flags = if jitter.is_some() { FRAME_FLAG_HALTON_JITTER } else { 0 }
-            | if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 }
-            | if self.settings.texture_lod == TextureLod::RayCones { FRAME_FLAG_TEXTURE_LOD } else { 0 }
-            | if self.settings.offscreen_samples == OffscreenSamples::Cull { FRAME_FLAG_CULL_OFFSCREEN } else { 0 };
-        self.write_frame_data(v, slot, &view_input.camera, input.frame_index, self.settings.max_depth, flags, jitter.unwrap_or(Vec2::ZERO))?;
+        let jitter = self
+            .settings
+            .taa
+            .settings()
+            .map(|t| t.jitter(input.frame_index));
+        let flags = if jitter.is_some() {
+            FRAME_FLAG_HALTON_JITTER
+        } else {
+            0
+        } | if self.scene.alpha_masked {
+            FRAME_FLAG_ALPHA_MASK
+        } else {
+            0
+        } | if self.settings.texture_lod == TextureLod::RayCones {
+            FRAME_FLAG_TEXTURE_LOD
+        } else {
+            0
+        } | if self.settings.offscreen_samples == OffscreenSamples::Cull {
+            FRAME_FLAG_CULL_OFFSCREEN
+        } else {
+            0
+        };
+        self.write_frame_data(
+            v,
+            slot,
+            &view_input.camera,
+            input.frame_index,
+            self.settings.max_depth,
+            flags,
+            jitter.unwrap_or(Vec2::ZERO),
+        )?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;
         let s = &view.slots[slot];
@@ -541,25 +643,34 @@ impl Renderer {
         let n = view.table_rows.len();
         // Without a previous frame its half repeats this frame's (no pass reads it then).
         match view.prev_sampling {
-            Some(_) if view.prev_table_rows.len() == n => view.table_rows.extend_from_slice(&view.prev_table_rows),
+            Some(_) if view.prev_table_rows.len() == n => {
+                view.table_rows.extend_from_slice(&view.prev_table_rows)
+            }
             _ => view.table_rows.extend_from_within(..n),
         }
         s.sampling_table.write(&view.table_rows)?;
         view.prev_table_rows.clear();
-        view.prev_table_rows.extend_from_slice(&view.table_rows[..n]);
+        view.prev_table_rows
+            .extend_from_slice(&view.table_rows[..n]);
         view.write_trace_tiles(slot, cull)
     }
 
     fn readable_slot(&self, frame: u64) -> Result<usize> {
         match self.ring.slot_of(frame) {
             Some(slot) if self.ring.is_readable(frame) => Ok(slot),
-            Some(_) => Err(Error::Invalid(format!("frame {frame} is still in flight (wait for it first)"))),
-            None => Err(Error::Invalid(format!("frame {frame} is no longer held: its slot was reused"))),
+            Some(_) => Err(Error::Invalid(format!(
+                "frame {frame} is still in flight (wait for it first)"
+            ))),
+            None => Err(Error::Invalid(format!(
+                "frame {frame} is no longer held: its slot was reused"
+            ))),
         }
     }
 
     fn last_slot(&self) -> Result<usize> {
-        let frame = self.last_waited.ok_or_else(|| Error::Invalid("no frame has completed yet".into()))?;
+        let frame = self
+            .last_waited
+            .ok_or_else(|| Error::Invalid("no frame has completed yet".into()))?;
         self.readable_slot(frame)
     }
 
@@ -577,12 +688,20 @@ impl Renderer {
 
     /// Linear screen image of one view of a completed frame (`FrameInput::read_hdr`), RGBA32F.
     pub fn read_view_hdr(&self, frame: u64, view: usize, out: &mut Vec<[f32; 4]>) -> Result<()> {
-        read_optional(&self.views[view].slots[self.readable_slot(frame)?].hdr_readback, "read_hdr", out)
+        read_optional(
+            &self.views[view].slots[self.readable_slot(frame)?].hdr_readback,
+            "read_hdr",
+            out,
+        )
     }
 
     /// Tonemapped sampling-grid image of one view of a completed frame (`read_grid`), RGBA8.
     pub fn read_view_grid_ldr(&self, frame: u64, view: usize, out: &mut Vec<u8>) -> Result<()> {
-        read_optional(&self.views[view].slots[self.readable_slot(frame)?].grid_readback, "read_grid", out)
+        read_optional(
+            &self.views[view].slots[self.readable_slot(frame)?].grid_readback,
+            "read_grid",
+            out,
+        )
     }
 
     /// The newest collected frame's tonemapped pixels (first view), RGBA8, rows top to bottom.
@@ -594,12 +713,20 @@ impl Renderer {
 
     /// The newest collected frame's tonemapped sampling-grid image (first view), RGBA8.
     pub fn read_grid_ldr(&self, out: &mut Vec<u8>) -> Result<()> {
-        read_optional(&self.views[0].slots[self.last_slot()?].grid_readback, "read_grid", out)
+        read_optional(
+            &self.views[0].slots[self.last_slot()?].grid_readback,
+            "read_grid",
+            out,
+        )
     }
 
     /// The newest collected frame's (or reference's) linear screen image (first view), RGBA32F.
     pub fn read_hdr(&self, out: &mut Vec<[f32; 4]>) -> Result<()> {
-        read_optional(&self.views[0].slots[self.last_slot()?].hdr_readback, "read_hdr", out)
+        read_optional(
+            &self.views[0].slots[self.last_slot()?].hdr_readback,
+            "read_hdr",
+            out,
+        )
     }
 
     /// Converged linear radiance of the first view: the mean of `spp` samples per pixel with
@@ -613,10 +740,14 @@ impl Renderer {
         mut progress: impl FnMut(u32),
     ) -> Result<Vec<[f32; 4]>> {
         if spp == 0 || max_depth == 0 {
-            return Err(Error::Invalid("reference needs spp ≥ 1 and max depth ≥ 1".into()));
+            return Err(Error::Invalid(
+                "reference needs spp ≥ 1 and max depth ≥ 1".into(),
+            ));
         }
         if self.space().grid_size() != self.space().screen_size() {
-            return Err(Error::Invalid("references are rendered in Cartesian space".into()));
+            return Err(Error::Invalid(
+                "references are rendered in Cartesian space".into(),
+            ));
         }
         self.finish()?;
         let screen = self.space().screen_size();
@@ -626,7 +757,13 @@ impl Renderer {
             view.prev_camera = None;
             view.prev_sampling = None;
             if view.accum.is_none() {
-                view.accum = Some(Image::new(&self.ctx, "accum", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?);
+                view.accum = Some(Image::new(
+                    &self.ctx,
+                    "accum",
+                    screen.x,
+                    screen.y,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                )?);
             }
         }
         let mut done = 0;
@@ -634,20 +771,49 @@ impl Renderer {
             let batch = (spp - done).min(REFERENCE_SAMPLES_PER_SUBMIT);
             let slot = self.ring.next_slot();
             self.views[0].ensure_readbacks(&self.ctx, slot, true, false)?;
-            let alpha = if self.scene.alpha_masked { FRAME_FLAG_ALPHA_MASK } else { 0 };
-            self.write_frame_data(0, slot, camera, 0, max_depth, FRAME_FLAG_REFERENCE | alpha, Vec2::ZERO)?;
-            self.views[0].slots[slot].sampling.write(&[self.views[0].space.params()])?;
+            let alpha = if self.scene.alpha_masked {
+                FRAME_FLAG_ALPHA_MASK
+            } else {
+                0
+            };
+            self.write_frame_data(
+                0,
+                slot,
+                camera,
+                0,
+                max_depth,
+                FRAME_FLAG_REFERENCE | alpha,
+                Vec2::ZERO,
+            )?;
+            self.views[0].slots[slot]
+                .sampling
+                .write(&[self.views[0].space.params()])?;
             self.views[0].write_trace_tiles(slot, false)?;
             let (_, rec) = self.ring.begin_next()?;
             let view = &self.views[0];
             let (s, accum) = (&view.slots[slot], view.accum.as_ref().expect("made above"));
             let tiles = TileList::new(&s.trace_tiles, &view.tiles);
             for i in done..done + batch {
-                view.trace.record(rec, &self.scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, i, None)?;
+                view.trace.record(
+                    rec,
+                    &self.scene,
+                    &s.frame_data,
+                    &s.sampling,
+                    &s.sampling_table,
+                    &s.ray_counters,
+                    &view.gbuffer,
+                    &tiles,
+                    i,
+                    None,
+                )?;
                 self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {
-                rec.copy_image_to_buffer("readback_hdr", accum, s.hdr_readback.as_ref().expect("made above"))?;
+                rec.copy_image_to_buffer(
+                    "readback_hdr",
+                    accum,
+                    s.hdr_readback.as_ref().expect("made above"),
+                )?;
             }
             rec.submit(SubmitSync::default())?;
             let frame = self.ring.submitted();
@@ -670,8 +836,16 @@ impl Drop for Renderer {
     }
 }
 
-fn build_views(ctx: &Arc<Context>, spaces: Vec<Box<dyn SamplingSpace>>, settings: &RenderSettings, slots: usize) -> Result<Vec<View>> {
-    spaces.into_iter().map(|space| View::new(ctx, space, settings, slots)).collect()
+fn build_views(
+    ctx: &Arc<Context>,
+    spaces: Vec<Box<dyn SamplingSpace>>,
+    settings: &RenderSettings,
+    slots: usize,
+) -> Result<Vec<View>> {
+    spaces
+        .into_iter()
+        .map(|space| View::new(ctx, space, settings, slots))
+        .collect()
 }
 
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
@@ -681,8 +855,16 @@ fn max_passes(views: &[View]) -> u32 {
     frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 2) + 2
 }
 
-fn read_optional<T: bytemuck::Pod>(buffer: &Option<Buffer>, flag: &str, out: &mut Vec<T>) -> Result<()> {
-    let b = buffer.as_ref().ok_or_else(|| Error::Invalid(format!("no frame asked for this read-back (FrameInput::{flag})")))?;
+fn read_optional<T: bytemuck::Pod>(
+    buffer: &Option<Buffer>,
+    flag: &str,
+    out: &mut Vec<T>,
+) -> Result<()> {
+    let b = buffer.as_ref().ok_or_else(|| {
+        Error::Invalid(format!(
+            "no frame asked for this read-back (FrameInput::{flag})"
+        ))
+    })?;
     out.resize(b.size as usize / std::mem::size_of::<T>(), T::zeroed());
     b.read_into(out)
 }
@@ -707,20 +889,47 @@ fn record_view(
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
     let tiles = TileList::new(&s.trace_tiles, &view.tiles);
-    let denoise_frame = DenoiseFrame { current: space, previous: view.prev_sampling, sampling_table: &s.sampling_table, tiles };
+    let denoise_frame = DenoiseFrame {
+        current: space,
+        previous: view.prev_sampling,
+        sampling_table: &s.sampling_table,
+        tiles,
+    };
     if let Some(d) = &mut view.denoiser {
         d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
-    trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, 0, gradients)?;
+    trace.record(
+        rec,
+        scene,
+        &s.frame_data,
+        &s.sampling,
+        &s.sampling_table,
+        &s.ray_counters,
+        &view.gbuffer,
+        &tiles,
+        0,
+        gradients,
+    )?;
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
     let traced = match &view.sample_mean {
         Some(mean) => {
             accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
             for k in 1..view.space.samples_per_texel() {
-                trace.record(rec, scene, &s.frame_data, &s.sampling, &s.sampling_table, &s.ray_counters, &view.gbuffer, &tiles, k, None)?;
+                trace.record(
+                    rec,
+                    scene,
+                    &s.frame_data,
+                    &s.sampling,
+                    &s.sampling_table,
+                    &s.ray_counters,
+                    &view.gbuffer,
+                    &tiles,
+                    k,
+                    None,
+                )?;
                 accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
             }
             mean
@@ -729,13 +938,18 @@ fn record_view(
     };
     let denoised = match &mut view.denoiser {
         Some(d) => {
-            let scene = DenoiseScene { camera_origin: view_input.camera.world_from_view.w_axis.truncate(), materials: &scene.materials };
+            let scene = DenoiseScene {
+                camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
+                materials: &scene.materials,
+            };
             d.record(rec, &view.gbuffer, &denoise_frame, &scene)?
         }
         None => traced,
     };
     let grid_hdr = match (&mut view.taa, jitter) {
-        (Some(taa), Some(jitter)) => taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?,
+        (Some(taa), Some(jitter)) => {
+            taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?
+        }
         _ => denoised,
     };
     let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
@@ -758,18 +972,32 @@ fn record_view(
     // (one full-screen pass fewer).
     let fused = (!input.read_hdr).then_some(display);
     let screen = match (&mut view.back, view.space.visual_polar()) {
-        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(rec, vp, &s.sampling_table, grid_hdr, &settings.blur, screen_taa.as_ref(), fused)?,
+        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(
+            rec,
+            vp,
+            &s.sampling_table,
+            grid_hdr,
+            &settings.blur,
+            screen_taa.as_ref(),
+            fused,
+        )?,
         (BackPasses::Upscale(upscale, screen), _) => {
             upscale.record(rec, grid_hdr, screen)?;
             ScreenOut::Radiance(screen)
         }
-        (BackPasses::Fill(fill), _) => ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?),
+        (BackPasses::Fill(fill), _) => {
+            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?)
+        }
         (BackPasses::BlockFill(fill, screen), _) => {
             fill.record(rec, &s.sampling, grid_hdr, screen)?;
             ScreenOut::Radiance(screen)
         }
         (BackPasses::Splat(splat, fill), _) => {
-            let inputs = SplatInputs { frame_data: &s.frame_data, sampling: &s.sampling, sampling_table: &s.sampling_table };
+            let inputs = SplatInputs {
+                frame_data: &s.frame_data,
+                sampling: &s.sampling,
+                sampling_table: &s.sampling_table,
+            };
             let sparse = splat.record(rec, &inputs, grid_hdr)?;
             ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?)
         }
@@ -785,7 +1013,10 @@ fn record_view(
         rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
     }
     if let (true, Some(b)) = (input.read_grid, &s.grid_readback) {
-        let grid_target = ToneTarget { ldr: LdrTarget::Own(&view.grid_ldr), ..display };
+        let grid_target = ToneTarget {
+            ldr: LdrTarget::Own(&view.grid_ldr),
+            ..display
+        };
         tonemap.record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
         rec.copy_image_to_buffer("readback_grid", &view.grid_ldr, b)?;
     }

@@ -25,11 +25,24 @@ pub struct PackedTextures {
 /// descriptor the device cannot bind.
 pub fn pack(scene: &Scene, max_texels: usize) -> PackedTextures {
     let srgb = srgb_images(scene);
-    let mut level0: Vec<std::borrow::Cow<Texture>> = scene.textures.iter().map(std::borrow::Cow::Borrowed).collect();
-    let total = |ts: &[std::borrow::Cow<Texture>]| ts.iter().map(|t| chain_texels(t.width, t.height)).sum::<usize>();
+    let mut level0: Vec<std::borrow::Cow<Texture>> = scene
+        .textures
+        .iter()
+        .map(std::borrow::Cow::Borrowed)
+        .collect();
+    let total = |ts: &[std::borrow::Cow<Texture>]| {
+        ts.iter()
+            .map(|t| chain_texels(t.width, t.height))
+            .sum::<usize>()
+    };
     let mut halvings = 0;
     while total(&level0) > max_texels.max(1) {
-        let Some((largest, _)) = level0.iter().enumerate().filter(|(_, t)| t.width * t.height > 1).max_by_key(|(_, t)| t.width * t.height) else {
+        let Some((largest, _)) = level0
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.width * t.height > 1)
+            .max_by_key(|(_, t)| t.width * t.height)
+        else {
             break;
         };
         level0[largest] = std::borrow::Cow::Owned(downsample(&level0[largest], srgb[largest]));
@@ -50,11 +63,19 @@ pub fn pack(scene: &Scene, max_texels: usize) -> PackedTextures {
         chains.push(UVec4::new(first, t.width, t.height, levels));
     }
     let (infos, material_slots) = views(scene, &chains);
-    PackedTextures { infos, texels, halvings, material_slots }
+    PackedTextures {
+        infos,
+        texels,
+        halvings,
+        material_slots,
+    }
 }
 
 /// One [`TextureGpu`] per distinct (image, transform) the materials bind.
-fn views(scene: &Scene, chains: &[UVec4]) -> (Vec<TextureGpu>, Vec<[Option<u32>; TextureSlot::COUNT]>) {
+fn views(
+    scene: &Scene,
+    chains: &[UVec4],
+) -> (Vec<TextureGpu>, Vec<[Option<u32>; TextureSlot::COUNT]>) {
     let mut infos = Vec::new();
     let mut index: HashMap<(u32, [u32; 5]), u32> = HashMap::new();
     let slots = scene
@@ -68,7 +89,11 @@ fn views(scene: &Scene, chains: &[UVec4]) -> (Vec<TextureGpu>, Vec<[Option<u32>;
                 let key = (image, transform_key(&transform));
                 Some(*index.entry(key).or_insert_with(|| {
                     let [u, v] = transform.rows();
-                    infos.push(TextureGpu { extent: chain, transform_u: u.extend(0.0), transform_v: v.extend(0.0) });
+                    infos.push(TextureGpu {
+                        extent: chain,
+                        transform_u: u.extend(0.0),
+                        transform_v: v.extend(0.0),
+                    });
                     infos.len() as u32 - 1
                 }))
             })
@@ -112,7 +137,11 @@ fn half(size: u32) -> u32 {
 }
 
 fn push_texels(texels: &mut Vec<u32>, t: &Texture) {
-    texels.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+    texels.extend(
+        t.rgba8
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])),
+    );
 }
 
 /// `t` at the next mip level: each texel the mean of its 2×2 block (colour in linear light when
@@ -123,19 +152,37 @@ pub fn downsample(t: &Texture, srgb: bool) -> Texture {
     let at = |x: u32, y: u32| {
         let i = ((y.min(t.height - 1) * t.width + x.min(t.width - 1)) * 4) as usize;
         let c = &t.rgba8[i..i + 4];
-        let channel = |k: usize| if srgb && k < 3 { decode[c[k] as usize] } else { c[k] as f32 / 255.0 };
+        let channel = |k: usize| {
+            if srgb && k < 3 {
+                decode[c[k] as usize]
+            } else {
+                c[k] as f32 / 255.0
+            }
+        };
         Vec4::new(channel(0), channel(1), channel(2), channel(3))
     };
     let mut rgba8 = Vec::with_capacity((w * h * 4) as usize);
     for y in 0..h {
         for x in 0..w {
-            let mean = (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1)) * 0.25;
+            let mean = (at(2 * x, 2 * y)
+                + at(2 * x + 1, 2 * y)
+                + at(2 * x, 2 * y + 1)
+                + at(2 * x + 1, 2 * y + 1))
+                * 0.25;
             for k in 0..4 {
-                rgba8.push(if srgb && k < 3 { srgb_encode(mean[k], &decode) } else { (mean[k] * 255.0).round() as u8 });
+                rgba8.push(if srgb && k < 3 {
+                    srgb_encode(mean[k], &decode)
+                } else {
+                    (mean[k] * 255.0).round() as u8
+                });
             }
         }
     }
-    Texture { width: w, height: h, rgba8 }
+    Texture {
+        width: w,
+        height: h,
+        rgba8,
+    }
 }
 
 /// Linear value of each 8-bit sRGB code (the shader's `srgb_to_linear`).
@@ -174,7 +221,11 @@ mod tests {
                 rgba8.extend([v, v, v, 255]);
             }
         }
-        Texture { width: size, height: size, rgba8 }
+        Texture {
+            width: size,
+            height: size,
+            rgba8,
+        }
     }
 
     #[test]
@@ -183,7 +234,11 @@ mod tests {
         let decode = srgb_decode_table();
         assert_eq!((mip.width, mip.height), (2, 2));
         // Half the light: code 188 (linear 0.5029), not the encoded mean 128 (linear 0.216).
-        assert!((decode[mip.rgba8[0] as usize] - 0.5).abs() < 0.003, "{}", mip.rgba8[0]);
+        assert!(
+            (decode[mip.rgba8[0] as usize] - 0.5).abs() < 0.003,
+            "{}",
+            mip.rgba8[0]
+        );
         let linear = downsample(&checker(4), false);
         assert_eq!(linear.rgba8[0], 128);
     }
@@ -202,7 +257,11 @@ mod tests {
         assert_eq!(chain_texels(4, 4), 16 + 4 + 1);
         // 5×3 → 3×2 → 2×1 → 1×1.
         assert_eq!(chain_texels(5, 3), 15 + 6 + 2 + 1);
-        let t = Texture { width: 5, height: 3, rgba8: vec![7; 60] };
+        let t = Texture {
+            width: 5,
+            height: 3,
+            rgba8: vec![7; 60],
+        };
         let m = downsample(&t, false);
         assert_eq!((m.width, m.height), (3, 2));
         assert!(m.rgba8.iter().all(|&v| v == 7));
@@ -210,14 +269,32 @@ mod tests {
 
     #[test]
     fn pack_lays_chains_end_to_end_and_shares_views() {
-        let transformed = UvTransform { offset: glam::Vec2::new(0.5, 0.0), rotation: 0.0, scale: glam::Vec2::splat(2.0) };
-        let mut a = Material { base_color_texture: Some(0), emissive_texture: Some(1), ..Default::default() };
-        let b = Material { base_color_texture: Some(0), ..Default::default() };
-        let c = Material { base_color_texture: Some(0), ..Default::default() };
+        let transformed = UvTransform {
+            offset: glam::Vec2::new(0.5, 0.0),
+            rotation: 0.0,
+            scale: glam::Vec2::splat(2.0),
+        };
+        let mut a = Material {
+            base_color_texture: Some(0),
+            emissive_texture: Some(1),
+            ..Default::default()
+        };
+        let b = Material {
+            base_color_texture: Some(0),
+            ..Default::default()
+        };
+        let c = Material {
+            base_color_texture: Some(0),
+            ..Default::default()
+        };
         a.uv_transforms[TextureSlot::Emissive as usize] = transformed;
         let mut c = c;
         c.uv_transforms[TextureSlot::BaseColor as usize] = transformed;
-        let scene = Scene { textures: vec![checker(4), checker(2)], materials: vec![a, b, c], ..Default::default() };
+        let scene = Scene {
+            textures: vec![checker(4), checker(2)],
+            materials: vec![a, b, c],
+            ..Default::default()
+        };
         let packed = pack(&scene, usize::MAX);
         assert_eq!(packed.texels.len(), chain_texels(4, 4) + chain_texels(2, 2));
         assert_eq!(packed.halvings, 0);
@@ -225,15 +302,26 @@ mod tests {
         assert_eq!(packed.infos.len(), 3);
         assert_eq!(packed.material_slots[0][0], packed.material_slots[1][0]);
         assert_ne!(packed.material_slots[2][0], packed.material_slots[0][0]);
-        let emissive = packed.infos[packed.material_slots[0][TextureSlot::Emissive as usize].unwrap() as usize];
-        assert_eq!(emissive.extent, UVec4::new(chain_texels(4, 4) as u32, 2, 2, 2));
+        let emissive = packed.infos
+            [packed.material_slots[0][TextureSlot::Emissive as usize].unwrap() as usize];
+        assert_eq!(
+            emissive.extent,
+            UVec4::new(chain_texels(4, 4) as u32, 2, 2, 2)
+        );
         assert_eq!(emissive.transform_u, glam::Vec4::new(2.0, 0.0, 0.5, 0.0));
         assert_eq!(packed.infos[0].extent, UVec4::new(0, 4, 4, 3));
     }
 
     #[test]
     fn pack_halves_the_largest_until_the_chains_fit() {
-        let scene = Scene { textures: vec![checker(8), checker(2)], materials: vec![Material { base_color_texture: Some(0), ..Default::default() }], ..Default::default() };
+        let scene = Scene {
+            textures: vec![checker(8), checker(2)],
+            materials: vec![Material {
+                base_color_texture: Some(0),
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
         let packed = pack(&scene, chain_texels(4, 4) + chain_texels(2, 2));
         assert_eq!(packed.halvings, 1);
         assert_eq!(packed.texels.len(), chain_texels(4, 4) + chain_texels(2, 2));

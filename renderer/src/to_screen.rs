@@ -55,7 +55,10 @@ pub struct BlurSettings {
 
 impl Default for BlurSettings {
     fn default() -> Self {
-        BlurSettings { sigma_at_30: FOVE_SIGMA_AT_30, space: BlurSpace::default() }
+        BlurSettings {
+            sigma_at_30: FOVE_SIGMA_AT_30,
+            space: BlurSpace::default(),
+        }
     }
 }
 
@@ -67,10 +70,18 @@ impl BlurSettings {
         let sigma_30 = self.sigma_at_30 * (screen.x * screen.y / FOVE_EYE_PIXELS).sqrt();
         let r_f = vp.r_fovea();
         let r_30 = vp.radius_of_eccentricity(SIGMA_REFERENCE_DEG);
-        let slope = if r_30 > r_f { sigma_30 / (r_30 - r_f) } else { 0.0 };
+        let slope = if r_30 > r_f {
+            sigma_30 / (r_30 - r_f)
+        } else {
+            0.0
+        };
         // The slope is the paper's (fovea edge → 30°); the blur starts where the space leaves the
         // image sharp (the fovea; log-polar: the buffer's inner half).
-        BlurShape { gaze: vp.gaze(), fovea_radius: vp.blur_start(), sigma_slope: slope }
+        BlurShape {
+            gaze: vp.gaze(),
+            fovea_radius: vp.blur_start(),
+            sigma_slope: slope,
+        }
     }
 }
 
@@ -91,16 +102,40 @@ pub struct FoveatedBlur {
 
 impl FoveatedBlur {
     pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FoveatedBlur> {
-        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
-        Ok(FoveatedBlur { pass: BlurPass::new(ctx)?, scratch: image("screen.blur_scratch")?, blurred: image("screen.blurred")? })
+        let image = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                screen.x,
+                screen.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )
+        };
+        Ok(FoveatedBlur {
+            pass: BlurPass::new(ctx)?,
+            scratch: image("screen.blur_scratch")?,
+            blurred: image("screen.blurred")?,
+        })
     }
 
     /// Blurs `src` around `axis`'s gaze into `blurred`; `src` itself when σ is 0.
-    pub fn record<'a>(&'a self, rec: &mut FrameRecorder, settings: &BlurSettings, axis: &VisualPolar, src: &'a Image) -> Result<&'a Image> {
+    pub fn record<'a>(
+        &'a self,
+        rec: &mut FrameRecorder,
+        settings: &BlurSettings,
+        axis: &VisualPolar,
+        src: &'a Image,
+    ) -> Result<&'a Image> {
         if settings.sigma_at_30 <= 0.0 {
             return Ok(src);
         }
-        self.pass.record(rec, &settings.shape(axis), src, &self.scratch, BlurTarget::Radiance(&self.blurred))?;
+        self.pass.record(
+            rec,
+            &settings.shape(axis),
+            src,
+            &self.scratch,
+            BlurTarget::Radiance(&self.blurred),
+        )?;
         Ok(&self.blurred)
     }
 
@@ -116,10 +151,18 @@ impl FoveatedBlur {
     ) -> Result<ScreenOut<'a>> {
         match display {
             Some(target) if settings.sigma_at_30 > 0.0 => {
-                self.pass.record(rec, &settings.shape(axis), src, &self.scratch, BlurTarget::Display(target))?;
+                self.pass.record(
+                    rec,
+                    &settings.shape(axis),
+                    src,
+                    &self.scratch,
+                    BlurTarget::Display(target),
+                )?;
                 Ok(ScreenOut::Shown)
             }
-            _ => self.record(rec, settings, axis, src).map(ScreenOut::Radiance),
+            _ => self
+                .record(rec, settings, axis, src)
+                .map(ScreenOut::Radiance),
         }
     }
 }
@@ -148,13 +191,30 @@ impl ToScreen {
     /// `taa`: resolve in screen space after the remap with these settings; `blur`: where the
     /// foveated blur runs (the grid only without screen-space TAA; the caller asks for the grid
     /// only for a space `GridBlurPass::supports`).
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, screen: UVec2, taa: Option<TaaSettings>, blur: BlurSpace) -> Result<ToScreen> {
-        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
-        let grid_image = |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
+    pub fn new(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        screen: UVec2,
+        taa: Option<TaaSettings>,
+        blur: BlurSpace,
+    ) -> Result<ToScreen> {
+        let image = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                screen.x,
+                screen.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )
+        };
+        let grid_image =
+            |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
         let grid_blur = match (blur, taa) {
-            (BlurSpace::Grid, None) => {
-                Some(GridBlur { pass: GridBlurPass::new(ctx)?, scratch: grid_image("grid.blur_scratch")?, blurred: grid_image("grid.blurred")? })
-            }
+            (BlurSpace::Grid, None) => Some(GridBlur {
+                pass: GridBlurPass::new(ctx)?,
+                scratch: grid_image("grid.blur_scratch")?,
+                blurred: grid_image("grid.blurred")?,
+            }),
             _ => None,
         };
         Ok(ToScreen {
@@ -189,18 +249,33 @@ impl ToScreen {
         let grid_blur = self.grid_blur.as_ref().filter(|_| blur.sigma_at_30 > 0.0);
         let vp_color = match grid_blur {
             Some(g) => {
-                g.pass.record(rec, &params, &blur.shape(vp), vp_color, &g.scratch, &g.blurred)?;
+                g.pass.record(
+                    rec,
+                    &params,
+                    &blur.shape(vp),
+                    vp_color,
+                    &g.scratch,
+                    &g.blurred,
+                )?;
                 &g.blurred
             }
             None => vp_color,
         };
-        self.mip_phi.record(rec, &params, columns, vp_color, &self.mips)?;
+        self.mip_phi
+            .record(rec, &params, columns, vp_color, &self.mips)?;
         // Samples jittered for the screen-space TAA are read where they were traced.
         let sample_offset = match (&self.taa, taa) {
             (Some(_), Some(frame)) => frame.jitter - Vec2::splat(0.5),
             _ => Vec2::ZERO,
         };
-        self.remap.record(rec, &params, columns, &self.mips, &self.remapped, sample_offset)?;
+        self.remap.record(
+            rec,
+            &params,
+            columns,
+            &self.mips,
+            &self.remapped,
+            sample_offset,
+        )?;
         let resolved = match (&mut self.taa, taa) {
             (Some(resolver), Some(frame)) => resolver.record(rec, &self.remapped, frame)?,
             _ => &self.remapped,

@@ -4,17 +4,17 @@
 //! reads (uniforms, counters, read-backs). The scene and the pipelines are shared by all views.
 
 use crate::error::{Error, Result};
+use crate::fill_to_screen::FillToScreen;
 use crate::layouts::{FrameData, SamplingParams};
+use crate::passes::block_fill::BlockFillPass;
+use crate::passes::blur_grid::GridBlurPass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
-use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
-use crate::passes::block_fill::BlockFillPass;
 use crate::passes::splat::SplatPass;
+use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
 use crate::passes::upscale::UpscalePass;
 use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
-use crate::fill_to_screen::FillToScreen;
 use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
-use crate::passes::blur_grid::GridBlurPass;
 use crate::to_screen::{BlurSpace, ToScreen};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
@@ -44,9 +44,23 @@ impl ViewSlot {
         let screen = space.screen_size();
         let grid = space.grid_size();
         Ok(ViewSlot {
-            frame_data: Buffer::with_data(ctx, "frame", &[FrameData::default()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
-            sampling: Buffer::with_data(ctx, "sampling", &[space.params()], vk::BufferUsageFlags::UNIFORM_BUFFER)?,
-            sampling_table: Buffer::texels(ctx, "sampling_table", &space.sampling_table().repeat(2))?,
+            frame_data: Buffer::with_data(
+                ctx,
+                "frame",
+                &[FrameData::default()],
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?,
+            sampling: Buffer::with_data(
+                ctx,
+                "sampling",
+                &[space.params()],
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )?,
+            sampling_table: Buffer::texels(
+                ctx,
+                "sampling_table",
+                &space.sampling_table().repeat(2),
+            )?,
             ray_counters: Buffer::new(
                 ctx,
                 "ray_counters",
@@ -54,7 +68,12 @@ impl ViewSlot {
                 vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )?,
-            trace_tiles: Buffer::with_data(ctx, "trace_tiles", &vec![0u32; tile_count(grid).element_product() as usize], vk::BufferUsageFlags::STORAGE_BUFFER)?,
+            trace_tiles: Buffer::with_data(
+                ctx,
+                "trace_tiles",
+                &vec![0u32; tile_count(grid).element_product() as usize],
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
             ldr_readback: readback(ctx, "ldr_readback", screen.x as u64 * screen.y as u64 * 4)?,
             hdr_readback: None,
             grid_readback: None,
@@ -80,13 +99,21 @@ impl ViewSlot {
 /// are made only for a view that uses them.
 fn blur_space(asked: BlurSpace, space: &dyn SamplingSpace) -> BlurSpace {
     match asked {
-        BlurSpace::Grid if !space.visual_polar().is_some_and(GridBlurPass::supports) => BlurSpace::Screen,
+        BlurSpace::Grid if !space.visual_polar().is_some_and(GridBlurPass::supports) => {
+            BlurSpace::Screen
+        }
         other => other,
     }
 }
 
 pub(crate) fn readback(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Buffer> {
-    Buffer::new(ctx, name, bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)
+    Buffer::new(
+        ctx,
+        name,
+        bytes,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+    )
 }
 
 /// The passes of one `WayBack` (sampling::WayBack), owned by the view.
@@ -135,11 +162,18 @@ pub struct View {
 }
 
 impl View {
-    pub(crate) fn new(ctx: &Arc<Context>, space: Box<dyn SamplingSpace>, settings: &RenderSettings, slots: usize) -> Result<View> {
+    pub(crate) fn new(
+        ctx: &Arc<Context>,
+        space: Box<dyn SamplingSpace>,
+        settings: &RenderSettings,
+        slots: usize,
+    ) -> Result<View> {
         let grid = space.grid_size();
         let screen = space.screen_size();
         let caps = space.capabilities();
-        if !caps.temporal_filters && (settings.denoiser != DenoiserSettings::None || settings.taa != TaaMode::Off) {
+        if !caps.temporal_filters
+            && (settings.denoiser != DenoiserSettings::None || settings.taa != TaaMode::Off)
+        {
             return Err(Error::Invalid(format!(
                 "denoiser '{}' / TAA '{}': the {} space supports no denoiser or TAA {}",
                 settings.denoiser.name(),
@@ -157,32 +191,74 @@ impl View {
         };
         let back = match caps.way_back {
             WayBack::Direct => BackPasses::Direct,
-            WayBack::Remap => BackPasses::Remap(ToScreen::new(ctx, grid, screen, screen_taa, blur_space(settings.blur.space, space.as_ref()))?),
-            WayBack::Upscale => BackPasses::Upscale(UpscalePass::new(ctx)?, Image::new(ctx, "upscaled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
+            WayBack::Remap => BackPasses::Remap(ToScreen::new(
+                ctx,
+                grid,
+                screen,
+                screen_taa,
+                blur_space(settings.blur.space, space.as_ref()),
+            )?),
+            WayBack::Upscale => BackPasses::Upscale(
+                UpscalePass::new(ctx)?,
+                Image::new(
+                    ctx,
+                    "upscaled",
+                    screen.x,
+                    screen.y,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                )?,
+            ),
             WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
-            WayBack::Splat => BackPasses::Splat(SplatPass::new(ctx, space.trace_variant(), screen)?, FillToScreen::new(ctx, screen)?),
-            WayBack::BlockFill => BackPasses::BlockFill(BlockFillPass::new(ctx, space.shader_variant())?, Image::new(ctx, "block_filled", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?),
+            WayBack::Splat => BackPasses::Splat(
+                SplatPass::new(ctx, space.trace_variant(), screen)?,
+                FillToScreen::new(ctx, screen)?,
+            ),
+            WayBack::BlockFill => BackPasses::BlockFill(
+                BlockFillPass::new(ctx, space.shader_variant())?,
+                Image::new(
+                    ctx,
+                    "block_filled",
+                    screen.x,
+                    screen.y,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                )?,
+            ),
         };
         let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
         let trace_gradients = match gradients {
             false => None,
-            true => Some(TracePass::new(ctx, &format!("{}_gradients", space.trace_variant()))?),
+            true => Some(TracePass::new(
+                ctx,
+                &format!("{}_gradients", space.trace_variant()),
+            )?),
         };
         let taa = match grid_taa {
             Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
             None => None,
         };
-        let slots = (0..slots).map(|_| ViewSlot::new(ctx, space.as_ref())).collect::<Result<Vec<_>>>()?;
+        let slots = (0..slots)
+            .map(|_| ViewSlot::new(ctx, space.as_ref()))
+            .collect::<Result<Vec<_>>>()?;
         Ok(View {
             trace: TracePass::new(ctx, space.trace_variant())?,
             trace_gradients,
-            gbuffer: if gradients { GBuffer::with_visibility(ctx, grid)? } else { GBuffer::new(ctx, grid)? },
+            gbuffer: if gradients {
+                GBuffer::with_visibility(ctx, grid)?
+            } else {
+                GBuffer::new(ctx, grid)?
+            },
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             accum: None,
             sample_mean: match space.samples_per_texel() > 1 {
-                true => Some(Image::new(ctx, "sample_mean", grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT)?),
+                true => Some(Image::new(
+                    ctx,
+                    "sample_mean",
+                    grid.x,
+                    grid.y,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                )?),
                 false => None,
             },
             back,
@@ -209,11 +285,13 @@ impl View {
     pub(crate) fn max_passes(&self) -> u32 {
         let extra_samples = 2 * self.space.samples_per_texel();
         // 26: the idle tiles' clear is one of them.
-        26 + extra_samples + self.denoiser.as_ref().map_or(0, |d| d.max_passes()) + match &self.back {
-            BackPasses::Fill(f) => f.passes(),
-            BackPasses::Splat(s, f) => s.passes() + f.passes(),
-            _ => 0,
-        }
+        26 + extra_samples
+            + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
+            + match &self.back {
+                BackPasses::Fill(f) => f.passes(),
+                BackPasses::Splat(s, f) => s.passes() + f.passes(),
+                _ => 0,
+            }
     }
 
     /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
@@ -235,15 +313,29 @@ impl View {
     }
 
     /// The read-back buffers a frame in `slot` needs, made on first use.
-    pub(crate) fn ensure_readbacks(&mut self, ctx: &Arc<Context>, slot: usize, hdr: bool, grid: bool) -> Result<()> {
+    pub(crate) fn ensure_readbacks(
+        &mut self,
+        ctx: &Arc<Context>,
+        slot: usize,
+        hdr: bool,
+        grid: bool,
+    ) -> Result<()> {
         let screen = self.space.screen_size();
         let size = self.space.grid_size();
         let s = &mut self.slots[slot];
         if hdr && s.hdr_readback.is_none() {
-            s.hdr_readback = Some(readback(ctx, "hdr_readback", screen.x as u64 * screen.y as u64 * 16)?);
+            s.hdr_readback = Some(readback(
+                ctx,
+                "hdr_readback",
+                screen.x as u64 * screen.y as u64 * 16,
+            )?);
         }
         if grid && s.grid_readback.is_none() {
-            s.grid_readback = Some(readback(ctx, "grid_readback", size.x as u64 * size.y as u64 * 4)?);
+            s.grid_readback = Some(readback(
+                ctx,
+                "grid_readback",
+                size.x as u64 * size.y as u64 * 4,
+            )?);
         }
         Ok(())
     }

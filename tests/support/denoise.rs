@@ -14,10 +14,17 @@ use std::sync::Arc;
 /// Any plain-old-data texels into an image of the matching format.
 pub fn upload<T: bytemuck::Pod>(ctx: &Arc<Context>, image: &Image, texels: &[T]) {
     assert_eq!(texels.len(), image.width as usize * image.height as usize);
-    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
+    let buffer = Buffer::with_data(
+        ctx,
+        "test_upload",
+        texels,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+    )
+    .unwrap();
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
-    rec.copy_buffer_to_image("test_upload", &buffer, image).unwrap();
+    rec.copy_buffer_to_image("test_upload", &buffer, image)
+        .unwrap();
     rec.submit_and_wait().unwrap();
 }
 
@@ -38,39 +45,110 @@ const HALF_ONE: u16 = 0x3c00;
 
 /// Fills the G-buffer like the tracer would (albedo 1): `None` = a texel without a sample.
 pub fn upload_gbuffer(ctx: &Arc<Context>, g: &GBuffer, texels: &[Option<Texel>]) {
-    let colour: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.radiance[0], t.radiance[1], t.radiance[2], 1.0])).collect();
+    let colour: Vec<[f32; 4]> = texels
+        .iter()
+        .map(|t| {
+            t.map_or([0.0; 4], |t| {
+                [t.radiance[0], t.radiance[1], t.radiance[2], 1.0]
+            })
+        })
+        .collect();
     upload(ctx, &g.color, &colour);
     upload(ctx, &g.radiance, &colour);
-    upload(ctx, &g.albedo, &texels.iter().map(|t| if t.is_some() { [HALF_ONE; 4] } else { [0u16; 4] }).collect::<Vec<_>>());
-    let nd: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.normal[0], t.normal[1], t.normal[2], -t.position[2]])).collect();
+    upload(
+        ctx,
+        &g.albedo,
+        &texels
+            .iter()
+            .map(|t| {
+                if t.is_some() {
+                    [HALF_ONE; 4]
+                } else {
+                    [0u16; 4]
+                }
+            })
+            .collect::<Vec<_>>(),
+    );
+    let nd: Vec<[f32; 4]> = texels
+        .iter()
+        .map(|t| {
+            t.map_or([0.0; 4], |t| {
+                [t.normal[0], t.normal[1], t.normal[2], -t.position[2]]
+            })
+        })
+        .collect();
     upload(ctx, &g.normal_depth, &nd);
     // w: depth gradient per texel, 0.2 % of the depth.
-    let pos: Vec<[f32; 4]> = texels.iter().map(|t| t.map_or([0.0; 4], |t| [t.position[0], t.position[1], t.position[2], -0.002 * t.position[2]])).collect();
+    let pos: Vec<[f32; 4]> = texels
+        .iter()
+        .map(|t| {
+            t.map_or([0.0; 4], |t| {
+                [
+                    t.position[0],
+                    t.position[1],
+                    t.position[2],
+                    -0.002 * t.position[2],
+                ]
+            })
+        })
+        .collect();
     upload(ctx, &g.position, &pos);
-    upload(ctx, &g.ids, &texels.iter().map(|t| t.map_or([0u32; 2], |t| [1, t.mesh << 16])).collect::<Vec<_>>());
-    upload(ctx, &g.motion, &texels.iter().map(|t| t.map_or([-1.0f32; 2], |t| t.motion.to_array())).collect::<Vec<_>>());
+    upload(
+        ctx,
+        &g.ids,
+        &texels
+            .iter()
+            .map(|t| t.map_or([0u32; 2], |t| [1, t.mesh << 16]))
+            .collect::<Vec<_>>(),
+    );
+    upload(
+        ctx,
+        &g.motion,
+        &texels
+            .iter()
+            .map(|t| t.map_or([-1.0f32; 2], |t| t.motion.to_array()))
+            .collect::<Vec<_>>(),
+    );
 }
 
 /// One material, not emissive (what the synthetic G-buffers' material index 0 reads).
 pub fn plain_materials(ctx: &Arc<Context>) -> Buffer {
-    Buffer::with_data(ctx, "materials", &[fovea_renderer::layouts::MaterialGpu::default()], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap()
+    Buffer::with_data(
+        ctx,
+        "materials",
+        &[fovea_renderer::layouts::MaterialGpu::default()],
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+    )
+    .unwrap()
 }
 
 /// Screen position of each grid texel's centre (`None`: no sample there).
 pub fn texel_screens(space: &dyn SamplingSpace) -> Vec<Option<Vec2>> {
     let g = space.grid_size();
-    (0..g.y).flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5))).map(|p| space.grid_to_screen(p)).collect()
+    (0..g.y)
+        .flat_map(|y| (0..g.x).map(move |x| Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))
+        .map(|p| space.grid_to_screen(p))
+        .collect()
 }
 
 pub fn assert_finite_non_negative(what: &str, pixels: &[[f32; 4]]) {
     for (i, p) in pixels.iter().enumerate() {
-        assert!(p.iter().all(|v| v.is_finite() && *v >= 0.0), "{what}: texel {i} = {p:?}");
+        assert!(
+            p.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{what}: texel {i} = {p:?}"
+        );
     }
 }
 
 /// RMSE over RGB of the pixels `keep` selects.
 pub fn rmse_where(a: &[[f32; 4]], b: &[[f32; 4]], keep: impl Fn(usize) -> bool) -> f64 {
-    let (a, b): (Vec<[f32; 4]>, Vec<[f32; 4]>) = a.iter().zip(b).enumerate().filter(|(i, _)| keep(*i)).map(|(_, (x, y))| (*x, *y)).unzip();
+    let (a, b): (Vec<[f32; 4]>, Vec<[f32; 4]>) = a
+        .iter()
+        .zip(b)
+        .enumerate()
+        .filter(|(i, _)| keep(*i))
+        .map(|(_, (x, y))| (*x, *y))
+        .unzip();
     crate::rmse(&a, &b)
 }
 
@@ -86,13 +164,18 @@ pub fn surface_interiors(ctx: &Arc<Context>, g: &GBuffer, space: &dyn SamplingSp
     let index = |x: u32, y: u32| (y * grid.x + x) as usize;
     let same = |i: usize, q: usize| {
         let cos = (0..3).map(|c| nd[i][c] * nd[q][c]).sum::<f32>();
-        ids[q][0] != 0 && ids[q][1] & 0xffff == ids[i][1] & 0xffff && (nd[q][3] - nd[i][3]).abs() < 0.05 * nd[i][3] && cos > 0.9
+        ids[q][0] != 0
+            && ids[q][1] & 0xffff == ids[i][1] & 0xffff
+            && (nd[q][3] - nd[i][3]).abs() < 0.05 * nd[i][3]
+            && cos > 0.9
     };
     let cartesian = space.visual_polar().is_none();
     (0..screen.x * screen.y)
         .map(|p| {
             let centre = Vec2::new((p % screen.x) as f32 + 0.5, (p / screen.x) as f32 + 0.5);
-            let Some(gp) = space.screen_to_grid(centre) else { return false };
+            let Some(gp) = space.screen_to_grid(centre) else {
+                return false;
+            };
             let (tx, ty) = (gp.x as u32, gp.y as u32);
             let (n, i) = (rows(tx), index(tx, ty));
             (-1..=1i32).all(|dx| {
@@ -137,7 +220,13 @@ pub fn seam_texels(vp: &VisualPolar, f: u32) -> Vec<Option<Texel>> {
             let radiance = seam_truth(vp, x, y) + seam_noise(i as u32, f);
             s.map(|s| {
                 let p = (s - centre) / 64.0 * 5.0;
-                Texel { radiance: [radiance; 3], normal: [0.0, 0.0, 1.0], position: [p.x, p.y, -5.0], mesh: 1, motion: s }
+                Texel {
+                    radiance: [radiance; 3],
+                    normal: [0.0, 0.0, 1.0],
+                    position: [p.x, p.y, -5.0],
+                    mesh: 1,
+                    motion: s,
+                }
             })
         })
         .collect()
@@ -182,11 +271,19 @@ impl SeamErrors {
                 }
             }
         }
-        assert!(count.iter().all(|&c| c > 0), "no column with a seam and 32 rows");
+        assert!(
+            count.iter().all(|&c| c > 0),
+            "no column with a seam and 32 rows"
+        );
         let bins: [f64; BINS] = std::array::from_fn(|b| (sum[b] / count[b] as f64).sqrt());
         let mut sorted = bins;
         sorted.sort_by(f64::total_cmp);
-        SeamErrors { seam: (seam / seam_n as f64).sqrt(), opposite: (opposite / opposite_n as f64).sqrt(), median: sorted[BINS / 2], bins }
+        SeamErrors {
+            seam: (seam / seam_n as f64).sqrt(),
+            opposite: (opposite / opposite_n as f64).sqrt(),
+            median: sorted[BINS / 2],
+            bins,
+        }
     }
 
     /// The seam filtered like any other angle: its error no larger (×1.25) than the median row
@@ -206,36 +303,61 @@ impl SeamErrors {
 /// `each(frame, renderer, over the culled tiles, over every tile)`: the same frame for a denoiser
 /// over the view's tile list and one over the whole grid. Asserts that tiles were culled and that
 /// the culled set moved with the gaze, so that the comparison tests something.
-pub fn denoise_over_culled_tiles(ctx: &Arc<Context>, frames: u32, mut each: impl FnMut(u32, &Renderer, &DenoiseFrame, &DenoiseFrame)) {
+pub fn denoise_over_culled_tiles(
+    ctx: &Arc<Context>,
+    frames: u32,
+    mut each: impl FnMut(u32, &Renderer, &DenoiseFrame, &DenoiseFrame),
+) {
     let scene = crate::owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
     let vp = VisualPolar::new(size, size.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
-    let settings = RenderSettings { denoiser: DenoiserSettings::None, ..Default::default() };
+    let settings = RenderSettings {
+        denoiser: DenoiserSettings::None,
+        ..Default::default()
+    };
     let mut r = Renderer::new(ctx, &scene, Box::new(vp), settings).unwrap();
     let mut previous = None;
     let mut idle_seen = Vec::new();
     for f in 0..frames {
         let gaze = size.as_vec2() * (0.3 - 0.2 * f as f32 / frames.max(2) as f32);
-        r.render_frame(&FrameInput::mono(camera, f, Some(gaze))).unwrap();
+        r.render_frame(&FrameInput::mono(camera, f, Some(gaze)))
+            .unwrap();
         let current = r.space().params();
         let table = crate::grid_table(ctx, r.space(), None);
         let culled = OwnedTileList::new(ctx, r.space(), true).unwrap();
         let whole = crate::grid_tiles(ctx, r.space());
-        assert!(culled.tiles.idle.len() > whole.tiles.idle.len(), "frame {f}: no tile culled, nothing tested");
+        assert!(
+            culled.tiles.idle.len() > whole.tiles.idle.len(),
+            "frame {f}: no tile culled, nothing tested"
+        );
         idle_seen.push(culled.tiles.idle.clone());
-        let over_culled = DenoiseFrame { current, previous, sampling_table: &table, tiles: culled.list() };
-        let over_every_tile = DenoiseFrame { tiles: whole.list(), ..over_culled };
+        let over_culled = DenoiseFrame {
+            current,
+            previous,
+            sampling_table: &table,
+            tiles: culled.list(),
+        };
+        let over_every_tile = DenoiseFrame {
+            tiles: whole.list(),
+            ..over_culled
+        };
         each(f, &r, &over_culled, &over_every_tile);
         previous = Some(current);
     }
-    assert!(idle_seen.windows(2).any(|w| w[0] != w[1]), "the idle tiles never changed with the gaze");
+    assert!(
+        idle_seen.windows(2).any(|w| w[0] != w[1]),
+        "the idle tiles never changed with the gaze"
+    );
 }
 
 /// Asserts that each named pair of images holds the same bits.
 pub fn assert_bit_equal(ctx: &Arc<Context>, what: &str, pairs: &[(&str, &Image, &Image)]) {
     for (name, a, b) in pairs {
-        let (a, b) = (crate::read_image::<[u32; 4]>(ctx, a), crate::read_image::<[u32; 4]>(ctx, b));
+        let (a, b) = (
+            crate::read_image::<[u32; 4]>(ctx, a),
+            crate::read_image::<[u32; 4]>(ctx, b),
+        );
         let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
         assert_eq!(differing, 0, "{what}: {name} differs in {differing} texels");
     }

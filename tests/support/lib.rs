@@ -14,12 +14,21 @@ use std::sync::Arc;
 
 /// A context on the default device (lavapipe without a GPU) with validation on.
 pub fn gpu() -> Arc<Context> {
-    Context::new(&ContextOptions { validation: true, ..Default::default() }).expect("Vulkan device with validation layers")
+    Context::new(&ContextOptions {
+        validation: true,
+        ..Default::default()
+    })
+    .expect("Vulkan device with validation layers")
 }
 
 /// Fails when the validation layer reported any warning or error.
 pub fn assert_clean(ctx: &Context) {
-    assert_eq!(ctx.validation.problems(), 0, "validation messages: {:#?}", ctx.validation.messages());
+    assert_eq!(
+        ctx.validation.problems(),
+        0,
+        "validation messages: {:#?}",
+        ctx.validation.messages()
+    );
 }
 
 /// The repository root (tests may read `scenes/` and, when present, `../shared/`).
@@ -63,7 +72,11 @@ pub fn rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
     let sum: f64 = a
         .iter()
         .zip(b)
-        .map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>())
+        .map(|(x, y)| {
+            (0..3)
+                .map(|c| (x[c] as f64 - y[c] as f64).powi(2))
+                .sum::<f64>()
+        })
         .sum();
     (sum / (3 * a.len()) as f64).sqrt()
 }
@@ -78,7 +91,14 @@ pub fn save_preview(name: &str, width: u32, height: u32, pixels: &[[f32; 4]]) ->
         })
         .collect();
     let path = artifacts_dir().join(name);
-    image::save_buffer(&path, &bytes, width, height, image::ExtendedColorType::Rgba8).expect("write preview");
+    image::save_buffer(
+        &path,
+        &bytes,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+    )
+    .expect("write preview");
     path
 }
 
@@ -86,10 +106,18 @@ pub fn save_preview(name: &str, width: u32, height: u32, pixels: &[[f32; 4]]) ->
 pub fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image: &Image) -> Vec<T> {
     let texels = image.width as usize * image.height as usize;
     let bytes = (texels * std::mem::size_of::<T>()) as u64;
-    let buffer = Buffer::new(ctx, "test_readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
+    let buffer = Buffer::new(
+        ctx,
+        "test_readback",
+        bytes,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        MemoryLocation::GpuToCpu,
+    )
+    .unwrap();
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
-    rec.copy_image_to_buffer("test_read_image", image, &buffer).unwrap();
+    rec.copy_image_to_buffer("test_read_image", image, &buffer)
+        .unwrap();
     rec.submit_and_wait().unwrap();
     let mut out = vec![T::default(); texels];
     buffer.read_into(&mut out).unwrap();
@@ -99,16 +127,26 @@ pub fn read_image<T: bytemuck::Pod + Default + Clone>(ctx: &Arc<Context>, image:
 /// Fills an RGBA32F image with `texels` (row-major, `width × height`).
 pub fn write_image(ctx: &Arc<Context>, image: &Image, texels: &[[f32; 4]]) {
     assert_eq!(texels.len(), image.width as usize * image.height as usize);
-    let buffer = Buffer::with_data(ctx, "test_upload", texels, vk::BufferUsageFlags::TRANSFER_SRC).unwrap();
+    let buffer = Buffer::with_data(
+        ctx,
+        "test_upload",
+        texels,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+    )
+    .unwrap();
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
-    rec.copy_buffer_to_image("test_write_image", &buffer, image).unwrap();
+    rec.copy_buffer_to_image("test_write_image", &buffer, image)
+        .unwrap();
     rec.submit_and_wait().unwrap();
 }
 
 /// `fovea render` arguments for a small, quick run (40×36, 2 frames, Cartesian, orbiting camera,
 /// EXR on, validation on) into `out`; tests change the fields they exercise.
-pub fn small_render_args<'a>(scene: &'a str, out: &'a std::path::Path) -> fovea_tools::commands::render::RenderArgs<'a> {
+pub fn small_render_args<'a>(
+    scene: &'a str,
+    out: &'a std::path::Path,
+) -> fovea_tools::commands::render::RenderArgs<'a> {
     fovea_tools::commands::render::RenderArgs {
         scene,
         method: "cartesian",
@@ -148,7 +186,11 @@ pub fn mean_over_frames(
     let mut sum = [0.0; 3];
     let mut hdr = Vec::new();
     for f in 0..frames {
-        renderer.render_frame(&fovea_renderer::pipeline::FrameInput::mono(camera, f, gaze).with_hdr(true)).unwrap();
+        renderer
+            .render_frame(
+                &fovea_renderer::pipeline::FrameInput::mono(camera, f, gaze).with_hdr(true),
+            )
+            .unwrap();
         renderer.read_hdr(&mut hdr).unwrap();
         check(f, &hdr);
         let m = mean_rgb(&hdr);
@@ -164,7 +206,9 @@ pub fn unit_hash(v: u32) -> f32 {
 
 /// The Cornell box's only emissive material (its ceiling light).
 pub fn light_material(scene: &fovea_scene::Scene) -> usize {
-    let lights: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].emissive.max_element() > 0.0).collect();
+    let lights: Vec<usize> = (0..scene.materials.len())
+        .filter(|&m| scene.materials[m].emissive.max_element() > 0.0)
+        .collect();
     assert_eq!(lights.len(), 1, "the Cornell box has one light material");
     lights[0]
 }
@@ -192,9 +236,17 @@ pub struct SpaceBuffers {
 }
 
 impl SpaceBuffers {
-    pub fn new(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace, frame: u32, seed: u32) -> SpaceBuffers {
+    pub fn new(
+        ctx: &Arc<Context>,
+        space: &dyn fovea_renderer::sampling::SamplingSpace,
+        frame: u32,
+        seed: u32,
+    ) -> SpaceBuffers {
         let uniform = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let data = fovea_renderer::layouts::FrameData { frame: glam::UVec4::new(frame, seed, 3, 0), ..Default::default() };
+        let data = fovea_renderer::layouts::FrameData {
+            frame: glam::UVec4::new(frame, seed, 3, 0),
+            ..Default::default()
+        };
         SpaceBuffers {
             frame: Buffer::with_data(ctx, "frame", &[data], uniform).unwrap(),
             sampling: Buffer::with_data(ctx, "sampling", &[space.params()], uniform).unwrap(),
@@ -218,7 +270,10 @@ pub fn grid_table(
 
 /// `space`'s tile list without culling: every tile where a texel holds a sample is live, as a
 /// synthetic G-buffer may place a sample in any of them (`DenoiseFrame::tiles`).
-pub fn grid_tiles(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace) -> fovea_renderer::passes::trace::OwnedTileList {
+pub fn grid_tiles(
+    ctx: &Arc<Context>,
+    space: &dyn fovea_renderer::sampling::SamplingSpace,
+) -> fovea_renderer::passes::trace::OwnedTileList {
     fovea_renderer::passes::trace::OwnedTileList::new(ctx, space, false).unwrap()
 }
 
@@ -230,39 +285,87 @@ pub struct ProbedTexel {
 }
 
 /// Every texel of `space`'s grid through its kernel variant of passes/space_probe (row-major).
-pub fn probe(ctx: &Arc<Context>, space: &dyn fovea_renderer::sampling::SamplingSpace, frame: u32, seed: u32) -> Vec<ProbedTexel> {
+pub fn probe(
+    ctx: &Arc<Context>,
+    space: &dyn fovea_renderer::sampling::SamplingSpace,
+    frame: u32,
+    seed: u32,
+) -> Vec<ProbedTexel> {
     use fovea_renderer::graph::{read_buffer, read_texels, write_buffer};
     let grid = space.grid_size();
-    let pipeline = fovea_renderer::vk::ComputePipeline::new(ctx, &format!("passes/space_probe.{}", space.trace_variant()), 0).unwrap();
+    let pipeline = fovea_renderer::vk::ComputePipeline::new(
+        ctx,
+        &format!("passes/space_probe.{}", space.trace_variant()),
+        0,
+    )
+    .unwrap();
     let buffers = SpaceBuffers::new(ctx, space, frame, seed);
-    let out = Buffer::new(ctx, "probe_out", grid.x as u64 * grid.y as u64 * 16, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let out = Buffer::new(
+        ctx,
+        "probe_out",
+        grid.x as u64 * grid.y as u64 * 16,
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        MemoryLocation::GpuToCpu,
+    )
+    .unwrap();
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
-    let binds = [read_buffer("frame", &buffers.frame), read_buffer("sampling", &buffers.sampling), read_texels("sampling_table", &buffers.table), write_buffer("mapped", &out)];
-    rec.dispatch("space_probe", &pipeline, &binds, &[], [grid.x, grid.y, 1]).unwrap();
+    let binds = [
+        read_buffer("frame", &buffers.frame),
+        read_buffer("sampling", &buffers.sampling),
+        read_texels("sampling_table", &buffers.table),
+        write_buffer("mapped", &out),
+    ];
+    rec.dispatch("space_probe", &pipeline, &binds, &[], [grid.x, grid.y, 1])
+        .unwrap();
     rec.submit_and_wait().unwrap();
     let got: Vec<[f32; 4]> = out.read().unwrap();
-    got.iter().map(|o| ProbedTexel { position: (o[2] > 0.0).then(|| glam::Vec2::new(o[0], o[1])), samples: o[3] as u32 }).collect()
+    got.iter()
+        .map(|o| ProbedTexel {
+            position: (o[2] > 0.0).then(|| glam::Vec2::new(o[0], o[1])),
+            samples: o[3] as u32,
+        })
+        .collect()
 }
 
 /// `fovea render --method METHOD` of the Cornell box at 64×72 (`small_render_args` otherwise,
 /// with `profile`): its report.json (the output folder is removed).
-pub fn render_report(method: &str, profile: fovea_tools::render_profile::RenderProfile) -> serde_json::Value {
+pub fn render_report(
+    method: &str,
+    profile: fovea_tools::render_profile::RenderProfile,
+) -> serde_json::Value {
     let out = artifacts_dir().join(format!("{method}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let args = fovea_tools::commands::render::RenderArgs { method, width: Some(64), height: Some(72), profile, ..small_render_args("cornell-box", &out) };
+    let args = fovea_tools::commands::render::RenderArgs {
+        method,
+        width: Some(64),
+        height: Some(72),
+        profile,
+        ..small_render_args("cornell-box", &out)
+    };
     fovea_tools::commands::render::run(&args).unwrap();
-    let report = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let _ = std::fs::remove_dir_all(&out);
     report
 }
 
 /// `Renderer::new` refuses SVGF on `space`, naming both.
-pub fn assert_refuses_svgf(ctx: &Arc<Context>, scene: &fovea_scene::Scene, space: Box<dyn fovea_renderer::sampling::SamplingSpace>) {
+pub fn assert_refuses_svgf(
+    ctx: &Arc<Context>,
+    scene: &fovea_scene::Scene,
+    space: Box<dyn fovea_renderer::sampling::SamplingSpace>,
+) {
     use fovea_renderer::passes::denoise::{svgf::SvgfSettings, DenoiserSettings};
     let name = space.name();
-    let svgf = fovea_renderer::pipeline::RenderSettings { denoiser: DenoiserSettings::Svgf(SvgfSettings::default()), ..Default::default() };
-    let err = fovea_renderer::pipeline::Renderer::new(ctx, scene, space, svgf).err().expect("refused").to_string();
+    let svgf = fovea_renderer::pipeline::RenderSettings {
+        denoiser: DenoiserSettings::Svgf(SvgfSettings::default()),
+        ..Default::default()
+    };
+    let err = fovea_renderer::pipeline::Renderer::new(ctx, scene, space, svgf)
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(err.contains("svgf") && err.contains(name), "{err}");
 }
 
@@ -281,9 +384,20 @@ pub fn assert_mean_like_cartesian(
     let name = renderer.space().name();
     let screen = renderer.space().screen_size();
     let a = mean_over_frames(renderer, camera, Some(gaze), frames, &mut check);
-    let mut cartesian = Renderer::new(ctx, scene, Box::new(fovea_renderer::sampling::Cartesian::new(screen)), RenderSettings::default()).unwrap();
+    let mut cartesian = Renderer::new(
+        ctx,
+        scene,
+        Box::new(fovea_renderer::sampling::Cartesian::new(screen)),
+        RenderSettings::default(),
+    )
+    .unwrap();
     let b = mean_over_frames(&mut cartesian, camera, Some(gaze), frames, &mut check);
     for c in 0..3 {
-        assert!((a[c] / b[c] - 1.0).abs() < 0.08, "channel {c}: {name} {} vs one per pixel {}", a[c], b[c]);
+        assert!(
+            (a[c] / b[c] - 1.0).abs() < 0.08,
+            "channel {c}: {name} {} vs one per pixel {}",
+            a[c],
+            b[c]
+        );
     }
 }

@@ -5,7 +5,9 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// Appends a quad (two triangles) with corners in counter-clockwise order seen from `normal`'s side.
 pub fn add_quad(scene: &mut Scene, corners: [Vec3; 4], material: u32) {
-    let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+    let normal = (corners[1] - corners[0])
+        .cross(corners[2] - corners[0])
+        .normalize();
     let base = scene.vertices.len() as u32;
     for (i, c) in corners.iter().enumerate() {
         scene.vertices.push(Vertex {
@@ -16,8 +18,16 @@ pub fn add_quad(scene: &mut Scene, corners: [Vec3; 4], material: u32) {
         });
     }
     let mesh = 0;
-    scene.triangles.push(Triangle { indices: [base, base + 1, base + 2], material, mesh });
-    scene.triangles.push(Triangle { indices: [base, base + 2, base + 3], material, mesh });
+    scene.triangles.push(Triangle {
+        indices: [base, base + 1, base + 2],
+        material,
+        mesh,
+    });
+    scene.triangles.push(Triangle {
+        indices: [base, base + 2, base + 3],
+        material,
+        mesh,
+    });
 }
 
 /// A Lambertian material of the given albedo (specular factor 0: exactly base_color / π).
@@ -37,17 +47,48 @@ pub fn lambert(albedo: f32, emission: f32) -> Material {
 /// emission × (1 + a + … + a^(D−1)).
 pub fn furnace(albedo: f32, emission: f32) -> Scene {
     // Double-sided so the winding of the faces cannot hide the emission from the inside.
-    let material = Material { double_sided: true, ..lambert(albedo, emission) };
-    let mut scene = Scene { materials: vec![material], mesh_names: vec!["box".into()], ..Default::default() };
+    let material = Material {
+        double_sided: true,
+        ..lambert(albedo, emission)
+    };
+    let mut scene = Scene {
+        materials: vec![material],
+        mesh_names: vec!["box".into()],
+        ..Default::default()
+    };
     let (lo, hi) = (-1.0f32, 1.0f32);
     let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
     // Each face wound so its normal points into the box.
-    add_quad(&mut scene, [p(lo, lo, lo), p(hi, lo, lo), p(hi, lo, hi), p(lo, lo, hi)], 0); // floor, +y
-    add_quad(&mut scene, [p(lo, hi, lo), p(lo, hi, hi), p(hi, hi, hi), p(hi, hi, lo)], 0); // ceiling, −y
-    add_quad(&mut scene, [p(lo, lo, lo), p(lo, lo, hi), p(lo, hi, hi), p(lo, hi, lo)], 0); // left, +x
-    add_quad(&mut scene, [p(hi, lo, lo), p(hi, hi, lo), p(hi, hi, hi), p(hi, lo, hi)], 0); // right, −x
-    add_quad(&mut scene, [p(lo, lo, lo), p(lo, hi, lo), p(hi, hi, lo), p(hi, lo, lo)], 0); // back, +z
-    add_quad(&mut scene, [p(lo, lo, hi), p(hi, lo, hi), p(hi, hi, hi), p(lo, hi, hi)], 0); // front, −z
+    add_quad(
+        &mut scene,
+        [p(lo, lo, lo), p(hi, lo, lo), p(hi, lo, hi), p(lo, lo, hi)],
+        0,
+    ); // floor, +y
+    add_quad(
+        &mut scene,
+        [p(lo, hi, lo), p(lo, hi, hi), p(hi, hi, hi), p(hi, hi, lo)],
+        0,
+    ); // ceiling, −y
+    add_quad(
+        &mut scene,
+        [p(lo, lo, lo), p(lo, lo, hi), p(lo, hi, hi), p(lo, hi, lo)],
+        0,
+    ); // left, +x
+    add_quad(
+        &mut scene,
+        [p(hi, lo, lo), p(hi, hi, lo), p(hi, hi, hi), p(hi, lo, hi)],
+        0,
+    ); // right, −x
+    add_quad(
+        &mut scene,
+        [p(lo, lo, lo), p(lo, hi, lo), p(hi, hi, lo), p(hi, lo, lo)],
+        0,
+    ); // back, +z
+    add_quad(
+        &mut scene,
+        [p(lo, lo, hi), p(hi, lo, hi), p(hi, hi, hi), p(lo, hi, hi)],
+        0,
+    ); // front, −z
     scene.cameras.push(Camera {
         world_from_view: Mat4::IDENTITY,
         yfov: 1.2,

@@ -57,9 +57,20 @@ pub struct CameraKeys {
 impl CameraKeys {
     pub fn load(path: &Path) -> Result<CameraKeys> {
         let limit = fovea_hal::file::MAX_PROFILE_BYTES * 64;
-        let text = fovea_hal::file::read_text(path, limit, "a camera path").with_context(|| format!("reading camera path {}", path.display()))?;
-        let file: KeysFile = toml::from_str(&text).with_context(|| format!("{}: invalid camera path", path.display()))?;
-        let keys = file.key.iter().map(|k| Key { time: k.time, position: Vec3::from(k.position), look: Vec3::from(k.look), fov: k.fov }).collect();
+        let text = fovea_hal::file::read_text(path, limit, "a camera path")
+            .with_context(|| format!("reading camera path {}", path.display()))?;
+        let file: KeysFile = toml::from_str(&text)
+            .with_context(|| format!("{}: invalid camera path", path.display()))?;
+        let keys = file
+            .key
+            .iter()
+            .map(|k| Key {
+                time: k.time,
+                position: Vec3::from(k.position),
+                look: Vec3::from(k.look),
+                fov: k.fov,
+            })
+            .collect();
         CameraKeys::new(keys).with_context(|| path.display().to_string())
     }
 
@@ -77,7 +88,12 @@ impl CameraKeys {
                 bail!("key[{i}].time = {}: must be finite and ≥ 0 seconds", k.time);
             }
             if i > 0 && k.time <= keys[i - 1].time {
-                bail!("key[{i}].time = {} s: must be after key[{}]'s {} s", k.time, i - 1, keys[i - 1].time);
+                bail!(
+                    "key[{i}].time = {} s: must be after key[{}]'s {} s",
+                    k.time,
+                    i - 1,
+                    keys[i - 1].time
+                );
             }
             for (field, v) in [("position", k.position), ("look", k.look)] {
                 if !(v.is_finite() && v.abs().max_element() <= MAX_COORDINATE) {
@@ -91,7 +107,14 @@ impl CameraKeys {
                 bail!("key[{i}].fov = {fov}: must be in (1, 170) degrees");
             }
             if k.fov.is_some() != keys[0].fov.is_some() {
-                bail!("key[{i}].fov: give fov on every key or on none (key[0] {})", if keys[0].fov.is_some() { "has one" } else { "has none" });
+                bail!(
+                    "key[{i}].fov: give fov on every key or on none (key[0] {})",
+                    if keys[0].fov.is_some() {
+                        "has one"
+                    } else {
+                        "has none"
+                    }
+                );
             }
         }
         Ok(CameraKeys { keys })
@@ -128,7 +151,12 @@ impl CameraKeys {
             look = k[i + 1].look; // the spline crossed the eye: keep a view direction
         }
         let fov = k[i].fov.zip(k[i + 1].fov).map(|(a, b)| a + (b - a) * s);
-        Key { time, position, look, fov }
+        Key {
+            time,
+            position,
+            look,
+            fov,
+        }
     }
 
     /// The camera at `time`: the key's position and look-at point, its FOV when the keys give
@@ -144,7 +172,10 @@ impl CameraKeys {
             None => start.fov_tan,
         };
         let camera = Camera::look_at(key.position, key.look, 1.0, "camera path");
-        CameraPose { world_from_view: camera.world_from_view, fov_tan }
+        CameraPose {
+            world_from_view: camera.world_from_view,
+            fov_tan,
+        }
     }
 
     pub fn keys(&self) -> &[Key] {
@@ -157,12 +188,23 @@ mod tests {
     use super::*;
 
     fn key(time: f64, x: f32) -> Key {
-        Key { time, position: Vec3::new(x, 0.0, 0.0), look: Vec3::new(x, 0.0, -1.0), fov: None }
+        Key {
+            time,
+            position: Vec3::new(x, 0.0, 0.0),
+            look: Vec3::new(x, 0.0, -1.0),
+            fov: None,
+        }
     }
 
     #[test]
     fn passes_through_every_key_and_holds_outside() {
-        let path = CameraKeys::new(vec![key(0.0, 0.0), key(1.0, 1.0), key(3.0, -2.0), key(3.5, 4.0)]).unwrap();
+        let path = CameraKeys::new(vec![
+            key(0.0, 0.0),
+            key(1.0, 1.0),
+            key(3.0, -2.0),
+            key(3.5, 4.0),
+        ])
+        .unwrap();
         for k in path.keys() {
             assert!(path.at(k.time).position.distance(k.position) < 1e-5);
         }
@@ -173,7 +215,12 @@ mod tests {
     #[test]
     fn evenly_timed_collinear_keys_move_at_constant_speed() {
         // Catmull-Rom reproduces linear motion exactly (the tangents are the chords).
-        let path = CameraKeys::new((0..5).map(|i| key(i as f64 * 0.5, i as f32 * 2.0)).collect()).unwrap();
+        let path = CameraKeys::new(
+            (0..5)
+                .map(|i| key(i as f64 * 0.5, i as f32 * 2.0))
+                .collect(),
+        )
+        .unwrap();
         for step in 0..=40 {
             let t = step as f64 * 0.05;
             let x = path.at(t).position.x;
@@ -183,13 +230,22 @@ mod tests {
 
     #[test]
     fn the_motion_is_smooth_through_keys() {
-        let path = CameraKeys::new(vec![key(0.0, 0.0), key(1.0, 3.0), key(2.0, 1.0), key(4.0, 5.0)]).unwrap();
+        let path = CameraKeys::new(vec![
+            key(0.0, 0.0),
+            key(1.0, 3.0),
+            key(2.0, 1.0),
+            key(4.0, 5.0),
+        ])
+        .unwrap();
         // Velocity just before and after an interior key agrees (C¹).
         for t in [1.0, 2.0] {
             let e = 1e-3;
             let before = (path.at(t).position - path.at(t - e).position) / e as f32;
             let after = (path.at(t + e).position - path.at(t).position) / e as f32;
-            assert!((before - after).length() < 0.05 * before.length().max(1.0), "t {t}: {before} vs {after}");
+            assert!(
+                (before - after).length() < 0.05 * before.length().max(1.0),
+                "t {t}: {before} vs {after}"
+            );
         }
     }
 
@@ -199,7 +255,10 @@ mod tests {
         (keys[0].fov, keys[1].fov) = (Some(40.0), Some(80.0));
         let path = CameraKeys::new(keys).unwrap();
         assert!((path.at(1.0).fov.unwrap() - 60.0).abs() < 1e-4);
-        let start = CameraPose { world_from_view: glam::Mat4::IDENTITY, fov_tan: Vec4::new(-2.0, 2.0, -1.0, 1.0) };
+        let start = CameraPose {
+            world_from_view: glam::Mat4::IDENTITY,
+            fov_tan: Vec4::new(-2.0, 2.0, -1.0, 1.0),
+        };
         let pose = path.pose(1.0, &start);
         let ty = 30f32.to_radians().tan();
         assert!((pose.fov_tan - Vec4::new(-2.0 * ty, 2.0 * ty, -ty, ty)).length() < 1e-5);
@@ -213,15 +272,35 @@ mod tests {
             (vec![], "at least one"),
             (vec![key(1.0, 0.0), key(0.5, 1.0)], "key[1].time"),
             (vec![key(f64::NAN, 0.0)], "key[0].time"),
-            (vec![Key { look: Vec3::ZERO, ..key(0.0, 0.0) }], "same point"),
-            (vec![Key { fov: Some(200.0), ..key(0.0, 0.0) }], "key[0].fov"),
+            (
+                vec![Key {
+                    look: Vec3::ZERO,
+                    ..key(0.0, 0.0)
+                }],
+                "same point",
+            ),
+            (
+                vec![Key {
+                    fov: Some(200.0),
+                    ..key(0.0, 0.0)
+                }],
+                "key[0].fov",
+            ),
         ];
         for (keys, needle) in cases {
             let err = format!("{:#}", CameraKeys::new(keys).unwrap_err());
             assert!(err.contains(needle), "{needle}: {err}");
         }
-        let mixed = vec![Key { fov: Some(50.0), ..key(0.0, 0.0) }, key(1.0, 1.0)];
-        assert!(format!("{:#}", CameraKeys::new(mixed).unwrap_err()).contains("every key or on none"));
+        let mixed = vec![
+            Key {
+                fov: Some(50.0),
+                ..key(0.0, 0.0)
+            },
+            key(1.0, 1.0),
+        ];
+        assert!(
+            format!("{:#}", CameraKeys::new(mixed).unwrap_err()).contains("every key or on none")
+        );
     }
 
     #[test]
@@ -234,14 +313,24 @@ mod tests {
         assert_eq!(path.keys().len(), 2);
         assert_eq!(path.keys()[1].position, Vec3::new(1.0, 1.0, 2.0));
         let bad = dir.join("bad.toml");
-        std::fs::write(&bad, "[[key]]\ntime = 0\nposition = [0, 1, 2]\nlook = [0, 0, 0]\nroll = 3\n").unwrap();
+        std::fs::write(
+            &bad,
+            "[[key]]\ntime = 0\nposition = [0, 1, 2]\nlook = [0, 0, 0]\nroll = 3\n",
+        )
+        .unwrap();
         let err = format!("{:#}", CameraKeys::load(&bad).unwrap_err());
         assert!(err.contains("bad.toml") && err.contains("roll"), "{err}");
         let order = dir.join("order.toml");
         std::fs::write(&order, "[[key]]\ntime = 2\nposition = [0, 1, 2]\nlook = [0, 0, 0]\n[[key]]\ntime = 1\nposition = [0, 1, 2]\nlook = [0, 0, 0]\n").unwrap();
         let err = format!("{:#}", CameraKeys::load(&order).unwrap_err());
-        assert!(err.contains("order.toml") && err.contains("key[1].time"), "{err}");
-        let missing = format!("{:#}", CameraKeys::load(&dir.join("none.toml")).unwrap_err());
+        assert!(
+            err.contains("order.toml") && err.contains("key[1].time"),
+            "{err}"
+        );
+        let missing = format!(
+            "{:#}",
+            CameraKeys::load(&dir.join("none.toml")).unwrap_err()
+        );
         assert!(missing.contains("none.toml"), "{missing}");
     }
 }

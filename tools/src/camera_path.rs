@@ -19,8 +19,12 @@ pub fn orbit(start: &CameraPose, scene_centre: Vec3, frame: u32, frames: u32) ->
     let pivot = eye + forward * distance;
     let phase = frame as f32 / frames.max(1) as f32 * std::f32::consts::TAU;
     let yaw = (SWING_DEGREES.to_radians()) * phase.sin();
-    let rotate = Mat4::from_translation(pivot) * Mat4::from_rotation_y(yaw) * Mat4::from_translation(-pivot);
-    CameraPose { world_from_view: rotate * start.world_from_view, fov_tan: start.fov_tan }
+    let rotate =
+        Mat4::from_translation(pivot) * Mat4::from_rotation_y(yaw) * Mat4::from_translation(-pivot);
+    CameraPose {
+        world_from_view: rotate * start.world_from_view,
+        fov_tan: start.fov_tan,
+    }
 }
 
 /// How the camera moves over a run (`--camera-path`).
@@ -41,7 +45,9 @@ impl CameraMotion {
         Ok(match flag {
             None => CameraMotion::Still,
             Some("orbit") => CameraMotion::Orbit,
-            Some(file) => CameraMotion::Keys(Arc::new(CameraKeys::load(Path::new(file)).context("--camera-path")?)),
+            Some(file) => CameraMotion::Keys(Arc::new(
+                CameraKeys::load(Path::new(file)).context("--camera-path")?,
+            )),
         })
     }
 
@@ -60,7 +66,14 @@ impl CameraMotion {
 }
 
 /// The camera of frame `frame` of `frames` (shown at frame / `refresh_hz` seconds).
-pub fn pose(start: &CameraPose, scene_centre: Vec3, frame: u32, frames: u32, motion: &CameraMotion, refresh_hz: f32) -> CameraPose {
+pub fn pose(
+    start: &CameraPose,
+    scene_centre: Vec3,
+    frame: u32,
+    frames: u32,
+    motion: &CameraMotion,
+    refresh_hz: f32,
+) -> CameraPose {
     match motion {
         CameraMotion::Still => *start,
         CameraMotion::Orbit => orbit(start, scene_centre, frame, frames),

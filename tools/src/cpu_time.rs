@@ -25,15 +25,25 @@ pub struct CpuUse {
 impl CpuTimes {
     pub fn now() -> CpuTimes {
         let machine = machine_seconds();
-        CpuTimes { process: process_seconds(), machine_busy: machine.map(|m| m.0), machine_steal: machine.map(|m| m.1) }
+        CpuTimes {
+            process: process_seconds(),
+            machine_busy: machine.map(|m| m.0),
+            machine_steal: machine.map(|m| m.1),
+        }
     }
 
     pub fn since(self, earlier: CpuTimes) -> CpuUse {
         let delta = |a: Option<f64>, b: Option<f64>| a.zip(b).map(|(a, b)| a - b);
         let process = delta(self.process, earlier.process);
         // /proc/stat counts in clock ticks: a small negative remainder is rounding, not time.
-        let others = delta(self.machine_busy, earlier.machine_busy).zip(process).map(|(busy, own)| (busy - own).max(0.0));
-        CpuUse { process, others, steal: delta(self.machine_steal, earlier.machine_steal) }
+        let others = delta(self.machine_busy, earlier.machine_busy)
+            .zip(process)
+            .map(|(busy, own)| (busy - own).max(0.0));
+        CpuUse {
+            process,
+            others,
+            steal: delta(self.machine_steal, earlier.machine_steal),
+        }
     }
 }
 
@@ -41,7 +51,11 @@ impl CpuUse {
     /// Adds `other`; a figure unknown in either stays unknown.
     pub fn add(&mut self, other: CpuUse) {
         let sum = |a: Option<f64>, b: Option<f64>| a.zip(b).map(|(a, b)| a + b);
-        *self = CpuUse { process: sum(self.process, other.process), others: sum(self.others, other.others), steal: sum(self.steal, other.steal) };
+        *self = CpuUse {
+            process: sum(self.process, other.process),
+            others: sum(self.others, other.others),
+            steal: sum(self.steal, other.steal),
+        };
     }
 }
 
@@ -67,16 +81,27 @@ fn process_seconds() -> Option<f64> {
 #[cfg(target_os = "linux")]
 fn machine_seconds() -> Option<(f64, f64)> {
     let stat = std::fs::read_to_string("/proc/stat").ok()?;
-    let ticks: Vec<u64> = stat.lines().next()?.strip_prefix("cpu ")?.split_whitespace().map(|v| v.parse().ok()).collect::<Option<_>>()?;
+    let ticks: Vec<u64> = stat
+        .lines()
+        .next()?
+        .strip_prefix("cpu ")?
+        .split_whitespace()
+        .map(|v| v.parse().ok())
+        .collect::<Option<_>>()?;
     // user nice system idle iowait irq softirq steal (guest time is already in user and nice).
-    let [user, nice, system, _idle, _iowait, irq, softirq, steal, ..] = ticks[..] else { return None };
+    let [user, nice, system, _idle, _iowait, irq, softirq, steal, ..] = ticks[..] else {
+        return None;
+    };
     // SAFETY: sysconf only reads a configuration value.
     let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
     if hz <= 0 {
         return None;
     }
     let seconds = |t: u64| t as f64 / hz as f64;
-    Some((seconds(user + nice + system + irq + softirq), seconds(steal)))
+    Some((
+        seconds(user + nice + system + irq + softirq),
+        seconds(steal),
+    ))
 }
 
 #[cfg(not(target_os = "linux"))]
@@ -94,6 +119,9 @@ mod tests {
         let used = CpuTimes::now().since(start);
         assert!(used.process.is_some_and(|s| s >= 0.0));
         #[cfg(target_os = "linux")]
-        assert!(used.others.is_some_and(|s| s >= 0.0) && used.steal.is_some_and(|s| s >= 0.0), "{used:?}");
+        assert!(
+            used.others.is_some_and(|s| s >= 0.0) && used.steal.is_some_and(|s| s >= 0.0),
+            "{used:?}"
+        );
     }
 }

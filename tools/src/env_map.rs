@@ -39,7 +39,8 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
         Format::Hdr => read_hdr(path),
     }
     .with_context(|| format!("environment map {name}"))?;
-    let mut map = EnvironmentMap::new(width, height, texels).map_err(|e| anyhow::anyhow!("environment map {name}: {e}"))?;
+    let mut map = EnvironmentMap::new(width, height, texels)
+        .map_err(|e| anyhow::anyhow!("environment map {name}: {e}"))?;
     map.rotation = rotation_deg.to_radians();
     map.intensity = intensity;
     Ok(map)
@@ -48,24 +49,46 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
 fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     use exr::prelude::*;
     let meta = MetaData::read_from_file(path, false).context("not a readable OpenEXR file")?;
-    let size = meta.headers.first().context("the OpenEXR file has no layer")?.layer_size;
+    let size = meta
+        .headers
+        .first()
+        .context("the OpenEXR file has no layer")?
+        .layer_size;
     check_size(size.width() as u32, size.height() as u32).map_err(anyhow::Error::msg)?;
     let image = read_first_rgba_layer_from_file(
         path,
-        |resolution, _| (resolution.width(), vec![Vec3::ZERO; resolution.width() * resolution.height()]),
-        |(w, texels), pos, (r, g, b, _a): (f32, f32, f32, f32)| texels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b),
+        |resolution, _| {
+            (
+                resolution.width(),
+                vec![Vec3::ZERO; resolution.width() * resolution.height()],
+            )
+        },
+        |(w, texels), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            texels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
+        },
     )
     .context("cannot read its RGB channels")?;
     let size = image.layer_data.size;
-    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
+    Ok((
+        size.width() as u32,
+        size.height() as u32,
+        image.layer_data.channel_data.pixels.1,
+    ))
 }
 
 fn read_hdr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     use image::ImageDecoder;
     let file = std::io::BufReader::new(std::fs::File::open(path)?);
-    let decoder = image::codecs::hdr::HdrDecoder::new(file).context("not a readable Radiance HDR file")?;
+    let decoder =
+        image::codecs::hdr::HdrDecoder::new(file).context("not a readable Radiance HDR file")?;
     let (width, height) = decoder.dimensions();
     check_size(width, height).map_err(anyhow::Error::msg)?;
-    let pixels = image::DynamicImage::from_decoder(decoder).context("cannot decode its pixels")?.into_rgb32f();
-    Ok((width, height, pixels.pixels().map(|p| Vec3::from_array(p.0)).collect()))
+    let pixels = image::DynamicImage::from_decoder(decoder)
+        .context("cannot decode its pixels")?
+        .into_rgb32f();
+    Ok((
+        width,
+        height,
+        pixels.pixels().map(|p| Vec3::from_array(p.0)).collect(),
+    ))
 }

@@ -4,7 +4,10 @@
 //! backends to rendering.
 
 use anyhow::{Context, Result};
-use fovea_hal::{Eye, EyeView, GazeOrigin, GazeSample, GazeSource, GazeSpec, HmdDescription, InvalidGazePolicy, ResolvedGaze, XrTime};
+use fovea_hal::{
+    Eye, EyeView, GazeOrigin, GazeSample, GazeSource, GazeSpec, HmdDescription, InvalidGazePolicy,
+    ResolvedGaze, XrTime,
+};
 use glam::{Vec2, Vec3};
 
 pub struct GazeDriver {
@@ -42,7 +45,12 @@ pub const GAZE_OUTSIDE: &str = "the gaze lies outside the eye's view";
 /// pixel), must lie on the `size` render image with one pixel of slack (the edges `--gaze X,Y`
 /// accepts, and rounding). Anywhere else the foveation would be centred off the image (or, behind
 /// the eye, nowhere), so the caller uses the centre and says why.
-pub fn project_gaze(eye: &EyeView, direction: Vec3, scale: Vec2, size: Vec2) -> Result<Vec2, &'static str> {
+pub fn project_gaze(
+    eye: &EyeView,
+    direction: Vec3,
+    scale: Vec2,
+    size: Vec2,
+) -> Result<Vec2, &'static str> {
     let p = eye.direction_to_pixel(direction).ok_or(GAZE_BEHIND)? * scale;
     let on = |v: f32, n: f32| (-1.0..=n + 1.0).contains(&v);
     if on(p.x, size.x) && on(p.y, size.y) {
@@ -61,28 +69,50 @@ pub fn frame_time(frame_period_ns: f64, index: u32) -> XrTime {
 /// Render pixels per headset pixel (the left eye's; both eyes share one render size).
 fn render_scale(hmd: &HmdDescription, render_width: u32, render_height: u32) -> Vec2 {
     let eye = hmd.eye(Eye::Left);
-    Vec2::new(render_width as f32 / eye.recommended_width as f32, render_height as f32 / eye.recommended_height as f32)
+    Vec2::new(
+        render_width as f32 / eye.recommended_width as f32,
+        render_height as f32 / eye.recommended_height as f32,
+    )
 }
 
 impl GazeDriver {
     /// `spec`: center | X,Y (render pixels, inside the render image) | sim[:seed] | trace path.
-    pub fn open(spec: &str, hmd: &HmdDescription, render_width: u32, render_height: u32) -> Result<GazeDriver> {
+    pub fn open(
+        spec: &str,
+        hmd: &HmdDescription,
+        render_width: u32,
+        render_height: u32,
+    ) -> Result<GazeDriver> {
         let scale = render_scale(hmd, render_width, render_height);
         let mut parsed: GazeSpec = spec.parse().with_context(|| format!("--gaze {spec}"))?;
         if let GazeSpec::Fixed { x, y } = &mut parsed {
             // Checked here in render pixels, the units the user wrote.
-            if !((0.0..=render_width as f32).contains(x) && (0.0..=render_height as f32).contains(y)) {
+            if !((0.0..=render_width as f32).contains(x)
+                && (0.0..=render_height as f32).contains(y))
+            {
                 anyhow::bail!("--gaze {spec}: ({x:?}, {y:?}) lies outside the {render_width}×{render_height} render image");
             }
             *x /= scale.x;
             *y /= scale.y;
         }
-        let source = parsed.open(hmd.clone()).with_context(|| format!("opening gaze source '{spec}'"))?;
-        Ok(GazeDriver::from_source(source, hmd, render_width, render_height))
+        let source = parsed
+            .open(hmd.clone())
+            .with_context(|| format!("opening gaze source '{spec}'"))?;
+        Ok(GazeDriver::from_source(
+            source,
+            hmd,
+            render_width,
+            render_height,
+        ))
     }
 
     /// A driver over a source opened elsewhere (`fovea xr`'s OpenXR eye tracker).
-    pub fn from_source(source: Box<dyn GazeSource>, hmd: &HmdDescription, render_width: u32, render_height: u32) -> GazeDriver {
+    pub fn from_source(
+        source: Box<dyn GazeSource>,
+        hmd: &HmdDescription,
+        render_width: u32,
+        render_height: u32,
+    ) -> GazeDriver {
         let scale = render_scale(hmd, render_width, render_height);
         GazeDriver {
             source,
@@ -114,7 +144,8 @@ impl GazeDriver {
         let t = self.frame_time(index);
         let (_, resolved) = self.resolve_at(t)?;
         let centre = self.size * 0.5;
-        let projected = [Eye::Left, Eye::Right].map(|eye| project_gaze(self.hmd.eye(eye), resolved.direction, self.scale, self.size));
+        let projected = [Eye::Left, Eye::Right]
+            .map(|eye| project_gaze(self.hmd.eye(eye), resolved.direction, self.scale, self.size));
         let reason = match resolved.source {
             GazeOrigin::Centre => None,
             _ => eyes.iter().find_map(|eye| projected[eye.index()].err()),
@@ -123,7 +154,13 @@ impl GazeDriver {
             Some(_) => (GazeOrigin::Centre, [centre; 2]),
             None => (resolved.source, projected.map(|p| p.unwrap_or(centre))),
         };
-        Ok(FrameGaze { pixel: pixels[0], pixels, origin, time_ns: t, reason })
+        Ok(FrameGaze {
+            pixel: pixels[0],
+            pixels,
+            origin,
+            time_ns: t,
+            reason,
+        })
     }
 }
 
@@ -134,21 +171,40 @@ mod tests {
 
     fn driver(direction: Vec3) -> GazeDriver {
         let hmd = HmdDescription::resolve("fove0").unwrap();
-        GazeDriver::from_source(Box::new(FixedGaze::new(hmd.clone(), direction)), &hmd, 40, 36)
+        GazeDriver::from_source(
+            Box::new(FixedGaze::new(hmd.clone(), direction)),
+            &hmd,
+            40,
+            36,
+        )
     }
 
     #[test]
     fn a_gaze_behind_or_outside_the_view_is_the_centre_with_a_reason() {
         // FOVE 0: ±45° horizontally, so (-3, 0, -1) (71.6° left) is off the image.
-        for (direction, reason) in [(Vec3::Z, GAZE_BEHIND), (Vec3::new(1.0, 0.0, 0.0), GAZE_BEHIND), (Vec3::new(-3.0, 0.0, -1.0), GAZE_OUTSIDE)] {
+        for (direction, reason) in [
+            (Vec3::Z, GAZE_BEHIND),
+            (Vec3::new(1.0, 0.0, 0.0), GAZE_BEHIND),
+            (Vec3::new(-3.0, 0.0, -1.0), GAZE_OUTSIDE),
+        ] {
             let g = driver(direction).frame(0, &[Eye::Left]).unwrap();
-            assert_eq!((g.origin, g.reason), (GazeOrigin::Centre, Some(reason)), "{direction}");
+            assert_eq!(
+                (g.origin, g.reason),
+                (GazeOrigin::Centre, Some(reason)),
+                "{direction}"
+            );
             assert_eq!(g.pixels, [Vec2::new(20.0, 18.0); 2]);
         }
-        let g = driver(Vec3::NEG_Z).frame(0, &[Eye::Left, Eye::Right]).unwrap();
+        let g = driver(Vec3::NEG_Z)
+            .frame(0, &[Eye::Left, Eye::Right])
+            .unwrap();
         assert_eq!((g.origin, g.reason), (GazeOrigin::Live, None));
         // Straight ahead is the FOVE's image centre (pixel index 639.5 of 1280, scaled by 1/32).
-        assert!((g.pixel - Vec2::new(20.0, 18.0)).length() < 0.05, "{}", g.pixel);
+        assert!(
+            (g.pixel - Vec2::new(20.0, 18.0)).length() < 0.05,
+            "{}",
+            g.pixel
+        );
     }
 
     /// Only the rendered eyes decide; `--gaze X,Y` on the image's edges and corners stays live.
@@ -156,16 +212,27 @@ mod tests {
     fn only_rendered_eyes_decide_and_edges_are_on_the_image() {
         let mut hmd = HmdDescription::resolve("fove0").unwrap();
         for spec in ["0,0", "40,36", "0,36", "40,0", "20,18"] {
-            let g = GazeDriver::open(spec, &hmd, 40, 36).unwrap().frame(0, &[Eye::Left]).unwrap();
-            assert_eq!((g.origin, g.reason), (GazeOrigin::Live, None), "--gaze {spec}");
+            let g = GazeDriver::open(spec, &hmd, 40, 36)
+                .unwrap()
+                .frame(0, &[Eye::Left])
+                .unwrap();
+            assert_eq!(
+                (g.origin, g.reason),
+                (GazeOrigin::Live, None),
+                "--gaze {spec}"
+            );
         }
         // 30° left: inside the left eye (45°), outside a right eye that sees only 10° left.
         hmd.eyes[Eye::Right.index()].fov.angle_left = -10f32.to_radians();
         let dir = Vec3::new(-30f32.to_radians().tan(), 0.0, -1.0);
-        let mut d = GazeDriver::from_source(Box::new(FixedGaze::new(hmd.clone(), dir)), &hmd, 40, 36);
+        let mut d =
+            GazeDriver::from_source(Box::new(FixedGaze::new(hmd.clone(), dir)), &hmd, 40, 36);
         let g = d.frame(0, &[Eye::Left]).unwrap();
         assert_eq!((g.origin, g.reason), (GazeOrigin::Live, None));
         let g = d.frame(1, &[Eye::Left, Eye::Right]).unwrap();
-        assert_eq!((g.origin, g.reason), (GazeOrigin::Centre, Some(GAZE_OUTSIDE)));
+        assert_eq!(
+            (g.origin, g.reason),
+            (GazeOrigin::Centre, Some(GAZE_OUTSIDE))
+        );
     }
 }

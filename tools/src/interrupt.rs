@@ -24,7 +24,12 @@ pub struct Interrupted {
 
 impl std::fmt::Display for Interrupted {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "interrupted by {} ({}); the outputs written so far are complete", signal_name(self.signal), self.signal)
+        write!(
+            f,
+            "interrupted by {} ({}); the outputs written so far are complete",
+            signal_name(self.signal),
+            self.signal
+        )
     }
 }
 
@@ -52,10 +57,17 @@ pub fn install() -> std::io::Result<()> {
     if STATE.get().is_some() {
         return Ok(());
     }
-    let state = State { pending: Arc::new(AtomicBool::new(false)), signal: Arc::new(AtomicUsize::new(0)) };
+    let state = State {
+        pending: Arc::new(AtomicBool::new(false)),
+        signal: Arc::new(AtomicUsize::new(0)),
+    };
     for sig in [SIGINT, SIGTERM] {
         // Registered first, so it sees the flag as it was before this signal set it.
-        signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, Arc::clone(&state.pending))?;
+        signal_hook::flag::register_conditional_shutdown(
+            sig,
+            128 + sig,
+            Arc::clone(&state.pending),
+        )?;
         signal_hook::flag::register_usize(sig, Arc::clone(&state.signal), sig as usize)?;
         signal_hook::flag::register(sig, Arc::clone(&state.pending))?;
     }
@@ -74,5 +86,7 @@ pub fn requested() -> Option<Interrupted> {
     if !state.pending.load(Ordering::SeqCst) {
         return None;
     }
-    Some(Interrupted { signal: state.signal.load(Ordering::SeqCst) as i32 })
+    Some(Interrupted {
+        signal: state.signal.load(Ordering::SeqCst) as i32,
+    })
 }

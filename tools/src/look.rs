@@ -15,8 +15,8 @@
 //!   usually holds its own sun — adding one would light the scene twice. Scenes with lights of
 //!   their own never get the sun.
 
-use anyhow::{bail, Context, Result};
 use crate::sky_model::{preetham_map, SkyModel};
+use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
 use glam::Vec3;
 use std::path::PathBuf;
@@ -110,25 +110,43 @@ impl EnvironmentOptions {
     /// The settings as replay baselines record them: the sun and sky fields as before environment
     /// maps existed (so older baselines do not read as changed), the map's fields only when given.
     pub fn describe(&self) -> String {
-        let base = format!("EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}", self.sun, self.sun_intensity, self.sky_intensity);
-        let sky = self.sky.map_or(String::new(), |m| format!(", sky: {}", m.name()));
+        let base = format!(
+            "EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}",
+            self.sun, self.sun_intensity, self.sky_intensity
+        );
+        let sky = self
+            .sky
+            .map_or(String::new(), |m| format!(", sky: {}", m.name()));
         if self.env.is_none() && self.env_rotation.is_none() && self.env_intensity.is_none() {
             return format!("{base}{sky} }}");
         }
-        format!("{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?}{sky} }}", self.env, self.env_rotation, self.env_intensity)
+        format!(
+            "{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?}{sky} }}",
+            self.env, self.env_rotation, self.env_intensity
+        )
     }
 
     pub fn validate(&self, names: &EnvironmentNames) -> Result<()> {
         if let Some([azimuth, elevation]) = self.sun {
-            if !(azimuth.is_finite() && elevation.is_finite() && elevation > 0.0 && elevation <= 90.0) {
+            if !(azimuth.is_finite()
+                && elevation.is_finite()
+                && elevation > 0.0
+                && elevation <= 90.0)
+            {
                 bail!(
                     "{} {azimuth},{elevation}: expected AZIMUTH,ELEVATION in degrees, azimuth finite, elevation in (0, 90] (a sun at or below the horizon lights nothing from above)",
                     names.sun
                 );
             }
         }
-        if let Some(r) = self.env_rotation.filter(|r| !(r.is_finite() && r.abs() <= MAX_ENV_ROTATION_DEG)) {
-            bail!("{} {r:?}: must be a finite angle in degrees within ±{MAX_ENV_ROTATION_DEG:e}", names.env_rotation);
+        if let Some(r) = self
+            .env_rotation
+            .filter(|r| !(r.is_finite() && r.abs() <= MAX_ENV_ROTATION_DEG))
+        {
+            bail!(
+                "{} {r:?}: must be a finite angle in degrees within ±{MAX_ENV_ROTATION_DEG:e}",
+                names.env_rotation
+            );
         }
         check_intensity(self.sun_intensity, &names.sun_intensity)?;
         check_intensity(self.sky_intensity, &names.sky_intensity)?;
@@ -147,7 +165,8 @@ fn check_intensity(value: Option<f32>, name: &str) -> Result<()> {
 
 /// `AZIMUTH,ELEVATION` (degrees) as `--sun` takes it.
 pub fn parse_sun(text: &str) -> Result<[f32; 2]> {
-    let values = parse_floats(text).with_context(|| format!("--sun {text}: expected AZIMUTH,ELEVATION in degrees"))?;
+    let values = parse_floats(text)
+        .with_context(|| format!("--sun {text}: expected AZIMUTH,ELEVATION in degrees"))?;
     match values[..] {
         [a, e] => Ok([a, e]),
         _ => bail!("--sun {text}: expected two numbers, AZIMUTH,ELEVATION in degrees"),
@@ -155,7 +174,13 @@ pub fn parse_sun(text: &str) -> Result<[f32; 2]> {
 }
 
 fn parse_floats(text: &str) -> Result<Vec<f32>> {
-    text.split(',').map(|v| v.trim().parse::<f32>().with_context(|| format!("'{}' is not a number", v.trim()))).collect()
+    text.split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f32>()
+                .with_context(|| format!("'{}' is not a number", v.trim()))
+        })
+        .collect()
 }
 
 /// The unit vector toward the sun at `azimuth` (from +Z toward +X) and `elevation` (degrees).
@@ -190,7 +215,10 @@ pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<
     let sky = env.sky_intensity.unwrap_or(DEFAULT_SKY_INTENSITY);
     if sun > 0.0 {
         // `direction` is where the light travels: away from the sun.
-        scene.punctual_lights.push(PunctualLight::Directional { direction: -sun_direction(azimuth, elevation), illuminance: Vec3::splat(sun) });
+        scene.punctual_lights.push(PunctualLight::Directional {
+            direction: -sun_direction(azimuth, elevation),
+            illuminance: Vec3::splat(sun),
+        });
     }
     set_sky(scene, env, sky);
     let model = env.sky.unwrap_or_default().name();
@@ -216,9 +244,18 @@ fn set_sky(scene: &mut Scene, env: &EnvironmentOptions, intensity: f32) {
 
 /// With `--env`: the map replaces the sky; the sun only with an explicit `sun` in a scene without
 /// lights (see the module's rule). Returns the notice for scenes without lights of their own.
-pub fn apply_environment_map(scene: &mut Scene, env: &EnvironmentOptions) -> Result<Option<String>> {
-    let Some(path) = &env.env else { return Ok(apply_environment(scene, env)) };
-    let map = crate::env_map::load(path, env.env_rotation.unwrap_or(0.0), env.env_intensity.unwrap_or(1.0))?;
+pub fn apply_environment_map(
+    scene: &mut Scene,
+    env: &EnvironmentOptions,
+) -> Result<Option<String>> {
+    let Some(path) = &env.env else {
+        return Ok(apply_environment(scene, env));
+    };
+    let map = crate::env_map::load(
+        path,
+        env.env_rotation.unwrap_or(0.0),
+        env.env_intensity.unwrap_or(1.0),
+    )?;
     scene.environment = Some(map);
     scene.sky = Sky::default();
     if scene.has_lights() {
@@ -227,12 +264,18 @@ pub fn apply_environment_map(scene: &mut Scene, env: &EnvironmentOptions) -> Res
     let sun = match env.sun {
         Some([azimuth, elevation]) if env.sun_intensity.unwrap_or(DEFAULT_SUN_INTENSITY) > 0.0 => {
             let e = env.sun_intensity.unwrap_or(DEFAULT_SUN_INTENSITY);
-            scene.punctual_lights.push(PunctualLight::Directional { direction: -sun_direction(azimuth, elevation), illuminance: Vec3::splat(e) });
+            scene.punctual_lights.push(PunctualLight::Directional {
+                direction: -sun_direction(azimuth, elevation),
+                illuminance: Vec3::splat(e),
+            });
             format!("sun at azimuth {azimuth}°, elevation {elevation}°, intensity {e}")
         }
         _ => "no sun: --sun AZIMUTH,ELEVATION adds one".into(),
     };
-    Ok(Some(format!("no lights in the scene: lit by the environment map {} ({sun})", path.display())))
+    Ok(Some(format!(
+        "no lights in the scene: lit by the environment map {} ({sun})",
+        path.display()
+    )))
 }
 
 /// How the camera is chosen (`--camera`, `--camera-pos`, `--camera-look`, `--fov`), as given.
@@ -248,14 +291,22 @@ pub struct CameraOptions {
 }
 
 /// No camera flag: the file's first camera, else the framing one (code that builds arguments).
-pub static NO_CAMERA_FLAGS: CameraOptions = CameraOptions { camera: None, position: None, look: None, fov: None };
+pub static NO_CAMERA_FLAGS: CameraOptions = CameraOptions {
+    camera: None,
+    position: None,
+    look: None,
+    fov: None,
+};
 
 /// A checked camera choice.
 #[derive(Clone, Debug, PartialEq)]
 enum Choice {
     /// `--camera`, or the file's first camera (None), else the framing camera.
     Scene(Option<String>),
-    Free { position: Vec3, look: Vec3 },
+    Free {
+        position: Vec3,
+        look: Vec3,
+    },
 }
 
 impl CameraOptions {
@@ -293,19 +344,37 @@ impl CameraOptions {
     pub fn camera_for(&self, scene: &Scene, aspect: f32) -> Result<(Camera, bool)> {
         let fov = self.fov.map(f32::to_radians);
         match self.choice()? {
-            Choice::Free { position, look } => {
-                Ok((Camera::look_at(position, look, fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), "free (--camera-pos)"), false))
-            }
+            Choice::Free { position, look } => Ok((
+                Camera::look_at(
+                    position,
+                    look,
+                    fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()),
+                    "free (--camera-pos)",
+                ),
+                false,
+            )),
             Choice::Scene(Some(wanted)) => {
                 let mut camera = find_camera(scene, &wanted)?.clone();
                 camera.yfov = fov.unwrap_or(camera.yfov);
                 Ok((camera, false))
             }
             Choice::Scene(None) => match scene.default_camera() {
-                Some(camera) => Ok((Camera { yfov: fov.unwrap_or(camera.yfov), ..camera.clone() }, false)),
+                Some(camera) => Ok((
+                    Camera {
+                        yfov: fov.unwrap_or(camera.yfov),
+                        ..camera.clone()
+                    },
+                    false,
+                )),
                 None => {
-                    let framing = scene.framing_camera(fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), aspect);
-                    let framing = framing.with_context(|| format!("{}: the scene is empty: no camera can frame it", scene.source.display()))?;
+                    let framing =
+                        scene.framing_camera(fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), aspect);
+                    let framing = framing.with_context(|| {
+                        format!(
+                            "{}: the scene is empty: no camera can frame it",
+                            scene.source.display()
+                        )
+                    })?;
                     Ok((framing, true))
                 }
             },
@@ -324,7 +393,10 @@ fn parse_point(text: &str, flag: &str) -> Result<Vec3> {
 
 /// A glTF camera by index (digits) or by name; the error lists what the file has.
 fn find_camera<'a>(scene: &'a Scene, wanted: &str) -> Result<&'a Camera> {
-    let by_index = wanted.parse::<usize>().ok().and_then(|i| scene.cameras.get(i));
+    let by_index = wanted
+        .parse::<usize>()
+        .ok()
+        .and_then(|i| scene.cameras.get(i));
     if let Some(camera) = by_index.or_else(|| scene.cameras.iter().find(|c| c.name == wanted)) {
         return Ok(camera);
     }
@@ -334,8 +406,17 @@ fn find_camera<'a>(scene: &'a Scene, wanted: &str) -> Result<&'a Camera> {
             scene.source.display()
         );
     }
-    let list: Vec<String> = scene.cameras.iter().enumerate().map(|(i, c)| format!("{i} \"{}\"", c.name)).collect();
-    bail!("--camera {wanted}: no such camera in {}; it has {}", scene.source.display(), list.join(", "))
+    let list: Vec<String> = scene
+        .cameras
+        .iter()
+        .enumerate()
+        .map(|(i, c)| format!("{i} \"{}\"", c.name))
+        .collect();
+    bail!(
+        "--camera {wanted}: no such camera in {}; it has {}",
+        scene.source.display(),
+        list.join(", ")
+    )
 }
 
 /// Says `text` on stderr once per process (`fovea quality` sets up many runs of one scene).
@@ -349,7 +430,12 @@ static ENVIRONMENT_NOTICE: AtomicBool = AtomicBool::new(false);
 static CAMERA_NOTICE: AtomicBool = AtomicBool::new(false);
 
 /// Loads `--scene` with its default environment (when the rule says so) and the chosen camera.
-pub fn load(scene_name: &str, camera: &CameraOptions, env: &EnvironmentOptions, aspect: f32) -> Result<(Scene, Camera)> {
+pub fn load(
+    scene_name: &str,
+    camera: &CameraOptions,
+    env: &EnvironmentOptions,
+    aspect: f32,
+) -> Result<(Scene, Camera)> {
     camera.check()?;
     env.validate(&EnvironmentNames::flags())?;
     let mut scene = crate::scenes::load(scene_name)?;

@@ -2,15 +2,19 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use fovea_tools::commands;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::scene::bvh::BvhBuilder;
+use fovea_tools::commands;
 use fovea_tools::render_profile::{ProfileOverrides, RenderProfile};
 use fovea_tools::replay::Tolerances;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "fovea", version, about = "Foveated real-time path tracing in Visual-Polar space (Vulkan compute)")]
+#[command(
+    name = "fovea",
+    version,
+    about = "Foveated real-time path tracing in Visual-Polar space (Vulkan compute)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -98,13 +102,22 @@ impl SceneFlags {
 
     fn environment(&self) -> Result<fovea_tools::look::EnvironmentOptions> {
         Ok(fovea_tools::look::EnvironmentOptions {
-            sun: self.sun.as_deref().map(fovea_tools::look::parse_sun).transpose()?,
+            sun: self
+                .sun
+                .as_deref()
+                .map(fovea_tools::look::parse_sun)
+                .transpose()?,
             sun_intensity: self.sun_intensity,
             sky_intensity: self.sky_intensity,
             env: self.env.clone(),
             env_rotation: self.env_rotation,
             env_intensity: self.env_intensity,
-            sky: self.sky.as_deref().map(fovea_tools::sky_model::SkyModel::parse).transpose().context("--sky")?,
+            sky: self
+                .sky
+                .as_deref()
+                .map(fovea_tools::sky_model::SkyModel::parse)
+                .transpose()
+                .context("--sky")?,
         })
     }
 }
@@ -558,9 +571,14 @@ fn render_args<'a>(
         headset: &opts.headset,
         gaze: opts.gaze.as_deref().unwrap_or(default_gaze),
         frames: opts.frames.unwrap_or(default_frames),
-        out: opts.out.as_deref().unwrap_or(std::path::Path::new(default_out)),
+        out: opts
+            .out
+            .as_deref()
+            .unwrap_or(std::path::Path::new(default_out)),
         exr: opts.exr,
-        camera_path: fovea_tools::camera_path::CameraMotion::from_flag(opts.camera_path.as_deref())?,
+        camera_path: fovea_tools::camera_path::CameraMotion::from_flag(
+            opts.camera_path.as_deref(),
+        )?,
         seed: opts.seed,
         max_depth: opts.max_depth,
         exposure: opts.exposure,
@@ -598,7 +616,10 @@ fn run() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
         opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
-        device: DeviceArgs { device: None, validation: false },
+        device: DeviceArgs {
+            device: None,
+            validation: false,
+        },
     });
     if matches!(command, Command::Render { .. } | Command::Xr { .. }) {
         // Only `render` and `xr` check for it (a clean end); other commands stop at once.
@@ -608,13 +629,35 @@ fn run() -> Result<()> {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;
             let camera = opts.look.camera();
-            commands::render::run(&render_args(&opts, &camera, &device, &profile, DEFAULT_RENDER_FRAMES, "sim:1", "out/render")?)
+            commands::render::run(&render_args(
+                &opts,
+                &camera,
+                &device,
+                &profile,
+                DEFAULT_RENDER_FRAMES,
+                "sim:1",
+                "out/render",
+            )?)
         }
-        Command::View { opts, screenshot, present_mode, debug_view, device } => {
+        Command::View {
+            opts,
+            screenshot,
+            present_mode,
+            debug_view,
+            device,
+        } => {
             let profile = opts.profile()?;
             let camera = opts.look.camera();
             // Without --frames the run has no length: the camera path's period is a long one.
-            let render = render_args(&opts, &camera, &device, &profile, u32::MAX, "center", "out/render")?;
+            let render = render_args(
+                &opts,
+                &camera,
+                &device,
+                &profile,
+                u32::MAX,
+                "center",
+                "out/render",
+            )?;
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
@@ -624,13 +667,29 @@ fn run() -> Result<()> {
                 render,
             })
         }
-        Command::Xr { opts, record, screenshot, device } => {
+        Command::Xr {
+            opts,
+            record,
+            screenshot,
+            device,
+        } => {
             let profile = opts.profile()?;
             let camera = opts.look.camera();
             // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
-            let render = render_args(&opts, &camera, &device, &profile, u32::MAX, "center", "out/xr")?;
+            let render = render_args(
+                &opts,
+                &camera,
+                &device,
+                &profile,
+                u32::MAX,
+                "center",
+                "out/xr",
+            )?;
             if opts.eyes != "left" && opts.eyes != "both" {
-                anyhow::bail!("fovea xr renders both eyes; --eyes {} does not apply", opts.eyes);
+                anyhow::bail!(
+                    "fovea xr renders both eyes; --eyes {} does not apply",
+                    opts.eyes
+                );
             }
             commands::xr::run(&commands::xr::XrArgs {
                 render,
@@ -640,14 +699,40 @@ fn run() -> Result<()> {
                 screenshot: screenshot.as_deref(),
             })
         }
-        Command::Replay { traces, baseline, update_baseline, reference_spp, rings, change_flip, change_rmse, quality_rel, quality_abs, opts, device } => {
+        Command::Replay {
+            traces,
+            baseline,
+            update_baseline,
+            reference_spp,
+            rings,
+            change_flip,
+            change_rmse,
+            quality_rel,
+            quality_abs,
+            opts,
+            device,
+        } => {
             let profile = opts.profile()?;
             let camera = opts.look.camera();
-            let mut render = render_args(&opts, &camera, &device, &profile, DEFAULT_REPLAY_FRAMES, "center", "out/replay")?;
+            let mut render = render_args(
+                &opts,
+                &camera,
+                &device,
+                &profile,
+                DEFAULT_REPLAY_FRAMES,
+                "center",
+                "out/replay",
+            )?;
             // Small by default: replays run in the test suite.
             render.width = Some(opts.width.unwrap_or(64));
             render.height = Some(opts.height.unwrap_or(72));
-            let tolerances = Tolerances { change_flip, change_rmse, quality_rel, quality_abs, ..Tolerances::default() };
+            let tolerances = Tolerances {
+                change_flip,
+                change_rmse,
+                quality_rel,
+                quality_abs,
+                ..Tolerances::default()
+            };
             commands::replay::run(&commands::replay::ReplayArgs {
                 traces: &traces,
                 baseline: &baseline,
@@ -660,33 +745,78 @@ fn run() -> Result<()> {
                 tolerances,
             })
         }
-        Command::Reference { scene, width, height, spp, max_depth, seed, out, look, force, preview, device } => {
-            commands::reference::run(&commands::reference::ReferenceArgs {
-                camera: &look.camera(),
-                environment: look.environment()?,
-                path_regularisation: fovea_tools::render_profile::check_path_regularisation(look.path_regularisation, "--path-regularisation")?,
-                scene: &scene,
-                width,
-                height,
-                spp,
-                max_depth,
-                seed,
-                out: &out,
-                force,
-                preview,
-                device: device.device.as_deref(),
-                validation: device.validation,
-            })
-        }
-        Command::Bench { scenes, bvh, flatten, sizes, vp_sizes, vp_gaze, frames, loop_size, loop_frames, camera_path, out, dump_rays, device } => {
-            let camera_path = camera_path.map(|f| fovea_tools::camera_keys::CameraKeys::load(&f)).transpose().context("--camera-path")?;
-            let builders = bvh.iter().map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg)).collect::<Result<Vec<_>>>().context("--bvh")?;
+        Command::Reference {
+            scene,
+            width,
+            height,
+            spp,
+            max_depth,
+            seed,
+            out,
+            look,
+            force,
+            preview,
+            device,
+        } => commands::reference::run(&commands::reference::ReferenceArgs {
+            camera: &look.camera(),
+            environment: look.environment()?,
+            path_regularisation: fovea_tools::render_profile::check_path_regularisation(
+                look.path_regularisation,
+                "--path-regularisation",
+            )?,
+            scene: &scene,
+            width,
+            height,
+            spp,
+            max_depth,
+            seed,
+            out: &out,
+            force,
+            preview,
+            device: device.device.as_deref(),
+            validation: device.validation,
+        }),
+        Command::Bench {
+            scenes,
+            bvh,
+            flatten,
+            sizes,
+            vp_sizes,
+            vp_gaze,
+            frames,
+            loop_size,
+            loop_frames,
+            camera_path,
+            out,
+            dump_rays,
+            device,
+        } => {
+            let camera_path = camera_path
+                .map(|f| fovea_tools::camera_keys::CameraKeys::load(&f))
+                .transpose()
+                .context("--camera-path")?;
+            let builders = bvh
+                .iter()
+                .map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg))
+                .collect::<Result<Vec<_>>>()
+                .context("--bvh")?;
             if builders.is_empty() {
                 bail!("--bvh: name at least one builder");
             }
-            let parse = |v: &[String]| v.iter().filter(|s| !s.is_empty()).map(|s| parse_size(s)).collect::<Result<Vec<_>>>();
-            let (sizes, vp_sizes) = (parse(&sizes).context("--sizes")?, parse(&vp_sizes).context("--vp-sizes")?);
-            let loop_size = (!loop_size.is_empty()).then(|| parse_size(&loop_size)).transpose().context("--loop-size")?;
+            let parse = |v: &[String]| {
+                v.iter()
+                    .filter(|s| !s.is_empty())
+                    .map(|s| parse_size(s))
+                    .collect::<Result<Vec<_>>>()
+            };
+            let (sizes, vp_sizes) = (
+                parse(&sizes).context("--sizes")?,
+                parse(&vp_sizes).context("--vp-sizes")?,
+            );
+            let loop_size = (!loop_size.is_empty())
+                .then(|| parse_size(&loop_size))
+                .transpose()
+                .context("--loop-size")?;
             let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
@@ -707,7 +837,12 @@ fn run() -> Result<()> {
         }
         Command::Headsets => commands::headsets::run(),
         Command::Info { device } => commands::info::run(device.device.as_deref()),
-        Command::GenScene { kind, out, min_triangles, force } => commands::gen_scene::run(&kind, &out, min_triangles, force),
+        Command::GenScene {
+            kind,
+            out,
+            min_triangles,
+            force,
+        } => commands::gen_scene::run(&kind, &out, min_triangles, force),
         Command::Quality {
             scene,
             width,
@@ -743,7 +878,10 @@ fn run() -> Result<()> {
                 offscreen_samples: look.offscreen_samples.clone(),
                 ..Default::default()
             })?;
-            let all: Vec<String> = DenoiserSettings::NAMES.iter().map(|s| s.to_string()).collect();
+            let all: Vec<String> = DenoiserSettings::NAMES
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
             commands::quality::run(&commands::quality::QualityArgs {
                 scene: &scene,
                 width,
@@ -753,7 +891,11 @@ fn run() -> Result<()> {
                 frames,
                 eval_frames,
                 methods: &commands::quality::expand_methods(methods),
-                denoisers: if denoisers.is_empty() { &all } else { &denoisers },
+                denoisers: if denoisers.is_empty() {
+                    &all
+                } else {
+                    &denoisers
+                },
                 taa: &taa,
                 cameras: &cameras,
                 reference_spp,
@@ -766,14 +908,28 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
-        Command::MethodTable { quality, bench, readme, pictures, equal_samples } => commands::method_table::run(&commands::method_table::MethodTableArgs {
+        Command::MethodTable {
+            quality,
+            bench,
+            readme,
+            pictures,
+            equal_samples,
+        } => commands::method_table::run(&commands::method_table::MethodTableArgs {
             quality: &quality,
             bench: &bench,
             readme: &readme,
             pictures: &pictures,
             equal_samples: &equal_samples,
         }),
-        Command::Eval { reference, test, gaze, rings, out, headset, ppd } => commands::eval::run(&commands::eval::EvalArgs {
+        Command::Eval {
+            reference,
+            test,
+            gaze,
+            rings,
+            out,
+            headset,
+            ppd,
+        } => commands::eval::run(&commands::eval::EvalArgs {
             reference: &reference,
             test: &test,
             gaze: &gaze,
@@ -786,7 +942,9 @@ fn run() -> Result<()> {
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
-    let parsed = s.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+    let parsed = s
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
     match parsed {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
         _ => anyhow::bail!("size '{s}' is not WIDTHxHEIGHT (e.g. 320x360)"),
@@ -796,9 +954,13 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
 /// `--vp-gaze FX,FY`: two fractions of the screen, each in [0, 1].
 fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
     let parts: Vec<&str> = spec.split(',').map(str::trim).collect();
-    let [x, y] = parts[..] else { bail!("'{spec}' is not FX,FY (two fractions of the screen)") };
+    let [x, y] = parts[..] else {
+        bail!("'{spec}' is not FX,FY (two fractions of the screen)")
+    };
     let fraction = |s: &str| -> Result<f32> {
-        let v: f32 = s.parse().with_context(|| format!("'{s}' is not a number"))?;
+        let v: f32 = s
+            .parse()
+            .with_context(|| format!("'{s}' is not a number"))?;
         if !(0.0..=1.0).contains(&v) {
             bail!("{v} is not a fraction of the screen in [0, 1]");
         }

@@ -48,15 +48,33 @@ pub struct PixelMaps {
 impl PixelMaps {
     pub fn new(reference: &[[f32; 4]], test: &[[f32; 4]], width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        assert!(reference.len() == n && test.len() == n, "images must both hold width×height pixels");
+        assert!(
+            reference.len() == n && test.len() == n,
+            "images must both hold width×height pixels"
+        );
         let squared_error = reference
             .iter()
             .zip(test)
-            .map(|(a, b)| (0..3).map(|c| (a[c] as f64 - b[c] as f64).powi(2)).sum::<f64>() / 3.0)
+            .map(|(a, b)| {
+                (0..3)
+                    .map(|c| (a[c] as f64 - b[c] as f64).powi(2))
+                    .sum::<f64>()
+                    / 3.0
+            })
             .collect();
         let luma_of = |img: &[[f32; 4]]| img.iter().map(|&p| luma(p)).collect::<Vec<_>>();
-        let ssim = ssim_map(&luma_of(reference), &luma_of(test), width as usize, height as usize);
-        Self { width, height, squared_error, ssim }
+        let ssim = ssim_map(
+            &luma_of(reference),
+            &luma_of(test),
+            width as usize,
+            height as usize,
+        );
+        Self {
+            width,
+            height,
+            squared_error,
+            ssim,
+        }
     }
 }
 
@@ -66,12 +84,27 @@ impl PixelMaps {
 /// would drop much of them.
 pub fn ssim_map(x: &[f64], y: &[f64], width: usize, height: usize) -> Vec<f64> {
     let kernel = gaussian_kernel();
-    let blur = |f: &dyn Fn(usize) -> f64| blur_clamped(&(0..x.len()).map(f).collect::<Vec<_>>(), width, height, &kernel);
+    let blur = |f: &dyn Fn(usize) -> f64| {
+        blur_clamped(
+            &(0..x.len()).map(f).collect::<Vec<_>>(),
+            width,
+            height,
+            &kernel,
+        )
+    };
     let (mx, my) = (blur(&|i| x[i]), blur(&|i| y[i]));
-    let (xx, yy, xy) = (blur(&|i| x[i] * x[i]), blur(&|i| y[i] * y[i]), blur(&|i| x[i] * y[i]));
+    let (xx, yy, xy) = (
+        blur(&|i| x[i] * x[i]),
+        blur(&|i| y[i] * y[i]),
+        blur(&|i| x[i] * y[i]),
+    );
     (0..x.len())
         .map(|i| {
-            let (vx, vy, cov) = (xx[i] - mx[i] * mx[i], yy[i] - my[i] * my[i], xy[i] - mx[i] * my[i]);
+            let (vx, vy, cov) = (
+                xx[i] - mx[i] * mx[i],
+                yy[i] - my[i] * my[i],
+                xy[i] - mx[i] * my[i],
+            );
             ((2.0 * mx[i] * my[i] + SSIM_C1) * (2.0 * cov + SSIM_C2))
                 / ((mx[i] * mx[i] + my[i] * my[i] + SSIM_C1) * (vx + vy + SSIM_C2))
         })
@@ -80,7 +113,9 @@ pub fn ssim_map(x: &[f64], y: &[f64], width: usize, height: usize) -> Vec<f64> {
 
 fn gaussian_kernel() -> Vec<f64> {
     let r = SSIM_RADIUS as f64;
-    let w: Vec<f64> = (0..=2 * SSIM_RADIUS).map(|i| (-(i as f64 - r).powi(2) / (2.0 * SSIM_SIGMA * SSIM_SIGMA)).exp()).collect();
+    let w: Vec<f64> = (0..=2 * SSIM_RADIUS)
+        .map(|i| (-(i as f64 - r).powi(2) / (2.0 * SSIM_SIGMA * SSIM_SIGMA)).exp())
+        .collect();
     let sum: f64 = w.iter().sum();
     w.iter().map(|v| v / sum).collect()
 }
@@ -88,17 +123,27 @@ fn gaussian_kernel() -> Vec<f64> {
 /// Separable convolution with clamp-to-edge addressing.
 fn blur_clamped(src: &[f64], width: usize, height: usize, kernel: &[f64]) -> Vec<f64> {
     let r = kernel.len() as isize / 2;
-    let tap = |i: usize, k: usize, n: usize| (i as isize + k as isize - r).clamp(0, n as isize - 1) as usize;
+    let tap = |i: usize, k: usize, n: usize| {
+        (i as isize + k as isize - r).clamp(0, n as isize - 1) as usize
+    };
     let mut rows = vec![0.0; src.len()];
     for y in 0..height {
         for x in 0..width {
-            rows[y * width + x] = kernel.iter().enumerate().map(|(k, w)| w * src[y * width + tap(x, k, width)]).sum();
+            rows[y * width + x] = kernel
+                .iter()
+                .enumerate()
+                .map(|(k, w)| w * src[y * width + tap(x, k, width)])
+                .sum();
         }
     }
     let mut out = vec![0.0; src.len()];
     for y in 0..height {
         for x in 0..width {
-            out[y * width + x] = kernel.iter().enumerate().map(|(k, w)| w * rows[tap(y, k, height) * width + x]).sum();
+            out[y * width + x] = kernel
+                .iter()
+                .enumerate()
+                .map(|(k, w)| w * rows[tap(y, k, height) * width + x])
+                .sum();
         }
     }
     out
@@ -122,7 +167,11 @@ impl Rings {
         assert!(count > 0, "at least one ring");
         let g = gaze.as_dvec2();
         let screen = glam::DVec2::new(width as f64, height as f64);
-        let r_max = g.abs().max((screen - g).abs()).length().max(f64::MIN_POSITIVE);
+        let r_max = g
+            .abs()
+            .max((screen - g).abs())
+            .length()
+            .max(f64::MIN_POSITIVE);
         let distances: Vec<f64> = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x, y)))
             .map(|(x, y)| (glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5) - g).length())
@@ -132,11 +181,26 @@ impl Rings {
 
     /// `count` equal-width rings of a per-pixel coordinate (row-major, ≥ 0) over [0, max];
     /// values past max fall in the last ring.
-    pub fn from_coordinates(width: u32, gaze: Vec2, coordinates: &[f64], max: f64, count: usize) -> Self {
+    pub fn from_coordinates(
+        width: u32,
+        gaze: Vec2,
+        coordinates: &[f64],
+        max: f64,
+        count: usize,
+    ) -> Self {
         assert!(count > 0, "at least one ring");
         let max = max.max(f64::MIN_POSITIVE);
-        let index = coordinates.iter().map(|&c| ((c / max * count as f64).max(0.0) as usize).min(count - 1) as u32).collect();
-        Self { gaze, r_max: max, count, width, index }
+        let index = coordinates
+            .iter()
+            .map(|&c| ((c / max * count as f64).max(0.0) as usize).min(count - 1) as u32)
+            .collect();
+        Self {
+            gaze,
+            r_max: max,
+            count,
+            width,
+            index,
+        }
     }
 
     /// Ring of pixel (x, y).
@@ -162,7 +226,11 @@ impl Rings {
     /// Mean of a per-pixel map over each ring's pixels, skipping NaN entries (pixels a metric
     /// does not cover); `None` where a ring has no such pixel.
     pub fn mean(&self, map: &[f64]) -> Vec<Option<f64>> {
-        assert_eq!(map.len(), self.index.len(), "map size differs from the image");
+        assert_eq!(
+            map.len(),
+            self.index.len(),
+            "map size differs from the image"
+        );
         let mut sum = vec![(0.0, 0usize); self.count];
         for (&i, &v) in self.index.iter().zip(map) {
             if !v.is_nan() {
@@ -170,7 +238,9 @@ impl Rings {
                 sum[i as usize].1 += 1;
             }
         }
-        sum.into_iter().map(|(s, n)| (n > 0).then(|| s / n as f64)).collect()
+        sum.into_iter()
+            .map(|(s, n)| (n > 0).then(|| s / n as f64))
+            .collect()
     }
 }
 
@@ -178,7 +248,11 @@ impl Rings {
 /// weights on the encoded values) is more than `levels` above that of every neighbour in its 3×3
 /// window (border pixels compare with the neighbours they have).
 pub fn isolated_bright_pixels(rgba: &[u8], width: usize, height: usize, levels: f64) -> usize {
-    let luma = |i: usize| 0.2126 * rgba[4 * i] as f64 + 0.7152 * rgba[4 * i + 1] as f64 + 0.0722 * rgba[4 * i + 2] as f64;
+    let luma = |i: usize| {
+        0.2126 * rgba[4 * i] as f64
+            + 0.7152 * rgba[4 * i + 1] as f64
+            + 0.0722 * rgba[4 * i + 2] as f64
+    };
     let mut count = 0;
     for y in 0..height {
         for x in 0..width {
@@ -196,7 +270,10 @@ pub fn isolated_bright_pixels(rgba: &[u8], width: usize, height: usize, levels: 
 
 /// Mean of a map, skipping NaN entries.
 pub fn mean(map: &[f64]) -> Option<f64> {
-    let (s, n) = map.iter().filter(|v| !v.is_nan()).fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    let (s, n) = map
+        .iter()
+        .filter(|v| !v.is_nan())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     (n > 0).then(|| s / n as f64)
 }
 
@@ -216,26 +293,46 @@ pub struct Metrics {
 impl Metrics {
     /// From the mean squared error and mean SSIM over `pixels` pixels.
     pub fn from_means(mse: Option<f64>, ssim: Option<f64>, pixels: usize) -> Self {
-        Self { pixels, rmse: mse.map(f64::sqrt), psnr: mse.map(psnr_from_mse), ssim, flip: None }
+        Self {
+            pixels,
+            rmse: mse.map(f64::sqrt),
+            psnr: mse.map(psnr_from_mse),
+            ssim,
+            flip: None,
+        }
     }
 }
 
 /// Temporal flicker of a frame pair: per pixel, |Δtest − Δreference| of the displayed sRGB values
 /// (mean of R, G, B in 0…1) from the previous frame to this one — the frame-to-frame change the
 /// converged images do not have (0 for a still camera's reference: all change is flicker).
-pub fn flicker_map(test_prev: &[u8], test: &[u8], reference_prev: &[u8], reference: &[u8]) -> Vec<f64> {
+pub fn flicker_map(
+    test_prev: &[u8],
+    test: &[u8],
+    reference_prev: &[u8],
+    reference: &[u8],
+) -> Vec<f64> {
     let grey = |p: &[u8]| (p[0] as f64 + p[1] as f64 + p[2] as f64) / (3.0 * 255.0);
     test_prev
         .chunks_exact(4)
         .zip(test.chunks_exact(4))
-        .zip(reference_prev.chunks_exact(4).zip(reference.chunks_exact(4)))
+        .zip(
+            reference_prev
+                .chunks_exact(4)
+                .zip(reference.chunks_exact(4)),
+        )
         .map(|((tp, t), (rp, r))| ((grey(t) - grey(tp)) - (grey(r) - grey(rp))).abs())
         .collect()
 }
 
 /// Fills `flip` of the whole frame and of every ring of `eval` from a per-pixel FLIP map.
 pub fn add_flip(eval: &mut Evaluation, flip_map: &[f64]) {
-    let rings = Rings::new(eval.width, eval.height, Vec2::from_array(eval.gaze), eval.rings.len());
+    let rings = Rings::new(
+        eval.width,
+        eval.height,
+        Vec2::from_array(eval.gaze),
+        eval.rings.len(),
+    );
     for (ring, flip) in eval.rings.iter_mut().zip(rings.mean(flip_map)) {
         ring.metrics.flip = flip;
     }
@@ -282,22 +379,48 @@ pub struct CoordinateRing {
 }
 
 /// Per-ring RMSE, PSNR and SSIM of `test` against `reference` over any ring set.
-pub fn evaluate_rings(reference: &[[f32; 4]], test: &[[f32; 4]], width: u32, height: u32, rings: &Rings) -> Vec<CoordinateRing> {
+pub fn evaluate_rings(
+    reference: &[[f32; 4]],
+    test: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    rings: &Rings,
+) -> Vec<CoordinateRing> {
     let maps = PixelMaps::new(reference, test, width, height);
-    let (mse, ssim, counts) = (rings.mean(&maps.squared_error), rings.mean(&maps.ssim), rings.pixel_counts());
+    let (mse, ssim, counts) = (
+        rings.mean(&maps.squared_error),
+        rings.mean(&maps.ssim),
+        rings.pixel_counts(),
+    );
     (0..rings.count)
         .map(|i| {
             let (inner, outer) = rings.bounds(i);
-            CoordinateRing { ring: i, inner, outer, metrics: Metrics::from_means(mse[i], ssim[i], counts[i]) }
+            CoordinateRing {
+                ring: i,
+                inner,
+                outer,
+                metrics: Metrics::from_means(mse[i], ssim[i], counts[i]),
+            }
         })
         .collect()
 }
 
 /// Whole-frame and per-ring RMSE, PSNR and SSIM of `test` against `reference`.
-pub fn evaluate(reference: &[[f32; 4]], test: &[[f32; 4]], width: u32, height: u32, gaze: Vec2, rings: usize) -> Evaluation {
+pub fn evaluate(
+    reference: &[[f32; 4]],
+    test: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    gaze: Vec2,
+    rings: usize,
+) -> Evaluation {
     let maps = PixelMaps::new(reference, test, width, height);
     let ring_set = Rings::new(width, height, gaze, rings);
-    let (mse, ssim, counts) = (ring_set.mean(&maps.squared_error), ring_set.mean(&maps.ssim), ring_set.pixel_counts());
+    let (mse, ssim, counts) = (
+        ring_set.mean(&maps.squared_error),
+        ring_set.mean(&maps.ssim),
+        ring_set.pixel_counts(),
+    );
     let rings = (0..rings)
         .map(|i| {
             let (r0, r1) = ring_set.bounds(i);
@@ -316,7 +439,11 @@ pub fn evaluate(reference: &[[f32; 4]], test: &[[f32; 4]], width: u32, height: u
         height,
         gaze: gaze.to_array(),
         r_max_px: ring_set.r_max,
-        frame: Metrics::from_means(mean(&maps.squared_error), mean(&maps.ssim), maps.squared_error.len()),
+        frame: Metrics::from_means(
+            mean(&maps.squared_error),
+            mean(&maps.ssim),
+            maps.squared_error.len(),
+        ),
         rings,
     }
 }

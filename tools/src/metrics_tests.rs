@@ -5,7 +5,9 @@ fn textured(width: u32, height: u32) -> Vec<[f32; 4]> {
     (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))
         .map(|(x, y)| {
-            let v = 0.3 + 0.3 * x as f32 / width as f32 + if (x / 4 + y / 4) % 2 == 0 { 0.2 } else { 0.0 };
+            let v = 0.3
+                + 0.3 * x as f32 / width as f32
+                + if (x / 4 + y / 4) % 2 == 0 { 0.2 } else { 0.0 };
             [v, v * 0.8, v * 0.6, 1.0]
         })
         .collect()
@@ -13,12 +15,25 @@ fn textured(width: u32, height: u32) -> Vec<[f32; 4]> {
 
 /// Deterministic noise in [-amplitude, amplitude] (an LCG: no test depends on a RNG crate).
 fn noisy(img: &[[f32; 4]], amplitude: f32, seed: u64) -> Vec<[f32; 4]> {
-    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
     };
-    img.iter().map(|p| [p[0] + amplitude * next(), p[1] + amplitude * next(), p[2] + amplitude * next(), 1.0]).collect()
+    img.iter()
+        .map(|p| {
+            [
+                p[0] + amplitude * next(),
+                p[1] + amplitude * next(),
+                p[2] + amplitude * next(),
+                1.0,
+            ]
+        })
+        .collect()
 }
 
 #[test]
@@ -29,7 +44,12 @@ fn identical_images_are_perfect_everywhere() {
     assert_eq!(e.frame.psnr, Some(PSNR_CAP_DB));
     assert_eq!(e.frame.ssim, Some(1.0));
     for r in &e.rings {
-        assert_eq!((r.metrics.rmse, r.metrics.ssim), (Some(0.0), Some(1.0)), "ring {}", r.ring);
+        assert_eq!(
+            (r.metrics.rmse, r.metrics.ssim),
+            (Some(0.0), Some(1.0)),
+            "ring {}",
+            r.ring
+        );
     }
     // The capped PSNR keeps the JSON numeric (no inf/NaN).
     let json: serde_json::Value = serde_json::to_value(&e).unwrap();
@@ -41,10 +61,17 @@ fn identical_images_are_perfect_everywhere() {
 fn constant_offset_gives_exact_rmse_and_psnr() {
     let a = vec![[0.25f32, 0.5, 0.75, 1.0]; 30 * 20];
     // 0.125 is exact in f32, so the expected numbers are exact too.
-    let b: Vec<_> = a.iter().map(|p| [p[0] + 0.125, p[1] + 0.125, p[2] + 0.125, 1.0]).collect();
+    let b: Vec<_> = a
+        .iter()
+        .map(|p| [p[0] + 0.125, p[1] + 0.125, p[2] + 0.125, 1.0])
+        .collect();
     let e = evaluate(&a, &b, 30, 20, Vec2::new(15.0, 10.0), 4);
     assert_eq!(e.frame.rmse, Some(0.125));
-    assert!((e.frame.psnr.unwrap() - 18.061_799_739_838_87).abs() < 1e-9, "{:?}", e.frame.psnr);
+    assert!(
+        (e.frame.psnr.unwrap() - 18.061_799_739_838_87).abs() < 1e-9,
+        "{:?}",
+        e.frame.psnr
+    );
     // One channel off: MSE is averaged over R, G, B.
     let c: Vec<_> = a.iter().map(|p| [p[0] + 0.125, p[1], p[2], 1.0]).collect();
     let e = evaluate(&a, &c, 30, 20, Vec2::new(15.0, 10.0), 4);
@@ -61,7 +88,11 @@ fn ssim_of_flat_images_follows_the_luminance_term() {
     let y = vec![[b as f32; 4]; 20 * 20];
     let expected = (2.0 * a * b + 1e-4) / (a * a + b * b + 1e-4);
     let e = evaluate(&x, &y, 20, 20, Vec2::new(10.0, 10.0), 2);
-    assert!((e.frame.ssim.unwrap() - expected).abs() < 1e-9, "{:?} vs {expected}", e.frame.ssim);
+    assert!(
+        (e.frame.ssim.unwrap() - expected).abs() < 1e-9,
+        "{:?} vs {expected}",
+        e.frame.ssim
+    );
 }
 
 #[test]
@@ -69,8 +100,21 @@ fn ssim_drops_with_noise() {
     let img = textured(64, 48);
     let mut last = 1.0;
     for amplitude in [0.01, 0.05, 0.2] {
-        let s = evaluate(&img, &noisy(&img, amplitude, 7), 64, 48, Vec2::new(32.0, 24.0), 4).frame.ssim.unwrap();
-        assert!(s < last, "SSIM {s} at noise {amplitude} is not below {last}");
+        let s = evaluate(
+            &img,
+            &noisy(&img, amplitude, 7),
+            64,
+            48,
+            Vec2::new(32.0, 24.0),
+            4,
+        )
+        .frame
+        .ssim
+        .unwrap();
+        assert!(
+            s < last,
+            "SSIM {s} at noise {amplitude} is not below {last}"
+        );
         last = s;
     }
     assert!(last < 0.8, "heavy noise still scores {last}");
@@ -78,9 +122,18 @@ fn ssim_drops_with_noise() {
 
 #[test]
 fn ring_pixel_counts_cover_the_image() {
-    for gaze in [Vec2::new(32.0, 36.0), Vec2::new(0.0, 0.0), Vec2::new(63.9, 5.5), Vec2::new(-20.0, 100.0)] {
+    for gaze in [
+        Vec2::new(32.0, 36.0),
+        Vec2::new(0.0, 0.0),
+        Vec2::new(63.9, 5.5),
+        Vec2::new(-20.0, 100.0),
+    ] {
         let rings = Rings::new(64, 72, gaze, 20);
-        assert_eq!(rings.pixel_counts().iter().sum::<usize>(), 64 * 72, "gaze {gaze}");
+        assert_eq!(
+            rings.pixel_counts().iter().sum::<usize>(),
+            64 * 72,
+            "gaze {gaze}"
+        );
     }
 }
 
@@ -95,10 +148,20 @@ fn pixels_land_in_the_expected_rings() {
     assert_eq!(rings.ring_of(0, 0), 9);
     assert_eq!(rings.ring_of(99, 99), 9);
     let (r0, r1) = rings.bounds(4);
-    assert!((r0 - 4.0 * rings.r_max / 10.0).abs() < 1e-12 && (r1 - 5.0 * rings.r_max / 10.0).abs() < 1e-12);
+    assert!(
+        (r0 - 4.0 * rings.r_max / 10.0).abs() < 1e-12
+            && (r1 - 5.0 * rings.r_max / 10.0).abs() < 1e-12
+    );
     // Gaze in a corner: r_max is the diagonal and the far corner is in the last ring.
     let rings = Rings::new(100, 100, Vec2::ZERO, 10);
-    assert_eq!((rings.ring_of(0, 0), rings.ring_of(99, 99), rings.ring_of(99, 0)), (0, 9, 7));
+    assert_eq!(
+        (
+            rings.ring_of(0, 0),
+            rings.ring_of(99, 99),
+            rings.ring_of(99, 0)
+        ),
+        (0, 9, 7)
+    );
 }
 
 #[test]
@@ -125,10 +188,20 @@ fn peripheral_error_shows_only_in_outer_rings() {
     // Rings 0..=4 end at 0.5·r_max ≈ 24 px: their 11×11 SSIM windows (reaching 5√2 ≈ 7.1 px) stay
     // inside the clean disc (0.7·r_max ≈ 33.7 px).
     for r in &e.rings[..5] {
-        assert_eq!((r.metrics.rmse, r.metrics.ssim), (Some(0.0), Some(1.0)), "inner ring {}", r.ring);
+        assert_eq!(
+            (r.metrics.rmse, r.metrics.ssim),
+            (Some(0.0), Some(1.0)),
+            "inner ring {}",
+            r.ring
+        );
     }
     for r in &e.rings[7..] {
-        assert!(r.metrics.rmse.unwrap() > 0.1 && r.metrics.ssim.unwrap() < 0.99, "outer ring {}: {:?}", r.ring, r.metrics);
+        assert!(
+            r.metrics.rmse.unwrap() > 0.1 && r.metrics.ssim.unwrap() < 0.99,
+            "outer ring {}: {:?}",
+            r.ring,
+            r.metrics
+        );
     }
     assert!(e.frame.rmse.unwrap() > 0.0 && e.frame.ssim.unwrap() < 1.0);
 }
@@ -140,7 +213,10 @@ fn empty_rings_report_null() {
     let e = evaluate(&img, &img, 4, 4, Vec2::new(-100.0, -100.0), 10);
     assert_eq!(e.rings[0].metrics.pixels, 0);
     assert!(e.rings[0].metrics.rmse.is_none() && e.rings[0].metrics.ssim.is_none());
-    assert_eq!(serde_json::to_value(&e).unwrap()["rings"][0]["rmse"], serde_json::Value::Null);
+    assert_eq!(
+        serde_json::to_value(&e).unwrap()["rings"][0]["rmse"],
+        serde_json::Value::Null
+    );
 }
 
 #[test]
@@ -149,15 +225,22 @@ fn flicker_is_change_the_reference_does_not_have() {
     let (a, b) = (px(100).repeat(4), px(140).repeat(4));
     // Still reference: the whole change is flicker; the same change in the reference: none.
     let still = flicker_map(&a, &b, &a, &a);
-    assert!(still.iter().all(|&f| (f - 40.0 / 255.0).abs() < 1e-12), "{still:?}");
+    assert!(
+        still.iter().all(|&f| (f - 40.0 / 255.0).abs() < 1e-12),
+        "{still:?}"
+    );
     assert!(flicker_map(&a, &b, &a, &b).iter().all(|&f| f == 0.0));
 }
 
 #[test]
 fn isolated_bright_pixels_counts_only_pixels_brighter_than_every_neighbour() {
     let (w, h) = (6usize, 5usize);
-    let mut img: Vec<u8> = std::iter::repeat_n([40u8, 40, 40, 255], w * h).flatten().collect();
-    let mut set = |x: usize, y: usize, v: u8| img[4 * (y * w + x)..4 * (y * w + x) + 3].copy_from_slice(&[v, v, v]);
+    let mut img: Vec<u8> = std::iter::repeat_n([40u8, 40, 40, 255], w * h)
+        .flatten()
+        .collect();
+    let mut set = |x: usize, y: usize, v: u8| {
+        img[4 * (y * w + x)..4 * (y * w + x) + 3].copy_from_slice(&[v, v, v])
+    };
     set(2, 2, 200); // a firefly
     set(0, 0, 150); // one in the corner (three neighbours)
     set(4, 1, 220); // two bright neighbours: neither is isolated

@@ -30,7 +30,11 @@ fn kind_of(meta: &std::fs::Metadata) -> &'static str {
 fn check_replaceable(path: &Path) -> Result<()> {
     match std::fs::symlink_metadata(path) {
         Ok(meta) if !meta.file_type().is_file() => {
-            bail!("{} is {}; fovea only writes or replaces regular files", path.display(), kind_of(&meta))
+            bail!(
+                "{} is {}; fovea only writes or replaces regular files",
+                path.display(),
+                kind_of(&meta)
+            )
         }
         Ok(_) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
@@ -54,7 +58,10 @@ impl Drop for TempFile {
 
 fn temp_path_for(path: &Path) -> Result<PathBuf> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path.file_name().ok_or_else(|| anyhow!("{} has no file name", path.display()))?.to_string_lossy();
+    let name = path
+        .file_name()
+        .ok_or_else(|| anyhow!("{} has no file name", path.display()))?
+        .to_string_lossy();
     // A bounded prefix keeps the temporary's name legal even for a target name near NAME_MAX.
     let short: String = name.chars().take(64).collect();
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -73,10 +80,21 @@ pub struct AtomicWriter {
 impl AtomicWriter {
     pub fn create(path: &Path) -> Result<AtomicWriter> {
         check_replaceable(path)?;
-        let temp = TempFile { path: temp_path_for(path)?, committed: false };
+        let temp = TempFile {
+            path: temp_path_for(path)?,
+            committed: false,
+        };
         // create_new: never opens something already there (a planted link at the temporary's name).
-        let file = OpenOptions::new().write(true).create_new(true).open(&temp.path).with_context(|| format!("writing {}", path.display()))?;
-        Ok(AtomicWriter { path: path.to_path_buf(), temp, writer: BufWriter::new(file) })
+        let file = OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&temp.path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(AtomicWriter {
+            path: path.to_path_buf(),
+            temp,
+            writer: BufWriter::new(file),
+        })
     }
 
     pub fn writer(&mut self) -> &mut BufWriter<File> {
@@ -89,13 +107,22 @@ impl AtomicWriter {
 
     /// Syncs the temporary and renames it over the target.
     pub fn commit(self) -> Result<()> {
-        let AtomicWriter { path, mut temp, writer } = self;
-        let file = writer.into_inner().map_err(|e| e.into_error()).with_context(|| format!("writing {}", path.display()))?;
+        let AtomicWriter {
+            path,
+            mut temp,
+            writer,
+        } = self;
+        let file = writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .with_context(|| format!("writing {}", path.display()))?;
         // On disk before the rename, so a crash leaves the old file or the complete new one.
-        file.sync_data().with_context(|| format!("writing {}", path.display()))?;
+        file.sync_data()
+            .with_context(|| format!("writing {}", path.display()))?;
         drop(file);
         check_replaceable(&path)?; // a link planted while we wrote is refused, not followed
-        std::fs::rename(&temp.path, &path).with_context(|| format!("moving the new {} into place", path.display()))?;
+        std::fs::rename(&temp.path, &path)
+            .with_context(|| format!("moving the new {} into place", path.display()))?;
         temp.committed = true;
         Ok(())
     }
@@ -103,7 +130,10 @@ impl AtomicWriter {
 
 /// Writes `path` atomically with `write` filling a buffered writer. On any error (or a panic in
 /// `write`) the temporary file is removed and an existing `path` is left exactly as it was.
-pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<()> {
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
+) -> Result<()> {
     let mut out = AtomicWriter::create(path)?;
     write(out.writer()).with_context(|| format!("writing {}", path.display()))?;
     out.commit()
@@ -120,8 +150,23 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
 }
 
 /// An 8-bit image (`color`: Rgb8 or Rgba8) as PNG, written atomically.
-pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[u8], color: image::ExtendedColorType) -> Result<()> {
-    write_atomic(path, |w| Ok(image::write_buffer_with_format(w, pixels, width, height, color, image::ImageFormat::Png)?))
+pub fn write_image(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[u8],
+    color: image::ExtendedColorType,
+) -> Result<()> {
+    write_atomic(path, |w| {
+        Ok(image::write_buffer_with_format(
+            w,
+            pixels,
+            width,
+            height,
+            color,
+            image::ImageFormat::Png,
+        )?)
+    })
 }
 
 pub fn write_png(path: &Path, width: u32, height: u32, rgba8: &[u8]) -> Result<()> {
@@ -133,13 +178,21 @@ pub fn write_exr(path: &Path, width: u32, height: u32, texels: &[[f32; 4]]) -> R
     use exr::prelude::*;
     let w = width as usize;
     if texels.len() != w * height as usize {
-        bail!("{}: {} texels do not make a {width}×{height} image", path.display(), texels.len());
+        bail!(
+            "{}: {} texels do not make a {width}×{height} image",
+            path.display(),
+            texels.len()
+        );
     }
     let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let t = texels[y * w + x];
         (t[0], t[1], t[2], 1.0f32)
     });
-    write_atomic(path, |out| Ok(Image::from_channels((w, height as usize), channels).write().to_buffered(out)?))
+    write_atomic(path, |out| {
+        Ok(Image::from_channels((w, height as usize), channels)
+            .write()
+            .to_buffered(out)?)
+    })
 }
 
 /// Reads a linear EXR's RGB channels (references for `fovea eval` and tests).
@@ -152,11 +205,17 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
             let w = resolution.width();
             (w, vec![[0f32; 4]; w * resolution.height()])
         },
-        |(w, pixels), pos, (r, g, b, a): (f32, f32, f32, f32)| pixels[pos.y() * *w + pos.x()] = [r, g, b, a],
+        |(w, pixels), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * *w + pos.x()] = [r, g, b, a]
+        },
     )
     .with_context(|| format!("reading {}", path.display()))?;
     let size = image.layer_data.size;
-    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
+    Ok((
+        size.width() as u32,
+        size.height() as u32,
+        image.layer_data.channel_data.pixels.1,
+    ))
 }
 
 /// Refuses to replace an existing file unless `force` is set, and refuses any target that is not a
@@ -165,20 +224,34 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
 pub fn check_new_file(path: &Path, force: bool) -> Result<()> {
     check_replaceable(path)?;
     if path.exists() && !force {
-        bail!("{} already exists; pass --force to replace it", path.display());
+        bail!(
+            "{} already exists; pass --force to replace it",
+            path.display()
+        );
     }
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
     }
     Ok(())
 }
 
 /// Names fovea writes into an output folder.
 fn is_fovea_file(name: &str) -> bool {
-    matches!(name, "report.json" | "eval.json" | "eval.png" | "quality.json" | "quality.md" | "frames.jsonl" | "replay.json" | "replay.md")
-        || (name.starts_with("reference_") && name.ends_with(".exr"))
+    matches!(
+        name,
+        "report.json"
+            | "eval.json"
+            | "eval.png"
+            | "quality.json"
+            | "quality.md"
+            | "frames.jsonl"
+            | "replay.json"
+            | "replay.md"
+    ) || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
-        || (name.starts_with("debug_") && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))
+        || (name.starts_with("debug_")
+            && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))
         || (name.starts_with("rays_") && name.ends_with(".bin"))
 }
 
@@ -198,7 +271,11 @@ fn identity(meta: &std::fs::Metadata) -> Version {
 
 #[cfg(not(unix))]
 fn identity(meta: &std::fs::Metadata) -> Version {
-    let t = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok()).unwrap_or_default();
+    let t = meta
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .unwrap_or_default();
     (meta.len(), t.as_secs() as i64, t.subsec_nanos() as i64)
 }
 
@@ -227,13 +304,23 @@ pub fn prepare_output_dir(dir: &Path) -> Result<OutputDir> {
     let lock = lock_folder(dir)?;
     // Under the lock no other run writes here, so leftover temporaries are a dead run's.
     let previous = scan(dir, true)?;
-    Ok(OutputDir { path: dir.to_path_buf(), _lock: lock, previous })
+    Ok(OutputDir {
+        path: dir.to_path_buf(),
+        _lock: lock,
+        previous,
+    })
 }
 
 fn lock_folder(dir: &Path) -> Result<File> {
     let path = dir.join(LOCK_FILE);
     check_replaceable(&path)?;
-    let file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("opening {}", path.display()))?;
+    let file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .with_context(|| format!("opening {}", path.display()))?;
     match file.try_lock() {
         Ok(()) => Ok(file),
         Err(std::fs::TryLockError::WouldBlock) => bail!(
@@ -255,7 +342,9 @@ fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, Version)>> {
             Ok(meta) => meta,
             // Renamed or removed since read_dir listed it (a run's temporary moving into place).
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
-            Err(e) => return Err(e).with_context(|| format!("inspecting {}", entry.path().display())),
+            Err(e) => {
+                return Err(e).with_context(|| format!("inspecting {}", entry.path().display()))
+            }
         };
         if meta.file_type().is_symlink() {
             bail!(
@@ -281,7 +370,11 @@ fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, Version)>> {
             bail!("output folder {} holds '{name}', which fovea did not write; choose an empty or new folder", dir.display());
         }
         if !regular {
-            bail!("output folder {} holds '{name}', which is {}; fovea writes only regular files", dir.display(), kind_of(&meta));
+            bail!(
+                "output folder {} holds '{name}', which is {}; fovea writes only regular files",
+                dir.display(),
+                kind_of(&meta)
+            );
         }
         found.push((entry.file_name(), identity(&meta)));
     }
@@ -300,9 +393,11 @@ impl OutputDir {
         let mut removed = 0;
         for (name, version) in &self.previous {
             let path = self.path.join(name);
-            let unchanged = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_file() && identity(&m) == *version);
+            let unchanged = std::fs::symlink_metadata(&path)
+                .is_ok_and(|m| m.file_type().is_file() && identity(&m) == *version);
             if unchanged {
-                std::fs::remove_file(&path).with_context(|| format!("removing the stale {}", path.display()))?;
+                std::fs::remove_file(&path)
+                    .with_context(|| format!("removing the stale {}", path.display()))?;
                 removed += 1;
             }
         }
@@ -315,7 +410,11 @@ impl OutputDir {
 pub fn check_regular_input(path: &Path) -> Result<()> {
     let meta = std::fs::metadata(path).with_context(|| format!("reading {}", path.display()))?;
     if !meta.is_file() {
-        bail!("reading {}: it is {}, not a regular file", path.display(), kind_of(&meta));
+        bail!(
+            "reading {}: it is {}, not a regular file",
+            path.display(),
+            kind_of(&meta)
+        );
     }
     Ok(())
 }
@@ -323,7 +422,13 @@ pub fn check_regular_input(path: &Path) -> Result<()> {
 /// Linear radiance → sRGB RGBA8 with the same fitted ACES curve as the tonemap pass (previews).
 pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32) -> Vec<u8> {
     let curve = |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
-    let srgb = |c: f32| if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    let srgb = |c: f32| {
+        if c <= 0.0031308 {
+            c * 12.92
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        }
+    };
     texels
         .iter()
         .flat_map(|t| {

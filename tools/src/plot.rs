@@ -49,11 +49,24 @@ fn read_font(path: &str) -> Result<Vec<u8>, String> {
 
 /// Writes a 900×600 PNG line plot with axis labels and a legend; `log_y` makes the y axis
 /// logarithmic (base 10).
-pub fn line_plot(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series], log_y: bool) -> Result<()> {
+pub fn line_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    log_y: bool,
+) -> Result<()> {
     ensure_font()?;
     let kept: Vec<Vec<(f64, f64)>> = series
         .iter()
-        .map(|s| s.points.iter().copied().filter(|&(x, y)| x.is_finite() && y.is_finite() && (!log_y || y > 0.0)).collect())
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|&(x, y)| x.is_finite() && y.is_finite() && (!log_y || y > 0.0))
+                .collect()
+        })
         .collect();
     let x = padded_range(kept.iter().flatten().map(|p| p.0), false);
     let (y0, y1) = padded_range(kept.iter().flatten().map(|p| p.1), log_y);
@@ -103,7 +116,10 @@ where
     for (i, (s, points)) in series.iter().zip(kept).enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
         chart
-            .draw_series(LineSeries::new(points.iter().copied(), colour.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                colour.stroke_width(2),
+            ))
             .map_err(|e| e.to_string())?
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], colour.stroke_width(2)));
@@ -122,7 +138,9 @@ where
 
 /// Data range with a small margin; never empty (plotters needs lo < hi), positive on log axes.
 fn padded_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
-    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
     if !(lo.is_finite() && hi.is_finite()) {
         return if log { (0.1, 10.0) } else { (0.0, 1.0) };
     }
@@ -164,8 +182,14 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("fovea-plot-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let series = [
-            Series { label: "rising".into(), points: (1..20).map(|i| (i as f64, (i * i) as f64)).collect() },
-            Series { label: "flat with a zero".into(), points: vec![(0.0, 0.0), (5.0, 2.0), (19.0, 2.0)] },
+            Series {
+                label: "rising".into(),
+                points: (1..20).map(|i| (i as f64, (i * i) as f64)).collect(),
+            },
+            Series {
+                label: "flat with a zero".into(),
+                points: vec![(0.0, 0.0), (5.0, 2.0), (19.0, 2.0)],
+            },
         ];
         for log_y in [false, true] {
             let path = dir.join(format!("plot_{log_y}.png"));
@@ -183,7 +207,10 @@ mod tests {
     #[test]
     fn a_missing_font_names_the_file_and_the_package() {
         let err = read_font("/no/such/DejaVuSans.ttf").unwrap_err();
-        assert!(err.contains("/no/such/DejaVuSans.ttf") && err.contains("fonts-dejavu-core"), "{err}");
+        assert!(
+            err.contains("/no/such/DejaVuSans.ttf") && err.contains("fonts-dejavu-core"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -6,15 +6,18 @@
 //! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
 //! (`RenderProfile::visual_polar_for`).
 
+use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::sampling::{CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent, LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout};
-use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
+use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
 use fovea_renderer::pipeline::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::sampling::{
+    CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent,
+    LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout,
+};
 use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
-use crate::look::{EnvironmentNames, EnvironmentOptions};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -251,7 +254,9 @@ pub fn parse_layout(s: &str) -> Result<VpLayout> {
         "paper" => Ok(VpLayout::Paper),
         "screen-clipped" => Ok(VpLayout::ScreenClipped),
         "screen-aware" => Ok(VpLayout::ScreenAware),
-        other => bail!("'{other}' is not a Visual-Polar layout (paper | screen-clipped | screen-aware)"),
+        other => {
+            bail!("'{other}' is not a Visual-Polar layout (paper | screen-clipped | screen-aware)")
+        }
     }
 }
 
@@ -284,9 +289,14 @@ pub fn parse_radius(s: &str) -> Result<RadiusMode> {
 
 impl RenderProfile {
     pub fn load(path: &Path) -> Result<RenderProfile> {
-        let text = fovea_hal::file::read_text(path, fovea_hal::file::MAX_PROFILE_BYTES, "a render profile")
-            .with_context(|| format!("reading render profile {}", path.display()))?;
-        let file: ProfileFile = toml::from_str(&text).with_context(|| format!("{}: invalid render profile", path.display()))?;
+        let text = fovea_hal::file::read_text(
+            path,
+            fovea_hal::file::MAX_PROFILE_BYTES,
+            "a render profile",
+        )
+        .with_context(|| format!("reading render profile {}", path.display()))?;
+        let file: ProfileFile = toml::from_str(&text)
+            .with_context(|| format!("{}: invalid render profile", path.display()))?;
         let mut profile = RenderProfile::default();
         let at = |key: &str| format!("{}: [{}]", path.display(), key);
         if let Some(vp) = file.visual_polar {
@@ -296,7 +306,8 @@ impl RenderProfile {
             p.fovea_deg = vp.fovea_deg.unwrap_or(p.fovea_deg);
             p.density_exponent = vp.density_exponent.unwrap_or(p.density_exponent);
             if let Some(mode) = vp.inverse_cdf {
-                p.inverse_cdf = parse_inverse_cdf(&mode).with_context(|| format!("{}.inverse_cdf", at("visual_polar")))?;
+                p.inverse_cdf = parse_inverse_cdf(&mode)
+                    .with_context(|| format!("{}.inverse_cdf", at("visual_polar")))?;
             }
             if let Some(radius) = vp.radius {
                 let text = match radius {
@@ -304,42 +315,59 @@ impl RenderProfile {
                     toml::Value::Integer(i) => i.to_string(),
                     // Debug keeps 1e30 short in the message (Display writes every digit).
                     toml::Value::Float(f) => format!("{f:?}"),
-                    other => bail!("{}.radius: expected \"corner\" or pixels, got {other}", at("visual_polar")),
+                    other => bail!(
+                        "{}.radius: expected \"corner\" or pixels, got {other}",
+                        at("visual_polar")
+                    ),
                 };
-                p.radius_mode = parse_radius(&text).with_context(|| format!("{}.radius", at("visual_polar")))?;
+                p.radius_mode = parse_radius(&text)
+                    .with_context(|| format!("{}.radius", at("visual_polar")))?;
             }
             if let Some(layout) = vp.layout {
-                p.layout = parse_layout(&layout).with_context(|| format!("{}.layout", at("visual_polar")))?;
+                p.layout = parse_layout(&layout)
+                    .with_context(|| format!("{}.layout", at("visual_polar")))?;
             }
             if let Some(mode) = vp.eccentricity {
-                profile.eccentricity =
-                    parse_eccentricity(&mode).with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
+                profile.eccentricity = parse_eccentricity(&mode)
+                    .with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
             }
             p.validate().with_context(|| at("visual_polar"))?;
-            profile.check_eccentricity().with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
+            profile
+                .check_eccentricity()
+                .with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
         }
         if let Some(lp) = file.log_polar {
             let p = &mut profile.log_polar;
             p.sigma = lp.sigma.unwrap_or(p.sigma);
             p.alpha = lp.alpha.unwrap_or(p.alpha);
             if let Some(extent) = lp.extent {
-                p.extent = parse_log_polar_extent(&extent).with_context(|| format!("{}.extent", at("log_polar")))?;
+                p.extent = parse_log_polar_extent(&extent)
+                    .with_context(|| format!("{}.extent", at("log_polar")))?;
             }
             p.validate().with_context(|| at("log_polar"))?;
         }
         if let Some(c) = file.composite {
             if let Some(mode) = c.mode {
-                profile.composite_mode = CompositeMode::parse(&mode)
-                    .with_context(|| format!("{}.mode: '{mode}', expected one of {}", at("composite"), CompositeMode::NAMES.join(", ")))?;
+                profile.composite_mode = CompositeMode::parse(&mode).with_context(|| {
+                    format!(
+                        "{}.mode: '{mode}', expected one of {}",
+                        at("composite"),
+                        CompositeMode::NAMES.join(", ")
+                    )
+                })?;
             }
             profile.composite_sigma = c.sigma;
             // A stand-in viewing distance: σ's range does not depend on it.
-            profile.composite_params(1000.0).validate().with_context(|| format!("{}.sigma", at("composite")))?;
+            profile
+                .composite_params(1000.0)
+                .validate()
+                .with_context(|| format!("{}.sigma", at("composite")))?;
         }
         if let Some(blur) = file.blur {
             profile.blur.sigma_at_30 = blur.sigma_at_30.unwrap_or(profile.blur.sigma_at_30);
             if let Some(space) = &blur.space {
-                profile.blur.space = parse_blur_space(space).with_context(|| format!("{}.space", at("blur")))?;
+                profile.blur.space =
+                    parse_blur_space(space).with_context(|| format!("{}.space", at("blur")))?;
             }
         }
         check_blur(&profile.blur).with_context(|| format!("{}.sigma_at_30", at("blur")))?;
@@ -377,7 +405,9 @@ impl RenderProfile {
             s.validate().with_context(|| at("taa"))?;
         }
         if let Some(f) = file.environment {
-            let env = f.env.map(|e| path.parent().map_or(e.clone(), |dir| dir.join(&e)));
+            let env = f
+                .env
+                .map(|e| path.parent().map_or(e.clone(), |dir| dir.join(&e)));
             profile.environment = EnvironmentOptions {
                 sun: f.sun,
                 sun_intensity: f.sun_intensity,
@@ -385,21 +415,34 @@ impl RenderProfile {
                 env,
                 env_rotation: f.env_rotation,
                 env_intensity: f.env_intensity,
-                sky: f.sky.as_deref().map(crate::sky_model::SkyModel::parse).transpose().with_context(|| format!("{}.sky", at("environment")))?,
+                sky: f
+                    .sky
+                    .as_deref()
+                    .map(crate::sky_model::SkyModel::parse)
+                    .transpose()
+                    .with_context(|| format!("{}.sky", at("environment")))?,
             };
-            profile.environment.validate(&EnvironmentNames::profile(&path.display().to_string()))?;
+            profile
+                .environment
+                .validate(&EnvironmentNames::profile(&path.display().to_string()))?;
             if let Some(env) = &profile.environment.env {
-                crate::env_map::check_path(env).with_context(|| format!("{}: [environment].env", path.display()))?;
+                crate::env_map::check_path(env)
+                    .with_context(|| format!("{}: [environment].env", path.display()))?;
             }
         }
         if let Some(lod) = file.textures.and_then(|t| t.lod) {
-            profile.texture_lod = TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
+            profile.texture_lod =
+                TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
         if let Some(mode) = file.trace.and_then(|t| t.offscreen) {
-            profile.offscreen_samples = OffscreenSamples::parse(&mode).with_context(|| format!("{}.offscreen", at("trace")))?;
+            profile.offscreen_samples = OffscreenSamples::parse(&mode)
+                .with_context(|| format!("{}.offscreen", at("trace")))?;
         }
         if let Some(strength) = file.path.and_then(|p| p.regularisation) {
-            profile.path_regularisation = Some(check_path_regularisation(Some(strength), &format!("{}.regularisation", at("path")))?);
+            profile.path_regularisation = Some(check_path_regularisation(
+                Some(strength),
+                &format!("{}.regularisation", at("path")),
+            )?);
         }
         Ok(profile)
     }
@@ -429,8 +472,12 @@ impl RenderProfile {
             self.log_polar.extent = parse_log_polar_extent(extent).context("--log-polar-extent")?;
         }
         if let Some(mode) = &o.composite_mode {
-            self.composite_mode = CompositeMode::parse(mode)
-                .with_context(|| format!("--composite-mode {mode}: expected one of {}", CompositeMode::NAMES.join(", ")))?;
+            self.composite_mode = CompositeMode::parse(mode).with_context(|| {
+                format!(
+                    "--composite-mode {mode}: expected one of {}",
+                    CompositeMode::NAMES.join(", ")
+                )
+            })?;
         }
         self.blur.sigma_at_30 = o.blur_sigma.unwrap_or(self.blur.sigma_at_30);
         if let Some(space) = &o.blur_space {
@@ -443,17 +490,22 @@ impl RenderProfile {
             self.texture_lod = TextureLod::parse(lod).context("--texture-lod")?;
         }
         if let Some(strength) = o.path_regularisation {
-            self.path_regularisation = Some(check_path_regularisation(Some(strength), "--path-regularisation")?);
+            self.path_regularisation = Some(check_path_regularisation(
+                Some(strength),
+                "--path-regularisation",
+            )?);
         }
         if let Some(mode) = &o.offscreen_samples {
-            self.offscreen_samples = OffscreenSamples::parse(mode).context("--offscreen-samples")?;
+            self.offscreen_samples =
+                OffscreenSamples::parse(mode).context("--offscreen-samples")?;
         }
         Ok(self)
     }
 
     /// The strength the engine runs with.
     pub fn path_regularisation(&self) -> f32 {
-        self.path_regularisation.unwrap_or(DEFAULT_PATH_REGULARISATION)
+        self.path_regularisation
+            .unwrap_or(DEFAULT_PATH_REGULARISATION)
     }
 }
 
@@ -472,7 +524,12 @@ pub fn check_path_regularisation(value: Option<f32>, name: &str) -> Result<f32> 
 
 /// An HMD eye's FOV as the plain tangents the renderer takes.
 pub fn fov_tangents(fov: &fovea_hal::Fov) -> FovTangents {
-    FovTangents { left: -fov.angle_left.tan(), right: fov.angle_right.tan(), up: fov.angle_up.tan(), down: -fov.angle_down.tan() }
+    FovTangents {
+        left: -fov.angle_left.tan(),
+        right: fov.angle_right.tan(),
+        up: fov.angle_up.tan(),
+        down: -fov.angle_down.tan(),
+    }
 }
 
 impl RenderProfile {
@@ -489,25 +546,40 @@ impl RenderProfile {
     /// The polar-space parameters of `--method log-polar`: Visual-Polar's defaults (fovea° for the
     /// blur's slope) with the profile's log-polar law.
     pub fn log_polar_space(&self) -> VisualPolarParams {
-        VisualPolarParams { radial: RadialLaw::LogPolar(self.log_polar), ..Default::default() }
+        VisualPolarParams {
+            radial: RadialLaw::LogPolar(self.log_polar),
+            ..Default::default()
+        }
     }
 
     /// The polar-space parameters of `--method composite` for an eye `viewing_distance_px` from
     /// the image (its gaze disc is d · tan a_G).
     pub fn composite_space(&self, viewing_distance_px: f32) -> VisualPolarParams {
-        VisualPolarParams { radial: RadialLaw::Composite(self.composite_params(viewing_distance_px)), ..Default::default() }
+        VisualPolarParams {
+            radial: RadialLaw::Composite(self.composite_params(viewing_distance_px)),
+            ..Default::default()
+        }
     }
 
     /// The mode's parameters with the profile's σ, if it sets one.
     fn composite_params(&self, viewing_distance_px: f32) -> CompositeParams {
         let mode = self.composite_mode.params(viewing_distance_px);
-        CompositeParams { sigma: self.composite_sigma.unwrap_or(mode.sigma), ..mode }
+        CompositeParams {
+            sigma: self.composite_sigma.unwrap_or(mode.sigma),
+            ..mode
+        }
     }
 
     /// The combinations the headset axis refuses, checked with a stand-in FOV (the real one is
     /// only known to the command).
     fn check_eccentricity(&self) -> Result<()> {
-        self.visual_polar_for(FovTangents { left: 1.0, right: 1.0, up: 1.0, down: 1.0 }).map(|_| ())
+        self.visual_polar_for(FovTangents {
+            left: 1.0,
+            right: 1.0,
+            up: 1.0,
+            down: 1.0,
+        })
+        .map(|_| ())
     }
 }
 
@@ -541,12 +613,31 @@ mod tests {
     /// `[composite]`: the mode and σ (the buffer's budget knob) reach `--method composite`'s space.
     #[test]
     fn composite_section_sets_mode_and_sigma() {
-        let p = load_str("composite.toml", "[composite]\nmode = \"kernel\"\nsigma = 1.66\n").unwrap();
+        let p = load_str(
+            "composite.toml",
+            "[composite]\nmode = \"kernel\"\nsigma = 1.66\n",
+        )
+        .unwrap();
         assert_eq!(p.composite_mode, CompositeMode::Kernel);
-        let RadialLaw::Composite(c) = p.composite_space(160.0).radial else { panic!("not composite") };
-        assert_eq!((c.mode, c.sigma, c.alpha), (CompositeMode::Kernel, 1.66, CompositeMode::Kernel.params(160.0).alpha));
-        let RadialLaw::Composite(c) = RenderProfile::default().composite_space(160.0).radial else { panic!("not composite") };
-        assert_eq!(c, CompositeMode::Composite.params(160.0), "without the section: the mode's own σ");
+        let RadialLaw::Composite(c) = p.composite_space(160.0).radial else {
+            panic!("not composite")
+        };
+        assert_eq!(
+            (c.mode, c.sigma, c.alpha),
+            (
+                CompositeMode::Kernel,
+                1.66,
+                CompositeMode::Kernel.params(160.0).alpha
+            )
+        );
+        let RadialLaw::Composite(c) = RenderProfile::default().composite_space(160.0).radial else {
+            panic!("not composite")
+        };
+        assert_eq!(
+            c,
+            CompositeMode::Composite.params(160.0),
+            "without the section: the mode's own σ"
+        );
     }
 
     #[test]
@@ -570,7 +661,15 @@ mod tests {
         assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
-        assert_eq!(p.environment, EnvironmentOptions { sun, sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY), sky_intensity: None, ..Default::default() });
+        assert_eq!(
+            p.environment,
+            EnvironmentOptions {
+                sun,
+                sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY),
+                sky_intensity: None,
+                ..Default::default()
+            }
+        );
     }
 
     #[test]
@@ -585,24 +684,61 @@ mod tests {
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Exact);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(900.0));
         assert_eq!(p.blur.sigma_at_30, 0.0);
-        let p = load_str("taa_ok.toml", "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n").unwrap();
-        assert_eq!(p.taa, TaaSettings { current_weight: 0.05, jitter_points: 8 });
-        let p = load_str("ecc_ok.toml", "[visual_polar]\neccentricity = \"headset\"\n").unwrap();
+        let p = load_str(
+            "taa_ok.toml",
+            "[taa]\ncurrent_weight = 0.05\njitter_points = 8\n",
+        )
+        .unwrap();
+        assert_eq!(
+            p.taa,
+            TaaSettings {
+                current_weight: 0.05,
+                jitter_points: 8
+            }
+        );
+        let p = load_str(
+            "ecc_ok.toml",
+            "[visual_polar]\neccentricity = \"headset\"\n",
+        )
+        .unwrap();
         assert_eq!(p.eccentricity, EccentricityMode::Headset);
         let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
-        assert_eq!(p.visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Headset(fov));
-        assert_eq!(RenderProfile::default().visual_polar_for(fov).unwrap().eccentricity, Eccentricity::Normalized);
+        assert_eq!(
+            p.visual_polar_for(fov).unwrap().eccentricity,
+            Eccentricity::Headset(fov)
+        );
+        assert_eq!(
+            RenderProfile::default()
+                .visual_polar_for(fov)
+                .unwrap()
+                .eccentricity,
+            Eccentricity::Normalized
+        );
         let p = load_str("bmfr_ok.toml", "[bmfr]\nalpha_noisy = 0.25\nnoise = 0\n").unwrap();
-        assert_eq!(p.bmfr, BmfrSettings { alpha_noisy: 0.25, noise: 0.0, ..Default::default() });
-        let p = load_str("asvgf_ok.toml", "[svgf]
+        assert_eq!(
+            p.bmfr,
+            BmfrSettings {
+                alpha_noisy: 0.25,
+                noise: 0.0,
+                ..Default::default()
+            }
+        );
+        let p = load_str(
+            "asvgf_ok.toml",
+            "[svgf]
 alpha_color = 0.1
 [asvgf]
 gradient_iterations = 2
 gradient_sigma_normal = 64
-").unwrap();
+",
+        )
+        .unwrap();
         assert_eq!(p.asvgf.gradient_iterations, 2);
         assert_eq!(p.asvgf.gradient_sigma_normal, 64.0);
-        assert_eq!(p.asvgf.svgf.alpha_color, 0.1, "A-SVGF's SVGF stages take the [svgf] section");
+        assert_eq!(
+            p.asvgf.svgf.alpha_color, 0.1,
+            "A-SVGF's SVGF stages take the [svgf] section"
+        );
     }
 
     #[test]
@@ -610,42 +746,122 @@ gradient_sigma_normal = 64
         let cases = [
             ("unknown.toml", "[visual_polar]\nclip = 0.1\n", "clip"),
             ("section.toml", "[vp]\n", "vp"),
-            ("range.toml", "[visual_polar]\nclip_fraction = 0.7\n", "clip_fraction"),
-            ("mode.toml", "[visual_polar]\ninverse_cdf = \"cubic\"\n", "inverse_cdf"),
+            (
+                "range.toml",
+                "[visual_polar]\nclip_fraction = 0.7\n",
+                "clip_fraction",
+            ),
+            (
+                "mode.toml",
+                "[visual_polar]\ninverse_cdf = \"cubic\"\n",
+                "inverse_cdf",
+            ),
             ("radius.toml", "[visual_polar]\nradius = -3\n", "radius"),
-            ("radius_huge.toml", "[visual_polar]\nradius = 1e30\n", "radius"),
-            ("radius_tiny.toml", "[visual_polar]\nradius = 1e-30\n", "radius"),
-            ("radius_text.toml", "[visual_polar]\nradius = \"inf\"\n", "radius"),
-            ("layout.toml", "[visual_polar]\nlayout = \"clipped\"\n", "layout"),
+            (
+                "radius_huge.toml",
+                "[visual_polar]\nradius = 1e30\n",
+                "radius",
+            ),
+            (
+                "radius_tiny.toml",
+                "[visual_polar]\nradius = 1e-30\n",
+                "radius",
+            ),
+            (
+                "radius_text.toml",
+                "[visual_polar]\nradius = \"inf\"\n",
+                "radius",
+            ),
+            (
+                "layout.toml",
+                "[visual_polar]\nlayout = \"clipped\"\n",
+                "layout",
+            ),
             ("layout_type.toml", "[visual_polar]\nlayout = 1\n", "layout"),
-            ("ecc.toml", "[visual_polar]\neccentricity = \"true\"\n", "eccentricity"),
-            ("ecc_type.toml", "[visual_polar]\neccentricity = 2\n", "eccentricity"),
-            ("ecc_clip.toml", "[visual_polar]\neccentricity = \"headset\"\nlayout = \"screen-clipped\"\n", "eccentricity"),
+            (
+                "ecc.toml",
+                "[visual_polar]\neccentricity = \"true\"\n",
+                "eccentricity",
+            ),
+            (
+                "ecc_type.toml",
+                "[visual_polar]\neccentricity = 2\n",
+                "eccentricity",
+            ),
+            (
+                "ecc_clip.toml",
+                "[visual_polar]\neccentricity = \"headset\"\nlayout = \"screen-clipped\"\n",
+                "eccentricity",
+            ),
             ("blur.toml", "[blur]\nsigma_at_30 = -1\n", "sigma_at_30"),
-            ("blur_space.toml", "[blur]\nspace = \"pyramid\"\n", "[blur].space"),
-            ("composite_sigma.toml", "[composite]\nsigma = 0\n", "[composite].sigma"),
-            ("composite_mode.toml", "[composite]\nmode = \"fovea\"\n", "[composite].mode"),
+            (
+                "blur_space.toml",
+                "[blur]\nspace = \"pyramid\"\n",
+                "[blur].space",
+            ),
+            (
+                "composite_sigma.toml",
+                "[composite]\nsigma = 0\n",
+                "[composite].sigma",
+            ),
+            (
+                "composite_mode.toml",
+                "[composite]\nmode = \"fovea\"\n",
+                "[composite].mode",
+            ),
             ("composite_key.toml", "[composite]\nalpha = 2\n", "alpha"),
-            ("type.toml", "[visual_polar]\naxis_scale = \"big\"\n", "axis_scale"),
+            (
+                "type.toml",
+                "[visual_polar]\naxis_scale = \"big\"\n",
+                "axis_scale",
+            ),
             ("svgf.toml", "[svgf]\natrous_iterations = 0\n", "svgf"),
             ("svgf_key.toml", "[svgf]\nsigma = 1\n", "sigma"),
             ("bmfr.toml", "[bmfr]\nalpha_filtered = 1.0\n", "bmfr"),
             ("bmfr_noise.toml", "[bmfr]\nnoise = -0.01\n", "bmfr"),
             ("bmfr_key.toml", "[bmfr]\nblock_size = 16\n", "block_size"),
             ("asvgf.toml", "[asvgf]\ngradient_iterations = 0\n", "asvgf"),
-            ("asvgf_sigma.toml", "[asvgf]\ngradient_sigma_depth = -1\n", "asvgf"),
+            (
+                "asvgf_sigma.toml",
+                "[asvgf]\ngradient_sigma_depth = -1\n",
+                "asvgf",
+            ),
             ("asvgf_key.toml", "[asvgf]\nalpha = 0.5\n", "alpha"),
-            ("asvgf_svgf.toml", "[svgf]\nalpha_color = 0\n[asvgf]\n", "svgf"),
+            (
+                "asvgf_svgf.toml",
+                "[svgf]\nalpha_color = 0\n[asvgf]\n",
+                "svgf",
+            ),
             ("taa.toml", "[taa]\njitter_points = 64\n", "taa"),
             ("taa_weight.toml", "[taa]\ncurrent_weight = 1.5\n", "taa"),
             ("taa_key.toml", "[taa]\nfeedback = 0.9\n", "feedback"),
-            ("lod.toml", "[textures]\nlod = \"trilinear\"\n", "[textures].lod"),
+            (
+                "lod.toml",
+                "[textures]\nlod = \"trilinear\"\n",
+                "[textures].lod",
+            ),
             ("lod_key.toml", "[textures]\nbias = 1\n", "bias"),
-            ("reg.toml", "[path]\nregularisation = -1\n", "[path].regularisation"),
-            ("reg_nan.toml", "[path]\nregularisation = nan\n", "[path].regularisation"),
-            ("reg_big.toml", "[path]\nregularisation = 101\n", "[path].regularisation"),
+            (
+                "reg.toml",
+                "[path]\nregularisation = -1\n",
+                "[path].regularisation",
+            ),
+            (
+                "reg_nan.toml",
+                "[path]\nregularisation = nan\n",
+                "[path].regularisation",
+            ),
+            (
+                "reg_big.toml",
+                "[path]\nregularisation = 101\n",
+                "[path].regularisation",
+            ),
             ("reg_key.toml", "[path]\nfilter = 1\n", "filter"),
-            ("offscreen.toml", "[trace]\noffscreen = \"skip\"\n", "[trace].offscreen"),
+            (
+                "offscreen.toml",
+                "[trace]\noffscreen = \"skip\"\n",
+                "[trace].offscreen",
+            ),
             ("offscreen_key.toml", "[trace]\ndepth = 1\n", "depth"),
         ];
         for (name, text, key) in cases {
@@ -665,64 +881,187 @@ gradient_sigma_normal = 64
         let p = RenderProfile::default().override_with(&o).unwrap();
         assert_eq!(p.visual_polar.clip_fraction, 0.2);
         assert_eq!(p.visual_polar.layout, VpLayout::ScreenClipped);
-        let bad = ProfileOverrides { layout: Some("full".into()), ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-layout"));
+        let bad = ProfileOverrides {
+            layout: Some("full".into()),
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("--vp-layout"));
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::Fixed(500.0));
         let p = load_str("lod_off.toml", "[textures]\nlod = \"off\"\n").unwrap();
         assert_eq!(p.texture_lod, TextureLod::Off);
-        let o = ProfileOverrides { texture_lod: Some("cones".into()), ..Default::default() };
-        assert_eq!(p.override_with(&o).unwrap().texture_lod, TextureLod::RayCones);
-        let bad = ProfileOverrides { texture_lod: Some("on".into()), ..Default::default() };
-        let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
-        assert!(err.contains("--texture-lod") && err.contains("cones, off"), "{err}");
+        let o = ProfileOverrides {
+            texture_lod: Some("cones".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().texture_lod,
+            TextureLod::RayCones
+        );
+        let bad = ProfileOverrides {
+            texture_lod: Some("on".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(
+            err.contains("--texture-lod") && err.contains("cones, off"),
+            "{err}"
+        );
         let p = load_str("offscreen.toml", "[trace]\noffscreen = \"trace\"\n").unwrap();
         assert_eq!(p.offscreen_samples, OffscreenSamples::Trace);
-        let o = ProfileOverrides { offscreen_samples: Some("cull".into()), ..Default::default() };
-        assert_eq!(p.override_with(&o).unwrap().offscreen_samples, OffscreenSamples::Cull);
-        let bad = ProfileOverrides { offscreen_samples: Some("skip".into()), ..Default::default() };
-        let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
-        assert!(err.contains("--offscreen-samples") && err.contains("cull, trace"), "{err}");
+        let o = ProfileOverrides {
+            offscreen_samples: Some("cull".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().offscreen_samples,
+            OffscreenSamples::Cull
+        );
+        let bad = ProfileOverrides {
+            offscreen_samples: Some("skip".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(
+            err.contains("--offscreen-samples") && err.contains("cull, trace"),
+            "{err}"
+        );
         let p = load_str("reg_off.toml", "[path]\nregularisation = 0\n").unwrap();
         assert_eq!(p.path_regularisation(), 0.0);
-        let o = ProfileOverrides { path_regularisation: Some(2.5), ..Default::default() };
+        let o = ProfileOverrides {
+            path_regularisation: Some(2.5),
+            ..Default::default()
+        };
         assert_eq!(p.override_with(&o).unwrap().path_regularisation(), 2.5);
         for bad in [f32::NAN, -0.5, f32::INFINITY, 1e9] {
-            let o = ProfileOverrides { path_regularisation: Some(bad), ..Default::default() };
-            let err = format!("{:#}", RenderProfile::default().override_with(&o).unwrap_err());
-            assert!(err.contains("--path-regularisation") && err.contains("[0, 100]"), "{err}");
+            let o = ProfileOverrides {
+                path_regularisation: Some(bad),
+                ..Default::default()
+            };
+            let err = format!(
+                "{:#}",
+                RenderProfile::default().override_with(&o).unwrap_err()
+            );
+            assert!(
+                err.contains("--path-regularisation") && err.contains("[0, 100]"),
+                "{err}"
+            );
         }
-        let o = ProfileOverrides { eccentricity: Some("headset".into()), ..Default::default() };
-        assert_eq!(RenderProfile::default().override_with(&o).unwrap().eccentricity, EccentricityMode::Headset);
-        let bad = ProfileOverrides { eccentricity: Some("degrees".into()), ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
-        let bad = ProfileOverrides { eccentricity: Some("headset".into()), layout: Some("screen-clipped".into()), ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--vp-eccentricity"));
+        let o = ProfileOverrides {
+            eccentricity: Some("headset".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            RenderProfile::default()
+                .override_with(&o)
+                .unwrap()
+                .eccentricity,
+            EccentricityMode::Headset
+        );
+        let bad = ProfileOverrides {
+            eccentricity: Some("degrees".into()),
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("--vp-eccentricity"));
+        let bad = ProfileOverrides {
+            eccentricity: Some("headset".into()),
+            layout: Some("screen-clipped".into()),
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("--vp-eccentricity"));
         for radius in ["1e30", "1e-30", "0.5", "NaN", "inf", "-1", "0"] {
-            let bad = ProfileOverrides { radius: Some(radius.into()), ..Default::default() };
-            let err = format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err());
+            let bad = ProfileOverrides {
+                radius: Some(radius.into()),
+                ..Default::default()
+            };
+            let err = format!(
+                "{:#}",
+                RenderProfile::default().override_with(&bad).unwrap_err()
+            );
             assert!(err.contains("--vp-radius") && err.contains(radius), "{err}");
         }
         for radius in ["1", "1000000"] {
-            let o = ProfileOverrides { radius: Some(radius.into()), ..Default::default() };
-            assert!(RenderProfile::default().override_with(&o).is_ok(), "{radius}");
+            let o = ProfileOverrides {
+                radius: Some(radius.into()),
+                ..Default::default()
+            };
+            assert!(
+                RenderProfile::default().override_with(&o).is_ok(),
+                "{radius}"
+            );
         }
-        let bad = ProfileOverrides { axis_scale: Some(0.0), ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("axis_scale"));
+        let bad = ProfileOverrides {
+            axis_scale: Some(0.0),
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("axis_scale"));
     }
 
     #[test]
     fn environment_section_and_flags() {
-        let p = load_str("env.toml", "[environment]\nsun = [45.0, 30.0]\nsky_intensity = 0.0\n").unwrap();
-        assert_eq!(p.environment, EnvironmentOptions { sun: Some([45.0, 30.0]), sun_intensity: None, sky_intensity: Some(0.0), ..Default::default() });
-        let err = format!("{:#}", load_str("env_bad.toml", "[environment]\nsun_intensity = -1.0\n").unwrap_err());
+        let p = load_str(
+            "env.toml",
+            "[environment]\nsun = [45.0, 30.0]\nsky_intensity = 0.0\n",
+        )
+        .unwrap();
+        assert_eq!(
+            p.environment,
+            EnvironmentOptions {
+                sun: Some([45.0, 30.0]),
+                sun_intensity: None,
+                sky_intensity: Some(0.0),
+                ..Default::default()
+            }
+        );
+        let err = format!(
+            "{:#}",
+            load_str("env_bad.toml", "[environment]\nsun_intensity = -1.0\n").unwrap_err()
+        );
         assert!(err.contains("[environment].sun_intensity"), "{err}");
         assert!(load_str("env_key.toml", "[environment]\nmoon = 1.0\n").is_err());
-        let o = ProfileOverrides { environment: EnvironmentOptions { sky_intensity: Some(2.0), ..Default::default() }, ..Default::default() };
+        let o = ProfileOverrides {
+            environment: EnvironmentOptions {
+                sky_intensity: Some(2.0),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
         let merged = p.override_with(&o).unwrap();
         assert_eq!(merged.environment.sky_intensity, Some(2.0));
         assert_eq!(merged.environment.sun, Some([45.0, 30.0]));
-        let bad = ProfileOverrides { environment: EnvironmentOptions { sun: Some([0.0, 95.0]), ..Default::default() }, ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--sun"));
+        let bad = ProfileOverrides {
+            environment: EnvironmentOptions {
+                sun: Some([0.0, 95.0]),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("--sun"));
     }
 
     #[test]
@@ -731,15 +1070,43 @@ gradient_sigma_normal = 64
         let dir = std::env::temp_dir().join(format!("fovea-profile-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("sky.hdr"), b"").unwrap();
-        let p = load_str("envmap.toml", "[environment]\nenv = \"sky.hdr\"\nenv_rotation = -90.0\nenv_intensity = 2.5\n").unwrap();
+        let p = load_str(
+            "envmap.toml",
+            "[environment]\nenv = \"sky.hdr\"\nenv_rotation = -90.0\nenv_intensity = 2.5\n",
+        )
+        .unwrap();
         assert_eq!(p.environment.env, Some(dir.join("sky.hdr")));
-        assert_eq!((p.environment.env_rotation, p.environment.env_intensity), (Some(-90.0), Some(2.5)));
+        assert_eq!(
+            (p.environment.env_rotation, p.environment.env_intensity),
+            (Some(-90.0), Some(2.5))
+        );
         // Flags override the profile, key by key.
-        let o = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(1.0), ..Default::default() }, ..Default::default() };
+        let o = ProfileOverrides {
+            environment: EnvironmentOptions {
+                env_intensity: Some(1.0),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
         let merged = p.clone().override_with(&o).unwrap();
-        assert_eq!((merged.environment.env_intensity, merged.environment.env_rotation), (Some(1.0), Some(-90.0)));
-        let o = ProfileOverrides { environment: EnvironmentOptions { env: Some("other.exr".into()), ..Default::default() }, ..Default::default() };
-        assert_eq!(p.override_with(&o).unwrap().environment.env, Some("other.exr".into()));
+        assert_eq!(
+            (
+                merged.environment.env_intensity,
+                merged.environment.env_rotation
+            ),
+            (Some(1.0), Some(-90.0))
+        );
+        let o = ProfileOverrides {
+            environment: EnvironmentOptions {
+                env: Some("other.exr".into()),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().environment.env,
+            Some("other.exr".into())
+        );
         // Errors name the file and the key.
         for (text, key) in [
             ("env = \"nowhere.exr\"", "[environment].env"),
@@ -748,10 +1115,26 @@ gradient_sigma_normal = 64
             ("env_rotation = inf", "[environment].env_rotation"),
             ("sky = \"hosek\"", "[environment].sky"),
         ] {
-            let err = format!("{:#}", load_str("envmap_bad.toml", &format!("[environment]\n{text}\n")).unwrap_err());
-            assert!(err.contains("envmap_bad.toml") && err.contains(key), "{text}: {err}");
+            let err = format!(
+                "{:#}",
+                load_str("envmap_bad.toml", &format!("[environment]\n{text}\n")).unwrap_err()
+            );
+            assert!(
+                err.contains("envmap_bad.toml") && err.contains(key),
+                "{text}: {err}"
+            );
         }
-        let bad = ProfileOverrides { environment: EnvironmentOptions { env_intensity: Some(f32::NAN), ..Default::default() }, ..Default::default() };
-        assert!(format!("{:#}", RenderProfile::default().override_with(&bad).unwrap_err()).contains("--env-intensity"));
+        let bad = ProfileOverrides {
+            environment: EnvironmentOptions {
+                env_intensity: Some(f32::NAN),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        assert!(format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        )
+        .contains("--env-intensity"));
     }
 }

@@ -14,7 +14,9 @@ fn generator_for(name: &str) -> Option<SceneKind> {
     match name {
         "cornell-box" => Some(SceneKind::CornellBox),
         "stress" => Some(SceneKind::Stress),
-        "large" => Some(SceneKind::Large { min_triangles: DEFAULT_LARGE_TRIANGLES }),
+        "large" => Some(SceneKind::Large {
+            min_triangles: DEFAULT_LARGE_TRIANGLES,
+        }),
         _ => None,
     }
 }
@@ -25,7 +27,9 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     if as_path.exists() {
         return Ok(as_path.to_path_buf());
     }
-    let looks_like_path = name_or_path.contains('/') || name_or_path.ends_with(".gltf") || name_or_path.ends_with(".glb");
+    let looks_like_path = name_or_path.contains('/')
+        || name_or_path.ends_with(".gltf")
+        || name_or_path.ends_with(".glb");
     if looks_like_path {
         bail!("scene file {name_or_path} does not exist");
     }
@@ -70,7 +74,8 @@ pub fn generated_in(cache: &Path, kind: &SceneKind) -> Result<PathBuf> {
     write_scene(kind, &tmp, true)?;
     let sum = sha256_hex(&tmp)?;
     crate::output::write_text(&sum_file, &format!("{sum}\n"))?;
-    std::fs::rename(&tmp, &file).with_context(|| format!("moving the generated scene to {}", file.display()))?;
+    std::fs::rename(&tmp, &file)
+        .with_context(|| format!("moving the generated scene to {}", file.display()))?;
     Ok(file)
 }
 
@@ -86,7 +91,8 @@ fn check_private(dir: &Path) -> Result<()> {
         bail!("scene cache {} belongs to uid {}, not to you (uid {me}); fovea does not use scenes others can plant", dir.display(), meta.uid());
     }
     if meta.permissions().mode() & 0o022 != 0 {
-        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o700)).with_context(|| format!("making {} private", dir.display()))?;
+        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o700))
+            .with_context(|| format!("making {} private", dir.display()))?;
     }
     Ok(())
 }
@@ -99,7 +105,10 @@ fn check_private(_dir: &Path) -> Result<()> {
 fn sha256_hex(path: &Path) -> Result<String> {
     use sha2::Digest;
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(sha2::Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect())
+    Ok(sha2::Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
 }
 
 /// Loads a scene within the budgets of `FOVEA_MAX_TRIANGLES`, `FOVEA_MAX_TEXELS` and
@@ -118,7 +127,8 @@ mod tests {
     use super::*;
 
     fn temp(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("fovea-scene-cache-{}-{name}", std::process::id()));
+        let d =
+            std::env::temp_dir().join(format!("fovea-scene-cache-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         d
     }
@@ -131,14 +141,21 @@ mod tests {
         let original = std::fs::read(&file).unwrap();
         std::fs::write(&file, b"{\"asset\":{\"version\":\"2.0\"}}").unwrap(); // planted or truncated
         assert_eq!(generated_in(&cache, &kind).unwrap(), file);
-        assert_eq!(std::fs::read(&file).unwrap(), original, "the altered copy was replaced");
+        assert_eq!(
+            std::fs::read(&file).unwrap(),
+            original,
+            "the altered copy was replaced"
+        );
         #[cfg(unix)]
         {
             use std::os::unix::fs::{MetadataExt, PermissionsExt};
             // Writable by others: made private.
             std::fs::set_permissions(&cache, std::fs::Permissions::from_mode(0o777)).unwrap();
             generated_in(&cache, &kind).unwrap();
-            assert_eq!(std::fs::metadata(&cache).unwrap().permissions().mode() & 0o777, 0o700);
+            assert_eq!(
+                std::fs::metadata(&cache).unwrap().permissions().mode() & 0o777,
+                0o700
+            );
             // Someone else's folder (only root can make one here): refused.
             if std::os::unix::fs::chown(&cache, Some(65534), None).is_ok() {
                 assert_eq!(std::fs::metadata(&cache).unwrap().uid(), 65534);

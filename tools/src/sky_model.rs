@@ -19,16 +19,35 @@ const GROUND_SHARE: f32 = 0.3;
 /// Perez's five coefficients for Y, x and y as linear functions of turbidity (A.2).
 fn perez_coefficients(t: f32) -> [[f32; 5]; 3] {
     [
-        [0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251, 0.1206 * t - 2.5771, -0.0670 * t + 0.3703],
-        [-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125, -0.0641 * t - 0.8989, -0.0033 * t + 0.0452],
-        [-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102, -0.0441 * t - 1.6537, -0.0109 * t + 0.0529],
+        [
+            0.1787 * t - 1.4630,
+            -0.3554 * t + 0.4275,
+            -0.0227 * t + 5.3251,
+            0.1206 * t - 2.5771,
+            -0.0670 * t + 0.3703,
+        ],
+        [
+            -0.0193 * t - 0.2592,
+            -0.0665 * t + 0.0008,
+            -0.0004 * t + 0.2125,
+            -0.0641 * t - 0.8989,
+            -0.0033 * t + 0.0452,
+        ],
+        [
+            -0.0167 * t - 0.2608,
+            -0.0950 * t + 0.0092,
+            -0.0079 * t + 0.2102,
+            -0.0441 * t - 1.6537,
+            -0.0109 * t + 0.0529,
+        ],
     ]
 }
 
 /// F(θ, γ) = (1 + A e^(B / cos θ)) (1 + C e^(Dγ) + E cos² γ); θ from the zenith, γ from the sun.
 fn perez(c: &[f32; 5], cos_theta: f32, gamma: f32) -> f32 {
     // cos θ → 0 at the horizon: B < 0 makes the term vanish, the clamp only avoids 0/0.
-    (1.0 + c[0] * (c[1] / cos_theta.max(1e-3)).exp()) * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
+    (1.0 + c[0] * (c[1] / cos_theta.max(1e-3)).exp())
+        * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
 }
 
 /// The zenith's luminance (kcd/m²) and chromaticity x, y for turbidity `t` and sun zenith angle `ts`.
@@ -70,7 +89,11 @@ impl Preetham {
         let ts = sun.y.clamp(-1.0, 1.0).acos();
         let z = zenith(turbidity, ts);
         let scale = [0, 1, 2].map(|i| z[i] / perez(&coefficients[i], 1.0, ts));
-        Preetham { sun, coefficients, scale }
+        Preetham {
+            sun,
+            coefficients,
+            scale,
+        }
     }
 
     /// Linear sRGB radiance (kcd/m²-based units) toward unit direction `dir` at or above the horizon.
@@ -90,7 +113,11 @@ pub fn upward_irradiance(map: &EnvironmentMap) -> f32 {
             let cos_theta = uv_to_direction(Vec2::new(0.5, (y as f32 + 0.5) / map.height as f32)).y;
             let row = &map.texels[(y * map.width) as usize..((y + 1) * map.width) as usize];
             let mean: f32 = row.iter().map(|&c| luminance(c)).sum::<f32>() / map.width as f32;
-            if cos_theta > 0.0 { mean * cos_theta * map.row_solid_angle(y) * map.width as f32 } else { 0.0 }
+            if cos_theta > 0.0 {
+                mean * cos_theta * map.row_solid_angle(y) * map.width as f32
+            } else {
+                0.0
+            }
         })
         .sum()
 }
@@ -101,22 +128,45 @@ pub fn upward_irradiance(map: &EnvironmentMap) -> f32 {
 pub fn preetham_map(sun: Vec3, intensity: f32) -> EnvironmentMap {
     let sky = Preetham::new(sun, TURBIDITY);
     let (width, height) = BAKE_SIZE;
-    let direction = |x: u32, y: u32| uv_to_direction(Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32));
+    let direction = |x: u32, y: u32| {
+        uv_to_direction(Vec2::new(
+            (x as f32 + 0.5) / width as f32,
+            (y as f32 + 0.5) / height as f32,
+        ))
+    };
     let below: Vec<bool> = (0..height).map(|y| direction(0, y).y < 0.0).collect();
     // The ground rows are filled once the sky's scale is known.
     let texels = (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| if below[y as usize] { Vec3::ZERO } else { sky.radiance(direction(x, y)) })
+        .map(|(x, y)| {
+            if below[y as usize] {
+                Vec3::ZERO
+            } else {
+                sky.radiance(direction(x, y))
+            }
+        })
         .collect();
-    let mut map = EnvironmentMap::new(width, height, texels).expect("a finite, non-negative bake of a valid size");
-    let target = upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(intensity)));
-    let scale = if intensity > 0.0 { target / upward_irradiance(&map) } else { 0.0 };
+    let mut map = EnvironmentMap::new(width, height, texels)
+        .expect("a finite, non-negative bake of a valid size");
+    let target = upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(
+        intensity,
+    )));
+    let scale = if intensity > 0.0 {
+        target / upward_irradiance(&map)
+    } else {
+        0.0
+    };
     let rows = map.texels.chunks_exact(width as usize).zip(&below);
-    let (sum, count) = rows.filter(|(_, &b)| !b).fold((Vec3::ZERO, 0usize), |(s, n), (row, _)| (s + row.iter().sum::<Vec3>(), n + row.len()));
+    let (sum, count) = rows
+        .filter(|(_, &b)| !b)
+        .fold((Vec3::ZERO, 0usize), |(s, n), (row, _)| {
+            (s + row.iter().sum::<Vec3>(), n + row.len())
+        });
     let mean = sum / count.max(1) as f32 * scale * GROUND_SHARE;
     let ground = Vec3::splat((mean.x + mean.y + mean.z) / 3.0);
     for (row, &b) in map.texels.chunks_exact_mut(width as usize).zip(&below) {
-        row.iter_mut().for_each(|c| *c = if b { ground } else { *c * scale });
+        row.iter_mut()
+            .for_each(|c| *c = if b { ground } else { *c * scale });
     }
     map
 }
@@ -162,31 +212,54 @@ mod tests {
         let high = zenith(TURBIDITY, 30f32.to_radians());
         assert!(high[0] > low[0] && low[0] > 0.0, "{low:?} {high:?}");
         for [_, x, y] in [low, high] {
-            assert!((0.2..0.313).contains(&x) && (0.2..0.329).contains(&y), "{x} {y}");
+            assert!(
+                (0.2..0.313).contains(&x) && (0.2..0.329).contains(&y),
+                "{x} {y}"
+            );
         }
         let sun = sun_direction(30.0, 30.0);
         let sky = Preetham::new(sun, TURBIDITY);
         let zenith_rgb = sky.radiance(Vec3::Y);
-        assert!(zenith_rgb.z > zenith_rgb.x, "the zenith should be blue: {zenith_rgb}");
+        assert!(
+            zenith_rgb.z > zenith_rgb.x,
+            "the zenith should be blue: {zenith_rgb}"
+        );
         // Near the sun brighter than opposite it at the same elevation (the circumsolar peak).
         let toward = sun_direction(30.0, 40.0);
         let away = sun_direction(210.0, 40.0);
         assert!(sky.radiance(toward).length() > 3.0 * sky.radiance(away).length());
         // Symmetric about the sun's vertical plane.
-        let (l, r) = (sky.radiance(sun_direction(10.0, 20.0)), sky.radiance(sun_direction(50.0, 20.0)));
-        assert!((l - r).abs().max_element() < 1e-3 * l.max_element(), "{l} vs {r}");
+        let (l, r) = (
+            sky.radiance(sun_direction(10.0, 20.0)),
+            sky.radiance(sun_direction(50.0, 20.0)),
+        );
+        assert!(
+            (l - r).abs().max_element() < 1e-3 * l.max_element(),
+            "{l} vs {r}"
+        );
     }
 
     #[test]
     fn baked_map_has_the_gradient_skys_irradiance_and_a_grey_ground() {
         for (azimuth, elevation) in [(30.0, 60.0), (200.0, 15.0)] {
             let map = preetham_map(sun_direction(azimuth, elevation), 0.5);
-            let target = upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(0.5)));
+            let target =
+                upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(0.5)));
             assert!((upward_irradiance(&map) - target).abs() < 1e-3 * target);
             let below = map.radiance(-Vec3::Y);
-            assert!(below.x == below.y && below.y == below.z && below.x > 0.0, "{below}");
-            assert!(map.radiance(sun_direction(azimuth, elevation.min(80.0))).length() > map.radiance(Vec3::Y).length() * 0.5);
+            assert!(
+                below.x == below.y && below.y == below.z && below.x > 0.0,
+                "{below}"
+            );
+            assert!(
+                map.radiance(sun_direction(azimuth, elevation.min(80.0)))
+                    .length()
+                    > map.radiance(Vec3::Y).length() * 0.5
+            );
         }
-        assert!(preetham_map(Vec3::Y, 0.0).texels.iter().all(|&c| c == Vec3::ZERO));
+        assert!(preetham_map(Vec3::Y, 0.0)
+            .texels
+            .iter()
+            .all(|&c| c == Vec3::ZERO));
     }
 }

@@ -51,8 +51,25 @@ fn frames_in(dir: &Path) -> Vec<String> {
 fn interrupt_render(signal: &str, number: i32) {
     let out = temp_dir(&format!("signal-{signal}"));
     let mut child = Command::new(env!("CARGO_BIN_EXE_fovea"))
-        .args(["render", "--scene", &cornell(), "--method", "cartesian", "--width", "16", "--height", "16"])
-        .args(["--frames", "100000", "--gaze", "center", "--validation", "--out"])
+        .args([
+            "render",
+            "--scene",
+            &cornell(),
+            "--method",
+            "cartesian",
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ])
+        .args([
+            "--frames",
+            "100000",
+            "--gaze",
+            "center",
+            "--validation",
+            "--out",
+        ])
         .arg(&out)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -60,27 +77,54 @@ fn interrupt_render(signal: &str, number: i32) {
         .unwrap();
     let start = Instant::now();
     while !out.join("frame_0002.png").exists() {
-        assert!(start.elapsed() < Duration::from_secs(120), "no frames after 2 minutes");
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no frames after 2 minutes"
+        );
         assert!(child.try_wait().unwrap().is_none(), "fovea exited early");
         std::thread::sleep(Duration::from_millis(20));
     }
-    assert!(Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap().success());
+    assert!(Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
     let status = wait_with_timeout(&mut child, Duration::from_secs(60));
     let mut stderr = String::new();
     std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
-    assert_eq!(status.code(), Some(128 + number), "exit status; stderr: {stderr}");
-    assert!(stderr.contains(&format!("interrupted by SIG{signal}")), "{stderr}");
+    assert_eq!(
+        status.code(),
+        Some(128 + number),
+        "exit status; stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("interrupted by SIG{signal}")),
+        "{stderr}"
+    );
 
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["interrupted"], true);
     let frames = frames_in(&out);
     let reported = report["frames"].as_u64().unwrap() as usize;
     assert!((3..100_000).contains(&reported), "{reported}");
-    assert_eq!(frames.len(), reported, "every reported frame is on disk, nothing more: {frames:?}");
+    assert_eq!(
+        frames.len(),
+        reported,
+        "every reported frame is on disk, nothing more: {frames:?}"
+    );
     assert_eq!(report["gaze"].as_array().unwrap().len(), reported);
     let last = out.join(frames.last().unwrap());
-    assert_eq!(image::open(&last).unwrap().width(), 16, "the last frame is complete");
-    let leftovers: Vec<_> = std::fs::read_dir(&out).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().ends_with(".tmp")).collect();
+    assert_eq!(
+        image::open(&last).unwrap().width(),
+        16,
+        "the last frame is complete"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
     assert!(leftovers.is_empty(), "temporaries left: {leftovers:?}");
 }
 
@@ -113,14 +157,38 @@ fn a_failing_forced_write_keeps_the_old_reference() {
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success(), "the write must fail under the limit: {stderr}");
-    assert!(stderr.contains("writing") && stderr.contains("ref.exr") && stderr.contains("File too large"), "the EXR write itself failed: {stderr}");
+    assert!(
+        !output.status.success(),
+        "the write must fail under the limit: {stderr}"
+    );
+    assert!(
+        stderr.contains("writing")
+            && stderr.contains("ref.exr")
+            && stderr.contains("File too large"),
+        "the EXR write itself failed: {stderr}"
+    );
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "OLD REFERENCE");
-    let names: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(names, vec!["ref.exr"], "no temporary left behind");
     // Without the limit the same command replaces it.
     let status = Command::new(fovea)
-        .args(["reference", "--scene", &cornell(), "--width", "64", "--height", "64", "--spp", "1", "--validation", "--force", "--out"])
+        .args([
+            "reference",
+            "--scene",
+            &cornell(),
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--spp",
+            "1",
+            "--validation",
+            "--force",
+            "--out",
+        ])
         .arg(&target)
         .stdout(Stdio::null())
         .stderr(Stdio::null())

@@ -42,7 +42,11 @@ fn committed() -> PathBuf {
 }
 
 /// The example trace, the simulator, and a GazeBase-style dataset file (a saccade and a blink).
-const TRACES: [&str; 3] = ["config/gaze/example_trace.csv", "sim:1", "gazebase:tests/replay/traces/gazebase_style.csv"];
+const TRACES: [&str; 3] = [
+    "config/gaze/example_trace.csv",
+    "sim:1",
+    "gazebase:tests/replay/traces/gazebase_style.csv",
+];
 
 fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
@@ -56,13 +60,22 @@ fn stderr(o: &Output) -> String {
 fn the_committed_baselines_replay_within_tolerance() {
     let out = temp_dir("committed");
     let done = replay(&TRACES, &committed(), &out, &[]);
-    assert_eq!(done.status.code(), Some(0), "{}\n{}", String::from_utf8_lossy(&done.stdout), stderr(&done));
+    assert_eq!(
+        done.status.code(),
+        Some(0),
+        "{}\n{}",
+        String::from_utf8_lossy(&done.stdout),
+        stderr(&done)
+    );
     let report = json(&out.join("replay.json"));
     assert_eq!(report["passed"], true);
     for t in report["traces"].as_array().unwrap() {
         assert_eq!(t["frames"].as_array().unwrap().len(), 8);
         assert!(t["failed_frames"].as_array().unwrap().is_empty());
-        assert!(!t["cost_ratio"].as_object().unwrap().is_empty(), "cost is reported");
+        assert!(
+            !t["cost_ratio"].as_object().unwrap().is_empty(),
+            "cost is reported"
+        );
     }
 }
 
@@ -72,16 +85,39 @@ fn a_planted_regression_fails_naming_frames_and_rings() {
     let out = temp_dir("planted");
     let done = replay(&TRACES[..1], &committed(), &out, &["--max-depth", "2"]);
     assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
-    assert!(stderr(&done).contains("outside the tolerances"), "{}", stderr(&done));
+    assert!(
+        stderr(&done).contains("outside the tolerances"),
+        "{}",
+        stderr(&done)
+    );
     let report = json(&out.join("replay.json"));
     let trace = &report["traces"][0];
     assert_eq!(trace["failed_frames"].as_array().unwrap().len(), 8);
-    let worse: usize = trace["frames"].as_array().unwrap().iter().map(|f| f["quality"].as_array().unwrap().iter().filter(|r| r["regressed"] == true).count()).sum();
+    let worse: usize = trace["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            f["quality"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|r| r["regressed"] == true)
+                .count()
+        })
+        .sum();
     assert!(worse >= 8, "quality regressions in {worse} frame-rings");
     assert!(trace["param_changes"].to_string().contains("max_depth"));
     let md = std::fs::read_to_string(out.join("replay.md")).unwrap();
-    assert!(md.contains("REGRESSION") && md.contains("| 0 |") && md.contains(" > "), "{md}");
-    assert!(out.join("run_example_trace/frame_0000_baseline.png").is_file() && out.join("run_example_trace/frame_0000_flip.png").is_file());
+    assert!(
+        md.contains("REGRESSION") && md.contains("| 0 |") && md.contains(" > "),
+        "{md}"
+    );
+    assert!(
+        out.join("run_example_trace/frame_0000_baseline.png")
+            .is_file()
+            && out.join("run_example_trace/frame_0000_flip.png").is_file()
+    );
 }
 
 /// TAA is an intended improvement: the frames change, their error against the reference does not grow.
@@ -92,8 +128,20 @@ fn a_better_setting_is_a_change_but_no_quality_regression() {
     assert_eq!(done.status.code(), Some(1), "{}", stderr(&done));
     let report = json(&out.join("replay.json"));
     let frames = report["traces"][0]["frames"].as_array().unwrap();
-    assert!(frames.iter().any(|f| f["change"].as_array().unwrap().iter().any(|r| r["changed"] == true)));
-    assert!(frames.iter().all(|f| f["quality"].as_array().unwrap().iter().all(|r| r["regressed"] == false)), "{}", report["traces"][0]["frames"]);
+    assert!(frames.iter().any(|f| f["change"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|r| r["changed"] == true)));
+    assert!(
+        frames.iter().all(|f| f["quality"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|r| r["regressed"] == false)),
+        "{}",
+        report["traces"][0]["frames"]
+    );
 }
 
 /// A trace whose eye closes for 50 ms: the frames in the blink use the held direction, exactly,
@@ -103,7 +151,10 @@ fn a_blink_replays_the_held_gaze_exactly() {
     let dir = temp_dir("blink");
     let trace = dir.join("blink.csv");
     let mut writer = TraceWriter::create(&HmdDescription::fove0(), &trace, false).unwrap();
-    let (a, b) = (Vec3::new(0.2, 0.1, -1.0).normalize(), Vec3::new(-0.3, 0.0, -1.0).normalize());
+    let (a, b) = (
+        Vec3::new(0.2, 0.1, -1.0).normalize(),
+        Vec3::new(-0.3, 0.0, -1.0).normalize(),
+    );
     for i in 0..16u64 {
         let t = (i as f64 * 1e9 / 120.0) as i64;
         let sample = match t {
@@ -116,16 +167,45 @@ fn a_blink_replays_the_held_gaze_exactly() {
     writer.finish().unwrap();
     let (baseline, out) = (dir.join("baseline"), dir.join("out"));
     let trace_arg = trace.display().to_string();
-    let made = replay(&[&trace_arg], &baseline, &out, &["--update-baseline", "--method", "cartesian", "--reference-spp", "16"]);
+    let made = replay(
+        &[&trace_arg],
+        &baseline,
+        &out,
+        &[
+            "--update-baseline",
+            "--method",
+            "cartesian",
+            "--reference-spp",
+            "16",
+        ],
+    );
     assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
-    let frames = json(&baseline.join("blink/baseline.json"))["frames"].as_array().unwrap().clone();
-    let origins: Vec<&str> = frames.iter().map(|f| f["origin"].as_str().unwrap()).collect();
-    assert_eq!(origins, ["live", "live", "live", "held", "held", "held", "held", "live"], "frames at k / 70 Hz");
+    let frames = json(&baseline.join("blink/baseline.json"))["frames"]
+        .as_array()
+        .unwrap()
+        .clone();
+    let origins: Vec<&str> = frames
+        .iter()
+        .map(|f| f["origin"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        origins,
+        ["live", "live", "live", "held", "held", "held", "held", "live"],
+        "frames at k / 70 Hz"
+    );
     for f in &frames[3..7] {
-        assert_eq!(f["gaze"], frames[2]["gaze"], "the held gaze is the last live one, bit for bit");
+        assert_eq!(
+            f["gaze"], frames[2]["gaze"],
+            "the held gaze is the last live one, bit for bit"
+        );
     }
     assert_ne!(frames[7]["gaze"], frames[2]["gaze"]);
-    let again = replay(&[&trace_arg], &baseline, &dir.join("out2"), &["--method", "cartesian", "--reference-spp", "16"]);
+    let again = replay(
+        &[&trace_arg],
+        &baseline,
+        &dir.join("out2"),
+        &["--method", "cartesian", "--reference-spp", "16"],
+    );
     assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
 }
 
@@ -135,19 +215,31 @@ fn bad_baselines_and_traces_are_exit_2_naming_the_file() {
     // No baseline yet: say how to make one.
     let missing = replay(&TRACES[..1], &dir.join("none"), &dir.join("o1"), &[]);
     assert_eq!(missing.status.code(), Some(2));
-    assert!(stderr(&missing).contains("--update-baseline"), "{}", stderr(&missing));
+    assert!(
+        stderr(&missing).contains("--update-baseline"),
+        "{}",
+        stderr(&missing)
+    );
     // A corrupt baseline.json.
     let broken = dir.join("broken/example_trace");
     std::fs::create_dir_all(&broken).unwrap();
     std::fs::write(broken.join("baseline.json"), "{ \"format\": 3 ").unwrap();
     let corrupt = replay(&TRACES[..1], &dir.join("broken"), &dir.join("o2"), &[]);
     assert_eq!(corrupt.status.code(), Some(2));
-    assert!(stderr(&corrupt).contains("baseline.json"), "{}", stderr(&corrupt));
+    assert!(
+        stderr(&corrupt).contains("baseline.json"),
+        "{}",
+        stderr(&corrupt)
+    );
     // A trace that is not one.
     let junk = dir.join("junk.csv");
     std::fs::write(&junk, "this is not a gaze trace\n").unwrap();
     let junk_arg = junk.display().to_string();
     let bad_trace = replay(&[&junk_arg], &committed(), &dir.join("o3"), &[]);
     assert_eq!(bad_trace.status.code(), Some(2));
-    assert!(stderr(&bad_trace).contains("junk.csv"), "{}", stderr(&bad_trace));
+    assert!(
+        stderr(&bad_trace).contains("junk.csv"),
+        "{}",
+        stderr(&bad_trace)
+    );
 }

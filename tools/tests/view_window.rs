@@ -16,9 +16,18 @@ struct Xvfb {
 impl Xvfb {
     fn start() -> Xvfb {
         // A display number no other server (or parallel test run) holds.
-        let number = (90..190).find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()).expect("a free X display number");
+        let number = (90..190)
+            .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
+            .expect("a free X display number");
         let child = Command::new("Xvfb")
-            .args([&format!(":{number}"), "-screen", "0", "800x600x24", "-nolisten", "tcp"])
+            .args([
+                &format!(":{number}"),
+                "-screen",
+                "0",
+                "800x600x24",
+                "-nolisten",
+                "tcp",
+            ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
@@ -26,10 +35,16 @@ impl Xvfb {
         let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
         let start = Instant::now();
         while !socket.exists() {
-            assert!(start.elapsed() < Duration::from_secs(20), "Xvfb :{number} did not start");
+            assert!(
+                start.elapsed() < Duration::from_secs(20),
+                "Xvfb :{number} did not start"
+            );
             std::thread::sleep(Duration::from_millis(50));
         }
-        Xvfb { child, display: format!(":{number}") }
+        Xvfb {
+            child,
+            display: format!(":{number}"),
+        }
     }
 }
 
@@ -48,11 +63,18 @@ fn fovea(args: &[&str], display: Option<&str>) {
         None => cmd.env_remove("DISPLAY"),
     };
     let out = cmd.output().expect("running fovea");
-    assert!(out.status.success(), "fovea {args:?} failed:\n{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "fovea {args:?} failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 fn rgba(path: &Path) -> image::RgbaImage {
-    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8()
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
 }
 
 fn check_screenshot_matches_render(name: &str, extra: &[&str]) {
@@ -62,14 +84,32 @@ fn check_screenshot_matches_render(name: &str, extra: &[&str]) {
     std::fs::create_dir_all(&dir).unwrap();
     let shot = dir.join("shot.png");
     let render_out = dir.join("render");
-    let common = ["--width", "80", "--height", "90", "--frames", "30", "--gaze", "sim:2", "--seed", "3"];
-    let view_args: Vec<&str> = ["view"].iter().chain(&common).chain(extra).copied().chain(["--screenshot", shot.to_str().unwrap()]).collect();
+    let common = [
+        "--width", "80", "--height", "90", "--frames", "30", "--gaze", "sim:2", "--seed", "3",
+    ];
+    let view_args: Vec<&str> = ["view"]
+        .iter()
+        .chain(&common)
+        .chain(extra)
+        .copied()
+        .chain(["--screenshot", shot.to_str().unwrap()])
+        .collect();
     fovea(&view_args, Some(&x.display));
-    let render_args: Vec<&str> = ["render"].iter().chain(&common).chain(extra).copied().chain(["--out", render_out.to_str().unwrap()]).collect();
+    let render_args: Vec<&str> = ["render"]
+        .iter()
+        .chain(&common)
+        .chain(extra)
+        .copied()
+        .chain(["--out", render_out.to_str().unwrap()])
+        .collect();
     fovea(&render_args, None);
     let shot = rgba(&shot);
     let stereo = extra.contains(&"both");
-    let eyes: Vec<String> = if stereo { vec!["frame_0029_left.png".into(), "frame_0029_right.png".into()] } else { vec!["frame_0029.png".into()] };
+    let eyes: Vec<String> = if stereo {
+        vec!["frame_0029_left.png".into(), "frame_0029_right.png".into()]
+    } else {
+        vec!["frame_0029.png".into()]
+    };
     assert_eq!(shot.dimensions(), (80 * eyes.len() as u32, 90));
     for (i, file) in eyes.iter().enumerate() {
         let expected = rgba(&render_out.join(file));
@@ -80,7 +120,10 @@ fn check_screenshot_matches_render(name: &str, extra: &[&str]) {
                 worst = worst.max(p[c].abs_diff(q[c]));
             }
         }
-        assert!(worst <= 1, "{name}: the window's {file} differs from fovea render's by up to {worst}/255");
+        assert!(
+            worst <= 1,
+            "{name}: the window's {file} differs from fovea render's by up to {worst}/255"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -104,23 +147,50 @@ fn debug_views_in_the_window() {
     let dir = std::env::temp_dir().join(format!("fovea-view-debug-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let common = ["--width", "80", "--height", "90", "--frames", "4", "--gaze", "sim:2"];
+    let common = [
+        "--width", "80", "--height", "90", "--frames", "4", "--gaze", "sim:2",
+    ];
     let shot = |view: &str, extra: &[&str]| {
         let path = dir.join(format!("{view}.png"));
-        let args: Vec<&str> = ["view"].iter().chain(&common).chain(extra).copied().chain(["--debug-view", view, "--screenshot", path.to_str().unwrap()]).collect();
+        let args: Vec<&str> = ["view"]
+            .iter()
+            .chain(&common)
+            .chain(extra)
+            .copied()
+            .chain(["--debug-view", view, "--screenshot", path.to_str().unwrap()])
+            .collect();
         fovea(&args, Some(&x.display));
         rgba(&path)
     };
     let render_out = dir.join("render");
-    let render_args: Vec<&str> = ["render"].iter().chain(&common).copied().chain(["--debug-views", "--out", render_out.to_str().unwrap()]).collect();
+    let render_args: Vec<&str> = ["render"]
+        .iter()
+        .chain(&common)
+        .copied()
+        .chain(["--debug-views", "--out", render_out.to_str().unwrap()])
+        .collect();
     fovea(&render_args, None);
-    assert_eq!(shot("density", &[]), rgba(&render_out.join("debug_density_0003.png")), "the window's density view is render's");
+    assert_eq!(
+        shot("density", &[]),
+        rgba(&render_out.join("debug_density_0003.png")),
+        "the window's density view is render's"
+    );
     let frame = rgba(&render_out.join("frame_0003.png"));
     let grid = shot("grid", &[]);
     assert_eq!(grid.dimensions(), (80, 90));
     assert_ne!(grid, frame, "the grid view is not the screen image");
     let rings = shot("rings", &["--eyes", "both"]);
     assert_eq!(rings.dimensions(), (160, 90));
-    let white = |x0: u32| (0..90).flat_map(|y| (x0..x0 + 80).map(move |x| (x, y))).filter(|&(x, y)| rings.get_pixel(x, y).0 == [255, 255, 255, 255]).count();
-    assert!(white(0) > 50 && white(80) > 50, "rings drawn in both eyes: {} and {} white pixels", white(0), white(80));
+    let white = |x0: u32| {
+        (0..90)
+            .flat_map(|y| (x0..x0 + 80).map(move |x| (x, y)))
+            .filter(|&(x, y)| rings.get_pixel(x, y).0 == [255, 255, 255, 255])
+            .count()
+    };
+    assert!(
+        white(0) > 50 && white(80) > 50,
+        "rings drawn in both eyes: {} and {} white pixels",
+        white(0),
+        white(80)
+    );
 }

@@ -12,11 +12,23 @@ pub const DEFAULT_HEADSET: &str = "fove0";
 
 const BUILTIN: &[(&str, &str)] = &[
     ("fove0", include_str!("../../../config/headsets/fove0.toml")),
-    ("vive_pro_eye", include_str!("../../../config/headsets/vive_pro_eye.toml")),
-    ("varjo_aero", include_str!("../../../config/headsets/varjo_aero.toml")),
-    ("quest_pro", include_str!("../../../config/headsets/quest_pro.toml")),
+    (
+        "vive_pro_eye",
+        include_str!("../../../config/headsets/vive_pro_eye.toml"),
+    ),
+    (
+        "varjo_aero",
+        include_str!("../../../config/headsets/varjo_aero.toml"),
+    ),
+    (
+        "quest_pro",
+        include_str!("../../../config/headsets/quest_pro.toml"),
+    ),
     ("psvr2", include_str!("../../../config/headsets/psvr2.toml")),
-    ("pimax_crystal", include_str!("../../../config/headsets/pimax_crystal.toml")),
+    (
+        "pimax_crystal",
+        include_str!("../../../config/headsets/pimax_crystal.toml"),
+    ),
 ];
 
 /// Names of the compiled-in profiles, default (`fove0`) first.
@@ -27,7 +39,10 @@ pub fn builtin_names() -> Vec<&'static str> {
 impl HmdDescription {
     /// The compiled-in profile `name` (ignores files on disk).
     pub fn builtin(name: &str) -> Result<HmdDescription, HalError> {
-        let (n, text) = BUILTIN.iter().find(|(n, _)| *n == name).ok_or_else(|| unknown(name))?;
+        let (n, text) = BUILTIN
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| unknown(name))?;
         HmdDescription::parse(text, &PathBuf::from(format!("<builtin:{n}>")))
     }
 
@@ -39,7 +54,10 @@ impl HmdDescription {
 
     /// All compiled-in profiles, parsed, default first (for `fovea headsets`).
     pub fn list_builtin() -> Vec<HmdDescription> {
-        BUILTIN.iter().filter_map(|(n, _)| HmdDescription::builtin(n).ok()).collect()
+        BUILTIN
+            .iter()
+            .filter_map(|(n, _)| HmdDescription::builtin(n).ok())
+            .collect()
     }
 
     /// Resolve a `--headset <name|path>` argument:
@@ -60,5 +78,8 @@ impl HmdDescription {
 }
 
 fn unknown(name: &str) -> HalError {
-    HalError::UnknownHeadset { name: name.to_string(), available: builtin_names().join(", ") }
+    HalError::UnknownHeadset {
+        name: name.to_string(),
+        available: builtin_names().join(", "),
+    }
 }

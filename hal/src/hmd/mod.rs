@@ -143,7 +143,8 @@ const MAX_RESOLUTION: u32 = 16384;
 impl HmdDescription {
     /// Load and validate a headset TOML file.
     pub fn load(path: &Path) -> Result<HmdDescription, HalError> {
-        let text = crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a headset profile")?;
+        let text =
+            crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a headset profile")?;
         Self::parse(&text, path)
     }
 
@@ -173,9 +174,18 @@ impl HmdDescription {
 fn validate(raw: HmdToml, file: &Path) -> Result<HmdDescription, HalError> {
     let bad = |key: &str, reason: String| Err(HalError::invalid(file, key, reason));
     if raw.id.is_empty()
-        || !raw.id.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-')
+        || !raw
+            .id
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-')
     {
-        return bad("id", format!("`{}` must be non-empty lowercase ASCII letters, digits, `_` or `-`", raw.id));
+        return bad(
+            "id",
+            format!(
+                "`{}` must be non-empty lowercase ASCII letters, digits, `_` or `-`",
+                raw.id
+            ),
+        );
     }
     positive(file, "refresh_hz", raw.refresh_hz, 1000.0)?;
     let left = validate_eye(&raw.left_eye, "left_eye", file)?;
@@ -201,7 +211,10 @@ fn validate(raw: HmdToml, file: &Path) -> Result<HmdDescription, HalError> {
 }
 
 fn validate_eye(e: &EyeToml, name: &str, file: &Path) -> Result<EyeView, HalError> {
-    for (key, v) in [("recommended_width", e.recommended_width), ("recommended_height", e.recommended_height)] {
+    for (key, v) in [
+        ("recommended_width", e.recommended_width),
+        ("recommended_height", e.recommended_height),
+    ] {
         if v == 0 || v > MAX_RESOLUTION {
             return Err(HalError::invalid(
                 file,
@@ -211,7 +224,12 @@ fn validate_eye(e: &EyeToml, name: &str, file: &Path) -> Result<EyeView, HalErro
         }
     }
     let f = &e.fov_deg;
-    for (key, v) in [("left", f.left), ("right", f.right), ("down", f.down), ("up", f.up)] {
+    for (key, v) in [
+        ("left", f.left),
+        ("right", f.right),
+        ("down", f.down),
+        ("up", f.up),
+    ] {
         if !v.is_finite() || v <= -90.0 || v >= 90.0 {
             return Err(HalError::invalid(
                 file,
@@ -220,21 +238,33 @@ fn validate_eye(e: &EyeToml, name: &str, file: &Path) -> Result<EyeView, HalErro
             ));
         }
     }
-    let pairs = [("right", f.left, f.right, "left"), ("up", f.down, f.up, "down")];
+    let pairs = [
+        ("right", f.left, f.right, "left"),
+        ("up", f.down, f.up, "down"),
+    ];
     for (key, lo, hi, lo_name) in pairs {
         if hi <= lo {
             return Err(HalError::invalid(
                 file,
                 format!("{name}.fov_deg.{key}"),
-                format!("{hi}° must be greater than {lo_name} ({lo}°); left/down are negative (XrFovf)"),
+                format!(
+                    "{hi}° must be greater than {lo_name} ({lo}°); left/down are negative (XrFovf)"
+                ),
             ));
         }
     }
-    if let Some(i) = e.offset_m.iter().position(|v| !v.is_finite() || v.abs() > 0.2) {
+    if let Some(i) = e
+        .offset_m
+        .iter()
+        .position(|v| !v.is_finite() || v.abs() > 0.2)
+    {
         return Err(HalError::invalid(
             file,
             format!("{name}.offset_m[{i}]"),
-            format!("{} m: eye offsets must be finite and within ±0.2 m of the view origin", e.offset_m[i]),
+            format!(
+                "{} m: eye offsets must be finite and within ±0.2 m of the view origin",
+                e.offset_m[i]
+            ),
         ));
     }
     Ok(EyeView {
@@ -247,14 +277,22 @@ fn validate_eye(e: &EyeToml, name: &str, file: &Path) -> Result<EyeView, HalErro
 
 fn positive(file: &Path, key: &str, v: f32, max: f32) -> Result<(), HalError> {
     if !v.is_finite() || v <= 0.0 || v > max {
-        return Err(HalError::invalid(file, key, format!("{v} must be > 0 and <= {max}")));
+        return Err(HalError::invalid(
+            file,
+            key,
+            format!("{v} must be > 0 and <= {max}"),
+        ));
     }
     Ok(())
 }
 
 fn non_negative(file: &Path, key: &str, v: f32, max: f32) -> Result<(), HalError> {
     if !v.is_finite() || v < 0.0 || v > max {
-        return Err(HalError::invalid(file, key, format!("{v} must be >= 0 and <= {max}")));
+        return Err(HalError::invalid(
+            file,
+            key,
+            format!("{v} must be >= 0 and <= {max}"),
+        ));
     }
     Ok(())
 }

@@ -12,13 +12,21 @@ const MIN_FORWARD: f32 = 1e-6;
 impl EyeView {
     fn tangents(&self) -> (f32, f32, f32, f32) {
         let f = &self.fov;
-        (f.angle_left.tan(), f.angle_right.tan(), f.angle_down.tan(), f.angle_up.tan())
+        (
+            f.angle_left.tan(),
+            f.angle_right.tan(),
+            f.angle_down.tan(),
+            f.angle_up.tan(),
+        )
     }
 
     /// Unit view-space direction through the centre of pixel `px` (may lie outside the image).
     pub fn pixel_to_direction(&self, px: Vec2) -> Vec3 {
         let (l, r, d, u) = self.tangents();
-        let (w, h) = (self.recommended_width as f32, self.recommended_height as f32);
+        let (w, h) = (
+            self.recommended_width as f32,
+            self.recommended_height as f32,
+        );
         let tx = l + (px.x + 0.5) / w * (r - l);
         let ty = u - (px.y + 0.5) / h * (u - d);
         Vec3::new(tx, ty, -1.0).normalize()
@@ -31,7 +39,10 @@ impl EyeView {
             return None;
         }
         let (l, r, d, u) = self.tangents();
-        let (w, h) = (self.recommended_width as f32, self.recommended_height as f32);
+        let (w, h) = (
+            self.recommended_width as f32,
+            self.recommended_height as f32,
+        );
         let tx = dir.x / -dir.z;
         let ty = dir.y / -dir.z;
         let px = (tx - l) / (r - l) * w - 0.5;
@@ -41,7 +52,10 @@ impl EyeView {
 
     /// Angle (degrees) between pixel `px`'s direction and the gaze direction.
     pub fn eccentricity_deg(&self, px: Vec2, gaze_dir: Vec3) -> f32 {
-        angle_between_deg(self.pixel_to_direction(px), gaze_dir.normalize_or(Vec3::NEG_Z))
+        angle_between_deg(
+            self.pixel_to_direction(px),
+            gaze_dir.normalize_or(Vec3::NEG_Z),
+        )
     }
 
     /// Pixel of the straight-ahead direction (not the image centre when the FOV is asymmetric).

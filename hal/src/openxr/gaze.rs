@@ -30,18 +30,31 @@ pub struct GazeActions {
 impl GazeActions {
     pub fn new(rt: &OpenXrRuntime) -> Result<Self, HalError> {
         if let Some(why) = rt.missing_eye_tracker() {
-            return Ok(GazeActions { actions: None, missing: Some(why) });
+            return Ok(GazeActions {
+                actions: None,
+                missing: Some(why),
+            });
         }
         let instance = &rt.instance;
-        let set = call("xrCreateActionSet", instance.create_action_set("fovea_gaze", "fovea gaze", 0))?;
-        let action = call("xrCreateAction", set.create_action::<xr::Posef>("gaze", "Eye gaze", &[]))?;
+        let set = call(
+            "xrCreateActionSet",
+            instance.create_action_set("fovea_gaze", "fovea gaze", 0),
+        )?;
+        let action = call(
+            "xrCreateAction",
+            set.create_action::<xr::Posef>("gaze", "Eye gaze", &[]),
+        )?;
         let profile = call("xrStringToPath", instance.string_to_path(EYE_GAZE_PROFILE))?;
         let pose = call("xrStringToPath", instance.string_to_path(EYE_GAZE_POSE))?;
         call(
             "xrSuggestInteractionProfileBindings(eye gaze)",
-            instance.suggest_interaction_profile_bindings(profile, &[xr::Binding::new(&action, pose)]),
+            instance
+                .suggest_interaction_profile_bindings(profile, &[xr::Binding::new(&action, pose)]),
         )?;
-        Ok(GazeActions { actions: Some((set, action)), missing: None })
+        Ok(GazeActions {
+            actions: Some((set, action)),
+            missing: None,
+        })
     }
 
     /// The set to attach, `None` without an eye tracker.
@@ -97,12 +110,21 @@ impl OpenXrGaze {
                          SessionOwner::attach_action_sets together with the renderer's sets",
                     ));
                 }
-                let gaze_space = call("xrCreateActionSpace(gaze)", action.create_space(&session, xr::Path::NULL, xr::Posef::IDENTITY))?;
-                Some(Tracker { attached: owner.attached_sets().to_vec(), gaze_space })
+                let gaze_space = call(
+                    "xrCreateActionSpace(gaze)",
+                    action.create_space(&session, xr::Path::NULL, xr::Posef::IDENTITY),
+                )?;
+                Some(Tracker {
+                    attached: owner.attached_sets().to_vec(),
+                    gaze_space,
+                })
             }
             None => None,
         };
-        let view_space = call("xrCreateReferenceSpace(VIEW)", session.create_reference_space(xr::ReferenceSpaceType::VIEW, xr::Posef::IDENTITY))?;
+        let view_space = call(
+            "xrCreateReferenceSpace(VIEW)",
+            session.create_reference_space(xr::ReferenceSpaceType::VIEW, xr::Posef::IDENTITY),
+        )?;
         let (hmd, figures) = owner.describe(base, tracker.is_some())?;
         Ok(OpenXrGaze {
             hmd,
@@ -142,7 +164,9 @@ impl OpenXrGaze {
 
     /// One line for the user when there is no eye tracker, `None` when there is one.
     pub fn fallback_notice(&self) -> Option<String> {
-        self.missing.as_ref().map(|why| format!("no eye tracker: {why}; the fovea stays at the view centre"))
+        self.missing
+            .as_ref()
+            .map(|why| format!("no eye tracker: {why}; the fovea stays at the view centre"))
     }
 
     /// Which figures of `describe()` the runtime reported.
@@ -169,7 +193,11 @@ impl OpenXrGaze {
     }
 
     fn update_views(&mut self, t: XrTime) {
-        let located = self.session.locate_views(xr::ViewConfigurationType::PRIMARY_STEREO, xr::Time::from_nanos(t), &self.view_space);
+        let located = self.session.locate_views(
+            xr::ViewConfigurationType::PRIMARY_STEREO,
+            xr::Time::from_nanos(t),
+            &self.view_space,
+        );
         if let Ok((flags, views)) = located {
             if apply_views(&mut self.hmd, flags, &views) {
                 self.figures.fov = true;
@@ -180,7 +208,11 @@ impl OpenXrGaze {
 
     /// One raw `xrLocateSpace` with `XrEyeGazeSampleTimeEXT` chained.
     fn locate_raw(&self, tracker: &Tracker, t: XrTime) -> Option<(xr::sys::SpaceLocation, XrTime)> {
-        let mut sample_time = xr::sys::EyeGazeSampleTimeEXT { ty: xr::sys::EyeGazeSampleTimeEXT::TYPE, next: ptr::null_mut(), time: xr::Time::from_nanos(0) };
+        let mut sample_time = xr::sys::EyeGazeSampleTimeEXT {
+            ty: xr::sys::EyeGazeSampleTimeEXT::TYPE,
+            next: ptr::null_mut(),
+            time: xr::Time::from_nanos(0),
+        };
         let mut loc = xr::sys::SpaceLocation {
             ty: xr::sys::SpaceLocation::TYPE,
             next: &mut sample_time as *mut _ as *mut _,
@@ -189,7 +221,12 @@ impl OpenXrGaze {
         };
         // SAFETY: both spaces belong to this session; `loc` and its chained struct outlive the call.
         let r = unsafe {
-            (self.instance.fp().locate_space)(tracker.gaze_space.as_raw(), self.view_space.as_raw(), xr::Time::from_nanos(t), &mut loc)
+            (self.instance.fp().locate_space)(
+                tracker.gaze_space.as_raw(),
+                self.view_space.as_raw(),
+                xr::Time::from_nanos(t),
+                &mut loc,
+            )
         };
         (r.into_raw() >= 0).then_some((loc, sample_time.time.as_nanos()))
     }
@@ -210,7 +247,11 @@ impl OpenXrGaze {
         let o = loc.pose.orientation;
         let direction = (Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize() * Vec3::NEG_Z).normalize();
         let origin = if flags.contains(xr::SpaceLocationFlags::POSITION_VALID) {
-            Vec3::new(loc.pose.position.x, loc.pose.position.y, loc.pose.position.z)
+            Vec3::new(
+                loc.pose.position.x,
+                loc.pose.position.y,
+                loc.pose.position.z,
+            )
         } else {
             Vec3::ZERO
         };
@@ -241,7 +282,13 @@ impl OpenXrGaze {
         let status = self.state.get();
         let owner_synced = status.syncs != self.owner_syncs;
         self.owner_syncs = status.syncs;
-        let Some(tracker) = self.tracker.as_ref().filter(|_| status.running && !owner_synced) else { return Ok(()) };
+        let Some(tracker) = self
+            .tracker
+            .as_ref()
+            .filter(|_| status.running && !owner_synced)
+        else {
+            return Ok(());
+        };
         sync_sets(&self.session, &tracker.attached)?;
         self.syncs += 1;
         Ok(())
@@ -299,7 +346,11 @@ impl Sequencer {
         }
         // An older measurement seen only now: numbers are taken, so it shares its predecessor's
         // (keeps the order; remembered so it stays the same on the next query).
-        let n = if at == 0 { self.seen[0].1 } else { self.seen[at - 1].1 };
+        let n = if at == 0 {
+            self.seen[0].1
+        } else {
+            self.seen[at - 1].1
+        };
         self.seen.insert(at, (measured, n));
         if self.seen.len() > HISTORY {
             self.seen.pop_front();
@@ -376,9 +427,16 @@ mod tests {
         let b = s.number(200, d);
         let c = s.number(300, d);
         assert!(a < b && b < c);
-        assert_eq!((s.number(100, d), s.number(200, d), s.number(300, d)), (a, b, c), "same measurement, same number");
+        assert_eq!(
+            (s.number(100, d), s.number(200, d), s.number(300, d)),
+            (a, b, c),
+            "same measurement, same number"
+        );
         let late = s.number(150, d);
-        assert!(a <= late && late <= b, "an older measurement seen late keeps the order: {a} ≤ {late} ≤ {b}");
+        assert!(
+            a <= late && late <= b,
+            "an older measurement seen late keeps the order: {a} ≤ {late} ≤ {b}"
+        );
         assert_eq!(s.number(150, d), late);
         assert_eq!(s.current(), c, "older measurements take no new number");
     }

@@ -16,17 +16,23 @@ mod session;
 mod vulkan;
 
 pub use gaze::{GazeActions, OpenXrGaze};
-pub use runtime::OpenXrRuntime;
-pub use session::{ExitHandle, RuntimeFigures, SessionEnd, SessionOwner, SessionStateHandle, SessionStatus, VulkanBinding, STORAGE_FORMATS};
 /// The `openxr` crate this backend is built on, so callers name the same types.
 pub use openxr as xr;
+pub use runtime::OpenXrRuntime;
+pub use session::{
+    ExitHandle, RuntimeFigures, SessionEnd, SessionOwner, SessionStateHandle, SessionStatus,
+    VulkanBinding, STORAGE_FORMATS,
+};
 
 use crate::error::HalError;
 
 const BACKEND: &str = "openxr";
 
 pub(crate) fn fail(reason: impl Into<String>) -> HalError {
-    HalError::Backend { backend: BACKEND, reason: reason.into() }
+    HalError::Backend {
+        backend: BACKEND,
+        reason: reason.into(),
+    }
 }
 
 pub(crate) fn call<T>(what: &str, r: Result<T, openxr::sys::Result>) -> Result<T, HalError> {

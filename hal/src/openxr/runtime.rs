@@ -37,10 +37,20 @@ impl OpenXrRuntime {
             fail(format!("no OpenXR runtime is installed or active (XR_RUNTIME_JSON / active_runtime.json): {e}"))
         })?;
         let wanted = wanted_extensions(&available);
-        let instance = call("xrCreateInstance", entry.create_instance(&app_info(application_name), &wanted, &[], &()))?;
-        let system = call("xrGetSystem(HEAD_MOUNTED_DISPLAY)", instance.system(xr::FormFactor::HEAD_MOUNTED_DISPLAY))?;
-        let supports_eye_gaze = wanted.ext_eye_gaze_interaction && query_eye_gaze_support(&instance, system)?;
-        let runtime_name = instance.properties().map(|p| p.runtime_name).unwrap_or_default();
+        let instance = call(
+            "xrCreateInstance",
+            entry.create_instance(&app_info(application_name), &wanted, &[], &()),
+        )?;
+        let system = call(
+            "xrGetSystem(HEAD_MOUNTED_DISPLAY)",
+            instance.system(xr::FormFactor::HEAD_MOUNTED_DISPLAY),
+        )?;
+        let supports_eye_gaze =
+            wanted.ext_eye_gaze_interaction && query_eye_gaze_support(&instance, system)?;
+        let runtime_name = instance
+            .properties()
+            .map(|p| p.runtime_name)
+            .unwrap_or_default();
         Ok(OpenXrRuntime {
             instance,
             system,
@@ -76,7 +86,10 @@ impl OpenXrRuntime {
     /// CLOCK_MONOTONIC nanoseconds → `XrTime` (`xrConvertTimespecTimeToTimeKHR`).
     pub fn monotonic_to_time(&self, monotonic_ns: i64) -> Result<XrTime, HalError> {
         let ext = self.timespec_ext()?;
-        let ts = libc::timespec { tv_sec: monotonic_ns.div_euclid(1_000_000_000), tv_nsec: monotonic_ns.rem_euclid(1_000_000_000) };
+        let ts = libc::timespec {
+            tv_sec: monotonic_ns.div_euclid(1_000_000_000),
+            tv_nsec: monotonic_ns.rem_euclid(1_000_000_000),
+        };
         let mut out = xr::Time::from_nanos(0);
         // SAFETY: valid instance; both pointers point to live locals.
         check("xrConvertTimespecTimeToTimeKHR", unsafe {
@@ -88,10 +101,17 @@ impl OpenXrRuntime {
     /// `XrTime` → CLOCK_MONOTONIC nanoseconds (`xrConvertTimeToTimespecTimeKHR`).
     pub fn time_to_monotonic(&self, time: XrTime) -> Result<i64, HalError> {
         let ext = self.timespec_ext()?;
-        let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
         // SAFETY: valid instance; `ts` outlives the call.
         check("xrConvertTimeToTimespecTimeKHR", unsafe {
-            (ext.convert_time_to_timespec_time)(self.instance.as_raw(), xr::Time::from_nanos(time), &mut ts)
+            (ext.convert_time_to_timespec_time)(
+                self.instance.as_raw(),
+                xr::Time::from_nanos(time),
+                &mut ts,
+            )
         })?;
         Ok(ts.tv_sec * 1_000_000_000 + ts.tv_nsec)
     }
@@ -101,7 +121,9 @@ impl OpenXrRuntime {
             .exts()
             .khr_convert_timespec_time
             .as_ref()
-            .ok_or_else(|| fail("the runtime lacks XR_KHR_convert_timespec_time: no way to read its clock"))
+            .ok_or_else(|| {
+                fail("the runtime lacks XR_KHR_convert_timespec_time: no way to read its clock")
+            })
     }
 }
 
@@ -132,7 +154,10 @@ fn app_info(application_name: &str) -> xr::ApplicationInfo<'_> {
 }
 
 fn monotonic_now_ns() -> i64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
     // SAFETY: `ts` is a valid out pointer; CLOCK_MONOTONIC always exists on Linux.
     unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
     ts.tv_sec * 1_000_000_000 + ts.tv_nsec
@@ -151,6 +176,8 @@ fn query_eye_gaze_support(instance: &xr::Instance, system: xr::SystemId) -> Resu
     props.ty = xr::sys::SystemProperties::TYPE;
     props.next = &mut eye as *mut _ as *mut _;
     // SAFETY: valid instance and system handles; both structs outlive the call.
-    check("xrGetSystemProperties", unsafe { (instance.fp().get_system_properties)(instance.as_raw(), system, &mut props) })?;
+    check("xrGetSystemProperties", unsafe {
+        (instance.fp().get_system_properties)(instance.as_raw(), system, &mut props)
+    })?;
     Ok(eye.supports_eye_gaze_interaction.into())
 }

@@ -40,8 +40,14 @@ pub struct SessionStatus {
 }
 
 impl SessionStatus {
-    const INITIAL: SessionStatus =
-        SessionStatus { state: xr::SessionState::UNKNOWN, running: false, end: None, begins: 0, ends: 0, syncs: 0 };
+    const INITIAL: SessionStatus = SessionStatus {
+        state: xr::SessionState::UNKNOWN,
+        running: false,
+        end: None,
+        begins: 0,
+        ends: 0,
+        syncs: 0,
+    };
 
     /// Actions (gaze) are only delivered while focused.
     pub fn focused(&self) -> bool {
@@ -129,11 +135,14 @@ impl SessionOwner<xr::Headless> {
     /// A session without graphics (`XR_MND_headless`): gaze and poses, no frames to submit.
     pub fn headless(rt: &OpenXrRuntime) -> Result<Self, HalError> {
         if !rt.has_headless {
-            return Err(fail("the runtime lacks XR_MND_headless: create a Vulkan session instead"));
+            return Err(fail(
+                "the runtime lacks XR_MND_headless: create a Vulkan session instead",
+            ));
         }
         // SAFETY: headless sessions take no graphics handles.
         let parts = call("xrCreateSession(headless)", unsafe {
-            rt.instance.create_session::<xr::Headless>(rt.system, &xr::headless::SessionCreateInfo {})
+            rt.instance
+                .create_session::<xr::Headless>(rt.system, &xr::headless::SessionCreateInfo {})
         })?;
         Ok(Self::from_parts(rt, parts, true))
     }
@@ -157,7 +166,9 @@ impl SessionOwner<xr::Vulkan> {
             queue_index: binding.queue_index,
         };
         // SAFETY: the caller vouches for the handles.
-        let parts = call("xrCreateSession(Vulkan)", unsafe { rt.instance.create_session::<xr::Vulkan>(rt.system, &info) })?;
+        let parts = call("xrCreateSession(Vulkan)", unsafe {
+            rt.instance.create_session::<xr::Vulkan>(rt.system, &info)
+        })?;
         Ok(Self::from_parts(rt, parts, false))
     }
 }
@@ -169,17 +180,27 @@ pub const STORAGE_FORMATS: [u32; 2] = [37, 44];
 impl SessionOwner<xr::Vulkan> {
     /// The runtime's swapchain formats (`VkFormat` values), its preferred first.
     pub fn swapchain_formats(&self) -> Result<Vec<u32>, HalError> {
-        call("xrEnumerateSwapchainFormats", self.session.enumerate_swapchain_formats())
+        call(
+            "xrEnumerateSwapchainFormats",
+            self.session.enumerate_swapchain_formats(),
+        )
     }
 
     /// A single-sample colour swapchain that compute shaders can write (`UNORDERED_ACCESS`, i.e.
     /// `VK_IMAGE_USAGE_STORAGE_BIT`), plus colour-attachment and transfer usage (transfer-source:
     /// screenshots of what was submitted).
     /// `format` must be one of [`Self::swapchain_formats`] (see [`STORAGE_FORMATS`]).
-    pub fn create_storage_swapchain(&self, format: u32, width: u32, height: u32) -> Result<xr::Swapchain<xr::Vulkan>, HalError> {
+    pub fn create_storage_swapchain(
+        &self,
+        format: u32,
+        width: u32,
+        height: u32,
+    ) -> Result<xr::Swapchain<xr::Vulkan>, HalError> {
         let offered = self.swapchain_formats()?;
         if !offered.contains(&format) {
-            return Err(fail(format!("swapchain format {format} is not offered by the runtime (offered: {offered:?})")));
+            return Err(fail(format!(
+                "swapchain format {format} is not offered by the runtime (offered: {offered:?})"
+            )));
         }
         let info = xr::SwapchainCreateInfo::<xr::Vulkan> {
             create_flags: xr::SwapchainCreateFlags::EMPTY,
@@ -255,14 +276,19 @@ impl<G: xr::Graphics> SessionOwner<G> {
         if self.attached.is_some() {
             return Err(fail("action sets are already attached to this session (OpenXR allows one attach per session): pass all of them in one call"));
         }
-        call("xrAttachSessionActionSets", self.session.attach_action_sets(sets))?;
+        call(
+            "xrAttachSessionActionSets",
+            self.session.attach_action_sets(sets),
+        )?;
         self.attached = Some(sets.iter().map(|&s| s.clone()).collect());
         Ok(())
     }
 
     /// Whether `set` went into this session's one attach.
     pub fn is_attached(&self, set: &xr::ActionSet) -> bool {
-        self.attached_sets().iter().any(|s| s.as_raw() == set.as_raw())
+        self.attached_sets()
+            .iter()
+            .any(|s| s.as_raw() == set.as_raw())
     }
 
     /// Every set of the one attach (empty before it).
@@ -293,13 +319,20 @@ impl<G: xr::Graphics> SessionOwner<G> {
 
     /// [`Self::poll_events`], handing every event it does not consume itself (interaction
     /// profile changes, reference space changes, other sessions' states …) to `other`.
-    pub fn poll_events_with(&mut self, mut other: impl FnMut(&xr::Event<'_>)) -> Result<SessionStatus, HalError> {
+    pub fn poll_events_with(
+        &mut self,
+        mut other: impl FnMut(&xr::Event<'_>),
+    ) -> Result<SessionStatus, HalError> {
         self.send_exit_request()?;
         let mut buffer = xr::EventDataBuffer::new();
         while self.status.end.is_none() {
-            let Some(event) = call("xrPollEvent", self.instance.poll_event(&mut buffer))? else { break };
+            let Some(event) = call("xrPollEvent", self.instance.poll_event(&mut buffer))? else {
+                break;
+            };
             match event {
-                xr::Event::SessionStateChanged(e) if e.session() == self.session.as_raw() => self.on_state(e.state())?,
+                xr::Event::SessionStateChanged(e) if e.session() == self.session.as_raw() => {
+                    self.on_state(e.state())?
+                }
                 xr::Event::InstanceLossPending(_) => self.finish(SessionEnd::InstanceLossPending),
                 ref e => other(e),
             }
@@ -359,7 +392,9 @@ impl<G: xr::Graphics> SessionOwner<G> {
     /// The runtime's clock now (display times of headless sessions, which have no frame loop).
     pub fn now(&self) -> Result<XrTime, HalError> {
         if !self.has_timespec {
-            return Err(fail("the runtime lacks XR_KHR_convert_timespec_time: no clock outside the frame loop"));
+            return Err(fail(
+                "the runtime lacks XR_KHR_convert_timespec_time: no clock outside the frame loop",
+            ));
         }
         call("xrConvertTimespecTimeToTimeKHR", self.instance.now()).map(|t| t.as_nanos())
     }
@@ -369,7 +404,9 @@ impl<G: xr::Graphics> SessionOwner<G> {
     pub fn wait_frame(&mut self) -> Result<xr::FrameState, HalError> {
         if self.headless {
             // Monado answers shouldRender = false without a usable time, and xrBeginFrame fails.
-            return Err(fail("a headless session has no frame loop: take display times from now()"));
+            return Err(fail(
+                "a headless session has no frame loop: take display times from now()",
+            ));
         }
         call("xrWaitFrame", self.waiter.wait())
     }
@@ -380,36 +417,66 @@ impl<G: xr::Graphics> SessionOwner<G> {
     }
 
     /// `xrEndFrame` with the renderer's layers (opaque blending).
-    pub fn end_frame(&mut self, display_time: XrTime, layers: &[&xr::CompositionLayerBase<'_, G>]) -> Result<(), HalError> {
+    pub fn end_frame(
+        &mut self,
+        display_time: XrTime,
+        layers: &[&xr::CompositionLayerBase<'_, G>],
+    ) -> Result<(), HalError> {
         call(
             "xrEndFrame",
-            self.stream.end(xr::Time::from_nanos(display_time), xr::EnvironmentBlendMode::OPAQUE, layers),
+            self.stream.end(
+                xr::Time::from_nanos(display_time),
+                xr::EnvironmentBlendMode::OPAQUE,
+                layers,
+            ),
         )
     }
 
     /// `xrLocateViews` (primary stereo) in `space`: per-eye pose and FOV for `display_time`.
-    pub fn locate_views(&self, display_time: XrTime, space: &xr::Space) -> Result<(xr::ViewStateFlags, Vec<xr::View>), HalError> {
-        call("xrLocateViews", self.session.locate_views(VIEW_TYPE, xr::Time::from_nanos(display_time), space))
+    pub fn locate_views(
+        &self,
+        display_time: XrTime,
+        space: &xr::Space,
+    ) -> Result<(xr::ViewStateFlags, Vec<xr::View>), HalError> {
+        call(
+            "xrLocateViews",
+            self.session
+                .locate_views(VIEW_TYPE, xr::Time::from_nanos(display_time), space),
+        )
     }
 
-    pub fn create_reference_space(&self, ty: xr::ReferenceSpaceType) -> Result<xr::Space, HalError> {
-        call("xrCreateReferenceSpace", self.session.create_reference_space(ty, xr::Posef::IDENTITY))
+    pub fn create_reference_space(
+        &self,
+        ty: xr::ReferenceSpaceType,
+    ) -> Result<xr::Space, HalError> {
+        call(
+            "xrCreateReferenceSpace",
+            self.session.create_reference_space(ty, xr::Posef::IDENTITY),
+        )
     }
 
     /// `base` (the headset TOML) overwritten with what the runtime reports: name and id,
     /// recommended per-eye size, per-eye FOV and eye offsets (`xrLocateViews` now, in VIEW
     /// space), refresh rate (`XR_FB_display_refresh_rate`). Tracker rate, latency, accuracy and
     /// precision are not reported by OpenXR and stay the TOML's.
-    pub fn describe(&self, base: &HmdDescription, eye_gaze: bool) -> Result<(HmdDescription, RuntimeFigures), HalError> {
+    pub fn describe(
+        &self,
+        base: &HmdDescription,
+        eye_gaze: bool,
+    ) -> Result<(HmdDescription, RuntimeFigures), HalError> {
         let mut hmd = base.clone();
         let mut figures = RuntimeFigures::default();
-        let props = call("xrGetSystemProperties", self.instance.system_properties(self.system))?;
+        let props = call(
+            "xrGetSystemProperties",
+            self.instance.system_properties(self.system),
+        )?;
         hmd.id = runtime_id(&props.system_name);
         hmd.display_name = format!("{} (OpenXR)", props.system_name);
         figures.name = true;
         let views = call(
             "xrEnumerateViewConfigurationViews",
-            self.instance.enumerate_view_configuration_views(self.system, VIEW_TYPE),
+            self.instance
+                .enumerate_view_configuration_views(self.system, VIEW_TYPE),
         )?;
         for (eye, view) in hmd.eyes.iter_mut().zip(&views) {
             eye.recommended_width = view.recommended_image_rect_width.max(1);
@@ -425,7 +492,11 @@ impl<G: xr::Graphics> SessionOwner<G> {
         Ok((hmd, figures))
     }
 
-    fn describe_views(&self, hmd: &mut HmdDescription, figures: &mut RuntimeFigures) -> Result<(), HalError> {
+    fn describe_views(
+        &self,
+        hmd: &mut HmdDescription,
+        figures: &mut RuntimeFigures,
+    ) -> Result<(), HalError> {
         let Ok(t) = self.now() else { return Ok(()) };
         let view_space = self.create_reference_space(xr::ReferenceSpaceType::VIEW)?;
         let (flags, views) = self.locate_views(t, &view_space)?;
@@ -442,13 +513,19 @@ impl<G: xr::Graphics> SessionOwner<G> {
         if !self.has_refresh_rate || self.headless {
             return None;
         }
-        self.session.get_display_refresh_rate().ok().filter(|hz| (1.0..=1000.0).contains(hz))
+        self.session
+            .get_display_refresh_rate()
+            .ok()
+            .filter(|hz| (1.0..=1000.0).contains(hz))
     }
 }
 
 /// `xrSyncActions` over `sets` (all of a session's attached sets). Not focused is a success code
 /// (`XR_SESSION_NOT_FOCUSED`): actions stay inactive.
-pub(crate) fn sync_sets<G>(session: &xr::Session<G>, sets: &[xr::ActionSet]) -> Result<(), HalError> {
+pub(crate) fn sync_sets<G>(
+    session: &xr::Session<G>,
+    sets: &[xr::ActionSet],
+) -> Result<(), HalError> {
     if sets.is_empty() {
         return Ok(());
     }
@@ -458,12 +535,21 @@ pub(crate) fn sync_sets<G>(session: &xr::Session<G>, sets: &[xr::ActionSet]) -> 
 
 /// Per-eye FOV (and offsets when the position is valid) from located views; false when the
 /// views are not usable (orientation invalid, not two of them).
-pub(crate) fn apply_views(hmd: &mut HmdDescription, flags: xr::ViewStateFlags, views: &[xr::View]) -> bool {
+pub(crate) fn apply_views(
+    hmd: &mut HmdDescription,
+    flags: xr::ViewStateFlags,
+    views: &[xr::View],
+) -> bool {
     if !flags.contains(xr::ViewStateFlags::ORIENTATION_VALID) || views.len() != 2 {
         return false;
     }
     for (eye, v) in hmd.eyes.iter_mut().zip(views) {
-        eye.fov = Fov { angle_left: v.fov.angle_left, angle_right: v.fov.angle_right, angle_down: v.fov.angle_down, angle_up: v.fov.angle_up };
+        eye.fov = Fov {
+            angle_left: v.fov.angle_left,
+            angle_right: v.fov.angle_right,
+            angle_down: v.fov.angle_down,
+            angle_up: v.fov.angle_up,
+        };
         if flags.contains(xr::ViewStateFlags::POSITION_VALID) {
             let p = v.pose.position;
             eye.offset = Vec3::new(p.x, p.y, p.z);
@@ -477,7 +563,11 @@ pub(crate) fn apply_views(hmd: &mut HmdDescription, flags: xr::ViewStateFlags, v
 fn runtime_id(system_name: &str) -> String {
     let mut id = String::from("openxr-");
     for c in system_name.chars().map(|c| c.to_ascii_lowercase()) {
-        let c = if c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' { c } else { '-' };
+        let c = if c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' {
+            c
+        } else {
+            '-'
+        };
         if c != '-' || !id.ends_with('-') {
             id.push(c);
         }

@@ -6,7 +6,10 @@
 use super::{call, fail, OpenXrRuntime};
 use crate::error::HalError;
 use openxr as xr;
-use xr::sys::platform::{VkDevice, VkDeviceCreateInfo, VkGetInstanceProcAddr, VkInstance, VkInstanceCreateInfo, VkPhysicalDevice};
+use xr::sys::platform::{
+    VkDevice, VkDeviceCreateInfo, VkGetInstanceProcAddr, VkInstance, VkInstanceCreateInfo,
+    VkPhysicalDevice,
+};
 
 impl OpenXrRuntime {
     fn require_vulkan2(&self) -> Result<(), HalError> {
@@ -22,7 +25,11 @@ impl OpenXrRuntime {
     /// makes it too).
     pub fn vulkan_requirements(&self) -> Result<xr::vulkan::Requirements, HalError> {
         self.require_vulkan2()?;
-        call("xrGetVulkanGraphicsRequirements2KHR", self.instance.graphics_requirements::<xr::Vulkan>(self.system))
+        call(
+            "xrGetVulkanGraphicsRequirements2KHR",
+            self.instance
+                .graphics_requirements::<xr::Vulkan>(self.system),
+        )
     }
 
     /// `xrCreateVulkanInstanceKHR`: the runtime creates the `VkInstance` from the renderer's
@@ -40,19 +47,30 @@ impl OpenXrRuntime {
         self.vulkan_requirements()?;
         // SAFETY: forwarded from the caller.
         let r = call("xrCreateVulkanInstanceKHR", unsafe {
-            self.instance.create_vulkan_instance(self.system, get_instance_proc_addr, create_info)
+            self.instance
+                .create_vulkan_instance(self.system, get_instance_proc_addr, create_info)
         })?;
-        r.map_err(|vk| fail(format!("xrCreateVulkanInstanceKHR: vkCreateInstance failed with {}", vk_result_name(vk))))
+        r.map_err(|vk| {
+            fail(format!(
+                "xrCreateVulkanInstanceKHR: vkCreateInstance failed with {}",
+                vk_result_name(vk)
+            ))
+        })
     }
 
     /// `xrGetVulkanGraphicsDevice2KHR`: the physical device the runtime drives the headset with.
     ///
     /// # Safety
     /// `instance` must come from [`Self::create_vulkan_instance`] and still be alive.
-    pub unsafe fn vulkan_physical_device(&self, instance: VkInstance) -> Result<VkPhysicalDevice, HalError> {
+    pub unsafe fn vulkan_physical_device(
+        &self,
+        instance: VkInstance,
+    ) -> Result<VkPhysicalDevice, HalError> {
         self.require_vulkan2()?;
         // SAFETY: forwarded from the caller.
-        call("xrGetVulkanGraphicsDevice2KHR", unsafe { self.instance.vulkan_graphics_device(self.system, instance) })
+        call("xrGetVulkanGraphicsDevice2KHR", unsafe {
+            self.instance.vulkan_graphics_device(self.system, instance)
+        })
     }
 
     /// `xrCreateVulkanDeviceKHR`: the runtime creates the `VkDevice` from the renderer's
@@ -70,9 +88,19 @@ impl OpenXrRuntime {
         self.require_vulkan2()?;
         // SAFETY: forwarded from the caller.
         let r = call("xrCreateVulkanDeviceKHR", unsafe {
-            self.instance.create_vulkan_device(self.system, get_instance_proc_addr, physical_device, create_info)
+            self.instance.create_vulkan_device(
+                self.system,
+                get_instance_proc_addr,
+                physical_device,
+                create_info,
+            )
         })?;
-        r.map_err(|vk| fail(format!("xrCreateVulkanDeviceKHR: vkCreateDevice failed with {}", vk_result_name(vk))))
+        r.map_err(|vk| {
+            fail(format!(
+                "xrCreateVulkanDeviceKHR: vkCreateDevice failed with {}",
+                vk_result_name(vk)
+            ))
+        })
     }
 }
 

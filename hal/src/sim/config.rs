@@ -107,11 +107,15 @@ impl Default for SimConfig {
 impl SimConfig {
     /// Default parameters with a different seed.
     pub fn seeded(seed: u64) -> Self {
-        SimConfig { seed, ..SimConfig::default() }
+        SimConfig {
+            seed,
+            ..SimConfig::default()
+        }
     }
 
     pub fn load(path: &Path) -> Result<SimConfig, HalError> {
-        let text = crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a simulator profile")?;
+        let text =
+            crate::file::read_text(path, crate::file::MAX_PROFILE_BYTES, "a simulator profile")?;
         Self::parse(&text, path)
     }
 
@@ -130,8 +134,14 @@ impl SimConfig {
         let positive = [
             ("fixation_mean_ms", self.fixation_mean_ms),
             ("fixation_sd_ms", self.fixation_sd_ms),
-            ("saccade_peak_velocity_max_deg_s", self.saccade_peak_velocity_max_deg_s),
-            ("saccade_velocity_scale_deg", self.saccade_velocity_scale_deg),
+            (
+                "saccade_peak_velocity_max_deg_s",
+                self.saccade_peak_velocity_max_deg_s,
+            ),
+            (
+                "saccade_velocity_scale_deg",
+                self.saccade_velocity_scale_deg,
+            ),
             ("drift_time_constant_ms", self.drift_time_constant_ms),
             ("pursuit_max_speed_deg_s", self.pursuit_max_speed_deg_s),
             ("catch_up_threshold_deg", self.catch_up_threshold_deg),
@@ -154,27 +164,50 @@ impl SimConfig {
                 return err(key, "must be a finite number >= 0");
             }
         }
-        for (key, v) in [("pursuit_probability", self.pursuit_probability), ("pursuit_gain", self.pursuit_gain)] {
+        for (key, v) in [
+            ("pursuit_probability", self.pursuit_probability),
+            ("pursuit_gain", self.pursuit_gain),
+        ] {
             if !(0.0..=1.0).contains(&v) {
                 return err(key, "must lie in 0..=1");
             }
         }
         let ranges = [
-            ("microsaccade_amplitude_deg", self.microsaccade_amplitude_deg, 0.0, 5.0),
+            (
+                "microsaccade_amplitude_deg",
+                self.microsaccade_amplitude_deg,
+                0.0,
+                5.0,
+            ),
             ("blink_duration_ms", self.blink_duration_ms, 1.0, 5000.0),
             ("pursuit_speed_deg_s", self.pursuit_speed_deg_s, 0.1, 200.0),
         ];
         for (key, [a, b], lo, hi) in ranges {
             let ok = a.is_finite() && b.is_finite() && a >= lo && b <= hi && a <= b;
             if !ok {
-                return err(key, &format!("must be [min, max] with {lo} <= min <= max <= {hi}"));
+                return err(
+                    key,
+                    &format!("must be [min, max] with {lo} <= min <= max <= {hi}"),
+                );
             }
         }
-        if !self.target_range_deg.iter().all(|v| (0.0..=80.0).contains(v)) {
-            return err("target_range_deg", "must be [azimuth, elevation] half-ranges within 0..=80 degrees");
+        if !self
+            .target_range_deg
+            .iter()
+            .all(|v| (0.0..=80.0).contains(v))
+        {
+            return err(
+                "target_range_deg",
+                "must be [azimuth, elevation] half-ranges within 0..=80 degrees",
+            );
         }
-        if self.blink_rate_per_min > 0.0 && 60_000.0 / self.blink_rate_per_min <= self.mean_blink_ms() {
-            return err("blink_rate_per_min", "blinks would overlap: 60000 / rate must exceed the mean blink duration");
+        if self.blink_rate_per_min > 0.0
+            && 60_000.0 / self.blink_rate_per_min <= self.mean_blink_ms()
+        {
+            return err(
+                "blink_rate_per_min",
+                "blinks would overlap: 60000 / rate must exceed the mean blink duration",
+            );
         }
         let tracker = [
             ("rate_hz", self.rate_hz, true),
@@ -186,7 +219,10 @@ impl SimConfig {
             if let Some(v) = v {
                 let ok = v.is_finite() && if strictly_positive { v > 0.0 } else { v >= 0.0 };
                 if !ok {
-                    return err(key, "must be a finite number (> 0 for rate_hz, >= 0 otherwise)");
+                    return err(
+                        key,
+                        "must be a finite number (> 0 for rate_hz, >= 0 otherwise)",
+                    );
                 }
             }
         }
@@ -194,10 +230,16 @@ impl SimConfig {
         for (i, s) in self.script.iter().enumerate() {
             let angles_ok = s.azimuth_deg.abs() < 89.0 && s.elevation_deg.abs() < 89.0;
             if !s.time_ms.is_finite() || s.time_ms < 0.0 || !angles_ok {
-                return err(&format!("script[{i}]"), "time_ms must be >= 0 and angles within ±89°");
+                return err(
+                    &format!("script[{i}]"),
+                    "time_ms must be >= 0 and angles within ±89°",
+                );
             }
             if s.time_ms <= prev {
-                return err(&format!("script[{i}].time_ms"), "script times must be strictly increasing");
+                return err(
+                    &format!("script[{i}].time_ms"),
+                    "script times must be strictly increasing",
+                );
             }
             prev = s.time_ms;
         }
@@ -210,6 +252,7 @@ impl SimConfig {
 
     /// Peak saccade velocity (°/s) for an amplitude, from the main sequence.
     pub fn main_sequence_peak_velocity(&self, amplitude_deg: f64) -> f64 {
-        self.saccade_peak_velocity_max_deg_s * (1.0 - (-amplitude_deg / self.saccade_velocity_scale_deg).exp())
+        self.saccade_peak_velocity_max_deg_s
+            * (1.0 - (-amplitude_deg / self.saccade_velocity_scale_deg).exp())
     }
 }

@@ -2,7 +2,9 @@
 //! pursuit with catch-up saccades, and a blink schedule. Time is seconds since tracker tick 0.
 
 use super::config::{ScriptMotion, SimConfig};
-use super::motion::{angle, direction_from_angles, offset_direction, Glide, Move, MIN_JERK_PEAK_SLOPE};
+use super::motion::{
+    angle, direction_from_angles, offset_direction, Glide, Move, MIN_JERK_PEAK_SLOPE,
+};
 use glam::{DQuat, DVec2, DVec3};
 use rand::Rng;
 use rand_distr::{Distribution, Exp, Gamma, StandardNormal};
@@ -27,10 +29,22 @@ struct Micro {
 
 #[derive(Debug, Clone, Copy)]
 enum State {
-    Fixating { target: DVec3, offset: DVec2, until: f64, next_micro: f64, micro: Option<Micro> },
+    Fixating {
+        target: DVec3,
+        offset: DVec2,
+        until: f64,
+        next_micro: f64,
+        micro: Option<Micro>,
+    },
     /// `resume`: the pursuit a catch-up saccade interrupted.
-    Saccading { mv: Move, resume: Option<Glide> },
-    Pursuing { glide: Glide, eye: DVec3 },
+    Saccading {
+        mv: Move,
+        resume: Option<Glide>,
+    },
+    Pursuing {
+        glide: Glide,
+        eye: DVec3,
+    },
 }
 
 pub struct EyeModel {
@@ -53,7 +67,15 @@ impl EyeModel {
             rng,
             // Validated config guarantees shape, scale > 0.
             fixation_durations: Gamma::new(shape, scale).expect("validated gamma parameters"),
-            state: State::Saccading { mv: Move { start: 0.0, duration: 1.0, from: DVec3::NEG_Z, to: DVec3::NEG_Z }, resume: None },
+            state: State::Saccading {
+                mv: Move {
+                    start: 0.0,
+                    duration: 1.0,
+                    from: DVec3::NEG_Z,
+                    to: DVec3::NEG_Z,
+                },
+                resume: None,
+            },
             script_index: 0,
             last_t: 0.0,
             direction: DVec3::NEG_Z,
@@ -82,7 +104,9 @@ impl EyeModel {
         // Bounded: every transition either moves time forward or consumes a script step.
         for _ in 0..10_000 {
             match self.state {
-                State::Fixating { until, target, .. } if t >= until => self.end_fixation(until, target),
+                State::Fixating { until, target, .. } if t >= until => {
+                    self.end_fixation(until, target)
+                }
                 State::Saccading { mv, resume } if t >= mv.end() => self.end_saccade(mv, resume),
                 State::Pursuing { glide, eye } if t >= glide.end => self.end_pursuit(glide, eye),
                 _ => return,
@@ -97,13 +121,21 @@ impl EyeModel {
             self.next_script_action_time()
         };
         let next_micro = at + self.exponential(self.cfg.microsaccade_rate_hz);
-        self.state = State::Fixating { target, offset: DVec2::ZERO, until, next_micro, micro: None };
+        self.state = State::Fixating {
+            target,
+            offset: DVec2::ZERO,
+            until,
+            next_micro,
+            micro: None,
+        };
         self.direction = target;
         self.last_t = at;
     }
 
     fn next_script_action_time(&self) -> f64 {
-        let Some(step) = self.cfg.script.get(self.script_index) else { return f64::INFINITY };
+        let Some(step) = self.cfg.script.get(self.script_index) else {
+            return f64::INFINITY;
+        };
         match step.motion {
             ScriptMotion::Jump => (step.time_ms + self.cfg.saccade_latency_ms) / 1000.0,
             ScriptMotion::Pursue => self.script_glide_start(),
@@ -111,7 +143,9 @@ impl EyeModel {
     }
 
     fn script_glide_start(&self) -> f64 {
-        self.script_index.checked_sub(1).map_or(0.0, |i| self.cfg.script[i].time_ms / 1000.0)
+        self.script_index
+            .checked_sub(1)
+            .map_or(0.0, |i| self.cfg.script[i].time_ms / 1000.0)
     }
 
     fn end_fixation(&mut self, at: f64, target: DVec3) {
@@ -123,7 +157,12 @@ impl EyeModel {
             match step.motion {
                 ScriptMotion::Jump => self.start_saccade(at, from, goal, None),
                 ScriptMotion::Pursue => {
-                    let glide = Glide { start, end: step.time_ms / 1000.0, from: target, to: goal };
+                    let glide = Glide {
+                        start,
+                        end: step.time_ms / 1000.0,
+                        from: target,
+                        to: goal,
+                    };
                     self.state = State::Pursuing { glide, eye: from };
                     self.last_t = at;
                 }
@@ -135,7 +174,15 @@ impl EyeModel {
             let [lo, hi] = self.cfg.pursuit_speed_deg_s;
             let speed = self.rng.random_range(lo..=hi);
             let duration = angle(target, goal).to_degrees() / speed;
-            self.state = State::Pursuing { glide: Glide { start: at, end: at + duration, from: target, to: goal }, eye: from };
+            self.state = State::Pursuing {
+                glide: Glide {
+                    start: at,
+                    end: at + duration,
+                    from: target,
+                    to: goal,
+                },
+                eye: from,
+            };
             self.last_t = at;
         } else {
             self.start_saccade(at, from, goal, None);
@@ -148,7 +195,15 @@ impl EyeModel {
             return self.start_fixation(at, to);
         }
         let duration = self.saccade_duration(amplitude);
-        self.state = State::Saccading { mv: Move { start: at, duration, from, to }, resume };
+        self.state = State::Saccading {
+            mv: Move {
+                start: at,
+                duration,
+                from,
+                to,
+            },
+            resume,
+        };
         self.last_t = at;
     }
 
@@ -181,7 +236,14 @@ impl EyeModel {
     }
 
     fn evaluate_fixation(&mut self, t: f64, dt: f64) -> EyePhase {
-        let State::Fixating { target, mut offset, until, mut next_micro, mut micro } = self.state else {
+        let State::Fixating {
+            target,
+            mut offset,
+            until,
+            mut next_micro,
+            mut micro,
+        } = self.state
+        else {
             return EyePhase::Fixation;
         };
         if micro.is_none() && t >= next_micro {
@@ -190,7 +252,8 @@ impl EyeModel {
         let mut phase = EyePhase::Fixation;
         match micro {
             Some(m) if t < m.start + m.duration => {
-                offset = m.from + (m.to - m.from) * super::motion::min_jerk((t - m.start) / m.duration);
+                offset =
+                    m.from + (m.to - m.from) * super::motion::min_jerk((t - m.start) / m.duration);
                 phase = EyePhase::Microsaccade;
             }
             Some(m) => {
@@ -200,33 +263,56 @@ impl EyeModel {
             }
             None => offset = self.drift(offset, dt),
         }
-        self.state = State::Fixating { target, offset, until, next_micro, micro };
+        self.state = State::Fixating {
+            target,
+            offset,
+            until,
+            next_micro,
+            micro,
+        };
         self.direction = offset_direction(target, offset);
         phase
     }
 
     fn plan_microsaccade(&mut self, start: f64, from: DVec2) -> Micro {
         let [lo, hi] = self.cfg.microsaccade_amplitude_deg;
-        let amplitude = if hi > lo { self.rng.random_range(lo..=hi) } else { lo };
+        let amplitude = if hi > lo {
+            self.rng.random_range(lo..=hi)
+        } else {
+            lo
+        };
         let heading = self.rng.random_range(0.0..std::f64::consts::TAU);
         let step = DVec2::new(heading.cos(), heading.sin()) * amplitude;
         // Microsaccades are corrective: never carry the eye further than `hi` from the target.
-        let to = if (from + step).length() > hi { from - step } else { from + step };
+        let to = if (from + step).length() > hi {
+            from - step
+        } else {
+            from + step
+        };
         let duration = self.saccade_duration(amplitude.max(1e-3));
-        Micro { start, duration, from, to }
+        Micro {
+            start,
+            duration,
+            from,
+            to,
+        }
     }
 
     /// Exact Ornstein–Uhlenbeck step, valid for any dt.
     fn drift(&mut self, offset: DVec2, dt: f64) -> DVec2 {
         let decay = (-dt * 1000.0 / self.cfg.drift_time_constant_ms).exp();
         let sd = self.cfg.drift_sd_deg * (1.0 - decay * decay).sqrt();
-        let n = DVec2::new(self.rng.sample(StandardNormal), self.rng.sample(StandardNormal));
+        let n = DVec2::new(
+            self.rng.sample(StandardNormal),
+            self.rng.sample(StandardNormal),
+        );
         offset * decay + n * sd
     }
 
     fn evaluate_pursuit(&mut self, t: f64, dt: f64, glide: Glide, mut eye: DVec3) -> EyePhase {
         if let Some((speed, axis)) = glide.velocity() {
-            let eye_speed = (speed * self.cfg.pursuit_gain).min(self.cfg.pursuit_max_speed_deg_s.to_radians());
+            let eye_speed =
+                (speed * self.cfg.pursuit_gain).min(self.cfg.pursuit_max_speed_deg_s.to_radians());
             if t > glide.start {
                 eye = (DQuat::from_axis_angle(axis, eye_speed * dt) * eye).normalize();
             }
@@ -245,8 +331,16 @@ impl EyeModel {
 
     fn random_target(&mut self) -> DVec3 {
         let [az, el] = self.cfg.target_range_deg;
-        let a = if az > 0.0 { self.rng.random_range(-az..=az) } else { 0.0 };
-        let e = if el > 0.0 { self.rng.random_range(-el..=el) } else { 0.0 };
+        let a = if az > 0.0 {
+            self.rng.random_range(-az..=az)
+        } else {
+            0.0
+        };
+        let e = if el > 0.0 {
+            self.rng.random_range(-el..=el)
+        } else {
+            0.0
+        };
         direction_from_angles(a, e)
     }
 
@@ -275,7 +369,13 @@ impl BlinkSchedule {
         } else {
             f64::INFINITY
         };
-        let mut s = BlinkSchedule { rng, mean_gap_s, duration_ms: cfg.blink_duration_ms, start: 0.0, end: 0.0 };
+        let mut s = BlinkSchedule {
+            rng,
+            mean_gap_s,
+            duration_ms: cfg.blink_duration_ms,
+            start: 0.0,
+            end: 0.0,
+        };
         s.schedule_after(0.0);
         s
     }
@@ -287,7 +387,11 @@ impl BlinkSchedule {
             f64::INFINITY
         };
         let [lo, hi] = self.duration_ms;
-        let duration = if hi > lo { self.rng.random_range(lo..=hi) } else { lo } / 1000.0;
+        let duration = if hi > lo {
+            self.rng.random_range(lo..=hi)
+        } else {
+            lo
+        } / 1000.0;
         self.start = t + gap;
         self.end = self.start + duration;
     }

@@ -68,11 +68,17 @@ impl SimulatedFove {
         t.accuracy_deg = cfg.accuracy_deg.unwrap_or(t.accuracy_deg);
         t.precision_deg = cfg.precision_deg.unwrap_or(t.precision_deg);
         let seed = cfg.seed;
-        let stream = |k: u64| Pcg64::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(k));
+        let stream =
+            |k: u64| Pcg64::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(k));
         // Mean 2D error magnitude of an isotropic Gaussian is σ·√(π/2): accuracy is that mean.
         let bias_sd = hmd.tracker.accuracy_deg as f64 / (std::f64::consts::PI / 2.0).sqrt();
         let mut noise_rng = stream(3);
-        let mut key = || DVec2::new(noise_rng.sample(StandardNormal), noise_rng.sample(StandardNormal)) * bias_sd;
+        let mut key = || {
+            DVec2::new(
+                noise_rng.sample(StandardNormal),
+                noise_rng.sample(StandardNormal),
+            ) * bias_sd
+        };
         let bias_keys = [key(), key()];
         Ok(SimulatedFove {
             latency_ns: (hmd.tracker.latency_ms as f64 * 1e6).round() as i64,
@@ -94,7 +100,8 @@ impl SimulatedFove {
     /// Default FOVE 0 with default behaviour for `seed`.
     pub fn fove0(seed: u64) -> Self {
         // Defaults are valid by construction (tested).
-        SimulatedFove::new(HmdDescription::fove0(), SimConfig::seeded(seed)).expect("default config is valid")
+        SimulatedFove::new(HmdDescription::fove0(), SimConfig::seeded(seed))
+            .expect("default config is valid")
     }
 
     pub fn config(&self) -> &SimConfig {
@@ -115,10 +122,16 @@ impl SimulatedFove {
         let (truth, phase) = self.eye.advance(t);
         let blinking = self.blinks.blinking(t);
         self.update_bias(t);
-        let noise = DVec2::new(self.noise_rng.sample(StandardNormal), self.noise_rng.sample(StandardNormal))
-            * self.hmd.tracker.precision_deg as f64;
+        let noise = DVec2::new(
+            self.noise_rng.sample(StandardNormal),
+            self.noise_rng.sample(StandardNormal),
+        ) * self.hmd.tracker.precision_deg as f64;
         let sample = if blinking {
-            GazeSample { time_kind: SampleTimeKind::Measured, eye_state: [EyeState::Closed; 2], ..GazeSample::no_gaze(time, k) }
+            GazeSample {
+                time_kind: SampleTimeKind::Measured,
+                eye_state: [EyeState::Closed; 2],
+                ..GazeSample::no_gaze(time, k)
+            }
         } else {
             self.measured_sample(time, k, motion::offset_direction(truth, self.bias + noise))
         };
@@ -126,7 +139,13 @@ impl SimulatedFove {
             self.history.pop_front();
         }
         self.history.push_back(sample);
-        SimTick { sample, truth: truth.as_vec3(), phase, blinking, bias_deg: self.bias.as_vec2() }
+        SimTick {
+            sample,
+            truth: truth.as_vec3(),
+            phase,
+            blinking,
+            bias_deg: self.bias.as_vec2(),
+        }
     }
 
     /// Slowly varying accuracy bias: independent Gaussian keyframes every time constant, blended
@@ -136,7 +155,10 @@ impl SimulatedFove {
         let period = self.cfg.bias_time_constant_s;
         let segment = (t / period).floor().max(0.0) as u64;
         while self.bias_segment < segment {
-            let next = DVec2::new(self.noise_rng.sample(StandardNormal), self.noise_rng.sample(StandardNormal)) * self.bias_sd;
+            let next = DVec2::new(
+                self.noise_rng.sample(StandardNormal),
+                self.noise_rng.sample(StandardNormal),
+            ) * self.bias_sd;
             self.bias_keys = [self.bias_keys[1], next];
             self.bias_segment += 1;
         }
@@ -152,7 +174,10 @@ impl SimulatedFove {
             direction: (point - offset.as_dvec3()).normalize().as_vec3(),
         };
         GazeSample {
-            eyes: Some([eye_ray(self.hmd.eyes[0].offset), eye_ray(self.hmd.eyes[1].offset)]),
+            eyes: Some([
+                eye_ray(self.hmd.eyes[0].offset),
+                eye_ray(self.hmd.eyes[1].offset),
+            ]),
             convergence_distance: Some(distance as f32),
             ..GazeSample::looking(time, k, dir.as_vec3())
         }
@@ -193,6 +218,7 @@ impl GazeSource for SimulatedFove {
     }
 
     fn latest(&self) -> GazeSample {
-        self.newest_available.unwrap_or_else(|| GazeSample::no_gaze(self.cfg.start_time_ns, 0))
+        self.newest_available
+            .unwrap_or_else(|| GazeSample::no_gaze(self.cfg.start_time_ns, 0))
     }
 }

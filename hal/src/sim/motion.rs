@@ -43,7 +43,8 @@ pub fn offset_direction(centre: DVec3, offset_deg: DVec2) -> DVec3 {
         return centre;
     }
     let (right, up) = tangent_basis(centre);
-    (centre + right * offset_deg.x.to_radians().tan() + up * offset_deg.y.to_radians().tan()).normalize()
+    (centre + right * offset_deg.x.to_radians().tan() + up * offset_deg.y.to_radians().tan())
+        .normalize()
 }
 
 /// A timed great-circle movement with a minimum-jerk profile (saccades).
@@ -60,7 +61,11 @@ impl Move {
         self.start + self.duration
     }
     pub fn at(&self, t: f64) -> DVec3 {
-        slerp(self.from, self.to, min_jerk((t - self.start) / self.duration))
+        slerp(
+            self.from,
+            self.to,
+            min_jerk((t - self.start) / self.duration),
+        )
     }
 }
 
@@ -76,7 +81,11 @@ pub struct Glide {
 impl Glide {
     pub fn at(&self, t: f64) -> DVec3 {
         let span = self.end - self.start;
-        let s = if span > 0.0 { ((t - self.start) / span).clamp(0.0, 1.0) } else { 1.0 };
+        let s = if span > 0.0 {
+            ((t - self.start) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
         slerp(self.from, self.to, s)
     }
     /// Angular speed (rad/s) and rotation axis; `None` when the target does not move.

@@ -26,7 +26,11 @@ pub struct DegreesImport {
 
 impl Default for DegreesImport {
     fn default() -> Self {
-        DegreesImport { device: "gazebase".into(), rate_hz: None, y_down: false }
+        DegreesImport {
+            device: "gazebase".into(),
+            rate_hz: None,
+            y_down: false,
+        }
     }
 }
 
@@ -66,8 +70,14 @@ struct Csv<'a> {
 impl<'a> Csv<'a> {
     fn parse(text: &'a str, file: &'a Path) -> Result<Csv<'a>, HalError> {
         let text = crate::file::strip_bom(text);
-        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).filter(|(_, l)| !l.trim().is_empty());
-        let (_, header) = lines.next().ok_or_else(|| HalError::trace(file, 1, "empty file; expected a header row"))?;
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l))
+            .filter(|(_, l)| !l.trim().is_empty());
+        let (_, header) = lines
+            .next()
+            .ok_or_else(|| HalError::trace(file, 1, "empty file; expected a header row"))?;
         let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
         let mut rows = Vec::new();
         for (n, line) in lines {
@@ -89,16 +99,26 @@ impl<'a> Csv<'a> {
     }
 
     fn require(&self, name: &str) -> Result<usize, HalError> {
-        self.column(name).ok_or_else(|| HalError::trace(self.file, 1, format!("required column `{name}` is missing")))
+        self.column(name).ok_or_else(|| {
+            HalError::trace(self.file, 1, format!("required column `{name}` is missing"))
+        })
     }
 
     /// A number; NaN is returned as is (datasets use it for lost samples), infinities are errors.
     fn number(&self, line: usize, fields: &[&str], col: usize) -> Result<f64, HalError> {
         let v: f64 = fields[col].parse().map_err(|_| {
-            HalError::trace(self.file, line, format!("{} `{}` is not a number", self.names[col], fields[col]))
+            HalError::trace(
+                self.file,
+                line,
+                format!("{} `{}` is not a number", self.names[col], fields[col]),
+            )
         })?;
         if v.is_infinite() {
-            return Err(HalError::trace(self.file, line, format!("{} is infinite", self.names[col])));
+            return Err(HalError::trace(
+                self.file,
+                line,
+                format!("{} is infinite", self.names[col]),
+            ));
         }
         Ok(v)
     }
@@ -106,7 +126,11 @@ impl<'a> Csv<'a> {
 
 fn time_ns(file: &Path, line: usize, ms: f64) -> Result<i64, HalError> {
     if !ms.is_finite() || ms.abs() > 9.0e12 {
-        return Err(HalError::trace(file, line, format!("time {ms} ms is not a usable time stamp")));
+        return Err(HalError::trace(
+            file,
+            line,
+            format!("time {ms} ms is not a usable time stamp"),
+        ));
     }
     Ok((ms * 1e6).round() as i64)
 }
@@ -126,7 +150,11 @@ pub fn import_gazebase(path: &Path, opts: &DegreesImport) -> Result<Trace, HalEr
     import_gazebase_text(&text, path, opts)
 }
 
-pub fn import_gazebase_text(text: &str, file: &Path, opts: &DegreesImport) -> Result<Trace, HalError> {
+pub fn import_gazebase_text(
+    text: &str,
+    file: &Path,
+    opts: &DegreesImport,
+) -> Result<Trace, HalError> {
     let csv = Csv::parse(text, file)?;
     let (n, x, y) = (csv.require("n")?, csv.require("x")?, csv.require("y")?);
     let val = csv.column("val");
@@ -141,20 +169,46 @@ pub fn import_gazebase_text(text: &str, file: &Path, opts: &DegreesImport) -> Re
             Some(c) => csv.number(*line, fields, c)? != 0.0,
             None => false,
         };
-        let dir = degrees_direction(csv.number(*line, fields, x)?, csv.number(*line, fields, y)?, opts.y_down);
+        let dir = degrees_direction(
+            csv.number(*line, fields, x)?,
+            csv.number(*line, fields, y)?,
+            opts.y_down,
+        );
         let mut s = match dir {
             Some(d) if !flagged_invalid => GazeSample::looking(time, samples.len() as u64, d),
-            _ => GazeSample { time_kind: SampleTimeKind::Measured, ..GazeSample::no_gaze(time, samples.len() as u64) },
+            _ => GazeSample {
+                time_kind: SampleTimeKind::Measured,
+                ..GazeSample::no_gaze(time, samples.len() as u64)
+            },
         };
         if let Some([lx, ly, rx, ry]) = binocular {
             let eye = |a, b| -> Result<Option<Vec3>, HalError> {
-                Ok(degrees_direction(csv.number(*line, fields, a)?, csv.number(*line, fields, b)?, opts.y_down))
+                Ok(degrees_direction(
+                    csv.number(*line, fields, a)?,
+                    csv.number(*line, fields, b)?,
+                    opts.y_down,
+                ))
             };
             let (l, r) = (eye(lx, ly)?, eye(rx, ry)?);
-            let state = |d: Option<Vec3>| if d.is_some() { EyeState::Open } else { EyeState::NotDetected };
+            let state = |d: Option<Vec3>| {
+                if d.is_some() {
+                    EyeState::Open
+                } else {
+                    EyeState::NotDetected
+                }
+            };
             s.eye_state = [state(l), state(r)];
             if let (Some(l), Some(r), true) = (l, r, s.valid) {
-                s.eyes = Some([GazeRay { origin: Vec3::ZERO, direction: l }, GazeRay { origin: Vec3::ZERO, direction: r }]);
+                s.eyes = Some([
+                    GazeRay {
+                        origin: Vec3::ZERO,
+                        direction: l,
+                    },
+                    GazeRay {
+                        origin: Vec3::ZERO,
+                        direction: r,
+                    },
+                ]);
             }
         }
         samples.push(s);
@@ -167,25 +221,53 @@ pub fn import_normalized(path: &Path, opts: &NormalizedImport) -> Result<Trace, 
     import_normalized_text(&text, path, opts)
 }
 
-pub fn import_normalized_text(text: &str, file: &Path, opts: &NormalizedImport) -> Result<Trace, HalError> {
+pub fn import_normalized_text(
+    text: &str,
+    file: &Path,
+    opts: &NormalizedImport,
+) -> Result<Trace, HalError> {
     let csv = Csv::parse(text, file)?;
-    let (tc, xc, yc) = (csv.require(&opts.time_column)?, csv.require(&opts.x_column)?, csv.require(&opts.y_column)?);
+    let (tc, xc, yc) = (
+        csv.require(&opts.time_column)?,
+        csv.require(&opts.x_column)?,
+        csv.require(&opts.y_column)?,
+    );
     let f = &opts.fov;
-    let (l, r, d, u) = (f.angle_left.tan() as f64, f.angle_right.tan() as f64, f.angle_down.tan() as f64, f.angle_up.tan() as f64);
+    let (l, r, d, u) = (
+        f.angle_left.tan() as f64,
+        f.angle_right.tan() as f64,
+        f.angle_down.tan() as f64,
+        f.angle_up.tan() as f64,
+    );
     let mut samples = Vec::with_capacity(csv.rows.len());
     for (line, fields) in &csv.rows {
         let time = time_ns(file, *line, csv.number(*line, fields, tc)?)?;
-        let (x, y) = (csv.number(*line, fields, xc)?, csv.number(*line, fields, yc)?);
+        let (x, y) = (
+            csv.number(*line, fields, xc)?,
+            csv.number(*line, fields, yc)?,
+        );
         let seq = samples.len() as u64;
         samples.push(if x.is_finite() && y.is_finite() {
-            let ty = if opts.origin_bottom_left { d + y * (u - d) } else { u - y * (u - d) };
+            let ty = if opts.origin_bottom_left {
+                d + y * (u - d)
+            } else {
+                u - y * (u - d)
+            };
             GazeSample::looking(time, seq, tangent_direction(l + x * (r - l), ty))
         } else {
-            GazeSample { time_kind: SampleTimeKind::Measured, ..GazeSample::no_gaze(time, seq) }
+            GazeSample {
+                time_kind: SampleTimeKind::Measured,
+                ..GazeSample::no_gaze(time, seq)
+            }
         });
     }
     let deg = |v: f32| v.to_degrees();
-    let fov = Some([deg(f.angle_left), deg(f.angle_right), deg(f.angle_down), deg(f.angle_up)]);
+    let fov = Some([
+        deg(f.angle_left),
+        deg(f.angle_right),
+        deg(f.angle_down),
+        deg(f.angle_up),
+    ]);
     finish(file, samples, &csv, opts.rate_hz, opts.device.clone(), fov)
 }
 
@@ -199,7 +281,11 @@ fn finish(
 ) -> Result<Trace, HalError> {
     for (w, rows) in samples.windows(2).zip(csv.rows.windows(2)) {
         if w[1].time <= w[0].time {
-            let what = if w[1].time == w[0].time { "duplicate" } else { "out-of-order" };
+            let what = if w[1].time == w[0].time {
+                "duplicate"
+            } else {
+                "out-of-order"
+            };
             let reason = format!("{what} time stamp (previous row is line {})", rows[0].0);
             return Err(HalError::trace(file, rows[1].0, reason));
         }

@@ -25,11 +25,33 @@ pub const UNIT_TOLERANCE: f32 = 1e-3;
 
 /// Every column the format knows, in the order the writer emits them.
 pub const COLUMNS: &[&str] = &[
-    "time_ns", "time_kind", "seq", "valid", "tracked",
-    "origin_x", "origin_y", "origin_z", "dir_x", "dir_y", "dir_z",
-    "left_state", "right_state", "confidence", "convergence_m",
-    "left_origin_x", "left_origin_y", "left_origin_z", "left_dir_x", "left_dir_y", "left_dir_z",
-    "right_origin_x", "right_origin_y", "right_origin_z", "right_dir_x", "right_dir_y", "right_dir_z",
+    "time_ns",
+    "time_kind",
+    "seq",
+    "valid",
+    "tracked",
+    "origin_x",
+    "origin_y",
+    "origin_z",
+    "dir_x",
+    "dir_y",
+    "dir_z",
+    "left_state",
+    "right_state",
+    "confidence",
+    "convergence_m",
+    "left_origin_x",
+    "left_origin_y",
+    "left_origin_z",
+    "left_dir_x",
+    "left_dir_y",
+    "left_dir_z",
+    "right_origin_x",
+    "right_origin_y",
+    "right_origin_z",
+    "right_dir_x",
+    "right_dir_y",
+    "right_dir_z",
 ];
 pub const REQUIRED_COLUMNS: &[&str] = &["time_ns", "valid", "dir_x", "dir_y", "dir_z"];
 
@@ -48,7 +70,13 @@ pub struct TraceHeader {
 
 impl TraceHeader {
     pub fn new(device: impl Into<String>, rate_hz: f32) -> Self {
-        TraceHeader { device: device.into(), rate_hz, fov_deg: None, source: None, notes: Vec::new() }
+        TraceHeader {
+            device: device.into(),
+            rate_hz,
+            fov_deg: None,
+            source: None,
+            notes: Vec::new(),
+        }
     }
 
     pub fn period_ns(&self) -> i64 {
@@ -140,7 +168,8 @@ impl Trace {
     /// unless `overwrite`.
     pub fn save(&self, path: &Path, overwrite: bool) -> Result<(), HalError> {
         let mut file = recorder::AtomicFile::create(path, overwrite)?;
-        self.write(file.writer()).map_err(|e| HalError::io(file.temp_path(), e))?;
+        self.write(file.writer())
+            .map_err(|e| HalError::io(file.temp_path(), e))?;
         file.commit()
     }
 }

@@ -26,7 +26,16 @@ impl Playback {
     pub fn new(trace: Trace, hmd: HmdDescription) -> Self {
         let max_gap_ns = trace.header.period_ns().saturating_mul(3) / 2;
         let times = trace.samples.iter().map(|s| s.time).collect();
-        Playback { hmd, trace, times, cursor: 0, time_offset: 0, align_on_first_frame: false, max_gap_ns, now: None }
+        Playback {
+            hmd,
+            trace,
+            times,
+            cursor: 0,
+            time_offset: 0,
+            align_on_first_frame: false,
+            max_gap_ns,
+            now: None,
+        }
     }
 
     pub fn open(path: &Path, hmd: HmdDescription) -> Result<Self, HalError> {
@@ -54,7 +63,10 @@ impl Playback {
     }
 
     fn shifted(&self, s: &GazeSample) -> GazeSample {
-        GazeSample { time: s.time.saturating_add(self.time_offset), ..*s }
+        GazeSample {
+            time: s.time.saturating_add(self.time_offset),
+            ..*s
+        }
     }
 
     /// Trace semantics in trace time (no offset): exact hit → that sample; before/after the
@@ -74,7 +86,11 @@ impl Playback {
         }
         let b = &s[i];
         if b.time - a.time > self.max_gap_ns {
-            return if t - a.time <= self.max_gap_ns { *a } else { GazeSample::no_gaze(t, a.sequence) };
+            return if t - a.time <= self.max_gap_ns {
+                *a
+            } else {
+                GazeSample::no_gaze(t, a.sequence)
+            };
         }
         if !(a.valid && b.valid) {
             return *a;
@@ -104,7 +120,10 @@ fn interpolate(a: &GazeSample, b: &GazeSample, t: XrTime) -> GazeSample {
     let wf = w as f32;
     let ray = |ra: &GazeRay, rb: &GazeRay| GazeRay {
         origin: ra.origin.lerp(rb.origin, wf),
-        direction: ra.direction.lerp(rb.direction, wf).normalize_or(ra.direction),
+        direction: ra
+            .direction
+            .lerp(rb.direction, wf)
+            .normalize_or(ra.direction),
     };
     let lerp_opt = |x: Option<f32>, y: Option<f32>| match (x, y) {
         (Some(x), Some(y)) => Some(x + (y - x) * wf),
@@ -149,7 +168,9 @@ impl GazeSource for Playback {
     /// The newest recorded sample at or before the current frame time (never interpolated).
     fn latest(&self) -> GazeSample {
         let samples = &self.trace.samples;
-        let t = self.now.map_or(samples[0].time, |n| n.saturating_sub(self.time_offset));
+        let t = self
+            .now
+            .map_or(samples[0].time, |n| n.saturating_sub(self.time_offset));
         let i = self.times.partition_point(|&x| x <= t).saturating_sub(1);
         self.shifted(&samples[i])
     }

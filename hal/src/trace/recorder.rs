@@ -21,12 +21,22 @@ pub(crate) struct AtomicFile {
 impl AtomicFile {
     pub(crate) fn create(path: &Path, overwrite: bool) -> Result<Self, HalError> {
         if !overwrite && path.exists() {
-            return Err(HalError::AlreadyExists { file: path.to_path_buf() });
+            return Err(HalError::AlreadyExists {
+                file: path.to_path_buf(),
+            });
         }
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "trace".into());
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "trace".into());
         let temp_path = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
         let file = File::create(&temp_path).map_err(|e| HalError::io(&temp_path, e))?;
-        Ok(AtomicFile { final_path: path.to_path_buf(), temp_path, overwrite, writer: Some(BufWriter::new(file)) })
+        Ok(AtomicFile {
+            final_path: path.to_path_buf(),
+            temp_path,
+            overwrite,
+            writer: Some(BufWriter::new(file)),
+        })
     }
 
     pub(crate) fn writer(&mut self) -> &mut BufWriter<File> {
@@ -41,14 +51,19 @@ impl AtomicFile {
     pub(crate) fn commit(mut self) -> Result<(), HalError> {
         let temp = self.temp_path.clone();
         let writer = self.writer.take().expect("writer present until commit");
-        let file = writer.into_inner().map_err(|e| HalError::io(&temp, e.into_error()))?;
+        let file = writer
+            .into_inner()
+            .map_err(|e| HalError::io(&temp, e.into_error()))?;
         file.sync_all().map_err(|e| HalError::io(&temp, e))?;
         if self.overwrite {
-            std::fs::rename(&temp, &self.final_path).map_err(|e| HalError::io(&self.final_path, e))?;
+            std::fs::rename(&temp, &self.final_path)
+                .map_err(|e| HalError::io(&self.final_path, e))?;
         } else {
             // hard_link fails if the target appeared meanwhile: no-overwrite holds even in a race.
             std::fs::hard_link(&temp, &self.final_path).map_err(|e| match e.kind() {
-                std::io::ErrorKind::AlreadyExists => HalError::AlreadyExists { file: self.final_path.clone() },
+                std::io::ErrorKind::AlreadyExists => HalError::AlreadyExists {
+                    file: self.final_path.clone(),
+                },
                 _ => HalError::io(&self.final_path, e),
             })?;
             let _ = std::fs::remove_file(&temp);
@@ -82,8 +97,16 @@ impl TraceWriter {
     /// `overwrite` false an existing file is an error, also if it appears before `finish`.
     pub fn create(hmd: &HmdDescription, path: &Path, overwrite: bool) -> Result<Self, HalError> {
         let mut file = AtomicFile::create(path, overwrite)?;
-        header_for(hmd).write(file.writer()).map_err(|e| HalError::io(file.temp_path(), e))?;
-        Ok(TraceWriter { file: Some(file), last_time: None, written: 0, error: None, failed: false })
+        header_for(hmd)
+            .write(file.writer())
+            .map_err(|e| HalError::io(file.temp_path(), e))?;
+        Ok(TraceWriter {
+            file: Some(file),
+            last_time: None,
+            written: 0,
+            error: None,
+            failed: false,
+        })
     }
 
     pub fn samples_written(&self) -> usize {
@@ -116,7 +139,9 @@ impl TraceWriter {
             return Err(e);
         }
         if let Some(file) = self.file.as_mut() {
-            file.writer().flush().map_err(|e| HalError::io(file.temp_path(), e))?;
+            file.writer()
+                .flush()
+                .map_err(|e| HalError::io(file.temp_path(), e))?;
         }
         Ok(())
     }
@@ -127,8 +152,13 @@ impl TraceWriter {
             return Err(e);
         }
         if self.failed {
-            let file = self.file.as_ref().map(|f| f.temp_path().to_path_buf()).unwrap_or_default();
-            let reason = "an earlier write failed; the recording is incomplete and was not published";
+            let file = self
+                .file
+                .as_ref()
+                .map(|f| f.temp_path().to_path_buf())
+                .unwrap_or_default();
+            let reason =
+                "an earlier write failed; the recording is incomplete and was not published";
             return Err(HalError::io(file, std::io::Error::other(reason)));
         }
         self.file.take().map_or(Ok(()), AtomicFile::commit)
@@ -168,7 +198,12 @@ fn header_for(hmd: &HmdDescription) -> TraceHeader {
     let f = hmd.eyes[0].fov;
     let deg = |r: f32| r.to_degrees();
     TraceHeader {
-        fov_deg: Some([deg(f.angle_left), deg(f.angle_right), deg(f.angle_down), deg(f.angle_up)]),
+        fov_deg: Some([
+            deg(f.angle_left),
+            deg(f.angle_right),
+            deg(f.angle_down),
+            deg(f.angle_up),
+        ]),
         source: Some(format!("recorded by fovea-hal from `{}`", hmd.display_name)),
         ..TraceHeader::new(hmd.id.clone(), hmd.tracker.rate_hz)
     }

@@ -41,13 +41,28 @@ impl EnvironmentMap {
     pub fn new(width: u32, height: u32, texels: Vec<Vec3>) -> Result<EnvironmentMap, String> {
         check_size(width, height)?;
         if texels.len() != width as usize * height as usize {
-            return Err(format!("{} texels for a {width}×{height} map", texels.len()));
+            return Err(format!(
+                "{} texels for a {width}×{height} map",
+                texels.len()
+            ));
         }
-        if let Some(i) = texels.iter().position(|t| !(t.is_finite() && t.min_element() >= 0.0)) {
+        if let Some(i) = texels
+            .iter()
+            .position(|t| !(t.is_finite() && t.min_element() >= 0.0))
+        {
             let (x, y) = (i as u32 % width, i as u32 / width);
-            return Err(format!("texel ({x}, {y}) is {:?}: radiance must be finite and ≥ 0", texels[i].to_array()));
+            return Err(format!(
+                "texel ({x}, {y}) is {:?}: radiance must be finite and ≥ 0",
+                texels[i].to_array()
+            ));
         }
-        Ok(EnvironmentMap { width, height, texels, rotation: 0.0, intensity: 1.0 })
+        Ok(EnvironmentMap {
+            width,
+            height,
+            texels,
+            rotation: 0.0,
+            intensity: 1.0,
+        })
     }
 
     /// The analytic sky ([`Sky`]) at each texel centre, so the default sky takes the same
@@ -56,12 +71,25 @@ impl EnvironmentMap {
         let (width, height) = SKY_BAKE_SIZE;
         let mut texels = Vec::with_capacity((width * height) as usize);
         for y in 0..height {
-            let dir = uv_to_direction(Vec2::new(0.5 / width as f32, (y as f32 + 0.5) / height as f32));
+            let dir = uv_to_direction(Vec2::new(
+                0.5 / width as f32,
+                (y as f32 + 0.5) / height as f32,
+            ));
             // Written as horizon + Δ·t so a uniform sky bakes to exactly its radiance.
-            let l = if dir.y < 0.0 { sky.ground } else { sky.horizon + (sky.zenith - sky.horizon) * dir.y.sqrt() };
+            let l = if dir.y < 0.0 {
+                sky.ground
+            } else {
+                sky.horizon + (sky.zenith - sky.horizon) * dir.y.sqrt()
+            };
             texels.extend(std::iter::repeat_n(l, width as usize));
         }
-        EnvironmentMap { width, height, texels, rotation: 0.0, intensity: 1.0 }
+        EnvironmentMap {
+            width,
+            height,
+            texels,
+            rotation: 0.0,
+            intensity: 1.0,
+        }
     }
 
     /// Radiance arriving from world direction `dir` (unit), intensity included.
@@ -88,7 +116,10 @@ impl EnvironmentMap {
 
     /// Solid angle of every texel in row `y` (exact: the band between its two polar angles).
     pub fn row_solid_angle(&self, y: u32) -> f32 {
-        let (t0, t1) = (PI * y as f32 / self.height as f32, PI * (y + 1) as f32 / self.height as f32);
+        let (t0, t1) = (
+            PI * y as f32 / self.height as f32,
+            PI * (y + 1) as f32 / self.height as f32,
+        );
         2.0 * PI / self.width as f32 * (t0.cos() - t1.cos())
     }
 
@@ -97,7 +128,13 @@ impl EnvironmentMap {
     pub fn luminance_integral(&self) -> f32 {
         let w = self.width as usize;
         let sum: f64 = (0..self.height)
-            .map(|y| self.texels[y as usize * w..(y as usize + 1) * w].iter().map(|t| luminance(*t) as f64).sum::<f64>() * self.row_solid_angle(y) as f64)
+            .map(|y| {
+                self.texels[y as usize * w..(y as usize + 1) * w]
+                    .iter()
+                    .map(|t| luminance(*t) as f64)
+                    .sum::<f64>()
+                    * self.row_solid_angle(y) as f64
+            })
             .sum();
         sum as f32 * self.intensity
     }
@@ -112,7 +149,10 @@ impl EnvironmentMap {
             for x in 0..w {
                 let (mut sum, mut weight) = (Vec3::ZERO, 0.0);
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let (sx, sy) = ((2 * x + dx).min(self.width - 1), (2 * y + dy).min(self.height - 1));
+                    let (sx, sy) = (
+                        (2 * x + dx).min(self.width - 1),
+                        (2 * y + dy).min(self.height - 1),
+                    );
                     let a = self.row_solid_angle(sy).max(1e-12);
                     sum += self.texels[(sy * self.width + sx) as usize] * a;
                     weight += a;
@@ -120,7 +160,13 @@ impl EnvironmentMap {
                 texels.push(sum / weight);
             }
         }
-        EnvironmentMap { width: w, height: h, texels, rotation: self.rotation, intensity: self.intensity }
+        EnvironmentMap {
+            width: w,
+            height: h,
+            texels,
+            rotation: self.rotation,
+            intensity: self.intensity,
+        }
     }
 }
 
@@ -128,10 +174,14 @@ impl EnvironmentMap {
 pub fn check_size(width: u32, height: u32) -> Result<(), String> {
     let (mw, mh) = MAX_ENVIRONMENT_SIZE;
     if width == 0 || height == 0 {
-        return Err(format!("the map is {width}×{height}: width and height must be at least 1"));
+        return Err(format!(
+            "the map is {width}×{height}: width and height must be at least 1"
+        ));
     }
     if width > mw || height > mh {
-        return Err(format!("the map is {width}×{height}, larger than the supported {mw}×{mh}"));
+        return Err(format!(
+            "the map is {width}×{height}, larger than the supported {mw}×{mh}"
+        ));
     }
     Ok(())
 }
@@ -140,7 +190,10 @@ pub fn check_size(width: u32, height: u32) -> Result<(), String> {
 pub fn direction_to_uv(d: Vec3) -> Vec2 {
     let phi = (-d.x).atan2(d.z);
     let u = phi / (2.0 * PI);
-    Vec2::new(if u < 0.0 { u + 1.0 } else { u }, d.y.clamp(-1.0, 1.0).acos() / PI)
+    Vec2::new(
+        if u < 0.0 { u + 1.0 } else { u },
+        d.y.clamp(-1.0, 1.0).acos() / PI,
+    )
 }
 
 /// (u, v) → map-local unit direction.
@@ -178,7 +231,11 @@ impl EnvironmentDistribution {
             .map(|(i, t)| luminance(*t) as f64 * map.row_solid_angle((i / w) as u32) as f64)
             .collect();
         let alias = build_alias_table(&weights);
-        (!alias.is_empty()).then_some(EnvironmentDistribution { width: map.width, height: map.height, alias })
+        (!alias.is_empty()).then_some(EnvironmentDistribution {
+            width: map.width,
+            height: map.height,
+            alias,
+        })
     }
 
     /// A texel and a point in it from four uniform numbers in [0, 1) (texel slot, alias choice,
@@ -186,9 +243,19 @@ impl EnvironmentDistribution {
     pub fn sample_uv(&self, u: [f32; 4]) -> (u32, Vec2) {
         let n = self.alias.len();
         let slot = ((u[0] * n as f32) as usize).min(n - 1);
-        let i = if u[1] < self.alias[slot].threshold { slot } else { self.alias[slot].alias as usize } as u32;
+        let i = if u[1] < self.alias[slot].threshold {
+            slot
+        } else {
+            self.alias[slot].alias as usize
+        } as u32;
         let (x, y) = (i % self.width, i / self.width);
-        (i, Vec2::new((x as f32 + u[2]) / self.width as f32, (y as f32 + u[3]) / self.height as f32))
+        (
+            i,
+            Vec2::new(
+                (x as f32 + u[2]) / self.width as f32,
+                (y as f32 + u[3]) / self.height as f32,
+            ),
+        )
     }
 
     /// Density per unit solid angle of map-local direction `d` (0 where sin θ vanishes).

@@ -22,12 +22,24 @@ pub(crate) fn strip_to_triangles(indices: &[u32]) -> Vec<[u32; 3]> {
 
 /// glTF §3.7.2.1: fan triangle i is (i+1, i+2, 0).
 pub(crate) fn fan_to_triangles(indices: &[u32]) -> Vec<[u32; 3]> {
-    (0..indices.len().saturating_sub(2)).map(|i| [indices[i + 1], indices[i + 2], indices[0]]).collect()
+    (0..indices.len().saturating_sub(2))
+        .map(|i| [indices[i + 1], indices[i + 2], indices[0]])
+        .collect()
 }
 
 /// Builds world-space vertices and triangles (indices local to the returned vertex list).
-pub(crate) fn build_world_vertices(data: PrimitiveData, needs_tangents: bool, world: Mat4) -> (Vec<Vertex>, Vec<[u32; 3]>) {
-    let PrimitiveData { positions, normals, uvs, tangents, mut triangles } = data;
+pub(crate) fn build_world_vertices(
+    data: PrimitiveData,
+    needs_tangents: bool,
+    world: Mat4,
+) -> (Vec<Vertex>, Vec<[u32; 3]>) {
+    let PrimitiveData {
+        positions,
+        normals,
+        uvs,
+        tangents,
+        mut triangles,
+    } = data;
     let n = positions.len();
     let mut vertices: Vec<Vertex> = (0..n)
         .map(|i| Vertex {
@@ -51,19 +63,26 @@ pub(crate) fn build_world_vertices(data: PrimitiveData, needs_tangents: bool, wo
             generate_tangents(&mut vertices, &triangles);
         } else {
             // Nothing samples a tangent frame without a normal map; any orthonormal one will do.
-            vertices.iter_mut().for_each(|v| v.tangent = any_perpendicular(v.normal).extend(1.0));
+            vertices
+                .iter_mut()
+                .for_each(|v| v.tangent = any_perpendicular(v.normal).extend(1.0));
         }
     }
     to_world(&mut vertices, &mut triangles, world);
     (vertices, triangles)
 }
 
-fn unweld_with_flat_normals(vertices: &[Vertex], triangles: &[[u32; 3]]) -> (Vec<Vertex>, Vec<[u32; 3]>) {
+fn unweld_with_flat_normals(
+    vertices: &[Vertex],
+    triangles: &[[u32; 3]],
+) -> (Vec<Vertex>, Vec<[u32; 3]>) {
     let mut out = Vec::with_capacity(triangles.len() * 3);
     let mut tris = Vec::with_capacity(triangles.len());
     for t in triangles {
         let [a, b, c] = t.map(|i| vertices[i as usize]);
-        let normal = (b.position - a.position).cross(c.position - a.position).normalize_or(Vec3::Z);
+        let normal = (b.position - a.position)
+            .cross(c.position - a.position)
+            .normalize_or(Vec3::Z);
         let base = out.len() as u32;
         out.extend([a, b, c].map(|v| Vertex { normal, ..v }));
         tris.push([base, base + 1, base + 2]);
@@ -95,8 +114,16 @@ fn generate_tangents(vertices: &mut [Vertex], triangles: &[[u32; 3]]) {
     for (i, v) in vertices.iter_mut().enumerate() {
         let n = v.normal;
         let t = (tan[i] - n * n.dot(tan[i])).normalize_or_zero();
-        let t = if t == Vec3::ZERO { any_perpendicular(n) } else { t };
-        let w = if n.cross(t).dot(bitan[i]) < 0.0 { -1.0 } else { 1.0 };
+        let t = if t == Vec3::ZERO {
+            any_perpendicular(n)
+        } else {
+            t
+        };
+        let w = if n.cross(t).dot(bitan[i]) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         v.tangent = t.extend(w);
     }
 }
@@ -115,13 +142,21 @@ pub(crate) fn any_perpendicular(n: Vec3) -> Vec3 {
 fn to_world(vertices: &mut [Vertex], triangles: &mut [[u32; 3]], world: Mat4) {
     let linear = Mat3::from_mat4(world);
     let det = linear.determinant();
-    let normal_matrix = if det.abs() > 1e-30 { linear.inverse().transpose() } else { linear };
+    let normal_matrix = if det.abs() > 1e-30 {
+        linear.inverse().transpose()
+    } else {
+        linear
+    };
     let flip = if det < 0.0 { -1.0 } else { 1.0 };
     for v in vertices.iter_mut() {
         v.position = world.transform_point3(v.position);
         v.normal = (normal_matrix * v.normal).normalize_or(Vec3::Z);
         let t = (linear * v.tangent.truncate()).normalize_or_zero();
-        let t = if t == Vec3::ZERO { any_perpendicular(v.normal) } else { t };
+        let t = if t == Vec3::ZERO {
+            any_perpendicular(v.normal)
+        } else {
+            t
+        };
         v.tangent = t.extend(v.tangent.w.signum() * flip);
     }
     if det < 0.0 {
@@ -135,7 +170,10 @@ mod tests {
 
     #[test]
     fn strips_and_fans_keep_counter_clockwise_winding() {
-        assert_eq!(strip_to_triangles(&[0, 1, 2, 3]), vec![[0, 1, 2], [1, 3, 2]]);
+        assert_eq!(
+            strip_to_triangles(&[0, 1, 2, 3]),
+            vec![[0, 1, 2], [1, 3, 2]]
+        );
         assert_eq!(fan_to_triangles(&[0, 1, 2, 3]), vec![[1, 2, 0], [2, 3, 0]]);
         assert!(strip_to_triangles(&[0, 1]).is_empty());
     }
@@ -145,7 +183,12 @@ mod tests {
         let quad = PrimitiveData {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
             normals: Some(vec![Vec3::Z; 4]),
-            uvs: Some(vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)]),
+            uvs: Some(vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(0.0, 1.0),
+            ]),
             tangents: None,
             triangles: vec![[0, 1, 2], [0, 2, 3]],
         };
@@ -169,7 +212,11 @@ mod tests {
         assert_eq!(t, vec![[0, 2, 1]]);
         let p = t[0].map(|i| v[i as usize].position);
         let geometric = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
-        assert!((geometric - v[0].normal).length() < 1e-6, "normal {:?} vs {geometric:?}", v[0].normal);
+        assert!(
+            (geometric - v[0].normal).length() < 1e-6,
+            "normal {:?} vs {geometric:?}",
+            v[0].normal
+        );
         assert!((v[0].normal - Vec3::Z).length() < 1e-6);
     }
 }

@@ -4,7 +4,9 @@
 //! before the pixels are decoded.
 
 use crate::limits::{over_budget, ByteBudget, TEXELS};
-use crate::source::{decode_data_uri, display_uri, parse_uri, read_bounded, resolve_inside, ReadError, Uri};
+use crate::source::{
+    decode_data_uri, display_uri, parse_uri, read_bounded, resolve_inside, ReadError, Uri,
+};
 use crate::{SceneError, Texture};
 use image::ImageFormat;
 use std::io::Cursor;
@@ -21,7 +23,11 @@ pub(crate) struct ImageInputs<'a> {
 }
 
 /// Decodes `images` (glTF image indices) in order, to RGBA8.
-pub(crate) fn decode_images(json: &gltf::json::Root, images: &[usize], mut inputs: ImageInputs) -> Result<Vec<Texture>, SceneError> {
+pub(crate) fn decode_images(
+    json: &gltf::json::Root,
+    images: &[usize],
+    mut inputs: ImageInputs,
+) -> Result<Vec<Texture>, SceneError> {
     let mut texels_used = 0u64;
     let mut out = Vec::with_capacity(images.len());
     for &index in images {
@@ -49,8 +55,17 @@ impl<'a> Named<'a> {
             (None, Some(view)) => format!("bufferViews[{}]", view.value()),
             (None, None) => "no source".into(),
         };
-        let mime = image.mime_type.as_ref().map(|m| m.0.clone()).or_else(|| image.uri.as_deref().and_then(mime_from_uri));
-        Named { file, index, location, mime }
+        let mime = image
+            .mime_type
+            .as_ref()
+            .map(|m| m.0.clone())
+            .or_else(|| image.uri.as_deref().and_then(mime_from_uri));
+        Named {
+            file,
+            index,
+            location,
+            mime,
+        }
     }
 
     fn error(&self, reason: String) -> SceneError {
@@ -65,7 +80,10 @@ impl<'a> Named<'a> {
 
     fn read_error(&self, e: ReadError) -> SceneError {
         match e {
-            ReadError::Budget(detail) => SceneError::Budget { file: self.file.to_path_buf(), detail },
+            ReadError::Budget(detail) => SceneError::Budget {
+                file: self.file.to_path_buf(),
+                detail,
+            },
             other => self.error(other.to_string()),
         }
     }
@@ -103,7 +121,12 @@ fn unsupported(mime: &str) -> String {
     format!("{mime} is not decoded (only image/png and image/jpeg); for DDS/KTX2/WebP give the texture a PNG or JPEG `source`")
 }
 
-fn encoded_bytes(json: &gltf::json::Root, image: &gltf::json::Image, named: &Named, inputs: &mut ImageInputs) -> Result<Vec<u8>, SceneError> {
+fn encoded_bytes(
+    json: &gltf::json::Root,
+    image: &gltf::json::Image,
+    named: &Named,
+    inputs: &mut ImageInputs,
+) -> Result<Vec<u8>, SceneError> {
     // Refuse a known-undecodable type before reading a byte of it.
     if let Some(mime) = named.mime.as_deref().filter(|m| format_of(m).is_none()) {
         return Err(named.error(unsupported(mime)));
@@ -111,36 +134,72 @@ fn encoded_bytes(json: &gltf::json::Root, image: &gltf::json::Image, named: &Nam
     let what = format!("images[{}]", named.index);
     if let Some(uri) = &image.uri {
         return match parse_uri(uri).map_err(|reason| named.error(reason))? {
-            Uri::Data { payload, .. } => decode_data_uri(payload, inputs.budget, &what).map_err(|reason| named.error(reason)),
+            Uri::Data { payload, .. } => {
+                decode_data_uri(payload, inputs.budget, &what).map_err(|reason| named.error(reason))
+            }
             Uri::Relative(relative) => {
-                let path = resolve_inside(inputs.folder, &relative).map_err(|reason| named.error(reason))?;
+                let path = resolve_inside(inputs.folder, &relative)
+                    .map_err(|reason| named.error(reason))?;
                 read_bounded(&path, None, inputs.budget, &what).map_err(|e| named.read_error(e))
             }
         };
     }
-    let view_index = image.buffer_view.map(|v| v.value()).ok_or_else(|| named.error("it has neither a uri nor a bufferView".into()))?;
-    let view = json.buffer_views.get(view_index).ok_or_else(|| named.error("its bufferView does not exist".into()))?;
+    let view_index = image
+        .buffer_view
+        .map(|v| v.value())
+        .ok_or_else(|| named.error("it has neither a uri nor a bufferView".into()))?;
+    let view = json
+        .buffer_views
+        .get(view_index)
+        .ok_or_else(|| named.error("its bufferView does not exist".into()))?;
     let start = view.byte_offset.map_or(0, |o| o.0);
-    let range = start.checked_add(view.byte_length.0).map(|end| start as usize..end as usize);
+    let range = start
+        .checked_add(view.byte_length.0)
+        .map(|end| start as usize..end as usize);
     let bytes = range.and_then(|r| inputs.buffers.get(view.buffer.value())?.get(r));
-    bytes.map(<[u8]>::to_vec).ok_or_else(|| named.error(format!("bufferViews[{view_index}] reaches past the end of its buffer")))
+    bytes.map(<[u8]>::to_vec).ok_or_else(|| {
+        named.error(format!(
+            "bufferViews[{view_index}] reaches past the end of its buffer"
+        ))
+    })
 }
 
-fn decode(encoded: &[u8], named: &Named, max_texels: u64, texels_used: &mut u64) -> Result<Texture, SceneError> {
+fn decode(
+    encoded: &[u8],
+    named: &Named,
+    max_texels: u64,
+    texels_used: &mut u64,
+) -> Result<Texture, SceneError> {
     let format = match named.mime.as_deref() {
         Some(mime) => format_of(mime).ok_or_else(|| named.error(unsupported(mime)))?,
         None => match image::guess_format(encoded) {
             Ok(f @ (ImageFormat::Png | ImageFormat::Jpeg)) => f,
-            Ok(other) => return Err(named.error(format!("its bytes look like {other:?}, which is not decoded (only PNG and JPEG)"))),
-            Err(_) => return Err(named.error("no mime type, and its bytes are neither PNG nor JPEG".into())),
+            Ok(other) => {
+                return Err(named.error(format!(
+                    "its bytes look like {other:?}, which is not decoded (only PNG and JPEG)"
+                )))
+            }
+            Err(_) => {
+                return Err(
+                    named.error("no mime type, and its bytes are neither PNG nor JPEG".into())
+                )
+            }
         },
     };
     let reason = |e: image::ImageError| named.error(e.to_string());
-    let (width, height) = image::ImageReader::with_format(Cursor::new(encoded), format).into_dimensions().map_err(reason)?;
+    let (width, height) = image::ImageReader::with_format(Cursor::new(encoded), format)
+        .into_dimensions()
+        .map_err(reason)?;
     let texels = width as u64 * height as u64;
     if texels_used.saturating_add(texels) > max_texels {
-        let what = format!("images[{}] ({width}×{height}, {}) with the {texels_used} texels decoded before it", named.index, named.location);
-        return Err(SceneError::Budget { file: named.file.to_path_buf(), detail: over_budget(&TEXELS, max_texels, what) });
+        let what = format!(
+            "images[{}] ({width}×{height}, {}) with the {texels_used} texels decoded before it",
+            named.index, named.location
+        );
+        return Err(SceneError::Budget {
+            file: named.file.to_path_buf(),
+            detail: over_budget(&TEXELS, max_texels, what),
+        });
     }
     let mut reader = image::ImageReader::with_format(Cursor::new(encoded), format);
     let mut limits = image::Limits::default();
@@ -151,7 +210,11 @@ fn decode(encoded: &[u8], named: &Named, max_texels: u64, texels_used: &mut u64)
     reader.limits(limits);
     let rgba8 = reader.decode().map_err(reason)?.into_rgba8().into_raw();
     *texels_used += texels;
-    Ok(Texture { width, height, rgba8 })
+    Ok(Texture {
+        width,
+        height,
+        rgba8,
+    })
 }
 
 #[cfg(test)]
@@ -160,12 +223,18 @@ mod tests {
 
     fn png(img: image::DynamicImage) -> Vec<u8> {
         let mut out = Vec::new();
-        img.write_to(&mut Cursor::new(&mut out), ImageFormat::Png).unwrap();
+        img.write_to(&mut Cursor::new(&mut out), ImageFormat::Png)
+            .unwrap();
         out
     }
 
     fn named(mime: Option<&str>) -> Named<'static> {
-        Named { file: Path::new("s.gltf"), index: 3, location: "uri \"t.png\"".into(), mime: mime.map(str::to_string) }
+        Named {
+            file: Path::new("s.gltf"),
+            index: 3,
+            location: "uri \"t.png\"".into(),
+            mime: mime.map(str::to_string),
+        }
     }
 
     #[test]
@@ -173,8 +242,16 @@ mod tests {
         let grey = image::GrayImage::from_raw(2, 1, vec![10, 20]).unwrap();
         let t = decode(&png(grey.into()), &named(Some("image/png")), 100, &mut 0).unwrap();
         assert_eq!(t.rgba8, vec![10, 10, 10, 255, 20, 20, 20, 255]);
-        let rgb16 = image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(1, 1, vec![65535u16, 0, 32896]).unwrap();
-        let t = decode(&png(image::DynamicImage::ImageRgb16(rgb16)), &named(None), 100, &mut 0).unwrap();
+        let rgb16 =
+            image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(1, 1, vec![65535u16, 0, 32896])
+                .unwrap();
+        let t = decode(
+            &png(image::DynamicImage::ImageRgb16(rgb16)),
+            &named(None),
+            100,
+            &mut 0,
+        )
+        .unwrap();
         assert_eq!(t.rgba8, vec![255, 0, 128, 255]);
     }
 
@@ -182,19 +259,39 @@ mod tests {
     fn texel_budget_is_checked_from_the_header_and_undecodable_bytes_are_named() {
         let img = png(image::RgbaImage::new(8, 8).into());
         let mut used = 40;
-        let err = decode(&img, &named(Some("image/png")), 100, &mut used).unwrap_err().to_string();
-        assert!(err.contains("images[3] (8×8") && err.contains("FOVEA_MAX_TEXELS") && err.contains("budget of 100"), "{err}");
+        let err = decode(&img, &named(Some("image/png")), 100, &mut used)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("images[3] (8×8")
+                && err.contains("FOVEA_MAX_TEXELS")
+                && err.contains("budget of 100"),
+            "{err}"
+        );
         assert_eq!(used, 40);
-        let err = decode(b"not a png at all", &named(Some("image/png")), 100, &mut 0).unwrap_err().to_string();
-        assert!(err.contains("images[3]") && err.contains("t.png") && err.contains("image/png"), "{err}");
-        let err = decode(b"DDS |....", &named(Some("image/vnd-ms.dds")), 100, &mut 0).unwrap_err().to_string();
+        let err = decode(b"not a png at all", &named(Some("image/png")), 100, &mut 0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("images[3]") && err.contains("t.png") && err.contains("image/png"),
+            "{err}"
+        );
+        let err = decode(b"DDS |....", &named(Some("image/vnd-ms.dds")), 100, &mut 0)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("image/vnd-ms.dds is not decoded"), "{err}");
     }
 
     #[test]
     fn mime_types_come_from_data_uris_and_extensions() {
-        assert_eq!(mime_from_uri("data:image/jpeg;base64,AAAA").as_deref(), Some("image/jpeg"));
-        assert_eq!(mime_from_uri("tex/Floor.DDS").as_deref(), Some("image/vnd-ms.dds"));
+        assert_eq!(
+            mime_from_uri("data:image/jpeg;base64,AAAA").as_deref(),
+            Some("image/jpeg")
+        );
+        assert_eq!(
+            mime_from_uri("tex/Floor.DDS").as_deref(),
+            Some("image/vnd-ms.dds")
+        );
         assert_eq!(mime_from_uri("a.png?x=1").as_deref(), Some("image/png"));
         assert_eq!(mime_from_uri("noext"), None);
     }

@@ -58,20 +58,28 @@ impl Instance {
             position: self.world_from_object.transform_point3(v.position),
             normal: (normal_matrix * v.normal).normalize_or(Vec3::Z),
             uv: v.uv,
-            tangent: (linear * v.tangent.truncate()).normalize_or(Vec3::X).extend(v.tangent.w * flip),
+            tangent: (linear * v.tangent.truncate())
+                .normalize_or(Vec3::X)
+                .extend(v.tangent.w * flip),
         }
     }
 }
 
 impl Instancing {
     pub fn placed_triangles(&self) -> usize {
-        self.instances.iter().map(|i| self.meshes[i.mesh as usize].triangles.len()).sum()
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh as usize].triangles.len())
+            .sum()
     }
 
     /// Object-space triangle corners of mesh `m`, by local index (its BLAS's input).
     pub fn mesh_positions(&self, m: usize) -> Vec<[Vec3; 3]> {
         let mesh = &self.meshes[m];
-        mesh.triangles.iter().map(|t| t.indices.map(|i| mesh.vertices[i as usize].position)).collect()
+        mesh.triangles
+            .iter()
+            .map(|t| t.indices.map(|i| mesh.vertices[i as usize].position))
+            .collect()
     }
 
     /// Gives the instances consecutive placed ids after the `flat` flattened triangles; `None`
@@ -95,22 +103,35 @@ impl Scene {
 
     /// Triangles uploaded once: the flattened ones plus each instanced mesh's.
     pub fn unique_triangle_count(&self) -> usize {
-        self.triangles.len() + self.instancing.meshes.iter().map(|m| m.triangles.len()).sum::<usize>()
+        self.triangles.len()
+            + self
+                .instancing
+                .meshes
+                .iter()
+                .map(|m| m.triangles.len())
+                .sum::<usize>()
     }
 
     /// The same scene with every instance copied into world space, triangles in placed-id order
     /// (mirrored copies with two indices swapped, as the loader flattens): the reference the
     /// instanced traversal and shading are tested against.
     pub fn flattened(&self) -> Scene {
-        let mut out = Scene { instancing: Instancing::default(), ..self.clone() };
+        let mut out = Scene {
+            instancing: Instancing::default(),
+            ..self.clone()
+        };
         for inst in &self.instancing.instances {
             let mesh = &self.instancing.meshes[inst.mesh as usize];
             let base = out.vertices.len() as u32;
-            out.vertices.extend(mesh.vertices.iter().map(|v| inst.vertex_to_world(v)));
+            out.vertices
+                .extend(mesh.vertices.iter().map(|v| inst.vertex_to_world(v)));
             let mirror = inst.mirrors();
             out.triangles.extend(mesh.triangles.iter().map(|t| {
                 let [a, b, c] = t.indices.map(|i| i + base);
-                Triangle { indices: if mirror { [a, c, b] } else { [a, b, c] }, ..*t }
+                Triangle {
+                    indices: if mirror { [a, c, b] } else { [a, b, c] },
+                    ..*t
+                }
             }));
         }
         out
@@ -119,12 +140,18 @@ impl Scene {
     /// Every placed triangle in id order: its world-space corners (counter-clockwise from the
     /// front, as [`Scene::flattened`]) and its flattened or mesh triangle.
     pub fn placed_triangles(&self) -> impl Iterator<Item = ([Vec3; 3], &Triangle)> + '_ {
-        let flat = self.triangles.iter().map(|t| (t.indices.map(|i| self.vertices[i as usize].position), t));
+        let flat = self
+            .triangles
+            .iter()
+            .map(|t| (t.indices.map(|i| self.vertices[i as usize].position), t));
         let instanced = self.instancing.instances.iter().flat_map(move |inst| {
             let mesh = &self.instancing.meshes[inst.mesh as usize];
             let mirror = inst.mirrors();
             mesh.triangles.iter().map(move |t| {
-                let [a, b, c] = t.indices.map(|i| inst.world_from_object.transform_point3(mesh.vertices[i as usize].position));
+                let [a, b, c] = t.indices.map(|i| {
+                    inst.world_from_object
+                        .transform_point3(mesh.vertices[i as usize].position)
+                });
                 (if mirror { [a, c, b] } else { [a, b, c] }, t)
             })
         });

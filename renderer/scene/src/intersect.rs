@@ -55,13 +55,31 @@ impl WatertightRay {
         let abs = d.abs();
         // kz: the dimension where |dir| is largest; kx, ky follow cyclically. Ties resolve exactly
         // as in shaders/common/bvh.glsl (strict comparisons), so both pick the same permutation.
-        let kz = if abs.x > abs.y { if abs.x > abs.z { 0 } else { 2 } } else if abs.y > abs.z { 1 } else { 2 };
+        let kz = if abs.x > abs.y {
+            if abs.x > abs.z {
+                0
+            } else {
+                2
+            }
+        } else if abs.y > abs.z {
+            1
+        } else {
+            2
+        };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky); // preserve the winding of the triangle's edges
         }
-        WatertightRay { origin: ray.origin, kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
+        WatertightRay {
+            origin: ray.origin,
+            kx,
+            ky,
+            kz,
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
+        }
     }
 
     /// Returns `(t, u, v)` with u, v the barycentric weights of v1 and v2.
@@ -101,7 +119,13 @@ impl WatertightRay {
 }
 
 /// Watertight, two-sided ray–triangle test; `(t, u, v)` for a hit with `0 < t < t_max`.
-pub fn intersect_triangle(ray: &Ray, v0: Vec3, v1: Vec3, v2: Vec3, t_max: f32) -> Option<(f32, f32, f32)> {
+pub fn intersect_triangle(
+    ray: &Ray,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
     WatertightRay::new(ray).intersect(v0, v1, v2, t_max)
 }
 
@@ -112,7 +136,12 @@ pub fn brute_force(tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> 
     let mut best: Option<Hit> = None;
     for (i, tri) in tris.iter().enumerate() {
         if let Some((t, u, v)) = wray.intersect(tri[0], tri[1], tri[2], t_max) {
-            let hit = Hit { t, triangle: i as u32, u, v };
+            let hit = Hit {
+                t,
+                triangle: i as u32,
+                u,
+                v,
+            };
             if any_hit {
                 return Some(hit);
             }
@@ -128,40 +157,86 @@ pub fn brute_force(tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> 
 mod tests {
     use super::*;
 
-    const TRI: [Vec3; 3] = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+    const TRI: [Vec3; 3] = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
 
     #[test]
     fn hit_distance_and_barycentrics_from_both_sides() {
-        for (origin, dir) in [(Vec3::new(0.25, 0.5, 2.0), Vec3::new(0.0, 0.0, -1.0)), (Vec3::new(0.25, 0.5, -4.0), Vec3::new(0.0, 0.0, 2.0))] {
+        for (origin, dir) in [
+            (Vec3::new(0.25, 0.5, 2.0), Vec3::new(0.0, 0.0, -1.0)),
+            (Vec3::new(0.25, 0.5, -4.0), Vec3::new(0.0, 0.0, 2.0)),
+        ] {
             let ray = Ray { origin, dir };
-            let (t, u, v) = intersect_triangle(&ray, TRI[0], TRI[1], TRI[2], f32::INFINITY).expect("hit");
+            let (t, u, v) =
+                intersect_triangle(&ray, TRI[0], TRI[1], TRI[2], f32::INFINITY).expect("hit");
             assert!((t - 2.0).abs() < 1e-6, "t = {t}");
-            assert!((u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6, "u = {u}, v = {v}");
+            assert!(
+                (u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6,
+                "u = {u}, v = {v}"
+            );
         }
     }
 
     #[test]
     fn misses_outside_behind_and_beyond_t_max() {
         let down = Vec3::new(0.0, 0.0, -1.0);
-        let outside = Ray { origin: Vec3::new(0.75, 0.75, 1.0), dir: down };
+        let outside = Ray {
+            origin: Vec3::new(0.75, 0.75, 1.0),
+            dir: down,
+        };
         assert!(intersect_triangle(&outside, TRI[0], TRI[1], TRI[2], f32::INFINITY).is_none());
-        let behind = Ray { origin: Vec3::new(0.2, 0.2, -1.0), dir: down };
+        let behind = Ray {
+            origin: Vec3::new(0.2, 0.2, -1.0),
+            dir: down,
+        };
         assert!(intersect_triangle(&behind, TRI[0], TRI[1], TRI[2], f32::INFINITY).is_none());
-        let short = Ray { origin: Vec3::new(0.2, 0.2, 1.0), dir: down };
-        assert!(intersect_triangle(&short, TRI[0], TRI[1], TRI[2], 1.0).is_none(), "t == t_max is a miss");
+        let short = Ray {
+            origin: Vec3::new(0.2, 0.2, 1.0),
+            dir: down,
+        };
+        assert!(
+            intersect_triangle(&short, TRI[0], TRI[1], TRI[2], 1.0).is_none(),
+            "t == t_max is a miss"
+        );
         assert!(intersect_triangle(&short, TRI[0], TRI[1], TRI[2], 1.0001).is_some());
-        let parallel = Ray { origin: Vec3::new(-1.0, 0.2, 0.0), dir: Vec3::X };
+        let parallel = Ray {
+            origin: Vec3::new(-1.0, 0.2, 0.0),
+            dir: Vec3::X,
+        };
         assert!(intersect_triangle(&parallel, TRI[0], TRI[1], TRI[2], f32::INFINITY).is_none());
     }
 
     #[test]
     fn shared_edge_ties_resolve_to_the_lower_triangle_index() {
         // Two triangles sharing the diagonal of the unit square; the ray hits the diagonal exactly.
-        let tris = [[Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::ZERO], [Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)]];
-        let ray = Ray { origin: Vec3::new(0.5, 0.5, 1.0), dir: Vec3::new(0.0, 0.0, -1.0) };
-        let hit = brute_force(&tris, &ray, f32::INFINITY, false).expect("an edge hit must not leak");
+        let tris = [
+            [
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::ZERO,
+            ],
+            [
+                Vec3::ZERO,
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+        ];
+        let ray = Ray {
+            origin: Vec3::new(0.5, 0.5, 1.0),
+            dir: Vec3::new(0.0, 0.0, -1.0),
+        };
+        let hit =
+            brute_force(&tris, &ray, f32::INFINITY, false).expect("an edge hit must not leak");
         assert_eq!(hit.triangle, 0);
         let reversed = [tris[1], tris[0]];
-        assert_eq!(brute_force(&reversed, &ray, f32::INFINITY, false).unwrap().triangle, 0);
+        assert_eq!(
+            brute_force(&reversed, &ray, f32::INFINITY, false)
+                .unwrap()
+                .triangle,
+            0
+        );
     }
 }

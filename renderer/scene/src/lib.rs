@@ -30,7 +30,9 @@ pub use bvh::{Bvh, BvhNode};
 pub use environment::{EnvironmentDistribution, EnvironmentMap};
 pub use instancing::{Instance, InstancedMesh, Instancing};
 pub use intersect::{Hit, Ray};
-pub use lights::{build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable};
+pub use lights::{
+    build_light_table, build_light_table_scaled, AliasSlot, LightEntry, LightKind, LightTable,
+};
 pub use limits::LoadLimits;
 pub use validate::MAX_EMISSIVE_STRENGTH;
 
@@ -128,8 +130,14 @@ pub enum TextureSlot {
 
 impl TextureSlot {
     pub const COUNT: usize = 6;
-    pub const ALL: [TextureSlot; TextureSlot::COUNT] =
-        [Self::BaseColor, Self::MetallicRoughness, Self::Normal, Self::Emissive, Self::Specular, Self::SpecularColor];
+    pub const ALL: [TextureSlot; TextureSlot::COUNT] = [
+        Self::BaseColor,
+        Self::MetallicRoughness,
+        Self::Normal,
+        Self::Emissive,
+        Self::Specular,
+        Self::SpecularColor,
+    ];
 
     /// Whether the slot's texels are sRGB-encoded colour (glTF: base colour, emissive, specular
     /// colour); the others hold linear data.
@@ -162,7 +170,11 @@ pub struct UvTransform {
 }
 
 impl UvTransform {
-    pub const IDENTITY: UvTransform = UvTransform { offset: Vec2::ZERO, rotation: 0.0, scale: Vec2::ONE };
+    pub const IDENTITY: UvTransform = UvTransform {
+        offset: Vec2::ZERO,
+        rotation: 0.0,
+        scale: Vec2::ONE,
+    };
 
     /// The affine map as two rows: u' = rows[0].xy · uv + rows[0].z, v' likewise with rows[1]
     /// (the extension's matrix T · R · S).
@@ -225,9 +237,23 @@ pub struct Texture {
 /// KHR_lights_punctual lights in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PunctualLight {
-    Point { position: Vec3, intensity: Vec3, range: Option<f32> },
-    Spot { position: Vec3, direction: Vec3, intensity: Vec3, range: Option<f32>, inner_cone: f32, outer_cone: f32 },
-    Directional { direction: Vec3, illuminance: Vec3 },
+    Point {
+        position: Vec3,
+        intensity: Vec3,
+        range: Option<f32>,
+    },
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        range: Option<f32>,
+        inner_cone: f32,
+        outer_cone: f32,
+    },
+    Directional {
+        direction: Vec3,
+        illuminance: Vec3,
+    },
 }
 
 /// A perspective camera. `world_from_view` maps glTF view space (−Z forward, +Y up, +X right)
@@ -256,7 +282,11 @@ pub struct Sky {
 impl Sky {
     /// The same radiance in every direction.
     pub fn uniform(radiance: Vec3) -> Sky {
-        Sky { zenith: radiance, horizon: radiance, ground: radiance }
+        Sky {
+            zenith: radiance,
+            horizon: radiance,
+            ground: radiance,
+        }
     }
     pub fn is_black(&self) -> bool {
         self.zenith == Vec3::ZERO && self.horizon == Vec3::ZERO && self.ground == Vec3::ZERO
@@ -272,7 +302,10 @@ pub struct Aabb {
 }
 
 impl Aabb {
-    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(1e30), max: Vec3::splat(-1e30) };
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(1e30),
+        max: Vec3::splat(-1e30),
+    };
 
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
@@ -282,7 +315,10 @@ impl Aabb {
         self.max = self.max.max(p);
     }
     pub fn union(&self, other: &Aabb) -> Aabb {
-        Aabb { min: self.min.min(other.min), max: self.max.max(other.max) }
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
     }
     pub fn contains_point(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
@@ -300,7 +336,11 @@ impl Aabb {
     }
     /// Radius of the sphere around `center()` that encloses the box; 0 when empty.
     pub fn bounding_sphere_radius(&self) -> f32 {
-        if self.is_empty() { 0.0 } else { (self.max - self.min).length() * 0.5 }
+        if self.is_empty() {
+            0.0
+        } else {
+            (self.max - self.min).length() * 0.5
+        }
     }
     pub fn of_points(points: &[Vec3]) -> Aabb {
         let mut b = Aabb::EMPTY;
@@ -313,7 +353,10 @@ impl Aabb {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     #[error("{}: cannot read the file: {source}", file.display())]
-    Io { file: PathBuf, source: std::io::Error },
+    Io {
+        file: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{}: not a readable glTF/GLB file (malformed JSON or binary container): {detail}", file.display())]
     Malformed { file: PathBuf, detail: String },
     #[error("{}: invalid glTF: {detail}", file.display())]
@@ -323,14 +366,30 @@ pub enum SceneError {
     #[error("{}: cannot load buffer or image data: {detail}", file.display())]
     Data { file: PathBuf, detail: String },
     #[error("{}: mesh '{mesh}' primitive {primitive}: {problem}", file.display())]
-    BadPrimitive { file: PathBuf, mesh: String, primitive: usize, problem: String },
+    BadPrimitive {
+        file: PathBuf,
+        mesh: String,
+        primitive: usize,
+        problem: String,
+    },
     /// A buffer that cannot be read: `item` is e.g. `buffers[2]`; `uri` is shown without data-URI
     /// payloads.
     #[error("{}: {item} (uri \"{uri}\"): {reason}", file.display())]
-    Reference { file: PathBuf, item: String, uri: String, reason: String },
+    Reference {
+        file: PathBuf,
+        item: String,
+        uri: String,
+        reason: String,
+    },
     /// An image that cannot be read or decoded; `location` is its URI or bufferView.
     #[error("{}: images[{index}] ({location}, mime type {mime}) cannot be loaded: {reason}", file.display())]
-    Image { file: PathBuf, index: usize, location: String, mime: String, reason: String },
+    Image {
+        file: PathBuf,
+        index: usize,
+        location: String,
+        mime: String,
+        reason: String,
+    },
     /// A [`LoadLimits`] budget would be exceeded; `detail` names the budget and how to raise it.
     #[error("{}: {detail}", file.display())]
     Budget { file: PathBuf, detail: String },
@@ -342,7 +401,10 @@ impl Scene {
     /// Orthographic cameras are ignored (the tracer only has a perspective model); a scene without
     /// a perspective camera loads with `cameras` empty and the caller chooses a fallback.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let limits = LoadLimits::from_env().map_err(|detail| SceneError::Budget { file: path.to_path_buf(), detail })?;
+        let limits = LoadLimits::from_env().map_err(|detail| SceneError::Budget {
+            file: path.to_path_buf(),
+            detail,
+        })?;
         load::load(path, &limits)
     }
 
@@ -363,12 +425,17 @@ impl Scene {
     /// World-space corners of every placed triangle, by placed id (instances expanded: what a
     /// flat reference traverses; the world BVH's input is [`Scene::flat_positions`]).
     pub fn triangle_positions(&self) -> Vec<[Vec3; 3]> {
-        self.placed_triangles().map(|(corners, _)| corners).collect()
+        self.placed_triangles()
+            .map(|(corners, _)| corners)
+            .collect()
     }
 
     /// World-space corners of the flattened triangles only (the world-space BVH's input).
     pub fn flat_positions(&self) -> Vec<[Vec3; 3]> {
-        self.triangles.iter().map(|t| t.indices.map(|i| self.vertices[i as usize].position)).collect()
+        self.triangles
+            .iter()
+            .map(|t| t.indices.map(|i| self.vertices[i as usize].position))
+            .collect()
     }
 
     /// The first perspective camera, if any.
@@ -381,7 +448,9 @@ impl Scene {
     pub fn environment_map(&self) -> Option<std::borrow::Cow<'_, EnvironmentMap>> {
         match &self.environment {
             Some(m) => Some(std::borrow::Cow::Borrowed(m)),
-            None if !self.sky.is_black() => Some(std::borrow::Cow::Owned(EnvironmentMap::from_sky(&self.sky))),
+            None if !self.sky.is_black() => {
+                Some(std::borrow::Cow::Owned(EnvironmentMap::from_sky(&self.sky)))
+            }
             None => None,
         }
     }
@@ -392,8 +461,17 @@ impl Scene {
         if !self.punctual_lights.is_empty() {
             return true;
         }
-        let emissive: Vec<bool> = self.materials.iter().map(|m| m.emissive.max_element() > 0.0).collect();
-        let mut used = self.instancing.meshes.iter().flat_map(|m| &m.triangles).chain(&self.triangles);
+        let emissive: Vec<bool> = self
+            .materials
+            .iter()
+            .map(|m| m.emissive.max_element() > 0.0)
+            .collect();
+        let mut used = self
+            .instancing
+            .meshes
+            .iter()
+            .flat_map(|m| &m.triangles)
+            .chain(&self.triangles);
         used.any(|t| emissive.get(t.material as usize).copied().unwrap_or(false))
     }
 
@@ -417,10 +495,20 @@ impl Camera {
     /// vertical FOV `yfov` (radians). `position` ≠ `target`.
     pub fn look_at(position: Vec3, target: Vec3, yfov: f32, name: &str) -> Camera {
         let forward = (target - position).normalize();
-        let up = if forward.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y };
+        let up = if forward.cross(Vec3::Y).length_squared() < 1e-6 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
         let view_from_world = Mat4::look_at_rh(position, target, up);
         let distance = (target - position).length();
-        Camera { world_from_view: view_from_world.inverse(), yfov, aspect: None, znear: (distance * 1e-3).max(1e-5), name: name.to_owned() }
+        Camera {
+            world_from_view: view_from_world.inverse(),
+            yfov,
+            aspect: None,
+            znear: (distance * 1e-3).max(1e-5),
+            name: name.to_owned(),
+        }
     }
 
     /// A camera that sees all of `bounds`: it looks at the centre from the front-right diagonal
@@ -434,13 +522,21 @@ impl Camera {
         let tan_y = (yfov * 0.5).tan();
         let half = tan_y.min(tan_y * aspect).atan();
         let distance = FRAMING_MARGIN * radius / half.sin();
-        let (az, el) = (FRAMING_AZIMUTH_DEG.to_radians(), FRAMING_ELEVATION_DEG.to_radians());
+        let (az, el) = (
+            FRAMING_AZIMUTH_DEG.to_radians(),
+            FRAMING_ELEVATION_DEG.to_radians(),
+        );
         let from = Vec3::new(az.sin() * el.cos(), el.sin(), az.cos() * el.cos());
-        Camera::look_at(centre + from * distance, centre, yfov, "default (frames the scene)")
+        Camera::look_at(
+            centre + from * distance,
+            centre,
+            yfov,
+            "default (frames the scene)",
+        )
     }
 }
 
 #[cfg(test)]
-mod load_tests;
-#[cfg(test)]
 mod load_safety_tests;
+#[cfg(test)]
+mod load_tests;

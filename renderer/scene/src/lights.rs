@@ -62,7 +62,11 @@ pub fn luminance(c: Vec3) -> f32 {
 }
 
 fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Mean linear RGB of an sRGB-encoded texture (emissive textures are sRGB).
@@ -70,7 +74,9 @@ fn mean_linear_colour(texture: &Texture) -> Vec3 {
     let lut: Vec<f32> = (0..256).map(|v| srgb_to_linear(v as f32 / 255.0)).collect();
     let texels = texture.rgba8.chunks_exact(4);
     let count = texels.len().max(1);
-    let sum = texels.fold(Vec3::ZERO, |acc, t| acc + Vec3::new(lut[t[0] as usize], lut[t[1] as usize], lut[t[2] as usize]));
+    let sum = texels.fold(Vec3::ZERO, |acc, t| {
+        acc + Vec3::new(lut[t[0] as usize], lut[t[1] as usize], lut[t[2] as usize])
+    });
     sum / count as f32
 }
 
@@ -93,41 +99,70 @@ pub fn build_light_table_scaled(scene: &Scene, emission_scale: &[f32]) -> LightT
                 let texture = scene.textures.get(t as usize)?;
                 Some(*texture_means[t as usize].get_or_insert_with(|| mean_linear_colour(texture)))
             });
-            m.emissive * texture_mean.unwrap_or(Vec3::ONE) * emission_scale.get(i).copied().unwrap_or(1.0)
+            m.emissive
+                * texture_mean.unwrap_or(Vec3::ONE)
+                * emission_scale.get(i).copied().unwrap_or(1.0)
         })
         .collect();
     // Placed ids: an instanced emissive mesh is listed once per instance, in world space.
     for (i, ([a, b, c], tri)) in scene.placed_triangles().enumerate() {
-        let emission = material_emission.get(tri.material as usize).copied().unwrap_or(Vec3::ZERO);
+        let emission = material_emission
+            .get(tri.material as usize)
+            .copied()
+            .unwrap_or(Vec3::ZERO);
         let lum = luminance(emission);
         if lum <= 0.0 {
             continue;
         }
         let area = 0.5 * (b - a).cross(c - a).length();
-        entries.push(LightEntry { kind: LightKind::EmissiveTriangle, index: i as u32, power: lum * area * PI });
+        entries.push(LightEntry {
+            kind: LightKind::EmissiveTriangle,
+            index: i as u32,
+            power: lum * area * PI,
+        });
     }
     let scene_radius = scene.bounds().bounding_sphere_radius();
     for (i, light) in scene.punctual_lights.iter().enumerate() {
         let (kind, power) = match *light {
-            PunctualLight::Point { intensity, .. } => (LightKind::Point, 4.0 * PI * luminance(intensity)),
-            PunctualLight::Spot { intensity, outer_cone, .. } => {
-                (LightKind::Spot, 2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity))
+            PunctualLight::Point { intensity, .. } => {
+                (LightKind::Point, 4.0 * PI * luminance(intensity))
             }
-            PunctualLight::Directional { illuminance, .. } => {
-                (LightKind::Directional, luminance(illuminance) * PI * scene_radius * scene_radius)
-            }
+            PunctualLight::Spot {
+                intensity,
+                outer_cone,
+                ..
+            } => (
+                LightKind::Spot,
+                2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity),
+            ),
+            PunctualLight::Directional { illuminance, .. } => (
+                LightKind::Directional,
+                luminance(illuminance) * PI * scene_radius * scene_radius,
+            ),
         };
-        entries.push(LightEntry { kind, index: i as u32, power });
+        entries.push(LightEntry {
+            kind,
+            index: i as u32,
+            power,
+        });
     }
     if let Some(map) = scene.environment_map() {
         let power = map.luminance_integral() * PI * scene_radius * scene_radius;
-        entries.push(LightEntry { kind: LightKind::Environment, index: 0, power });
+        entries.push(LightEntry {
+            kind: LightKind::Environment,
+            index: 0,
+            power,
+        });
     }
     entries.retain(|e| e.power > 0.0 && e.power.is_finite());
     let powers: Vec<f64> = entries.iter().map(|e| e.power as f64).collect();
     let alias = build_alias_table(&powers);
     let total_power = powers.iter().sum::<f64>() as f32;
-    LightTable { entries, alias, total_power }
+    LightTable {
+        entries,
+        alias,
+        total_power,
+    }
 }
 
 /// Vose's alias method in f64 (exact up to the final rounding to f32).
@@ -139,8 +174,13 @@ pub fn build_alias_table(weights: &[f64]) -> Vec<AliasSlot> {
         return Vec::new();
     }
     let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
-    let mut slots: Vec<AliasSlot> =
-        (0..n).map(|i| AliasSlot { threshold: 1.0, alias: i as u32, pdf: (weights[i] / total) as f32 }).collect();
+    let mut slots: Vec<AliasSlot> = (0..n)
+        .map(|i| AliasSlot {
+            threshold: 1.0,
+            alias: i as u32,
+            pdf: (weights[i] / total) as f32,
+        })
+        .collect();
     let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
     while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
         small.pop();
@@ -165,7 +205,11 @@ pub fn sample_alias(slots: &[AliasSlot], u: f32) -> usize {
     let n = slots.len();
     let scaled = u * n as f32;
     let i = (scaled as usize).min(n - 1);
-    if scaled - (i as f32) < slots[i].threshold { i } else { slots[i].alias as usize }
+    if scaled - (i as f32) < slots[i].threshold {
+        i
+    } else {
+        slots[i].alias as usize
+    }
 }
 
 #[cfg(test)]

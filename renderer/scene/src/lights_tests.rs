@@ -5,7 +5,15 @@ use glam::{Vec2, Vec4};
 
 fn random_weights(rng: &mut TestRng, n: usize) -> Vec<f64> {
     // A wide dynamic range, with a few tiny ones, as real scenes have.
-    (0..n).map(|i| if i % 7 == 3 { 1e-3 } else { (rng.f32() as f64 * 4.0).exp() }).collect()
+    (0..n)
+        .map(|i| {
+            if i % 7 == 3 {
+                1e-3
+            } else {
+                (rng.f32() as f64 * 4.0).exp()
+            }
+        })
+        .collect()
 }
 
 #[test]
@@ -22,7 +30,12 @@ fn alias_table_is_exact() {
             mass[s.alias as usize] += (1.0 - s.threshold as f64) / n as f64;
         }
         for i in 0..n {
-            assert!((mass[i] - w[i] / total).abs() < 1e-6, "n={n} entry {i}: {} vs {}", mass[i], w[i] / total);
+            assert!(
+                (mass[i] - w[i] / total).abs() < 1e-6,
+                "n={n} entry {i}: {} vs {}",
+                mass[i],
+                w[i] / total
+            );
             assert!((slots[i].pdf as f64 - w[i] / total).abs() < 1e-6);
         }
         let pdf_sum: f64 = slots.iter().map(|s| s.pdf as f64).sum();
@@ -62,39 +75,118 @@ fn empty_scene_gives_empty_table() {
 
 #[test]
 fn powers_follow_the_documented_formulas() {
-    let v = |p: Vec3| Vertex { position: p, normal: Vec3::Z, uv: Vec2::ZERO, tangent: Vec4::X };
+    let v = |p: Vec3| Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    };
     let mut scene = Scene {
-        vertices: vec![v(Vec3::ZERO), v(Vec3::new(2.0, 0.0, 0.0)), v(Vec3::new(0.0, 1.0, 0.0))],
-        triangles: vec![Triangle { indices: [0, 1, 2], material: 1, mesh: 0 }, Triangle { indices: [0, 1, 2], material: 0, mesh: 0 }],
-        materials: vec![Material::default(), Material { emissive: Vec3::splat(3.0), ..Material::default() }],
+        vertices: vec![
+            v(Vec3::ZERO),
+            v(Vec3::new(2.0, 0.0, 0.0)),
+            v(Vec3::new(0.0, 1.0, 0.0)),
+        ],
+        triangles: vec![
+            Triangle {
+                indices: [0, 1, 2],
+                material: 1,
+                mesh: 0,
+            },
+            Triangle {
+                indices: [0, 1, 2],
+                material: 0,
+                mesh: 0,
+            },
+        ],
+        materials: vec![
+            Material::default(),
+            Material {
+                emissive: Vec3::splat(3.0),
+                ..Material::default()
+            },
+        ],
         ..Scene::default()
     };
     scene.punctual_lights = vec![
-        PunctualLight::Point { position: Vec3::ONE, intensity: Vec3::splat(2.0), range: None },
-        PunctualLight::Spot { position: Vec3::ONE, direction: Vec3::NEG_Y, intensity: Vec3::splat(2.0), range: None, inner_cone: 0.1, outer_cone: 0.5 },
-        PunctualLight::Directional { direction: Vec3::NEG_Y, illuminance: Vec3::splat(5.0) },
-        PunctualLight::Point { position: Vec3::ONE, intensity: Vec3::ZERO, range: None },
+        PunctualLight::Point {
+            position: Vec3::ONE,
+            intensity: Vec3::splat(2.0),
+            range: None,
+        },
+        PunctualLight::Spot {
+            position: Vec3::ONE,
+            direction: Vec3::NEG_Y,
+            intensity: Vec3::splat(2.0),
+            range: None,
+            inner_cone: 0.1,
+            outer_cone: 0.5,
+        },
+        PunctualLight::Directional {
+            direction: Vec3::NEG_Y,
+            illuminance: Vec3::splat(5.0),
+        },
+        PunctualLight::Point {
+            position: Vec3::ONE,
+            intensity: Vec3::ZERO,
+            range: None,
+        },
     ];
     let table = build_light_table(&scene);
     let kinds: Vec<_> = table.entries.iter().map(|e| (e.kind, e.index)).collect();
-    assert_eq!(kinds, vec![(LightKind::EmissiveTriangle, 0), (LightKind::Point, 0), (LightKind::Spot, 1), (LightKind::Directional, 2)]);
+    assert_eq!(
+        kinds,
+        vec![
+            (LightKind::EmissiveTriangle, 0),
+            (LightKind::Point, 0),
+            (LightKind::Spot, 1),
+            (LightKind::Directional, 2)
+        ]
+    );
     let r = scene.bounds().bounding_sphere_radius();
-    let expected = [3.0 * 1.0 * PI, 4.0 * PI * 2.0, 2.0 * PI * (1.0 - 0.5f32.cos()) * 2.0, 5.0 * PI * r * r];
+    let expected = [
+        3.0 * 1.0 * PI,
+        4.0 * PI * 2.0,
+        2.0 * PI * (1.0 - 0.5f32.cos()) * 2.0,
+        5.0 * PI * r * r,
+    ];
     for (e, x) in table.entries.iter().zip(expected) {
-        assert!((e.power - x).abs() < 1e-4 * x, "{:?}: {} vs {x}", e.kind, e.power);
+        assert!(
+            (e.power - x).abs() < 1e-4 * x,
+            "{:?}: {} vs {x}",
+            e.kind,
+            e.power
+        );
     }
     assert!((table.total_power - expected.iter().sum::<f32>()).abs() < 1e-3);
 }
 
 #[test]
 fn emissive_texture_mean_scales_triangle_power() {
-    let v = |p: Vec3| Vertex { position: p, normal: Vec3::Z, uv: Vec2::ZERO, tangent: Vec4::X };
+    let v = |p: Vec3| Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    };
     let scene = Scene {
         vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
-        triangles: vec![Triangle { indices: [0, 1, 2], material: 0, mesh: 0 }],
-        materials: vec![Material { emissive: Vec3::ONE, emissive_texture: Some(0), ..Material::default() }],
+        triangles: vec![Triangle {
+            indices: [0, 1, 2],
+            material: 0,
+            mesh: 0,
+        }],
+        materials: vec![Material {
+            emissive: Vec3::ONE,
+            emissive_texture: Some(0),
+            ..Material::default()
+        }],
         // Half the texels white, half black: mean linear colour 0.5.
-        textures: vec![Texture { width: 2, height: 1, rgba8: vec![255, 255, 255, 255, 0, 0, 0, 255] }],
+        textures: vec![Texture {
+            width: 2,
+            height: 1,
+            rgba8: vec![255, 255, 255, 255, 0, 0, 0, 255],
+        }],
         ..Scene::default()
     };
     let table = build_light_table(&scene);
@@ -103,20 +195,56 @@ fn emissive_texture_mean_scales_triangle_power() {
 
 #[test]
 fn emission_scale_dims_or_drops_a_materials_triangles() {
-    let v = |p: Vec3| Vertex { position: p, normal: Vec3::Z, uv: Vec2::ZERO, tangent: Vec4::X };
+    let v = |p: Vec3| Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    };
     let scene = Scene {
         vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
-        triangles: vec![Triangle { indices: [0, 1, 2], material: 0, mesh: 0 }, Triangle { indices: [0, 1, 2], material: 1, mesh: 1 }],
-        materials: vec![Material { emissive: Vec3::ONE, ..Material::default() }, Material { emissive: Vec3::ONE, ..Material::default() }],
+        triangles: vec![
+            Triangle {
+                indices: [0, 1, 2],
+                material: 0,
+                mesh: 0,
+            },
+            Triangle {
+                indices: [0, 1, 2],
+                material: 1,
+                mesh: 1,
+            },
+        ],
+        materials: vec![
+            Material {
+                emissive: Vec3::ONE,
+                ..Material::default()
+            },
+            Material {
+                emissive: Vec3::ONE,
+                ..Material::default()
+            },
+        ],
         ..Scene::default()
     };
     let full = build_light_table(&scene);
     let dimmed = build_light_table_scaled(&scene, &[0.25]);
     assert_eq!(dimmed.entries.len(), 2);
     assert!((dimmed.entries[0].power - 0.25 * full.entries[0].power).abs() < 1e-6);
-    assert_eq!(dimmed.entries[1].power, full.entries[1].power, "materials beyond the slice keep their emission");
-    assert!((dimmed.alias[0].pdf - 0.2).abs() < 1e-6, "pdfs follow the new powers");
+    assert_eq!(
+        dimmed.entries[1].power, full.entries[1].power,
+        "materials beyond the slice keep their emission"
+    );
+    assert!(
+        (dimmed.alias[0].pdf - 0.2).abs() < 1e-6,
+        "pdfs follow the new powers"
+    );
     let off = build_light_table_scaled(&scene, &[1.0, 0.0]);
-    assert_eq!(off.entries.iter().map(|e| e.index).collect::<Vec<_>>(), vec![0]);
-    assert!(build_light_table_scaled(&scene, &[0.0, 0.0]).entries.is_empty());
+    assert_eq!(
+        off.entries.iter().map(|e| e.index).collect::<Vec<_>>(),
+        vec![0]
+    );
+    assert!(build_light_table_scaled(&scene, &[0.0, 0.0])
+        .entries
+        .is_empty());
 }

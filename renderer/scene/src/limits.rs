@@ -34,15 +34,41 @@ pub struct Budget {
     pub default: u64,
 }
 
-pub const TRIANGLES: Budget = Budget { name: "triangle", env: "FOVEA_MAX_TRIANGLES", default: 4_000_000 };
-pub const INSTANCES: Budget = Budget { name: "instance", env: "FOVEA_MAX_INSTANCES", default: 1_000_000 };
-pub const INSTANCE_ABOVE: Budget = Budget { name: "instancing threshold", env: "FOVEA_INSTANCE_ABOVE", default: 1_000_000 };
-pub const TEXELS: Budget = Budget { name: "texel", env: "FOVEA_MAX_TEXELS", default: 256 << 20 };
-pub const BYTES: Budget = Budget { name: "byte", env: "FOVEA_MAX_SCENE_BYTES", default: 2 << 30 };
+pub const TRIANGLES: Budget = Budget {
+    name: "triangle",
+    env: "FOVEA_MAX_TRIANGLES",
+    default: 4_000_000,
+};
+pub const INSTANCES: Budget = Budget {
+    name: "instance",
+    env: "FOVEA_MAX_INSTANCES",
+    default: 1_000_000,
+};
+pub const INSTANCE_ABOVE: Budget = Budget {
+    name: "instancing threshold",
+    env: "FOVEA_INSTANCE_ABOVE",
+    default: 1_000_000,
+};
+pub const TEXELS: Budget = Budget {
+    name: "texel",
+    env: "FOVEA_MAX_TEXELS",
+    default: 256 << 20,
+};
+pub const BYTES: Budget = Budget {
+    name: "byte",
+    env: "FOVEA_MAX_SCENE_BYTES",
+    default: 2 << 30,
+};
 
 impl Default for LoadLimits {
     fn default() -> Self {
-        LoadLimits { max_triangles: TRIANGLES.default, max_instances: INSTANCES.default, instance_above: INSTANCE_ABOVE.default, max_texels: TEXELS.default, max_bytes: BYTES.default }
+        LoadLimits {
+            max_triangles: TRIANGLES.default,
+            max_instances: INSTANCES.default,
+            instance_above: INSTANCE_ABOVE.default,
+            max_texels: TEXELS.default,
+            max_bytes: BYTES.default,
+        }
     }
 }
 
@@ -50,12 +76,18 @@ impl Budget {
     fn read_env(&self) -> Result<u64, String> {
         match std::env::var(self.env) {
             Err(std::env::VarError::NotPresent) => Ok(self.default),
-            Err(std::env::VarError::NotUnicode(_)) => Err(format!("{} is not valid UTF-8", self.env)),
+            Err(std::env::VarError::NotUnicode(_)) => {
+                Err(format!("{} is not valid UTF-8", self.env))
+            }
             Ok(text) => {
                 let digits: String = text.trim().chars().filter(|&c| c != '_').collect();
                 match digits.parse::<u64>() {
                     Ok(n) if n > 0 => Ok(n),
-                    _ => Err(format!("{}='{}' must be a whole number above 0", self.env, text.escape_debug())),
+                    _ => Err(format!(
+                        "{}='{}' must be a whole number above 0",
+                        self.env,
+                        text.escape_debug()
+                    )),
                 }
             }
         }
@@ -96,12 +128,20 @@ impl ByteBudget {
 
     /// Reserves `n` bytes, or says what would exceed the budget.
     pub(crate) fn take(&mut self, n: u64, what: &str) -> Result<(), String> {
-        match self.used.checked_add(n).filter(|&total| total <= self.limit) {
+        match self
+            .used
+            .checked_add(n)
+            .filter(|&total| total <= self.limit)
+        {
             Some(total) => {
                 self.used = total;
                 Ok(())
             }
-            None => Err(over_budget(&BYTES, self.limit, format!("{what} ({n} bytes, {} already read)", self.used))),
+            None => Err(over_budget(
+                &BYTES,
+                self.limit,
+                format!("{what} ({n} bytes, {} already read)", self.used),
+            )),
         }
     }
 }
@@ -115,22 +155,38 @@ mod tests {
         let mut b = ByteBudget::new(10);
         b.take(6, "a").unwrap();
         let err = b.take(5, "buffers[1]").unwrap_err();
-        assert!(err.contains("buffers[1]") && err.contains("FOVEA_MAX_SCENE_BYTES") && err.contains("budget of 10"), "{err}");
+        assert!(
+            err.contains("buffers[1]")
+                && err.contains("FOVEA_MAX_SCENE_BYTES")
+                && err.contains("budget of 10"),
+            "{err}"
+        );
         assert!(b.take(u64::MAX, "huge").is_err(), "no overflow");
-        b.take(4, "the rest").expect("a refused take reserves nothing");
+        b.take(4, "the rest")
+            .expect("a refused take reserves nothing");
     }
 
     #[test]
     fn budget_values_parse_with_separators_and_refuse_junk() {
         // Uses a variable no other test sets, so the process environment stays race-free.
-        let b = Budget { name: "test", env: "FOVEA_TEST_ONLY_LIMIT", default: 7 };
+        let b = Budget {
+            name: "test",
+            env: "FOVEA_TEST_ONLY_LIMIT",
+            default: 7,
+        };
         assert_eq!(b.read_env(), Ok(7));
         std::env::set_var(b.env, "1_000");
         assert_eq!(b.read_env(), Ok(1000));
         std::env::set_var(b.env, "lots");
-        assert!(b.read_env().unwrap_err().contains("FOVEA_TEST_ONLY_LIMIT='lots'"));
+        assert!(b
+            .read_env()
+            .unwrap_err()
+            .contains("FOVEA_TEST_ONLY_LIMIT='lots'"));
         std::env::set_var(b.env, "0");
-        assert!(b.read_env().is_err(), "a zero budget would refuse every scene");
+        assert!(
+            b.read_env().is_err(),
+            "a zero budget would refuse every scene"
+        );
         std::env::remove_var(b.env);
     }
 }

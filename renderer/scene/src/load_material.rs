@@ -22,14 +22,25 @@ pub(crate) fn images_used(m: &gltf::Material) -> Vec<usize> {
         pbr.metallic_roughness_texture().map(|i| i.texture()),
         m.normal_texture().map(|t| t.texture()),
         m.emissive_texture().map(|i| i.texture()),
-        specular.as_ref().and_then(|s| s.specular_texture()).map(|i| i.texture()),
-        specular.as_ref().and_then(|s| s.specular_color_texture()).map(|i| i.texture()),
+        specular
+            .as_ref()
+            .and_then(|s| s.specular_texture())
+            .map(|i| i.texture()),
+        specular
+            .as_ref()
+            .and_then(|s| s.specular_color_texture())
+            .map(|i| i.texture()),
     ];
-    textures.into_iter().flatten().map(|t| t.source().index()).collect()
+    textures
+        .into_iter()
+        .flatten()
+        .map(|t| t.source().index())
+        .collect()
 }
 
 pub(crate) fn convert_material(m: &gltf::Material, map: ImageMap) -> Material {
-    let image_of = |info: Option<gltf::texture::Info>| info.and_then(|i| map(i.texture().source().index()));
+    let image_of =
+        |info: Option<gltf::texture::Info>| info.and_then(|i| map(i.texture().source().index()));
     let pbr = m.pbr_metallic_roughness();
     let specular = m.specular();
     Material {
@@ -38,15 +49,23 @@ pub(crate) fn convert_material(m: &gltf::Material, map: ImageMap) -> Material {
         metallic: pbr.metallic_factor(),
         roughness: pbr.roughness_factor(),
         metallic_roughness_texture: image_of(pbr.metallic_roughness_texture()),
-        normal_texture: m.normal_texture().and_then(|t| map(t.texture().source().index())),
+        normal_texture: m
+            .normal_texture()
+            .and_then(|t| map(t.texture().source().index())),
         normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
         emissive: Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
         emissive_texture: image_of(m.emissive_texture()),
         // KHR_materials_specular defaults (factor 1, colour 1) when the extension is absent.
         specular_factor: specular.as_ref().map_or(1.0, |s| s.specular_factor()),
-        specular_texture: specular.as_ref().and_then(|s| image_of(s.specular_texture())),
-        specular_color: specular.as_ref().map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
-        specular_color_texture: specular.as_ref().and_then(|s| image_of(s.specular_color_texture())),
+        specular_texture: specular
+            .as_ref()
+            .and_then(|s| image_of(s.specular_texture())),
+        specular_color: specular
+            .as_ref()
+            .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
+        specular_color_texture: specular
+            .as_ref()
+            .and_then(|s| image_of(s.specular_color_texture())),
         ior: m.ior().unwrap_or(1.5),
         double_sided: m.double_sided(),
         alpha_cutoff: match m.alpha_mode() {
@@ -60,33 +79,59 @@ pub(crate) fn convert_material(m: &gltf::Material, map: ImageMap) -> Material {
 }
 
 /// Each slot's KHR_texture_transform (identity where none), or which one is unusable and why.
-pub(crate) fn uv_transforms(m: &gltf::Material) -> Result<[UvTransform; TextureSlot::COUNT], String> {
+pub(crate) fn uv_transforms(
+    m: &gltf::Material,
+) -> Result<[UvTransform; TextureSlot::COUNT], String> {
     let pbr = m.pbr_metallic_roughness();
     let specular = m.specular();
     let from_info = |info: Option<gltf::texture::Info>| {
-        info.and_then(|i| i.texture_transform()).map(|t| UvTransform {
-            offset: Vec2::from(t.offset()),
-            rotation: t.rotation(),
-            scale: Vec2::from(t.scale()),
-        })
+        info.and_then(|i| i.texture_transform())
+            .map(|t| UvTransform {
+                offset: Vec2::from(t.offset()),
+                rotation: t.rotation(),
+                scale: Vec2::from(t.scale()),
+            })
     };
-    let normal = match m.normal_texture().as_ref().and_then(|t| t.extension_value("KHR_texture_transform")) {
+    let normal = match m
+        .normal_texture()
+        .as_ref()
+        .and_then(|t| t.extension_value("KHR_texture_transform"))
+    {
         Some(value) => Some(normal_texture_transform(value)?),
         None => None,
     };
     let slots = [
-        ("pbrMetallicRoughness.baseColorTexture", from_info(pbr.base_color_texture())),
-        ("pbrMetallicRoughness.metallicRoughnessTexture", from_info(pbr.metallic_roughness_texture())),
+        (
+            "pbrMetallicRoughness.baseColorTexture",
+            from_info(pbr.base_color_texture()),
+        ),
+        (
+            "pbrMetallicRoughness.metallicRoughnessTexture",
+            from_info(pbr.metallic_roughness_texture()),
+        ),
         ("normalTexture", normal),
         ("emissiveTexture", from_info(m.emissive_texture())),
-        ("extensions.KHR_materials_specular.specularTexture", specular.as_ref().and_then(|s| from_info(s.specular_texture()))),
-        ("extensions.KHR_materials_specular.specularColorTexture", specular.as_ref().and_then(|s| from_info(s.specular_color_texture()))),
+        (
+            "extensions.KHR_materials_specular.specularTexture",
+            specular
+                .as_ref()
+                .and_then(|s| from_info(s.specular_texture())),
+        ),
+        (
+            "extensions.KHR_materials_specular.specularColorTexture",
+            specular
+                .as_ref()
+                .and_then(|s| from_info(s.specular_color_texture())),
+        ),
     ];
     let mut out = [UvTransform::IDENTITY; TextureSlot::COUNT];
     for (slot, (field, transform)) in out.iter_mut().zip(slots) {
         let Some(t) = transform else { continue };
         let values = [t.offset.x, t.offset.y, t.rotation, t.scale.x, t.scale.y];
-        if let Some(v) = values.iter().find(|v| !v.is_finite() || v.abs() > MAX_UV_TRANSFORM) {
+        if let Some(v) = values
+            .iter()
+            .find(|v| !v.is_finite() || v.abs() > MAX_UV_TRANSFORM)
+        {
             return Err(format!("{field}.extensions.KHR_texture_transform holds {v}: offset, rotation and scale must be finite and within ±{MAX_UV_TRANSFORM:e}"));
         }
         *slot = t;
@@ -101,17 +146,25 @@ const MAX_UV_TRANSFORM: f32 = 1e6;
 /// raw JSON (the extension's defaults where a member is absent).
 fn normal_texture_transform(value: &gltf::json::Value) -> Result<UvTransform, String> {
     let field = "normalTexture.extensions.KHR_texture_transform";
-    let number = |v: &gltf::json::Value, member: &str| v.as_f64().map(|x| x as f32).ok_or(format!("{field}.{member} must be a number"));
+    let number = |v: &gltf::json::Value, member: &str| {
+        v.as_f64()
+            .map(|x| x as f32)
+            .ok_or(format!("{field}.{member} must be a number"))
+    };
     let pair = |member: &str, default: Vec2| -> Result<Vec2, String> {
         match value.get(member) {
             None => Ok(default),
-            Some(gltf::json::Value::Array(a)) if a.len() == 2 => Ok(Vec2::new(number(&a[0], member)?, number(&a[1], member)?)),
+            Some(gltf::json::Value::Array(a)) if a.len() == 2 => {
+                Ok(Vec2::new(number(&a[0], member)?, number(&a[1], member)?))
+            }
             Some(_) => Err(format!("{field}.{member} must be an array of two numbers")),
         }
     };
     Ok(UvTransform {
         offset: pair("offset", Vec2::ZERO)?,
-        rotation: value.get("rotation").map_or(Ok(0.0), |r| number(r, "rotation"))?,
+        rotation: value
+            .get("rotation")
+            .map_or(Ok(0.0), |r| number(r, "rotation"))?,
         scale: pair("scale", Vec2::ONE)?,
     })
 }

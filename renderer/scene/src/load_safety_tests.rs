@@ -39,7 +39,10 @@ fn triangle_doc(buffer_uri: &str) -> Value {
 }
 
 fn embedded_triangle_doc() -> Value {
-    triangle_doc(&format!("data:application/octet-stream;base64,{}", base64(&triangle_bytes())))
+    triangle_doc(&format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&triangle_bytes())
+    ))
 }
 
 fn write_doc(dir: &Path, doc: &Value) -> PathBuf {
@@ -74,11 +77,23 @@ fn float_index_accessor_is_an_error_not_a_panic() {
     doc["accessors"][1]["componentType"] = json!(5126);
     doc["bufferViews"][1]["byteLength"] = json!(6);
     let msg = error_text(load(&write_doc(&dir, &doc)));
-    assert_mentions(&msg, &["scene.gltf", "meshes[0].primitives[0].indices", "accessors[1]", "componentType 5126", "Scalar of U16"]);
+    assert_mentions(
+        &msg,
+        &[
+            "scene.gltf",
+            "meshes[0].primitives[0].indices",
+            "accessors[1]",
+            "componentType 5126",
+            "Scalar of U16",
+        ],
+    );
     // A POSITION of the wrong shape trips a size assertion in the gltf crate's reader.
     let mut doc = embedded_triangle_doc();
     doc["accessors"][0]["type"] = json!("VEC2");
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["attributes.POSITION", "Vec2 of F32"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &["attributes.POSITION", "Vec2 of F32"],
+    );
 }
 
 #[test]
@@ -86,11 +101,26 @@ fn accessors_reaching_past_their_view_or_with_count_zero_are_refused() {
     let dir = temp_dir("accessor_ranges");
     for (edit, needle) in [
         (("accessors", 0, "count", json!(0)), "count 0"),
-        (("accessors", 0, "byteOffset", json!(4)), "reaches past the end of bufferViews[0]"),
-        (("accessors", 1, "count", json!(4)), "reaches past the end of bufferViews[1]"),
-        (("bufferViews", 1, "byteOffset", json!(40)), "reaches past the end of buffers[0]"),
-        (("accessors", 0, "byteOffset", json!(u64::MAX - 8)), "reaches past the end"),
-        (("bufferViews", 0, "byteStride", json!(4)), "byteStride is 4"),
+        (
+            ("accessors", 0, "byteOffset", json!(4)),
+            "reaches past the end of bufferViews[0]",
+        ),
+        (
+            ("accessors", 1, "count", json!(4)),
+            "reaches past the end of bufferViews[1]",
+        ),
+        (
+            ("bufferViews", 1, "byteOffset", json!(40)),
+            "reaches past the end of buffers[0]",
+        ),
+        (
+            ("accessors", 0, "byteOffset", json!(u64::MAX - 8)),
+            "reaches past the end",
+        ),
+        (
+            ("bufferViews", 0, "byteStride", json!(4)),
+            "byteStride is 4",
+        ),
     ] {
         let mut doc = embedded_triangle_doc();
         let (array, index, key, value) = edit;
@@ -106,7 +136,10 @@ fn camera_whose_type_names_a_missing_projection_is_an_error() {
     doc["cameras"] = json!([{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}]);
     doc["nodes"] = json!([{"mesh": 0}, {"camera": 0}]);
     doc["scenes"] = json!([{"nodes": [0, 1]}]);
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["cameras[0]", "projection"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &["cameras[0]", "projection"],
+    );
 }
 
 #[test]
@@ -114,7 +147,8 @@ fn meaningless_camera_emission_and_position_values_are_refused() {
     let dir = temp_dir("meaningless");
     let with_camera = |yfov: f64| {
         let mut doc = embedded_triangle_doc();
-        doc["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": yfov, "znear": 0.1}}]);
+        doc["cameras"] =
+            json!([{"type": "perspective", "perspective": {"yfov": yfov, "znear": 0.1}}]);
         doc["nodes"] = json!([{"mesh": 0}, {"camera": 0}]);
         doc["scenes"] = json!([{"nodes": [0, 1]}]);
         doc
@@ -130,20 +164,32 @@ fn meaningless_camera_emission_and_position_values_are_refused() {
         doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
         doc["materials"] = json!([{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}}]);
         doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-        assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["materials[0]", "emissiveStrength", "finite, ≥ 0"]);
+        assert_mentions(
+            &error_text(load(&write_doc(&dir, &doc))),
+            &["materials[0]", "emissiveStrength", "finite, ≥ 0"],
+        );
     }
 
     // NaN and infinity cannot be written in JSON, but binary buffers hold them.
     for bad in [f32::NAN, f32::INFINITY] {
         let mut bytes = f32_bytes(&[0.0, 0.0, 0.0, bad, 0.0, 0.0, 0.0, 1.0, 0.0]);
         bytes.extend([0u16, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
-        let doc = triangle_doc(&format!("data:application/octet-stream;base64,{}", base64(&bytes)));
-        assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["mesh 'tri'", "POSITION element 1", "finite"]);
+        let doc = triangle_doc(&format!(
+            "data:application/octet-stream;base64,{}",
+            base64(&bytes)
+        ));
+        assert_mentions(
+            &error_text(load(&write_doc(&dir, &doc))),
+            &["mesh 'tri'", "POSITION element 1", "finite"],
+        );
     }
     // Finite transforms whose product is not.
     let mut doc = embedded_triangle_doc();
     doc["nodes"] = json!([{"children": [1], "scale": [1e30, 1e30, 1e30]}, {"mesh": 0, "scale": [1e30, 1e30, 1e30]}]);
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["nodes[1]", "not finite"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &["nodes[1]", "not finite"],
+    );
 }
 
 /// A folder with the scene in `scene/` and a secret file beside it, outside the folder.
@@ -174,13 +220,28 @@ fn buffer_uris_leaving_the_scene_folder_are_refused_without_echoing_the_file() {
     ] {
         let msg = error_text(load(&write_doc(&scene_dir, &triangle_doc(&uri))));
         assert_mentions(&msg, &["scene.gltf", "buffers[0]", &uri, reason]);
-        assert!(!msg.contains("SECRET"), "the refused file's bytes leak into the message: {msg}");
+        assert!(
+            !msg.contains("SECRET"),
+            "the refused file's bytes leak into the message: {msg}"
+        );
     }
     // A symbolic link that stays inside the folder is fine.
     std::fs::write(scene_dir.join("real.bin"), triangle_bytes()).unwrap();
     std::os::unix::fs::symlink("real.bin", scene_dir.join("alias.bin")).unwrap();
-    assert_eq!(load(&write_doc(&scene_dir, &triangle_doc("alias.bin"))).unwrap().triangles.len(), 1);
-    assert_eq!(load(&write_doc(&scene_dir, &triangle_doc("./real%2Ebin"))).unwrap().triangles.len(), 1);
+    assert_eq!(
+        load(&write_doc(&scene_dir, &triangle_doc("alias.bin")))
+            .unwrap()
+            .triangles
+            .len(),
+        1
+    );
+    assert_eq!(
+        load(&write_doc(&scene_dir, &triangle_doc("./real%2Ebin")))
+            .unwrap()
+            .triangles
+            .len(),
+        1
+    );
 }
 
 /// Runs `f` on a thread and fails the test if it does not finish in time (a blocking open of a
@@ -190,11 +251,15 @@ fn within_seconds<T: Send + 'static>(seconds: u64, f: impl FnOnce() -> T + Send 
     std::thread::spawn(move || {
         let _ = tx.send(f());
     });
-    rx.recv_timeout(std::time::Duration::from_secs(seconds)).expect("the loader blocked or ran away")
+    rx.recv_timeout(std::time::Duration::from_secs(seconds))
+        .expect("the loader blocked or ran away")
 }
 
 fn mkfifo(path: &Path) {
-    let status = std::process::Command::new("mkfifo").arg(path).status().expect("run mkfifo");
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("run mkfifo");
     assert!(status.success(), "mkfifo {} failed", path.display());
 }
 
@@ -204,7 +269,10 @@ fn fifos_and_devices_are_never_opened_for_reading() {
     mkfifo(&dir.join("pipe.bin"));
     let path = write_doc(&dir, &triangle_doc("pipe.bin"));
     let msg = within_seconds(10, move || error_text(load(&path)));
-    assert_mentions(&msg, &["buffers[0]", "pipe.bin", "FIFO", "not a regular file"]);
+    assert_mentions(
+        &msg,
+        &["buffers[0]", "pipe.bin", "FIFO", "not a regular file"],
+    );
 
     // /dev/zero never ends: as the scene file, and through a link in the folder.
     let msg = within_seconds(10, || error_text(load(Path::new("/dev/zero"))));
@@ -215,8 +283,12 @@ fn fifos_and_devices_are_never_opened_for_reading() {
     assert_mentions(&msg, &["buffers[0]", "zero.bin"]);
     // Inside the folder's own view, a device is refused by type (not only by location).
     let mut budget = crate::limits::ByteBudget::new(1 << 20);
-    let err = crate::source::read_bounded(Path::new("/dev/zero"), Some(16), &mut budget, "b").unwrap_err();
-    assert!(err.to_string().contains("a device, not a regular file"), "{err}");
+    let err = crate::source::read_bounded(Path::new("/dev/zero"), Some(16), &mut budget, "b")
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("a device, not a regular file"),
+        "{err}"
+    );
     // The scene file as a FIFO.
     mkfifo(&dir.join("pipe.gltf"));
     let fifo_scene = dir.join("pipe.gltf");
@@ -229,7 +301,14 @@ fn buffers_are_read_exactly_as_far_as_declared() {
     let dir = temp_dir("declared");
     std::fs::write(dir.join("short.bin"), &triangle_bytes()[..40]).unwrap();
     let msg = error_text(load(&write_doc(&dir, &triangle_doc("short.bin"))));
-    assert_mentions(&msg, &["buffers[0]", "short.bin", "has 40 bytes but byteLength declares 42"]);
+    assert_mentions(
+        &msg,
+        &[
+            "buffers[0]",
+            "short.bin",
+            "has 40 bytes but byteLength declares 42",
+        ],
+    );
     // A longer file loads; only the declared bytes are read (the budget proves it: 42 + the
     // JSON fit, the whole file would not).
     let mut long = triangle_bytes();
@@ -237,13 +316,28 @@ fn buffers_are_read_exactly_as_far_as_declared() {
     std::fs::write(dir.join("long.bin"), &long).unwrap();
     let path = write_doc(&dir, &triangle_doc("long.bin"));
     let json_len = std::fs::metadata(&path).unwrap().len();
-    let limits = LoadLimits { max_bytes: json_len + 42, ..LoadLimits::default() };
+    let limits = LoadLimits {
+        max_bytes: json_len + 42,
+        ..LoadLimits::default()
+    };
     assert_eq!(load_unguarded(&path, &limits).unwrap().triangles.len(), 1);
-    let limits = LoadLimits { max_bytes: json_len + 41, ..LoadLimits::default() };
-    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["buffers[0]", "byte budget", "FOVEA_MAX_SCENE_BYTES"]);
+    let limits = LoadLimits {
+        max_bytes: json_len + 41,
+        ..LoadLimits::default()
+    };
+    assert_mentions(
+        &error_text(load_unguarded(&path, &limits)),
+        &["buffers[0]", "byte budget", "FOVEA_MAX_SCENE_BYTES"],
+    );
     // A data URI shorter than declared.
-    let short = triangle_doc(&format!("data:application/octet-stream;base64,{}", base64(&triangle_bytes()[..30])));
-    assert_mentions(&error_text(load(&write_doc(&dir, &short))), &["buffers[0]", "holds 30 bytes but byteLength declares 42"]);
+    let short = triangle_doc(&format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&triangle_bytes()[..30])
+    ));
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &short))),
+        &["buffers[0]", "holds 30 bytes but byteLength declares 42"],
+    );
 }
 
 /// One mesh of `triangles` triangles (three shared vertices, indices repeated) placed by `nodes`
@@ -255,7 +349,9 @@ fn instancing_bomb(triangles: usize, nodes: usize) -> Value {
     doc["bufferViews"][1]["byteLength"] = json!(index_bytes);
     doc["accessors"][1]["count"] = json!(triangles * 3);
     doc["meshes"][0]["name"] = json!("bomb");
-    doc["nodes"] = json!((0..nodes).map(|i| json!({"mesh": 0, "translation": [i as f32, 0, 0]})).collect::<Vec<_>>());
+    doc["nodes"] = json!((0..nodes)
+        .map(|i| json!({"mesh": 0, "translation": [i as f32, 0, 0]}))
+        .collect::<Vec<_>>());
     doc["scenes"] = json!([{"nodes": (0..nodes).collect::<Vec<_>>()}]);
     doc
 }
@@ -266,18 +362,52 @@ fn the_instancing_bomb_is_instanced_and_its_budgets_are_checked_before_any_geome
     // 12 M placed triangles but 20 000 uploaded: instancing makes it fit the triangle budget, so
     // the load gets as far as reading its (missing) buffer.
     let path = write_doc(&dir, &instancing_bomb(20_000, 600));
-    assert_mentions(&error_text(load(&path)), &["buffers[0]", "never-read.bin", "cannot open"]);
-    let limits = LoadLimits { max_triangles: 19_999, ..LoadLimits::default() };
+    assert_mentions(
+        &error_text(load(&path)),
+        &["buffers[0]", "never-read.bin", "cannot open"],
+    );
+    let limits = LoadLimits {
+        max_triangles: 19_999,
+        ..LoadLimits::default()
+    };
     let msg = error_text(load_unguarded(&path, &limits));
-    assert_mentions(&msg, &["meshes: 20000 triangles to upload", "mesh 'bomb', 20000 triangles × 1 copies", "triangle budget of 19999", "FOVEA_MAX_TRIANGLES"]);
-    assert!(!msg.contains("never-read.bin"), "the budget must be checked before buffers are read: {msg}");
-    let limits = LoadLimits { max_instances: 599, ..LoadLimits::default() };
-    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["nodes: 600 mesh instances", "mesh 'bomb', placed by 600 nodes", "instance budget of 599", "FOVEA_MAX_INSTANCES"]);
+    assert_mentions(
+        &msg,
+        &[
+            "meshes: 20000 triangles to upload",
+            "mesh 'bomb', 20000 triangles × 1 copies",
+            "triangle budget of 19999",
+            "FOVEA_MAX_TRIANGLES",
+        ],
+    );
+    assert!(
+        !msg.contains("never-read.bin"),
+        "the budget must be checked before buffers are read: {msg}"
+    );
+    let limits = LoadLimits {
+        max_instances: 599,
+        ..LoadLimits::default()
+    };
+    assert_mentions(
+        &error_text(load_unguarded(&path, &limits)),
+        &[
+            "nodes: 600 mesh instances",
+            "mesh 'bomb', placed by 600 nodes",
+            "instance budget of 599",
+            "FOVEA_MAX_INSTANCES",
+        ],
+    );
     // Placed triangles beyond 32-bit ids are refused whatever the budgets, without expanding.
     let started = std::time::Instant::now();
     let path = write_doc(&dir, &instancing_bomb(1_500_000, 3_000));
-    assert_mentions(&error_text(load(&path)), &["nodes: 4500000000 placed triangles", "32-bit id"]);
-    assert!(started.elapsed().as_secs() < 5, "refusing must not expand the copies");
+    assert_mentions(
+        &error_text(load(&path)),
+        &["nodes: 4500000000 placed triangles", "32-bit id"],
+    );
+    assert!(
+        started.elapsed().as_secs() < 5,
+        "refusing must not expand the copies"
+    );
 }
 
 fn png_bytes(width: u32, height: u32) -> Vec<u8> {
@@ -293,10 +423,19 @@ fn textured_doc(images: Value, textures: Value) -> Value {
     let mut bytes = triangle_bytes();
     bytes.extend([0u8; 2]); // align the UVs
     bytes.extend(f32_bytes(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0]));
-    let mut doc = triangle_doc(&format!("data:application/octet-stream;base64,{}", base64(&bytes)));
+    let mut doc = triangle_doc(&format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&bytes)
+    ));
     doc["buffers"][0]["byteLength"] = json!(bytes.len());
-    doc["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 0, "byteOffset": 44, "byteLength": 24}));
-    doc["accessors"].as_array_mut().unwrap().push(json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}));
+    doc["bufferViews"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"buffer": 0, "byteOffset": 44, "byteLength": 24}));
+    doc["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}));
     doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(2);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
     doc["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
@@ -319,17 +458,31 @@ fn dds_alternatives_are_skipped_and_png_sources_load() {
         ]),
         json!([{"source": 1, "extensions": {"MSFT_texture_dds": {"source": 0}}}]),
     );
-    doc["extensionsUsed"] = json!(["MSFT_texture_dds", "EXT_texture_webp", "KHR_texture_transform"]);
+    doc["extensionsUsed"] = json!([
+        "MSFT_texture_dds",
+        "EXT_texture_webp",
+        "KHR_texture_transform"
+    ]);
     let scene = load(&write_doc(&dir, &doc)).unwrap();
-    assert_eq!(scene.textures.len(), 1, "only the PNG a material samples is decoded");
+    assert_eq!(
+        scene.textures.len(),
+        1,
+        "only the PNG a material samples is decoded"
+    );
     assert_eq!((scene.textures[0].width, scene.textures[0].height), (4, 2));
     assert_eq!(&scene.textures[0].rgba8[..4], &[200, 100, 50, 255]);
     assert_eq!(scene.materials[0].base_color_texture, Some(0));
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
-    assert_mentions(&scene.warnings[0], &["MSFT_texture_dds, EXT_texture_webp", "does not understand"]);
+    assert_mentions(
+        &scene.warnings[0],
+        &["MSFT_texture_dds, EXT_texture_webp", "does not understand"],
+    );
     // Required, it is refused as before.
     doc["extensionsRequired"] = json!(["MSFT_texture_dds"]);
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["required extension MSFT_texture_dds"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &["required extension MSFT_texture_dds"],
+    );
 }
 
 #[test]
@@ -338,19 +491,45 @@ fn undecodable_images_are_named_with_uri_mime_type_and_reason() {
     std::fs::write(dir.join("broken.png"), b"this is not a PNG").unwrap();
     let doc = textured_doc(json!([{"uri": "broken.png"}]), json!([{"source": 0}]));
     let msg = error_text(load(&write_doc(&dir, &doc)));
-    assert_mentions(&msg, &["scene.gltf", "images[0]", "uri \"broken.png\"", "mime type image/png", "cannot be loaded"]);
+    assert_mentions(
+        &msg,
+        &[
+            "scene.gltf",
+            "images[0]",
+            "uri \"broken.png\"",
+            "mime type image/png",
+            "cannot be loaded",
+        ],
+    );
     assert!(!msg.contains("this is not"), "{msg}");
     // A DDS used as a texture's only source: named, and never read.
     let doc = textured_doc(json!([{"uri": "missing.dds"}]), json!([{"source": 0}]));
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["images[0]", "missing.dds", "image/vnd-ms.dds is not decoded"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &[
+            "images[0]",
+            "missing.dds",
+            "image/vnd-ms.dds is not decoded",
+        ],
+    );
     // An embedded image with a lying mime type.
     let bogus = format!("data:image/jpeg;base64,{}", base64(&png_bytes(2, 2)));
     let doc = textured_doc(json!([{"uri": bogus}]), json!([{"source": 0}]));
     let msg = error_text(load(&write_doc(&dir, &doc)));
-    assert_mentions(&msg, &["images[0]", "data:image/jpeg;base64,…", "mime type image/jpeg"]);
+    assert_mentions(
+        &msg,
+        &[
+            "images[0]",
+            "data:image/jpeg;base64,…",
+            "mime type image/jpeg",
+        ],
+    );
     // Image URIs are confined like buffer URIs.
     let doc = textured_doc(json!([{"uri": "../floor.png"}]), json!([{"source": 0}]));
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["images[0]", "'..'"]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &["images[0]", "'..'"],
+    );
 }
 
 #[test]
@@ -359,9 +538,22 @@ fn texel_budget_is_enforced_before_decoding() {
     std::fs::write(dir.join("big.png"), png_bytes(64, 64)).unwrap();
     let doc = textured_doc(json!([{"uri": "big.png"}]), json!([{"source": 0}]));
     let path = write_doc(&dir, &doc);
-    let limits = LoadLimits { max_texels: 4095, ..LoadLimits::default() };
-    assert_mentions(&error_text(load_unguarded(&path, &limits)), &["images[0] (64×64", "texel budget of 4095", "FOVEA_MAX_TEXELS"]);
-    let limits = LoadLimits { max_texels: 4096, ..LoadLimits::default() };
+    let limits = LoadLimits {
+        max_texels: 4095,
+        ..LoadLimits::default()
+    };
+    assert_mentions(
+        &error_text(load_unguarded(&path, &limits)),
+        &[
+            "images[0] (64×64",
+            "texel budget of 4095",
+            "FOVEA_MAX_TEXELS",
+        ],
+    );
+    let limits = LoadLimits {
+        max_texels: 4096,
+        ..LoadLimits::default()
+    };
     assert_eq!(load_unguarded(&path, &limits).unwrap().textures.len(), 1);
 }
 
@@ -369,8 +561,14 @@ fn texel_budget_is_enforced_before_decoding() {
 fn unused_materials_keep_their_slot_but_decode_no_images() {
     let dir = temp_dir("unused_material");
     let png = format!("data:image/png;base64,{}", base64(&png_bytes(2, 2)));
-    let mut doc = textured_doc(json!([{"uri": png}, {"uri": "does-not-exist.png"}]), json!([{"source": 0}, {"source": 1}]));
-    doc["materials"].as_array_mut().unwrap().push(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}}));
+    let mut doc = textured_doc(
+        json!([{"uri": png}, {"uri": "does-not-exist.png"}]),
+        json!([{"source": 0}, {"source": 1}]),
+    );
+    doc["materials"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}}));
     let scene = load(&write_doc(&dir, &doc)).unwrap();
     assert_eq!(scene.materials.len(), 2);
     assert_eq!(scene.textures.len(), 1);
@@ -385,10 +583,17 @@ mod fuzz {
 
     /// Seeds: the project's Cornell box, and a small textured file (images, UVs, materials).
     fn seeds() -> Vec<Value> {
-        let cornell = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.gltf");
-        let cornell: Value = serde_json::from_str(&std::fs::read_to_string(cornell).expect("scenes/cornell-box.gltf")).unwrap();
+        let cornell =
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.gltf");
+        let cornell: Value = serde_json::from_str(
+            &std::fs::read_to_string(cornell).expect("scenes/cornell-box.gltf"),
+        )
+        .unwrap();
         let png = format!("data:image/png;base64,{}", base64(&png_bytes(2, 2)));
-        vec![cornell, textured_doc(json!([{"uri": png}]), json!([{"source": 0}]))]
+        vec![
+            cornell,
+            textured_doc(json!([{"uri": png}]), json!([{"source": 0}])),
+        ]
     }
 
     /// The triangle as a binary glTF (JSON chunk + BIN chunk): mutations hit the container's
@@ -452,10 +657,36 @@ mod fuzz {
     /// and offsets, out-of-range indices, non-finite-after-parse floats, wrong JSON types.
     fn nasty(k: usize) -> Value {
         let table = [
-            json!(0), json!(-1), json!(1), json!(3), json!(4), json!(7), json!(255), json!(65535), json!(5120), json!(5121),
-            json!(5122), json!(5123), json!(5125), json!(5126), json!(4294967295u64), json!(u64::MAX), json!(1e30), json!(-1e30),
-            json!(1e39), json!(0.5), json!("VEC4"), json!("SCALAR"), json!("MAT4"), json!(""), json!("../x.bin"),
-            json!("data:;base64,"), json!(null), json!([]), json!({}), json!(true),
+            json!(0),
+            json!(-1),
+            json!(1),
+            json!(3),
+            json!(4),
+            json!(7),
+            json!(255),
+            json!(65535),
+            json!(5120),
+            json!(5121),
+            json!(5122),
+            json!(5123),
+            json!(5125),
+            json!(5126),
+            json!(4294967295u64),
+            json!(u64::MAX),
+            json!(1e30),
+            json!(-1e30),
+            json!(1e39),
+            json!(0.5),
+            json!("VEC4"),
+            json!("SCALAR"),
+            json!("MAT4"),
+            json!(""),
+            json!("../x.bin"),
+            json!("data:;base64,"),
+            json!(null),
+            json!([]),
+            json!({}),
+            json!(true),
         ];
         table[k % table.len()].clone()
     }
@@ -525,16 +756,22 @@ mod fuzz {
 #[test]
 fn shared_real_scenes_load_within_the_default_budgets() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/scenes");
-    for (file, triangles, cameras) in
-        [("sponza/Sponza.gltf", 262_087, 4), ("breakfast-room/BreakfastRoom.gltf", 262_687, 3), ("flight-helmet/FlightHelmet.gltf", 94_722, 0)]
-    {
+    for (file, triangles, cameras) in [
+        ("sponza/Sponza.gltf", 262_087, 4),
+        ("breakfast-room/BreakfastRoom.gltf", 262_687, 3),
+        ("flight-helmet/FlightHelmet.gltf", 94_722, 0),
+    ] {
         let path = root.join(file);
         if !path.exists() {
             println!("note: {} not found; skipping", path.display());
             continue;
         }
         let scene = load(&path).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((scene.placed_triangle_count(), scene.cameras.len()), (triangles, cameras), "{file}");
+        assert_eq!(
+            (scene.placed_triangle_count(), scene.cameras.len()),
+            (triangles, cameras),
+            "{file}"
+        );
         println!(
             "{file}: {} flattened triangles, {} instanced meshes ({} triangles) placed by {} instances",
             scene.triangles.len(),
@@ -556,24 +793,48 @@ fn texture_transforms_are_read_per_slot_and_checked() {
     std::fs::write(dir.join("floor.png"), png_bytes(4, 2)).unwrap();
     let mut doc = textured_doc(json!([{"uri": "floor.png"}]), json!([{"source": 0}]));
     doc["extensionsUsed"] = json!(["KHR_texture_transform"]);
-    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] =
-        json!({"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 1.5707964, "scale": [2, 3]}});
-    doc["materials"][0]["normalTexture"] = json!({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [4, 4]}}});
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = json!({"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 1.5707964, "scale": [2, 3]}});
+    doc["materials"][0]["normalTexture"] =
+        json!({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [4, 4]}}});
     let scene = load(&write_doc(&dir, &doc)).unwrap();
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     let m = &scene.materials[0];
     let base = m.uv_transforms[TextureSlot::BaseColor as usize];
-    assert_eq!((base.offset, base.rotation, base.scale), (Vec2::new(0.5, 0.25), 1.5707964, Vec2::new(2.0, 3.0)));
+    assert_eq!(
+        (base.offset, base.rotation, base.scale),
+        (Vec2::new(0.5, 0.25), 1.5707964, Vec2::new(2.0, 3.0))
+    );
     // Rotated a quarter turn: u' = 3v + 0.5, v' = −2u + 0.25.
     let moved = base.apply(Vec2::new(1.0, 1.0));
     assert!((moved - Vec2::new(3.5, -1.75)).length() < 1e-5, "{moved}");
     let normal = m.uv_transforms[TextureSlot::Normal as usize];
-    assert_eq!((normal.offset, normal.rotation, normal.scale), (Vec2::ZERO, 0.0, Vec2::splat(4.0)));
-    assert_eq!(m.uv_transforms[TextureSlot::Emissive as usize], UvTransform::IDENTITY);
+    assert_eq!(
+        (normal.offset, normal.rotation, normal.scale),
+        (Vec2::ZERO, 0.0, Vec2::splat(4.0))
+    );
+    assert_eq!(
+        m.uv_transforms[TextureSlot::Emissive as usize],
+        UvTransform::IDENTITY
+    );
 
-    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] = json!("a lot");
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["materials[0].normalTexture.extensions.KHR_texture_transform.rotation", "number"]);
-    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] = json!(0);
-    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] = json!([1e30, 1]);
-    assert_mentions(&error_text(load(&write_doc(&dir, &doc))), &["materials[0].pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform", "finite"]);
+    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] =
+        json!("a lot");
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &[
+            "materials[0].normalTexture.extensions.KHR_texture_transform.rotation",
+            "number",
+        ],
+    );
+    doc["materials"][0]["normalTexture"]["extensions"]["KHR_texture_transform"]["rotation"] =
+        json!(0);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
+        ["KHR_texture_transform"]["scale"] = json!([1e30, 1]);
+    assert_mentions(
+        &error_text(load(&write_doc(&dir, &doc))),
+        &[
+            "materials[0].pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform",
+            "finite",
+        ],
+    );
 }

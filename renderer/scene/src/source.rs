@@ -15,7 +15,10 @@ use std::path::{Component, Path, PathBuf};
 #[derive(Debug, PartialEq)]
 pub(crate) enum Uri<'a> {
     /// `data:[<media type>];base64,<payload>`.
-    Data { media_type: &'a str, payload: &'a str },
+    Data {
+        media_type: &'a str,
+        payload: &'a str,
+    },
     /// A relative path, percent-decoded, checked to stay below the scene's folder.
     Relative(PathBuf),
 }
@@ -30,7 +33,10 @@ pub(crate) fn parse_uri(uri: &str) -> Result<Uri<'_>, String> {
         let Some(media_type) = header.strip_suffix(";base64") else {
             return Err("data: URI is not base64-encoded (glTF data URIs are ';base64,')".into());
         };
-        return Ok(Uri::Data { media_type, payload });
+        return Ok(Uri::Data {
+            media_type,
+            payload,
+        });
     }
     if let Some(scheme) = uri_scheme(uri) {
         return Err(format!(
@@ -51,7 +57,9 @@ fn uri_scheme(uri: &str) -> Option<&str> {
     let candidate = &uri[..end];
     let is_scheme = uri[end..].starts_with(':')
         && candidate.starts_with(|c: char| c.is_ascii_alphabetic())
-        && candidate.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
+        && candidate
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
     is_scheme.then_some(candidate)
 }
 
@@ -61,8 +69,12 @@ fn percent_decode(s: &str) -> Result<String, String> {
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%' {
-            let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
-            let value = hex.and_then(|h| u8::from_str_radix(h, 16).ok()).ok_or("malformed %-escape in the URI")?;
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok());
+            let value = hex
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .ok_or("malformed %-escape in the URI")?;
             out.push(value);
             i += 3;
         } else {
@@ -81,7 +93,9 @@ fn check_relative(path: &str) -> Result<(), String> {
         return Err("the URI contains a NUL character".into());
     }
     if path.starts_with(['/', '\\']) {
-        return Err("absolute paths are not allowed: URIs resolve inside the scene's folder".into());
+        return Err(
+            "absolute paths are not allowed: URIs resolve inside the scene's folder".into(),
+        );
     }
     // Backslashes count as separators too, so `..\x` cannot slip through on any platform.
     if path.split(['/', '\\']).any(|part| part == "..") {
@@ -93,13 +107,27 @@ fn check_relative(path: &str) -> Result<(), String> {
 /// Resolves a relative URI path below `folder`, following symbolic links and refusing any that
 /// lead out of it. Returns the canonical path.
 pub(crate) fn resolve_inside(folder: &Path, relative: &Path) -> Result<PathBuf, String> {
-    let root = folder.canonicalize().map_err(|e| format!("cannot resolve the scene's folder {}: {e}", folder.display()))?;
-    if !relative.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)) {
+    let root = folder.canonicalize().map_err(|e| {
+        format!(
+            "cannot resolve the scene's folder {}: {e}",
+            folder.display()
+        )
+    })?;
+    if !relative
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+    {
         return Err("the URI is not a plain relative path".into());
     }
-    let target = root.join(relative).canonicalize().map_err(|e| format!("cannot open it: {e}"))?;
+    let target = root
+        .join(relative)
+        .canonicalize()
+        .map_err(|e| format!("cannot open it: {e}"))?;
     if !target.starts_with(&root) {
-        return Err(format!("it resolves outside the scene's folder {} (through a symbolic link)", root.display()));
+        return Err(format!(
+            "it resolves outside the scene's folder {} (through a symbolic link)",
+            root.display()
+        ));
     }
     Ok(target)
 }
@@ -121,9 +149,15 @@ impl std::fmt::Display for ReadError {
         match self {
             ReadError::Open(e) => write!(f, "cannot open it: {e}"),
             ReadError::NotRegular(kind) => write!(f, "it is {kind}, not a regular file"),
-            ReadError::Short { size, declared } => write!(f, "the file has {size} bytes but byteLength declares {declared}"),
+            ReadError::Short { size, declared } => write!(
+                f,
+                "the file has {size} bytes but byteLength declares {declared}"
+            ),
             ReadError::Read(e) => write!(f, "reading it failed: {e}"),
-            ReadError::Shrank { read, want } => write!(f, "the file shrank while being read ({read} of {want} bytes)"),
+            ReadError::Shrank { read, want } => write!(
+                f,
+                "the file shrank while being read ({read} of {want} bytes)"
+            ),
             ReadError::Budget(detail) => f.write_str(detail),
         }
     }
@@ -143,7 +177,10 @@ pub(crate) fn open_regular(path: &Path) -> Result<(File, u64), ReadError> {
 #[cfg(unix)]
 fn open_nonblocking(path: &Path) -> std::io::Result<File> {
     use std::os::unix::fs::OpenOptionsExt;
-    std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC).open(path)
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_CLOEXEC)
+        .open(path)
 }
 
 #[cfg(not(unix))]
@@ -176,7 +213,12 @@ fn describe_kind(kind: &std::fs::FileType) -> &'static str {
 /// Reads a regular file: exactly `declared` bytes when the document declares a length (a file
 /// shorter than that is an error, the rest of a longer one is not read), else the whole file.
 /// The bytes are taken from `budget` before anything is allocated.
-pub(crate) fn read_bounded(path: &Path, declared: Option<u64>, budget: &mut ByteBudget, what: &str) -> Result<Vec<u8>, ReadError> {
+pub(crate) fn read_bounded(
+    path: &Path,
+    declared: Option<u64>,
+    budget: &mut ByteBudget,
+    what: &str,
+) -> Result<Vec<u8>, ReadError> {
     let (file, size) = open_regular(path)?;
     let want = match declared {
         Some(d) if size < d => return Err(ReadError::Short { size, declared: d }),
@@ -186,28 +228,44 @@ pub(crate) fn read_bounded(path: &Path, declared: Option<u64>, budget: &mut Byte
     budget.take(want, what).map_err(ReadError::Budget)?;
     // `want` fits: the budget is far below usize::MAX on 64-bit targets.
     let mut data = Vec::with_capacity(usize::try_from(want).unwrap_or(0));
-    file.take(want).read_to_end(&mut data).map_err(ReadError::Read)?;
+    file.take(want)
+        .read_to_end(&mut data)
+        .map_err(ReadError::Read)?;
     if (data.len() as u64) < want {
-        return Err(ReadError::Shrank { read: data.len() as u64, want });
+        return Err(ReadError::Shrank {
+            read: data.len() as u64,
+            want,
+        });
     }
     Ok(data)
 }
 
 /// Decodes a base64 data-URI payload (padding optional), charging its decoded size to `budget`.
-pub(crate) fn decode_data_uri(payload: &str, budget: &mut ByteBudget, what: &str) -> Result<Vec<u8>, String> {
+pub(crate) fn decode_data_uri(
+    payload: &str,
+    budget: &mut ByteBudget,
+    what: &str,
+) -> Result<Vec<u8>, String> {
     let decoded_len = payload.len() as u64 / 4 * 3 + 3;
     budget.take(decoded_len, what)?;
     let engine = base64::engine::GeneralPurpose::new(
         &base64::alphabet::STANDARD,
-        base64::engine::GeneralPurposeConfig::new().with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
+        base64::engine::GeneralPurposeConfig::new()
+            .with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
     );
-    engine.decode(payload.trim()).map_err(|e| format!("invalid base64 payload: {e}"))
+    engine
+        .decode(payload.trim())
+        .map_err(|e| format!("invalid base64 payload: {e}"))
 }
 
 /// A URI as error messages show it: data URIs abbreviated (their payload is file content),
 /// control characters escaped, long ones cut.
 pub(crate) fn display_uri(uri: &str) -> String {
-    if let Ok(Uri::Data { media_type, payload }) = parse_uri(uri) {
+    if let Ok(Uri::Data {
+        media_type,
+        payload,
+    }) = parse_uri(uri)
+    {
         return format!("data:{media_type};base64,… ({} characters)", payload.len());
     }
     let escaped: String = uri.escape_debug().collect();
@@ -245,21 +303,49 @@ mod tests {
 
     #[test]
     fn relative_and_data_uris_parse() {
-        assert_eq!(parse_uri("tex/a%20b.png"), Ok(Uri::Relative(PathBuf::from("tex/a b.png"))));
-        assert_eq!(parse_uri("a.bin#frag"), Ok(Uri::Relative(PathBuf::from("a.bin"))));
+        assert_eq!(
+            parse_uri("tex/a%20b.png"),
+            Ok(Uri::Relative(PathBuf::from("tex/a b.png")))
+        );
+        assert_eq!(
+            parse_uri("a.bin#frag"),
+            Ok(Uri::Relative(PathBuf::from("a.bin")))
+        );
         assert_eq!(parse_uri("dir:x/a.bin"), Err("the 'dir:' scheme is not allowed: only relative paths inside the scene's folder and data: URIs are read".into()));
-        assert_eq!(parse_uri("./x:y.bin"), Ok(Uri::Relative(PathBuf::from("./x:y.bin"))), "a colon after a '/' is part of a name");
-        assert_eq!(parse_uri("data:image/png;base64,AAAA"), Ok(Uri::Data { media_type: "image/png", payload: "AAAA" }));
-        assert!(parse_uri("data:text/plain,hello").unwrap_err().contains("base64"));
+        assert_eq!(
+            parse_uri("./x:y.bin"),
+            Ok(Uri::Relative(PathBuf::from("./x:y.bin"))),
+            "a colon after a '/' is part of a name"
+        );
+        assert_eq!(
+            parse_uri("data:image/png;base64,AAAA"),
+            Ok(Uri::Data {
+                media_type: "image/png",
+                payload: "AAAA"
+            })
+        );
+        assert!(parse_uri("data:text/plain,hello")
+            .unwrap_err()
+            .contains("base64"));
         let mut budget = ByteBudget::new(100);
-        assert_eq!(decode_data_uri("AAEC", &mut budget, "b").unwrap(), vec![0, 1, 2]);
-        assert_eq!(decode_data_uri("AAE", &mut budget, "b").unwrap(), vec![0, 1], "padding is optional");
+        assert_eq!(
+            decode_data_uri("AAEC", &mut budget, "b").unwrap(),
+            vec![0, 1, 2]
+        );
+        assert_eq!(
+            decode_data_uri("AAE", &mut budget, "b").unwrap(),
+            vec![0, 1],
+            "padding is optional"
+        );
         assert!(decode_data_uri("A!!A", &mut budget, "b").is_err());
     }
 
     #[test]
     fn displayed_uris_never_carry_data_payloads() {
-        assert_eq!(display_uri("data:application/octet-stream;base64,c2VjcmV0"), "data:application/octet-stream;base64,… (8 characters)");
+        assert_eq!(
+            display_uri("data:application/octet-stream;base64,c2VjcmV0"),
+            "data:application/octet-stream;base64,… (8 characters)"
+        );
         assert_eq!(display_uri("a\nb.png"), "a\\nb.png");
         assert_eq!(display_uri(&"x".repeat(500)).chars().count(), 201);
     }

@@ -42,7 +42,11 @@ pub fn sphere(c: Vec3, r: f32, rings: u32, segments: u32) -> Vec<[Vec3; 3]> {
     let p = |i: u32, j: u32| {
         let theta = std::f32::consts::PI * i as f32 / rings as f32;
         let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-        c + r * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        c + r * Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
     };
     let mut tris = Vec::new();
     for i in 0..rings {
@@ -59,7 +63,11 @@ pub fn triangle_soup(rng: &mut TestRng, count: usize, extent: f32, size: f32) ->
     (0..count)
         .map(|_| {
             let c = rng.vec3(-extent, extent);
-            [c + rng.vec3(-size, size), c + rng.vec3(-size, size), c + rng.vec3(-size, size)]
+            [
+                c + rng.vec3(-size, size),
+                c + rng.vec3(-size, size),
+                c + rng.vec3(-size, size),
+            ]
         })
         .collect()
 }
@@ -99,7 +107,10 @@ pub fn quad_grid(n: u32) -> Vec<[Vec3; 3]> {
 pub fn bunny() -> Option<Vec<[Vec3; 3]>> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/bunny.ply");
     let Ok(text) = std::fs::read_to_string(&path) else {
-        println!("note: {} not found; skipping the bunny mesh", path.display());
+        println!(
+            "note: {} not found; skipping the bunny mesh",
+            path.display()
+        );
         return None;
     };
     let mut lines = text.lines();
@@ -117,14 +128,23 @@ pub fn bunny() -> Option<Vec<[Vec3; 3]>> {
         .by_ref()
         .take(vertex_count)
         .map(|l| {
-            let v: Vec<f32> = l.split_whitespace().take(3).filter_map(|w| w.parse().ok()).collect();
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .take(3)
+                .filter_map(|w| w.parse().ok())
+                .collect();
             Vec3::new(v[0], v[1], v[2])
         })
         .collect();
     let tris = lines
         .take(face_count)
         .map(|l| {
-            let idx: Vec<usize> = l.split_whitespace().skip(1).take(3).filter_map(|w| w.parse().ok()).collect();
+            let idx: Vec<usize> = l
+                .split_whitespace()
+                .skip(1)
+                .take(3)
+                .filter_map(|w| w.parse().ok())
+                .collect();
             [vertices[idx[0]], vertices[idx[1]], vertices[idx[2]]]
         })
         .collect();
@@ -136,7 +156,11 @@ pub fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
         let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
         for k in 0..4 {
             if k <= chunk.len() {

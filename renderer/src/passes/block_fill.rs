@@ -14,13 +14,31 @@ pub struct BlockFillPass {
 impl BlockFillPass {
     /// `variant`: the space's kernel (`passes/block_fill.<variant>`).
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<BlockFillPass> {
-        Ok(BlockFillPass { pipeline: ComputePipeline::shared(ctx, &format!("passes/block_fill.{variant}"), 0)? })
+        Ok(BlockFillPass {
+            pipeline: ComputePipeline::shared(ctx, &format!("passes/block_fill.{variant}"), 0)?,
+        })
     }
 
     /// `grid`: the atlas (each unit's mean colour, alpha 1 where traced); `sampling`: the
     /// space's parameters.
-    pub fn record(&self, rec: &mut FrameRecorder, sampling: &Buffer, grid: &Image, screen: &Image) -> Result<()> {
-        let binds = [read_buffer("sampling", sampling), read_image("grid", grid), write_image("screen", screen)];
-        rec.dispatch("block_fill", &self.pipeline, &binds, &[], [screen.width, screen.height, 1])
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        sampling: &Buffer,
+        grid: &Image,
+        screen: &Image,
+    ) -> Result<()> {
+        let binds = [
+            read_buffer("sampling", sampling),
+            read_image("grid", grid),
+            write_image("screen", screen),
+        ];
+        rec.dispatch(
+            "block_fill",
+            &self.pipeline,
+            &binds,
+            &[],
+            [screen.width, screen.height, 1],
+        )
     }
 }

@@ -5,8 +5,8 @@
 //! tonemap's full-screen pass when nothing reads the blurred radiance.
 
 use super::push_bytes;
-use crate::error::Result;
 use super::tonemap::{no_external_targets, LdrTarget, ToneTarget};
+use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
 use crate::layouts::{BlurPush, TonemapPush, BLUR_MAX_RADIUS};
 use crate::vk::{ComputePipeline, Context, Image};
@@ -49,7 +49,11 @@ impl BlurPass {
     pub fn new(ctx: &Arc<Context>) -> Result<BlurPass> {
         let push = std::mem::size_of::<BlurPush>() as u32;
         let ldr_external = match ctx.storage_write_without_format {
-            true => Some(ComputePipeline::shared(ctx, "passes/blur.ldr_external", push)?),
+            true => Some(ComputePipeline::shared(
+                ctx,
+                "passes/blur.ldr_external",
+                push,
+            )?),
             false => None,
         };
         Ok(BlurPass {
@@ -60,27 +64,59 @@ impl BlurPass {
     }
 
     /// `src` → (horizontal) → `scratch` → (vertical) → `dst`; `src` and `scratch` screen-sized.
-    pub fn record(&self, rec: &mut FrameRecorder, shape: &BlurShape, src: &Image, scratch: &Image, dst: BlurTarget) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        shape: &BlurShape,
+        src: &Image,
+        scratch: &Image,
+        dst: BlurTarget,
+    ) -> Result<()> {
         let push = |axis: u32, tone: TonemapPush| BlurPush {
-            shape: Vec4::new(shape.gaze.x, shape.gaze.y, shape.fovea_radius, shape.sigma_slope),
+            shape: Vec4::new(
+                shape.gaze.x,
+                shape.gaze.y,
+                shape.fovea_radius,
+                shape.sigma_slope,
+            ),
             config: UVec4::new(axis, BLUR_MAX_RADIUS, 0, 0),
             tone,
         };
         let size = [src.width, src.height, 1];
         let binds = [read_image("src", src), write_image("dst", scratch)];
-        rec.dispatch("blur_h", &self.hdr, &binds, push_bytes(&push(0, TonemapPush::default())), size)?;
+        rec.dispatch(
+            "blur_h",
+            &self.hdr,
+            &binds,
+            push_bytes(&push(0, TonemapPush::default())),
+            size,
+        )?;
         match dst {
             BlurTarget::Radiance(image) => {
                 let binds = [read_image("src", scratch), write_image("dst", image)];
-                rec.dispatch("blur_v", &self.hdr, &binds, push_bytes(&push(1, TonemapPush::default())), size)
+                rec.dispatch(
+                    "blur_v",
+                    &self.hdr,
+                    &binds,
+                    push_bytes(&push(1, TonemapPush::default())),
+                    size,
+                )
             }
             BlurTarget::Display(target) => {
                 let pipeline = match target.ldr {
                     LdrTarget::Own(_) => &self.ldr,
-                    LdrTarget::External { .. } => self.ldr_external.as_ref().ok_or_else(no_external_targets)?,
+                    LdrTarget::External { .. } => {
+                        self.ldr_external.as_ref().ok_or_else(no_external_targets)?
+                    }
                 };
                 let binds = [read_image("src", scratch), target.bind("dst")];
-                rec.dispatch("blur_v_tonemap", pipeline, &binds, push_bytes(&push(1, target.push())), size)
+                rec.dispatch(
+                    "blur_v_tonemap",
+                    pipeline,
+                    &binds,
+                    push_bytes(&push(1, target.push())),
+                    size,
+                )
             }
         }
     }

@@ -34,15 +34,40 @@ impl GridBlurPass {
     }
 
     /// `src` → (φ) → `scratch` → (ρ) → `dst`, all of the grid's size.
-    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, shape: &BlurShape, src: &Image, scratch: &Image, dst: &Image) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        vp: &SamplingParams,
+        shape: &BlurShape,
+        src: &Image,
+        scratch: &Image,
+        dst: &Image,
+    ) -> Result<()> {
         let push = GridBlurPush {
             space: *vp,
-            shape: Vec4::new(shape.gaze.x, shape.gaze.y, shape.fovea_radius, shape.sigma_slope),
+            shape: Vec4::new(
+                shape.gaze.x,
+                shape.gaze.y,
+                shape.fovea_radius,
+                shape.sigma_slope,
+            ),
         };
         let size = [src.width, src.height, 1];
         let binds = [read_image("src", src), write_image("dst", scratch)];
-        rec.dispatch("blur_grid_phi", self.along_phi.for_space(vp), &binds, push_bytes(&push), size)?;
+        rec.dispatch(
+            "blur_grid_phi",
+            self.along_phi.for_space(vp),
+            &binds,
+            push_bytes(&push),
+            size,
+        )?;
         let binds = [read_image("src", scratch), write_image("dst", dst)];
-        rec.dispatch("blur_grid_rho", self.along_rho.for_space(vp), &binds, push_bytes(&push), size)
+        rec.dispatch(
+            "blur_grid_rho",
+            self.along_rho.for_space(vp),
+            &binds,
+            push_bytes(&push),
+            size,
+        )
     }
 }

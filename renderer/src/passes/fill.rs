@@ -35,14 +35,26 @@ pub fn pyramid_levels(screen: UVec2) -> Vec<UVec2> {
 
 impl FillPass {
     pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FillPass> {
-        let image = |name: &str, s: UVec2| Image::new(ctx, name, s.x, s.y, vk::Format::R32G32B32A32_SFLOAT);
+        let image =
+            |name: &str, s: UVec2| Image::new(ctx, name, s.x, s.y, vk::Format::R32G32B32A32_SFLOAT);
         let levels = pyramid_levels(screen);
-        let pulled = levels.iter().map(|&s| image("fill.pulled", s)).collect::<Result<Vec<_>>>()?;
+        let pulled = levels
+            .iter()
+            .map(|&s| image("fill.pulled", s))
+            .collect::<Result<Vec<_>>>()?;
         let mut filled = vec![image("fill.result", screen)?];
         for &s in levels.iter().take(levels.len().saturating_sub(1)) {
             filled.push(image("fill.filled", s)?);
         }
-        Ok(FillPass { pipeline: ComputePipeline::shared(ctx, "passes/fill", std::mem::size_of::<FillPush>() as u32)?, pulled, filled })
+        Ok(FillPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                "passes/fill",
+                std::mem::size_of::<FillPush>() as u32,
+            )?,
+            pulled,
+            filled,
+        })
     }
 
     /// Dispatches per frame.
@@ -61,16 +73,40 @@ impl FillPass {
             self.dispatch(rec, "fill_pull", PULL, fine(l), fine(l), &self.pulled[l])?;
         }
         for l in (0..n).rev() {
-            let coarse = if l + 1 == n { &self.pulled[l] } else { &self.filled[l + 1] };
+            let coarse = if l + 1 == n {
+                &self.pulled[l]
+            } else {
+                &self.filled[l + 1]
+            };
             self.dispatch(rec, "fill_push", PUSH, fine(l), coarse, &self.filled[l])?;
         }
         Ok(&self.filled[0])
     }
 
-    fn dispatch(&self, rec: &mut FrameRecorder, name: &'static str, mode: u32, fine: &Image, coarse: &Image, dst: &Image) -> Result<()> {
-        let binds = [read_image("fine", fine), read_image("coarse", coarse), write_image("dst", dst)];
-        let push = FillPush { config: UVec4::new(mode, 0, 0, 0) };
-        rec.dispatch(name, &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+    fn dispatch(
+        &self,
+        rec: &mut FrameRecorder,
+        name: &'static str,
+        mode: u32,
+        fine: &Image,
+        coarse: &Image,
+        dst: &Image,
+    ) -> Result<()> {
+        let binds = [
+            read_image("fine", fine),
+            read_image("coarse", coarse),
+            write_image("dst", dst),
+        ];
+        let push = FillPush {
+            config: UVec4::new(mode, 0, 0, 0),
+        };
+        rec.dispatch(
+            name,
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [dst.width, dst.height, 1],
+        )
     }
 }
 
@@ -80,7 +116,10 @@ mod tests {
 
     #[test]
     fn the_pyramid_halves_down_to_one_texel() {
-        assert_eq!(pyramid_levels(UVec2::new(5, 3)), vec![UVec2::new(3, 2), UVec2::new(2, 1), UVec2::new(1, 1)]);
+        assert_eq!(
+            pyramid_levels(UVec2::new(5, 3)),
+            vec![UVec2::new(3, 2), UVec2::new(2, 1), UVec2::new(1, 1)]
+        );
         assert!(pyramid_levels(UVec2::new(1, 1)).is_empty());
     }
 }

@@ -45,7 +45,16 @@ impl PhiMips {
     pub fn new(ctx: &Arc<Context>, grid: UVec2) -> Result<PhiMips> {
         let levels = level_count(grid.y);
         let height = level_offset(levels, grid.y);
-        Ok(PhiMips { image: Image::new(ctx, "phi_mips", grid.x, height, vk::Format::R32G32B32A32_SFLOAT)?, levels })
+        Ok(PhiMips {
+            image: Image::new(
+                ctx,
+                "phi_mips",
+                grid.x,
+                height,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )?,
+            levels,
+        })
     }
 }
 
@@ -56,21 +65,40 @@ pub struct MipPhiPass {
 impl MipPhiPass {
     pub fn new(ctx: &Arc<Context>) -> Result<MipPhiPass> {
         let size = std::mem::size_of::<MipPhiPush>() as u32;
-        Ok(MipPhiPass { pipelines: VpLayoutPipelines::new(ctx, "passes/mip_phi", size)? })
+        Ok(MipPhiPass {
+            pipelines: VpLayoutPipelines::new(ctx, "passes/mip_phi", size)?,
+        })
     }
 
     /// Copies `vp_color` (the VP grid of `vp`) into level 0 of `mips` and builds the levels above
     /// it, one dispatch per level. `columns` holds the space's `VisualPolar::column_table`: in the
     /// screen-clipped layout no level averages across the gap between two on-screen arcs.
-    pub fn record(&self, rec: &mut FrameRecorder, vp: &SamplingParams, columns: &Buffer, vp_color: &Image, mips: &PhiMips) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        vp: &SamplingParams,
+        columns: &Buffer,
+        vp_color: &Image,
+        mips: &PhiMips,
+    ) -> Result<()> {
         for src in 0..mips.levels - 1 {
-            let binds = [read_image("vp_color", vp_color), write_image("mips", &mips.image), read_texels("vp_columns", columns)];
+            let binds = [
+                read_image("vp_color", vp_color),
+                write_image("mips", &mips.image),
+                read_texels("vp_columns", columns),
+            ];
             let push = MipPhiPush {
                 space: *vp,
                 config: UVec4::new(src, 0, 0, 0),
             };
             let rows = rows_at_level(vp_color.height, src + 1);
-            rec.dispatch("mip_phi", self.pipelines.for_space(vp), &binds, push_bytes(&push), [vp_color.width, rows, 1])?;
+            rec.dispatch(
+                "mip_phi",
+                self.pipelines.for_space(vp),
+                &binds,
+                push_bytes(&push),
+                [vp_color.width, rows, 1],
+            )?;
         }
         Ok(())
     }

@@ -26,15 +26,27 @@ pub(crate) struct VpLayoutPipelines {
 
 impl VpLayoutPipelines {
     /// `shader` without the variant suffix (e.g. `passes/remap`).
-    pub fn new(ctx: &std::sync::Arc<crate::vk::Context>, shader: &str, push_size: u32) -> crate::error::Result<Self> {
+    pub fn new(
+        ctx: &std::sync::Arc<crate::vk::Context>,
+        shader: &str,
+        push_size: u32,
+    ) -> crate::error::Result<Self> {
         Self::with_prefix(ctx, &format!("{shader}."), push_size)
     }
 
     /// Variants `{prefix}paper` and `{prefix}clipped` (e.g. `passes/blur_grid.phi_`).
-    pub fn with_prefix(ctx: &std::sync::Arc<crate::vk::Context>, prefix: &str, push_size: u32) -> crate::error::Result<Self> {
+    pub fn with_prefix(
+        ctx: &std::sync::Arc<crate::vk::Context>,
+        prefix: &str,
+        push_size: u32,
+    ) -> crate::error::Result<Self> {
         Ok(VpLayoutPipelines {
             paper: crate::vk::ComputePipeline::shared(ctx, &format!("{prefix}paper"), push_size)?,
-            clipped: crate::vk::ComputePipeline::shared(ctx, &format!("{prefix}clipped"), push_size)?,
+            clipped: crate::vk::ComputePipeline::shared(
+                ctx,
+                &format!("{prefix}clipped"),
+                push_size,
+            )?,
         })
     }
 

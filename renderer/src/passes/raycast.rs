@@ -15,7 +15,13 @@ pub struct RaycastPass {
 
 impl RaycastPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RaycastPass> {
-        Ok(RaycastPass { pipeline: ComputePipeline::shared(ctx, "passes/raycast", std::mem::size_of::<RaycastPush>() as u32)? })
+        Ok(RaycastPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                "passes/raycast",
+                std::mem::size_of::<RaycastPush>() as u32,
+            )?,
+        })
     }
 
     /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel
@@ -35,13 +41,29 @@ impl RaycastPass {
     ) -> Result<()> {
         let s = scene.binds();
         let binds = [
-            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[9],
+            s[0],
+            s[1],
+            s[2],
+            s[3],
+            s[4],
+            s[5],
+            s[6],
+            s[7],
+            s[9],
             read_buffer("frame", frame),
             read_texels("rays", rays),
             write_buffer("hits", hits),
         ];
-        let push = RaycastPush { config: UVec4::new(count, any_hit as u32, 0, 0) };
-        rec.dispatch(pass_name, &self.pipeline, &binds, push_bytes(&push), [count, 1, 1])
+        let push = RaycastPush {
+            config: UVec4::new(count, any_hit as u32, 0, 0),
+        };
+        rec.dispatch(
+            pass_name,
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [count, 1, 1],
+        )
     }
 }
 
@@ -62,7 +84,12 @@ impl RayCaster {
         Ok(RayCaster {
             ctx: ctx.clone(),
             pass: RaycastPass::new(ctx)?,
-            frame: Buffer::with_data(ctx, "frame", &[crate::layouts::FrameData::default()], uniform)?,
+            frame: Buffer::with_data(
+                ctx,
+                "frame",
+                &[crate::layouts::FrameData::default()],
+                uniform,
+            )?,
             rays: None,
             hits: None,
             recorder: crate::graph::FrameRecorder::new(ctx, 4)?,
@@ -72,23 +99,55 @@ impl RayCaster {
     /// Traces `rays` (closest hit, or any hit for shadow rays); returns the hits and GPU ms.
     /// Rays and hits live in device-local memory, copied in and out outside the timed pass: on a
     /// discrete GPU the pass would otherwise time the bus, not the traversal.
-    pub fn trace(&mut self, scene: &GpuScene, rays: &[crate::layouts::RayGpu], any_hit: bool) -> Result<(Vec<crate::layouts::HitGpu>, f64)> {
+    pub fn trace(
+        &mut self,
+        scene: &GpuScene,
+        rays: &[crate::layouts::RayGpu],
+        any_hit: bool,
+    ) -> Result<(Vec<crate::layouts::HitGpu>, f64)> {
         use gpu_allocator::MemoryLocation;
-        let usage = ash::vk::BufferUsageFlags::STORAGE_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_SRC;
+        let usage =
+            ash::vk::BufferUsageFlags::STORAGE_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_SRC;
         let ray_bytes = (std::mem::size_of_val(rays) as u64).max(16);
         let hit_bytes = (rays.len() * std::mem::size_of::<crate::layouts::HitGpu>()) as u64;
         if self.rays.as_ref().is_none_or(|b| b.size < ray_bytes) {
-            self.rays = Some(Buffer::device_texels(&self.ctx, "rays", bytemuck::cast_slice(rays))?);
-            self.hits = Some(Buffer::new(&self.ctx, "hits", hit_bytes.max(32), usage, MemoryLocation::GpuOnly)?);
+            self.rays = Some(Buffer::device_texels(
+                &self.ctx,
+                "rays",
+                bytemuck::cast_slice(rays),
+            )?);
+            self.hits = Some(Buffer::new(
+                &self.ctx,
+                "hits",
+                hit_bytes.max(32),
+                usage,
+                MemoryLocation::GpuOnly,
+            )?);
         } else {
             self.rays.as_ref().unwrap().upload(rays)?;
         }
         let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());
         // The instance level's slots are the scene's; everything else in the frame stays default.
-        self.frame.write(&[crate::layouts::FrameData { instancing: scene.instancing_slots, ..Default::default() }])?;
+        self.frame.write(&[crate::layouts::FrameData {
+            instancing: scene.instancing_slots,
+            ..Default::default()
+        }])?;
         self.recorder.begin()?;
-        let name = if any_hit { "raycast_any" } else { "raycast_closest" };
-        self.pass.record(&mut self.recorder, name, scene, &self.frame, ray_buf, hit_buf, rays.len() as u32, any_hit)?;
+        let name = if any_hit {
+            "raycast_any"
+        } else {
+            "raycast_closest"
+        };
+        self.pass.record(
+            &mut self.recorder,
+            name,
+            scene,
+            &self.frame,
+            ray_buf,
+            hit_buf,
+            rays.len() as u32,
+            any_hit,
+        )?;
         let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
         let mut hits = vec![crate::layouts::HitGpu::default(); rays.len()];
         hit_buf.download(&mut hits)?;

@@ -18,7 +18,9 @@ pub struct RemapPass {
 impl RemapPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RemapPass> {
         let size = std::mem::size_of::<RemapPush>() as u32;
-        Ok(RemapPass { pipelines: VpLayoutPipelines::new(ctx, "passes/remap", size)? })
+        Ok(RemapPass {
+            pipelines: VpLayoutPipelines::new(ctx, "passes/remap", size)?,
+        })
     }
 
     /// Fills `screen` (screen size) from the mip stack of a VP image; `vp` and `columns` (its
@@ -34,12 +36,22 @@ impl RemapPass {
         screen: &Image,
         sample_offset: Vec2,
     ) -> Result<()> {
-        let binds = [read_image("mips", &mips.image), write_image("screen_color", screen), read_texels("vp_columns", columns)];
+        let binds = [
+            read_image("mips", &mips.image),
+            write_image("screen_color", screen),
+            read_texels("vp_columns", columns),
+        ];
         let push = RemapPush {
             space: *vp,
             config: UVec4::new(mips.levels, 0, 0, 0),
             sample_offset: Vec4::new(sample_offset.x, sample_offset.y, 0.0, 0.0),
         };
-        rec.dispatch("remap", self.pipelines.for_space(vp), &binds, push_bytes(&push), [screen.width, screen.height, 1])
+        rec.dispatch(
+            "remap",
+            self.pipelines.for_space(vp),
+            &binds,
+            push_bytes(&push),
+            [screen.width, screen.height, 1],
+        )
     }
 }

@@ -4,7 +4,9 @@
 
 use super::push_bytes;
 use crate::error::Result;
-use crate::graph::{read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder};
+use crate::graph::{
+    read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
+};
 use crate::layouts::SplatPush;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
@@ -35,9 +37,19 @@ impl SplatPass {
         let bytes = screen.x as u64 * screen.y as u64 * 16;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         Ok(SplatPass {
-            pipeline: ComputePipeline::shared(ctx, &format!("passes/splat.{variant}"), std::mem::size_of::<SplatPush>() as u32)?,
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &format!("passes/splat.{variant}"),
+                std::mem::size_of::<SplatPush>() as u32,
+            )?,
             sums: Buffer::new(ctx, "splat.sums", bytes, usage, MemoryLocation::GpuOnly)?,
-            sparse: Image::new(ctx, "splat.sparse", screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT)?,
+            sparse: Image::new(
+                ctx,
+                "splat.sparse",
+                screen.x,
+                screen.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )?,
         })
     }
 
@@ -46,7 +58,12 @@ impl SplatPass {
         3
     }
 
-    pub fn record<'a>(&'a self, rec: &mut FrameRecorder, inputs: &SplatInputs, grid_color: &'a Image) -> Result<&'a Image> {
+    pub fn record<'a>(
+        &'a self,
+        rec: &mut FrameRecorder,
+        inputs: &SplatInputs,
+        grid_color: &'a Image,
+    ) -> Result<&'a Image> {
         rec.fill_buffer("splat_clear", &self.sums, 0)?;
         let binds = [
             read_buffer("frame", inputs.frame_data),
@@ -56,9 +73,23 @@ impl SplatPass {
             write_buffer("sums", &self.sums),
             write_image("sparse", &self.sparse),
         ];
-        let push = |mode: u32| SplatPush { config: UVec4::new(mode, 0, 0, 0) };
-        rec.dispatch("splat_scatter", &self.pipeline, &binds, push_bytes(&push(SCATTER)), [grid_color.width, grid_color.height, 1])?;
-        rec.dispatch("splat_resolve", &self.pipeline, &binds, push_bytes(&push(RESOLVE)), [self.sparse.width, self.sparse.height, 1])?;
+        let push = |mode: u32| SplatPush {
+            config: UVec4::new(mode, 0, 0, 0),
+        };
+        rec.dispatch(
+            "splat_scatter",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push(SCATTER)),
+            [grid_color.width, grid_color.height, 1],
+        )?;
+        rec.dispatch(
+            "splat_resolve",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push(RESOLVE)),
+            [self.sparse.width, self.sparse.height, 1],
+        )?;
         Ok(&self.sparse)
     }
 }

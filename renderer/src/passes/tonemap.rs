@@ -23,7 +23,10 @@ pub enum ToneCurve {
 pub enum LdrTarget<'a> {
     Own(&'a Image),
     /// An external image, the view's top-left pixel at `offset`.
-    External { image: &'a ExternalImage, offset: UVec2 },
+    External {
+        image: &'a ExternalImage,
+        offset: UVec2,
+    },
 }
 
 /// The display image of a frame and how radiance becomes its pixels: what the tonemap pass
@@ -46,7 +49,10 @@ impl ToneTarget<'_> {
             LdrTarget::Own(_) => UVec2::ZERO,
             LdrTarget::External { offset, .. } => offset,
         };
-        TonemapPush { params: Vec4::new(self.exposure, 0.0, 0.0, 0.0), config: UVec4::new(op, offset.x, offset.y, 0) }
+        TonemapPush {
+            params: Vec4::new(self.exposure, 0.0, 0.0, 0.0),
+            config: UVec4::new(op, offset.x, offset.y, 0),
+        }
     }
 
     /// The target's binding, named `name`.
@@ -76,19 +82,38 @@ impl TonemapPass {
     pub fn new(ctx: &Arc<Context>) -> Result<TonemapPass> {
         let push = std::mem::size_of::<TonemapPush>() as u32;
         let external = match ctx.storage_write_without_format {
-            true => Some(ComputePipeline::shared(ctx, "passes/tonemap.external", push)?),
+            true => Some(ComputePipeline::shared(
+                ctx,
+                "passes/tonemap.external",
+                push,
+            )?),
             false => None,
         };
-        Ok(TonemapPass { own: ComputePipeline::shared(ctx, "passes/tonemap.own", push)?, external })
+        Ok(TonemapPass {
+            own: ComputePipeline::shared(ctx, "passes/tonemap.own", push)?,
+            external,
+        })
     }
 
     /// `pass` names the dispatch in the timing report (the frame and the debug grid view differ).
-    pub fn record(&self, rec: &mut FrameRecorder, pass: &'static str, hdr: &Image, target: &ToneTarget) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        pass: &'static str,
+        hdr: &Image,
+        target: &ToneTarget,
+    ) -> Result<()> {
         let pipeline: &ComputePipeline = match target.ldr {
             LdrTarget::Own(_) => &self.own,
             LdrTarget::External { .. } => self.external.as_ref().ok_or_else(no_external_targets)?,
         };
         let binds = [read_image("hdr", hdr), target.bind("ldr")];
-        rec.dispatch(pass, pipeline, &binds, push_bytes(&target.push()), [hdr.width, hdr.height, 1])
+        rec.dispatch(
+            pass,
+            pipeline,
+            &binds,
+            push_bytes(&target.push()),
+            [hdr.width, hdr.height, 1],
+        )
     }
 }

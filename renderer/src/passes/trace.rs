@@ -2,10 +2,10 @@
 //! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf).
 
 use super::push_bytes;
+use super::trace_clear::TraceClearPass;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, write_image, Bind, FrameRecorder};
-use super::trace_clear::TraceClearPass;
 use crate::layouts::{TracePush, WORKGROUP_2D};
 use crate::sampling::{SamplingSpace, TraceTiles};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
@@ -69,7 +69,13 @@ impl GBuffer {
     /// A G-buffer with the visibility image the A-SVGF gradient samples are projected from.
     pub fn with_visibility(ctx: &Arc<Context>, size: UVec2) -> Result<GBuffer> {
         let mut g = GBuffer::new(ctx, size)?;
-        g.visibility = Some(Image::new(ctx, "gbuffer.visibility", size.x, size.y, vk::Format::R32G32B32A32_UINT)?);
+        g.visibility = Some(Image::new(
+            ctx,
+            "gbuffer.visibility",
+            size.x,
+            size.y,
+            vk::Format::R32G32B32A32_UINT,
+        )?);
         Ok(g)
     }
 }
@@ -98,7 +104,12 @@ pub struct TileList<'a> {
 impl<'a> TileList<'a> {
     /// `tiles` as written into `buffer`.
     pub fn new(buffer: &'a Buffer, tiles: &TraceTiles) -> TileList<'a> {
-        TileList { buffer, live: tiles.live.len() as u32, idle: tiles.idle.len() as u32, culled_samples: tiles.culled_samples }
+        TileList {
+            buffer,
+            live: tiles.live.len() as u32,
+            idle: tiles.idle.len() as u32,
+            culled_samples: tiles.culled_samples,
+        }
     }
 
     /// The threads of a dispatch over the live tiles (one workgroup each; shaders/common/tiles.glsl).
@@ -124,7 +135,12 @@ impl OwnedTileList {
     pub fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace, cull: bool) -> Result<OwnedTileList> {
         let mut tiles = TraceTiles::default();
         space.trace_tiles(cull, &mut tiles);
-        let buffer = Buffer::with_data(ctx, "tiles", tiles.packed(), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let buffer = Buffer::with_data(
+            ctx,
+            "tiles",
+            tiles.packed(),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
         Ok(OwnedTileList { buffer, tiles })
     }
 
@@ -145,7 +161,14 @@ pub const RAY_COUNTERS: usize = 5;
 impl TracePass {
     pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {
         let shader = format!("passes/trace.{sampling_variant}");
-        Ok(TracePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TracePush>() as u32)?, clear: TraceClearPass::new(ctx)? })
+        Ok(TracePass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<TracePush>() as u32,
+            )?,
+            clear: TraceClearPass::new(ctx)?,
+        })
     }
 
     /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
@@ -178,26 +201,57 @@ impl TracePass {
         let s = scene.binds();
         // A fixed array sliced to what this kernel binds: no host allocation per frame.
         let gradient_binds = match (gradients, &out.visibility) {
-            (Some(g), Some(visibility)) => {
-                Some([write_buffer("gradient_samples", g.samples), write_image("out_gradient", g.gradient), write_image("out_visibility", visibility)])
-            }
+            (Some(g), Some(visibility)) => Some([
+                write_buffer("gradient_samples", g.samples),
+                write_image("out_gradient", g.gradient),
+                write_image("out_visibility", visibility),
+            ]),
             _ => None,
         };
         let extra = gradient_binds.unwrap_or([s[0]; 3]);
         let g = out.write_binds();
         let binds = [
-            s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8], s[9],
+            s[0],
+            s[1],
+            s[2],
+            s[3],
+            s[4],
+            s[5],
+            s[6],
+            s[7],
+            s[8],
+            s[9],
             read_buffer("frame", frame),
             read_buffer("sampling", sampling),
             read_texels("sampling_table", sampling_table),
             write_buffer("ray_counters", ray_counters),
-            g[0], g[1], g[2], g[3], g[4], g[5], g[6],
+            g[0],
+            g[1],
+            g[2],
+            g[3],
+            g[4],
+            g[5],
+            g[6],
             read_buffer("tiles", tiles.buffer),
-            extra[0], extra[1], extra[2],
+            extra[0],
+            extra[1],
+            extra[2],
         ];
-        let binds = &binds[..if gradient_binds.is_some() { binds.len() } else { binds.len() - 3 }];
+        let binds = &binds[..if gradient_binds.is_some() {
+            binds.len()
+        } else {
+            binds.len() - 3
+        }];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
-        let push = TracePush { config: UVec4::new(sample_index, 0, 0, 0) };
-        rec.dispatch("trace", &self.pipeline, binds, push_bytes(&push), tiles.live_threads())
+        let push = TracePush {
+            config: UVec4::new(sample_index, 0, 0, 0),
+        };
+        rec.dispatch(
+            "trace",
+            &self.pipeline,
+            binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

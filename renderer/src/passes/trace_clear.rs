@@ -27,23 +27,46 @@ impl TraceClearPass {
     }
 
     /// The idle tiles of `tiles` in `out` (nothing to record when there are none).
-    pub fn record(&self, rec: &mut FrameRecorder, tiles: &TileList, ray_counters: &Buffer, out: &GBuffer) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        tiles: &TileList,
+        ray_counters: &Buffer,
+        out: &GBuffer,
+    ) -> Result<()> {
         if tiles.idle == 0 {
             return Ok(());
         }
-        let push = TraceClearPush { config: UVec4::new(tiles.live, tiles.culled_samples, 0, 0) };
+        let push = TraceClearPush {
+            config: UVec4::new(tiles.live, tiles.culled_samples, 0, 0),
+        };
         // A fixed array (no host allocation per frame): the plain kernel binds all but the last.
         let g = out.write_binds();
         let binds = [
-            g[0], g[1], g[2], g[3], g[4], g[5], g[6],
+            g[0],
+            g[1],
+            g[2],
+            g[3],
+            g[4],
+            g[5],
+            g[6],
             read_buffer("tiles", tiles.buffer),
             write_buffer("ray_counters", ray_counters),
-            write_image("out_visibility", out.visibility.as_ref().unwrap_or(&out.color)),
+            write_image(
+                "out_visibility",
+                out.visibility.as_ref().unwrap_or(&out.color),
+            ),
         ];
         let (pipeline, binds) = match out.visibility {
             Some(_) => (&self.gradients, &binds[..]),
             None => (&self.plain, &binds[..binds.len() - 1]),
         };
-        rec.dispatch("trace_clear", pipeline, binds, push_bytes(&push), tiles.idle_threads())
+        rec.dispatch(
+            "trace_clear",
+            pipeline,
+            binds,
+            push_bytes(&push),
+            tiles.idle_threads(),
+        )
     }
 }

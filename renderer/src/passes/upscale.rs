@@ -12,11 +12,19 @@ pub struct UpscalePass {
 
 impl UpscalePass {
     pub fn new(ctx: &Arc<Context>) -> Result<UpscalePass> {
-        Ok(UpscalePass { pipeline: ComputePipeline::shared(ctx, "passes/upscale", 0)? })
+        Ok(UpscalePass {
+            pipeline: ComputePipeline::shared(ctx, "passes/upscale", 0)?,
+        })
     }
 
     pub fn record(&self, rec: &mut FrameRecorder, grid: &Image, screen: &Image) -> Result<()> {
         let binds = [read_image("grid", grid), write_image("screen", screen)];
-        rec.dispatch("upscale", &self.pipeline, &binds, &[], [screen.width, screen.height, 1])
+        rec.dispatch(
+            "upscale",
+            &self.pipeline,
+            &binds,
+            &[],
+            [screen.width, screen.height, 1],
+        )
     }
 }

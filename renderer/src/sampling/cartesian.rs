@@ -15,7 +15,10 @@ pub struct Cartesian {
 impl Cartesian {
     /// Uniform sampling of `screen`, gaze at its centre.
     pub fn new(screen: UVec2) -> Cartesian {
-        Cartesian { screen, gaze: screen.as_vec2() * 0.5 }
+        Cartesian {
+            screen,
+            gaze: screen.as_vec2() * 0.5,
+        }
     }
 }
 

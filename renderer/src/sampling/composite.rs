@@ -52,7 +52,14 @@ impl CompositeMode {
             CompositeMode::Composite => (1.4, 1.0, 0.20, 0.33),
             CompositeMode::CompositeKernel => (1.3, 2.0, 0.15, 0.35),
         };
-        CompositeParams { mode: self, sigma, alpha, gaze_angle, aspect, viewing_distance_px }
+        CompositeParams {
+            mode: self,
+            sigma,
+            alpha,
+            gaze_angle,
+            aspect,
+            viewing_distance_px,
+        }
     }
 }
 
@@ -82,8 +89,14 @@ impl CompositeParams {
     pub fn validate(&self) -> Result<()> {
         // σ and α within log-polar's own ranges.
         let within = |v: f32, (lo, hi): (f32, f32)| v >= lo && v <= hi;
-        let ok = within(self.sigma, SIGMA_RANGE) && within(self.alpha, ALPHA_RANGE) && within(self.aspect, ASPECT_RANGE);
-        if !(ok && (0.0..1.2).contains(&self.gaze_angle) && self.viewing_distance_px.is_finite() && self.viewing_distance_px > 0.0) {
+        let ok = within(self.sigma, SIGMA_RANGE)
+            && within(self.alpha, ALPHA_RANGE)
+            && within(self.aspect, ASPECT_RANGE);
+        if !(ok
+            && (0.0..1.2).contains(&self.gaze_angle)
+            && self.viewing_distance_px.is_finite()
+            && self.viewing_distance_px > 0.0)
+        {
             let ((s0, s1), (a0, a1), (p0, p1)) = (SIGMA_RANGE, ALPHA_RANGE, ASPECT_RANGE);
             return Err(Error::Invalid(format!(
                 "composite: σ in [{s0}, {s1}], α in [{a0}, {a1}], aspect in [{p0}, {p1}], a_G in [0, 1.2) rad and a positive viewing distance, got {self:?}"
@@ -98,20 +111,35 @@ impl CompositeParams {
 
     pub fn layout(&self, screen: UVec2) -> Result<CompositeLayout> {
         let (w_px, h_px) = (screen.x as f32, screen.y as f32);
-        let rows = ((w_px * h_px / self.aspect).sqrt() / self.sigma).round().max(2.0);
+        let rows = ((w_px * h_px / self.aspect).sqrt() / self.sigma)
+            .round()
+            .max(2.0);
         let columns = (rows * self.aspect).round().max(2.0);
         let mut law = LogPolarLaw::new(Vec2::new(w_px, h_px).length(), self.alpha)?;
         let r_g = self.gaze_radius_px();
         if r_g < 1.0 {
-            return Ok(CompositeLayout { grid: UVec2::new(columns as u32, rows as u32), law, u_f: 0.0, r_f: 0.0 });
+            return Ok(CompositeLayout {
+                grid: UVec2::new(columns as u32, rows as u32),
+                law,
+                u_f: 0.0,
+                r_f: 0.0,
+            });
         }
         let fovea_columns = (std::f32::consts::TAU * r_g * r_g / rows).round().max(1.0);
         law.inner = law.u_of_r(r_g);
         if law.inner >= 1.0 {
-            return Err(Error::Invalid(format!("composite: the gaze disc (r_G = {r_g:.0} px) covers the whole {}×{} screen", screen.x, screen.y)));
+            return Err(Error::Invalid(format!(
+                "composite: the gaze disc (r_G = {r_g:.0} px) covers the whole {}×{} screen",
+                screen.x, screen.y
+            )));
         }
         let width = columns + fovea_columns;
-        Ok(CompositeLayout { grid: UVec2::new(width as u32, rows as u32), law, u_f: fovea_columns / width, r_f: r_g })
+        Ok(CompositeLayout {
+            grid: UVec2::new(width as u32, rows as u32),
+            law,
+            u_f: fovea_columns / width,
+            r_f: r_g,
+        })
     }
 }
 
@@ -122,7 +150,15 @@ mod tests {
 
     fn space(mode: CompositeMode, screen: UVec2) -> VisualPolar {
         let radial = RadialLaw::Composite(mode.params(screen.x as f32 / 2.0));
-        VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams { radial, ..Default::default() }).unwrap()
+        VisualPolar::new(
+            screen,
+            screen.as_vec2() * 0.5,
+            VisualPolarParams {
+                radial,
+                ..Default::default()
+            },
+        )
+        .unwrap()
     }
 
     /// Rays traced on the screen per screen pixel, texel centres, gaze centred, a 90° eye: within
@@ -130,7 +166,12 @@ mod tests {
     #[test]
     fn the_modes_trace_the_shares_their_paper_reports() {
         let screen = UVec2::new(320, 360);
-        for (mode, paper) in [(CompositeMode::Fov, 1.54), (CompositeMode::Kernel, 0.657), (CompositeMode::Composite, 0.375), (CompositeMode::CompositeKernel, 0.377)] {
+        for (mode, paper) in [
+            (CompositeMode::Fov, 1.54),
+            (CompositeMode::Kernel, 0.657),
+            (CompositeMode::Composite, 0.375),
+            (CompositeMode::CompositeKernel, 0.377),
+        ] {
             let vp = space(mode, screen);
             let g = vp.grid_size();
             let on_screen = (0..g.y)
@@ -139,7 +180,11 @@ mod tests {
                 .filter(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(screen.as_vec2()).all())
                 .count();
             let share = on_screen as f64 / (screen.x * screen.y) as f64;
-            assert!((share - paper).abs() < 0.06, "{}: {share:.3} on screen vs the paper's {paper}", mode.name());
+            assert!(
+                (share - paper).abs() < 0.06,
+                "{}: {share:.3} on screen vs the paper's {paper}",
+                mode.name()
+            );
         }
     }
 
@@ -150,12 +195,24 @@ mod tests {
         let vp = space(CompositeMode::Composite, screen);
         let r_g = CompositeMode::Composite.params(320.0).gaze_radius_px();
         let fovea_columns = (vp.u_fovea() * vp.grid_size().x as f32).round() as u32;
-        let fovea_samples: u64 = (0..fovea_columns).map(|c| vp.rows_in_column(c) as u64).sum();
+        let fovea_samples: u64 = (0..fovea_columns)
+            .map(|c| vp.rows_in_column(c) as u64)
+            .sum();
         let disc = std::f64::consts::PI * (r_g as f64).powi(2);
-        assert!((fovea_samples as f64 / disc - 1.0).abs() < 0.03, "{fovea_samples} samples in a disc of {disc:.0} px");
+        assert!(
+            (fovea_samples as f64 / disc - 1.0).abs() < 0.03,
+            "{fovea_samples} samples in a disc of {disc:.0} px"
+        );
         let u_f = vp.u_fovea();
-        assert!((vp.r_of_u(u_f) - r_g).abs() < 1e-2 && (vp.r_of_u(u_f - 1e-4) - r_g).abs() < 0.1, "{} vs {r_g}", vp.r_of_u(u_f));
-        assert!((vp.u_of_r(r_g) - u_f).abs() < 1e-5 && (vp.u_of_r(3.0 * r_g) - vp.u_of_r(2.0 * r_g)) > 0.0);
+        assert!(
+            (vp.r_of_u(u_f) - r_g).abs() < 1e-2 && (vp.r_of_u(u_f - 1e-4) - r_g).abs() < 0.1,
+            "{} vs {r_g}",
+            vp.r_of_u(u_f)
+        );
+        assert!(
+            (vp.u_of_r(r_g) - u_f).abs() < 1e-5
+                && (vp.u_of_r(3.0 * r_g) - vp.u_of_r(2.0 * r_g)) > 0.0
+        );
         // The plain modes have no disc.
         assert_eq!(space(CompositeMode::Kernel, screen).u_fovea(), 0.0);
     }

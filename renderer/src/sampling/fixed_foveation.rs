@@ -20,9 +20,16 @@ pub struct FixedFoveation {
 }
 
 impl FixedFoveation {
-    pub fn new(screen: UVec2, lens_centre: Vec2, params: VisualPolarParams) -> Result<FixedFoveation> {
+    pub fn new(
+        screen: UVec2,
+        lens_centre: Vec2,
+        params: VisualPolarParams,
+    ) -> Result<FixedFoveation> {
         let vp = VisualPolar::new(screen, lens_centre, params)?;
-        Ok(FixedFoveation { vp, gaze: lens_centre })
+        Ok(FixedFoveation {
+            vp,
+            gaze: lens_centre,
+        })
     }
 
     /// Where the eye's optical axis (view direction, tangent 0) meets its screen: the screen
@@ -30,8 +37,15 @@ impl FixedFoveation {
     /// FOV that does not contain its own axis.
     pub fn lens_centre(screen: UVec2, fov: FovTangents) -> Vec2 {
         let s = screen.as_vec2();
-        let fraction = Vec2::new(fov.left / (fov.left + fov.right), fov.up / (fov.up + fov.down));
-        let fraction = if fraction.is_finite() { fraction } else { Vec2::splat(0.5) };
+        let fraction = Vec2::new(
+            fov.left / (fov.left + fov.right),
+            fov.up / (fov.up + fov.down),
+        );
+        let fraction = if fraction.is_finite() {
+            fraction
+        } else {
+            Vec2::splat(0.5)
+        };
         (fraction * s).clamp(Vec2::ZERO, s)
     }
 
@@ -78,7 +92,10 @@ impl SamplingSpace for FixedFoveation {
     /// Records the gaze; the samples stay on the lens.
     fn set_gaze(&mut self, gaze: Vec2) -> Result<()> {
         if !gaze.is_finite() {
-            return Err(Error::Invalid(format!("fixed foveation: gaze must be finite, got ({}, {})", gaze.x, gaze.y)));
+            return Err(Error::Invalid(format!(
+                "fixed foveation: gaze must be finite, got ({}, {})",
+                gaze.x, gaze.y
+            )));
         }
         self.gaze = gaze;
         Ok(())
@@ -101,12 +118,26 @@ mod tests {
         let screen = UVec2::new(320, 360);
         let fov = FovTangents::from_angles_deg(-45.0, 45.0, -48.4, 48.4);
         let centre = FixedFoveation::lens_centre(screen, fov);
-        assert!((centre - Vec2::new(160.0, 180.0)).length() < 1e-3, "{centre}");
+        assert!(
+            (centre - Vec2::new(160.0, 180.0)).length() < 1e-3,
+            "{centre}"
+        );
         let mut s = FixedFoveation::new(screen, centre, VisualPolarParams::default()).unwrap();
-        let before = (s.params(), s.sample_count(), s.grid_to_screen(Vec2::new(3.5, 7.5)));
+        let before = (
+            s.params(),
+            s.sample_count(),
+            s.grid_to_screen(Vec2::new(3.5, 7.5)),
+        );
         s.set_gaze(Vec2::new(20.0, 30.0)).unwrap();
         assert_eq!(s.gaze(), Vec2::new(20.0, 30.0));
-        assert_eq!((s.params(), s.sample_count(), s.grid_to_screen(Vec2::new(3.5, 7.5))), before);
+        assert_eq!(
+            (
+                s.params(),
+                s.sample_count(),
+                s.grid_to_screen(Vec2::new(3.5, 7.5))
+            ),
+            before
+        );
         assert_eq!(s.visual_polar().unwrap().gaze(), centre);
         assert!(s.set_gaze(Vec2::new(f32::NAN, 0.0)).is_err());
     }
@@ -115,11 +146,21 @@ mod tests {
     fn the_lens_centre_follows_an_asymmetric_fov() {
         let screen = UVec2::new(1000, 800);
         // 30° to the nose, 60° to the temple; 45° up and down.
-        let c = FixedFoveation::lens_centre(screen, FovTangents::from_angles_deg(-30.0, 60.0, -45.0, 45.0));
-        let expected = 1000.0 * 30f32.to_radians().tan() / (30f32.to_radians().tan() + 60f32.to_radians().tan());
-        assert!((c.x - expected).abs() < 1e-2 && (c.y - 400.0).abs() < 1e-3, "{c}");
+        let c = FixedFoveation::lens_centre(
+            screen,
+            FovTangents::from_angles_deg(-30.0, 60.0, -45.0, 45.0),
+        );
+        let expected = 1000.0 * 30f32.to_radians().tan()
+            / (30f32.to_radians().tan() + 60f32.to_radians().tan());
+        assert!(
+            (c.x - expected).abs() < 1e-2 && (c.y - 400.0).abs() < 1e-3,
+            "{c}"
+        );
         // An FOV that does not contain its axis keeps the centre on the screen.
-        let off = FixedFoveation::lens_centre(screen, FovTangents::from_angles_deg(10.0, 60.0, -45.0, 45.0));
+        let off = FixedFoveation::lens_centre(
+            screen,
+            FovTangents::from_angles_deg(10.0, 60.0, -45.0, 45.0),
+        );
         assert!(off.x >= 0.0 && off.x <= 1000.0, "{off}");
     }
 }

@@ -23,7 +23,11 @@ pub struct FalloffShape {
 
 impl Default for FalloffShape {
     fn default() -> Self {
-        FalloffShape { inner_deg: 10.0, outer_deg: 20.0, floor: 0.2 }
+        FalloffShape {
+            inner_deg: 10.0,
+            outer_deg: 20.0,
+            floor: 0.2,
+        }
     }
 }
 
@@ -44,18 +48,35 @@ pub struct LinearFalloff {
 impl LinearFalloff {
     /// The falloff on `screen` with `vp`'s eccentricity axis, scaled so that with the gaze at the
     /// centre it traces `budget_of_vp` × Visual-Polar's sample count (on average).
-    pub fn new(screen: UVec2, vp: VisualPolarParams, shape: FalloffShape, budget_of_vp: f64) -> Result<LinearFalloff> {
-        if !(shape.inner_deg > 0.0 && shape.outer_deg > shape.inner_deg && (0.0..=1.0).contains(&shape.floor)) {
+    pub fn new(
+        screen: UVec2,
+        vp: VisualPolarParams,
+        shape: FalloffShape,
+        budget_of_vp: f64,
+    ) -> Result<LinearFalloff> {
+        if !(shape.inner_deg > 0.0
+            && shape.outer_deg > shape.inner_deg
+            && (0.0..=1.0).contains(&shape.floor))
+        {
             return Err(Error::Invalid(format!("linear falloff: needs 0 < inner < outer degrees and a floor in [0, 1], got {shape:?}")));
         }
         if !(budget_of_vp.is_finite() && budget_of_vp > 0.0) {
-            return Err(Error::Invalid(format!("linear falloff: budget {budget_of_vp} × Visual-Polar's samples must be positive")));
+            return Err(Error::Invalid(format!(
+                "linear falloff: budget {budget_of_vp} × Visual-Polar's samples must be positive"
+            )));
         }
         let centre = screen.as_vec2() * 0.5;
         let axis = VisualPolar::new(screen, centre, vp)?;
-        let mut space = LinearFalloff { axis, shape, inner_px: 0.0, outer_px: 0.0, scale: 1.0 };
+        let mut space = LinearFalloff {
+            axis,
+            shape,
+            inner_px: 0.0,
+            outer_px: 0.0,
+            scale: 1.0,
+        };
         space.set_radii();
-        let target = (budget_of_vp * axis.sample_count() as f64).min(screen.x as f64 * screen.y as f64);
+        let target =
+            (budget_of_vp * axis.sample_count() as f64).min(screen.x as f64 * screen.y as f64);
         space.scale = space.scale_for(target);
         Ok(space)
     }
@@ -67,7 +88,8 @@ impl LinearFalloff {
 
     /// As `falloff_keep_probability` in the GLSL.
     pub fn keep_probability(&self, r: f32) -> f32 {
-        let ramp = ((r - self.inner_px) / (self.outer_px - self.inner_px).max(1e-6)).clamp(0.0, 1.0);
+        let ramp =
+            ((r - self.inner_px) / (self.outer_px - self.inner_px).max(1e-6)).clamp(0.0, 1.0);
         (self.scale * (1.0 + (self.shape.floor - 1.0) * ramp)).min(1.0)
     }
 
@@ -77,7 +99,8 @@ impl LinearFalloff {
         let mut sum = 0.0;
         for y in 0..size.y {
             for x in 0..size.x {
-                sum += self.keep_probability((Vec2::new(x as f32, y as f32) + 0.5 - gaze).length()) as f64;
+                sum += self.keep_probability((Vec2::new(x as f32, y as f32) + 0.5 - gaze).length())
+                    as f64;
             }
         }
         sum
@@ -118,7 +141,10 @@ impl LinearFalloff {
     /// The pixels one frame traces.
     pub fn traced_count(&self, frame: u32, seed: u32) -> u64 {
         let size = self.axis.screen();
-        (0..size.y).flat_map(|y| (0..size.x).map(move |x| UVec2::new(x, y))).filter(|&t| self.keeps(t, frame, seed)).count() as u64
+        (0..size.y)
+            .flat_map(|y| (0..size.x).map(move |x| UVec2::new(x, y)))
+            .filter(|&t| self.keeps(t, frame, seed))
+            .count() as u64
     }
 }
 
@@ -167,7 +193,11 @@ impl SamplingSpace for LinearFalloff {
         Some(&self.axis)
     }
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { way_back: WayBack::Fill, temporal_filters: false, filters_note: "(its pixels are killed at random each frame)" }
+        SpaceCapabilities {
+            way_back: WayBack::Fill,
+            temporal_filters: false,
+            filters_note: "(its pixels are killed at random each frame)",
+        }
     }
 }
 
@@ -179,19 +209,39 @@ mod tests {
     fn the_budget_is_met_and_the_shape_kept() {
         let screen = UVec2::new(320, 360);
         let vp = VisualPolarParams::default();
-        let s = LinearFalloff::new(screen, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap();
-        let vp_count = VisualPolar::new(screen, screen.as_vec2() * 0.5, vp).unwrap().sample_count() as f64;
-        assert!((s.sample_count() as f64 / (1.5 * vp_count) - 1.0).abs() < 0.002, "{} vs {}", s.sample_count(), vp_count);
+        let s =
+            LinearFalloff::new(screen, vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).unwrap();
+        let vp_count = VisualPolar::new(screen, screen.as_vec2() * 0.5, vp)
+            .unwrap()
+            .sample_count() as f64;
+        assert!(
+            (s.sample_count() as f64 / (1.5 * vp_count) - 1.0).abs() < 0.002,
+            "{} vs {}",
+            s.sample_count(),
+            vp_count
+        );
         // Full rate in the core, never rising outwards.
         assert_eq!(s.keep_probability(0.0), 1.0);
         let p: Vec<f32> = (0..400).map(|r| s.keep_probability(r as f32)).collect();
         assert!(p.windows(2).all(|w| w[1] <= w[0]));
         // One frame's traced pixels scatter around the expectation (binomial, σ ≪ 1 %).
         let traced = s.traced_count(0, 1) as f64;
-        assert!((traced / s.sample_count() as f64 - 1.0).abs() < 0.02, "{traced}");
+        assert!(
+            (traced / s.sample_count() as f64 - 1.0).abs() < 0.02,
+            "{traced}"
+        );
         // A budget below the unscaled shape's count lowers the probabilities everywhere.
         let low = LinearFalloff::new(screen, vp, FalloffShape::default(), 0.2).unwrap();
         assert!(low.scale() < 1.0 && low.keep_probability(0.0) < 1.0);
-        assert!(LinearFalloff::new(screen, vp, FalloffShape { floor: 1.5, ..Default::default() }, 1.5).is_err());
+        assert!(LinearFalloff::new(
+            screen,
+            vp,
+            FalloffShape {
+                floor: 1.5,
+                ..Default::default()
+            },
+            1.5
+        )
+        .is_err());
     }
 }

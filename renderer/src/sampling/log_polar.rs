@@ -11,9 +11,9 @@
 //! Areal density (samples per pixel) ρ(r) = w·h·α·(ln r / L)^(α−1) / (2π·L·r²): α > 1 moves
 //! samples from the (otherwise heavily over-sampled) gaze toward the periphery.
 
+use super::acuity::ln_f32;
 use crate::error::{Error, Result};
 use glam::{UVec2, Vec2};
-use super::acuity::ln_f32;
 
 /// Where L comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +36,11 @@ pub struct LogPolarParams {
 
 impl Default for LogPolarParams {
     fn default() -> Self {
-        LogPolarParams { sigma: 1.8, alpha: 4.0, extent: LogPolarExtent::FarthestCorner }
+        LogPolarParams {
+            sigma: 1.8,
+            alpha: 4.0,
+            extent: LogPolarExtent::FarthestCorner,
+        }
     }
 }
 
@@ -48,7 +52,9 @@ pub const ALPHA_RANGE: (f32, f32) = (1.0, 8.0);
 impl LogPolarParams {
     pub fn validate(&self) -> Result<()> {
         let bad = |name: &str, v: f32, (lo, hi): (f32, f32)| {
-            Error::Invalid(format!("log-polar: {name} must be in [{lo}, {hi}], got {v}"))
+            Error::Invalid(format!(
+                "log-polar: {name} must be in [{lo}, {hi}], got {v}"
+            ))
         };
         if !(self.sigma >= SIGMA_RANGE.0 && self.sigma <= SIGMA_RANGE.1) {
             return Err(bad("sigma", self.sigma, SIGMA_RANGE));
@@ -82,9 +88,15 @@ impl LogPolarLaw {
     /// `extent_px` > 1 (an extent of one pixel has no periphery).
     pub fn new(extent_px: f32, alpha: f32) -> Result<Self> {
         if !(extent_px.is_finite() && extent_px > 1.0) {
-            return Err(Error::Invalid(format!("log-polar: the extent must exceed one pixel, got {extent_px} px")));
+            return Err(Error::Invalid(format!(
+                "log-polar: the extent must exceed one pixel, got {extent_px} px"
+            )));
         }
-        Ok(LogPolarLaw { l: ln_f32(extent_px), alpha, inner: 0.0 })
+        Ok(LogPolarLaw {
+            l: ln_f32(extent_px),
+            alpha,
+            inner: 0.0,
+        })
     }
 
     /// Pixels from the gaze of normalised column u. GLSL `lp_r_of_u`.
@@ -128,7 +140,11 @@ pub fn pow_unit(t: f32, a: f32) -> f32 {
 pub fn exp_f32(x: f32) -> f32 {
     let k = (x * 1.442_695 + 0.5).floor();
     let f = (x - k * 0.693_145_75) - k * 1.428_606_8e-6;
-    let p = ((((((1.984_127e-4 * f + 1.388_888_9e-3) * f + 8.333_333e-3) * f + 4.166_666_8e-2) * f + 0.166_666_67) * f + 0.5)
+    let p = ((((((1.984_127e-4 * f + 1.388_888_9e-3) * f + 8.333_333e-3) * f + 4.166_666_8e-2)
+        * f
+        + 0.166_666_67)
+        * f
+        + 0.5)
         * f
         + 1.0)
         * f
@@ -170,19 +186,49 @@ mod tests {
     use crate::sampling::{RadialLaw, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 
     fn space(screen: UVec2, gaze: Vec2, lp: LogPolarParams) -> VisualPolar {
-        VisualPolar::new(screen, gaze, VisualPolarParams { radial: RadialLaw::LogPolar(lp), ..Default::default() }).unwrap()
+        VisualPolar::new(
+            screen,
+            gaze,
+            VisualPolarParams {
+                radial: RadialLaw::LogPolar(lp),
+                ..Default::default()
+            },
+        )
+        .unwrap()
     }
 
     #[test]
     fn the_buffer_is_screen_over_sigma_and_every_texel_is_a_sample() {
-        let s = space(UVec2::new(320, 360), Vec2::new(160.0, 180.0), LogPolarParams::default());
-        assert_eq!(s.grid_size(), UVec2::new(178, 200), "320/1.8, 360/1.8 rounded");
+        let s = space(
+            UVec2::new(320, 360),
+            Vec2::new(160.0, 180.0),
+            LogPolarParams::default(),
+        );
+        assert_eq!(
+            s.grid_size(),
+            UVec2::new(178, 200),
+            "320/1.8, 360/1.8 rounded"
+        );
         assert_eq!(SamplingSpace::sample_count(&s), 178 * 200, "no clip");
-        assert_eq!((s.name(), s.trace_variant(), s.shader_variant()), ("log-polar", "log_polar", "visual_polar"));
+        assert_eq!(
+            (s.name(), s.trace_variant(), s.shader_variant()),
+            ("log-polar", "log_polar", "visual_polar")
+        );
         // L: the farthest corner (Meng) or the diagonal (Andersson & Hansson), whatever the gaze.
-        let corner = space(UVec2::new(320, 360), Vec2::new(40.0, 300.0), LogPolarParams::default());
+        let corner = space(
+            UVec2::new(320, 360),
+            Vec2::new(40.0, 300.0),
+            LogPolarParams::default(),
+        );
         assert!((corner.log_polar().unwrap().l - (280.0f32.hypot(300.0)).ln()).abs() < 1e-5);
-        let diag = space(UVec2::new(320, 360), Vec2::new(40.0, 300.0), LogPolarParams { extent: LogPolarExtent::Diagonal, ..Default::default() });
+        let diag = space(
+            UVec2::new(320, 360),
+            Vec2::new(40.0, 300.0),
+            LogPolarParams {
+                extent: LogPolarExtent::Diagonal,
+                ..Default::default()
+            },
+        );
         assert!((diag.log_polar().unwrap().l - 320f32.hypot(360.0).ln()).abs() < 1e-5);
         // Meng blurs the outer half of the buffer.
         assert!((s.blur_start() - s.r_of_u(0.5)).abs() < 1e-4);
@@ -190,8 +236,18 @@ mod tests {
 
     #[test]
     fn grid_and_screen_round_trip() {
-        for (gaze, extent) in [(Vec2::new(160.0, 180.0), LogPolarExtent::FarthestCorner), (Vec2::new(30.0, 330.0), LogPolarExtent::Diagonal)] {
-            let s = space(UVec2::new(320, 360), gaze, LogPolarParams { extent, ..Default::default() });
+        for (gaze, extent) in [
+            (Vec2::new(160.0, 180.0), LogPolarExtent::FarthestCorner),
+            (Vec2::new(30.0, 330.0), LogPolarExtent::Diagonal),
+        ] {
+            let s = space(
+                UVec2::new(320, 360),
+                gaze,
+                LogPolarParams {
+                    extent,
+                    ..Default::default()
+                },
+            );
             let g = s.grid_size();
             for x in 0..g.x {
                 for y in (0..g.y).step_by(7) {
@@ -199,14 +255,20 @@ mod tests {
                     let screen = s.grid_to_screen(p).unwrap();
                     let back = s.screen_to_grid(screen).unwrap();
                     // ln r loses ~1e-7 relative near the gaze, where a column spans < 0.01 px.
-                    assert!((back - p).abs().max_element() < 2e-3, "{p} -> {screen} -> {back}");
+                    assert!(
+                        (back - p).abs().max_element() < 2e-3,
+                        "{p} -> {screen} -> {back}"
+                    );
                 }
             }
             for (px, py) in [(1.5f32, 0.5f32), (0.0, 0.0), (319.5, 359.5), (200.0, 17.0)] {
                 let q = Vec2::new(px, py);
                 if (q - gaze).length() > 2.0 {
                     let back = s.grid_to_screen(s.screen_to_grid(q).unwrap()).unwrap();
-                    assert!((back - q).length() < 1e-3 * (q - gaze).length(), "{q} -> {back}");
+                    assert!(
+                        (back - q).length() < 1e-3 * (q - gaze).length(),
+                        "{q} -> {back}"
+                    );
                 }
             }
         }
@@ -218,17 +280,40 @@ mod tests {
     #[test]
     fn samples_per_ring_follow_the_papers_density() {
         for alpha in [1.0f32, 4.0] {
-            let s = space(UVec2::new(320, 360), Vec2::new(160.0, 180.0), LogPolarParams { alpha, ..Default::default() });
+            let s = space(
+                UVec2::new(320, 360),
+                Vec2::new(160.0, 180.0),
+                LogPolarParams {
+                    alpha,
+                    ..Default::default()
+                },
+            );
             let (g, law) = (s.grid_size(), *s.log_polar().unwrap());
-            let radii: Vec<f32> = (0..g.x).map(|x| (s.grid_to_screen(Vec2::new(x as f32 + 0.5, 0.5)).unwrap() - s.gaze()).length()).collect();
+            let radii: Vec<f32> = (0..g.x)
+                .map(|x| {
+                    (s.grid_to_screen(Vec2::new(x as f32 + 0.5, 0.5)).unwrap() - s.gaze()).length()
+                })
+                .collect();
             let edges = [2.0f64, 8.0, 20.0, 45.0, 80.0, 120.0, 159.0];
             for e in edges.windows(2) {
-                let counted = radii.iter().filter(|&&r| (r as f64) >= e[0] && (r as f64) < e[1]).count() as f64 * g.y as f64;
+                let counted = radii
+                    .iter()
+                    .filter(|&&r| (r as f64) >= e[0] && (r as f64) < e[1])
+                    .count() as f64
+                    * g.y as f64;
                 let n = 20_000;
                 let dr = (e[1] - e[0]) / n as f64;
-                let expected: f64 = (0..n).map(|i| e[0] + (i as f64 + 0.5) * dr).map(|r| law.density(r, g) * std::f64::consts::TAU * r * dr).sum();
+                let expected: f64 = (0..n)
+                    .map(|i| e[0] + (i as f64 + 0.5) * dr)
+                    .map(|r| law.density(r, g) * std::f64::consts::TAU * r * dr)
+                    .sum();
                 let tolerance = g.y as f64 + 0.01 * expected;
-                assert!((counted - expected).abs() <= tolerance, "α {alpha} ring [{}, {}) px: {counted} samples, density gives {expected:.0}", e[0], e[1]);
+                assert!(
+                    (counted - expected).abs() <= tolerance,
+                    "α {alpha} ring [{}, {}) px: {counted} samples, density gives {expected:.0}",
+                    e[0],
+                    e[1]
+                );
             }
         }
     }
@@ -236,16 +321,34 @@ mod tests {
     #[test]
     fn the_law_refuses_what_it_does_not_take() {
         let lp = RadialLaw::LogPolar(LogPolarParams::default());
-        let bad = VisualPolarParams { radial: lp, layout: VpLayout::ScreenClipped, ..Default::default() };
-        let e = VisualPolar::new(UVec2::new(64, 72), Vec2::new(32.0, 36.0), bad).unwrap_err().to_string();
+        let bad = VisualPolarParams {
+            radial: lp,
+            layout: VpLayout::ScreenClipped,
+            ..Default::default()
+        };
+        let e = VisualPolar::new(UVec2::new(64, 72), Vec2::new(32.0, 36.0), bad)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("log-polar") && e.contains("layout"), "{e}");
     }
 
     #[test]
     fn bad_parameters_name_the_field() {
-        let e = LogPolarParams { sigma: 0.0, ..Default::default() }.validate().unwrap_err().to_string();
+        let e = LogPolarParams {
+            sigma: 0.0,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("sigma"), "{e}");
-        let e = LogPolarParams { alpha: f32::NAN, ..Default::default() }.validate().unwrap_err().to_string();
+        let e = LogPolarParams {
+            alpha: f32::NAN,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("alpha"), "{e}");
         assert!(LogPolarLaw::new(1.0, 4.0).is_err());
     }

@@ -8,10 +8,10 @@ mod composite;
 mod fixed_foveation;
 mod linear_falloff;
 mod log_polar;
-mod trace_tiles;
 mod pixel_blocks;
 pub mod random;
 mod random_acuity;
+mod trace_tiles;
 mod uniform_budget;
 mod visual_polar;
 mod visual_polar_clipped;
@@ -23,14 +23,17 @@ pub use cartesian::Cartesian;
 pub use composite::{CompositeMode, CompositeParams};
 pub use fixed_foveation::FixedFoveation;
 pub use linear_falloff::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
-pub use trace_tiles::{tile_count, TraceTiles, TRACE_TILE};
 pub use log_polar::{exp_f32, pow_unit, LogPolarExtent, LogPolarLaw, LogPolarParams};
 pub use pixel_blocks::{BlockShape, PixelBlocks, BLOCK_LEVELS};
 pub use random_acuity::RandomAcuity;
+pub use trace_tiles::{tile_count, TraceTiles, TRACE_TILE};
 pub use uniform_budget::UniformBudget;
-pub use visual_polar::{params_need_general_kernel, params_select_clipped_layout, Eccentricity, VisualPolar, VisualPolarParams, InverseCdf, RadialLaw, RadiusMode, VpLayout};
-pub use visual_polar_headset::{FovTangents, HeadsetAxis};
+pub use visual_polar::{
+    params_need_general_kernel, params_select_clipped_layout, Eccentricity, InverseCdf, RadialLaw,
+    RadiusMode, VisualPolar, VisualPolarParams, VpLayout,
+};
 pub use visual_polar_clipped::{on_screen_arcs, ColumnArcs};
+pub use visual_polar_headset::{FovTangents, HeadsetAxis};
 pub use visual_polar_screen_axis::{ScreenAxis, AXIS_KNOT_TEXELS, AXIS_PIECES};
 pub use vrs_tiles::{VrsTiles, VRS_TILE};
 
@@ -137,6 +140,10 @@ pub trait SamplingSpace {
     }
     /// The space's capabilities (default: a screen-sized grid every filter supports).
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { way_back: WayBack::Direct, temporal_filters: true, filters_note: "" }
+        SpaceCapabilities {
+            way_back: WayBack::Direct,
+            temporal_filters: true,
+            filters_note: "",
+        }
     }
 }

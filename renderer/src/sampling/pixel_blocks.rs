@@ -24,7 +24,11 @@ pub struct BlockShape {
 
 impl Default for BlockShape {
     fn default() -> Self {
-        BlockShape { fovea_deg: 5.2, intermediate_deg: 17.0, samples: [4, 2, 1] }
+        BlockShape {
+            fovea_deg: 5.2,
+            intermediate_deg: 17.0,
+            samples: [4, 2, 1],
+        }
     }
 }
 
@@ -50,20 +54,40 @@ fn window_for(radius: f32, b: f32) -> i32 {
 
 impl PixelBlocks {
     pub fn new(screen: UVec2, vp: VisualPolarParams, shape: BlockShape) -> Result<PixelBlocks> {
-        if !(shape.fovea_deg > 0.0 && shape.intermediate_deg > shape.fovea_deg) || shape.samples.iter().any(|&s| s == 0 || s > 64) {
+        if !(shape.fovea_deg > 0.0 && shape.intermediate_deg > shape.fovea_deg)
+            || shape.samples.iter().any(|&s| s == 0 || s > 64)
+        {
             return Err(Error::Invalid(format!("pixel blocks: needs 0 < fovea < intermediate degrees and 1..=64 samples per unit, got {shape:?}")));
         }
         // The windows hold the largest regions of any gaze: the corners' and the centre's.
         let s = screen.as_vec2();
         let mut windows = [0; 2];
-        for gaze in [Vec2::ZERO, Vec2::new(s.x, 0.0), Vec2::new(0.0, s.y), s, s * 0.5] {
+        for gaze in [
+            Vec2::ZERO,
+            Vec2::new(s.x, 0.0),
+            Vec2::new(0.0, s.y),
+            s,
+            s * 0.5,
+        ] {
             let axis = VisualPolar::new(screen, gaze, vp)?;
-            windows[0] = windows[0].max(window_for(axis.radius_of_eccentricity(shape.fovea_deg), 1.0));
+            windows[0] = windows[0].max(window_for(
+                axis.radius_of_eccentricity(shape.fovea_deg),
+                1.0,
+            ));
             let reach = 2.0 * std::f32::consts::SQRT_2;
-            windows[1] = windows[1].max(window_for(axis.radius_of_eccentricity(shape.intermediate_deg) + reach, 2.0));
+            windows[1] = windows[1].max(window_for(
+                axis.radius_of_eccentricity(shape.intermediate_deg) + reach,
+                2.0,
+            ));
         }
         let axis = VisualPolar::new(screen, s * 0.5, vp)?;
-        let mut space = PixelBlocks { axis, shape, fovea_px: 0.0, intermediate_px: 0.0, windows };
+        let mut space = PixelBlocks {
+            axis,
+            shape,
+            fovea_px: 0.0,
+            intermediate_px: 0.0,
+            windows,
+        };
         space.set_radii();
         Ok(space)
     }
@@ -71,9 +95,15 @@ impl PixelBlocks {
     /// The regions' radii for the current gaze, within what the windows hold.
     fn set_radii(&mut self) {
         let fits = |window: i32, b: f32| (window / 2 - WINDOW_MARGIN) as f32 * b;
-        self.fovea_px = self.axis.radius_of_eccentricity(self.shape.fovea_deg).min(fits(self.windows[0], 1.0));
+        self.fovea_px = self
+            .axis
+            .radius_of_eccentricity(self.shape.fovea_deg)
+            .min(fits(self.windows[0], 1.0));
         let reach = 2.0 * std::f32::consts::SQRT_2;
-        self.intermediate_px = self.axis.radius_of_eccentricity(self.shape.intermediate_deg).min(fits(self.windows[1], 2.0) - reach);
+        self.intermediate_px = self
+            .axis
+            .radius_of_eccentricity(self.shape.intermediate_deg)
+            .min(fits(self.windows[1], 2.0) - reach);
     }
 
     /// The region radii in pixels (fovea, intermediate).
@@ -120,10 +150,18 @@ impl PixelBlocks {
 
     /// The level and block of an atlas texel (GLSL `pb_unit`).
     pub fn unit(&self, texel: IVec2) -> Option<(usize, IVec2)> {
-        let level = if texel.x < self.atlas_origin(0).x { 2 } else if texel.y < self.atlas_origin(1).y { 0 } else { 1 };
+        let level = if texel.x < self.atlas_origin(0).x {
+            2
+        } else if texel.y < self.atlas_origin(1).y {
+            0
+        } else {
+            1
+        };
         let local = texel - self.atlas_origin(level);
         let block = local + self.window_first_block(level);
-        let inside = local.cmplt(self.window_size(level)).all() && block.cmpge(IVec2::ZERO).all() && block.cmplt(self.level_size(level)).all();
+        let inside = local.cmplt(self.window_size(level)).all()
+            && block.cmpge(IVec2::ZERO).all()
+            && block.cmplt(self.level_size(level)).all();
         inside.then_some((level, block))
     }
 
@@ -183,7 +221,10 @@ impl SamplingSpace for PixelBlocks {
     /// Samples per frame: every traced unit × its level's count (exact, no randomness).
     fn sample_count(&self) -> u64 {
         let g = self.grid_size().as_ivec2();
-        (0..g.y).flat_map(|y| (0..g.x).map(move |x| IVec2::new(x, y))).map(|t| self.samples_in_texel(t) as u64).sum()
+        (0..g.y)
+            .flat_map(|y| (0..g.x).map(move |x| IVec2::new(x, y)))
+            .map(|t| self.samples_in_texel(t) as u64)
+            .sum()
     }
     fn samples_per_texel(&self) -> u32 {
         self.shape.samples.into_iter().max().unwrap_or(1)
@@ -210,12 +251,20 @@ impl SamplingSpace for PixelBlocks {
     }
     /// The unit of the level whose region holds the position.
     fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
-        if !(screen.is_finite() && screen.cmpge(Vec2::ZERO).all() && screen.cmplt(self.axis.screen().as_vec2()).all()) {
+        if !(screen.is_finite()
+            && screen.cmpge(Vec2::ZERO).all()
+            && screen.cmplt(self.axis.screen().as_vec2()).all())
+        {
             return None;
         }
         let level = self.level_of(screen);
         let in_level = screen / (1 << level) as f32;
-        Some(in_level - in_level.floor() + self.atlas_texel(level, in_level.floor().as_ivec2()).as_vec2())
+        Some(
+            in_level - in_level.floor()
+                + self
+                    .atlas_texel(level, in_level.floor().as_ivec2())
+                    .as_vec2(),
+        )
     }
     fn gaze(&self) -> Vec2 {
         self.axis.gaze()
@@ -226,7 +275,11 @@ impl SamplingSpace for PixelBlocks {
         Ok(())
     }
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { way_back: WayBack::BlockFill, temporal_filters: false, filters_note: "(its grid is an atlas of three block levels)" }
+        SpaceCapabilities {
+            way_back: WayBack::BlockFill,
+            temporal_filters: false,
+            filters_note: "(its grid is an atlas of three block levels)",
+        }
     }
 }
 
@@ -237,9 +290,14 @@ mod tests {
     #[test]
     fn the_windows_hold_every_traced_unit_and_the_regions_nest() {
         let screen = UVec2::new(322, 361);
-        let mut s = PixelBlocks::new(screen, VisualPolarParams::default(), BlockShape::default()).unwrap();
+        let mut s =
+            PixelBlocks::new(screen, VisualPolarParams::default(), BlockShape::default()).unwrap();
         let grid = s.grid_size();
-        for gaze in [Vec2::new(161.0, 180.0), Vec2::new(3.0, 350.0), Vec2::new(321.5, 0.5)] {
+        for gaze in [
+            Vec2::new(161.0, 180.0),
+            Vec2::new(3.0, 350.0),
+            Vec2::new(321.5, 0.5),
+        ] {
             s.set_gaze(gaze).unwrap();
             assert_eq!(s.grid_size(), grid, "the grid never changes size");
             let (f, m) = s.radii();
@@ -253,7 +311,10 @@ mod tests {
                         assert_eq!(s.atlas_texel(level, block), IVec2::new(x, y));
                         let centre = s.grid_to_screen(IVec2::new(x, y).as_vec2() + 0.5).unwrap();
                         if centre.cmplt(screen.as_vec2()).all() && s.level_of(centre) == level {
-                            assert_eq!(s.screen_to_grid(centre), Some(IVec2::new(x, y).as_vec2() + 0.5));
+                            assert_eq!(
+                                s.screen_to_grid(centre),
+                                Some(IVec2::new(x, y).as_vec2() + 0.5)
+                            );
                         }
                     }
                 }
@@ -264,7 +325,10 @@ mod tests {
                     for bx in 0..n.x {
                         let b = IVec2::new(bx, by);
                         if s.traced(level, b) {
-                            assert!(seen.contains(&(level, b)), "gaze {gaze}: level {level} block {b} traced but not in its window");
+                            assert!(
+                                seen.contains(&(level, b)),
+                                "gaze {gaze}: level {level} block {b} traced but not in its window"
+                            );
                         }
                     }
                 }
@@ -289,6 +353,14 @@ mod tests {
         }
         // A small atlas: far fewer lanes than the screen.
         assert!(grid.x * grid.y < screen.x * screen.y / 2, "{grid}");
-        assert!(PixelBlocks::new(screen, VisualPolarParams::default(), BlockShape { samples: [4, 0, 1], ..Default::default() }).is_err());
+        assert!(PixelBlocks::new(
+            screen,
+            VisualPolarParams::default(),
+            BlockShape {
+                samples: [4, 0, 1],
+                ..Default::default()
+            }
+        )
+        .is_err());
     }
 }

@@ -9,7 +9,11 @@ pub fn pcg_hash(v: u32) -> u32 {
 
 /// `rng_seed` of random.glsl.
 pub fn rng_seed(texel: [u32; 2], frame: u32, seed: u32, sample_index: u32) -> u32 {
-    pcg_hash(texel[0].wrapping_add(pcg_hash(texel[1].wrapping_add(pcg_hash(frame.wrapping_add(pcg_hash(seed.wrapping_add(pcg_hash(sample_index)))))))))
+    pcg_hash(
+        texel[0].wrapping_add(pcg_hash(texel[1].wrapping_add(pcg_hash(
+            frame.wrapping_add(pcg_hash(seed.wrapping_add(pcg_hash(sample_index)))),
+        )))),
+    )
 }
 
 /// `unit_hash` of random.glsl: uniform in [0, 1), 24 bits.
@@ -24,12 +28,16 @@ mod tests {
     #[test]
     fn unit_hash_is_uniform_in_the_unit_interval() {
         let n = 40_000;
-        let values: Vec<f32> = (0..n).map(|i| unit_hash([i % 200, i / 200], 3, 7, 11)).collect();
+        let values: Vec<f32> = (0..n)
+            .map(|i| unit_hash([i % 200, i / 200], 3, 7, 11))
+            .collect();
         assert!(values.iter().all(|v| (0.0..1.0).contains(v)));
         let mean = values.iter().map(|&v| v as f64).sum::<f64>() / n as f64;
         assert!((mean - 0.5).abs() < 0.01, "{mean}");
         // Another frame draws anew.
-        let same = (0..n).filter(|&i| unit_hash([i % 200, i / 200], 4, 7, 11) == values[i as usize]).count();
+        let same = (0..n)
+            .filter(|&i| unit_hash([i % 200, i / 200], 4, 7, 11) == values[i as usize])
+            .count();
         assert!(same < 10, "{same}");
     }
 }

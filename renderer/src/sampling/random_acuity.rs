@@ -24,7 +24,9 @@ impl RandomAcuity {
         }
         let vp = VisualPolar::new(screen, gaze, params)?;
         if vp.log_polar().is_some() {
-            return Err(Error::Invalid("random acuity: draws from the acuity density, not the log-polar law".into()));
+            return Err(Error::Invalid(
+                "random acuity: draws from the acuity density, not the log-polar law".into(),
+            ));
         }
         Ok(RandomAcuity { vp })
     }
@@ -44,7 +46,10 @@ impl RandomAcuity {
         let last = self.vp.grid_size().as_ivec2() - 1;
         (0..RANDOM_ACUITY_TRIES).find_map(|k| {
             let salt = SPARSE_SALT_POSITION.wrapping_add(2 * k);
-            let draw = Vec2::new(unit_hash(texel.to_array(), frame, seed, salt), unit_hash(texel.to_array(), frame, seed, salt + 1)) * size;
+            let draw = Vec2::new(
+                unit_hash(texel.to_array(), frame, seed, salt),
+                unit_hash(texel.to_array(), frame, seed, salt + 1),
+            ) * size;
             let t: IVec2 = draw.floor().as_ivec2().min(last);
             self.vp.is_valid_texel(t).then_some(draw)
         })
@@ -52,13 +57,17 @@ impl RandomAcuity {
 
     /// Screen position of `texel`'s sample this frame (may lie off the screen, as VP's do).
     pub fn screen_position(&self, texel: UVec2, frame: u32, seed: u32) -> Option<Vec2> {
-        self.grid_position(texel, frame, seed).map(|g| self.vp.paper_vp_to_screen(g))
+        self.grid_position(texel, frame, seed)
+            .map(|g| self.vp.paper_vp_to_screen(g))
     }
 
     /// The samples one frame traces (every kept texel whose draw succeeded).
     pub fn traced_count(&self, frame: u32, seed: u32) -> u64 {
         let g = self.vp.grid_size();
-        (0..g.y).flat_map(|y| (0..g.x).map(move |x| UVec2::new(x, y))).filter(|&t| self.grid_position(t, frame, seed).is_some()).count() as u64
+        (0..g.y)
+            .flat_map(|y| (0..g.x).map(move |x| UVec2::new(x, y)))
+            .filter(|&t| self.grid_position(t, frame, seed).is_some())
+            .count() as u64
     }
 }
 
@@ -114,7 +123,11 @@ impl SamplingSpace for RandomAcuity {
         Some(&self.vp)
     }
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { way_back: WayBack::Splat, temporal_filters: false, filters_note: "(its samples move to new positions every frame)" }
+        SpaceCapabilities {
+            way_back: WayBack::Splat,
+            temporal_filters: false,
+            filters_note: "(its samples move to new positions every frame)",
+        }
     }
 }
 
@@ -125,7 +138,8 @@ mod tests {
     #[test]
     fn draws_land_in_kept_texels_and_change_every_frame() {
         let screen = UVec2::new(320, 360);
-        let s = RandomAcuity::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+        let s = RandomAcuity::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default())
+            .unwrap();
         let vp = s.visual_polar_space();
         let mut moved = 0;
         let g = vp.grid_size();
@@ -142,6 +156,14 @@ mod tests {
         }
         assert_eq!(s.traced_count(3, 1), s.sample_count());
         assert!(moved as u64 == s.sample_count(), "{moved}");
-        assert!(RandomAcuity::new(screen, Vec2::ZERO, VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() }).is_err());
+        assert!(RandomAcuity::new(
+            screen,
+            Vec2::ZERO,
+            VisualPolarParams {
+                layout: VpLayout::ScreenClipped,
+                ..Default::default()
+            }
+        )
+        .is_err());
     }
 }

@@ -60,7 +60,8 @@ impl TraceTiles {
     pub fn fill_live(&mut self, grid: UVec2) {
         self.clear();
         let n = tile_count(grid);
-        self.live.extend((0..n.y).flat_map(|y| (0..n.x).map(move |x| pack(x, y))));
+        self.live
+            .extend((0..n.y).flat_map(|y| (0..n.x).map(move |x| pack(x, y))));
     }
 
     /// The tile buffer's contents: the live tiles, then the idle ones.
@@ -90,19 +91,31 @@ pub fn visual_polar_tiles(vp: &VisualPolar, cull: bool, tiles: &mut TraceTiles) 
         let direction = |phi: f32| Vec2::new(phi.cos(), phi.sin());
         directions.clear();
         directions.extend((0..n.y).map(|ty| {
-            let (y0, y1) = ((ty * TRACE_TILE) as f32, ((ty + 1) * TRACE_TILE).min(grid.y) as f32);
-            [direction(angle(y0)), direction(angle(0.5 * (y0 + y1))), direction(angle(y1))]
+            let (y0, y1) = (
+                (ty * TRACE_TILE) as f32,
+                ((ty + 1) * TRACE_TILE).min(grid.y) as f32,
+            );
+            [
+                direction(angle(y0)),
+                direction(angle(0.5 * (y0 + y1))),
+                direction(angle(y1)),
+            ]
         }));
     }
     for ty in 0..n.y {
         for tx in 0..n.x {
             let (x0, y0) = (tx * TRACE_TILE, ty * TRACE_TILE);
             let (x1, y1) = ((x0 + TRACE_TILE).min(grid.x), (y0 + TRACE_TILE).min(grid.y));
-            let samples: u32 = (x0..x1).map(|c| vp.rows_in_column(c).min(y1).saturating_sub(y0)).sum();
+            let samples: u32 = (x0..x1)
+                .map(|c| vp.rows_in_column(c).min(y1).saturating_sub(y0))
+                .sum();
             let full_columns = (x0..x1).all(|c| vp.rows_in_column(c) == grid.y);
             if samples == 0 {
                 tiles.idle.push(pack(tx, ty));
-            } else if cull && full_columns && surely_culled(vp, &radii, &directions[ty as usize], (x0, x1), (y0, y1)) {
+            } else if cull
+                && full_columns
+                && surely_culled(vp, &radii, &directions[ty as usize], (x0, x1), (y0, y1))
+            {
                 tiles.idle.push(pack(tx, ty));
                 tiles.culled_samples += samples;
             } else {
@@ -117,16 +130,27 @@ pub fn visual_polar_tiles(vp: &VisualPolar, cull: bool, tiles: &mut TraceTiles) 
 /// Whether every sample of the tile's full columns [x0, x1) × rows [y0, y1), at any jitter,
 /// lies farther off the screen than its culling margin (`far_off_screen` in trace.comp).
 /// `directions`: at the rows' first, middle and last angle.
-fn surely_culled(vp: &VisualPolar, radii: &[f32], directions: &[Vec2; 3], (x0, x1): (u32, u32), (y0, y1): (u32, u32)) -> bool {
+fn surely_culled(
+    vp: &VisualPolar,
+    radii: &[f32],
+    directions: &[Vec2; 3],
+    (x0, x1): (u32, u32),
+    (y0, y1): (u32, u32),
+) -> bool {
     let grid = vp.grid_size();
     let w = grid.x as usize;
     let (r_a, r_b) = (radii[x0 as usize], radii[x1 as usize]);
     let tau = std::f32::consts::TAU;
-    let (phi_a, phi_b) = (tau * y0 as f32 / grid.y as f32, tau * y1 as f32 / grid.y as f32);
+    let (phi_a, phi_b) = (
+        tau * y0 as f32 / grid.y as f32,
+        tau * y1 as f32 / grid.y as f32,
+    );
     // The largest footprint a sample here can have: its ρ neighbour (one column out, or in at
     // the last column) lies within two column spacings, its φ neighbour one arc step away.
     let lo = (x0 as usize).saturating_sub(1);
-    let rho = (lo..x1 as usize).map(|c| radii[(c + 2).min(w)] - radii[c]).fold(0.0f32, f32::max);
+    let rho = (lo..x1 as usize)
+        .map(|c| radii[(c + 2).min(w)] - radii[c])
+        .fold(0.0f32, f32::max);
     let footprint = rho.max(r_b * tau / grid.y as f32).max(1.0);
     let margin = CULL_FOOTPRINTS * footprint + CULL_PIXELS + CULL_SLACK_PIXELS;
     // How far the tile's annular sector lies off the screen, from 3 × 3 points on it: the

@@ -21,11 +21,18 @@ impl UniformBudget {
     pub fn with_samples(screen: UVec2, samples: u64) -> Result<UniformBudget> {
         let pixels = screen.x as f64 * screen.y as f64;
         if screen.x == 0 || screen.y == 0 || samples == 0 {
-            return Err(Error::Invalid(format!("uniform budget: {samples} samples over a {}×{} screen", screen.x, screen.y)));
+            return Err(Error::Invalid(format!(
+                "uniform budget: {samples} samples over a {}×{} screen",
+                screen.x, screen.y
+            )));
         }
         let scale = (samples as f64 / pixels).sqrt().min(1.0);
         let axis = |n: u32| ((n as f64 * scale).round() as u32).clamp(1, n);
-        Ok(UniformBudget { screen, grid: UVec2::new(axis(screen.x), axis(screen.y)), gaze: screen.as_vec2() * 0.5 })
+        Ok(UniformBudget {
+            screen,
+            grid: UVec2::new(axis(screen.x), axis(screen.y)),
+            gaze: screen.as_vec2() * 0.5,
+        })
     }
 
     fn scale(&self) -> Vec2 {
@@ -73,7 +80,11 @@ impl SamplingSpace for UniformBudget {
     fn capabilities(&self) -> SpaceCapabilities {
         // The denoisers' Cartesian addressing takes the grid for the screen (no scaled
         // reprojection yet), so they and TAA are refused rather than run wrong.
-        SpaceCapabilities { way_back: WayBack::Upscale, temporal_filters: false, filters_note: "(its grid is coarser than the screen)" }
+        SpaceCapabilities {
+            way_back: WayBack::Upscale,
+            temporal_filters: false,
+            filters_note: "(its grid is coarser than the screen)",
+        }
     }
 }
 
@@ -84,13 +95,22 @@ mod tests {
     #[test]
     fn the_grid_keeps_the_budget_and_the_aspect() {
         let s = UniformBudget::with_samples(UVec2::new(1280, 1440), 360_000).unwrap();
-        assert!((s.sample_count() as f64 / 360_000.0 - 1.0).abs() < 0.01, "{:?}", s.grid);
+        assert!(
+            (s.sample_count() as f64 / 360_000.0 - 1.0).abs() < 0.01,
+            "{:?}",
+            s.grid
+        );
         assert!((s.grid.x as f32 / s.grid.y as f32 - 1280.0 / 1440.0).abs() < 0.01);
         let p = Vec2::new(100.5, 700.25);
         let back = s.grid_to_screen(s.screen_to_grid(p).unwrap()).unwrap();
         assert!((back - p).length() < 1e-3);
         // Never more than one sample per pixel.
-        assert_eq!(UniformBudget::with_samples(UVec2::new(64, 72), 1 << 20).unwrap().grid, UVec2::new(64, 72));
+        assert_eq!(
+            UniformBudget::with_samples(UVec2::new(64, 72), 1 << 20)
+                .unwrap()
+                .grid,
+            UVec2::new(64, 72)
+        );
         assert!(UniformBudget::with_samples(UVec2::new(64, 72), 0).is_err());
     }
 }

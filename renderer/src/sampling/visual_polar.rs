@@ -31,11 +31,11 @@
 //! kernel log-polar law (`log_polar.rs`: no clip, grid = screen / σ, r_max = the law's extent).
 //! Everything else — rows, φ wrap, arcs, mips, remap, the denoisers' grid addressing — is shared.
 
+use super::acuity::*;
 use super::composite::CompositeParams;
 use super::log_polar::{LogPolarLaw, LogPolarParams};
 use super::visual_polar_headset::{FovTangents, HeadsetAxis};
 use super::visual_polar_screen_axis::ScreenAxis;
-use super::acuity::*;
 use super::SamplingSpace;
 use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
@@ -155,7 +155,10 @@ impl VisualPolarParams {
     /// Range checks of every parameter, each error naming the parameter.
     pub fn validate(&self) -> Result<()> {
         if !(self.axis_scale.is_finite() && self.axis_scale > 0.0 && self.axis_scale <= 4.0) {
-            return Err(invalid(format!("axis_scale must be in (0, 4], got {}", self.axis_scale)));
+            return Err(invalid(format!(
+                "axis_scale must be in (0, 4], got {}",
+                self.axis_scale
+            )));
         }
         if !(self.clip_fraction > 0.0 && self.clip_fraction < 0.5) {
             return Err(invalid(format!(
@@ -164,14 +167,22 @@ impl VisualPolarParams {
             )));
         }
         if !(self.fovea_deg > 0.0 && self.fovea_deg < E_MAX_DEG) {
-            return Err(invalid(format!("fovea_deg must be in (0, {E_MAX_DEG}), got {}", self.fovea_deg)));
+            return Err(invalid(format!(
+                "fovea_deg must be in (0, {E_MAX_DEG}), got {}",
+                self.fovea_deg
+            )));
         }
         if !(self.density_exponent >= 0.0 && self.density_exponent <= 4.0) {
-            return Err(invalid(format!("density_exponent must be in [0, 4], got {}", self.density_exponent)));
+            return Err(invalid(format!(
+                "density_exponent must be in [0, 4], got {}",
+                self.density_exponent
+            )));
         }
         if let RadiusMode::Fixed(r) = self.radius_mode {
             if !(r.is_finite() && r > 0.0) {
-                return Err(invalid(format!("radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}")));
+                return Err(invalid(format!(
+                    "radius_mode Fixed(r) needs a finite r > 0 pixels, got {r}"
+                )));
             }
         }
         match self.radial {
@@ -181,7 +192,10 @@ impl VisualPolarParams {
         }
         if self.radial != RadialLaw::Acuity {
             // Meng's buffer spans full circles on the screen's own distances, its extent set by L.
-            if self.layout != VpLayout::Paper || self.eccentricity != Eccentricity::Normalized || self.radius_mode != RadiusMode::FarthestCorner {
+            if self.layout != VpLayout::Paper
+                || self.eccentricity != Eccentricity::Normalized
+                || self.radius_mode != RadiusMode::FarthestCorner
+            {
                 return Err(invalid(
                     "the log-polar law takes the paper layout, the normalized axis and the corner radius (its extent is set by L)".to_string(),
                 ));
@@ -193,7 +207,8 @@ impl VisualPolarParams {
             // are conics.
             if self.layout != VpLayout::Paper {
                 return Err(invalid(
-                    "eccentricity = headset supports only the paper layout (layout = paper)".to_string(),
+                    "eccentricity = headset supports only the paper layout (layout = paper)"
+                        .to_string(),
                 ));
             }
             if self.radius_mode != RadiusMode::FarthestCorner {
@@ -251,10 +266,16 @@ impl VisualPolar {
     pub fn new(screen: UVec2, gaze: Vec2, params: VisualPolarParams) -> Result<Self> {
         params.validate()?;
         if screen.x == 0 || screen.y == 0 {
-            return Err(invalid(format!("screen size must be non-zero, got {}x{}", screen.x, screen.y)));
+            return Err(invalid(format!(
+                "screen size must be non-zero, got {}x{}",
+                screen.x, screen.y
+            )));
         }
         if !gaze.is_finite() {
-            return Err(invalid(format!("gaze must be finite, got ({}, {})", gaze.x, gaze.y)));
+            return Err(invalid(format!(
+                "gaze must be finite, got ({}, {})",
+                gaze.x, gaze.y
+            )));
         }
         let composite = match params.radial {
             RadialLaw::Composite(c) => Some(c.layout(screen)?),
@@ -266,7 +287,10 @@ impl VisualPolar {
         };
         let grid = match &composite {
             Some(c) => c.grid,
-            None => (screen.as_vec2() * axis_scale).round().as_uvec2().max(UVec2::ONE),
+            None => (screen.as_vec2() * axis_scale)
+                .round()
+                .as_uvec2()
+                .max(UVec2::ONE),
         };
         let k = params.density_exponent;
         let headset = match params.eccentricity {
@@ -281,7 +305,9 @@ impl VisualPolar {
         };
         let log_polar = match params.radial {
             RadialLaw::Acuity => None,
-            RadialLaw::LogPolar(lp) => Some(LogPolarLaw::new(lp.extent_px(screen, gaze), lp.alpha)?),
+            RadialLaw::LogPolar(lp) => {
+                Some(LogPolarLaw::new(lp.extent_px(screen, gaze), lp.alpha)?)
+            }
             RadialLaw::Composite(_) => composite.as_ref().map(|c| c.law),
         };
         let (cdf_max, r_max, r_f, e_norm) = match headset {
@@ -295,7 +321,10 @@ impl VisualPolar {
                 let (e_f, e_norm) = if exact {
                     (params.fovea_deg, E_MAX_DEG)
                 } else {
-                    (inverse_cdf_poly(fovea_fraction(params.fovea_deg, k)), inverse_cdf_poly(1.0))
+                    (
+                        inverse_cdf_poly(fovea_fraction(params.fovea_deg, k)),
+                        inverse_cdf_poly(1.0),
+                    )
                 };
                 (cdf(E_MAX_DEG, k), r_max, e_f / e_norm * r_max, e_norm)
             }
@@ -314,7 +343,10 @@ impl VisualPolar {
             },
             p_f: cdf(params.fovea_deg, k) / cdf_max,
             r_max,
-            r_f: composite.as_ref().filter(|c| c.u_f > 0.0).map_or(r_f, |c| c.r_f),
+            r_f: composite
+                .as_ref()
+                .filter(|c| c.u_f > 0.0)
+                .map_or(r_f, |c| c.r_f),
             e_norm,
             cdf_max,
             exact,
@@ -325,7 +357,14 @@ impl VisualPolar {
         };
         if params.layout == VpLayout::ScreenAware {
             // No mass beyond the fovea on the screen (a screen inside the fovea): the paper's axis.
-            vp.screen_axis = ScreenAxis::new(gaze, screen, vp.r_f, vp.r_max, vp.e_norm / vp.r_max, params.density_exponent);
+            vp.screen_axis = ScreenAxis::new(
+                gaze,
+                screen,
+                vp.r_f,
+                vp.r_max,
+                vp.e_norm / vp.r_max,
+                params.density_exponent,
+            );
         }
         if let Some(axis) = headset {
             if !axis.e_max.is_finite() || axis.e_max <= params.fovea_deg {
@@ -338,7 +377,11 @@ impl VisualPolar {
         }
         // Guards against parameter combinations that pass the range checks but break the math
         // (e.g. an extreme density exponent overflowing the CDF).
-        if !(vp.r_max > 0.0 && vp.r_f.is_finite() && vp.r_f > 0.0 && vp.cdf_max.is_finite() && vp.cdf_max > 0.0)
+        if !(vp.r_max > 0.0
+            && vp.r_f.is_finite()
+            && vp.r_f > 0.0
+            && vp.cdf_max.is_finite()
+            && vp.cdf_max > 0.0)
             || !(vp.p_f > 0.0 && vp.p_f < 1.0)
         {
             return Err(invalid(format!(
@@ -480,8 +523,18 @@ impl VisualPolar {
         let e = if self.exact {
             // The tail fraction 1 − p straight from u (see `inverse_cdf_exact`).
             let q = (1.0 - u) / (1.0 - self.u_f) * (1.0 - self.p_f);
-            let e_top = if self.headset.is_some() { E_TOP_HEADSET_DEG } else { E_MAX_DEG };
-            inverse_cdf_exact(q, self.params.density_exponent, self.cdf_max, self.e_max(), e_top)
+            let e_top = if self.headset.is_some() {
+                E_TOP_HEADSET_DEG
+            } else {
+                E_MAX_DEG
+            };
+            inverse_cdf_exact(
+                q,
+                self.params.density_exponent,
+                self.cdf_max,
+                self.e_max(),
+                e_top,
+            )
         } else {
             inverse_cdf_poly(self.p_f + (u - self.u_f) / (1.0 - self.u_f) * (1.0 - self.p_f))
         };
@@ -524,7 +577,8 @@ impl VisualPolar {
         let e = r / self.r_max * self.e_norm;
         if self.exact {
             // Through the tail, like r_of_u, so both directions stay well conditioned at e_max.
-            let q = cdf_tail(e, self.params.density_exponent, self.e_max(), self.cdf_max) / self.cdf_max;
+            let q = cdf_tail(e, self.params.density_exponent, self.e_max(), self.cdf_max)
+                / self.cdf_max;
             return 1.0 - q / (1.0 - self.p_f) * (1.0 - self.u_f);
         }
         let p = poly_fraction_of(e, self.cdf_max);
@@ -605,7 +659,12 @@ impl VisualPolar {
                 grid,
                 gaze: Vec4::new(self.gaze.x, self.gaze.y, self.r_max, k),
                 // Log-polar: shape0.y = the law's inner column instead of p_f (unused by the law).
-                shape0: Vec4::new(self.u_f, self.log_polar.map_or(self.p_f, |law| law.inner), self.r_f, self.e_norm),
+                shape0: Vec4::new(
+                    self.u_f,
+                    self.log_polar.map_or(self.p_f, |law| law.inner),
+                    self.r_f,
+                    self.e_norm,
+                ),
                 // Log-polar: shape1.zw = (α, L) instead of (fovea°, 0).
                 shape1: match &self.log_polar {
                     None => Vec4::new(self.cdf_max, flags as f32, self.params.fovea_deg, 0.0),
@@ -697,7 +756,8 @@ impl SamplingSpace for VisualPolar {
         if t.x < 0.0 || t.y < 0.0 || t.x >= self.grid.x as f32 || t.y >= self.grid.y as f32 {
             return None;
         }
-        self.is_valid_texel(t.as_ivec2()).then(|| self.vp_to_screen(grid))
+        self.is_valid_texel(t.as_ivec2())
+            .then(|| self.vp_to_screen(grid))
     }
     /// `None` where no texel samples the position: beyond r_max (only possible on screen with
     /// `RadiusMode::Fixed`). Off-screen positions inside r_max do have samples. r = r_max itself
@@ -731,7 +791,11 @@ impl SamplingSpace for VisualPolar {
     /// Every layout runs the filters: the screen-clipped one addresses its grid through the
     /// per-column arcs of this frame and the previous one (`DenoiseFrame::sampling_table`).
     fn capabilities(&self) -> super::SpaceCapabilities {
-        super::SpaceCapabilities { way_back: super::WayBack::Remap, temporal_filters: true, filters_note: "" }
+        super::SpaceCapabilities {
+            way_back: super::WayBack::Remap,
+            temporal_filters: true,
+            filters_note: "",
+        }
     }
 }
 

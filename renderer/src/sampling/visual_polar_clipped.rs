@@ -31,7 +31,10 @@ pub struct ColumnArcs {
 
 impl ColumnArcs {
     /// The whole circle from φ = 0: the paper's layout.
-    pub const FULL: ColumnArcs = ColumnArcs { start: [0.0; 4], end: [TAU; 4] };
+    pub const FULL: ColumnArcs = ColumnArcs {
+        start: [0.0; 4],
+        end: [TAU; 4],
+    };
 
     /// Total on-screen angle A (2π for a full circle).
     pub fn total(&self) -> f32 {
@@ -66,7 +69,10 @@ impl ColumnArcs {
     /// the last). The φ mips average only rows of one interval and the remap reads only those of
     /// the pixel's, so nothing is blended across a gap.
     pub fn interval_of_row(&self, y: f32, n: f32) -> usize {
-        (1..4).rev().find(|&j| self.end[j] > self.end[j - 1] && y >= self.arc_row(self.end[j - 1], n)).unwrap_or(0)
+        (1..4)
+            .rev()
+            .find(|&j| self.end[j] > self.end[j - 1] && y >= self.arc_row(self.end[j - 1], n))
+            .unwrap_or(0)
     }
 
     /// The column's two RGBA32F texels in the GPU table: starts, then ends.
@@ -81,7 +87,8 @@ impl ColumnArcs {
             return a;
         }
         let a = a.clamp(0.0, self.total());
-        let i = (a >= self.end[0]) as usize + (a >= self.end[1]) as usize + (a >= self.end[2]) as usize;
+        let i =
+            (a >= self.end[0]) as usize + (a >= self.end[1]) as usize + (a >= self.end[2]) as usize;
         self.start[i] + (a - self.arc_start(i))
     }
 
@@ -132,7 +139,12 @@ pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
     // vectors: the renderer rebuilds every column's arcs each frame and must not allocate.
     let mut cuts = [(0.0f64, 0.0f64); 8];
     let mut n_cuts = 0;
-    let edges = [(0.0, s.x - g.x), (FRAC_PI_2, s.y - g.y), (PI, g.x), (3.0 * FRAC_PI_2, g.y)];
+    let edges = [
+        (0.0, s.x - g.x),
+        (FRAC_PI_2, s.y - g.y),
+        (PI, g.x),
+        (3.0 * FRAC_PI_2, g.y),
+    ];
     for (normal, d) in edges {
         if d >= r {
             continue;
@@ -194,8 +206,14 @@ pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
     if on.is_empty() || total > TAU64 - MIN_ARC {
         return ColumnArcs::FULL;
     }
-    debug_assert!(on.len() <= 4, "a circle meets a rectangle in at most 4 arcs: {on:?}");
-    let mut arcs = ColumnArcs { start: [0.0; 4], end: [0.0; 4] };
+    debug_assert!(
+        on.len() <= 4,
+        "a circle meets a rectangle in at most 4 arcs: {on:?}"
+    );
+    let mut arcs = ColumnArcs {
+        start: [0.0; 4],
+        end: [0.0; 4],
+    };
     let mut cumulative = 0.0;
     let mut last_end = 0.0;
     for i in 0..4 {
@@ -299,11 +317,22 @@ mod tests {
     /// Dense angle sweep: an angle is inside the arcs exactly when its point is on the screen.
     #[test]
     fn arcs_are_the_on_screen_part_of_the_circle() {
-        let gazes = [(640.0, 720.0), (10.0, 10.0), (200.0, 300.0), (200.0, 720.0), (0.0, 720.0), (1270.0, 5.0), (-50.0, 700.0), (640.0, 1500.0)];
+        let gazes = [
+            (640.0, 720.0),
+            (10.0, 10.0),
+            (200.0, 300.0),
+            (200.0, 720.0),
+            (0.0, 720.0),
+            (1270.0, 5.0),
+            (-50.0, 700.0),
+            (640.0, 1500.0),
+        ];
         let mut counts = [0usize; 5];
         for (gx, gy) in gazes {
             let gaze = Vec2::new(gx, gy);
-            for r in [5.0f32, 300.0, 650.0, 700.0, 730.0, 800.0, 1000.0, 1300.0, 1500.0, 1900.0, 2500.0] {
+            for r in [
+                5.0f32, 300.0, 650.0, 700.0, 730.0, 800.0, 1000.0, 1300.0, 1500.0, 1900.0, 2500.0,
+            ] {
                 let arcs = on_screen_arcs(gaze, r, SCREEN);
                 counts[arcs.count()] += 1;
                 assert!(arcs.end.windows(2).all(|w| w[0] <= w[1]), "{arcs:?}");
@@ -336,25 +365,42 @@ mod tests {
                 }
                 // Full circles are either all on screen or all off.
                 if arcs.wraps() {
-                    assert!(on_count < 10 || on_count > steps - 10, "gaze {gaze} r {r}: {on_count}");
+                    assert!(
+                        on_count < 10 || on_count > steps - 10,
+                        "gaze {gaze} r {r}: {on_count}"
+                    );
                 } else {
                     let share = arcs.total() as f64 / std::f64::consts::TAU;
-                    assert!((share - on_count as f64 / steps as f64).abs() < 1e-3, "gaze {gaze} r {r}");
+                    assert!(
+                        (share - on_count as f64 / steps as f64).abs() < 1e-3,
+                        "gaze {gaze} r {r}"
+                    );
                 }
             }
         }
         // The sweep saw 1, 2, 3 and 4 intervals.
-        assert!(counts[1..].iter().all(|&c| c > 0), "interval counts {counts:?}");
+        assert!(
+            counts[1..].iter().all(|&c| c > 0),
+            "interval counts {counts:?}"
+        );
     }
 
     fn clipped(w: u32, h: u32, gaze: Vec2) -> VisualPolar {
-        let params = crate::sampling::VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() };
+        let params = crate::sampling::VisualPolarParams {
+            layout: VpLayout::ScreenClipped,
+            ..Default::default()
+        };
         VisualPolar::new(UVec2::new(w, h), gaze, params).unwrap()
     }
 
     fn gazes(w: u32, h: u32) -> [Vec2; 4] {
         let s = Vec2::new(w as f32, h as f32);
-        [s * 0.5, s * Vec2::new(200.0 / 1280.0, 300.0 / 1440.0), Vec2::splat(10.0), Vec2::new(0.0, s.y * 0.45)]
+        [
+            s * 0.5,
+            s * Vec2::new(200.0 / 1280.0, 300.0 / 1440.0),
+            Vec2::splat(10.0),
+            Vec2::new(0.0, s.y * 0.45),
+        ]
     }
 
     /// Every texel centre of the screen-clipped layout lies on the screen, the sample count is
@@ -366,10 +412,16 @@ mod tests {
                 let vp = clipped(w, h, gaze);
                 let paper = VisualPolar::new(vp.screen(), gaze, Default::default()).unwrap();
                 assert_eq!(vp.sample_count(), paper.sample_count());
-                assert!(crate::sampling::params_select_clipped_layout(&vp.sampling_params()));
-                assert!(!crate::sampling::params_select_clipped_layout(&paper.sampling_params()));
+                assert!(crate::sampling::params_select_clipped_layout(
+                    &vp.sampling_params()
+                ));
+                assert!(!crate::sampling::params_select_clipped_layout(
+                    &paper.sampling_params()
+                ));
                 let columns = 2 * paper.grid_size().x as usize;
-                assert!(paper.column_table()[..columns].chunks(2).all(|t| t[0] == [0.0; 4] && t[1] == [TAU; 4]));
+                assert!(paper.column_table()[..columns]
+                    .chunks(2)
+                    .all(|t| t[0] == [0.0; 4] && t[1] == [TAU; 4]));
                 let (grid, mut off, mut full_columns) = (vp.grid_size(), 0, 0);
                 for x in 0..grid.x {
                     let arcs = vp.column_arcs(x);
@@ -379,14 +431,23 @@ mod tests {
                         let p = vp.vp_to_screen(g);
                         // Centres lie on their column's centre circle, inside its arcs: on screen
                         // up to f32 rounding.
-                        off += (p.x < -1e-3 || p.y < -1e-3 || p.x > w as f32 + 1e-3 || p.y > h as f32 + 1e-3) as u32;
+                        off += (p.x < -1e-3
+                            || p.y < -1e-3
+                            || p.x > w as f32 + 1e-3
+                            || p.y > h as f32 + 1e-3) as u32;
                         if arcs.wraps() {
-                            assert!((p - paper.vp_to_screen(g)).length() < 1e-4, "full column {x} differs from the paper's");
+                            assert!(
+                                (p - paper.vp_to_screen(g)).length() < 1e-4,
+                                "full column {x} differs from the paper's"
+                            );
                         }
                     }
                 }
                 assert_eq!(off, 0, "{w}x{h} gaze {gaze}: texel centres off the screen");
-                assert!(full_columns < grid.x, "{w}x{h} gaze {gaze}: some circle must leave the screen");
+                assert!(
+                    full_columns < grid.x,
+                    "{w}x{h} gaze {gaze}: some circle must leave the screen"
+                );
             }
         }
     }
@@ -398,7 +459,9 @@ mod tests {
     fn clipped_round_trips() {
         let mut seed = 7u64;
         let mut rand = move || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
             (seed >> 40) as f32 / (1u64 << 24) as f32
         };
         for (w, h) in [(1280u32, 1440u32), (640, 720)] {
@@ -410,7 +473,10 @@ mod tests {
                     let p = Vec2::new(rand() * w as f32, rand() * h as f32);
                     let g = vp.screen_to_vp(p);
                     let col = vp.column_of(g.x);
-                    assert!(g.y >= 0.0 && g.y < vp.rows_in_column(col) as f32, "{p} → {g}");
+                    assert!(
+                        g.y >= 0.0 && g.y < vp.rows_in_column(col) as f32,
+                        "{p} → {g}"
+                    );
                     let back = vp.vp_to_screen(g);
                     let err = (back - p).length();
                     if err < 5e-3 {
@@ -423,7 +489,10 @@ mod tests {
                     let u = |x: f32| x / grid.x as f32;
                     let extent = vp.r_of_u(u(col as f32 + 1.0)) - vp.r_of_u(u(col as f32));
                     let border = p.x.min(p.y).min(w as f32 - p.x).min(h as f32 - p.y);
-                    assert!(border <= extent + 1e-2, "{w}x{h} gaze {gaze}: {p} → {g} → {back} ({border} px from the border)");
+                    assert!(
+                        border <= extent + 1e-2,
+                        "{w}x{h} gaze {gaze}: {p} → {g} → {back} ({border} px from the border)"
+                    );
                 }
                 println!("{w}x{h} gaze {gaze}: screen→grid→screen worst {worst:.2e} px, {clamped} of 10000 clamped at the border");
                 assert!(clamped < 300, "{clamped} clamped");
@@ -445,7 +514,10 @@ mod tests {
                     // φ compared as arc length on screen: a short corner arc packs many rows
                     // into few pixels, so rows are the wrong unit there.
                     let arc_px = dy / n * arcs.total() * (p - gaze).length();
-                    assert!((g.x - x).abs() < 2e-3 && arc_px < 5e-3, "({x},{y}) → {p} → {g}: {arc_px} px");
+                    assert!(
+                        (g.x - x).abs() < 2e-3 && arc_px < 5e-3,
+                        "({x},{y}) → {p} → {g}: {arc_px} px"
+                    );
                 }
             }
         }
@@ -465,7 +537,11 @@ mod tests {
         // A gap angle clamps to the nearer end: φ = 0 points at the right edge, the middle of a cut.
         let (a, i, gap) = arcs.arc_of_phi(0.01);
         assert!(a == arcs.arc_start(i) || a == arcs.end[i]);
-        assert!(gap > 0.01 && (arcs.phi_of_arc(a) - 0.01 - gap).abs() < 1e-5, "gap {gap}: φ {}", arcs.phi_of_arc(a));
+        assert!(
+            gap > 0.01 && (arcs.phi_of_arc(a) - 0.01 - gap).abs() < 1e-5,
+            "gap {gap}: φ {}",
+            arcs.phi_of_arc(a)
+        );
         let (a2, _, _) = arcs.arc_of_phi(TAU - 0.01);
         assert!(a != a2, "the two sides of a cut clamp to different ends");
         assert_eq!(ColumnArcs::FULL.arc_of_phi(1.5), (1.5, 0, 0.0));

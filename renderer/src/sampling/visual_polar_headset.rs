@@ -50,7 +50,10 @@ impl FovTangents {
     /// Every tangent finite and each axis spanning a positive width.
     pub fn check(&self) -> Result<(), String> {
         let all = [self.left, self.right, self.up, self.down];
-        if !all.iter().all(|t| t.is_finite()) || self.left + self.right <= 0.0 || self.up + self.down <= 0.0 {
+        if !all.iter().all(|t| t.is_finite())
+            || self.left + self.right <= 0.0
+            || self.up + self.down <= 0.0
+        {
             return Err(format!(
                 "eccentricity = headset needs finite FOV tangents spanning a positive width and height \
                  (every half-angle below 90°), got left {} right {} up {} down {}",
@@ -68,10 +71,17 @@ impl FovTangents {
 // 0.785_398_2 is π/4 spelled as the GLSL twin spells it (the point is op-for-op agreement).
 #[allow(clippy::approx_constant)]
 fn atan_unit(z: f32) -> f32 {
-    let (base, w) = if z > 0.414_213_57 { (0.785_398_2, (z - 1.0) / (z + 1.0)) } else { (0.0, z) };
+    let (base, w) = if z > 0.414_213_57 {
+        (0.785_398_2, (z - 1.0) / (z + 1.0))
+    } else {
+        (0.0, z)
+    };
     let v = w / (1.0 + (1.0 + w * w).sqrt());
     let v2 = v * v;
-    let q = (((((-0.076_923_08 * v2 + 0.090_909_09) * v2 - 0.111_111_11) * v2 + 0.142_857_15) * v2 - 0.2) * v2
+    let q = (((((-0.076_923_08 * v2 + 0.090_909_09) * v2 - 0.111_111_11) * v2 + 0.142_857_15)
+        * v2
+        - 0.2)
+        * v2
         + 0.333_333_34)
         * v2;
     base + 2.0 * (v - v * q)
@@ -109,14 +119,27 @@ pub struct HeadsetAxis {
 impl HeadsetAxis {
     pub fn new(fov: FovTangents, screen: UVec2, gaze: Vec2) -> HeadsetAxis {
         let size = screen.as_vec2();
-        let scale = Vec2::new((fov.left + fov.right) / size.x, (fov.up + fov.down) / size.y);
+        let scale = Vec2::new(
+            (fov.left + fov.right) / size.x,
+            (fov.up + fov.down) / size.y,
+        );
         let gaze_tan = gaze * scale - Vec2::new(fov.left, fov.up);
         let far = FAR_PIXELS_PER_SCREEN * (size.x + size.y);
-        let mut axis = HeadsetAxis { gaze_tan, scale, e_max: 0.0, far };
-        axis.e_max = [Vec2::ZERO, Vec2::new(size.x, 0.0), Vec2::new(0.0, size.y), size]
-            .iter()
-            .map(|&corner| axis.eccentricity(corner - gaze))
-            .fold(0.0, f32::max);
+        let mut axis = HeadsetAxis {
+            gaze_tan,
+            scale,
+            e_max: 0.0,
+            far,
+        };
+        axis.e_max = [
+            Vec2::ZERO,
+            Vec2::new(size.x, 0.0),
+            Vec2::new(0.0, size.y),
+            size,
+        ]
+        .iter()
+        .map(|&corner| axis.eccentricity(corner - gaze))
+        .fold(0.0, f32::max);
         axis
     }
 

@@ -12,13 +12,20 @@ fn pimax_left() -> FovTangents {
 }
 
 fn headset(fov: FovTangents) -> VisualPolarParams {
-    VisualPolarParams { eccentricity: Eccentricity::Headset(fov), ..Default::default() }
+    VisualPolarParams {
+        eccentricity: Eccentricity::Headset(fov),
+        ..Default::default()
+    }
 }
 
 /// Centre, near an edge and in a corner of a w×h screen.
 fn gazes(w: u32, h: u32) -> [(&'static str, Vec2); 3] {
     let s = Vec2::new(w as f32, h as f32);
-    [("centre", s * 0.5), ("edge", s * Vec2::new(0.97, 0.5)), ("corner", s * Vec2::new(0.02, 0.03))]
+    [
+        ("centre", s * 0.5),
+        ("edge", s * Vec2::new(0.97, 0.5)),
+        ("corner", s * Vec2::new(0.02, 0.03)),
+    ]
 }
 
 /// The angle between the view directions of two pixels, from the FOV definition, in f64.
@@ -31,8 +38,15 @@ fn angle_between(fov: FovTangents, screen: Vec2, a: Vec2, b: Vec2) -> f64 {
     };
     let (u, v) = (dir(a), dir(b));
     let dot = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    let cross = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
-    (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt().atan2(dot).to_degrees()
+    let cross = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
+        .sqrt()
+        .atan2(dot)
+        .to_degrees()
 }
 
 #[test]
@@ -43,12 +57,23 @@ fn true_eccentricity_matches_the_view_directions() {
             let screen = Vec2::new(w as f32, h as f32);
             for (name, gaze) in gazes(w, h) {
                 let s = vp(w, h, gaze.x, gaze.y, headset(fov));
-                let corners = [Vec2::ZERO, Vec2::new(screen.x, 0.0), Vec2::new(0.0, screen.y), screen];
-                let e_max = corners.iter().map(|&c| angle_between(fov, screen, gaze, c)).fold(0.0, f64::max);
+                let corners = [
+                    Vec2::ZERO,
+                    Vec2::new(screen.x, 0.0),
+                    Vec2::new(0.0, screen.y),
+                    screen,
+                ];
+                let e_max = corners
+                    .iter()
+                    .map(|&c| angle_between(fov, screen, gaze, c))
+                    .fold(0.0, f64::max);
                 let got = s.headset().unwrap().e_max as f64;
                 assert!((got - e_max).abs() < 1e-3, "{name}: e_max {got} vs {e_max}");
                 for _ in 0..2000 {
-                    let p = Vec2::new(rng.random::<f32>() * screen.x, rng.random::<f32>() * screen.y);
+                    let p = Vec2::new(
+                        rng.random::<f32>() * screen.x,
+                        rng.random::<f32>() * screen.y,
+                    );
                     let want = angle_between(fov, screen, gaze, p);
                     let e = s.true_eccentricity(p).unwrap() as f64;
                     assert!((e - want).abs() < 1e-3, "{name} {p}: {e}° vs {want}°");
@@ -71,7 +96,10 @@ fn headset_mapping_round_trips() {
             for _ in 0..20_000 {
                 let col = rng.random_range(0..g.x);
                 let row = rng.random_range(0..s.rows_in_column(col));
-                let t = Vec2::new(col as f32 + rng.random::<f32>().min(0.999), row as f32 + rng.random::<f32>().min(0.999));
+                let t = Vec2::new(
+                    col as f32 + rng.random::<f32>().min(0.999),
+                    row as f32 + rng.random::<f32>().min(0.999),
+                );
                 let p = s.vp_to_screen(t);
                 if !(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32) {
                     continue;
@@ -84,13 +112,22 @@ fn headset_mapping_round_trips() {
                 worst_grid = worst_grid.max((back.x - t.x).abs()).max(dy.min(n - dy));
             }
             for _ in 0..20_000 {
-                let p = Vec2::new(rng.random::<f32>() * w as f32, rng.random::<f32>() * h as f32);
+                let p = Vec2::new(
+                    rng.random::<f32>() * w as f32,
+                    rng.random::<f32>() * h as f32,
+                );
                 worst_screen = worst_screen.max((s.vp_to_screen(s.screen_to_vp(p)) - p).length());
             }
             println!("{name}: {checked} on-screen samples, grid round trip {worst_grid:.2e} texels, screen {worst_screen:.2e} px");
             assert!(checked > 5000, "{name}: only {checked} samples on screen");
-            assert!(worst_grid < 2e-3, "{name}: grid round trip off by {worst_grid} texels");
-            assert!(worst_screen < 1e-2, "{name}: screen round trip off by {worst_screen} px");
+            assert!(
+                worst_grid < 2e-3,
+                "{name}: grid round trip off by {worst_grid} texels"
+            );
+            assert!(
+                worst_screen < 1e-2,
+                "{name}: screen round trip off by {worst_screen} px"
+            );
         }
     }
 }
@@ -110,7 +147,10 @@ fn headset_fovea_is_linear_in_true_degrees() {
                 for row in 0..s.rows_in_column(col) {
                     let p = s.vp_to_screen(Vec2::new(x, row as f32 + 0.5));
                     let e = s.true_eccentricity(p).unwrap();
-                    assert!((e - want).abs() < 1e-3, "{name} column {col} row {row}: {e}° vs {want}°");
+                    assert!(
+                        (e - want).abs() < 1e-3,
+                        "{name} column {col} row {row}: {e}° vs {want}°"
+                    );
                 }
             }
         }
@@ -143,8 +183,10 @@ fn headset_ring_density_follows_acuity() {
             let ecc = |p: Vec2| axis.eccentricity(p - gaze);
             let in_pixel = |p: Vec2| {
                 let hd = 0.25f32;
-                let de_dx = (ecc(p + Vec2::X * hd) - ecc(p - Vec2::X * hd)) as f64 / (2.0 * hd) as f64;
-                let de_dy = (ecc(p + Vec2::Y * hd) - ecc(p - Vec2::Y * hd)) as f64 / (2.0 * hd) as f64;
+                let de_dx =
+                    (ecc(p + Vec2::X * hd) - ecc(p - Vec2::X * hd)) as f64 / (2.0 * hd) as f64;
+                let de_dy =
+                    (ecc(p + Vec2::Y * hd) - ecc(p - Vec2::Y * hd)) as f64 / (2.0 * hd) as f64;
                 let d = p - gaze;
                 let r2 = d.length_squared() as f64;
                 let (dphi_dx, dphi_dy) = (-d.y as f64 / r2, d.x as f64 / r2);
@@ -159,11 +201,21 @@ fn headset_ring_density_follows_acuity() {
                 100.0 * offscreen,
                 rows.iter().map(|r| format!("{:.1}: {:.3} {:.2}", r.0, r.1, r.2)).collect::<Vec<_>>()
             );
-            assert!(rows.len() >= 12, "{fov_name} {name}: only {} rings on screen", rows.len());
+            assert!(
+                rows.len() >= 12,
+                "{fov_name} {name}: only {} rings on screen",
+                rows.len()
+            );
             for &(e, ratio, spp) in &rows {
-                assert!((ratio - 1.0).abs() < 0.10, "{fov_name} {name}: ring at {e}°: measured/target {ratio}");
+                assert!(
+                    (ratio - 1.0).abs() < 0.10,
+                    "{fov_name} {name}: ring at {e}°: measured/target {ratio}"
+                );
                 if e < f {
-                    assert!(spp >= 1.0, "{fov_name} {name}: fovea ring at {e}°: {spp} samples/pixel");
+                    assert!(
+                        spp >= 1.0,
+                        "{fov_name} {name}: fovea ring at {e}°: {spp} samples/pixel"
+                    );
                 }
             }
         }
@@ -176,8 +228,14 @@ fn headset_ring_density_follows_acuity() {
 fn headset_packing() {
     let paper = vp(640, 720, 320.0, 360.0, Default::default());
     let p = paper.sampling_params();
-    assert_eq!(VisualPolarParams::default().eccentricity, Eccentricity::Normalized);
-    assert_eq!((p.gaze.z, p.shape0.w, p.shape1.y, p.shape1.w), (paper.r_max(), inverse_cdf_poly(1.0), 0.0, 0.0));
+    assert_eq!(
+        VisualPolarParams::default().eccentricity,
+        Eccentricity::Normalized
+    );
+    assert_eq!(
+        (p.gaze.z, p.shape0.w, p.shape1.y, p.shape1.w),
+        (paper.r_max(), inverse_cdf_poly(1.0), 0.0, 0.0)
+    );
     let s = vp(640, 720, 100.0, 200.0, headset(fove0()));
     let q = s.sampling_params();
     let axis = s.headset().unwrap();
@@ -189,7 +247,11 @@ fn headset_packing() {
     // The whole ρ axis: u = 1 is the farthest corner's true eccentricity.
     assert!((s.r_of_u(1.0) - axis.e_max).abs() < 1e-3);
     // Pixel radii for pixel-based code: the fovea is a few percent of the screen.
-    assert!(s.r_fovea() > 10.0 && s.r_fovea() < 80.0, "fovea radius {} px", s.r_fovea());
+    assert!(
+        s.r_fovea() > 10.0 && s.r_fovea() < 80.0,
+        "fovea radius {} px",
+        s.r_fovea()
+    );
     assert!(s.radius_of_eccentricity(30.0) > s.r_fovea());
 }
 
@@ -197,22 +259,47 @@ fn headset_packing() {
 fn headset_invalid_parameters_are_errors() {
     let screen = UVec2::new(640, 720);
     let gaze = Vec2::new(320.0, 360.0);
-    let nan = FovTangents { left: f32::NAN, ..fove0() };
-    let flat = FovTangents { left: -1.0, right: 1.0, ..fove0() };
+    let nan = FovTangents {
+        left: f32::NAN,
+        ..fove0()
+    };
+    let flat = FovTangents {
+        left: -1.0,
+        right: 1.0,
+        ..fove0()
+    };
     let cases: Vec<(VisualPolarParams, &str)> = vec![
-        (VisualPolarParams { layout: VpLayout::ScreenClipped, ..headset(fove0()) }, "layout"),
-        (VisualPolarParams { radius_mode: RadiusMode::Fixed(300.0), ..headset(fove0()) }, "radius_mode"),
+        (
+            VisualPolarParams {
+                layout: VpLayout::ScreenClipped,
+                ..headset(fove0())
+            },
+            "layout",
+        ),
+        (
+            VisualPolarParams {
+                radius_mode: RadiusMode::Fixed(300.0),
+                ..headset(fove0())
+            },
+            "radius_mode",
+        ),
         (headset(nan), "FOV tangents"),
         (headset(flat), "FOV tangents"),
         // A 10°-wide view whose farthest corner is within the 20° fovea.
         (
-            VisualPolarParams { fovea_deg: 20.0, ..headset(FovTangents::from_angles_deg(-5.0, 5.0, -5.0, 5.0)) },
+            VisualPolarParams {
+                fovea_deg: 20.0,
+                ..headset(FovTangents::from_angles_deg(-5.0, 5.0, -5.0, 5.0))
+            },
             "fovea",
         ),
     ];
     for (params, name) in cases {
         match VisualPolar::new(screen, gaze, params) {
-            Err(e) => assert!(e.to_string().contains(name), "{params:?}: error '{e}' should name {name}"),
+            Err(e) => assert!(
+                e.to_string().contains(name),
+                "{params:?}: error '{e}' should name {name}"
+            ),
             Ok(_) => panic!("{params:?} accepted"),
         }
     }

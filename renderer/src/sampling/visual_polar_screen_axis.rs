@@ -64,7 +64,14 @@ impl ScreenAxis {
     /// The axis for one gaze: the periphery from `r_f` to `r_end` pixels, eccentricity
     /// `e = r · ecc_per_px` (the paper's normalised degrees), density exponent `k`. `None` when no
     /// acuity mass lies on the screen beyond the fovea (then the paper's axis applies).
-    pub fn new(gaze: Vec2, screen: UVec2, r_f: f32, r_end: f32, ecc_per_px: f32, k: f32) -> Option<ScreenAxis> {
+    pub fn new(
+        gaze: Vec2,
+        screen: UVec2,
+        r_f: f32,
+        r_end: f32,
+        ecc_per_px: f32,
+        k: f32,
+    ) -> Option<ScreenAxis> {
         if !(r_f > 0.0 && r_end > r_f && ecc_per_px > 0.0 && r_end.is_finite()) {
             return None;
         }
@@ -96,7 +103,11 @@ impl ScreenAxis {
                 step += 1;
             }
             let span = mass[step + 1] - mass[step];
-            let t = if span > 0.0 { ((target - mass[step]) / span).clamp(0.0, 1.0) } else { 0.0 };
+            let t = if span > 0.0 {
+                ((target - mass[step]) / span).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             *knot = (r_f as f64 + (step as f64 + t) * dr) as f32;
         }
         Some(ScreenAxis { knots })
@@ -162,9 +173,17 @@ mod tests {
 
     #[test]
     fn knots_rise_from_the_fovea_to_the_far_corner_and_invert() {
-        for gaze in [Vec2::new(640.0, 720.0), Vec2::splat(10.0), Vec2::new(0.0, 700.0)] {
+        for gaze in [
+            Vec2::new(640.0, 720.0),
+            Vec2::splat(10.0),
+            Vec2::new(0.0, 700.0),
+        ] {
             let a = axis(gaze);
-            assert!(a.knots.windows(2).all(|w| w[1] > w[0]), "{gaze}: {:?}", a.knots);
+            assert!(
+                a.knots.windows(2).all(|w| w[1] > w[0]),
+                "{gaze}: {:?}",
+                a.knots
+            );
             // Past p = 1 too (a last column's far edge): still increasing and invertible.
             let mut last = 0.0;
             for k in 0..=6144 {
@@ -192,7 +211,10 @@ mod tests {
                 .map(|i| {
                     let r = r0 as f64 + (i as f64 + 0.5) * dr;
                     let e = r * (80.0 / far) as f64;
-                    acuity(e as f32) as f64 * e * on_screen_angle(gaze, r as f32, SCREEN) as f64 * dr
+                    acuity(e as f32) as f64
+                        * e
+                        * on_screen_angle(gaze, r as f32, SCREEN) as f64
+                        * dr
                 })
                 .sum::<f64>()
         };
@@ -205,7 +227,12 @@ mod tests {
         // The last piece holds (1/128)² of the mass, a few of the integral's steps: absolute there.
         for (j, m) in pieces.iter().enumerate() {
             let off = (m / total - share(j)).abs();
-            assert!(off < 0.01 * share(j) || off < 5e-5, "piece {j}: {} of the mass, its share {}", m / total, share(j));
+            assert!(
+                off < 0.01 * share(j) || off < 5e-5,
+                "piece {j}: {} of the mass, its share {}",
+                m / total,
+                share(j)
+            );
         }
     }
 
@@ -223,6 +250,8 @@ mod tests {
     #[test]
     fn no_axis_without_mass_beyond_the_fovea() {
         assert!(ScreenAxis::new(Vec2::new(640.0, 720.0), SCREEN, 100.0, 50.0, 0.1, 1.0).is_none());
-        assert!(ScreenAxis::new(Vec2::new(-5000.0, 720.0), SCREEN, 100.0, 200.0, 0.1, 1.0).is_none());
+        assert!(
+            ScreenAxis::new(Vec2::new(-5000.0, 720.0), SCREEN, 100.0, 200.0, 0.1, 1.0).is_none()
+        );
     }
 }

@@ -5,7 +5,8 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 fn vp(w: u32, h: u32, gx: f32, gy: f32, params: VisualPolarParams) -> VisualPolar {
-    VisualPolar::new(UVec2::new(w, h), Vec2::new(gx, gy), params).expect("valid visual-polar parameters")
+    VisualPolar::new(UVec2::new(w, h), Vec2::new(gx, gy), params)
+        .expect("valid visual-polar parameters")
 }
 
 fn with_inverse(inverse_cdf: InverseCdf) -> VisualPolarParams {
@@ -89,7 +90,9 @@ fn polynomial_matches_exact_inverse() {
         let p = p_f + (1.0 - p_f) * i as f32 / 2000.0;
         let exact = bisect_inverse(p as f64, 1.0);
         worst_poly = worst_poly.max((inverse_cdf_poly(p) as f64 - exact).abs());
-        worst_newton = worst_newton.max((inverse_cdf_exact(1.0 - p, 1.0, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64 - exact).abs());
+        worst_newton = worst_newton.max(
+            (inverse_cdf_exact(1.0 - p, 1.0, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64 - exact).abs(),
+        );
         // The quartic's inverse (used by screen → VP) undoes Eq. 3.
         let back = poly_fraction_of(inverse_cdf_poly(p), cdf_max);
         assert!((back - p).abs() < 2e-6, "poly inverse at p {p}: {back}");
@@ -103,7 +106,9 @@ fn polynomial_matches_exact_inverse() {
         let p_f = fovea_fraction(ACUITY_KNEE_DEG, k);
         for i in 0..=200 {
             let p = p_f + (1.0 - p_f) * i as f32 / 200.0;
-            let err = (inverse_cdf_exact(1.0 - p, k, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64 - bisect_inverse(p as f64, k)).abs();
+            let err = (inverse_cdf_exact(1.0 - p, k, cdf_max, E_MAX_DEG, E_MAX_DEG) as f64
+                - bisect_inverse(p as f64, k))
+            .abs();
             assert!(err < 1e-3, "k {k} p {p}: Newton off by {err}°");
         }
     }
@@ -251,7 +256,10 @@ fn derived_numbers() {
 fn ring_edges(fovea: f32, e_end: f32, rings_periphery: usize) -> Vec<f32> {
     (0..=4)
         .map(|i| fovea * i as f32 / 4.0)
-        .chain((1..=rings_periphery).map(|i| fovea + (e_end - fovea) * i as f32 / rings_periphery as f32))
+        .chain(
+            (1..=rings_periphery)
+                .map(|i| fovea + (e_end - fovea) * i as f32 / rings_periphery as f32),
+        )
         .collect()
 }
 
@@ -394,30 +402,123 @@ fn invalid_parameters_are_errors() {
     let screen = UVec2::new(640, 720);
     let gaze = Vec2::new(320.0, 360.0);
     let cases: Vec<(VisualPolarParams, &str)> = vec![
-        (VisualPolarParams { clip_fraction: 0.0, ..Default::default() }, "clip_fraction"),
-        (VisualPolarParams { clip_fraction: 0.5, ..Default::default() }, "clip_fraction"),
-        (VisualPolarParams { clip_fraction: -0.1, ..Default::default() }, "clip_fraction"),
-        (VisualPolarParams { clip_fraction: f32::NAN, ..Default::default() }, "clip_fraction"),
-        (VisualPolarParams { axis_scale: 0.0, ..Default::default() }, "axis_scale"),
-        (VisualPolarParams { axis_scale: f32::INFINITY, ..Default::default() }, "axis_scale"),
-        (VisualPolarParams { fovea_deg: 0.0, ..Default::default() }, "fovea_deg"),
-        (VisualPolarParams { fovea_deg: 80.0, ..Default::default() }, "fovea_deg"),
-        (VisualPolarParams { density_exponent: -1.0, ..Default::default() }, "density_exponent"),
-        (VisualPolarParams { density_exponent: f32::NAN, ..Default::default() }, "density_exponent"),
-        (VisualPolarParams { radius_mode: RadiusMode::Fixed(0.0), ..Default::default() }, "radius_mode"),
-        (VisualPolarParams { radius_mode: RadiusMode::Fixed(f32::NAN), ..Default::default() }, "radius_mode"),
+        (
+            VisualPolarParams {
+                clip_fraction: 0.0,
+                ..Default::default()
+            },
+            "clip_fraction",
+        ),
+        (
+            VisualPolarParams {
+                clip_fraction: 0.5,
+                ..Default::default()
+            },
+            "clip_fraction",
+        ),
+        (
+            VisualPolarParams {
+                clip_fraction: -0.1,
+                ..Default::default()
+            },
+            "clip_fraction",
+        ),
+        (
+            VisualPolarParams {
+                clip_fraction: f32::NAN,
+                ..Default::default()
+            },
+            "clip_fraction",
+        ),
+        (
+            VisualPolarParams {
+                axis_scale: 0.0,
+                ..Default::default()
+            },
+            "axis_scale",
+        ),
+        (
+            VisualPolarParams {
+                axis_scale: f32::INFINITY,
+                ..Default::default()
+            },
+            "axis_scale",
+        ),
+        (
+            VisualPolarParams {
+                fovea_deg: 0.0,
+                ..Default::default()
+            },
+            "fovea_deg",
+        ),
+        (
+            VisualPolarParams {
+                fovea_deg: 80.0,
+                ..Default::default()
+            },
+            "fovea_deg",
+        ),
+        (
+            VisualPolarParams {
+                density_exponent: -1.0,
+                ..Default::default()
+            },
+            "density_exponent",
+        ),
+        (
+            VisualPolarParams {
+                density_exponent: f32::NAN,
+                ..Default::default()
+            },
+            "density_exponent",
+        ),
+        (
+            VisualPolarParams {
+                radius_mode: RadiusMode::Fixed(0.0),
+                ..Default::default()
+            },
+            "radius_mode",
+        ),
+        (
+            VisualPolarParams {
+                radius_mode: RadiusMode::Fixed(f32::NAN),
+                ..Default::default()
+            },
+            "radius_mode",
+        ),
     ];
     for (params, name) in cases {
         match VisualPolar::new(screen, gaze, params) {
-            Err(e) => assert!(e.to_string().contains(name), "{params:?}: error '{e}' should name {name}"),
+            Err(e) => assert!(
+                e.to_string().contains(name),
+                "{params:?}: error '{e}' should name {name}"
+            ),
             Ok(_) => panic!("{params:?} accepted"),
         }
     }
-    assert!(VisualPolar::new(UVec2::new(0, 720), gaze, Default::default()).unwrap_err().to_string().contains("screen"));
-    assert!(VisualPolar::new(screen, Vec2::new(f32::NAN, 0.0), Default::default()).unwrap_err().to_string().contains("gaze"));
+    assert!(
+        VisualPolar::new(UVec2::new(0, 720), gaze, Default::default())
+            .unwrap_err()
+            .to_string()
+            .contains("screen")
+    );
+    assert!(
+        VisualPolar::new(screen, Vec2::new(f32::NAN, 0.0), Default::default())
+            .unwrap_err()
+            .to_string()
+            .contains("gaze")
+    );
     // The acuity-exact clip and an off-screen gaze are fine.
     let exact_clip = VisualPolarParams::default().acuity_exact_clip_fraction();
-    VisualPolar::new(screen, gaze, VisualPolarParams { clip_fraction: exact_clip, ..Default::default() }).unwrap();
+    VisualPolar::new(
+        screen,
+        gaze,
+        VisualPolarParams {
+            clip_fraction: exact_clip,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     VisualPolar::new(screen, Vec2::new(-50.0, 900.0), Default::default()).unwrap();
 }
 
@@ -443,21 +544,44 @@ fn sampling_space_impl() {
                 Some(p) => {
                     assert!(valid, "clipped texel ({x}, {y}) mapped");
                     assert!((p - s.vp_to_screen(t)).length() < 1e-6);
-                    let back = space.screen_to_grid(p).expect("a sample's position has a grid position");
-                    assert!((back.x - t.x).abs() < 2e-2, "({x}, {y}): x {} vs {}", back.x, t.x);
+                    let back = space
+                        .screen_to_grid(p)
+                        .expect("a sample's position has a grid position");
+                    assert!(
+                        (back.x - t.x).abs() < 2e-2,
+                        "({x}, {y}): x {} vs {}",
+                        back.x,
+                        t.x
+                    );
                 }
                 None => assert!(!valid, "valid texel ({x}, {y}) not mapped"),
             }
         }
     }
-    for bad in [Vec2::new(-0.5, 0.5), Vec2::new(0.5, -0.5), Vec2::new(g.x as f32 + 0.5, 0.5), Vec2::new(0.5, g.y as f32), Vec2::NAN, Vec2::new(1e30, 0.5)] {
+    for bad in [
+        Vec2::new(-0.5, 0.5),
+        Vec2::new(0.5, -0.5),
+        Vec2::new(g.x as f32 + 0.5, 0.5),
+        Vec2::new(0.5, g.y as f32),
+        Vec2::NAN,
+        Vec2::new(1e30, 0.5),
+    ] {
         assert_eq!(space.grid_to_screen(bad), None, "{bad}");
     }
     assert_eq!(space.screen_to_grid(Vec2::NAN), None);
     // A corner of the screen is at r_max: still inside the grid (the last column).
     assert!(space.screen_to_grid(Vec2::ZERO).is_some());
     // With a fixed radius, positions beyond it have no sample.
-    let fixed = vp(160, 180, 80.0, 90.0, VisualPolarParams { radius_mode: RadiusMode::Fixed(50.0), ..Default::default() });
+    let fixed = vp(
+        160,
+        180,
+        80.0,
+        90.0,
+        VisualPolarParams {
+            radius_mode: RadiusMode::Fixed(50.0),
+            ..Default::default()
+        },
+    );
     assert_eq!(SamplingSpace::screen_to_grid(&fixed, Vec2::ZERO), None);
     assert!(SamplingSpace::screen_to_grid(&fixed, Vec2::new(100.0, 90.0)).is_some());
 }

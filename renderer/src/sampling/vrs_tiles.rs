@@ -11,7 +11,9 @@
 //! layout and normalised axis only (the density is VP's radial one).
 //! GLSL: sampling/vrs_tiles.glsl.
 
-use super::{RadialLaw, SamplingSpace, SpaceCapabilities, VisualPolar, VisualPolarParams, VpLayout, WayBack};
+use super::{
+    RadialLaw, SamplingSpace, SpaceCapabilities, VisualPolar, VisualPolarParams, VpLayout, WayBack,
+};
 use crate::error::{Error, Result};
 use crate::layouts::{SamplingParams, WORKGROUP_2D};
 use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
@@ -41,12 +43,17 @@ type Run = (i32, i32, i32);
 
 impl VrsTiles {
     pub fn new(screen: UVec2, gaze: Vec2, params: VisualPolarParams) -> Result<VrsTiles> {
-        let paper = params.layout == VpLayout::Paper && params.radial == RadialLaw::Acuity && params.eccentricity == super::Eccentricity::Normalized;
+        let paper = params.layout == VpLayout::Paper
+            && params.radial == RadialLaw::Acuity
+            && params.eccentricity == super::Eccentricity::Normalized;
         if !paper {
             return Err(Error::Invalid("vrs tiles: follow the paper's Visual-Polar density only (layout = \"paper\", eccentricity = \"normalized\")".into()));
         }
         let axis = VisualPolar::new(screen, gaze, params)?;
-        Ok(VrsTiles { axis, coarse_from: coarse_thresholds(&axis) })
+        Ok(VrsTiles {
+            axis,
+            coarse_from: coarse_thresholds(&axis),
+        })
     }
 
     fn tiles(&self) -> IVec2 {
@@ -58,7 +65,9 @@ impl VrsTiles {
     /// gaze (GLSL `vrs_columns_within`).
     fn columns_within(&self, row: i32, r: f32) -> IVec2 {
         let (g, t, tiles_x) = (self.axis.gaze(), VRS_TILE as f32, self.tiles().x);
-        let dy = (row as f32 * t - g.y).max(g.y - (row + 1) as f32 * t).max(0.0);
+        let dy = (row as f32 * t - g.y)
+            .max(g.y - (row + 1) as f32 * t)
+            .max(0.0);
         if dy >= r {
             return IVec2::ZERO;
         }
@@ -77,12 +86,21 @@ impl VrsTiles {
             fine = IVec2::splat(mid.x);
         }
         let tiles_x = self.tiles().x;
-        [(fine.x, fine.y - fine.x, 1), (mid.x, fine.x - mid.x, 2), (fine.y, mid.y - fine.y, 2), (0, mid.x, 4), (mid.y, tiles_x - mid.y, 4)]
+        [
+            (fine.x, fine.y - fine.x, 1),
+            (mid.x, fine.x - mid.x, 2),
+            (fine.y, mid.y - fine.y, 2),
+            (0, mid.x, 4),
+            (mid.y, tiles_x - mid.y, 4),
+        ]
     }
 
     /// Pixels per block side of the tile at `tile` (column, row).
     pub fn rate(&self, tile: IVec2) -> u32 {
-        self.runs(tile.y).iter().find(|&&(first, n, _)| (first..first + n).contains(&tile.x)).map_or(RATES[2], |r| r.2 as u32)
+        self.runs(tile.y)
+            .iter()
+            .find(|&&(first, n, _)| (first..first + n).contains(&tile.x))
+            .map_or(RATES[2], |r| r.2 as u32)
     }
 
     /// The screen pixel of grid texel `texel`'s sample (GLSL `vrs_pixel`); `None` where the
@@ -94,7 +112,9 @@ impl VrsTiles {
             return None;
         }
         let wg = WORKGROUP_2D as i32;
-        let mut k = ((texel.y / wg) * (grid.x / wg) + texel.x / wg) * wg * wg + (texel.y % wg) * wg + texel.x % wg;
+        let mut k = ((texel.y / wg) * (grid.x / wg) + texel.x / wg) * wg * wg
+            + (texel.y % wg) * wg
+            + texel.x % wg;
         let tile = VRS_TILE as i32;
         let capacity = self.tiles().x * tile * tile;
         let row = k / capacity;
@@ -105,7 +125,8 @@ impl VrsTiles {
             if k < tiles * per_tile {
                 let (column, s) = (first + k / per_tile, k % per_tile);
                 let (patches, patch, q) = (per_side / 4, s / 16, s % 16);
-                let block = IVec2::new((patch % patches) * 4 + q % 4, (patch / patches) * 4 + q / 4);
+                let block =
+                    IVec2::new((patch % patches) * 4 + q % 4, (patch / patches) * 4 + q / 4);
                 let origin = IVec2::new(column, row) * tile + block * rate;
                 if origin.cmpge(screen).any() {
                     return None;
@@ -151,7 +172,11 @@ fn coarse_thresholds(vp: &VisualPolar) -> [f32; 2] {
         // Beyond every pixel (but finite, for the GPU's square) when no radius on the screen is
         // that sparse.
         let beyond = 2.0 * (vp.screen().x + vp.screen().y) as f32;
-        if r >= far { beyond } else { (r + SCAN_STEP).max(0.0) }
+        if r >= far {
+            beyond
+        } else {
+            (r + SCAN_STEP).max(0.0)
+        }
     })
 }
 
@@ -186,7 +211,12 @@ impl SamplingSpace for VrsTiles {
     /// grid = (padded grid, screen), gaze = (x, y, rate-2 radius, rate-4 radius),
     /// shape0 = (tile side, tiles across, tiles down, 0).
     fn params(&self) -> SamplingParams {
-        let (s, g, grid, tiles) = (self.axis.screen(), self.axis.gaze(), self.padded_grid(), self.tiles());
+        let (s, g, grid, tiles) = (
+            self.axis.screen(),
+            self.axis.gaze(),
+            self.padded_grid(),
+            self.tiles(),
+        );
         SamplingParams {
             grid: UVec4::new(grid.x, grid.y, s.x, s.y),
             gaze: Vec4::new(g.x, g.y, self.coarse_from[0], self.coarse_from[1]),
@@ -196,7 +226,10 @@ impl SamplingSpace for VrsTiles {
     }
     /// The texel's sample (its pixel's centre).
     fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
-        grid.is_finite().then(|| self.pixel(grid.floor().as_ivec2())).flatten().map(|p| p.as_vec2() + 0.5)
+        grid.is_finite()
+            .then(|| self.pixel(grid.floor().as_ivec2()))
+            .flatten()
+            .map(|p| p.as_vec2() + 0.5)
     }
     /// Samples have no inverse on the packed grid (a pixel maps to a texel only through the
     /// rows' runs): the way back splats them.
@@ -215,7 +248,11 @@ impl SamplingSpace for VrsTiles {
         Some(&self.axis)
     }
     fn capabilities(&self) -> SpaceCapabilities {
-        SpaceCapabilities { way_back: WayBack::Splat, temporal_filters: false, filters_note: "(its samples are packed by tile, not laid out as on the screen)" }
+        SpaceCapabilities {
+            way_back: WayBack::Splat,
+            temporal_filters: false,
+            filters_note: "(its samples are packed by tile, not laid out as on the screen)",
+        }
     }
 }
 
@@ -226,7 +263,11 @@ mod tests {
     #[test]
     fn every_block_traces_once_and_no_tile_is_sparser_than_visual_polar() {
         let screen = UVec2::new(320, 360);
-        for gaze in [Vec2::new(120.0, 150.0), Vec2::new(3.0, 350.5), Vec2::new(-40.0, 20.0)] {
+        for gaze in [
+            Vec2::new(120.0, 150.0),
+            Vec2::new(3.0, 350.5),
+            Vec2::new(-40.0, 20.0),
+        ] {
             let s = VrsTiles::new(screen, gaze, VisualPolarParams::default()).unwrap();
             // The packed grid covers every block's pixel exactly once.
             let grid = s.grid_size().as_ivec2();
@@ -238,7 +279,11 @@ mod tests {
                     }
                 }
             }
-            assert_eq!(hits.iter().map(|&h| h as u64).sum::<u64>(), s.sample_count(), "gaze {gaze}");
+            assert_eq!(
+                hits.iter().map(|&h| h as u64).sum::<u64>(),
+                s.sample_count(),
+                "gaze {gaze}"
+            );
             let mut rates = [0u32; 5];
             for y in 0..screen.y as i32 {
                 for x in 0..screen.x as i32 {
@@ -248,11 +293,19 @@ mod tests {
                     // A coarse tile is at least as dense as VP anywhere in it (the fovea's VP
                     // density may exceed one sample per pixel a little: rate 1 is the finest).
                     let r = (p.as_vec2() + 0.5 - gaze).length();
-                    assert!(rate == 1 || 1.0 / (rate * rate) as f32 >= s.vp_density(r) * 0.999, "{p}: rate {rate}, VP {}", s.vp_density(r));
+                    assert!(
+                        rate == 1 || 1.0 / (rate * rate) as f32 >= s.vp_density(r) * 0.999,
+                        "{p}: rate {rate}, VP {}",
+                        s.vp_density(r)
+                    );
                     // One traced pixel per block, the one nearest its centre.
                     let r = rate as i32;
                     let chosen = (p / r * r + r / 2).min(screen.as_ivec2() - 1);
-                    assert_eq!(hits[(p.y * screen.x as i32 + p.x) as usize], (p == chosen) as u32, "{p}, gaze {gaze}");
+                    assert_eq!(
+                        hits[(p.y * screen.x as i32 + p.x) as usize],
+                        (p == chosen) as u32,
+                        "{p}, gaze {gaze}"
+                    );
                 }
             }
             assert!(rates[2] > 0 && rates[4] > 0, "{rates:?}");
@@ -260,7 +313,15 @@ mod tests {
                 assert!(rates[1] > 0, "{rates:?}");
             }
         }
-        assert!(VrsTiles::new(screen, Vec2::ZERO, VisualPolarParams { layout: VpLayout::ScreenClipped, ..Default::default() }).is_err());
+        assert!(VrsTiles::new(
+            screen,
+            Vec2::ZERO,
+            VisualPolarParams {
+                layout: VpLayout::ScreenClipped,
+                ..Default::default()
+            }
+        )
+        .is_err());
     }
 
     #[test]
@@ -269,19 +330,31 @@ mod tests {
         let gaze = screen.as_vec2() * 0.5;
         let s = VrsTiles::new(screen, gaze, VisualPolarParams::default()).unwrap();
         let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default()).unwrap();
-        let (n, vp_n, pixels) = (s.sample_count(), vp.sample_count(), (screen.x * screen.y) as u64);
-        assert!(n > vp_n && n < pixels * 3 / 5, "{n} vs VP {vp_n}, {pixels} pixels");
+        let (n, vp_n, pixels) = (
+            s.sample_count(),
+            vp.sample_count(),
+            (screen.x * screen.y) as u64,
+        );
+        assert!(
+            n > vp_n && n < pixels * 3 / 5,
+            "{n} vs VP {vp_n}, {pixels} pixels"
+        );
         // Workgroups hold samples in one run: at most one partly idle workgroup per tile row.
         let wg = WORKGROUP_2D as i32;
         let groups = s.grid_size().as_ivec2() / wg;
         let partial = (0..groups.y)
             .flat_map(|gy| (0..groups.x).map(move |gx| IVec2::new(gx, gy)))
             .filter(|g| {
-                let live = (0..wg * wg).filter(|i| s.pixel(*g * wg + IVec2::new(i % wg, i / wg)).is_some()).count();
+                let live = (0..wg * wg)
+                    .filter(|i| s.pixel(*g * wg + IVec2::new(i % wg, i / wg)).is_some())
+                    .count();
                 live > 0 && live < (wg * wg) as usize
             })
             .count();
-        assert!(partial <= s.tiles().y as usize, "{partial} partly idle workgroups");
+        assert!(
+            partial <= s.tiles().y as usize,
+            "{partial} partly idle workgroups"
+        );
         eprintln!("vrs tiles at 320×360, gaze centred: {n} samples, VP {vp_n}, {partial} partly idle workgroups");
     }
 }

@@ -37,10 +37,17 @@ impl std::str::FromStr for DeviceSelector {
 pub trait DeviceCreator: Send + Sync {
     /// # Safety
     /// `info` and everything it points to are valid for the call.
-    unsafe fn create_instance(&self, entry: &ash::Entry, info: &vk::InstanceCreateInfo) -> std::result::Result<vk::Instance, String>;
+    unsafe fn create_instance(
+        &self,
+        entry: &ash::Entry,
+        info: &vk::InstanceCreateInfo,
+    ) -> std::result::Result<vk::Instance, String>;
     /// # Safety
     /// `instance` came from [`Self::create_instance`] and is alive.
-    unsafe fn physical_device(&self, instance: vk::Instance) -> std::result::Result<vk::PhysicalDevice, String>;
+    unsafe fn physical_device(
+        &self,
+        instance: vk::Instance,
+    ) -> std::result::Result<vk::PhysicalDevice, String>;
     /// # Safety
     /// `physical` came from [`Self::physical_device`]; `info` is valid for the call.
     unsafe fn create_device(
@@ -79,7 +86,10 @@ impl std::fmt::Debug for ContextOptions {
             .field("device", &self.device)
             .field("instance_extensions", &self.instance_extensions)
             .field("device_extensions", &self.device_extensions)
-            .field("require_storage_write_without_format", &self.require_storage_write_without_format)
+            .field(
+                "require_storage_write_without_format",
+                &self.require_storage_write_without_format,
+            )
             .field("creator", &self.creator.as_ref().map(|_| "external"))
             .finish()
     }
@@ -139,7 +149,8 @@ pub struct Context {
     pub storage_write_without_format: bool,
     /// Compute pipelines by shader name, shared by every view and pass that uses the kernel.
     /// Weak: a pipeline lives as long as a pass holds it (no cycle through the context).
-    pub(crate) pipelines: Mutex<std::collections::HashMap<String, std::sync::Weak<super::ComputePipeline>>>,
+    pub(crate) pipelines:
+        Mutex<std::collections::HashMap<String, std::sync::Weak<super::ComputePipeline>>>,
     /// Serialises queue submissions (vkQueueSubmit needs external synchronisation).
     pub(crate) queue_lock: Mutex<()>,
     pub(crate) pool: Mutex<vk::CommandPool>,
@@ -175,19 +186,32 @@ impl Context {
         let physicals = unsafe { instance.enumerate_physical_devices()? };
         let chosen = match &options.creator {
             Some(creator) => {
-                let physical = unsafe { creator.physical_device(instance.handle()) }.map_err(Error::Invalid)?;
-                let index = physicals.iter().position(|&p| p == physical).ok_or_else(|| Error::Invalid("the device creator chose a physical device the instance does not list".into()))?;
+                let physical = unsafe { creator.physical_device(instance.handle()) }
+                    .map_err(Error::Invalid)?;
+                let index = physicals
+                    .iter()
+                    .position(|&p| p == physical)
+                    .ok_or_else(|| {
+                        Error::Invalid(
+                            "the device creator chose a physical device the instance does not list"
+                                .into(),
+                        )
+                    })?;
                 let chosen = &devices[index];
                 if let Err(why) = &chosen.suitable {
-                    return Err(Error::NoSuitableDevice(format!("{} (chosen by the OpenXR runtime): {why}", chosen.name)));
+                    return Err(Error::NoSuitableDevice(format!(
+                        "{} (chosen by the OpenXR runtime): {why}",
+                        chosen.name
+                    )));
                 }
                 chosen
             }
             None => choose_device(&devices, &options.device)?,
         };
         let physical = physicals[chosen.index];
-        let queue_family = compute_queue_family(&instance, physical)
-            .ok_or_else(|| Error::NoSuitableDevice(format!("{} has no compute queue", chosen.name)))?;
+        let queue_family = compute_queue_family(&instance, physical).ok_or_else(|| {
+            Error::NoSuitableDevice(format!("{} has no compute queue", chosen.name))
+        })?;
 
         let priorities = [1.0];
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
@@ -198,16 +222,21 @@ impl Context {
         let supported = unsafe { instance.get_physical_device_features(physical) };
         let without_format = supported.shader_storage_image_write_without_format == vk::TRUE;
         if options.require_storage_write_without_format && !without_format {
-            return Err(Error::NoSuitableDevice(format!("{}: no shaderStorageImageWriteWithoutFormat (needed for external targets)", chosen.name)));
+            return Err(Error::NoSuitableDevice(format!(
+                "{}: no shaderStorageImageWriteWithoutFormat (needed for external targets)",
+                chosen.name
+            )));
         }
-        let features = vk::PhysicalDeviceFeatures::default().shader_storage_image_write_without_format(without_format);
+        let features = vk::PhysicalDeviceFeatures::default()
+            .shader_storage_image_write_without_format(without_format);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&extensions)
             .enabled_features(&features);
         let device = match &options.creator {
             Some(creator) => {
-                let raw = unsafe { creator.create_device(&entry, physical, &device_info) }.map_err(Error::Invalid)?;
+                let raw = unsafe { creator.create_device(&entry, physical, &device_info) }
+                    .map_err(Error::Invalid)?;
                 unsafe { ash::Device::load(instance.fp_v1_0(), raw) }
             }
             None => unsafe { instance.create_device(physical, &device_info, None)? },
@@ -231,7 +260,8 @@ impl Context {
 
         Ok(Arc::new(Context {
             push_descriptor: ash::khr::push_descriptor::Device::new(&instance, &device),
-            debug_utils: debug_enabled.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
+            debug_utils: debug_enabled
+                .then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
             entry,
             physical,
             queue,
@@ -266,18 +296,24 @@ impl Context {
         desc: &gpu_allocator::vulkan::AllocationCreateDesc,
     ) -> Result<gpu_allocator::vulkan::Allocation> {
         let mut guard = self.allocator.lock().expect("allocator lock poisoned");
-        let allocation = guard.as_mut().expect("allocator alive while the context is").allocate(desc)?;
+        let allocation = guard
+            .as_mut()
+            .expect("allocator alive while the context is")
+            .allocate(desc)?;
         self.live_allocations.fetch_add(1, Ordering::SeqCst);
-        self.allocated_bytes.fetch_add(allocation.size() as i64, Ordering::SeqCst);
+        self.allocated_bytes
+            .fetch_add(allocation.size() as i64, Ordering::SeqCst);
         Ok(allocation)
     }
 
     pub(crate) fn free(&self, allocation: gpu_allocator::vulkan::Allocation) {
         let mut guard = self.allocator.lock().expect("allocator lock poisoned");
         if let Some(a) = guard.as_mut() {
-            self.allocated_bytes.fetch_sub(allocation.size() as i64, Ordering::SeqCst);
+            self.allocated_bytes
+                .fetch_sub(allocation.size() as i64, Ordering::SeqCst);
             // Freeing can only fail for a foreign allocation, which would be a bug here.
-            a.free(allocation).expect("free of an allocation from this allocator");
+            a.free(allocation)
+                .expect("free of an allocation from this allocator");
             self.live_allocations.fetch_sub(1, Ordering::SeqCst);
         }
     }
@@ -296,14 +332,20 @@ impl Context {
     /// Waits until the device is idle (shutdown and resource rebuilds, never the frame loop);
     /// counted in `counters.device_idle_waits`.
     pub fn wait_idle(&self) -> Result<()> {
-        self.counters.device_idle_waits.fetch_add(1, Ordering::SeqCst);
+        self.counters
+            .device_idle_waits
+            .fetch_add(1, Ordering::SeqCst);
         let _guard = self.queue_lock.lock().expect("queue lock");
         unsafe { self.device.device_wait_idle()? };
         Ok(())
     }
 
     /// Submits under the queue lock, counted in `counters.submits`.
-    pub(crate) fn submit(&self, submits: &[vk::SubmitInfo], fence: vk::Fence) -> std::result::Result<(), vk::Result> {
+    pub(crate) fn submit(
+        &self,
+        submits: &[vk::SubmitInfo],
+        fence: vk::Fence,
+    ) -> std::result::Result<(), vk::Result> {
         self.counters.submits.fetch_add(1, Ordering::SeqCst);
         let _guard = self.queue_lock.lock().expect("queue lock");
         unsafe { self.device.queue_submit(self.queue, submits, fence) }
@@ -315,8 +357,18 @@ impl Context {
     }
 
     /// Whether the compute queue family can present to `surface` (a window's).
-    pub fn queue_supports_surface(&self, surface_loader: &ash::khr::surface::Instance, surface: vk::SurfaceKHR) -> Result<bool> {
-        Ok(unsafe { surface_loader.get_physical_device_surface_support(self.physical, self.queue_family, surface)? })
+    pub fn queue_supports_surface(
+        &self,
+        surface_loader: &ash::khr::surface::Instance,
+        surface: vk::SurfaceKHR,
+    ) -> Result<bool> {
+        Ok(unsafe {
+            surface_loader.get_physical_device_surface_support(
+                self.physical,
+                self.queue_family,
+                surface,
+            )?
+        })
     }
 
     /// Records and runs a short command buffer now and waits for it (set-up work, not frames).
@@ -328,20 +380,25 @@ impl Context {
             .command_buffer_count(1);
         let cmd = unsafe { self.device.allocate_command_buffers(&alloc)? }[0];
         let result = (|| unsafe {
-            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             self.device.begin_command_buffer(cmd, &begin)?;
             record(&self.device, cmd);
             self.device.end_command_buffer(cmd)?;
             let cmds = [cmd];
             let submit = vk::SubmitInfo::default().command_buffers(&cmds);
             self.submit(&[submit], vk::Fence::null())?;
-            self.counters.queue_idle_waits.fetch_add(1, Ordering::SeqCst);
+            self.counters
+                .queue_idle_waits
+                .fetch_add(1, Ordering::SeqCst);
             let _guard = self.queue_lock.lock().expect("queue lock");
             self.device.queue_wait_idle(self.queue)
         })();
         unsafe { self.device.free_command_buffers(*pool, &[cmd]) };
         result.map_err(|e| match e {
-            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost { last_pass: "set-up".into() },
+            vk::Result::ERROR_DEVICE_LOST => Error::DeviceLost {
+                last_pass: "set-up".into(),
+            },
             other => Error::Vulkan(other),
         })
     }
@@ -350,24 +407,58 @@ impl Context {
     /// barrier on each side (set-up work; what ran before and what runs after see the data).
     pub fn copy_now(&self, src: &super::Buffer, dst: &super::Buffer, bytes: u64) -> Result<()> {
         if bytes > src.size || bytes > dst.size {
-            return Err(Error::Invalid(format!("copy of {bytes} bytes from '{}' ({} bytes) to '{}' ({} bytes)", src.name, src.size, dst.name, dst.size)));
+            return Err(Error::Invalid(format!(
+                "copy of {bytes} bytes from '{}' ({} bytes) to '{}' ({} bytes)",
+                src.name, src.size, dst.name, dst.size
+            )));
         }
         self.one_shot(|device, cmd| unsafe {
             let all = vk::PipelineStageFlags::ALL_COMMANDS;
             let barrier = vk::MemoryBarrier::default()
                 .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
                 .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
-            device.cmd_pipeline_barrier(cmd, all, all, vk::DependencyFlags::empty(), &[barrier], &[], &[]);
-            device.cmd_copy_buffer(cmd, src.raw, dst.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: bytes }]);
-            let after = barrier.dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE | vk::AccessFlags::HOST_READ);
-            device.cmd_pipeline_barrier(cmd, all, all | vk::PipelineStageFlags::HOST, vk::DependencyFlags::empty(), &[after], &[], &[]);
+            device.cmd_pipeline_barrier(
+                cmd,
+                all,
+                all,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            );
+            device.cmd_copy_buffer(
+                cmd,
+                src.raw,
+                dst.raw,
+                &[vk::BufferCopy {
+                    src_offset: 0,
+                    dst_offset: 0,
+                    size: bytes,
+                }],
+            );
+            let after = barrier.dst_access_mask(
+                vk::AccessFlags::MEMORY_READ
+                    | vk::AccessFlags::MEMORY_WRITE
+                    | vk::AccessFlags::HOST_READ,
+            );
+            device.cmd_pipeline_barrier(
+                cmd,
+                all,
+                all | vk::PipelineStageFlags::HOST,
+                vk::DependencyFlags::empty(),
+                &[after],
+                &[],
+                &[],
+            );
         })
     }
 
     pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
         if let Some(du) = &self.debug_utils {
             let name = std::ffi::CString::new(name).unwrap_or_default();
-            let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(handle).object_name(&name);
+            let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                .object_handle(handle)
+                .object_name(&name);
             unsafe {
                 let _ = du.set_debug_utils_object_name(&info);
             }
@@ -407,18 +498,26 @@ fn create_instance(entry: &ash::Entry, options: &ContextOptions) -> Result<(ash:
         ));
     }
     let available_ext = unsafe { entry.enumerate_instance_extension_properties(None)? };
-    let has_debug_utils = available_ext
-        .iter()
-        .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::ext::debug_utils::NAME));
+    let has_debug_utils = available_ext.iter().any(|e| {
+        e.extension_name_as_c_str()
+            .is_ok_and(|n| n == ash::ext::debug_utils::NAME)
+    });
     let debug_enabled = validation || has_debug_utils;
 
     let app = vk::ApplicationInfo::default()
         .application_name(c"fovea")
         .engine_name(c"fovea")
         .api_version(vk::API_VERSION_1_2);
-    let layers: Vec<*const c_char> = if validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-    let mut extensions: Vec<*const c_char> =
-        if debug_enabled { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+    let layers: Vec<*const c_char> = if validation {
+        vec![VALIDATION_LAYER.as_ptr()]
+    } else {
+        vec![]
+    };
+    let mut extensions: Vec<*const c_char> = if debug_enabled {
+        vec![ash::ext::debug_utils::NAME.as_ptr()]
+    } else {
+        vec![]
+    };
     extensions.extend(options.instance_extensions.iter().map(|e| e.as_ptr()));
     let sync_validation = validation && options.sync_validation;
     if sync_validation {
@@ -460,10 +559,12 @@ fn list_devices(instance: &ash::Instance) -> Result<Vec<DeviceInfo>> {
             let props = unsafe { instance.get_physical_device_properties(p) };
             let limits = props.limits;
             let v = props.api_version;
-            let exts = unsafe { instance.enumerate_device_extension_properties(p) }.unwrap_or_default();
-            let has_push = exts
-                .iter()
-                .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::khr::push_descriptor::NAME));
+            let exts =
+                unsafe { instance.enumerate_device_extension_properties(p) }.unwrap_or_default();
+            let has_push = exts.iter().any(|e| {
+                e.extension_name_as_c_str()
+                    .is_ok_and(|n| n == ash::khr::push_descriptor::NAME)
+            });
             let suitable = if vk::api_version_minor(v) < 2 && vk::api_version_major(v) == 1 {
                 Err("needs Vulkan 1.2".to_string())
             } else if !has_push {
@@ -475,7 +576,10 @@ fn list_devices(instance: &ash::Instance) -> Result<Vec<DeviceInfo>> {
             };
             DeviceInfo {
                 index,
-                name: props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
+                name: props
+                    .device_name_as_c_str()
+                    .map(|c| c.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
                 kind: format!("{:?}", props.device_type),
                 api_version: format!(
                     "{}.{}.{}",
@@ -495,9 +599,14 @@ fn list_devices(instance: &ash::Instance) -> Result<Vec<DeviceInfo>> {
         .collect())
 }
 
-fn choose_device<'a>(devices: &'a [DeviceInfo], selector: &DeviceSelector) -> Result<&'a DeviceInfo> {
+fn choose_device<'a>(
+    devices: &'a [DeviceInfo],
+    selector: &DeviceSelector,
+) -> Result<&'a DeviceInfo> {
     let found = match selector {
-        DeviceSelector::Index(i) => devices.get(*i).ok_or_else(|| Error::NoSuchDevice(i.to_string()))?,
+        DeviceSelector::Index(i) => devices
+            .get(*i)
+            .ok_or_else(|| Error::NoSuchDevice(i.to_string()))?,
         DeviceSelector::NameContains(s) => devices
             .iter()
             .find(|d| d.name.to_lowercase().contains(&s.to_lowercase()))
@@ -517,9 +626,19 @@ fn choose_device<'a>(devices: &'a [DeviceInfo], selector: &DeviceSelector) -> Re
                 .ok_or_else(|| {
                     let why: Vec<String> = devices
                         .iter()
-                        .map(|d| format!("{}: {}", d.name, d.suitable.clone().err().unwrap_or_default()))
+                        .map(|d| {
+                            format!(
+                                "{}: {}",
+                                d.name,
+                                d.suitable.clone().err().unwrap_or_default()
+                            )
+                        })
                         .collect();
-                    Error::NoSuitableDevice(if why.is_empty() { "no Vulkan devices".into() } else { why.join("; ") })
+                    Error::NoSuitableDevice(if why.is_empty() {
+                        "no Vulkan devices".into()
+                    } else {
+                        why.join("; ")
+                    })
                 })?
         }
     };

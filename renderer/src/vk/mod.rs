@@ -6,7 +6,9 @@ mod pipeline;
 mod resources;
 mod validation;
 
-pub use context::{Context, ContextOptions, DeviceCreator, DeviceInfo, DeviceSelector, EngineCounters};
+pub use context::{
+    Context, ContextOptions, DeviceCreator, DeviceInfo, DeviceSelector, EngineCounters,
+};
 pub use pipeline::{BindingInfo, ComputePipeline};
 pub use resources::{color_range, format_bytes, next_resource_id, Buffer, Image, ResourceId};
 pub use validation::ValidationCounter;

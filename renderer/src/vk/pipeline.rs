@@ -32,25 +32,41 @@ impl ComputePipeline {
     /// whose push-constant block must be exactly `push_size` bytes (0 for none).
     pub fn new(ctx: &Arc<Context>, shader: &str, push_size: u32) -> Result<ComputePipeline> {
         let bytes = shaders::spirv(shader)?;
-        let err = |reason: String| Error::Shader { shader: shader.to_string(), reason };
-        let reflection = Reflection::new_from_spirv(bytes).map_err(|e| err(format!("reflection: {e:?}")))?;
-        let sets = reflection.get_descriptor_sets().map_err(|e| err(format!("reflection: {e:?}")))?;
+        let err = |reason: String| Error::Shader {
+            shader: shader.to_string(),
+            reason,
+        };
+        let reflection =
+            Reflection::new_from_spirv(bytes).map_err(|e| err(format!("reflection: {e:?}")))?;
+        let sets = reflection
+            .get_descriptor_sets()
+            .map_err(|e| err(format!("reflection: {e:?}")))?;
         if sets.keys().any(|&s| s != 0) {
-            return Err(err("only descriptor set 0 is supported (push descriptors)".into()));
+            return Err(err(
+                "only descriptor set 0 is supported (push descriptors)".into()
+            ));
         }
         let mut bindings: Vec<BindingInfo> = Vec::new();
         if let Some(set) = sets.get(&0) {
             for (&binding, info) in set {
-                bindings.push(BindingInfo { name: info.name.clone(), binding, ty: descriptor_type(info.ty).map_err(err)? });
+                bindings.push(BindingInfo {
+                    name: info.name.clone(),
+                    binding,
+                    ty: descriptor_type(info.ty).map_err(err)?,
+                });
             }
         }
-        let local = reflection.get_compute_group_size().ok_or_else(|| err("no workgroup size".into()))?;
+        let local = reflection
+            .get_compute_group_size()
+            .ok_or_else(|| err("no workgroup size".into()))?;
         let reflected_push = reflection
             .get_push_constant_range()
             .map_err(|e| err(format!("reflection: {e:?}")))?
             .map_or(0, |p| p.size);
         if reflected_push != push_size {
-            return Err(err(format!("push-constant block is {reflected_push} bytes, the Rust params struct {push_size}")));
+            return Err(err(format!(
+                "push-constant block is {reflected_push} bytes, the Rust params struct {push_size}"
+            )));
         }
 
         let device = &ctx.device;
@@ -68,7 +84,11 @@ impl ComputePipeline {
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&layout_bindings);
         let set_layout = unsafe { device.create_descriptor_set_layout(&set_info, None)? };
-        let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::COMPUTE, offset: 0, size: push_size }];
+        let ranges = [vk::PushConstantRange {
+            stage_flags: vk::ShaderStageFlags::COMPUTE,
+            offset: 0,
+            size: push_size,
+        }];
         let set_layouts = [set_layout];
         let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
         if push_size > 0 {
@@ -76,15 +96,19 @@ impl ComputePipeline {
         }
         let layout = unsafe { device.create_pipeline_layout(&layout_info, None)? };
 
-        let words = ash::util::read_spv(&mut std::io::Cursor::new(bytes)).map_err(|e| err(e.to_string()))?;
+        let words = ash::util::read_spv(&mut std::io::Cursor::new(bytes))
+            .map_err(|e| err(e.to_string()))?;
         let module_info = vk::ShaderModuleCreateInfo::default().code(&words);
         let module = unsafe { device.create_shader_module(&module_info, None)? };
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
-        let result = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+        let info = vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(layout);
+        let result =
+            unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         unsafe { device.destroy_shader_module(module, None) };
         let raw = result.map_err(|(_, e)| Error::Vulkan(e))?[0];
         ctx.set_name(raw, shader);
@@ -102,11 +126,21 @@ impl ComputePipeline {
 
     /// The one pipeline of `shader` on this context, built on first use and shared by every pass
     /// and view that runs the kernel (stereo views share their pipelines).
-    pub fn shared(ctx: &Arc<Context>, shader: &str, push_size: u32) -> Result<Arc<ComputePipeline>> {
+    pub fn shared(
+        ctx: &Arc<Context>,
+        shader: &str,
+        push_size: u32,
+    ) -> Result<Arc<ComputePipeline>> {
         let mut cache = ctx.pipelines.lock().expect("pipeline cache lock");
         if let Some(p) = cache.get(shader).and_then(|w| w.upgrade()) {
             if p.push_size != push_size {
-                return Err(Error::Shader { shader: shader.into(), reason: format!("push-constant block is {} bytes, the Rust params struct {push_size}", p.push_size) });
+                return Err(Error::Shader {
+                    shader: shader.into(),
+                    reason: format!(
+                        "push-constant block is {} bytes, the Rust params struct {push_size}",
+                        p.push_size
+                    ),
+                });
             }
             return Ok(p);
         }
@@ -127,7 +161,9 @@ impl Drop for ComputePipeline {
         unsafe {
             self.ctx.device.destroy_pipeline(self.raw, None);
             self.ctx.device.destroy_pipeline_layout(self.layout, None);
-            self.ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+            self.ctx
+                .device
+                .destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }

@@ -33,7 +33,13 @@ pub struct Buffer {
 }
 
 impl Buffer {
-    pub fn new(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(usage)
@@ -62,14 +68,22 @@ impl Buffer {
             name: name.to_string(),
             allocation: None,
         };
-        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset())? };
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())?
+        };
         buffer.allocation = Some(allocation);
         ctx.set_name(raw, name);
         Ok(buffer)
     }
 
     /// A host-visible storage buffer filled with `data` (small per-scene or per-frame data).
-    pub fn with_data<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    pub fn with_data<T: bytemuck::Pod>(
+        ctx: &Arc<Context>,
+        name: &str,
+        data: &[T],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Buffer> {
         // Zero-sized buffers are invalid in Vulkan; keep one element of room.
         let size = (std::mem::size_of_val(data) as u64).max(16);
         let buffer = Buffer::new(ctx, name, size, usage, MemoryLocation::CpuToGpu)?;
@@ -88,7 +102,13 @@ impl Buffer {
     /// An empty host-visible (CpuToGpu) RGBA32F texel buffer of `size` bytes, refilled with
     /// `write` between submissions (per-frame tables read with `texelFetch`).
     pub fn host_texels(ctx: &Arc<Context>, name: &str, size: u64) -> Result<Buffer> {
-        Self::texel_buffer(ctx, name, size, vk::BufferUsageFlags::empty(), MemoryLocation::CpuToGpu)
+        Self::texel_buffer(
+            ctx,
+            name,
+            size,
+            vk::BufferUsageFlags::empty(),
+            MemoryLocation::CpuToGpu,
+        )
     }
 
     /// A device-local RGBA32F texel buffer holding `texels`, uploaded once (BVH nodes and
@@ -101,13 +121,28 @@ impl Buffer {
         Ok(buffer)
     }
 
-    fn texel_buffer(ctx: &Arc<Context>, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
+    fn texel_buffer(
+        ctx: &Arc<Context>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
         let size = size.max(16).next_multiple_of(16);
         let limit = ctx.info.max_texel_buffer_elements as u64;
         if size / 16 > limit {
-            return Err(Error::Invalid(format!("{name}: {} texels exceed the device limit {limit}", size / 16)));
+            return Err(Error::Invalid(format!(
+                "{name}: {} texels exceed the device limit {limit}",
+                size / 16
+            )));
         }
-        let mut buffer = Buffer::new(ctx, name, size, usage | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, location)?;
+        let mut buffer = Buffer::new(
+            ctx,
+            name,
+            size,
+            usage | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+            location,
+        )?;
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.raw)
             .format(vk::Format::R32G32B32A32_SFLOAT)
@@ -121,7 +156,12 @@ impl Buffer {
     /// that every ray reads and the host never rewrites. On a discrete GPU host-visible memory
     /// may sit across the bus (every BVH node fetch a PCIe read); on lavapipe both are system
     /// memory and this costs one copy at load.
-    pub fn device_local<T: bytemuck::Pod>(ctx: &Arc<Context>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    pub fn device_local<T: bytemuck::Pod>(
+        ctx: &Arc<Context>,
+        name: &str,
+        data: &[T],
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Buffer> {
         let size = (std::mem::size_of_val(data) as u64).max(16);
         let transfer = vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC;
         let buffer = Buffer::new(ctx, name, size, usage | transfer, MemoryLocation::GpuOnly)?;
@@ -136,7 +176,13 @@ impl Buffer {
         if bytes == 0 {
             return Ok(());
         }
-        let staging = Buffer::new(&self.ctx, &format!("{}.staging", self.name), bytes, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+        let staging = Buffer::new(
+            &self.ctx,
+            &format!("{}.staging", self.name),
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
         staging.write(data)?;
         self.ctx.copy_now(&staging, self, bytes)
     }
@@ -148,7 +194,13 @@ impl Buffer {
         if bytes == 0 {
             return Ok(());
         }
-        let staging = Buffer::new(&self.ctx, &format!("{}.readback", self.name), bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let staging = Buffer::new(
+            &self.ctx,
+            &format!("{}.readback", self.name),
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
         self.ctx.copy_now(self, &staging, bytes)?;
         staging.read_into(out)
     }
@@ -165,11 +217,18 @@ impl Buffer {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         let slice = self.mapped()?;
         if bytes.len() as u64 > self.size {
-            return Err(Error::Invalid(format!("buffer '{}': {} bytes do not fit in {}", self.name, bytes.len(), self.size)));
+            return Err(Error::Invalid(format!(
+                "buffer '{}': {} bytes do not fit in {}",
+                self.name,
+                bytes.len(),
+                self.size
+            )));
         }
         // SAFETY: mapped host-visible memory of at least `size` bytes, not in use by the GPU
         // (callers write between submissions).
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), slice.as_ptr() as *mut u8, bytes.len()) };
+        unsafe {
+            std::ptr::copy_nonoverlapping(bytes.as_ptr(), slice.as_ptr() as *mut u8, bytes.len())
+        };
         Ok(())
     }
 
@@ -178,10 +237,19 @@ impl Buffer {
         let ptr = self.mapped()?;
         let bytes = std::mem::size_of_val(out);
         if bytes as u64 > self.size {
-            return Err(Error::Invalid(format!("buffer '{}': {bytes} bytes requested from {}", self.name, self.size)));
+            return Err(Error::Invalid(format!(
+                "buffer '{}': {bytes} bytes requested from {}",
+                self.name, self.size
+            )));
         }
         // SAFETY: mapped host-visible memory of at least `bytes`; the GPU is done with it.
-        unsafe { std::ptr::copy_nonoverlapping(ptr.as_ptr() as *const u8, out.as_mut_ptr() as *mut u8, bytes) };
+        unsafe {
+            std::ptr::copy_nonoverlapping(
+                ptr.as_ptr() as *const u8,
+                out.as_mut_ptr() as *mut u8,
+                bytes,
+            )
+        };
         Ok(())
     }
 
@@ -221,11 +289,21 @@ pub struct Image {
 }
 
 impl Image {
-    pub fn new(ctx: &Arc<Context>, name: &str, width: u32, height: u32, format: vk::Format) -> Result<Image> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        width: u32,
+        height: u32,
+        format: vk::Format,
+    ) -> Result<Image> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
-            .extent(vk::Extent3D { width, height, depth: 1 })
+            .extent(vk::Extent3D {
+                width,
+                height,
+                depth: 1,
+            })
             .mip_levels(1)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -252,7 +330,10 @@ impl Image {
                 return Err(e);
             }
         };
-        unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset())? };
+        unsafe {
+            ctx.device
+                .bind_image_memory(raw, allocation.memory(), allocation.offset())?
+        };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
             .view_type(vk::ImageViewType::TYPE_2D)
@@ -266,7 +347,12 @@ impl Image {
                 .image(raw)
                 .old_layout(vk::ImageLayout::UNDEFINED)
                 .new_layout(vk::ImageLayout::GENERAL)
-                .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE)
+                .dst_access_mask(
+                    vk::AccessFlags::SHADER_READ
+                        | vk::AccessFlags::SHADER_WRITE
+                        | vk::AccessFlags::TRANSFER_READ
+                        | vk::AccessFlags::TRANSFER_WRITE,
+                )
                 .subresource_range(color_range());
             device.cmd_pipeline_barrier(
                 cmd,
@@ -277,7 +363,13 @@ impl Image {
                 &[],
                 &[barrier],
             );
-            device.cmd_clear_color_image(cmd, raw, vk::ImageLayout::GENERAL, &vk::ClearColorValue::default(), &[color_range()]);
+            device.cmd_clear_color_image(
+                cmd,
+                raw,
+                vk::ImageLayout::GENERAL,
+                &vk::ClearColorValue::default(),
+                &[color_range()],
+            );
         })?;
         Ok(Image {
             ctx: ctx.clone(),

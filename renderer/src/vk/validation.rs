@@ -57,7 +57,9 @@ pub unsafe extern "system" fn debug_callback(
     let id = if data.p_message_id_name.is_null() {
         String::new()
     } else {
-        CStr::from_ptr(data.p_message_id_name).to_string_lossy().into_owned()
+        CStr::from_ptr(data.p_message_id_name)
+            .to_string_lossy()
+            .into_owned()
     };
     if SUPPRESSED_VUIDS.iter().any(|(vuid, _why)| id == *vuid) {
         return vk::FALSE;
@@ -65,7 +67,9 @@ pub unsafe extern "system" fn debug_callback(
     let message = if data.p_message.is_null() {
         String::new()
     } else {
-        CStr::from_ptr(data.p_message).to_string_lossy().into_owned()
+        CStr::from_ptr(data.p_message)
+            .to_string_lossy()
+            .into_owned()
     };
     let counter = &*(user as *const ValidationCounter);
     counter.record(severity, format!("{id}: {message}"));

@@ -10,8 +10,8 @@ use fovea_renderer::layouts::{HitGpu, RayGpu};
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
-use fovea_renderer::scene::bvh::wide::Bvh4;
 use fovea_renderer::scene::bvh::instanced::InstancingStats;
+use fovea_renderer::scene::bvh::wide::Bvh4;
 use fovea_renderer::scene::bvh::{Bvh, BvhBuilder, BvhStats};
 use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
 use fovea_renderer::scene::{PunctualLight, Scene};
@@ -114,16 +114,27 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     let _out_dir = crate::output::prepare_output_dir(args.out)?;
     let ctx = super::open_device(args.device, args.validation)?;
-    let mut report =
-        BenchReport { device: ctx.info.name.clone(), bvh: Vec::new(), rays: Vec::new(), visual_polar: Vec::new(), real_time_loop: None };
+    let mut report = BenchReport {
+        device: ctx.info.name.clone(),
+        bvh: Vec::new(),
+        rays: Vec::new(),
+        visual_polar: Vec::new(),
+        real_time_loop: None,
+    };
     for name in args.scenes {
         let scene = crate::scenes::load(name)?;
-        let scene = if args.flatten { scene.flattened() } else { scene };
+        let scene = if args.flatten {
+            scene.flattened()
+        } else {
+            scene
+        };
         // The builders compared make the world tree over the flattened triangles; hits name placed
         // ids (instances expanded), which the secondary rays look up.
         let positions = scene.flat_positions();
         let placed = scene.triangle_positions();
-        let Some(camera) = scene.default_camera() else { bail!("{name}: no camera") };
+        let Some(camera) = scene.default_camera() else {
+            bail!("{name}: no camera")
+        };
         let mut variants = Vec::new();
         for &builder in args.builders {
             let started = Instant::now();
@@ -183,7 +194,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut caster = RayCaster::new(&ctx)?;
         // A B … B A: a drift of the machine's load over the run hits every builder alike.
         let order: Vec<(usize, u32)> = if variants.len() > 1 {
-            (0..variants.len()).map(|i| (i, 1)).chain((0..variants.len()).rev().map(|i| (i, 2))).collect()
+            (0..variants.len())
+                .map(|i| (i, 1))
+                .chain((0..variants.len()).rev().map(|i| (i, 2)))
+                .collect()
         } else {
             vec![(0, 1)]
         };
@@ -209,17 +223,23 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         (ta < 0.0) != (tb < 0.0) || (ta - tb).abs() > 1e-5 * ta.abs().max(1.0)
                     })
                     .count();
-                let shadow_ms = if shadow.is_empty() { None } else { Some(timed_trace(&mut caster, gpu, &shadow, true)?.1) };
+                let shadow_ms = if shadow.is_empty() {
+                    None
+                } else {
+                    Some(timed_trace(&mut caster, gpu, &shadow, true)?.1)
+                };
                 let (_, indirect_ms) = timed_trace(&mut caster, gpu, &indirect, false)?;
                 let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
                 // Whole frames once per builder (on the way there).
                 let (sums, frame_rays) = if pass == 1 {
                     let space = Box::new(Cartesian::new(UVec2::new(w, h)));
                     let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?;
-                    let mut renderer = Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
+                    let mut renderer =
+                        Renderer::with_gpu_scene(&ctx, upload, space, RenderSettings::default())?;
                     // One untimed frame first: the first dispatch of a pipeline pays one-off costs
                     // (lavapipe's lazy set-up, first-touch page faults) that are not the kernel's speed.
-                    let sums = super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
+                    let sums =
+                        super::bench_vp::pass_medians(&mut renderer, pose, None, args.frames)?;
                     let input = FrameInput::mono(pose, 0, None);
                     (sums, renderer.render_frame(&input)?.rays_traced())
                 } else {
@@ -255,7 +275,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let (_, bvh, _) = &variants[0];
         for &size in args.vp_sizes {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
-            report.visual_polar.push(super::bench_vp::measure(&ctx, name, &make_scene, &mut caster, camera, args.camera_path, size, args.vp_gaze, args.frames)?);
+            report.visual_polar.push(super::bench_vp::measure(
+                &ctx,
+                name,
+                &make_scene,
+                &mut caster,
+                camera,
+                args.camera_path,
+                size,
+                args.vp_gaze,
+                args.frames,
+            )?);
         }
     }
     if let Some(size) = args.loop_size {
@@ -271,7 +301,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 /// The 1-minute load average (`/proc/loadavg`), printed beside each ray figure: on a shared
 /// machine a figure taken at a load above the core count is disturbed.
 fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg").ok().and_then(|s| s.split_whitespace().next().map(str::to_owned)).unwrap_or_else(|| "?".into())
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_else(|| "?".into())
 }
 
 /// Runs of each ray set after the untimed warm-up; the median GPU time is reported.
@@ -279,7 +312,12 @@ const TIMED_RUNS: usize = 5;
 
 /// Traces `rays` once untimed (warm-up), then `TIMED_RUNS` times; returns the hits and the
 /// median GPU milliseconds.
-pub(crate) fn timed_trace(caster: &mut RayCaster, gpu: &GpuScene, rays: &[RayGpu], any_hit: bool) -> Result<(Vec<HitGpu>, f64)> {
+pub(crate) fn timed_trace(
+    caster: &mut RayCaster,
+    gpu: &GpuScene,
+    rays: &[RayGpu],
+    any_hit: bool,
+) -> Result<(Vec<HitGpu>, f64)> {
     let (hits, _) = caster.trace(gpu, rays, any_hit)?;
     let mut ms = Vec::with_capacity(TIMED_RUNS);
     for _ in 0..TIMED_RUNS {
@@ -295,9 +333,18 @@ pub const PATH_RAY_POSES: usize = 4;
 
 /// The poses of the ray-rate figures: the still camera, or [`PATH_RAY_POSES`] along the keyframes.
 fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) -> Vec<CameraPose> {
-    let Some(keys) = path else { return vec![*still] };
+    let Some(keys) = path else {
+        return vec![*still];
+    };
     let (first, last) = (keys.keys()[0].time, keys.keys()[keys.keys().len() - 1].time);
-    (0..PATH_RAY_POSES).map(|i| keys.pose(first + (last - first) * i as f64 / (PATH_RAY_POSES - 1) as f64, still)).collect()
+    (0..PATH_RAY_POSES)
+        .map(|i| {
+            keys.pose(
+                first + (last - first) * i as f64 / (PATH_RAY_POSES - 1) as f64,
+                still,
+            )
+        })
+        .collect()
 }
 
 pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
@@ -310,7 +357,10 @@ pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
             let fy = (y as f32 + 0.5) / h as f32;
             let view = Vec3::new(t.x + fx * (t.y - t.x), t.w + fy * (t.z - t.w), -1.0);
             let dir = pose.world_from_view.transform_vector3(view).normalize();
-            rays.push(RayGpu { origin_tmin: origin.extend(0.0), direction_tmax: dir.extend(1e30) });
+            rays.push(RayGpu {
+                origin_tmin: origin.extend(0.0),
+                direction_tmax: dir.extend(1e30),
+            });
         }
     }
     rays
@@ -318,13 +368,27 @@ pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
 
 /// `DIR/rays_SCENE-WxH.{triangles,primary,indirect}.bin`: little-endian f32, 9 per triangle
 /// (three world-space vertices), 8 per ray (origin, t_min, direction, t_max).
-fn dump_rays(dir: &Path, scene: &str, (w, h): (u32, u32), tris: &[[Vec3; 3]], primary: &[RayGpu], indirect: &[RayGpu]) -> Result<()> {
-    let stem = Path::new(scene).file_stem().map_or(scene.into(), |s| s.to_string_lossy());
+fn dump_rays(
+    dir: &Path,
+    scene: &str,
+    (w, h): (u32, u32),
+    tris: &[[Vec3; 3]],
+    primary: &[RayGpu],
+    indirect: &[RayGpu],
+) -> Result<()> {
+    let stem = Path::new(scene)
+        .file_stem()
+        .map_or(scene.into(), |s| s.to_string_lossy());
     let write = |kind: &str, floats: &[f32]| {
         let path = dir.join(format!("rays_{stem}-{w}x{h}.{kind}.bin"));
-        crate::output::write_atomic(&path, |f| Ok(std::io::Write::write_all(f, bytemuck::cast_slice(floats))?))
+        crate::output::write_atomic(&path, |f| {
+            Ok(std::io::Write::write_all(f, bytemuck::cast_slice(floats))?)
+        })
     };
-    let tri_floats: Vec<f32> = tris.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())).collect();
+    let tri_floats: Vec<f32> = tris
+        .iter()
+        .flat_map(|t| t.iter().flat_map(|v| v.to_array()))
+        .collect();
     write("triangles", &tri_floats)?;
     write("primary", bytemuck::cast_slice(primary))?;
     write("indirect", bytemuck::cast_slice(indirect))
@@ -343,7 +407,12 @@ fn hash01(i: u32, salt: u32) -> f32 {
 
 /// From each primary hit: one shadow ray to a random point on a random light and one
 /// cosine-distributed indirect ray, like the path tracer's first vertex.
-fn secondary_rays(scene: &Scene, tris: &[[Vec3; 3]], primary: &[RayGpu], hits: &[HitGpu]) -> (Vec<RayGpu>, Vec<RayGpu>) {
+fn secondary_rays(
+    scene: &Scene,
+    tris: &[[Vec3; 3]],
+    primary: &[RayGpu],
+    hits: &[HitGpu],
+) -> (Vec<RayGpu>, Vec<RayGpu>) {
     let table = build_light_table(scene);
     let (mut shadow, mut indirect) = (Vec::new(), Vec::new());
     for (i, (ray, hit)) in primary.iter().zip(hits).enumerate() {
@@ -369,23 +438,37 @@ fn secondary_rays(scene: &Scene, tris: &[[Vec3; 3]], primary: &[RayGpu], hits: &
                 // The bench's shadow rays go to points; an environment has none.
                 LightKind::Environment => None,
                 _ => match &scene.punctual_lights[entry.index as usize] {
-                    PunctualLight::Point { position, .. } | PunctualLight::Spot { position, .. } => Some(*position),
+                    PunctualLight::Point { position, .. }
+                    | PunctualLight::Spot { position, .. } => Some(*position),
                     PunctualLight::Directional { direction, .. } => Some(p - *direction * 1e4),
                 },
             };
             if let Some(q) = target {
                 let to = q - p;
                 let d = to.length();
-                shadow.push(RayGpu { origin_tmin: p.extend(0.0), direction_tmax: (to / d).extend(d * (1.0 - 1e-4)) });
+                shadow.push(RayGpu {
+                    origin_tmin: p.extend(0.0),
+                    direction_tmax: (to / d).extend(d * (1.0 - 1e-4)),
+                });
             }
         }
         let (u1, u2) = (hash01(i, 4), hash01(i, 5));
         let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-        let local = Vec4::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt(), 0.0);
-        let t = if n.x.abs() > 0.5 { Vec3::Y } else { Vec3::X }.cross(n).normalize();
+        let local = Vec4::new(
+            r * phi.cos(),
+            r * phi.sin(),
+            (1.0 - u1).max(0.0).sqrt(),
+            0.0,
+        );
+        let t = if n.x.abs() > 0.5 { Vec3::Y } else { Vec3::X }
+            .cross(n)
+            .normalize();
         let bt = n.cross(t);
         let d = (t * local.x + bt * local.y + n * local.z).normalize();
-        indirect.push(RayGpu { origin_tmin: p.extend(0.0), direction_tmax: d.extend(1e30) });
+        indirect.push(RayGpu {
+            origin_tmin: p.extend(0.0),
+            direction_tmax: d.extend(1e30),
+        });
     }
     (shadow, indirect)
 }

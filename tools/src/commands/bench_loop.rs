@@ -104,8 +104,20 @@ struct Config {
 
 const STEREO: &[Spec] = &[&[Eye::Left, Eye::Right]];
 const TWO_MONO: &[Spec] = &[&[Eye::Left], &[Eye::Right]];
-const CONFIGS: [Config; 3] =
-    [Config { specs: STEREO, in_flight: 1 }, Config { specs: STEREO, in_flight: 2 }, Config { specs: TWO_MONO, in_flight: 2 }];
+const CONFIGS: [Config; 3] = [
+    Config {
+        specs: STEREO,
+        in_flight: 1,
+    },
+    Config {
+        specs: STEREO,
+        in_flight: 2,
+    },
+    Config {
+        specs: TWO_MONO,
+        in_flight: 2,
+    },
+];
 /// Forwards, then backwards.
 const ORDER: [usize; 6] = [0, 1, 2, 2, 1, 0];
 
@@ -162,27 +174,58 @@ impl LoopSetup {
         let hmd = HmdDescription::resolve(HEADSET).with_context(|| format!("headset {HEADSET}"))?;
         let profile = RenderProfile::default();
         let (denoiser, taa) = filters(DENOISER, "off", &profile)?;
-        let settings = RenderSettings { blur: profile.blur, denoiser, taa, ..Default::default() };
+        let settings = RenderSettings {
+            blur: profile.blur,
+            denoiser,
+            taa,
+            ..Default::default()
+        };
         let scene = crate::scenes::load(LOOP_SCENE)?;
-        let Some(camera) = scene.default_camera() else { bail!("{LOOP_SCENE}: no camera") };
+        let Some(camera) = scene.default_camera() else {
+            bail!("{LOOP_SCENE}: no camera")
+        };
         let head = CameraPose::from_scene_camera(camera, width, height);
-        Ok(LoopSetup { scene, hmd, profile, settings, screen: glam::UVec2::new(width, height), head })
+        Ok(LoopSetup {
+            scene,
+            hmd,
+            profile,
+            settings,
+            screen: glam::UVec2::new(width, height),
+            head,
+        })
     }
 
     /// A renderer of `eyes` over its own scene upload, like `fovea render --eyes`, and the
     /// upload's GPU bytes.
-    fn renderer(&self, ctx: &Arc<Context>, eyes: Spec, in_flight: usize) -> Result<(Renderer, i64)> {
-        let spaces = eyes.iter().map(|&eye| space_for(METHOD, &self.profile, &self.hmd, eye, self.screen)).collect::<Result<_>>()?;
+    fn renderer(
+        &self,
+        ctx: &Arc<Context>,
+        eyes: Spec,
+        in_flight: usize,
+    ) -> Result<(Renderer, i64)> {
+        let spaces = eyes
+            .iter()
+            .map(|&eye| space_for(METHOD, &self.profile, &self.hmd, eye, self.screen))
+            .collect::<Result<_>>()?;
         let before = ctx.allocated_bytes();
         let scene = GpuScene::upload(ctx, &self.scene)?;
         let scene_bytes = ctx.allocated_bytes() - before;
-        Ok((Renderer::with_views(ctx, scene, spaces, self.settings, in_flight)?, scene_bytes))
+        Ok((
+            Renderer::with_views(ctx, scene, spaces, self.settings, in_flight)?,
+            scene_bytes,
+        ))
     }
 
     /// Frame `frame` of `eyes`: the still head pose offset by each eye, gaze at the centre.
     fn input(&self, eyes: Spec, frame: u32) -> Result<FrameInput> {
         let gaze = Some(self.screen.as_vec2() * 0.5);
-        let views: Vec<ViewInput> = eyes.iter().map(|&eye| ViewInput { camera: eye_pose(&self.head, &self.hmd, eye, Eyes::Both), gaze }).collect();
+        let views: Vec<ViewInput> = eyes
+            .iter()
+            .map(|&eye| ViewInput {
+                camera: eye_pose(&self.head, &self.hmd, eye, Eyes::Both),
+                gaze,
+            })
+            .collect();
         Ok(FrameInput::views(&views, frame)?)
     }
 }
@@ -223,7 +266,11 @@ impl Counts {
     }
 
     fn since(self, earlier: Counts) -> Counts {
-        Counts { submits: self.submits - earlier.submits, fence_waits: self.fence_waits - earlier.fence_waits, drains: self.drains - earlier.drains }
+        Counts {
+            submits: self.submits - earlier.submits,
+            fence_waits: self.fence_waits - earlier.fence_waits,
+            drains: self.drains - earlier.drains,
+        }
     }
 
     fn add(&mut self, other: Counts) {
@@ -274,7 +321,8 @@ impl Sums {
 
     fn report(self) -> LoopRun {
         let n = self.frames as f64;
-        let passes_ms: BTreeMap<String, f64> = self.pass_ms.into_iter().map(|(k, v)| (k, v / n)).collect();
+        let passes_ms: BTreeMap<String, f64> =
+            self.pass_ms.into_iter().map(|(k, v)| (k, v / n)).collect();
         LoopRun {
             renderers: self.renderers,
             views_per_renderer: self.views_per_renderer,
@@ -301,11 +349,20 @@ impl Sums {
 fn run(ctx: &Arc<Context>, setup: &LoopSetup, config: &Config, frames: u32) -> Result<Sums> {
     let (specs, in_flight) = (config.specs, config.in_flight);
     let bytes_before = ctx.allocated_bytes();
-    let (mut renderers, scene_bytes): (Vec<Renderer>, Vec<i64>) =
-        specs.iter().map(|eyes| setup.renderer(ctx, eyes, in_flight)).collect::<Result<Vec<_>>>()?.into_iter().unzip();
+    let (mut renderers, scene_bytes): (Vec<Renderer>, Vec<i64>) = specs
+        .iter()
+        .map(|eyes| setup.renderer(ctx, eyes, in_flight))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     // Built before the loop: the timed frames make no inputs.
     let inputs = (0..WARMUP_FRAMES + frames)
-        .map(|f| specs.iter().map(|eyes| setup.input(eyes, f)).collect::<Result<Vec<_>>>())
+        .map(|f| {
+            specs
+                .iter()
+                .map(|eyes| setup.input(eyes, f))
+                .collect::<Result<Vec<_>>>()
+        })
         .collect::<Result<Vec<_>>>()?;
     let mut tally = Tally::default();
     let mut counts_before = Counts::default();
@@ -313,7 +370,12 @@ fn run(ctx: &Arc<Context>, setup: &LoopSetup, config: &Config, frames: u32) -> R
         if f as u32 == WARMUP_FRAMES {
             counts_before = Counts::now(ctx, &renderers);
         }
-        run_frame(&mut tally, &mut renderers, frame_inputs, f as u32 >= WARMUP_FRAMES)?;
+        run_frame(
+            &mut tally,
+            &mut renderers,
+            frame_inputs,
+            f as u32 >= WARMUP_FRAMES,
+        )?;
     }
     // Over the timed frames' retires and submits, before `finish` drains the ring.
     let counts = Counts::now(ctx, &renderers).since(counts_before);
@@ -324,11 +386,16 @@ fn run(ctx: &Arc<Context>, setup: &LoopSetup, config: &Config, frames: u32) -> R
     let total = (WARMUP_FRAMES + frames) as u64;
     for renderer in &renderers {
         // The frames still in flight at the loop's end (those before were read when retired).
-        for done in total.saturating_sub(in_flight as u64).max(WARMUP_FRAMES as u64)..total {
+        for done in total
+            .saturating_sub(in_flight as u64)
+            .max(WARMUP_FRAMES as u64)..total
+        {
             tally.add_timings(renderer, done)?;
         }
     }
-    let Some((start, start_cpu)) = tally.start else { bail!("the last warm-up frame was never retired") };
+    let Some((start, start_cpu)) = tally.start else {
+        bail!("the last warm-up frame was never retired")
+    };
     Ok(Sums {
         renderers: renderers.len(),
         views_per_renderer: specs[0].len(),
@@ -346,7 +413,12 @@ fn run(ctx: &Arc<Context>, setup: &LoopSetup, config: &Config, frames: u32) -> R
 
 /// One loop frame: each renderer frees its next slot (the fence wait, outside the host time),
 /// then records and submits its frame.
-fn run_frame(tally: &mut Tally, renderers: &mut [Renderer], inputs: &[FrameInput], timed: bool) -> Result<()> {
+fn run_frame(
+    tally: &mut Tally,
+    renderers: &mut [Renderer],
+    inputs: &[FrameInput],
+    timed: bool,
+) -> Result<()> {
     let last = renderers.len() - 1;
     for (i, (renderer, input)) in renderers.iter_mut().zip(inputs).enumerate() {
         if let Some(done) = renderer.retire_next()? {
@@ -380,7 +452,11 @@ fn print_summary(r: &LoopReport, device: &str) {
     );
     println!("| run | frames in flight | scene uploads | submits/frame | frames/s | wall ms/frame | GPU ms/frame | host ms/frame | process CPU ms/frame | others' CPU ms/frame | GPU MiB |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
-    let runs = [("stereo (1 renderer, 2 views)", &r.stereo_in_flight_1), ("stereo (1 renderer, 2 views)", &r.stereo_in_flight_2), ("2 × mono (2 renderers)", &r.two_mono_in_flight_2)];
+    let runs = [
+        ("stereo (1 renderer, 2 views)", &r.stereo_in_flight_1),
+        ("stereo (1 renderer, 2 views)", &r.stereo_in_flight_2),
+        ("2 × mono (2 renderers)", &r.two_mono_in_flight_2),
+    ];
     let ms = |v: Option<f64>| v.map_or("n/a".to_string(), |ms| format!("{ms:.0}"));
     for (name, run) in runs {
         println!(

@@ -9,8 +9,12 @@ use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer};
-use fovea_renderer::sampling::{Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams};
+use fovea_renderer::pipeline::{
+    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
+};
+use fovea_renderer::sampling::{
+    Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams,
+};
 use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
@@ -22,7 +26,16 @@ use std::collections::BTreeMap;
 /// Cartesian's frame spends in `tonemap`.
 /// With `--blur-space grid` the blur runs in the grid before the remap and the tonemap pass
 /// writes the display image.
-const TO_SCREEN_PASSES: &[&str] = &["mip_phi", "remap", "blur_h", "blur_v", "blur_v_tonemap", "blur_grid_phi", "blur_grid_rho", "tonemap"];
+const TO_SCREEN_PASSES: &[&str] = &[
+    "mip_phi",
+    "remap",
+    "blur_h",
+    "blur_v",
+    "blur_v_tonemap",
+    "blur_grid_phi",
+    "blur_grid_rho",
+    "tonemap",
+];
 
 #[derive(Serialize)]
 pub struct VpFrameReport {
@@ -78,7 +91,11 @@ pub struct VpFrameReport {
 
 /// The denoisers measured, each with its defaults; a denoiser's passes are named `<name>_*`.
 fn denoisers() -> Vec<DenoiserSettings> {
-    DenoiserSettings::NAMES.iter().filter(|n| **n != "none").map(|n| DenoiserSettings::parse(n).expect("a listed denoiser")).collect()
+    DenoiserSettings::NAMES
+        .iter()
+        .filter(|n| **n != "none")
+        .map(|n| DenoiserSettings::parse(n).expect("a listed denoiser"))
+        .collect()
 }
 
 /// Name prefixes of a denoiser's passes: its own, and for A-SVGF the SVGF stages it reuses.
@@ -139,7 +156,12 @@ const VP_GRID_BLUR: &str = "vp-grid-blur";
 pub const CAMERA_PATH_HZ: f64 = 70.0;
 
 /// Median GPU ms per pass over `frames` frames after one untimed warm-up frame.
-pub fn pass_medians(renderer: &mut Renderer, camera: CameraPose, gaze: Option<Vec2>, frames: u32) -> Result<BTreeMap<String, f64>> {
+pub fn pass_medians(
+    renderer: &mut Renderer,
+    camera: CameraPose,
+    gaze: Option<Vec2>,
+    frames: u32,
+) -> Result<BTreeMap<String, f64>> {
     let mut medians = interleaved_pass_medians(&mut [(renderer, gaze)], &|_| camera, frames)?;
     Ok(medians.remove(0).passes)
 }
@@ -157,7 +179,11 @@ pub struct FrameMedians {
 /// the machine's speed during the run (up to ±25 % within an hour on these CPU machines) then
 /// hits every side alike, and the ratios between them stay fair. `camera` gives frame i's camera
 /// (every renderer sees the same one).
-pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)], camera: &dyn Fn(u32) -> CameraPose, frames: u32) -> Result<Vec<FrameMedians>> {
+pub fn interleaved_pass_medians(
+    renderers: &mut [(&mut Renderer, Option<Vec2>)],
+    camera: &dyn Fn(u32) -> CameraPose,
+    frames: u32,
+) -> Result<Vec<FrameMedians>> {
     let input = |frame_index, gaze| FrameInput::mono(camera(frame_index), frame_index, gaze);
     for (renderer, gaze) in renderers.iter_mut() {
         renderer.render_frame(&input(0, *gaze))?;
@@ -165,8 +191,12 @@ pub fn interleaved_pass_medians(renderers: &mut [(&mut Renderer, Option<Vec2>)],
     let mut samples: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); renderers.len()];
     let mut traced = vec![0u64; renderers.len()];
     for frame in 0..frames.max(1) {
-        for (((renderer, gaze), samples), traced) in renderers.iter_mut().zip(&mut samples).zip(&mut traced) {
-            *traced = renderer.render_frame(&input(frame + 1, *gaze))?.samples_traced;
+        for (((renderer, gaze), samples), traced) in
+            renderers.iter_mut().zip(&mut samples).zip(&mut traced)
+        {
+            *traced = renderer
+                .render_frame(&input(frame + 1, *gaze))?
+                .samples_traced;
             // A pass recorded several times in one frame (one mip level each) counts as one.
             let mut frame_sums: BTreeMap<&str, f64> = BTreeMap::new();
             for t in renderer.timings() {
@@ -200,11 +230,17 @@ const MEASURED_APART: &[&str] = &["vp", "cartesian"];
 /// their papers' defaults, VP's variants, fixed foveation), as `fovea render` builds it with the
 /// default profile for the FOVE 0's left eye, around `gaze`; each one measured beside `vp`.
 fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSpace>>> {
-    let (profile, hmd) = (crate::render_profile::RenderProfile::default(), fovea_hal::HmdDescription::resolve("fove0")?);
-    let names = super::methods::names().into_iter().filter(|n| !MEASURED_APART.contains(n));
+    let (profile, hmd) = (
+        crate::render_profile::RenderProfile::default(),
+        fovea_hal::HmdDescription::resolve("fove0")?,
+    );
+    let names = super::methods::names()
+        .into_iter()
+        .filter(|n| !MEASURED_APART.contains(n));
     names
         .map(|name| {
-            let mut space = super::setup::space_for(name, &profile, &hmd, fovea_hal::Eye::Left, screen)?;
+            let mut space =
+                super::setup::space_for(name, &profile, &hmd, fovea_hal::Eye::Left, screen)?;
             space.set_gaze(gaze)?;
             Ok(space)
         })
@@ -214,12 +250,18 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSp
 /// The FOVE 0 left eye's FOV from its headset profile, for the headset-axis variant.
 pub fn fove0_fov() -> Result<FovTangents> {
     let hmd = fovea_hal::HmdDescription::resolve("fove0")?;
-    Ok(crate::render_profile::fov_tangents(&hmd.eye(fovea_hal::Eye::Left).fov))
+    Ok(crate::render_profile::fov_tangents(
+        &hmd.eye(fovea_hal::Eye::Left).fov,
+    ))
 }
 
 /// Passes of the displayed frame (read-backs are I/O, not rendering).
 fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {
-    passes.iter().filter(|(k, _)| !k.starts_with("readback") && *k != "clear_counters").map(|(_, v)| v).sum()
+    passes
+        .iter()
+        .filter(|(k, _)| !k.starts_with("readback") && *k != "clear_counters")
+        .map(|(_, v)| v)
+        .sum()
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -237,63 +279,132 @@ pub fn measure(
     let screen = UVec2::new(w, h);
     let gaze = screen.as_vec2() * gaze_fraction;
     let pose = CameraPose::from_scene_camera(camera, w, h);
-    let camera_at = |frame: u32| camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose));
+    let camera_at = |frame: u32| {
+        camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose))
+    };
     let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
     // One renderer per space (Cartesian first, gaze-less) with these settings, their frames
     // interleaved: each one's pass medians and denoiser history bytes (the renderers are dropped
     // before the next measurement).
     // A foveated space may come with its own settings (VP with every off-screen sample traced).
-    let measure = |settings: RenderSettings, foveated: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)>| -> Result<Vec<(FrameMedians, u64)>> {
-        let mut renderers = vec![(Renderer::with_gpu_scene(ctx, make_scene()?, Box::new(Cartesian::new(screen)), settings)?, None)];
+    let measure = |settings: RenderSettings,
+                   foveated: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)>|
+     -> Result<Vec<(FrameMedians, u64)>> {
+        let mut renderers = vec![(
+            Renderer::with_gpu_scene(
+                ctx,
+                make_scene()?,
+                Box::new(Cartesian::new(screen)),
+                settings,
+            )?,
+            None,
+        )];
         for (space, own) in foveated {
-            renderers.push((Renderer::with_gpu_scene(ctx, make_scene()?, space, own.unwrap_or(settings))?, Some(gaze)));
+            renderers.push((
+                Renderer::with_gpu_scene(ctx, make_scene()?, space, own.unwrap_or(settings))?,
+                Some(gaze),
+            ));
         }
-        let history: Vec<u64> = renderers.iter().map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes())).collect();
-        let mut timed: Vec<(&mut Renderer, Option<Vec2>)> = renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
-        Ok(interleaved_pass_medians(&mut timed, &camera_at, frames)?.into_iter().zip(history).collect())
+        let history: Vec<u64> = renderers
+            .iter()
+            .map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes()))
+            .collect();
+        let mut timed: Vec<(&mut Renderer, Option<Vec2>)> =
+            renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
+        Ok(interleaved_pass_medians(&mut timed, &camera_at, frames)?
+            .into_iter()
+            .zip(history)
+            .collect())
     };
     // Without a denoiser the comparators join the same interleaved run.
     let comparator_spaces = comparator_spaces(screen, gaze)?;
     let described_vp = |name| (name, vp.grid_size().to_array(), vp.sample_count());
-    let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![described_vp(VP_OFFSCREEN_TRACED), described_vp(VP_GRID_BLUR)];
-    described.extend(comparator_spaces.iter().map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())));
-    let traced_everywhere = RenderSettings { offscreen_samples: OffscreenSamples::Trace, ..Default::default() };
-    let blur_in_grid = RenderSettings { blur: BlurSettings { space: BlurSpace::Grid, ..Default::default() }, ..Default::default() };
-    let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> =
-        vec![(Box::new(vp), None), (Box::new(vp), Some(traced_everywhere)), (Box::new(vp), Some(blur_in_grid))];
+    let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![
+        described_vp(VP_OFFSCREEN_TRACED),
+        described_vp(VP_GRID_BLUR),
+    ];
+    described.extend(
+        comparator_spaces
+            .iter()
+            .map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())),
+    );
+    let traced_everywhere = RenderSettings {
+        offscreen_samples: OffscreenSamples::Trace,
+        ..Default::default()
+    };
+    let blur_in_grid = RenderSettings {
+        blur: BlurSettings {
+            space: BlurSpace::Grid,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> = vec![
+        (Box::new(vp), None),
+        (Box::new(vp), Some(traced_everywhere)),
+        (Box::new(vp), Some(blur_in_grid)),
+    ];
     spaces.extend(comparator_spaces.into_iter().map(|s| (s, None)));
-    let mut plain = measure(RenderSettings::default(), spaces)?.into_iter().map(|(medians, _)| medians);
+    let mut plain = measure(RenderSettings::default(), spaces)?
+        .into_iter()
+        .map(|(medians, _)| medians);
     let cartesian_passes_ms = plain.next().expect("the Cartesian medians").passes;
-    let FrameMedians { passes: vp_passes_ms, samples_traced: vp_samples_traced } = plain.next().expect("the Visual-Polar medians");
+    let FrameMedians {
+        passes: vp_passes_ms,
+        samples_traced: vp_samples_traced,
+    } = plain.next().expect("the Visual-Polar medians");
     let cartesian_frame_ms = frame_ms(&cartesian_passes_ms);
     let mut comparators: Vec<MethodCost> = described
         .into_iter()
         .zip(plain)
-        .map(|((method, grid, samples), FrameMedians { passes: passes_ms, samples_traced })| {
-            let frame = frame_ms(&passes_ms);
-            MethodCost {
-                method,
-                grid,
-                samples,
-                samples_traced,
-                frame_ratio: frame / cartesian_frame_ms,
-                trace_ratio: passes_ms["trace"] / cartesian_passes_ms["trace"],
-                passes_ms,
-                frame_ms: frame,
-            }
-        })
+        .map(
+            |(
+                (method, grid, samples),
+                FrameMedians {
+                    passes: passes_ms,
+                    samples_traced,
+                },
+            )| {
+                let frame = frame_ms(&passes_ms);
+                MethodCost {
+                    method,
+                    grid,
+                    samples,
+                    samples_traced,
+                    frame_ratio: frame / cartesian_frame_ms,
+                    trace_ratio: passes_ms["trace"] / cartesian_passes_ms["trace"],
+                    passes_ms,
+                    frame_ms: frame,
+                }
+            },
+        )
         .collect();
     let vp_offscreen_traced = comparators.remove(0);
     let vp_grid_blur = comparators.remove(0);
     let mut costs = Vec::new();
     for denoiser in denoisers() {
         let prefixes = pass_prefixes(&denoiser);
-        let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)]: [_; 2] =
-            measure(RenderSettings { denoiser, ..Default::default() }, vec![(Box::new(vp), None)])?.try_into().expect("one median map per renderer");
+        let [(cart_all, cartesian_history_bytes), (vp_all, vp_history_bytes)]: [_; 2] = measure(
+            RenderSettings {
+                denoiser,
+                ..Default::default()
+            },
+            vec![(Box::new(vp), None)],
+        )?
+        .try_into()
+        .expect("one median map per renderer");
         let (cart_all, vp_all) = (cart_all.passes, vp_all.passes);
         let (cartesian_frame_ms, vp_frame_ms) = (frame_ms(&cart_all), frame_ms(&vp_all));
-        let (cartesian_passes_ms, vp_passes_ms) = (denoiser_passes(cart_all, &prefixes), denoiser_passes(vp_all, &prefixes));
-        let own = |m: &BTreeMap<String, f64>| m.iter().filter(|(k, _)| *k != "trace").map(|(_, v)| v).sum::<f64>();
+        let (cartesian_passes_ms, vp_passes_ms) = (
+            denoiser_passes(cart_all, &prefixes),
+            denoiser_passes(vp_all, &prefixes),
+        );
+        let own = |m: &BTreeMap<String, f64>| {
+            m.iter()
+                .filter(|(k, _)| *k != "trace")
+                .map(|(_, v)| v)
+                .sum::<f64>()
+        };
         let (cartesian_ms, vp_ms) = (own(&cartesian_passes_ms), own(&vp_passes_ms));
         costs.push(DenoiserCost {
             name: denoiser.name().to_string(),
@@ -310,7 +421,9 @@ pub fn measure(
         });
     }
     let vp_frame_ms = frame_ms(&vp_passes_ms);
-    let to_screen = |passes: &BTreeMap<String, f64>| -> f64 { TO_SCREEN_PASSES.iter().filter_map(|p| passes.get(*p)).sum() };
+    let to_screen = |passes: &BTreeMap<String, f64>| -> f64 {
+        TO_SCREEN_PASSES.iter().filter_map(|p| passes.get(*p)).sum()
+    };
     let grid_blur_to_screen_share = to_screen(&vp_grid_blur.passes_ms) / vp_grid_blur.frame_ms;
 
     let rays = vp_primary_rays(&vp, &pose);
@@ -320,13 +433,18 @@ pub fn measure(
     let (_, shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffled, false)?;
     let screen_rays = super::bench::primary_rays(&pose, w, h);
     let (_, screen_ms) = super::bench::timed_trace(caster, &gpu, &screen_rays, false)?;
-    let (_, screen_shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffle(screen_rays.clone()), false)?;
+    let (_, screen_shuffled_ms) =
+        super::bench::timed_trace(caster, &gpu, &shuffle(screen_rays.clone()), false)?;
     let rate = |ms: f64| rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let screen_rate = |ms: f64| screen_rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let grid = vp.grid_size();
     let report = VpFrameReport {
         scene: scene_name.to_string(),
-        camera_motion: if camera_path.is_some() { "keys" } else { "still" },
+        camera_motion: if camera_path.is_some() {
+            "keys"
+        } else {
+            "still"
+        },
         width: w,
         height: h,
         vp_width: grid.x,
@@ -372,9 +490,18 @@ pub fn measure(
         report.vp_ray_cost_ordered,
         report.vp_ray_cost_shuffled,
     );
-    println!("  VP traced {} of its {} samples (the rest lay far off the screen)", report.vp_samples_traced, report.vp_samples);
-    println!("  way back with the blur in the grid: {:.1} % of that frame", 100.0 * report.grid_blur_to_screen_share);
-    for m in [&report.vp_offscreen_traced, &report.vp_grid_blur].into_iter().chain(&report.comparators) {
+    println!(
+        "  VP traced {} of its {} samples (the rest lay far off the screen)",
+        report.vp_samples_traced, report.vp_samples
+    );
+    println!(
+        "  way back with the blur in the grid: {:.1} % of that frame",
+        100.0 * report.grid_blur_to_screen_share
+    );
+    for m in [&report.vp_offscreen_traced, &report.vp_grid_blur]
+        .into_iter()
+        .chain(&report.comparators)
+    {
         println!(
             "  {} {}×{} ({} samples, {} traced, vs VP's {}): frame {:.1} ms = {:.3} of Cartesian (trace {:.3})",
             m.method, m.grid[0], m.grid[1], m.samples, m.samples_traced, report.vp_samples, m.frame_ms, m.frame_ratio, m.trace_ratio
@@ -409,7 +536,10 @@ pub fn measure(
 /// Of a renderer's pass medians: the denoiser's passes (named `prefix*` for one of `prefixes`)
 /// and the trace.
 fn denoiser_passes(passes: BTreeMap<String, f64>, prefixes: &[String]) -> BTreeMap<String, f64> {
-    passes.into_iter().filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str()))).collect()
+    passes
+        .into_iter()
+        .filter(|(k, _)| k == "trace" || prefixes.iter().any(|p| k.starts_with(p.as_str())))
+        .collect()
 }
 
 /// One primary ray per kept VP texel (centre), in grid order (row by row, as the trace kernel's
@@ -428,7 +558,10 @@ fn vp_primary_rays(vp: &VisualPolar, pose: &CameraPose) -> Vec<RayGpu> {
             let s = vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) / screen;
             let view = Vec3::new(t.x + s.x * (t.y - t.x), t.w + s.y * (t.z - t.w), -1.0);
             let dir = pose.world_from_view.transform_vector3(view).normalize();
-            rays.push(RayGpu { origin_tmin: origin.extend(0.0), direction_tmax: dir.extend(1e30) });
+            rays.push(RayGpu {
+                origin_tmin: origin.extend(0.0),
+                direction_tmax: dir.extend(1e30),
+            });
         }
     }
     rays
@@ -458,12 +591,21 @@ mod tests {
         let gaze = Vec2::new(100.0, 120.0);
         let spaces = comparator_spaces(screen, gaze).unwrap();
         let names: Vec<_> = spaces.iter().map(|s| s.name()).collect();
-        let expected: Vec<_> = super::super::methods::names().into_iter().filter(|n| !MEASURED_APART.contains(n)).collect();
+        let expected: Vec<_> = super::super::methods::names()
+            .into_iter()
+            .filter(|n| !MEASURED_APART.contains(n))
+            .collect();
         assert_eq!(names, expected);
         assert!(spaces.iter().all(|s| s.gaze() == gaze), "{names:?}");
-        let (profile, hmd) = (crate::render_profile::RenderProfile::default(), fovea_hal::HmdDescription::resolve("fove0").unwrap());
-        let registry_vp = super::super::setup::space_for("vp", &profile, &hmd, fovea_hal::Eye::Left, screen).unwrap();
-        let bench_vp = VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+        let (profile, hmd) = (
+            crate::render_profile::RenderProfile::default(),
+            fovea_hal::HmdDescription::resolve("fove0").unwrap(),
+        );
+        let registry_vp =
+            super::super::setup::space_for("vp", &profile, &hmd, fovea_hal::Eye::Left, screen)
+                .unwrap();
+        let bench_vp =
+            VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
         assert_eq!(registry_vp.params(), bench_vp.sampling_params());
     }
 }

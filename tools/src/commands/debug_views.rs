@@ -27,24 +27,50 @@ pub struct DebugViews {
 
 impl DebugViews {
     pub fn new(out: &Path, screen: UVec2, grid: UVec2) -> DebugViews {
-        DebugViews { out: out.to_path_buf(), screen, grid, pixels: Vec::new(), frame: Vec::new() }
+        DebugViews {
+            out: out.to_path_buf(),
+            screen,
+            grid,
+            pixels: Vec::new(),
+            frame: Vec::new(),
+        }
     }
 
     /// Writes `debug_grid_NNNN.png`, `debug_density_NNNN.png` and `debug_overlay_NNNN.png` for
     /// the frame just rendered (rendered with `FrameInput::read_grid`; the first view's).
     pub fn frame(&mut self, index: u32, renderer: &Renderer) -> Result<()> {
         renderer.read_grid_ldr(&mut self.pixels)?;
-        write_png(&self.out.join(format!("debug_grid_{index:04}.png")), self.grid.x, self.grid.y, &self.pixels)?;
+        write_png(
+            &self.out.join(format!("debug_grid_{index:04}.png")),
+            self.grid.x,
+            self.grid.y,
+            &self.pixels,
+        )?;
         let space = renderer.space();
         // Far from the gaze single pixels get 0 or 1 samples: a box average over a few pixels
         // shows the density rather than the sample pattern.
         let radius = (self.screen.x / 160).max(2);
-        let density = box_filter(&samples_per_pixel(space), self.screen.x, self.screen.y, radius);
+        let density = box_filter(
+            &samples_per_pixel(space),
+            self.screen.x,
+            self.screen.y,
+            radius,
+        );
         let heat = heatmap_rgba(&density, self.screen.x, self.screen.y, space.gaze());
-        write_png(&self.out.join(format!("debug_density_{index:04}.png")), self.screen.x, self.screen.y, &heat)?;
+        write_png(
+            &self.out.join(format!("debug_density_{index:04}.png")),
+            self.screen.x,
+            self.screen.y,
+            &heat,
+        )?;
         renderer.read_view_ldr(index as u64, 0, &mut self.frame)?;
         let laid_over = overlay(&self.frame, &heat, OVERLAY_WEIGHT);
-        write_png(&self.out.join(format!("debug_overlay_{index:04}.png")), self.screen.x, self.screen.y, &laid_over)
+        write_png(
+            &self.out.join(format!("debug_overlay_{index:04}.png")),
+            self.screen.x,
+            self.screen.y,
+            &laid_over,
+        )
     }
 
     /// Writes `debug_density_plot.png` for the last frame's gaze (Visual-Polar runs only: the

@@ -4,7 +4,9 @@
 //! project's tone curve, PNG as it is) at the headset's pixels per degree.
 
 use crate::flip::flip_map;
-use crate::metrics::{add_flip, add_flip_rings, evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings};
+use crate::metrics::{
+    add_flip, add_flip_rings, evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings,
+};
 use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_json};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
@@ -87,7 +89,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     if reference_input.png != test_input.png {
         bail!("--reference and --test must both be linear EXR or both PNG (as displayed); got {} and {}", args.reference.display(), args.test.display());
     }
-    let (w, h, reference) = (reference_input.width, reference_input.height, &reference_input.values);
+    let (w, h, reference) = (
+        reference_input.width,
+        reference_input.height,
+        &reference_input.values,
+    );
     let (tw, th, test) = (test_input.width, test_input.height, &test_input.values);
     if (tw, th) != (w, h) {
         bail!(
@@ -99,7 +105,10 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     check_rings(args.rings, Some((w, h)))?;
     let gaze = parse_gaze(args.gaze, w, h)?;
     let hmd = match args.headset {
-        Some(name) => Some(fovea_hal::HmdDescription::resolve(name).with_context(|| format!("--headset {name}"))?),
+        Some(name) => Some(
+            fovea_hal::HmdDescription::resolve(name)
+                .with_context(|| format!("--headset {name}"))?,
+        ),
         None => None,
     };
     let ppd = flip_ppd(args.ppd, hmd.as_ref(), w)?;
@@ -117,7 +126,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         let rings = Rings::from_coordinates(w, gaze, &degrees, axis.e_max as f64, args.rings);
         let mut found = evaluate_rings(reference, test, w, h, &rings);
         add_flip_rings(&mut found, &rings, &flip);
-        TrueEccentricity { headset: hmd.id.clone(), e_max_deg: axis.e_max as f64, rings: found }
+        TrueEccentricity {
+            headset: hmd.id.clone(),
+            e_max_deg: axis.e_max as f64,
+            rings: found,
+        }
     });
 
     let json_path = args.out.join("eval.json");
@@ -155,22 +168,45 @@ pub fn run(args: &EvalArgs) -> Result<()> {
 
 /// A PNG as it is (values in 0…1, no tone curve) or a linear EXR (tonemapped for FLIP).
 fn read_input(path: &Path) -> Result<Input> {
-    let png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if png {
         crate::output::check_regular_input(path)?;
-        let image = image::open(path).with_context(|| format!("reading {}", path.display()))?.to_rgba8();
+        let image = image::open(path)
+            .with_context(|| format!("reading {}", path.display()))?
+            .to_rgba8();
         let (width, height) = image.dimensions();
         let displayed = image.into_raw();
-        let values = displayed.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]].map(|c| c as f32 / 255.0)).collect();
-        return Ok(Input { width, height, values, displayed, png });
+        let values = displayed
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]].map(|c| c as f32 / 255.0))
+            .collect();
+        return Ok(Input {
+            width,
+            height,
+            values,
+            displayed,
+            png,
+        });
     }
     let (width, height, values) = read_checked(path)?;
     let displayed = tonemap_preview(&values, 1.0);
-    Ok(Input { width, height, values, displayed, png })
+    Ok(Input {
+        width,
+        height,
+        values,
+        displayed,
+        png,
+    })
 }
 
 /// `--ppd`, or the image stretched over the headset eye's horizontal FOV.
-fn flip_ppd(given: Option<f32>, hmd: Option<&fovea_hal::HmdDescription>, width: u32) -> Result<f32> {
+fn flip_ppd(
+    given: Option<f32>,
+    hmd: Option<&fovea_hal::HmdDescription>,
+    width: u32,
+) -> Result<f32> {
     if let Some(ppd) = given {
         if !(ppd.is_finite() && ppd > 0.0 && ppd <= 1000.0) {
             bail!("--ppd {ppd} must be in (0, 1000] pixels per degree");
@@ -185,8 +221,17 @@ fn flip_ppd(given: Option<f32>, hmd: Option<&fovea_hal::HmdDescription>, width: 
 fn read_checked(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     let (w, h, pixels) = read_exr(path)?;
     let bad = |p: &[f32; 4]| p[..3].iter().copied().find(|c| !c.is_finite());
-    if let Some((i, c)) = pixels.iter().enumerate().find_map(|(i, p)| Some((i, bad(p)?))) {
-        bail!("{} has a non-finite value ({c}) at pixel ({}, {})", path.display(), i as u32 % w, i as u32 / w);
+    if let Some((i, c)) = pixels
+        .iter()
+        .enumerate()
+        .find_map(|(i, p)| Some((i, bad(p)?)))
+    {
+        bail!(
+            "{} has a non-finite value ({c}) at pixel ({}, {})",
+            path.display(),
+            i as u32 % w,
+            i as u32 / w
+        );
     }
     Ok((w, h, pixels))
 }
@@ -197,7 +242,9 @@ fn parse_gaze(spec: &str, width: u32, height: u32) -> Result<Vec2> {
     if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
         return Ok(Vec2::new(width as f32, height as f32) * 0.5);
     }
-    let parsed = t.split_once(',').and_then(|(x, y)| Some(Vec2::new(x.trim().parse().ok()?, y.trim().parse().ok()?)));
+    let parsed = t
+        .split_once(',')
+        .and_then(|(x, y)| Some(Vec2::new(x.trim().parse().ok()?, y.trim().parse().ok()?)));
     let Some(g) = parsed.filter(|g| g.is_finite()) else {
         bail!("--gaze '{spec}': expected X,Y as two finite pixel coordinates (e.g. 160,180) or center");
     };
@@ -210,9 +257,26 @@ fn parse_gaze(spec: &str, width: u32, height: u32) -> Result<Vec2> {
 fn write_plot(path: &Path, eval: &Evaluation) -> Result<()> {
     let per_ring = |label: &str, value: &dyn Fn(&crate::metrics::Metrics) -> Option<f64>| Series {
         label: label.into(),
-        points: eval.rings.iter().filter_map(|r| Some((0.5 * (r.ecc_inner + r.ecc_outer), value(&r.metrics)?))).collect(),
+        points: eval
+            .rings
+            .iter()
+            .filter_map(|r| Some((0.5 * (r.ecc_inner + r.ecc_outer), value(&r.metrics)?)))
+            .collect(),
     };
-    let series = [per_ring("RMSE (linear RGB)", &|m| m.rmse), per_ring("SSIM (luma)", &|m| m.ssim)];
-    let title = format!("Error per eccentricity ring, gaze ({:.0}, {:.0})", eval.gaze[0], eval.gaze[1]);
-    line_plot(path, &title, "normalised eccentricity (r / r_max · 80)", "RMSE, SSIM", &series, false)
+    let series = [
+        per_ring("RMSE (linear RGB)", &|m| m.rmse),
+        per_ring("SSIM (luma)", &|m| m.ssim),
+    ];
+    let title = format!(
+        "Error per eccentricity ring, gaze ({:.0}, {:.0})",
+        eval.gaze[0], eval.gaze[1]
+    );
+    line_plot(
+        path,
+        &title,
+        "normalised eccentricity (r / r_max · 80)",
+        "RMSE, SSIM",
+        &series,
+        false,
+    )
 }

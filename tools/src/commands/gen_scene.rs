@@ -8,7 +8,9 @@ pub fn run(kind: &str, out: &Path, min_triangles: Option<usize>, force: bool) ->
     let kind = match kind {
         "cornell-box" => SceneKind::CornellBox,
         "stress" => SceneKind::Stress,
-        "large" => SceneKind::Large { min_triangles: min_triangles.unwrap_or(DEFAULT_LARGE_TRIANGLES) },
+        "large" => SceneKind::Large {
+            min_triangles: min_triangles.unwrap_or(DEFAULT_LARGE_TRIANGLES),
+        },
         other => bail!("unknown scene kind '{other}' (cornell-box, stress, large)"),
     };
     crate::output::check_new_file(out, force)?;

@@ -4,7 +4,10 @@ use anyhow::Result;
 use fovea_hal::{Eye, HmdDescription};
 
 pub fn run() -> Result<()> {
-    println!("{:<16} {:<28} {:>11} {:>7} {:>22} {:>9}", "name", "display name", "per eye", "refresh", "FOV l/r/d/u (deg)", "tracker");
+    println!(
+        "{:<16} {:<28} {:>11} {:>7} {:>22} {:>9}",
+        "name", "display name", "per eye", "refresh", "FOV l/r/d/u (deg)", "tracker"
+    );
     for hmd in HmdDescription::list_builtin() {
         let eye = hmd.eye(Eye::Left);
         let f = eye.fov;

@@ -13,16 +13,37 @@ pub fn run(device: Option<&str>) -> Result<()> {
             Ok(()) => String::new(),
             Err(why) => format!("  [unsuitable: {why}]"),
         };
-        println!("[{}] {} ({}, Vulkan {}){note}", d.index, d.name, d.kind, d.api_version);
+        println!(
+            "[{}] {} ({}, Vulkan {}){note}",
+            d.index, d.name, d.kind, d.api_version
+        );
     }
     let ctx = super::open_device(device, false)?;
     let i = &ctx.info;
     println!("\nchosen: [{}] {}", i.index, i.name);
-    println!("  max compute workgroup invocations: {}", i.max_compute_workgroup_invocations);
-    println!("  max storage buffer range:          {} bytes", i.max_storage_buffer_range);
-    println!("  max texel buffer elements:         {}", i.max_texel_buffer_elements);
-    println!("  max 2-D image dimension:           {}", i.max_image_dimension_2d);
-    println!("  max push constants:                {} bytes", i.max_push_constants_size);
-    println!("  timestamp period:                  {} ns", i.timestamp_period_ns);
+    println!(
+        "  max compute workgroup invocations: {}",
+        i.max_compute_workgroup_invocations
+    );
+    println!(
+        "  max storage buffer range:          {} bytes",
+        i.max_storage_buffer_range
+    );
+    println!(
+        "  max texel buffer elements:         {}",
+        i.max_texel_buffer_elements
+    );
+    println!(
+        "  max 2-D image dimension:           {}",
+        i.max_image_dimension_2d
+    );
+    println!(
+        "  max push constants:                {} bytes",
+        i.max_push_constants_size
+    );
+    println!(
+        "  timestamp period:                  {} ns",
+        i.timestamp_period_ns
+    );
     Ok(())
 }

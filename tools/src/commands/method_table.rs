@@ -18,7 +18,11 @@ pub const END: &str = "<!-- method-table:end -->";
 
 /// Ring bands of the paper's normalised eccentricity (degrees): a ring belongs to the band its
 /// middle falls in.
-const BANDS: [(&str, f64, f64); 3] = [("fovea", 0.0, 10.0), ("mid", 10.0, 30.0), ("periphery", 30.0, f64::INFINITY)];
+const BANDS: [(&str, f64, f64); 3] = [
+    ("fovea", 0.0, 10.0),
+    ("mid", 10.0, 30.0),
+    ("periphery", 30.0, f64::INFINITY),
+];
 
 #[derive(Deserialize)]
 struct Quality {
@@ -113,8 +117,10 @@ pub struct MethodTableArgs<'a> {
 }
 
 fn read<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("{}: not the expected report", path.display()))
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("{}: not the expected report", path.display()))
 }
 
 pub fn run(args: &MethodTableArgs) -> Result<()> {
@@ -123,15 +129,25 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
     for path in args.bench {
         let bench: Bench = read(path)?;
         if bench.visual_polar.is_empty() {
-            bail!("{}: no visual_polar section (run fovea bench with --vp-sizes)", path.display());
+            bail!(
+                "{}: no visual_polar section (run fovea bench with --vp-sizes)",
+                path.display()
+            );
         }
         benches.push(bench);
     }
-    let Some(bench) = benches.first() else { bail!("--bench: at least one fovea bench report") };
+    let Some(bench) = benches.first() else {
+        bail!("--bench: at least one fovea bench report")
+    };
     let size = &bench.visual_polar[0];
-    let readme = std::fs::read_to_string(args.readme).with_context(|| format!("reading {}", args.readme.display()))?;
+    let readme = std::fs::read_to_string(args.readme)
+        .with_context(|| format!("reading {}", args.readme.display()))?;
     // The markers on lines of their own (the README may quote them elsewhere).
-    let line_of = |marker: &str| readme.match_indices(marker).map(|(i, _)| i).find(|&i| (i == 0 || readme[..i].ends_with('\n')) && readme[i + marker.len()..].starts_with('\n'));
+    let line_of = |marker: &str| {
+        readme.match_indices(marker).map(|(i, _)| i).find(|&i| {
+            (i == 0 || readme[..i].ends_with('\n')) && readme[i + marker.len()..].starts_with('\n')
+        })
+    };
     let (Some(begin), Some(end)) = (line_of(BEGIN), line_of(END)) else {
         bail!("{}: needs the markers {BEGIN} and {END}, each on a line of its own, around the table's place", args.readme.display())
     };
@@ -143,8 +159,16 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
     let mut table = String::new();
     write_table(&mut table, &quality, bench, size, &costs);
     write_pictures(&mut table, &pictures, args)?;
-    let scenes: Vec<(String, BTreeMap<String, Cost>)> =
-        benches.iter().flat_map(|b| &b.visual_polar).map(|v| (format!("{} {}×{}", scene_name(&v.scene), v.width, v.height), self::costs(v))).collect();
+    let scenes: Vec<(String, BTreeMap<String, Cost>)> = benches
+        .iter()
+        .flat_map(|b| &b.visual_polar)
+        .map(|v| {
+            (
+                format!("{} {}×{}", scene_name(&v.scene), v.width, v.height),
+                self::costs(v),
+            )
+        })
+        .collect();
     write_claims(&mut table, &quality, &costs, &scenes);
     for path in args.equal_samples {
         write_equal_samples_claim(&mut table, path, &read(path)?)?;
@@ -160,11 +184,32 @@ fn costs(size: &BenchSize) -> BTreeMap<String, Cost> {
     let trace = |p: &BTreeMap<String, f64>| p.get("trace").copied().unwrap_or(0.0);
     let screen = size.width as u64 * size.height as u64;
     let mut out = BTreeMap::from([
-        ("cartesian".to_string(), Cost { samples: screen, frame_ms: size.cartesian_frame_ms, trace_ms: trace(&size.cartesian_passes_ms) }),
-        ("vp".to_string(), Cost { samples: size.vp_samples_traced.unwrap_or(size.vp_samples), frame_ms: size.vp_frame_ms, trace_ms: trace(&size.vp_passes_ms) }),
+        (
+            "cartesian".to_string(),
+            Cost {
+                samples: screen,
+                frame_ms: size.cartesian_frame_ms,
+                trace_ms: trace(&size.cartesian_passes_ms),
+            },
+        ),
+        (
+            "vp".to_string(),
+            Cost {
+                samples: size.vp_samples_traced.unwrap_or(size.vp_samples),
+                frame_ms: size.vp_frame_ms,
+                trace_ms: trace(&size.vp_passes_ms),
+            },
+        ),
     ]);
     for m in &size.comparators {
-        out.insert(m.method.clone(), Cost { samples: m.samples_traced.unwrap_or(m.samples), frame_ms: m.frame_ms, trace_ms: trace(&m.passes_ms) });
+        out.insert(
+            m.method.clone(),
+            Cost {
+                samples: m.samples_traced.unwrap_or(m.samples),
+                frame_ms: m.frame_ms,
+                trace_ms: trace(&m.passes_ms),
+            },
+        );
     }
     out
 }
@@ -174,14 +219,29 @@ fn bands(run: &Run, metric: impl Fn(&Ring) -> Option<f64>) -> String {
     let cells: Vec<String> = BANDS
         .iter()
         .map(|&(_, lo, hi)| {
-            let values: Vec<f64> = run.rings.iter().filter(|r| (lo..hi).contains(&(0.5 * (r.ecc_inner + r.ecc_outer)))).filter_map(&metric).collect();
-            if values.is_empty() { "–".to_string() } else { format!("{:.3}", values.iter().sum::<f64>() / values.len() as f64) }
+            let values: Vec<f64> = run
+                .rings
+                .iter()
+                .filter(|r| (lo..hi).contains(&(0.5 * (r.ecc_inner + r.ecc_outer))))
+                .filter_map(&metric)
+                .collect();
+            if values.is_empty() {
+                "–".to_string()
+            } else {
+                format!("{:.3}", values.iter().sum::<f64>() / values.len() as f64)
+            }
         })
         .collect();
     cells.join(" / ")
 }
 
-fn write_table(s: &mut String, q: &Quality, bench: &Bench, size: &BenchSize, costs: &BTreeMap<String, Cost>) {
+fn write_table(
+    s: &mut String,
+    q: &Quality,
+    bench: &Bench,
+    size: &BenchSize,
+    costs: &BTreeMap<String, Cost>,
+) {
     let _ = writeln!(
         s,
         "Generated by `fovea method-table` from `fovea quality` ({} at {}×{}, gaze `{}`, {} frames, the last {} evaluated against {}-spp references; \
@@ -194,10 +254,25 @@ fn write_table(s: &mut String, q: &Quality, bench: &Bench, size: &BenchSize, cos
         "| method + denoiser | samples / rays per frame | bench: samples, frame ms (× Cartesian), trace µs per 1k samples | FLIP still: fovea / mid / periphery | flicker still | flicker moving |\n|---|---|---|---|---|---|"
     );
     let cartesian_ms = costs.get("cartesian").map_or(f64::NAN, |c| c.frame_ms);
-    for run in q.runs.iter().filter(|r| r.camera == "still" && r.taa == "off") {
-        let moving = q.runs.iter().find(|m| m.camera == "moving" && m.method == run.method && m.denoiser == run.denoiser && m.taa == run.taa);
+    for run in q
+        .runs
+        .iter()
+        .filter(|r| r.camera == "still" && r.taa == "off")
+    {
+        let moving = q.runs.iter().find(|m| {
+            m.camera == "moving"
+                && m.method == run.method
+                && m.denoiser == run.denoiser
+                && m.taa == run.taa
+        });
         let cost = match (run.denoiser.as_str(), costs.get(&run.method)) {
-            ("none", Some(c)) => format!("{}, {:.1} ({:.2}×), {:.1}", c.samples, c.frame_ms, c.frame_ms / cartesian_ms, 1e6 * c.trace_ms / c.samples.max(1) as f64),
+            ("none", Some(c)) => format!(
+                "{}, {:.1} ({:.2}×), {:.1}",
+                c.samples,
+                c.frame_ms,
+                c.frame_ms / cartesian_ms,
+                1e6 * c.trace_ms / c.samples.max(1) as f64
+            ),
             _ => "–".to_string(),
         };
         let _ = writeln!(
@@ -213,7 +288,11 @@ fn write_table(s: &mut String, q: &Quality, bench: &Bench, size: &BenchSize, cos
         );
     }
     for r in q.refused.iter().filter(|r| r.camera == "still") {
-        let _ = writeln!(s, "| {} + {} | refused: {} | | | | |", r.method, r.denoiser, r.reason);
+        let _ = writeln!(
+            s,
+            "| {} + {} | refused: {} | | | | |",
+            r.method, r.denoiser, r.reason
+        );
     }
     s.push('\n');
 }
@@ -224,20 +303,39 @@ fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, 
     let reference_path = args.quality.join("reference_still_0000.exr");
     let (w, h, reference) = read_exr(&reference_path)?;
     let reference = tonemap_preview(&reference, 1.0);
-    std::fs::create_dir_all(args.pictures).with_context(|| format!("creating {}", args.pictures.display()))?;
+    std::fs::create_dir_all(args.pictures)
+        .with_context(|| format!("creating {}", args.pictures.display()))?;
     write_png(&args.pictures.join("reference.png"), w, h, &reference)?;
     let ppd = crate::flip::headset_ppd(&fovea_hal::HmdDescription::resolve("fove0")?, w);
     let mut out = Vec::new();
-    for run in q.runs.iter().filter(|r| r.camera == "still" && r.denoiser == "none" && r.taa == "off") {
-        let Some(&last) = run.frames.last() else { continue };
-        let dir = args.quality.join(format!("run_still_{}_none_taa-off", run.method));
+    for run in q
+        .runs
+        .iter()
+        .filter(|r| r.camera == "still" && r.denoiser == "none" && r.taa == "off")
+    {
+        let Some(&last) = run.frames.last() else {
+            continue;
+        };
+        let dir = args
+            .quality
+            .join(format!("run_still_{}_none_taa-off", run.method));
         let frame_path = dir.join(format!("frame_{last:04}.png"));
-        let frame = image::open(&frame_path).with_context(|| format!("reading {}", frame_path.display()))?.to_rgba8();
+        let frame = image::open(&frame_path)
+            .with_context(|| format!("reading {}", frame_path.display()))?
+            .to_rgba8();
         if frame.dimensions() != (w, h) {
-            bail!("{}: {}×{}, the reference is {w}×{h}", frame_path.display(), frame.width(), frame.height());
+            bail!(
+                "{}: {}×{}, the reference is {w}×{h}",
+                frame_path.display(),
+                frame.width(),
+                frame.height()
+            );
         }
         let map = flip_image(&flip_map(&reference, frame.as_raw(), w, h, ppd), w, h);
-        let (frame_name, map_name) = (format!("{}.png", run.method), format!("{}_flip.png", run.method));
+        let (frame_name, map_name) = (
+            format!("{}.png", run.method),
+            format!("{}_flip.png", run.method),
+        );
         write_png(&args.pictures.join(&frame_name), w, h, frame.as_raw())?;
         write_png(&args.pictures.join(&map_name), w, h, &map)?;
         out.push((run.method.clone(), frame_name, map_name));
@@ -245,49 +343,132 @@ fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, 
     Ok(out)
 }
 
-fn write_pictures(s: &mut String, pictures: &[(String, String, String)], args: &MethodTableArgs) -> Result<()> {
+fn write_pictures(
+    s: &mut String,
+    pictures: &[(String, String, String)],
+    args: &MethodTableArgs,
+) -> Result<()> {
     let base = args.readme.parent().unwrap_or(Path::new("."));
-    let dir = args.pictures.strip_prefix(base).unwrap_or(args.pictures).display().to_string();
+    let dir = args
+        .pictures
+        .strip_prefix(base)
+        .unwrap_or(args.pictures)
+        .display()
+        .to_string();
     let _ = writeln!(s, "Still camera, no denoiser, the last evaluated frame (same gaze for every method); below each, its FLIP map against the reference (`{dir}/reference.png`).\n");
-    let _ = writeln!(s, "| {} |", pictures.iter().map(|p| p.0.as_str()).collect::<Vec<_>>().join(" | "));
+    let _ = writeln!(
+        s,
+        "| {} |",
+        pictures
+            .iter()
+            .map(|p| p.0.as_str())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
     let _ = writeln!(s, "|{}", "---|".repeat(pictures.len()));
-    let _ = writeln!(s, "| {} |", pictures.iter().map(|p| format!("![{}]({dir}/{})", p.0, p.1)).collect::<Vec<_>>().join(" | "));
-    let _ = writeln!(s, "| {} |\n", pictures.iter().map(|p| format!("![{} FLIP]({dir}/{})", p.0, p.2)).collect::<Vec<_>>().join(" | "));
+    let _ = writeln!(
+        s,
+        "| {} |",
+        pictures
+            .iter()
+            .map(|p| format!("![{}]({dir}/{})", p.0, p.1))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
+    let _ = writeln!(
+        s,
+        "| {} |\n",
+        pictures
+            .iter()
+            .map(|p| format!("![{} FLIP]({dir}/{})", p.0, p.2))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
     Ok(())
 }
 
 /// A scene path's file stem (reports name scenes by path or by name).
 fn scene_name(scene: &str) -> &str {
-    Path::new(scene).file_stem().and_then(|s| s.to_str()).unwrap_or(scene)
+    Path::new(scene)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(scene)
 }
 
 /// The papers' claims against this run's figures (`scenes`: every bench screen's costs).
-fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, scenes: &[(String, BTreeMap<String, Cost>)]) {
-    let per_sample = |c: &BTreeMap<String, Cost>, m: &str| c.get(m).map(|c| c.trace_ms / c.samples.max(1) as f64);
-    let flip = |m: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m && r.denoiser == "none" && r.taa == "off").map(|r| bands(r, |g| g.flip));
-    let _ = writeln!(s, "Claims (trace time per sample from the bench, per scene; ≥ 1.15× counts as confirmed):\n");
+fn write_claims(
+    s: &mut String,
+    q: &Quality,
+    costs: &BTreeMap<String, Cost>,
+    scenes: &[(String, BTreeMap<String, Cost>)],
+) {
+    let per_sample = |c: &BTreeMap<String, Cost>, m: &str| {
+        c.get(m).map(|c| c.trace_ms / c.samples.max(1) as f64)
+    };
+    let flip = |m: &str| {
+        q.runs
+            .iter()
+            .find(|r| {
+                r.camera == "still" && r.method == m && r.denoiser == "none" && r.taa == "off"
+            })
+            .map(|r| bands(r, |g| g.flip))
+    };
+    let _ = writeln!(
+        s,
+        "Claims (trace time per sample from the bench, per scene; ≥ 1.15× counts as confirmed):\n"
+    );
     for (other, paper, claim) in [
-        ("linear-falloff", "Koskela et al. 2019", "≈ 1.3× faster traversal per sample for Visual-Polar than linear falloff"),
-        ("random-acuity", "Koskela et al. 2019 / 2018", "1.3–1.5× faster traversal per sample for Visual-Polar than random acuity samples"),
+        (
+            "linear-falloff",
+            "Koskela et al. 2019",
+            "≈ 1.3× faster traversal per sample for Visual-Polar than linear falloff",
+        ),
+        (
+            "random-acuity",
+            "Koskela et al. 2019 / 2018",
+            "1.3–1.5× faster traversal per sample for Visual-Polar than random acuity samples",
+        ),
     ] {
         let figures: Vec<String> = scenes
             .iter()
             .filter_map(|(name, c)| {
                 let ratio = per_sample(c, other)? / per_sample(c, "vp")?;
-                Some(format!("{ratio:.2}× on {name} ({})", if ratio >= 1.15 { "confirmed" } else { "not confirmed" }))
+                Some(format!(
+                    "{ratio:.2}× on {name} ({})",
+                    if ratio >= 1.15 {
+                        "confirmed"
+                    } else {
+                        "not confirmed"
+                    }
+                ))
             })
             .collect();
         if !figures.is_empty() {
             let _ = writeln!(s, "- {paper}: {claim} — measured {}.", figures.join(", "));
         }
     }
-    let samples = |m: &str| q.runs.iter().find(|r| r.camera == "still" && r.method == m).map(|r| r.samples_traced);
-    for (other, paper) in [("log-polar", "Meng et al. 2018"), ("composite", "Andersson & Hansson 2020")] {
-        if let (Some(vp), Some(o), Some(nv), Some(no)) = (flip("vp"), flip(other), samples("vp"), samples(other)) {
+    let samples = |m: &str| {
+        q.runs
+            .iter()
+            .find(|r| r.camera == "still" && r.method == m)
+            .map(|r| r.samples_traced)
+    };
+    for (other, paper) in [
+        ("log-polar", "Meng et al. 2018"),
+        ("composite", "Andersson & Hansson 2020"),
+    ] {
+        if let (Some(vp), Some(o), Some(nv), Some(no)) =
+            (flip("vp"), flip(other), samples("vp"), samples(other))
+        {
             let _ = writeln!(s, "- Visual-Polar vs {other} ({paper}), no denoiser: FLIP {vp} with {nv} samples vs {o} with {no} (each at its paper's budget, not equal samples).");
         }
     }
-    if let (Some(t), Some(v), Some(tf), Some(vf)) = (costs.get("vrs-tiles"), costs.get("vp"), flip("vrs-tiles"), flip("vp")) {
+    if let (Some(t), Some(v), Some(tf), Some(vf)) = (
+        costs.get("vrs-tiles"),
+        costs.get("vp"),
+        flip("vrs-tiles"),
+        flip("vp"),
+    ) {
         let _ = writeln!(
             s,
             "- Variable-rate tiles (VP's density quantised to 1×1 / 2×2 / 4×4 blocks in 16×16 tiles, never sparser than VP): {} samples = {:.2}× VP's, frame {:.2}× VP's, FLIP {tf} vs VP's {vf}.",
@@ -296,7 +477,12 @@ fn write_claims(s: &mut String, q: &Quality, costs: &BTreeMap<String, Cost>, sce
             t.frame_ms / v.frame_ms
         );
     }
-    if let (Some(pb), Some(c), Some(pf), Some(cf)) = (costs.get("pixel-blocks"), costs.get("cartesian"), flip("pixel-blocks"), flip("cartesian")) {
+    if let (Some(pb), Some(c), Some(pf), Some(cf)) = (
+        costs.get("pixel-blocks"),
+        costs.get("cartesian"),
+        flip("pixel-blocks"),
+        flip("cartesian"),
+    ) {
         let _ = writeln!(
             s,
             "- Pixel blocks (Mohanto et al. 2023: 23–30× faster than uniform 32 spp, offline): its frames take {:.2}× the time of one sample per pixel here, FLIP {pf} vs {cf}.",
@@ -322,18 +508,39 @@ fn paper_of(method: &str) -> &'static str {
 /// count: FLIP per band for every denoiser both ran, still camera.
 fn write_equal_samples_claim(s: &mut String, path: &Path, q: &Quality) -> Result<()> {
     fn still_runs<'q>(q: &'q Quality, method: &'q str) -> impl Iterator<Item = &'q Run> + 'q {
-        q.runs.iter().filter(move |r| r.camera == "still" && r.method == method && r.taa == "off")
+        q.runs
+            .iter()
+            .filter(move |r| r.camera == "still" && r.method == method && r.taa == "off")
     }
     let still = |m| still_runs(q, m);
-    let others: BTreeSet<&str> = q.runs.iter().map(|r| r.method.as_str()).filter(|&m| m != "vp").collect();
+    let others: BTreeSet<&str> = q
+        .runs
+        .iter()
+        .map(|r| r.method.as_str())
+        .filter(|&m| m != "vp")
+        .collect();
     let others: Vec<&str> = others.into_iter().collect();
     let (Some(vp), [other]) = (still("vp").next(), others.as_slice()) else {
-        bail!("{}: an equal-samples report needs still runs of vp and exactly one other method", path.display())
+        bail!(
+            "{}: an equal-samples report needs still runs of vp and exactly one other method",
+            path.display()
+        )
     };
     let other = *other;
-    let Some(theirs) = still(other).next() else { bail!("{}: no still run of {other}", path.display()) };
+    let Some(theirs) = still(other).next() else {
+        bail!("{}: no still run of {other}", path.display())
+    };
     let figures: Vec<String> = still("vp")
-        .filter_map(|v| still(other).find(|o| o.denoiser == v.denoiser).map(|o| format!("{} {} vs {}", v.denoiser, bands(v, |g| g.flip), bands(o, |g| g.flip))))
+        .filter_map(|v| {
+            still(other).find(|o| o.denoiser == v.denoiser).map(|o| {
+                format!(
+                    "{} {} vs {}",
+                    v.denoiser,
+                    bands(v, |g| g.flip),
+                    bands(o, |g| g.flip)
+                )
+            })
+        })
         .collect();
     let _ = writeln!(
         s,

@@ -7,8 +7,9 @@ use crate::render_profile::RenderProfile;
 use anyhow::{anyhow, Context, Result};
 use fovea_hal::HmdDescription;
 use fovea_renderer::sampling::{
-    BlockShape, Cartesian, Eccentricity, FalloffShape, FixedFoveation, FovTangents, LinearFalloff, PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VrsTiles,
-    VisualPolarParams, VpLayout, FALLOFF_BUDGET_OF_VP,
+    BlockShape, Cartesian, Eccentricity, FalloffShape, FixedFoveation, FovTangents, LinearFalloff,
+    PixelBlocks, RandomAcuity, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams,
+    VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
 use glam::{UVec2, Vec2};
 
@@ -61,8 +62,15 @@ impl SpaceInputs<'_> {
         self.screen.as_vec2() * 0.5
     }
 
-    fn visual_polar(&self, params: VisualPolarParams, what: &str) -> Result<Box<dyn SamplingSpace>> {
-        Ok(Box::new(VisualPolar::new(self.screen, self.centre(), params).with_context(|| what.to_string())?))
+    fn visual_polar(
+        &self,
+        params: VisualPolarParams,
+        what: &str,
+    ) -> Result<Box<dyn SamplingSpace>> {
+        Ok(Box::new(
+            VisualPolar::new(self.screen, self.centre(), params)
+                .with_context(|| what.to_string())?,
+        ))
     }
 }
 
@@ -92,7 +100,13 @@ pub const METHODS: &[Method] = &[
         report: ReportSection::VisualPolar(VpVariant::Profile),
         build: |i| i.visual_polar(i.vp, "Visual-Polar space"),
     },
-    Method { name: "cartesian", screen: ScreenNeeds::Any, blurs: false, report: ReportSection::None, build: |i| Ok(Box::new(Cartesian::new(i.screen))) },
+    Method {
+        name: "cartesian",
+        screen: ScreenNeeds::Any,
+        blurs: false,
+        report: ReportSection::None,
+        build: |i| Ok(Box::new(Cartesian::new(i.screen))),
+    },
     // Visual-Polar's sample count for this eye and profile, spent on a regular grid.
     Method {
         name: "uniform-budget",
@@ -100,8 +114,12 @@ pub const METHODS: &[Method] = &[
         blurs: false,
         report: ReportSection::None,
         build: |i| {
-            let vp = VisualPolar::new(i.screen, i.centre(), i.vp).context("Visual-Polar space (the uniform budget's count)")?;
-            Ok(Box::new(UniformBudget::with_samples(i.screen, vp.sample_count())?))
+            let vp = VisualPolar::new(i.screen, i.centre(), i.vp)
+                .context("Visual-Polar space (the uniform budget's count)")?;
+            Ok(Box::new(UniformBudget::with_samples(
+                i.screen,
+                vp.sample_count(),
+            )?))
         },
     },
     // Meng's kernel log-polar buffer: the polar space with the log-polar radial law.
@@ -118,7 +136,17 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::None,
-        build: |i| Ok(Box::new(LinearFalloff::new(i.screen, i.vp, FalloffShape::default(), FALLOFF_BUDGET_OF_VP).context("linear falloff")?)),
+        build: |i| {
+            Ok(Box::new(
+                LinearFalloff::new(
+                    i.screen,
+                    i.vp,
+                    FalloffShape::default(),
+                    FALLOFF_BUDGET_OF_VP,
+                )
+                .context("linear falloff")?,
+            ))
+        },
     },
     // VP's samples at random positions drawn from its density (Koskela et al. 2018).
     Method {
@@ -126,7 +154,11 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::None,
-        build: |i| Ok(Box::new(RandomAcuity::new(i.screen, i.centre(), i.vp).context("random acuity")?)),
+        build: |i| {
+            Ok(Box::new(
+                RandomAcuity::new(i.screen, i.centre(), i.vp).context("random acuity")?,
+            ))
+        },
     },
     // Mohanto et al.'s pixel / 2×2 / 4×4 regions on VP's eccentricity axis, 4 / 2 / 1 samples.
     Method {
@@ -134,7 +166,11 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: false,
         report: ReportSection::None,
-        build: |i| Ok(Box::new(PixelBlocks::new(i.screen, i.vp, BlockShape::default()).context("pixel blocks")?)),
+        build: |i| {
+            Ok(Box::new(
+                PixelBlocks::new(i.screen, i.vp, BlockShape::default()).context("pixel blocks")?,
+            ))
+        },
     },
     // Andersson & Hansson's gaze disc + log-polar; the eye's distance from its FOV.
     Method {
@@ -144,7 +180,10 @@ pub const METHODS: &[Method] = &[
         report: ReportSection::Composite,
         build: |i| {
             let viewing_distance = i.screen.x as f32 / (i.fov.right + i.fov.left).max(1e-3);
-            i.visual_polar(i.profile.composite_space(viewing_distance), "composite space")
+            i.visual_polar(
+                i.profile.composite_space(viewing_distance),
+                "composite space",
+            )
         },
     },
     // Visual-Polar's variants as methods of their own (the method table's rows).
@@ -153,14 +192,30 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::ScreenClipped),
-        build: |i| i.visual_polar(VisualPolarParams { layout: VpLayout::ScreenClipped, ..i.vp }, "Visual-Polar space, screen-clipped layout"),
+        build: |i| {
+            i.visual_polar(
+                VisualPolarParams {
+                    layout: VpLayout::ScreenClipped,
+                    ..i.vp
+                },
+                "Visual-Polar space, screen-clipped layout",
+            )
+        },
     },
     Method {
         name: "vp-screen-aware",
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::ScreenAware),
-        build: |i| i.visual_polar(VisualPolarParams { layout: VpLayout::ScreenAware, ..i.vp }, "Visual-Polar space, screen-aware axis"),
+        build: |i| {
+            i.visual_polar(
+                VisualPolarParams {
+                    layout: VpLayout::ScreenAware,
+                    ..i.vp
+                },
+                "Visual-Polar space, screen-aware axis",
+            )
+        },
     },
     Method {
         name: "vp-headset",
@@ -168,8 +223,15 @@ pub const METHODS: &[Method] = &[
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::Headset),
         build: |i| {
-            let params = VisualPolarParams { eccentricity: Eccentricity::Headset(i.fov), layout: VpLayout::Paper, ..i.vp };
-            i.visual_polar(params, &format!("Visual-Polar space, headset axis of {}", i.hmd.id))
+            let params = VisualPolarParams {
+                eccentricity: Eccentricity::Headset(i.fov),
+                layout: VpLayout::Paper,
+                ..i.vp
+            };
+            i.visual_polar(
+                params,
+                &format!("Visual-Polar space, headset axis of {}", i.hmd.id),
+            )
         },
     },
     // Visual-Polar held on the lens centre (fixed foveated rendering): what eye tracking buys.
@@ -178,7 +240,12 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::VisualPolar(VpVariant::Profile),
-        build: |i| Ok(Box::new(FixedFoveation::new(i.screen, FixedFoveation::lens_centre(i.screen, i.fov), i.vp).context("fixed foveation")?)),
+        build: |i| {
+            Ok(Box::new(
+                FixedFoveation::new(i.screen, FixedFoveation::lens_centre(i.screen, i.fov), i.vp)
+                    .context("fixed foveation")?,
+            ))
+        },
     },
     // Variable-rate-shading foveation: 16×16 tiles at 1×1, 2×2 or 4×4, never sparser than VP.
     Method {
@@ -186,13 +253,20 @@ pub const METHODS: &[Method] = &[
         screen: ScreenNeeds::VisualPolarGrid,
         blurs: true,
         report: ReportSection::None,
-        build: |i| Ok(Box::new(VrsTiles::new(i.screen, i.centre(), i.vp).context("vrs tiles")?)),
+        build: |i| {
+            Ok(Box::new(
+                VrsTiles::new(i.screen, i.centre(), i.vp).context("vrs tiles")?,
+            ))
+        },
     },
 ];
 
 /// The method called `name`, or an error naming the ones there are.
 pub fn method(name: &str) -> Result<&'static Method> {
-    METHODS.iter().find(|m| m.name == name).ok_or_else(|| anyhow!("--method {name}: expected one of {}", names().join(", ")))
+    METHODS
+        .iter()
+        .find(|m| m.name == name)
+        .ok_or_else(|| anyhow!("--method {name}: expected one of {}", names().join(", ")))
 }
 
 /// Every method's name, in registry order.
@@ -211,6 +285,9 @@ mod tests {
         sorted.dedup();
         assert_eq!(sorted.len(), METHODS.len());
         let err = method("foveated").err().unwrap().to_string();
-        assert!(err.contains("--method foveated") && err.contains("vp-screen-clipped"), "{err}");
+        assert!(
+            err.contains("--method foveated") && err.contains("vp-screen-clipped"),
+            "{err}"
+        );
     }
 }

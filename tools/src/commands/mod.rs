@@ -1,8 +1,8 @@
 pub mod bench;
 mod bench_loop;
 pub mod bench_vp;
-pub mod eval;
 pub mod debug_views;
+pub mod eval;
 pub mod gen_scene;
 pub mod headsets;
 pub mod info;
@@ -30,7 +30,9 @@ pub fn open_device(device: Option<&str>, validation: bool) -> Result<Arc<Context
 pub fn device_options(device: Option<&str>, validation: bool) -> ContextOptions {
     ContextOptions {
         validation: validation || cfg!(debug_assertions),
-        device: device.map(|d| d.parse::<DeviceSelector>().expect("infallible")).unwrap_or_default(),
+        device: device
+            .map(|d| d.parse::<DeviceSelector>().expect("infallible"))
+            .unwrap_or_default(),
         ..Default::default()
     }
 }
@@ -39,7 +41,10 @@ pub fn device_options(device: Option<&str>, validation: bool) -> ContextOptions 
 pub fn check_validation(ctx: &Context) -> Result<()> {
     let problems = ctx.validation.problems();
     if problems > 0 {
-        anyhow::bail!("{problems} Vulkan validation warning(s)/error(s): {:?}", ctx.validation.messages());
+        anyhow::bail!(
+            "{problems} Vulkan validation warning(s)/error(s): {:?}",
+            ctx.validation.messages()
+        );
     }
     Ok(())
 }

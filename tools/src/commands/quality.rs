@@ -9,7 +9,9 @@ use super::render::{self, RenderArgs};
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
-use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text};
+use crate::output::{
+    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text,
+};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::denoise::taa::TaaMode;
@@ -125,17 +127,31 @@ fn check_names(flag: &str, given: &[String], allowed: &[&str]) -> Result<()> {
 /// `--methods all` → every method of `fovea render`.
 pub fn expand_methods(methods: Vec<String>) -> Vec<String> {
     match methods.as_slice() {
-        [one] if one == "all" => super::methods::names().iter().map(|m| m.to_string()).collect(),
+        [one] if one == "all" => super::methods::names()
+            .iter()
+            .map(|m| m.to_string())
+            .collect(),
         _ => methods,
     }
 }
 
 /// Why `method` cannot run a denoiser or TAA, if it cannot (asked of the space itself, once per
 /// method: some spaces take a full-screen sum to build).
-fn filters_refusal(args: &QualityArgs, hmd: &fovea_hal::HmdDescription, method: &str) -> Result<Option<String>> {
-    let space = super::setup::space_for(method, &args.profile, hmd, fovea_hal::Eye::Left, UVec2::new(args.width, args.height))?;
+fn filters_refusal(
+    args: &QualityArgs,
+    hmd: &fovea_hal::HmdDescription,
+    method: &str,
+) -> Result<Option<String>> {
+    let space = super::setup::space_for(
+        method,
+        &args.profile,
+        hmd,
+        fovea_hal::Eye::Left,
+        UVec2::new(args.width, args.height),
+    )?;
     let caps = space.capabilities();
-    Ok((!caps.temporal_filters).then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
+    Ok((!caps.temporal_filters)
+        .then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
 }
 
 pub fn run(args: &QualityArgs) -> Result<()> {
@@ -144,7 +160,11 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     check_names("--taa", args.taa, TaaMode::NAMES)?;
     check_names("--cameras", args.cameras, CAMERAS)?;
     if args.eval_frames == 0 || args.eval_frames > args.frames {
-        bail!("--eval-frames {} must be in 1..={} (--frames)", args.eval_frames, args.frames);
+        bail!(
+            "--eval-frames {} must be in 1..={} (--frames)",
+            args.eval_frames,
+            args.frames
+        );
     }
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
@@ -153,21 +173,35 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let ppd = flip_ppd(args)?;
-    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset)
+        .with_context(|| format!("--headset {}", args.headset))?;
     let (mut runs, mut refused) = (Vec::new(), Vec::new());
     for camera in args.cameras {
         let moving = camera == "moving";
         let references = references(args, moving, &evaluated)?;
         for method in args.methods {
-            let filtered = args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
-            let refusal = if filtered { filters_refusal(args, &hmd, method)? } else { None };
+            let filtered =
+                args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
+            let refusal = if filtered {
+                filters_refusal(args, &hmd, method)?
+            } else {
+                None
+            };
             for denoiser in args.denoisers {
                 for taa in args.taa {
                     if let (Some(reason), false) = (&refusal, denoiser == "none" && taa == "off") {
-                        refused.push(RefusedRun { camera: camera.clone(), method: method.clone(), denoiser: denoiser.clone(), taa: taa.clone(), reason: reason.clone() });
+                        refused.push(RefusedRun {
+                            camera: camera.clone(),
+                            method: method.clone(),
+                            denoiser: denoiser.clone(),
+                            taa: taa.clone(),
+                            reason: reason.clone(),
+                        });
                         continue;
                     }
-                    let dir = args.out.join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
+                    let dir = args
+                        .out
+                        .join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
                     let render_args = RenderArgs {
                         scene: args.scene,
                         method,
@@ -179,7 +213,11 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         frames: args.frames,
                         out: &dir,
                         exr: true,
-                        camera_path: if moving { camera_path::CameraMotion::Orbit } else { camera_path::CameraMotion::Still },
+                        camera_path: if moving {
+                            camera_path::CameraMotion::Orbit
+                        } else {
+                            camera_path::CameraMotion::Still
+                        },
                         seed: args.seed,
                         max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
                         exposure: 1.0,
@@ -193,9 +231,16 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         frames_in_flight: 2,
                         camera: args.camera,
                     };
-                    render::run(&render_args).with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
+                    render::run(&render_args).with_context(|| {
+                        format!("{camera} camera, {method} + {denoiser}, taa {taa}")
+                    })?;
                     let mut q = measure(args, &dir, &evaluated, &references, ppd)?;
-                    (q.camera, q.method, q.denoiser, q.taa) = (camera.clone(), method.clone(), denoiser.clone(), taa.clone());
+                    (q.camera, q.method, q.denoiser, q.taa) = (
+                        camera.clone(),
+                        method.clone(),
+                        denoiser.clone(),
+                        taa.clone(),
+                    );
                     runs.push(q);
                 }
             }
@@ -225,31 +270,62 @@ pub fn run(args: &QualityArgs) -> Result<()> {
 /// Converged references of the evaluated frames' camera poses (one for a still camera), written
 /// to `DIR/reference_<camera>_NNNN.exr`.
 fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
-    let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, args.width as f32 / args.height as f32)?;
+    let (scene, camera) = crate::look::load(
+        args.scene,
+        args.camera,
+        &args.profile.environment,
+        args.width as f32 / args.height as f32,
+    )?;
     let start = CameraPose::from_scene_camera(&camera, args.width, args.height);
     let centre = scene.bounds().center();
     let ctx = super::open_device(args.device, args.validation)?;
     let size = UVec2::new(args.width, args.height);
-    let settings = RenderSettings { seed: args.seed.wrapping_add(0x5eed), ..Default::default() };
+    let settings = RenderSettings {
+        seed: args.seed.wrapping_add(0x5eed),
+        ..Default::default()
+    };
     let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
     let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
     let mut out = Vec::new();
     for &f in &poses {
-        let pose = if moving { camera_path::orbit(&start, centre, f, args.frames) } else { start };
-        let reference = renderer.render_reference(&pose, args.reference_spp, fovea_renderer::pipeline::REALTIME_MAX_DEPTH, |_| {})?;
-        let name = format!("reference_{}_{f:04}.exr", if moving { "moving" } else { "still" });
+        let pose = if moving {
+            camera_path::orbit(&start, centre, f, args.frames)
+        } else {
+            start
+        };
+        let reference = renderer.render_reference(
+            &pose,
+            args.reference_spp,
+            fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+            |_| {},
+        )?;
+        let name = format!(
+            "reference_{}_{f:04}.exr",
+            if moving { "moving" } else { "still" }
+        );
         write_exr(&args.out.join(name), args.width, args.height, &reference)?;
         out.push(reference);
     }
     super::check_validation(&ctx)?;
-    Ok(if moving { out } else { vec![out.remove(0); evaluated.len()] })
+    Ok(if moving {
+        out
+    } else {
+        vec![out.remove(0); evaluated.len()]
+    })
 }
 
 /// The run's evaluated frames against their references, ring metrics averaged over frames.
-fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<[f32; 4]>], ppd: f32) -> Result<RunQuality> {
+fn measure(
+    args: &QualityArgs,
+    dir: &Path,
+    evaluated: &[u32],
+    references: &[Vec<[f32; 4]>],
+    ppd: f32,
+) -> Result<RunQuality> {
     let report_path = dir.join("report.json");
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&report_path)?)
-        .with_context(|| format!("reading {}", report_path.display()))?;
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report_path)?)
+            .with_context(|| format!("reading {}", report_path.display()))?;
     let mut evals: Vec<Evaluation> = Vec::new();
     let mut gazes = Vec::new();
     // Per consecutive pair: flicker per ring and whole frame.
@@ -257,34 +333,61 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
     let mut previous: Option<(u32, Vec<u8>, Vec<u8>)> = None;
     for (&f, reference) in evaluated.iter().zip(references) {
         let gaze = &report["gaze"][f as usize];
-        let gaze = Vec2::new(gaze[0].as_f64().unwrap_or(0.0) as f32, gaze[1].as_f64().unwrap_or(0.0) as f32);
+        let gaze = Vec2::new(
+            gaze[0].as_f64().unwrap_or(0.0) as f32,
+            gaze[1].as_f64().unwrap_or(0.0) as f32,
+        );
         let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
         let (_, _, test) = read_exr(&path)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?.to_rgba8().into_raw();
+        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?
+            .to_rgba8()
+            .into_raw();
         let reference_displayed = tonemap_preview(reference, 1.0);
-        let flip = flip_map(&reference_displayed, &displayed, args.width, args.height, ppd);
+        let flip = flip_map(
+            &reference_displayed,
+            &displayed,
+            args.width,
+            args.height,
+            ppd,
+        );
         add_flip(&mut eval, &flip);
         if let Some((_, test_prev, reference_prev)) = previous.as_ref().filter(|p| p.0 + 1 == f) {
             let map = flicker_map(test_prev, &displayed, reference_prev, &reference_displayed);
-            flickers.push((Rings::new(args.width, args.height, gaze, args.rings).mean(&map), metrics_mean(&map)));
+            flickers.push((
+                Rings::new(args.width, args.height, gaze, args.rings).mean(&map),
+                metrics_mean(&map),
+            ));
         }
         previous = Some((f, displayed, reference_displayed));
         evals.push(eval);
         gazes.push(gaze.to_array());
     }
     let n = evals.len() as f64;
-    let mean = |v: Vec<Option<f64>>| -> Option<f64> { v.iter().copied().sum::<Option<f64>>().map(|s| s / v.len() as f64) };
+    let mean = |v: Vec<Option<f64>>| -> Option<f64> {
+        v.iter()
+            .copied()
+            .sum::<Option<f64>>()
+            .map(|s| s / v.len() as f64)
+    };
     let rings = (0..args.rings)
         .map(|i| RingMean {
             ecc_inner: evals[0].rings[i].ecc_inner,
             ecc_outer: evals[0].rings[i].ecc_outer,
             // RMSE averaged as MSE, so frames add like pixels do.
-            rmse: mean(evals.iter().map(|e| e.rings[i].metrics.rmse.map(|r| r * r)).collect()).map(f64::sqrt),
+            rmse: mean(
+                evals
+                    .iter()
+                    .map(|e| e.rings[i].metrics.rmse.map(|r| r * r))
+                    .collect(),
+            )
+            .map(f64::sqrt),
             ssim: mean(evals.iter().map(|e| e.rings[i].metrics.ssim).collect()),
             flip: mean(evals.iter().map(|e| e.rings[i].metrics.flip).collect()),
-            flicker: (!flickers.is_empty()).then(|| mean(flickers.iter().map(|f| f.0[i]).collect())).flatten(),
+            flicker: (!flickers.is_empty())
+                .then(|| mean(flickers.iter().map(|f| f.0[i]).collect()))
+                .flatten(),
         })
         .collect();
     Ok(RunQuality {
@@ -298,16 +401,32 @@ fn measure(args: &QualityArgs, dir: &Path, evaluated: &[u32], references: &[Vec<
         frames: evaluated.to_vec(),
         gaze: gazes,
         rings,
-        frame_rmse: (evals.iter().map(|e| e.frame.rmse.unwrap_or(0.0).powi(2)).sum::<f64>() / n).sqrt(),
-        frame_ssim: evals.iter().map(|e| e.frame.ssim.unwrap_or(0.0)).sum::<f64>() / n,
-        frame_flip: evals.iter().map(|e| e.frame.flip.unwrap_or(0.0)).sum::<f64>() / n,
-        frame_flicker: (!flickers.is_empty()).then(|| mean(flickers.iter().map(|f| f.1).collect())).flatten(),
+        frame_rmse: (evals
+            .iter()
+            .map(|e| e.frame.rmse.unwrap_or(0.0).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt(),
+        frame_ssim: evals
+            .iter()
+            .map(|e| e.frame.ssim.unwrap_or(0.0))
+            .sum::<f64>()
+            / n,
+        frame_flip: evals
+            .iter()
+            .map(|e| e.frame.flip.unwrap_or(0.0))
+            .sum::<f64>()
+            / n,
+        frame_flicker: (!flickers.is_empty())
+            .then(|| mean(flickers.iter().map(|f| f.1).collect()))
+            .flatten(),
     })
 }
 
 /// The render across the headset eye's horizontal FOV, in pixels per degree.
 fn flip_ppd(args: &QualityArgs) -> Result<f32> {
-    let hmd = fovea_hal::HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset)
+        .with_context(|| format!("--headset {}", args.headset))?;
     Ok(crate::flip::headset_ppd(&hmd, args.width))
 }
 
@@ -326,11 +445,18 @@ fn markdown(r: &Report) -> String {
         let runs: Vec<&RunQuality> = r.runs.iter().filter(|q| q.camera == *camera).collect();
         let Some(first) = runs.first() else {
             for q in r.refused.iter().filter(|q| q.camera == *camera) {
-                let _ = writeln!(s, "- {camera} camera, {} + {}, {}: refused: {}", q.method, q.denoiser, q.taa, q.reason);
+                let _ = writeln!(
+                    s,
+                    "- {camera} camera, {} + {}, {}: refused: {}",
+                    q.method, q.denoiser, q.taa, q.reason
+                );
             }
             continue;
         };
-        let _ = write!(s, "**{camera} camera** — RMSE / SSIM / FLIP\n\n| method + denoiser, TAA |");
+        let _ = write!(
+            s,
+            "**{camera} camera** — RMSE / SSIM / FLIP\n\n| method + denoiser, TAA |"
+        );
         for ring in &first.rings {
             let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
         }
@@ -346,10 +472,22 @@ fn markdown(r: &Report) -> String {
                     _ => s.push_str(" – |"),
                 }
             }
-            let _ = writeln!(s, " {:.4} / {:.3} / {:.3} | {:.1} |", q.frame_rmse, q.frame_ssim, q.frame_flip, q.frame_gpu_ms);
+            let _ = writeln!(
+                s,
+                " {:.4} / {:.3} / {:.3} | {:.1} |",
+                q.frame_rmse, q.frame_ssim, q.frame_flip, q.frame_gpu_ms
+            );
         }
         for q in r.refused.iter().filter(|q| q.camera == *camera) {
-            let _ = writeln!(s, "| {} + {}, {} | refused: {}{} |", q.method, q.denoiser, q.taa, q.reason, " |".repeat(first.rings.len() + 1));
+            let _ = writeln!(
+                s,
+                "| {} + {}, {} | refused: {}{} |",
+                q.method,
+                q.denoiser,
+                q.taa,
+                q.reason,
+                " |".repeat(first.rings.len() + 1)
+            );
         }
         s.push('\n');
         if first.frame_flicker.is_some() {
@@ -361,17 +499,32 @@ fn markdown(r: &Report) -> String {
             for q in &runs {
                 let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
                 for ring in &q.rings {
-                    let _ = write!(s, " {} |", ring.flicker.map_or("–".to_string(), |f| format!("{f:.4}")));
+                    let _ = write!(
+                        s,
+                        " {} |",
+                        ring.flicker.map_or("–".to_string(), |f| format!("{f:.4}"))
+                    );
                 }
-                let _ = writeln!(s, " {} |", q.frame_flicker.map_or("–".to_string(), |f| format!("{f:.4}")));
+                let _ = writeln!(
+                    s,
+                    " {} |",
+                    q.frame_flicker
+                        .map_or("–".to_string(), |f| format!("{f:.4}"))
+                );
             }
             s.push('\n');
         }
         for vp in runs.iter().filter(|q| q.method == "vp") {
-            let cartesian = runs.iter().find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
+            let cartesian = runs
+                .iter()
+                .find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
             if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
                 if let Some(c_rmse) = c.rings[0].rmse {
-                    let verdict = if v_rmse < c_rmse { "VP wins" } else { "Cartesian wins" };
+                    let verdict = if v_rmse < c_rmse {
+                        "VP wins"
+                    } else {
+                        "Cartesian wins"
+                    };
                     let _ = writeln!(
                         s,
                         "- {} + TAA {}, innermost ring: Cartesian / VP RMSE = {:.2}× ({verdict})",

@@ -32,23 +32,41 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         bail!("--width, --height, --spp and --max-depth must be at least 1");
     }
     if args.max_depth > super::setup::MAX_DEPTH_LIMIT {
-        bail!("--max-depth {} must be in 1..={} (path vertices)", args.max_depth, super::setup::MAX_DEPTH_LIMIT);
+        bail!(
+            "--max-depth {} must be in 1..={} (path vertices)",
+            args.max_depth,
+            super::setup::MAX_DEPTH_LIMIT
+        );
     }
     check_new_file(args.out, args.force)?;
     let preview = args.out.with_extension("png");
     if args.preview {
         check_new_file(&preview, args.force)?;
     }
-    let (scene, camera) = crate::look::load(args.scene, args.camera, &args.environment, args.width as f32 / args.height as f32)?;
+    let (scene, camera) = crate::look::load(
+        args.scene,
+        args.camera,
+        &args.environment,
+        args.width as f32 / args.height as f32,
+    )?;
     let pose = CameraPose::from_scene_camera(&camera, args.width, args.height);
     let ctx = super::open_device(args.device, args.validation)?;
-    let settings = RenderSettings { max_depth: args.max_depth, seed: args.seed, path_regularisation: args.path_regularisation, ..Default::default() };
+    let settings = RenderSettings {
+        max_depth: args.max_depth,
+        seed: args.seed,
+        path_regularisation: args.path_regularisation,
+        ..Default::default()
+    };
     let space = Box::new(Cartesian::new(UVec2::new(args.width, args.height)));
     let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
     let bar = ProgressBar::new(args.spp as u64);
-    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")?);
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})",
+    )?);
     let started = std::time::Instant::now();
-    let image = renderer.render_reference(&pose, args.spp, args.max_depth, |done| bar.set_position(done as u64))?;
+    let image = renderer.render_reference(&pose, args.spp, args.max_depth, |done| {
+        bar.set_position(done as u64)
+    })?;
     bar.finish_and_clear();
     write_exr(args.out, args.width, args.height, &image)?;
     let displayed = tonemap_preview(&image, 1.0);
@@ -69,7 +87,8 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     );
     // What a converged image should not have: isolated pixels far brighter than their neighbours.
     let (w, h) = (args.width as usize, args.height as usize);
-    let [ff30, ff60, ff100] = [30.0, 60.0, 100.0].map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
+    let [ff30, ff60, ff100] = [30.0, 60.0, 100.0]
+        .map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
     println!("fireflies (pixels of the tonemapped image brighter than all 8 neighbours by > 30 / 60 / 100 of 255 levels): {ff30} / {ff60} / {ff100} of {}", w * h);
     Ok(())
 }

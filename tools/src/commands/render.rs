@@ -4,11 +4,11 @@
 use super::methods::{ReportSection, VpVariant};
 use super::setup::{Eyes, Setup};
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
+use crate::render_profile::RenderProfile;
 use anyhow::Result;
 use fovea_hal::GazeOrigin;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::pipeline::{FrameStats, Renderer};
-use crate::render_profile::RenderProfile;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -49,7 +49,6 @@ pub struct RenderArgs<'a> {
     /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
     pub camera: &'a crate::look::CameraOptions,
 }
-
 
 #[derive(Serialize)]
 struct Report {
@@ -167,7 +166,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let screen = setup.screen();
     let screen_pixels = screen.x as u64 * screen.y as u64;
     // Debug views read the space's gaze after each frame: they need each frame waited for.
-    let in_flight = if args.debug_views { 1 } else { args.frames_in_flight.max(1) };
+    let in_flight = if args.debug_views {
+        1
+    } else {
+        args.frames_in_flight.max(1)
+    };
     let scene = GpuScene::upload(&ctx, &setup.scene)?;
     let mut renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, in_flight)?;
     let mut out = FrameWriter {
@@ -175,7 +178,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         eyes,
         width,
         height,
-        debug: args.debug_views.then(|| super::debug_views::DebugViews::new(args.out, screen, grid)),
+        debug: args
+            .debug_views
+            .then(|| super::debug_views::DebugViews::new(args.out, screen, grid)),
         pass_sums: BTreeMap::new(),
         totals: FrameStats::default(),
         ldr: Vec::new(),
@@ -183,7 +188,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
 
     let bar = ProgressBar::new(frames as u64);
-    bar.set_style(ProgressStyle::with_template("{bar:40} frame {pos}/{len}  {elapsed} (eta {eta})")?);
+    bar.set_style(ProgressStyle::with_template(
+        "{bar:40} frame {pos}/{len}  {elapsed} (eta {eta})",
+    )?);
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
     let mut gaze_origin = Vec::with_capacity(frames as usize);
@@ -222,7 +229,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let frames = submitted;
     if frames == 0 {
         // Stopped before the first frame: nothing to report.
-        return Err(interrupted.map(anyhow::Error::from).unwrap_or_else(|| anyhow::anyhow!("no frame rendered")));
+        return Err(interrupted
+            .map(anyhow::Error::from)
+            .unwrap_or_else(|| anyhow::anyhow!("no frame rendered")));
     }
     if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
@@ -232,8 +241,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let views = eyes.list().len() as u64;
     let n = frames as u64 * views;
     let totals = out.totals;
-    let passes: BTreeMap<String, f64> = out.pass_sums.into_iter().map(|(k, v)| (k, v / frames as f64)).collect();
-    let rays = RayReport { primary: totals.primary_rays / n, shadow: totals.shadow_rays / n, continuation: totals.continuation_rays / n };
+    let passes: BTreeMap<String, f64> = out
+        .pass_sums
+        .into_iter()
+        .map(|(k, v)| (k, v / frames as f64))
+        .collect();
+    let rays = RayReport {
+        primary: totals.primary_rays / n,
+        shadow: totals.shadow_rays / n,
+        continuation: totals.continuation_rays / n,
+    };
     let method = super::methods::method(args.method)?;
     let report = Report {
         method: args.method.to_string(),
@@ -275,9 +292,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         log_polar: (method.report == ReportSection::LogPolar).then(|| {
             let p = &args.profile.log_polar;
-            LogPolarReport { sigma: p.sigma, alpha: p.alpha, extent: crate::render_profile::log_polar_extent_name(p.extent) }
+            LogPolarReport {
+                sigma: p.sigma,
+                alpha: p.alpha,
+                extent: crate::render_profile::log_polar_extent_name(p.extent),
+            }
         }),
-        composite_mode: (method.report == ReportSection::Composite).then(|| args.profile.composite_mode.name()),
+        composite_mode: (method.report == ReportSection::Composite)
+            .then(|| args.profile.composite_mode.name()),
         blur_sigma_at_30: method.blurs.then_some(args.profile.blur.sigma_at_30),
         blur_space: method.blurs.then_some(args.profile.blur.space.name()),
         frame_gpu_ms: passes.values().sum(),
@@ -342,10 +364,20 @@ impl FrameWriter<'_> {
                 _ => String::new(),
             };
             renderer.read_view_ldr(frame, view, &mut self.ldr)?;
-            write_png(&self.args.out.join(format!("frame_{frame:04}{suffix}.png")), self.width, self.height, &self.ldr)?;
+            write_png(
+                &self.args.out.join(format!("frame_{frame:04}{suffix}.png")),
+                self.width,
+                self.height,
+                &self.ldr,
+            )?;
             if self.args.exr {
                 renderer.read_view_hdr(frame, view, &mut self.hdr)?;
-                write_exr(&self.args.out.join(format!("frame_{frame:04}{suffix}.exr")), self.width, self.height, &self.hdr)?;
+                write_exr(
+                    &self.args.out.join(format!("frame_{frame:04}{suffix}.exr")),
+                    self.width,
+                    self.height,
+                    &self.hdr,
+                )?;
             }
         }
         if let Some(debug) = &mut self.debug {
@@ -360,7 +392,8 @@ impl FrameWriter<'_> {
 fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
     use fovea_renderer::sampling::{InverseCdf, RadiusMode};
     let p = &profile.visual_polar;
-    let headset = variant == VpVariant::Headset || profile.eccentricity == crate::render_profile::EccentricityMode::Headset;
+    let headset = variant == VpVariant::Headset
+        || profile.eccentricity == crate::render_profile::EccentricityMode::Headset;
     VpReport {
         axis_scale: p.axis_scale,
         clip_fraction: p.clip_fraction,
@@ -380,6 +413,10 @@ fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
             VpVariant::ScreenAware => "screen-aware".into(),
             _ => crate::render_profile::layout_name(p.layout).into(),
         },
-        eccentricity: if headset { "headset".into() } else { crate::render_profile::eccentricity_name(profile.eccentricity).into() },
+        eccentricity: if headset {
+            "headset".into()
+        } else {
+            crate::render_profile::eccentricity_name(profile.eccentricity).into()
+        },
     }
 }

@@ -6,7 +6,9 @@
 
 use super::render::RenderArgs;
 use crate::flip::{flip_image, flip_map};
-use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_png, write_text};
+use crate::output::{
+    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_png, write_text,
+};
 use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
 use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
 use anyhow::{bail, Context, Result};
@@ -43,7 +45,12 @@ pub struct Regression {
 
 impl std::fmt::Display for Regression {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} frame(s) outside the tolerances; see {}", self.failed_frames, self.report.display())
+        write!(
+            f,
+            "{} frame(s) outside the tolerances; see {}",
+            self.failed_frames,
+            self.report.display()
+        )
     }
 }
 
@@ -83,12 +90,20 @@ struct ReplayReport<'a> {
 }
 
 pub fn run(args: &ReplayArgs) -> Result<()> {
-    run_checked(args).map_err(|e| if e.is::<Regression>() { e } else { BadInput(format!("{e:#}")).into() })
+    run_checked(args).map_err(|e| {
+        if e.is::<Regression>() {
+            e
+        } else {
+            BadInput(format!("{e:#}")).into()
+        }
+    })
 }
 
 fn run_checked(args: &ReplayArgs) -> Result<()> {
     if args.traces.is_empty() {
-        bail!("fovea replay needs at least one trace (a trace file or a gaze source such as sim:1)");
+        bail!(
+            "fovea replay needs at least one trace (a trace file or a gaze source such as sim:1)"
+        );
     }
     if !(1..=64).contains(&args.rings) || !(1..=1 << 16).contains(&args.reference_spp) {
         bail!("--rings must be in 1..=64 and --reference-spp in 1..=65536");
@@ -103,17 +118,29 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
         results.push(result);
     }
     if args.update {
-        println!("fovea replay: wrote {} baseline(s) under {}", results.len(), args.baseline.display());
+        println!(
+            "fovea replay: wrote {} baseline(s) under {}",
+            results.len(),
+            args.baseline.display()
+        );
         return Ok(());
     }
     let failed: usize = results.iter().map(|r| r.failed_frames.len()).sum();
-    let report = ReplayReport { tolerances: &args.tolerances, passed: failed == 0, traces: results };
+    let report = ReplayReport {
+        tolerances: &args.tolerances,
+        passed: failed == 0,
+        traces: results,
+    };
     write_json(&args.out.join("replay.json"), &report)?;
     let table = markdown(&report);
     write_text(&args.out.join("replay.md"), &table)?;
     print!("{table}");
     if failed > 0 {
-        return Err(Regression { failed_frames: failed, report: args.out.join("replay.md") }.into());
+        return Err(Regression {
+            failed_frames: failed,
+            report: args.out.join("replay.md"),
+        }
+        .into());
     }
     Ok(())
 }
@@ -122,19 +149,43 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
     let name = trace_name(trace);
     // The trace first: a file that is not one is named as such, not as a missing baseline.
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
-    crate::gaze::GazeDriver::open(trace, &hmd, args.render.width.unwrap_or(64), args.render.height.unwrap_or(72))?;
+    crate::gaze::GazeDriver::open(
+        trace,
+        &hmd,
+        args.render.width.unwrap_or(64),
+        args.render.height.unwrap_or(72),
+    )?;
     let base_dir = args.baseline.join(&name);
-    let baseline = if args.update { None } else { Some(Baseline::load(&base_dir)?) };
+    let baseline = if args.update {
+        None
+    } else {
+        Some(Baseline::load(&base_dir)?)
+    };
     let frames = match (&baseline, args.frames) {
-        (Some(b), Some(n)) if n != b.params.frames => bail!("--frames {n}: the baseline {} has {} frames", base_dir.display(), b.params.frames),
+        (Some(b), Some(n)) if n != b.params.frames => bail!(
+            "--frames {n}: the baseline {} has {} frames",
+            base_dir.display(),
+            b.params.frames
+        ),
         (Some(b), _) => b.params.frames,
         (None, n) => n.unwrap_or(DEFAULT_FRAMES),
     };
     let run_dir = args.out.join(format!("run_{name}"));
-    let render = RenderArgs { gaze: trace, out: &run_dir, frames, eyes: super::setup::Eyes::Left, camera_path: Default::default(), ..args.render.clone() };
+    let render = RenderArgs {
+        gaze: trace,
+        out: &run_dir,
+        frames,
+        eyes: super::setup::Eyes::Left,
+        camera_path: Default::default(),
+        ..args.render.clone()
+    };
     super::render::run(&render)?;
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run_dir.join("report.json"))?)?;
-    let (width, height) = (report["width"].as_u64().unwrap_or(0) as u32, report["height"].as_u64().unwrap_or(0) as u32);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("report.json"))?)?;
+    let (width, height) = (
+        report["width"].as_u64().unwrap_or(0) as u32,
+        report["height"].as_u64().unwrap_or(0) as u32,
+    );
     let params = params_of(args, &render, width, height);
     let reference = match &baseline {
         Some(_) => read_exr(&Baseline::reference_exr(&base_dir))?.2,
@@ -142,43 +193,108 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
     };
     let reference_ldr = tonemap_preview(&reference, render.exposure);
     let ppd = pixels_per_degree(args, width)?;
-    let passes: BTreeMap<String, f64> = serde_json::from_value(report["passes"].clone()).unwrap_or_default();
+    let passes: BTreeMap<String, f64> =
+        serde_json::from_value(report["passes"].clone()).unwrap_or_default();
     let mut records = Vec::new();
     let mut checks = Vec::new();
     for k in 0..frames {
-        let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?.to_rgba8().into_raw();
+        let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?
+            .to_rgba8()
+            .into_raw();
         let reference_flip = flip_map(&reference_ldr, &ldr, width, height, ppd);
         let g = &report["gaze"][k as usize];
-        let gaze = Vec2::new(g[0].as_f64().unwrap_or(0.0) as f32, g[1].as_f64().unwrap_or(0.0) as f32);
-        let origin = report["gaze_origin"][k as usize].as_str().unwrap_or("").to_string();
+        let gaze = Vec2::new(
+            g[0].as_f64().unwrap_or(0.0) as f32,
+            g[1].as_f64().unwrap_or(0.0) as f32,
+        );
+        let origin = report["gaze_origin"][k as usize]
+            .as_str()
+            .unwrap_or("")
+            .to_string();
         match &baseline {
             None => {
-                let images = FrameImages { width, height, ldr: &ldr, ldr_baseline: &ldr, reference_flip: &reference_flip, gaze, origin: &origin };
-                records.push(FrameRecord { frame: k, gaze: gaze.to_array(), origin: origin.clone(), quality_flip: quality_flip(&images, args.rings) });
-                write_png(&Baseline::frame_png(&base_dir_created(&base_dir)?, k), width, height, &ldr)?;
+                let images = FrameImages {
+                    width,
+                    height,
+                    ldr: &ldr,
+                    ldr_baseline: &ldr,
+                    reference_flip: &reference_flip,
+                    gaze,
+                    origin: &origin,
+                };
+                records.push(FrameRecord {
+                    frame: k,
+                    gaze: gaze.to_array(),
+                    origin: origin.clone(),
+                    quality_flip: quality_flip(&images, args.rings),
+                });
+                write_png(
+                    &Baseline::frame_png(&base_dir_created(&base_dir)?, k),
+                    width,
+                    height,
+                    &ldr,
+                )?;
             }
             Some(b) => {
                 let base_png = Baseline::frame_png(&base_dir, k);
-                let base_ldr = image::open(&base_png).with_context(|| format!("reading {}", base_png.display()))?.to_rgba8();
+                let base_ldr = image::open(&base_png)
+                    .with_context(|| format!("reading {}", base_png.display()))?
+                    .to_rgba8();
                 if base_ldr.dimensions() != (width, height) {
-                    bail!("{}: {}×{}, the replay renders {width}×{height}", base_png.display(), base_ldr.width(), base_ldr.height());
+                    bail!(
+                        "{}: {}×{}, the replay renders {width}×{height}",
+                        base_png.display(),
+                        base_ldr.width(),
+                        base_ldr.height()
+                    );
                 }
                 let base_ldr = base_ldr.into_raw();
-                let images = FrameImages { width, height, ldr: &ldr, ldr_baseline: &base_ldr, reference_flip: &reference_flip, gaze, origin: &origin };
+                let images = FrameImages {
+                    width,
+                    height,
+                    ldr: &ldr,
+                    ldr_baseline: &base_ldr,
+                    reference_flip: &reference_flip,
+                    gaze,
+                    origin: &origin,
+                };
                 let flip = flip_map(&base_ldr, &ldr, width, height, ppd);
                 let check = check_frame(&images, &b.frames[k as usize], &flip, &args.tolerances);
                 if check.failed() {
-                    write_png(&run_dir.join(format!("frame_{k:04}_baseline.png")), width, height, &base_ldr)?;
-                    write_png(&run_dir.join(format!("frame_{k:04}_flip.png")), width, height, &flip_image(&flip, width, height))?;
+                    write_png(
+                        &run_dir.join(format!("frame_{k:04}_baseline.png")),
+                        width,
+                        height,
+                        &base_ldr,
+                    )?;
+                    write_png(
+                        &run_dir.join(format!("frame_{k:04}_flip.png")),
+                        width,
+                        height,
+                        &flip_image(&flip, width, height),
+                    )?;
                 }
                 checks.push(check);
             }
         }
     }
     if baseline.is_none() {
-        write_exr(&Baseline::reference_exr(&base_dir), width, height, &reference)?;
+        write_exr(
+            &Baseline::reference_exr(&base_dir),
+            width,
+            height,
+            &reference,
+        )?;
         let device = report["device"].as_str().unwrap_or("").to_string();
-        let new = Baseline { format: FORMAT.into(), trace: trace.into(), commit: current_commit(), device, params: params.clone(), frames: records, passes: passes.clone() };
+        let new = Baseline {
+            format: FORMAT.into(),
+            trace: trace.into(),
+            commit: current_commit(),
+            device,
+            params: params.clone(),
+            frames: records,
+            passes: passes.clone(),
+        };
         write_json(&base_dir.join("baseline.json"), &new)?;
     }
     let b = baseline.as_ref();
@@ -187,10 +303,25 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         baseline: base_dir.display().to_string(),
         baseline_commit: b.map(|b| b.commit.clone()).unwrap_or_default(),
         baseline_device: b.map(|b| b.device.clone()).unwrap_or_default(),
-        param_changes: b.map(|b| param_changes(&b.params, &params)).unwrap_or_default(),
-        failed_frames: checks.iter().filter(|c| c.failed()).map(|c| c.frame).collect(),
+        param_changes: b
+            .map(|b| param_changes(&b.params, &params))
+            .unwrap_or_default(),
+        failed_frames: checks
+            .iter()
+            .filter(|c| c.failed())
+            .map(|c| c.frame)
+            .collect(),
         frames: checks,
-        cost_ratio: b.map(|b| passes.iter().filter_map(|(k, v)| Some((k.clone(), v / b.passes.get(k).filter(|&&x| x > 0.0)?))).collect()).unwrap_or_default(),
+        cost_ratio: b
+            .map(|b| {
+                passes
+                    .iter()
+                    .filter_map(|(k, v)| {
+                        Some((k.clone(), v / b.passes.get(k).filter(|&&x| x > 0.0)?))
+                    })
+                    .collect()
+            })
+            .unwrap_or_default(),
     })
 }
 
@@ -220,17 +351,49 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
 }
 
 fn param_changes(base: &Params, now: &Params) -> Vec<(String, String, String)> {
-    let (a, b) = (serde_json::to_value(base).unwrap_or_default(), serde_json::to_value(now).unwrap_or_default());
-    let (Some(a), Some(b)) = (a.as_object(), b.as_object()) else { return Vec::new() };
-    a.iter().filter(|(k, v)| b.get(*k) != Some(v)).map(|(k, v)| (k.clone(), v.to_string(), b.get(k).map(|x| x.to_string()).unwrap_or_default())).collect()
+    let (a, b) = (
+        serde_json::to_value(base).unwrap_or_default(),
+        serde_json::to_value(now).unwrap_or_default(),
+    );
+    let (Some(a), Some(b)) = (a.as_object(), b.as_object()) else {
+        return Vec::new();
+    };
+    a.iter()
+        .filter(|(k, v)| b.get(*k) != Some(v))
+        .map(|(k, v)| {
+            (
+                k.clone(),
+                v.to_string(),
+                b.get(k).map(|x| x.to_string()).unwrap_or_default(),
+            )
+        })
+        .collect()
 }
 
 /// The converged image of the still camera (Cartesian, `--reference-spp` samples per pixel).
-fn reference_for(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Result<Vec<[f32; 4]>> {
-    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, width as f32 / height as f32)?;
+fn reference_for(
+    args: &ReplayArgs,
+    r: &RenderArgs,
+    width: u32,
+    height: u32,
+) -> Result<Vec<[f32; 4]>> {
+    let (scene, camera) = crate::look::load(
+        r.scene,
+        r.camera,
+        &r.profile.environment,
+        width as f32 / height as f32,
+    )?;
     let ctx = super::open_device(r.device, r.validation)?;
-    let settings = RenderSettings { seed: r.seed.wrapping_add(0x5eed), ..Default::default() };
-    let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(UVec2::new(width, height))), settings)?;
+    let settings = RenderSettings {
+        seed: r.seed.wrapping_add(0x5eed),
+        ..Default::default()
+    };
+    let mut renderer = Renderer::new(
+        &ctx,
+        &scene,
+        Box::new(Cartesian::new(UVec2::new(width, height))),
+        settings,
+    )?;
     let pose = CameraPose::from_scene_camera(&camera, width, height);
     let reference = renderer.render_reference(&pose, args.reference_spp, r.max_depth, |_| {})?;
     super::check_validation(&ctx)?;
@@ -244,9 +407,19 @@ fn pixels_per_degree(args: &ReplayArgs, width: u32) -> Result<f32> {
 }
 
 fn markdown(r: &ReplayReport) -> String {
-    let mut s = format!("# fovea replay: {}\n\n", if r.passed { "within tolerance" } else { "REGRESSION" });
+    let mut s = format!(
+        "# fovea replay: {}\n\n",
+        if r.passed {
+            "within tolerance"
+        } else {
+            "REGRESSION"
+        }
+    );
     for t in &r.traces {
-        s += &format!("## {} (baseline {} from commit {} on {})\n\n", t.trace, t.baseline, t.baseline_commit, t.baseline_device);
+        s += &format!(
+            "## {} (baseline {} from commit {} on {})\n\n",
+            t.trace, t.baseline, t.baseline_commit, t.baseline_device
+        );
         for (k, was, now) in &t.param_changes {
             s += &format!("- setting `{k}`: {was} in the baseline, {now} now\n");
         }
@@ -255,16 +428,60 @@ fn markdown(r: &ReplayReport) -> String {
         } else {
             s += "| frame | changed rings (FLIP, RMSE) | worse rings (error now > limit) | gaze |\n|---|---|---|---|\n";
             for c in t.frames.iter().filter(|c| c.failed()) {
-                let changed: Vec<String> = c.change.iter().filter(|x| x.changed).map(|x| format!("{}: {:.4}, {:.4}", x.ring, x.flip.unwrap_or(0.0), x.rmse.unwrap_or(0.0))).collect();
-                let worse: Vec<String> = c.quality.iter().filter(|x| x.regressed).map(|x| format!("{}: {:.4} > {:.4}", x.ring, x.actual.unwrap_or(0.0), x.limit.unwrap_or(0.0))).collect();
-                let gaze = if c.gaze_differs { format!("{:?} {} (baseline {:?} {})", c.gaze, c.origin, c.gaze_baseline, c.origin_baseline) } else { "same".into() };
-                s += &format!("| {} | {} | {} | {} |\n", c.frame, changed.join("; "), worse.join("; "), gaze);
+                let changed: Vec<String> = c
+                    .change
+                    .iter()
+                    .filter(|x| x.changed)
+                    .map(|x| {
+                        format!(
+                            "{}: {:.4}, {:.4}",
+                            x.ring,
+                            x.flip.unwrap_or(0.0),
+                            x.rmse.unwrap_or(0.0)
+                        )
+                    })
+                    .collect();
+                let worse: Vec<String> = c
+                    .quality
+                    .iter()
+                    .filter(|x| x.regressed)
+                    .map(|x| {
+                        format!(
+                            "{}: {:.4} > {:.4}",
+                            x.ring,
+                            x.actual.unwrap_or(0.0),
+                            x.limit.unwrap_or(0.0)
+                        )
+                    })
+                    .collect();
+                let gaze = if c.gaze_differs {
+                    format!(
+                        "{:?} {} (baseline {:?} {})",
+                        c.gaze, c.origin, c.gaze_baseline, c.origin_baseline
+                    )
+                } else {
+                    "same".into()
+                };
+                s += &format!(
+                    "| {} | {} | {} | {} |\n",
+                    c.frame,
+                    changed.join("; "),
+                    worse.join("; "),
+                    gaze
+                );
             }
             s += &format!("\nImages of failing frames: `run_{}/frame_NNNN.png` (now), `_baseline.png`, `_flip.png` (FLIP map).\n\n", trace_name(&t.trace));
         }
         if !t.cost_ratio.is_empty() {
-            let costs: Vec<String> = t.cost_ratio.iter().map(|(k, v)| format!("{k} {v:.2}×")).collect();
-            s += &format!("Cost now / baseline (GPU ms per pass, report only): {}\n\n", costs.join(", "));
+            let costs: Vec<String> = t
+                .cost_ratio
+                .iter()
+                .map(|(k, v)| format!("{k} {v:.2}×"))
+                .collect();
+            s += &format!(
+                "Cost now / baseline (GPU ms per pass, report only): {}\n\n",
+                costs.join(", ")
+            );
         }
     }
     s

@@ -77,7 +77,8 @@ impl Setup {
     /// Checks the flags and loads what the run needs. `frames`: the run's length (the camera
     /// path's period).
     pub fn new(args: &RenderArgs, frames: u32) -> Result<Setup> {
-        let hmd = HmdDescription::resolve(args.headset).with_context(|| format!("--headset {}", args.headset))?;
+        let hmd = HmdDescription::resolve(args.headset)
+            .with_context(|| format!("--headset {}", args.headset))?;
         check_common(args)?;
         let (scaled_width, scaled_height) = scaled_eye_size(hmd.eye(Eye::Left), args.scale);
         let width = args.width.unwrap_or(scaled_width);
@@ -89,7 +90,12 @@ impl Setup {
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
         let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
-        let (scene, camera) = crate::look::load(args.scene, args.camera, &args.profile.environment, width as f32 / height as f32)?;
+        let (scene, camera) = crate::look::load(
+            args.scene,
+            args.camera,
+            &args.profile.environment,
+            width as f32 / height as f32,
+        )?;
         let start_pose = CameraPose::from_scene_camera(&camera, width, height);
         let settings = render_settings(args, denoiser, taa);
         Ok(Setup {
@@ -114,19 +120,40 @@ impl Setup {
     }
 
     /// One sampling space per rendered eye, centred on the screen until the first gaze.
-    pub fn spaces(&self, method: &str, profile: &RenderProfile) -> Result<Vec<Box<dyn SamplingSpace>>> {
-        self.eyes.list().iter().map(|&eye| space_for(method, profile, &self.hmd, eye, self.screen())).collect()
+    pub fn spaces(
+        &self,
+        method: &str,
+        profile: &RenderProfile,
+    ) -> Result<Vec<Box<dyn SamplingSpace>>> {
+        self.eyes
+            .list()
+            .iter()
+            .map(|&eye| space_for(method, profile, &self.hmd, eye, self.screen()))
+            .collect()
     }
 
     /// Frame `frame`'s input: each eye's camera (the head pose on the camera path, offset by the
     /// eye's position) and gaze (the combined gaze direction projected into that eye).
     pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
         let gaze = self.gaze.frame(frame, self.eyes.list())?;
-        let head = camera_path::pose(&self.start_pose, self.scene_centre, frame, self.frames, &self.camera_path, self.hmd.refresh_hz);
-        let mut views = [ViewInput { camera: head, gaze: None }; 2];
+        let head = camera_path::pose(
+            &self.start_pose,
+            self.scene_centre,
+            frame,
+            self.frames,
+            &self.camera_path,
+            self.hmd.refresh_hz,
+        );
+        let mut views = [ViewInput {
+            camera: head,
+            gaze: None,
+        }; 2];
         let eyes = self.eyes.list();
         for (view, &eye) in views.iter_mut().zip(eyes) {
-            *view = ViewInput { camera: eye_pose(&head, &self.hmd, eye, self.eyes), gaze: Some(gaze.pixels[eye.index()]) };
+            *view = ViewInput {
+                camera: eye_pose(&head, &self.hmd, eye, self.eyes),
+                gaze: Some(gaze.pixels[eye.index()]),
+            };
         }
         Ok((FrameInput::views(&views[..eyes.len()], frame)?, gaze))
     }
@@ -134,9 +161,17 @@ impl Setup {
 
 /// The head pose for one eye: a mono run keeps the head pose (the scene camera, as before
 /// stereo); a stereo run offsets each eye by its position in the headset (metres = glTF units).
-pub(crate) fn eye_pose(head: &CameraPose, hmd: &HmdDescription, eye: Eye, eyes: Eyes) -> CameraPose {
+pub(crate) fn eye_pose(
+    head: &CameraPose,
+    hmd: &HmdDescription,
+    eye: Eye,
+    eyes: Eyes,
+) -> CameraPose {
     match eyes {
-        Eyes::Both => CameraPose { world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset), fov_tan: head.fov_tan },
+        Eyes::Both => CameraPose {
+            world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset),
+            fov_tan: head.fov_tan,
+        },
         _ => *head,
     }
 }
@@ -257,7 +292,11 @@ pub fn scaled_eye_size(eye: &EyeView, scale: f32) -> (u32, u32) {
 }
 
 /// The engine settings the render flags give, with the filters already chosen (`filters`).
-pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMode) -> RenderSettings {
+pub fn render_settings(
+    args: &RenderArgs,
+    denoiser: DenoiserSettings,
+    taa: TaaMode,
+) -> RenderSettings {
     RenderSettings {
         max_depth: args.max_depth,
         seed: args.seed,
@@ -275,23 +314,43 @@ pub fn render_settings(args: &RenderArgs, denoiser: DenoiserSettings, taa: TaaMo
 /// `--denoiser` and `--taa` with their parameters from the profile (`fovea render`, `fovea view`'s
 /// live switching and `fovea xr` share it); whether the method's space runs them is checked by
 /// the renderer.
-pub fn filters(denoiser: &str, taa: &str, profile: &RenderProfile) -> Result<(DenoiserSettings, TaaMode)> {
+pub fn filters(
+    denoiser: &str,
+    taa: &str,
+    profile: &RenderProfile,
+) -> Result<(DenoiserSettings, TaaMode)> {
     let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
         DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
         DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
         DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
         other => other,
     };
-    let taa_mode = TaaMode::parse(taa).context("--taa")?.with_settings(profile.taa);
+    let taa_mode = TaaMode::parse(taa)
+        .context("--taa")?
+        .with_settings(profile.taa);
     Ok((denoiser_settings, taa_mode))
 }
 
 /// The sampling space of `method_name` for one eye of `hmd` (its FOV drives the headset ρ axis).
-pub fn space_for(method_name: &str, profile: &RenderProfile, hmd: &HmdDescription, eye: Eye, screen: UVec2) -> Result<Box<dyn SamplingSpace>> {
+pub fn space_for(
+    method_name: &str,
+    profile: &RenderProfile,
+    hmd: &HmdDescription,
+    eye: Eye,
+    screen: UVec2,
+) -> Result<Box<dyn SamplingSpace>> {
     check_space(method_name, profile, screen)?;
     let fov = crate::render_profile::fov_tangents(&hmd.eye(eye).fov);
-    let vp = profile.visual_polar_for(fov).with_context(|| format!("--headset {}", hmd.id))?;
-    method(method_name)?.space(&SpaceInputs { profile, hmd, fov, vp, screen })
+    let vp = profile
+        .visual_polar_for(fov)
+        .with_context(|| format!("--headset {}", hmd.id))?;
+    method(method_name)?.space(&SpaceInputs {
+        profile,
+        hmd,
+        fov,
+        vp,
+        screen,
+    })
 }
 
 /// The eye's name in file names and reports.

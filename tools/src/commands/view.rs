@@ -12,7 +12,9 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::{FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS};
+use fovea_renderer::pipeline::{
+    FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{UVec2, Vec2};
 use gpu_allocator::MemoryLocation;
@@ -47,12 +49,18 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         .iter()
         .find(|(name, _)| *name == args.present_mode)
         .map(|p| p.1)
-        .ok_or_else(|| anyhow!("--present-mode {}: expected one of fifo, mailbox, immediate", args.present_mode))?;
+        .ok_or_else(|| {
+            anyhow!(
+                "--present-mode {}: expected one of fifo, mailbox, immediate",
+                args.present_mode
+            )
+        })?;
     if args.screenshot.is_some() && args.frames.is_none() {
         bail!("--screenshot needs --frames N (the screenshot is of frame N − 1)");
     }
     let setup = Setup::new(&args.render, args.frames.unwrap_or(u32::MAX))?;
-    let event_loop = EventLoop::new().context("opening the display (X11 or Wayland; is DISPLAY or WAYLAND_DISPLAY set?)")?;
+    let event_loop = EventLoop::new()
+        .context("opening the display (X11 or Wayland; is DISPLAY or WAYLAND_DISPLAY set?)")?;
     let display = event_loop.display_handle()?.as_raw();
     let mut options = super::device_options(args.render.device, args.render.validation);
     options.instance_extensions = ash_window::enumerate_required_extensions(display)?
@@ -64,7 +72,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let ctx = Context::new(&options).context("opening the Vulkan device")?;
     let scene = GpuScene::upload(&ctx, &setup.scene)?;
     let spaces = setup.spaces(args.render.method, &args.render.profile)?;
-    let renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, args.render.frames_in_flight.max(1))?;
+    let renderer = Renderer::with_views(
+        &ctx,
+        scene,
+        spaces,
+        setup.settings,
+        args.render.frames_in_flight.max(1),
+    )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Viewer {
         args,
@@ -149,7 +163,9 @@ impl ApplicationHandler for Viewer<'_> {
                 }
                 Ok(())
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => self.key(event_loop, &event.logical_key),
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                self.key(event_loop, &event.logical_key)
+            }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
             _ => Ok(()),
         };
@@ -188,25 +204,51 @@ impl Viewer<'_> {
     fn open_window(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let eyes = self.setup.eyes.list().len() as u32;
         let size = winit::dpi::PhysicalSize::new(self.setup.width * eyes, self.setup.height);
-        let attrs = Window::default_attributes().with_title("fovea").with_inner_size(size).with_resizable(true);
+        let attrs = Window::default_attributes()
+            .with_title("fovea")
+            .with_inner_size(size)
+            .with_resizable(true);
         let window = Arc::new(event_loop.create_window(attrs)?);
         let surface = unsafe {
-            ash_window::create_surface(&self.ctx.entry, &self.ctx.instance, window.display_handle()?.as_raw(), window.window_handle()?.as_raw(), None)?
+            ash_window::create_surface(
+                &self.ctx.entry,
+                &self.ctx.instance,
+                window.display_handle()?.as_raw(),
+                window.window_handle()?.as_raw(),
+                None,
+            )?
         };
         let surface_loader = ash::khr::surface::Instance::new(&self.ctx.entry, &self.ctx.instance);
         if !self.ctx.queue_supports_surface(&surface_loader, surface)? {
-            bail!("the compute queue of {} cannot present to this window", self.ctx.info.name);
+            bail!(
+                "the compute queue of {} cannot present to this window",
+                self.ctx.info.name
+            );
         }
         let acquired = (0..self.renderer.frames_in_flight())
-            .map(|_| unsafe { self.ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) })
+            .map(|_| unsafe {
+                self.ctx
+                    .device
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            })
             .collect::<std::result::Result<Vec<_>, _>>()?;
-        self.window = Some(WindowState { window, surface_loader, surface, swapchain: None, acquired, screenshot: None, debug_staging: None });
+        self.window = Some(WindowState {
+            window,
+            surface_loader,
+            surface,
+            swapchain: None,
+            acquired,
+            screenshot: None,
+            debug_staging: None,
+        });
         self.rebuild_swapchain()
     }
 
     /// A new swapchain at the window's size, and views resized to it (each eye half the width).
     fn rebuild_swapchain(&mut self) -> Result<()> {
-        let Some(mut w) = self.window.take() else { return Ok(()) };
+        let Some(mut w) = self.window.take() else {
+            return Ok(());
+        };
         let result = self.rebuild_swapchain_of(&mut w);
         self.window = Some(w);
         result
@@ -220,7 +262,14 @@ impl Viewer<'_> {
         // A resize is not the steady state: drain the frames that use the old images.
         self.renderer.finish()?;
         let old = w.swapchain.take();
-        let swapchain = Swapchain::new(&self.ctx, &w.surface_loader, w.surface, (size.width, size.height), self.present_mode, old.as_ref().map_or(vk::SwapchainKHR::null(), |s| s.raw))?;
+        let swapchain = Swapchain::new(
+            &self.ctx,
+            &w.surface_loader,
+            w.surface,
+            (size.width, size.height),
+            self.present_mode,
+            old.as_ref().map_or(vk::SwapchainKHR::null(), |s| s.raw),
+        )?;
         drop(old);
         if w.swapchain.is_none() && self.frame == 0 {
             eprintln!(
@@ -234,7 +283,10 @@ impl Viewer<'_> {
         if self.args.frames.is_none() && eye != self.setup.screen() && eye.x > 0 {
             self.setup.width = eye.x;
             self.setup.height = eye.y;
-            self.setup.start_pose = fovea_renderer::pipeline::CameraPose { fov_tan: scaled_fov(self.setup.start_pose.fov_tan, eye), ..self.setup.start_pose };
+            self.setup.start_pose = fovea_renderer::pipeline::CameraPose {
+                fov_tan: scaled_fov(self.setup.start_pose.fov_tan, eye),
+                ..self.setup.start_pose
+            };
             self.rebuild_views()?;
         }
         if self.args.screenshot.is_some() {
@@ -242,7 +294,13 @@ impl Viewer<'_> {
                 bail!("this surface does not allow copying its images (TRANSFER_SRC): no --screenshot");
             }
             let bytes = swapchain.extent.width as u64 * swapchain.extent.height as u64 * 4;
-            w.screenshot = Some(Buffer::new(&self.ctx, "screenshot", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+            w.screenshot = Some(Buffer::new(
+                &self.ctx,
+                "screenshot",
+                bytes,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?);
         }
         w.debug_staging = None; // sized by the extent
         w.swapchain = Some(swapchain);
@@ -251,15 +309,36 @@ impl Viewer<'_> {
 
     fn rebuild_views(&mut self) -> Result<()> {
         let profile = &self.args.render.profile;
-        let spaces = self.setup.eyes.list().iter().map(|&eye| space_for(&self.method, profile, &self.setup.hmd, eye, self.setup.screen())).collect::<Result<Vec<_>>>()?;
+        let spaces = self
+            .setup
+            .eyes
+            .list()
+            .iter()
+            .map(|&eye| {
+                space_for(
+                    &self.method,
+                    profile,
+                    &self.setup.hmd,
+                    eye,
+                    self.setup.screen(),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
         let (denoiser, taa) = super::setup::filters(&self.denoiser, &self.taa, profile)?;
-        let settings = RenderSettings { denoiser, taa, ..self.renderer.settings };
+        let settings = RenderSettings {
+            denoiser,
+            taa,
+            ..self.renderer.settings
+        };
         self.renderer.replace_views(spaces, settings)?;
         Ok(())
     }
 
     fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) -> Result<()> {
-        let next = |list: &[&str], current: &str| list[(list.iter().position(|m| *m == current).unwrap_or(0) + 1) % list.len()].to_string();
+        let next = |list: &[&str], current: &str| {
+            list[(list.iter().position(|m| *m == current).unwrap_or(0) + 1) % list.len()]
+                .to_string()
+        };
         match key.as_ref() {
             Key::Named(NamedKey::Escape) | Key::Character("q") => {
                 event_loop.exit();
@@ -298,9 +377,18 @@ impl Viewer<'_> {
         self.renderer.retire_next()?;
         let slot = self.renderer.ring().next_slot();
         let Some(w) = &self.window else { return Ok(()) };
-        let Some(swapchain) = &w.swapchain else { return Ok(()) };
+        let Some(swapchain) = &w.swapchain else {
+            return Ok(());
+        };
         let acquired = w.acquired[slot];
-        let (index, _) = match unsafe { swapchain.loader.acquire_next_image(swapchain.raw, u64::MAX, acquired, vk::Fence::null()) } {
+        let (index, _) = match unsafe {
+            swapchain.loader.acquire_next_image(
+                swapchain.raw,
+                u64::MAX,
+                acquired,
+                vk::Fence::null(),
+            )
+        } {
             Ok(r) => r,
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => return self.rebuild_swapchain(),
             Err(e) => return Err(e.into()),
@@ -319,13 +407,19 @@ impl Viewer<'_> {
         let target = FrameTarget {
             image,
             offsets,
-            sync: SubmitSync { wait: &waits, signal: &rendered },
+            sync: SubmitSync {
+                wait: &waits,
+                signal: &rendered,
+            },
             copy_to: if last { w.screenshot.as_ref() } else { None },
         };
         self.renderer.submit(&input, Some(&target))?;
         let swapchains = [swapchain.raw];
         let indices = [index];
-        let present = vk::PresentInfoKHR::default().wait_semaphores(&rendered).swapchains(&swapchains).image_indices(&indices);
+        let present = vk::PresentInfoKHR::default()
+            .wait_semaphores(&rendered)
+            .swapchains(&swapchains)
+            .image_indices(&indices);
         let result = {
             let _queue = self.ctx.queue_guard();
             unsafe { swapchain.loader.queue_present(self.ctx.queue, &present) }
@@ -348,10 +442,21 @@ impl Viewer<'_> {
         let frame = self.renderer.submit(&input, None)?;
         self.renderer.finish()?;
         let eye = self.setup.screen();
-        let pixels = compose(self.debug, &self.renderer, frame, eye, &self.setup.hmd, self.setup.eyes.list())?;
+        let pixels = compose(
+            self.debug,
+            &self.renderer,
+            frame,
+            eye,
+            &self.setup.hmd,
+            self.setup.eyes.list(),
+        )?;
         let last = self.args.frames.is_some_and(|n| self.frame + 1 == n);
-        let Some(w) = self.window.as_mut() else { return Ok(()) };
-        let Some(swapchain) = &w.swapchain else { return Ok(()) };
+        let Some(w) = self.window.as_mut() else {
+            return Ok(());
+        };
+        let Some(swapchain) = &w.swapchain else {
+            return Ok(());
+        };
         let (width, height) = (eye.x * self.setup.eyes.list().len() as u32, eye.y);
         if (swapchain.extent.width, swapchain.extent.height) != (width, height) {
             return Ok(()); // mid-resize: the views follow on the next frame
@@ -360,11 +465,19 @@ impl Viewer<'_> {
             bail!("this surface does not allow copying into its images (TRANSFER_DST): no debug views");
         }
         if w.debug_staging.is_none() {
-            w.debug_staging = Some(Buffer::new(&self.ctx, "debug view", pixels.len() as u64, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?);
+            w.debug_staging = Some(Buffer::new(
+                &self.ctx,
+                "debug view",
+                pixels.len() as u64,
+                vk::BufferUsageFlags::TRANSFER_SRC,
+                MemoryLocation::CpuToGpu,
+            )?);
         }
-        let presented = swapchain.present_pixels(w.debug_staging.as_ref().expect("made above"), &pixels)?;
+        let presented =
+            swapchain.present_pixels(w.debug_staging.as_ref().expect("made above"), &pixels)?;
         if let (true, Some(path)) = (last, self.args.screenshot) {
-            crate::output::write_png(path, width, height, &pixels).with_context(|| format!("--screenshot {}", path.display()))?;
+            crate::output::write_png(path, width, height, &pixels)
+                .with_context(|| format!("--screenshot {}", path.display()))?;
         }
         self.frame += 1;
         self.frames_since_title += 1;
@@ -382,11 +495,21 @@ impl Viewer<'_> {
         if !self.args.mouse_gaze || self.args.frames.is_some() {
             return Ok(input);
         }
-        let mut views = [ViewInput { camera: input.view_inputs()[0].camera, gaze: None }; MAX_VIEWS];
+        let mut views = [ViewInput {
+            camera: input.view_inputs()[0].camera,
+            gaze: None,
+        }; MAX_VIEWS];
         let count = input.view_inputs().len();
         for (view, given) in views.iter_mut().zip(input.view_inputs()) {
             // None keeps the space's gaze: frozen, or no cursor yet.
-            *view = ViewInput { camera: given.camera, gaze: if self.frozen { None } else { self.mouse.or(given.gaze) } };
+            *view = ViewInput {
+                camera: given.camera,
+                gaze: if self.frozen {
+                    None
+                } else {
+                    self.mouse.or(given.gaze)
+                },
+            };
         }
         Ok(FrameInput::views(&views[..count], self.frame)?)
     }
@@ -398,7 +521,13 @@ impl Viewer<'_> {
         }
         let fps = self.frames_since_title as f64 / elapsed;
         let total: f64 = self.renderer.timings().iter().map(|t| t.ms).sum();
-        let trace: f64 = self.renderer.timings().iter().filter(|t| t.name == "trace").map(|t| t.ms).sum();
+        let trace: f64 = self
+            .renderer
+            .timings()
+            .iter()
+            .filter(|t| t.name == "trace")
+            .map(|t| t.ms)
+            .sum();
         let title = format!(
             "fovea — {} · {} · taa {} · {:.1} fps · GPU {:.1} ms (trace {:.1}) · {}{}[m d t f v: method denoiser taa freeze debug view]",
             self.method,
@@ -421,16 +550,25 @@ impl Viewer<'_> {
         if self.debug != DebugView::Off {
             return Ok(()); // redraw_debug saved the picture it presented
         }
-        let (Some(path), Some(w)) = (self.args.screenshot, &self.window) else { return Ok(()) };
+        let (Some(path), Some(w)) = (self.args.screenshot, &self.window) else {
+            return Ok(());
+        };
         self.renderer.finish()?;
-        let (Some(buffer), Some(swapchain)) = (&w.screenshot, &w.swapchain) else { return Ok(()) };
+        let (Some(buffer), Some(swapchain)) = (&w.screenshot, &w.swapchain) else {
+            return Ok(());
+        };
         let mut pixels = vec![0u8; buffer.size as usize];
         buffer.read_into(&mut pixels)?;
         if swapchain.format == vk::Format::B8G8R8A8_UNORM {
             pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
         }
-        crate::output::write_png(path, swapchain.extent.width, swapchain.extent.height, &pixels)
-            .with_context(|| format!("--screenshot {}", path.display()))
+        crate::output::write_png(
+            path,
+            swapchain.extent.width,
+            swapchain.extent.height,
+            &pixels,
+        )
+        .with_context(|| format!("--screenshot {}", path.display()))
     }
 }
 

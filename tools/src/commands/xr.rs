@@ -13,11 +13,15 @@ use crate::xr::gaze::{Timebase, XrFrameGaze, XrGaze};
 use crate::xr::vulkan::{binding, open_context, XrSwapchain};
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
-use fovea_hal::openxr::{xr, GazeActions, OpenXrGaze, OpenXrRuntime, RuntimeFigures, SessionEnd, SessionOwner};
+use fovea_hal::openxr::{
+    xr, GazeActions, OpenXrGaze, OpenXrRuntime, RuntimeFigures, SessionEnd, SessionOwner,
+};
 use fovea_hal::{Eye, GazeOrigin, HmdDescription};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS};
+use fovea_renderer::pipeline::{
+    CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
@@ -87,18 +91,30 @@ pub fn run(args: &XrArgs) -> Result<()> {
     }
     check_common(r)?;
     let (denoiser, taa) = filters(r.denoiser, r.taa, &r.profile)?;
-    let base = HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
+    let base =
+        HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
     let eye = base.eye(fovea_hal::Eye::Left);
     // The runtime's size is known only later; the headset's recommended eye frames the scene.
     let aspect = eye.recommended_width as f32 / eye.recommended_height.max(1) as f32;
     let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, aspect)?;
     let camera = &camera;
     let out_dir = prepare_output_dir(r.out)?;
-    let rt = Arc::new(OpenXrRuntime::create("fovea").context("fovea xr needs an OpenXR runtime (see README: On a headset)")?);
+    let rt = Arc::new(
+        OpenXrRuntime::create("fovea")
+            .context("fovea xr needs an OpenXR runtime (see README: On a headset)")?,
+    );
     let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;
     let settings = render_settings(r, denoiser, taa);
     let started = Instant::now();
-    let (mut run, session) = XrRun::start(args, &rt, ctx, &base, &scene, camera.world_from_view, settings)?;
+    let (mut run, session) = XrRun::start(
+        args,
+        &rt,
+        ctx,
+        &base,
+        &scene,
+        camera.world_from_view,
+        settings,
+    )?;
     let end = run.frame_loop()?;
     run.finish(&rt, &base, &session, end, started)?;
     out_dir.remove_stale()?;
@@ -145,7 +161,10 @@ impl<'a> XrRun<'a> {
             let actions = GazeActions::new(rt)?;
             owner.attach_action_sets(&actions.action_set().into_iter().collect::<Vec<_>>())?;
             let gaze = OpenXrGaze::new(rt, &owner, actions, base)?;
-            let (hmd, figures) = (fovea_hal::GazeSource::describe(&gaze).clone(), gaze.runtime_figures());
+            let (hmd, figures) = (
+                fovea_hal::GazeSource::describe(&gaze).clone(),
+                gaze.runtime_figures(),
+            );
             (hmd, figures, Some(gaze))
         } else {
             let (hmd, figures) = owner.describe(base, false)?;
@@ -153,10 +172,18 @@ impl<'a> XrRun<'a> {
         };
         let eye_size = scaled_eye_size(hmd.eye(Eye::Left), r.scale);
         let (driver, timebase, gaze_source) = match source {
-            Some(gaze) => (GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1), Timebase::Runtime, "openxr".to_string()),
+            Some(gaze) => (
+                GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1),
+                Timebase::Runtime,
+                "openxr".to_string(),
+            ),
             None => {
                 let spec = args.gaze.unwrap_or("center");
-                (GazeDriver::open(spec, &hmd, eye_size.0, eye_size.1)?, Timebase::FromFirstFrame, spec.to_string())
+                (
+                    GazeDriver::open(spec, &hmd, eye_size.0, eye_size.1)?,
+                    Timebase::FromFirstFrame,
+                    spec.to_string(),
+                )
             }
         };
         let gaze = XrGaze::new(driver, timebase, base, args.record)?;
@@ -168,15 +195,51 @@ impl<'a> XrRun<'a> {
             hmd.display_name, eye_size.0, eye_size.1, swapchain.format, hmd.refresh_hz
         );
         let screen = UVec2::new(eye_size.0, eye_size.1);
-        let spaces = [Eye::Left, Eye::Right].iter().map(|&e| space_for(r.method, &r.profile, &hmd, e, screen)).collect::<Result<Vec<_>>>()?;
-        let renderer = Renderer::with_views(&ctx, GpuScene::upload(&ctx, scene)?, spaces, settings, r.frames_in_flight.max(1))?;
+        let spaces = [Eye::Left, Eye::Right]
+            .iter()
+            .map(|&e| space_for(r.method, &r.profile, &hmd, e, screen))
+            .collect::<Result<Vec<_>>>()?;
+        let renderer = Renderer::with_views(
+            &ctx,
+            GpuScene::upload(&ctx, scene)?,
+            spaces,
+            settings,
+            r.frames_in_flight.max(1),
+        )?;
         let screenshot = match args.screenshot {
-            Some(_) => Some(Buffer::new(&ctx, "xr screenshot", swapchain.images[0].bytes(), vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?),
+            Some(_) => Some(Buffer::new(
+                &ctx,
+                "xr screenshot",
+                swapchain.images[0].bytes(),
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?),
             None => None,
         };
         let log = FrameLog::create(&r.out.join("frames.jsonl"))?;
-        let run = XrRun { args, ctx, owner, local, view_space, swapchain, renderer, gaze, world_from_local, log, screenshot, tally: Tally::default() };
-        Ok((run, SessionFacts { hmd, figures, gaze_source, notice }))
+        let run = XrRun {
+            args,
+            ctx,
+            owner,
+            local,
+            view_space,
+            swapchain,
+            renderer,
+            gaze,
+            world_from_local,
+            log,
+            screenshot,
+            tally: Tally::default(),
+        };
+        Ok((
+            run,
+            SessionFacts {
+                hmd,
+                figures,
+                gaze_source,
+                notice,
+            },
+        ))
     }
 
     /// Runs frames until the session ends; returns why it ended.
@@ -230,20 +293,38 @@ impl<'a> XrRun<'a> {
         // One xrSyncActions per frame for every attached set, before the gaze source reads.
         self.owner.sync_actions()?;
         let eye_size = (self.swapchain.eye_width, self.swapchain.height);
-        let gaze = self.gaze.frame(t, self.tally.rendered, &eyes_in_head, eye_size)?;
+        let gaze = self
+            .gaze
+            .frame(t, self.tally.rendered, &eyes_in_head, eye_size)?;
         self.count_gaze(&gaze);
-        let mut inputs = [ViewInput { camera: self.camera(&views[0]), gaze: None }; MAX_VIEWS];
+        let mut inputs = [ViewInput {
+            camera: self.camera(&views[0]),
+            gaze: None,
+        }; MAX_VIEWS];
         for (i, view) in views.iter().enumerate() {
-            inputs[i] = ViewInput { camera: self.camera(view), gaze: Some(gaze.pixels[i]) };
+            inputs[i] = ViewInput {
+                camera: self.camera(view),
+                gaze: Some(gaze.pixels[i]),
+            };
         }
         let input = FrameInput::views(&inputs, self.tally.rendered)?;
-        let index = self.swapchain.handle.acquire_image().context("xrAcquireSwapchainImage")? as usize;
-        self.swapchain.handle.wait_image(xr::Duration::INFINITE).context("xrWaitSwapchainImage")?;
+        let index = self
+            .swapchain
+            .handle
+            .acquire_image()
+            .context("xrAcquireSwapchainImage")? as usize;
+        self.swapchain
+            .handle
+            .wait_image(xr::Duration::INFINITE)
+            .context("xrWaitSwapchainImage")?;
         // The slot this frame takes held frame − frames in flight: read its GPU times first.
         if let Some(done) = self.renderer.retire_next()? {
             self.read_finished(done)?;
         }
-        let last = self.args.frames.is_some_and(|n| self.tally.rendered + 1 == n);
+        let last = self
+            .args
+            .frames
+            .is_some_and(|n| self.tally.rendered + 1 == n);
         let mut offsets = [UVec2::ZERO; MAX_VIEWS];
         offsets[1] = UVec2::new(self.swapchain.eye_width, 0);
         let target = FrameTarget {
@@ -254,7 +335,10 @@ impl<'a> XrRun<'a> {
         };
         // Submitted before the release: the runtime waits for the queue's work on the image.
         let engine_frame = self.renderer.submit(&input, Some(&target))?;
-        self.swapchain.handle.release_image().context("xrReleaseSwapchainImage")?;
+        self.swapchain
+            .handle
+            .release_image()
+            .context("xrReleaseSwapchainImage")?;
         self.end_with_layer(t, &views)?;
         self.tally.rendered += 1;
         let row = FrameRow {
@@ -262,7 +346,10 @@ impl<'a> XrRun<'a> {
             predicted_display_time_ns: t,
             should_render: true,
             rendered: true,
-            views: vec![ViewRow::new("left", &views[0]), ViewRow::new("right", &views[1])],
+            views: vec![
+                ViewRow::new("left", &views[0]),
+                ViewRow::new("right", &views[1]),
+            ],
             gaze: Some(gaze_row(&gaze)),
             gpu_ms: None,
             cpu_ms: 0.0,
@@ -271,19 +358,37 @@ impl<'a> XrRun<'a> {
     }
 
     fn end_with_layer(&mut self, t: i64, views: &[xr::View]) -> Result<()> {
-        let (w, h) = (self.swapchain.eye_width as i32, self.swapchain.height as i32);
+        let (w, h) = (
+            self.swapchain.eye_width as i32,
+            self.swapchain.height as i32,
+        );
         let projection: Vec<_> = views
             .iter()
             .enumerate()
             .map(|(i, v)| {
-                let rect = xr::Rect2Di { offset: xr::Offset2Di { x: i as i32 * w, y: 0 }, extent: xr::Extent2Di { width: w, height: h } };
+                let rect = xr::Rect2Di {
+                    offset: xr::Offset2Di {
+                        x: i as i32 * w,
+                        y: 0,
+                    },
+                    extent: xr::Extent2Di {
+                        width: w,
+                        height: h,
+                    },
+                };
                 xr::CompositionLayerProjectionView::new()
                     .pose(v.pose)
                     .fov(v.fov)
-                    .sub_image(xr::SwapchainSubImage::new().swapchain(&self.swapchain.handle).image_rect(rect))
+                    .sub_image(
+                        xr::SwapchainSubImage::new()
+                            .swapchain(&self.swapchain.handle)
+                            .image_rect(rect),
+                    )
             })
             .collect();
-        let layer = xr::CompositionLayerProjection::new().space(&self.local).views(&projection);
+        let layer = xr::CompositionLayerProjection::new()
+            .space(&self.local)
+            .views(&projection);
         self.owner.end_frame(t, &[&layer])?;
         Ok(())
     }
@@ -291,10 +396,18 @@ impl<'a> XrRun<'a> {
     /// An eye's camera: its located pose (LOCAL space) placed at the scene camera, its FOV.
     fn camera(&self, view: &xr::View) -> CameraPose {
         let (p, o, f) = (view.pose.position, view.pose.orientation, view.fov);
-        let local_from_eye = Mat4::from_rotation_translation(Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize(), Vec3::new(p.x, p.y, p.z));
+        let local_from_eye = Mat4::from_rotation_translation(
+            Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize(),
+            Vec3::new(p.x, p.y, p.z),
+        );
         CameraPose {
             world_from_view: self.world_from_local * local_from_eye,
-            fov_tan: Vec4::new(f.angle_left.tan(), f.angle_right.tan(), f.angle_down.tan(), f.angle_up.tan()),
+            fov_tan: Vec4::new(
+                f.angle_left.tan(),
+                f.angle_right.tan(),
+                f.angle_down.tan(),
+                f.angle_up.tan(),
+            ),
         }
     }
 
@@ -328,7 +441,14 @@ impl<'a> XrRun<'a> {
     }
 
     /// Drains the ring, writes the log, the screenshot, the recording and report.json.
-    fn finish(mut self, rt: &OpenXrRuntime, base: &HmdDescription, facts: &SessionFacts, end: SessionEnd, started: Instant) -> Result<()> {
+    fn finish(
+        mut self,
+        rt: &OpenXrRuntime,
+        base: &HmdDescription,
+        facts: &SessionFacts,
+        end: SessionEnd,
+        started: Instant,
+    ) -> Result<()> {
         self.renderer.finish()?;
         let submitted = self.renderer.ring().next_frame();
         let in_flight = self.renderer.frames_in_flight() as u64;
@@ -337,7 +457,15 @@ impl<'a> XrRun<'a> {
         }
         self.save_screenshot()?;
         super::check_validation(&self.ctx)?;
-        let XrRun { args, log, gaze, tally, swapchain, ctx, .. } = self;
+        let XrRun {
+            args,
+            log,
+            gaze,
+            tally,
+            swapchain,
+            ctx,
+            ..
+        } = self;
         let logged = log.commit()?;
         let recorded = gaze.finish()?;
         let report = super::xr_report::build(&super::xr_report::Inputs {
@@ -386,14 +514,17 @@ impl<'a> XrRun<'a> {
     }
 
     fn save_screenshot(&self) -> Result<()> {
-        let (Some(path), Some(buffer)) = (self.args.screenshot, &self.screenshot) else { return Ok(()) };
+        let (Some(path), Some(buffer)) = (self.args.screenshot, &self.screenshot) else {
+            return Ok(());
+        };
         let mut pixels = vec![0u8; buffer.size as usize];
         buffer.read_into(&mut pixels)?;
         if self.swapchain.format == vk::Format::B8G8R8A8_UNORM {
             pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
         }
         let (w, h) = (self.swapchain.eye_width * 2, self.swapchain.height);
-        crate::output::write_png(path, w, h, &pixels).with_context(|| format!("--screenshot {}", path.display()))
+        crate::output::write_png(path, w, h, &pixels)
+            .with_context(|| format!("--screenshot {}", path.display()))
     }
 }
 

@@ -138,16 +138,39 @@ pub struct XrReport {
 }
 
 pub fn build(i: &Inputs) -> Result<XrReport> {
-    let props = i.rt.instance.properties().context("xrGetInstanceProperties")?;
-    let sys = i.rt.instance.system_properties(i.rt.system).context("xrGetSystemProperties")?;
+    let props =
+        i.rt.instance
+            .properties()
+            .context("xrGetInstanceProperties")?;
+    let sys =
+        i.rt.instance
+            .system_properties(i.rt.system)
+            .context("xrGetSystemProperties")?;
     let t = i.tally;
     let r = &i.args.render;
-    let source = |from_runtime: bool| if from_runtime { "runtime" } else { "headset TOML" };
+    let source = |from_runtime: bool| {
+        if from_runtime {
+            "runtime"
+        } else {
+            "headset TOML"
+        }
+    };
     let eye_frames = (t.timed as u64 * 2).max(1);
-    let passes: BTreeMap<String, f64> = t.pass_sums.iter().map(|(k, v)| (k.clone(), v / t.timed.max(1) as f64)).collect();
+    let passes: BTreeMap<String, f64> = t
+        .pass_sums
+        .iter()
+        .map(|(k, v)| (k.clone(), v / t.timed.max(1) as f64))
+        .collect();
     Ok(XrReport {
-        runtime: Runtime { name: props.runtime_name.clone(), version: props.runtime_version.to_string() },
-        monotonic_minus_xr_time_ns: i.rt.now().ok().and_then(|t| Some(i.rt.time_to_monotonic(t).ok()? - t)),
+        runtime: Runtime {
+            name: props.runtime_name.clone(),
+            version: props.runtime_version.to_string(),
+        },
+        monotonic_minus_xr_time_ns: i
+            .rt
+            .now()
+            .ok()
+            .and_then(|t| Some(i.rt.time_to_monotonic(t).ok()? - t)),
         system: System {
             name: sys.system_name.clone(),
             vendor_id: sys.vendor_id,
@@ -221,5 +244,9 @@ fn gaze_age(ages_ns: &[i64]) -> GazeAge {
         let i = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
         Some(sorted[i] as f64 / 1e6)
     };
-    GazeAge { median_ms: rank(0.5), p99_ms: rank(0.99), frames: sorted.len() }
+    GazeAge {
+        median_ms: rank(0.5),
+        p99_ms: rank(0.99),
+        frames: sorted.len(),
+    }
 }

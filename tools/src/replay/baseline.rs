@@ -61,16 +61,30 @@ impl Baseline {
     pub fn load(dir: &Path) -> Result<Baseline> {
         let path = dir.join("baseline.json");
         if !path.exists() {
-            bail!("no baseline at {} (make one with --update-baseline)", dir.display());
+            bail!(
+                "no baseline at {} (make one with --update-baseline)",
+                dir.display()
+            );
         }
         let text = fovea_hal::file::read_text(&path, 16 << 20, "replay baseline")?;
-        let baseline: Baseline = serde_json::from_str(&text).with_context(|| format!("{}: not a replay baseline", path.display()))?;
+        let baseline: Baseline = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a replay baseline", path.display()))?;
         if baseline.format != FORMAT {
-            bail!("{}: format '{}', expected '{FORMAT}'", path.display(), baseline.format);
+            bail!(
+                "{}: format '{}', expected '{FORMAT}'",
+                path.display(),
+                baseline.format
+            );
         }
         for (i, f) in baseline.frames.iter().enumerate() {
             if f.frame != i as u32 || f.quality_flip.len() != baseline.params.rings {
-                bail!("{}: frames[{i}] is frame {} with {} rings; expected frame {i} with {} rings", path.display(), f.frame, f.quality_flip.len(), baseline.params.rings);
+                bail!(
+                    "{}: frames[{i}] is frame {} with {} rings; expected frame {i} with {} rings",
+                    path.display(),
+                    f.frame,
+                    f.quality_flip.len(),
+                    baseline.params.rings
+                );
             }
         }
         Ok(baseline)
@@ -89,9 +103,21 @@ impl Baseline {
 /// [A-Za-z0-9_-] replaced (`sim:1` → `sim-1`).
 pub fn trace_name(trace: &str) -> String {
     let path = Path::new(trace);
-    let stem = if path.extension().is_some() { path.file_stem().map(|s| s.to_string_lossy().into_owned()) } else { None };
+    let stem = if path.extension().is_some() {
+        path.file_stem().map(|s| s.to_string_lossy().into_owned())
+    } else {
+        None
+    };
     let raw = stem.unwrap_or_else(|| trace.to_string());
-    raw.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '-' }).collect()
+    raw.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
 }
 
 /// The commit of the working tree the tool runs in, if it is a git checkout.

@@ -27,7 +27,13 @@ pub struct Tolerances {
 impl Default for Tolerances {
     fn default() -> Self {
         // Same device and build: frames are bit-identical; these allow another driver's rounding.
-        Tolerances { change_flip: 0.01, change_rmse: 0.004, quality_rel: 0.05, quality_abs: 0.005, gaze_px: 1e-3 }
+        Tolerances {
+            change_flip: 0.01,
+            change_rmse: 0.004,
+            quality_rel: 0.05,
+            quality_abs: 0.005,
+            gaze_px: 1e-3,
+        }
     }
 }
 
@@ -93,20 +99,41 @@ pub fn quality_flip(images: &FrameImages, rings: usize) -> Vec<Option<f64>> {
 }
 
 /// The frame against its baseline record; `flip_map`: per-pixel FLIP of now against the baseline.
-pub fn check_frame(images: &FrameImages, base: &FrameRecord, flip_map: &[f64], tol: &Tolerances) -> FrameCheck {
-    let rings = Rings::new(images.width, images.height, images.gaze, base.quality_flip.len());
+pub fn check_frame(
+    images: &FrameImages,
+    base: &FrameRecord,
+    flip_map: &[f64],
+    tol: &Tolerances,
+) -> FrameCheck {
+    let rings = Rings::new(
+        images.width,
+        images.height,
+        images.gaze,
+        base.quality_flip.len(),
+    );
     let squared: Vec<f64> = images
         .ldr
         .chunks_exact(4)
         .zip(images.ldr_baseline.chunks_exact(4))
-        .map(|(a, b)| (0..3).map(|c| ((a[c] as f64 - b[c] as f64) / 255.0).powi(2)).sum::<f64>() / 3.0)
+        .map(|(a, b)| {
+            (0..3)
+                .map(|c| ((a[c] as f64 - b[c] as f64) / 255.0).powi(2))
+                .sum::<f64>()
+                / 3.0
+        })
         .collect();
     let (flip, mse) = (rings.mean(flip_map), rings.mean(&squared));
     let change = (0..rings.count)
         .map(|i| {
             let rmse = mse[i].map(f64::sqrt);
-            let changed = flip[i].is_some_and(|f| f > tol.change_flip) || rmse.is_some_and(|r| r > tol.change_rmse);
-            RingChange { ring: i, flip: flip[i], rmse, changed }
+            let changed = flip[i].is_some_and(|f| f > tol.change_flip)
+                || rmse.is_some_and(|r| r > tol.change_rmse);
+            RingChange {
+                ring: i,
+                flip: flip[i],
+                rmse,
+                changed,
+            }
         })
         .collect();
     let quality = rings
@@ -117,7 +144,13 @@ pub fn check_frame(images: &FrameImages, base: &FrameRecord, flip_map: &[f64], t
         .map(|(ring, (actual, &baseline))| {
             let limit = baseline.map(|b| b * (1.0 + tol.quality_rel) + tol.quality_abs);
             let regressed = matches!((actual, limit), (Some(a), Some(l)) if a > l);
-            RingQuality { ring, baseline, actual, limit, regressed }
+            RingQuality {
+                ring,
+                baseline,
+                actual,
+                limit,
+                regressed,
+            }
         })
         .collect();
     let gaze_baseline = Vec2::from_array(base.gaze);
@@ -129,6 +162,7 @@ pub fn check_frame(images: &FrameImages, base: &FrameRecord, flip_map: &[f64], t
         gaze_baseline: base.gaze,
         origin: images.origin.to_string(),
         origin_baseline: base.origin.clone(),
-        gaze_differs: (images.gaze - gaze_baseline).length() as f64 > tol.gaze_px || images.origin != base.origin,
+        gaze_differs: (images.gaze - gaze_baseline).length() as f64 > tol.gaze_px
+            || images.origin != base.origin,
     }
 }

@@ -29,7 +29,8 @@ pub fn build() -> GltfWriter {
     let green = w.add_material(diffuse("green", [0.14, 0.45, 0.091]));
     let mut light_material = diffuse("light", [0.78, 0.78, 0.78]);
     light_material["emissiveFactor"] = json!([1.0, 12.0 / 17.0, 4.0 / 17.0]);
-    light_material["extensions"]["KHR_materials_emissive_strength"] = json!({"emissiveStrength": 17.0});
+    light_material["extensions"]["KHR_materials_emissive_strength"] =
+        json!({"emissiveStrength": 17.0});
     let light = w.add_material(light_material);
 
     let (x0, x1, y1, z0, z1) = (-0.5, 0.5, 1.0, -0.5, 0.5);
@@ -37,8 +38,20 @@ pub fn build() -> GltfWriter {
         ("floor", Vec3::new(x0, 0.0, z1), Vec3::X, Vec3::NEG_Z, white),
         ("ceiling", Vec3::new(x0, y1, z0), Vec3::X, Vec3::Z, white),
         ("back wall", Vec3::new(x0, 0.0, z0), Vec3::X, Vec3::Y, white),
-        ("left wall", Vec3::new(x0, 0.0, z1), Vec3::NEG_Z, Vec3::Y, red),
-        ("right wall", Vec3::new(x1, 0.0, z0), Vec3::Z, Vec3::Y, green),
+        (
+            "left wall",
+            Vec3::new(x0, 0.0, z1),
+            Vec3::NEG_Z,
+            Vec3::Y,
+            red,
+        ),
+        (
+            "right wall",
+            Vec3::new(x1, 0.0, z0),
+            Vec3::Z,
+            Vec3::Y,
+            green,
+        ),
     ];
     for (name, corner, u, v, material) in walls {
         let mesh = w.add_mesh(name, &quad(corner, u, v, 1, Vec2::ONE), material);
@@ -46,7 +59,13 @@ pub fn build() -> GltfWriter {
     }
     // The light: 0.235 × 0.19 m (the original 130 × 105 mm), 1 mm under the ceiling, facing down.
     let (lw, ld) = (0.235, 0.19);
-    let lamp = quad(Vec3::new(-lw / 2.0, y1 - 0.001, -ld / 2.0), Vec3::X * lw, Vec3::Z * ld, 1, Vec2::ONE);
+    let lamp = quad(
+        Vec3::new(-lw / 2.0, y1 - 0.001, -ld / 2.0),
+        Vec3::X * lw,
+        Vec3::Z * ld,
+        1,
+        Vec2::ONE,
+    );
     let lamp = w.add_mesh("light", &lamp, light);
     w.add_root_node(json!({"name": "light", "mesh": lamp}));
 
@@ -54,14 +73,33 @@ pub fn build() -> GltfWriter {
     // tall: back left). One unit cube mesh, instanced with scale, exercises node transforms.
     let cube = w.add_mesh("block", &cuboid(Vec3::ONE), white);
     let blocks = [
-        ("short block", Vec3::new(0.3, 0.3, 0.3), Vec3::new(0.19, 0.15, 0.2), -17.0f32),
-        ("tall block", Vec3::new(0.3, 0.6, 0.3), Vec3::new(-0.165, 0.3, -0.2), 17.0),
+        (
+            "short block",
+            Vec3::new(0.3, 0.3, 0.3),
+            Vec3::new(0.19, 0.15, 0.2),
+            -17.0f32,
+        ),
+        (
+            "tall block",
+            Vec3::new(0.3, 0.6, 0.3),
+            Vec3::new(-0.165, 0.3, -0.2),
+            17.0,
+        ),
     ];
     for (name, size, centre, degrees) in blocks {
-        let (t, r) = translation_rotation(Mat4::from_rotation_translation(Quat::from_rotation_y(degrees.to_radians()), centre));
+        let (t, r) = translation_rotation(Mat4::from_rotation_translation(
+            Quat::from_rotation_y(degrees.to_radians()),
+            centre,
+        ));
         w.add_root_node(json!({"name": name, "mesh": cube, "translation": t.to_array(), "rotation": r.to_array(), "scale": size.to_array()}));
     }
     // The original camera: 800 mm in front of the opening, centred, 39.3° vertical field of view.
-    w.add_camera("camera", 39.3f32.to_radians(), 1.0, [0.0, 0.5, z1 + 800.0 / 555.0], [0.0, 0.0, 0.0, 1.0]);
+    w.add_camera(
+        "camera",
+        39.3f32.to_radians(),
+        1.0,
+        [0.0, 0.5, z1 + 800.0 / 555.0],
+        [0.0, 0.0, 0.0, 1.0],
+    );
     w
 }

@@ -31,7 +31,8 @@ impl GltfWriter {
     fn push_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         let padding = (4 - self.buffer.len() % 4) % 4;
         self.buffer.resize(self.buffer.len() + padding, 0);
-        let mut view = json!({"buffer": 0, "byteOffset": self.buffer.len(), "byteLength": bytes.len()});
+        let mut view =
+            json!({"buffer": 0, "byteOffset": self.buffer.len(), "byteLength": bytes.len()});
         if let Some(target) = target {
             view["target"] = json!(target);
         }
@@ -45,7 +46,13 @@ impl GltfWriter {
         self.accessors.len() - 1
     }
 
-    fn float_accessor(&mut self, data: &[f32], components: usize, kind: &str, with_bounds: bool) -> usize {
+    fn float_accessor(
+        &mut self,
+        data: &[f32],
+        components: usize,
+        kind: &str,
+        with_bounds: bool,
+    ) -> usize {
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.push_view(&bytes, Some(34962));
         let mut accessor = json!({"bufferView": view, "componentType": 5126, "count": data.len() / components, "type": kind});
@@ -75,9 +82,18 @@ impl GltfWriter {
         let uv = self.float_accessor(&uvs, 2, "VEC2", false);
         // 16-bit indices when they fit: half the bytes for every small mesh.
         let (bytes, component): (Vec<u8>, u32) = if mesh.positions.len() <= u16::MAX as usize {
-            (mesh.indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(), 5123)
+            (
+                mesh.indices
+                    .iter()
+                    .flat_map(|&i| (i as u16).to_le_bytes())
+                    .collect(),
+                5123,
+            )
         } else {
-            (mesh.indices.iter().flat_map(|i| i.to_le_bytes()).collect(), 5125)
+            (
+                mesh.indices.iter().flat_map(|i| i.to_le_bytes()).collect(),
+                5125,
+            )
         };
         let view = self.push_view(&bytes, Some(34963));
         let indices = self.push_accessor(json!({"bufferView": view, "componentType": component, "count": mesh.indices.len(), "type": "SCALAR"}));
@@ -94,7 +110,10 @@ impl GltfWriter {
         if let Some(ext) = material.get("extensions").and_then(Value::as_object) {
             for (name, known) in [
                 ("KHR_materials_specular", "KHR_materials_specular"),
-                ("KHR_materials_emissive_strength", "KHR_materials_emissive_strength"),
+                (
+                    "KHR_materials_emissive_strength",
+                    "KHR_materials_emissive_strength",
+                ),
                 ("KHR_materials_ior", "KHR_materials_ior"),
             ] {
                 if ext.contains_key(name) {
@@ -109,8 +128,10 @@ impl GltfWriter {
     /// Embeds PNG bytes as an image + texture (repeat wrapping, trilinear); returns the texture index.
     pub fn add_png_texture(&mut self, name: &str, png: &[u8]) -> usize {
         let view = self.push_view(png, None);
-        self.images.push(json!({"name": name, "bufferView": view, "mimeType": "image/png"}));
-        self.textures.push(json!({"source": self.images.len() - 1, "sampler": 0}));
+        self.images
+            .push(json!({"name": name, "bufferView": view, "mimeType": "image/png"}));
+        self.textures
+            .push(json!({"source": self.images.len() - 1, "sampler": 0}));
         self.textures.len() - 1
     }
 
@@ -125,7 +146,14 @@ impl GltfWriter {
     }
 
     /// A perspective camera at `translation` with rotation quaternion `rotation` (xyzw).
-    pub fn add_camera(&mut self, name: &str, yfov: f32, aspect: f32, translation: [f32; 3], rotation: [f32; 4]) {
+    pub fn add_camera(
+        &mut self,
+        name: &str,
+        yfov: f32,
+        aspect: f32,
+        translation: [f32; 3],
+        rotation: [f32; 4],
+    ) {
         self.cameras.push(json!({"name": name, "type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": 0.01}}));
         self.add_root_node(json!({"name": name, "camera": self.cameras.len() - 1, "translation": translation, "rotation": rotation}));
     }
@@ -139,7 +167,10 @@ impl GltfWriter {
     }
 
     pub fn finish(self) -> Value {
-        let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&self.buffer));
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.buffer)
+        );
         let mut doc = json!({
             "asset": {"version": "2.0", "generator": "fovea scenegen"},
             "scene": 0,
@@ -158,7 +189,8 @@ impl GltfWriter {
             doc["images"] = json!(self.images);
             doc["textures"] = json!(self.textures);
             // 10497 = REPEAT, 9729 = LINEAR, 9987 = LINEAR_MIPMAP_LINEAR.
-            doc["samplers"] = json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
+            doc["samplers"] =
+                json!([{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]);
         }
         if !self.lights.is_empty() {
             doc["extensions"] = json!({"KHR_lights_punctual": {"lights": self.lights}});

@@ -23,7 +23,10 @@ fn pbr(name: &str, rgb: [f32; 3], metallic: f32, roughness: f32) -> serde_json::
 pub fn build(min_triangles: usize) -> GltfWriter {
     let mut w = GltfWriter::default();
     let mut rng = SplitMix64::new(0x5350_4f4e_5a41); // fixed seed
-    let checker = w.add_png_texture("floor checker", &near_checker_png(512, 4, [60, 50, 40], [200, 185, 160], &mut rng));
+    let checker = w.add_png_texture(
+        "floor checker",
+        &near_checker_png(512, 4, [60, 50, 40], [200, 185, 160], &mut rng),
+    );
     let mut floor_mat = pbr("floor", [1.0, 1.0, 1.0], 0.0, 0.7);
     floor_mat["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": checker});
     let floor_mat = w.add_material(floor_mat);
@@ -37,7 +40,13 @@ pub fn build(min_triangles: usize) -> GltfWriter {
     let lamp = w.add_material(lamp);
 
     let (half_x, half_z) = (BAYS_X as f32 * BAY / 2.0, BAYS_Z as f32 * BAY / 2.0);
-    let floor = quad(Vec3::new(-half_x - 4.0, 0.0, half_z + 4.0), Vec3::X * (2.0 * half_x + 8.0), Vec3::NEG_Z * (2.0 * half_z + 8.0), 16, Vec2::splat(12.0));
+    let floor = quad(
+        Vec3::new(-half_x - 4.0, 0.0, half_z + 4.0),
+        Vec3::X * (2.0 * half_x + 8.0),
+        Vec3::NEG_Z * (2.0 * half_z + 8.0),
+        16,
+        Vec2::splat(12.0),
+    );
     let floor = w.add_mesh("floor", &floor, floor_mat);
     w.add_root_node(json!({"name": "floor", "mesh": floor}));
 
@@ -46,7 +55,11 @@ pub fn build(min_triangles: usize) -> GltfWriter {
     let block = w.add_mesh("column block", &cuboid(Vec3::new(0.8, 0.2, 0.8)), stone);
     // A semicircular arch between neighbouring columns (half torus standing in the XY plane).
     let arch = w.add_mesh("arch", &torus(BAY / 2.0, 0.18, 32, 12, PI), stone);
-    let slab = w.add_mesh("gallery slab", &cuboid(Vec3::new(2.0 * half_x + 2.0, 0.3, 2.0)), stone);
+    let slab = w.add_mesh(
+        "gallery slab",
+        &cuboid(Vec3::new(2.0 * half_x + 2.0, 0.3, 2.0)),
+        stone,
+    );
 
     let mut columns = Vec::new();
     for i in 0..=BAYS_X {
@@ -88,13 +101,27 @@ pub fn build(min_triangles: usize) -> GltfWriter {
     ];
     let mut k = 0usize;
     while w.scene_triangles < min_triangles {
-        let p = Vec3::new(rng.range(-half_x + 1.0, half_x - 1.0), rng.range(0.3, 2.0), rng.range(-half_z + 1.0, half_z - 1.0));
+        let p = Vec3::new(
+            rng.range(-half_x + 1.0, half_x - 1.0),
+            rng.range(0.3, 2.0),
+            rng.range(-half_z + 1.0, half_z - 1.0),
+        );
         let r = Quat::from_axis_angle(rng.unit_vector(), rng.range(0.0, 2.0 * PI));
         w.add_root_node(json!({"mesh": props[k % props.len()], "translation": p.to_array(), "rotation": r.to_array()}));
         k += 1;
     }
 
-    let panel = w.add_mesh("light panel", &quad(Vec3::new(-2.0, 9.0, -1.0), Vec3::X * 4.0, Vec3::Z * 2.0, 1, Vec2::ONE), lamp);
+    let panel = w.add_mesh(
+        "light panel",
+        &quad(
+            Vec3::new(-2.0, 9.0, -1.0),
+            Vec3::X * 4.0,
+            Vec3::Z * 2.0,
+            1,
+            Vec2::ONE,
+        ),
+        lamp,
+    );
     w.add_root_node(json!({"name": "light panel", "mesh": panel}));
     let sun = Quat::from_rotation_arc(Vec3::NEG_Z, Vec3::new(-0.4, -0.8, -0.45).normalize());
     w.add_light(
@@ -105,6 +132,12 @@ pub fn build(min_triangles: usize) -> GltfWriter {
     let eye = Vec3::new(half_x - 2.2, 1.7, half_z - 1.2);
     let dir = (Vec3::new(0.0, 1.0, 0.0) - eye).normalize();
     let look = Quat::from_rotation_y((-dir.x).atan2(-dir.z)) * Quat::from_rotation_x(dir.y.asin());
-    w.add_camera("camera", 60f32.to_radians(), 1280.0 / 1440.0, eye.to_array(), look.normalize().to_array());
+    w.add_camera(
+        "camera",
+        60f32.to_radians(),
+        1280.0 / 1440.0,
+        eye.to_array(),
+        look.normalize().to_array(),
+    );
     w
 }

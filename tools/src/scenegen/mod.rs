@@ -64,7 +64,10 @@ pub fn scene_json(kind: &SceneKind) -> (serde_json::Value, usize) {
 /// mistyped path cannot silently destroy a scene.
 pub fn write_scene(kind: &SceneKind, out: &Path, overwrite: bool) -> anyhow::Result<SceneStats> {
     if out.exists() && !overwrite {
-        bail!("{} already exists (pass overwrite to replace it)", out.display());
+        bail!(
+            "{} already exists (pass overwrite to replace it)",
+            out.display()
+        );
     }
     let (doc, triangles) = scene_json(kind);
     let text = serde_json::to_string(&doc).context("serialising the glTF JSON")?;

@@ -21,8 +21,14 @@ fn textured(name: &str, texture: usize) -> Value {
 pub fn build() -> GltfWriter {
     let mut w = GltfWriter::default();
     let mut rng = SplitMix64::new(0x5745_5353); // fixed seed: the stored file is reproducible
-    let checker = w.add_png_texture("near-checker", &near_checker_png(512, 3, [30, 30, 34], [215, 210, 200], &mut rng));
-    let grid = w.add_png_texture("fine-grid", &fine_grid_png(256, 4, [180, 170, 150], [40, 40, 60]));
+    let checker = w.add_png_texture(
+        "near-checker",
+        &near_checker_png(512, 3, [30, 30, 34], [215, 210, 200], &mut rng),
+    );
+    let grid = w.add_png_texture(
+        "fine-grid",
+        &fine_grid_png(256, 4, [180, 170, 150], [40, 40, 60]),
+    );
 
     let floor_mat = w.add_material(textured("checker floor", checker));
     let wall_mat = w.add_material(textured("grid wall", grid));
@@ -40,13 +46,43 @@ pub fn build() -> GltfWriter {
     let frame = w.add_material(pbr("dark frame", [0.05, 0.05, 0.05], 0.0, 0.6));
 
     // Floor 8 × 8 m, texture repeated 4× per side: a texel is ~4 mm, a square ~12 mm.
-    let floor = w.add_mesh("floor", &quad(Vec3::new(-4.0, 0.0, 4.0), Vec3::X * 8.0, Vec3::NEG_Z * 8.0, 8, Vec2::splat(4.0)), floor_mat);
+    let floor = w.add_mesh(
+        "floor",
+        &quad(
+            Vec3::new(-4.0, 0.0, 4.0),
+            Vec3::X * 8.0,
+            Vec3::NEG_Z * 8.0,
+            8,
+            Vec2::splat(4.0),
+        ),
+        floor_mat,
+    );
     w.add_root_node(json!({"name": "floor", "mesh": floor}));
-    let wall = w.add_mesh("back wall", &quad(Vec3::new(-4.0, 0.0, -4.0), Vec3::X * 8.0, Vec3::Y * 3.0, 4, Vec2::new(8.0, 3.0)), wall_mat);
+    let wall = w.add_mesh(
+        "back wall",
+        &quad(
+            Vec3::new(-4.0, 0.0, -4.0),
+            Vec3::X * 8.0,
+            Vec3::Y * 3.0,
+            4,
+            Vec2::new(8.0, 3.0),
+        ),
+        wall_mat,
+    );
     w.add_root_node(json!({"name": "back wall", "mesh": wall}));
 
     // A 1.2 × 1.8 m mirror on the left, turned towards the centre, in a thin frame.
-    let mirror = w.add_mesh("mirror", &quad(Vec3::new(-0.6, 0.1, 0.0), Vec3::X * 1.2, Vec3::Y * 1.8, 1, Vec2::ONE), mirror_mat);
+    let mirror = w.add_mesh(
+        "mirror",
+        &quad(
+            Vec3::new(-0.6, 0.1, 0.0),
+            Vec3::X * 1.2,
+            Vec3::Y * 1.8,
+            1,
+            Vec2::ONE,
+        ),
+        mirror_mat,
+    );
     let mirror_frame = w.add_mesh("mirror frame", &cuboid(Vec3::new(1.3, 1.9, 0.03)), frame);
     let turn = Quat::from_rotation_y(40f32.to_radians()).to_array();
     w.add_root_node(json!({"name": "mirror", "mesh": mirror, "translation": [-2.2, 0.0, -1.5], "rotation": turn}));
@@ -56,8 +92,12 @@ pub fn build() -> GltfWriter {
     let sphere = uv_sphere(0.35, 48, 96);
     let gold_sphere = w.add_mesh("gold sphere", &sphere, gold);
     let red_sphere = w.add_mesh("red sphere", &sphere, plastic);
-    w.add_root_node(json!({"name": "gold sphere", "mesh": gold_sphere, "translation": [-0.5, 0.35, -0.8]}));
-    w.add_root_node(json!({"name": "red sphere", "mesh": red_sphere, "translation": [0.6, 0.35, -0.3]}));
+    w.add_root_node(
+        json!({"name": "gold sphere", "mesh": gold_sphere, "translation": [-0.5, 0.35, -0.8]}),
+    );
+    w.add_root_node(
+        json!({"name": "red sphere", "mesh": red_sphere, "translation": [0.6, 0.35, -0.3]}),
+    );
     let ring = w.add_mesh("blue torus", &torus(0.4, 0.12, 64, 24, TAU), glaze);
     let stand_up = Quat::from_rotation_x(FRAC_PI_2) * Quat::from_rotation_z(0.3);
     w.add_root_node(json!({"name": "blue torus", "mesh": ring, "translation": [1.6, 0.52, -1.6], "rotation": stand_up.normalize().to_array()}));
@@ -65,10 +105,15 @@ pub fn build() -> GltfWriter {
     // The fence: 4 mm posts every 10 cm and 2 mm wires, 3 m long, diagonal through the view.
     let post = w.add_mesh("fence post", &cylinder(0.002, 1.2, 8, 1, 0, 0.0), steel);
     let wire = w.add_mesh("fence wire", &cylinder(0.001, 3.0, 6, 1, 0, 0.0), steel);
-    let (start, along) = (Vec3::new(-0.5, 0.0, 1.2), Vec3::new(1.0, 0.0, -0.35).normalize());
+    let (start, along) = (
+        Vec3::new(-0.5, 0.0, 1.2),
+        Vec3::new(1.0, 0.0, -0.35).normalize(),
+    );
     for i in 0..=30 {
         let p = start + along * (i as f32 * 0.1);
-        w.add_root_node(json!({"name": format!("post {i}"), "mesh": post, "translation": p.to_array()}));
+        w.add_root_node(
+            json!({"name": format!("post {i}"), "mesh": post, "translation": p.to_array()}),
+        );
     }
     // Wires lie along `along`: rotate the +Y cylinder onto that direction.
     let lay = Quat::from_rotation_arc(Vec3::Y, along);
@@ -79,16 +124,35 @@ pub fn build() -> GltfWriter {
 
     // Area light: a 1 × 0.5 m emissive panel 2.8 m up, facing down. Spot light: a warm key from
     // the right, aimed at the spheres (glTF lights shine along the node's −Z).
-    let panel = w.add_mesh("light panel", &quad(Vec3::new(-0.5, 2.8, -1.25), Vec3::X, Vec3::Z * 0.5, 1, Vec2::ONE), lamp);
+    let panel = w.add_mesh(
+        "light panel",
+        &quad(
+            Vec3::new(-0.5, 2.8, -1.25),
+            Vec3::X,
+            Vec3::Z * 0.5,
+            1,
+            Vec2::ONE,
+        ),
+        lamp,
+    );
     w.add_root_node(json!({"name": "light panel", "mesh": panel}));
     let spot_at = Vec3::new(2.5, 2.5, 1.5);
-    let aim = Quat::from_rotation_arc(Vec3::NEG_Z, (Vec3::new(0.0, 0.4, -0.6) - spot_at).normalize());
+    let aim = Quat::from_rotation_arc(
+        Vec3::NEG_Z,
+        (Vec3::new(0.0, 0.4, -0.6) - spot_at).normalize(),
+    );
     w.add_light(
         json!({"name": "spot", "type": "spot", "color": [1.0, 0.85, 0.7], "intensity": 40.0, "spot": {"innerConeAngle": 0.35, "outerConeAngle": 0.6}}),
         json!({"name": "spot", "translation": spot_at.to_array(), "rotation": aim.to_array()}),
     );
     // Camera at eye height looking slightly down into the scene; aspect of one 1280×1440 eye.
     let look = Quat::from_rotation_x(-12f32.to_radians());
-    w.add_camera("camera", 60f32.to_radians(), 1280.0 / 1440.0, [0.0, 1.6, 3.2], look.to_array());
+    w.add_camera(
+        "camera",
+        60f32.to_radians(),
+        1280.0 / 1440.0,
+        [0.0, 1.6, 3.2],
+        look.to_array(),
+    );
     w
 }

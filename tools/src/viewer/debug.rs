@@ -32,7 +32,10 @@ impl DebugView {
             "grid" => DebugView::Grid,
             "density" => DebugView::Density,
             "rings" => DebugView::Rings,
-            _ => bail!("--debug-view {name}: expected one of {}", DebugView::NAMES.join(", ")),
+            _ => bail!(
+                "--debug-view {name}: expected one of {}",
+                DebugView::NAMES.join(", ")
+            ),
         })
     }
 
@@ -52,7 +55,14 @@ impl DebugView {
 
 /// The debug picture of every view of completed frame `frame`, side by side (RGBA8, each view
 /// `eye.x` × `eye.y`). `eyes`: which headset eye each view is (for the rings' FOV).
-pub fn compose(mode: DebugView, renderer: &Renderer, frame: u64, eye: UVec2, hmd: &HmdDescription, eyes: &[Eye]) -> Result<Vec<u8>> {
+pub fn compose(
+    mode: DebugView,
+    renderer: &Renderer,
+    frame: u64,
+    eye: UVec2,
+    hmd: &HmdDescription,
+    eyes: &[Eye],
+) -> Result<Vec<u8>> {
     let (w, h) = (eye.x as usize, eye.y as usize);
     let width = w * eyes.len();
     let mut out = vec![0u8; width * h * 4];
@@ -68,7 +78,12 @@ pub fn compose(mode: DebugView, renderer: &Renderer, frame: u64, eye: UVec2, hmd
             DebugView::Density => {
                 // As `fovea render --debug-views`: a box average shows density, not the pattern.
                 let radius = (eye.x / 160).max(2);
-                heatmap_rgba(&box_filter(&samples_per_pixel(space), eye.x, eye.y, radius), eye.x, eye.y, space.gaze())
+                heatmap_rgba(
+                    &box_filter(&samples_per_pixel(space), eye.x, eye.y, radius),
+                    eye.x,
+                    eye.y,
+                    space.gaze(),
+                )
             }
             DebugView::Rings => {
                 renderer.read_view_ldr(frame, v, &mut pixels)?;
@@ -102,9 +117,13 @@ fn stretch(pixels: &[u8], from: UVec2, to: UVec2) -> Vec<u8> {
 /// (render pixels mapped onto the headset eye's FOV, as the headset shows them).
 fn draw_rings(pixels: &mut [u8], eye: UVec2, gaze: Vec2, hmd: &HmdDescription, headset_eye: Eye) {
     let view = hmd.eye(headset_eye);
-    let scale = Vec2::new(view.recommended_width as f32 / eye.x as f32, view.recommended_height as f32 / eye.y as f32);
+    let scale = Vec2::new(
+        view.recommended_width as f32 / eye.x as f32,
+        view.recommended_height as f32 / eye.y as f32,
+    );
     let gaze_dir = view.pixel_to_direction(gaze * scale - Vec2::splat(0.5));
-    let ecc = |x: u32, y: u32| view.eccentricity_deg(Vec2::new(x as f32, y as f32) * scale, gaze_dir);
+    let ecc =
+        |x: u32, y: u32| view.eccentricity_deg(Vec2::new(x as f32, y as f32) * scale, gaze_dir);
     for y in 0..eye.y.saturating_sub(1) {
         for x in 0..eye.x.saturating_sub(1) {
             // A ring passes between this pixel and its right or lower neighbour.
@@ -131,7 +150,10 @@ mod tests {
             m = m.next();
         }
         assert_eq!(m, DebugView::Off);
-        assert!(DebugView::parse("heat").unwrap_err().to_string().contains("--debug-view heat"));
+        assert!(DebugView::parse("heat")
+            .unwrap_err()
+            .to_string()
+            .contains("--debug-view heat"));
     }
 
     #[test]
@@ -144,7 +166,10 @@ mod tests {
         // Near the gaze (< 5°) nothing; along the row through it, rings on both sides.
         assert!(!white(80, 90) && !white(81, 90));
         let row: Vec<usize> = (0..160).filter(|&x| white(x, 90)).collect();
-        assert!(row.iter().any(|&x| x < 80) && row.iter().any(|&x| x > 80), "{row:?}");
+        assert!(
+            row.iter().any(|&x| x < 80) && row.iter().any(|&x| x > 80),
+            "{row:?}"
+        );
     }
 
     #[test]

@@ -39,8 +39,16 @@ impl ViewRow {
         let (p, o, f) = (view.pose.position, view.pose.orientation, view.fov);
         ViewRow {
             eye,
-            fov: FovTangents { left: f.angle_left.tan(), right: f.angle_right.tan(), down: f.angle_down.tan(), up: f.angle_up.tan() },
-            pose: Pose { position: [p.x, p.y, p.z], orientation: [o.x, o.y, o.z, o.w] },
+            fov: FovTangents {
+                left: f.angle_left.tan(),
+                right: f.angle_right.tan(),
+                down: f.angle_down.tan(),
+                up: f.angle_up.tan(),
+            },
+            pose: Pose {
+                position: [p.x, p.y, p.z],
+                orientation: [o.x, o.y, o.z, o.w],
+            },
         }
     }
 }
@@ -81,7 +89,16 @@ pub struct FrameRow {
 impl FrameRow {
     /// A frame ended without layers (`frame` and `cpu_ms` are filled in by the loop).
     pub fn not_rendered(predicted_display_time_ns: i64, should_render: bool) -> FrameRow {
-        FrameRow { frame: 0, predicted_display_time_ns, should_render, rendered: false, views: Vec::new(), gaze: None, gpu_ms: None, cpu_ms: 0.0 }
+        FrameRow {
+            frame: 0,
+            predicted_display_time_ns,
+            should_render,
+            rendered: false,
+            views: Vec::new(),
+            gaze: None,
+            gpu_ms: None,
+            cpu_ms: 0.0,
+        }
     }
 }
 
@@ -94,7 +111,11 @@ pub struct FrameLog {
 
 impl FrameLog {
     pub fn create(path: &Path) -> Result<FrameLog> {
-        Ok(FrameLog { out: AtomicWriter::create(path)?, pending: VecDeque::new(), written: 0 })
+        Ok(FrameLog {
+            out: AtomicWriter::create(path)?,
+            pending: VecDeque::new(),
+            written: 0,
+        })
     }
 
     /// Queues a row; `engine_frame`: the renderer's frame id whose GPU times fill `gpu_ms`.
@@ -115,10 +136,15 @@ impl FrameLog {
     }
 
     fn flush_ready(&mut self) -> Result<()> {
-        while self.pending.front().is_some_and(|(_, waits)| waits.is_none()) {
+        while self
+            .pending
+            .front()
+            .is_some_and(|(_, waits)| waits.is_none())
+        {
             let (row, _) = self.pending.pop_front().expect("front checked");
             let line = serde_json::to_string(&row)?;
-            writeln!(self.out.writer(), "{line}").with_context(|| format!("writing {}", self.out.path().display()))?;
+            writeln!(self.out.writer(), "{line}")
+                .with_context(|| format!("writing {}", self.out.path().display()))?;
             self.written += 1;
         }
         Ok(())

@@ -7,7 +7,9 @@
 use crate::gaze::{project_gaze, GazeDriver};
 use anyhow::{Context, Result};
 use fovea_hal::openxr::xr;
-use fovea_hal::{EyeView, Fov, GazeOrigin, GazeSample, HmdDescription, SampleTimeKind, TraceWriter, XrTime};
+use fovea_hal::{
+    EyeView, Fov, GazeOrigin, GazeSample, HmdDescription, SampleTimeKind, TraceWriter, XrTime,
+};
 use glam::{Quat, Vec2, Vec3};
 use std::path::Path;
 
@@ -50,17 +52,37 @@ impl XrGaze {
     /// `record`: a new trace file (an existing one is refused) written in `base`'s frame timebase
     /// (`index × 1 / base.refresh_hz`), which is what `fovea render --headset <the same> --gaze
     /// TRACE.csv` samples.
-    pub fn new(driver: GazeDriver, timebase: Timebase, base: &HmdDescription, record: Option<&Path>) -> Result<XrGaze> {
+    pub fn new(
+        driver: GazeDriver,
+        timebase: Timebase,
+        base: &HmdDescription,
+        record: Option<&Path>,
+    ) -> Result<XrGaze> {
         let recorder = match record {
-            Some(path) => Some(TraceWriter::create(base, path, false).with_context(|| format!("--record {}", path.display()))?),
+            Some(path) => Some(
+                TraceWriter::create(base, path, false)
+                    .with_context(|| format!("--record {}", path.display()))?,
+            ),
             None => None,
         };
-        Ok(XrGaze { driver, record_period_ns: 1e9 / base.refresh_hz as f64, timebase, first_display_time: None, recorder })
+        Ok(XrGaze {
+            driver,
+            record_period_ns: 1e9 / base.refresh_hz as f64,
+            timebase,
+            first_display_time: None,
+            recorder,
+        })
     }
 
     /// The gaze for the rendered frame `render_index` displayed at `display_time`; `eyes_in_head`:
     /// the two views located in VIEW space; `size`: one eye's render size.
-    pub fn frame(&mut self, display_time: XrTime, render_index: u32, eyes_in_head: &[xr::View], size: (u32, u32)) -> Result<XrFrameGaze> {
+    pub fn frame(
+        &mut self,
+        display_time: XrTime,
+        render_index: u32,
+        eyes_in_head: &[xr::View],
+        size: (u32, u32),
+    ) -> Result<XrFrameGaze> {
         let first = *self.first_display_time.get_or_insert(display_time);
         let t = match self.timebase {
             Timebase::Runtime => display_time,
@@ -90,14 +112,22 @@ impl XrGaze {
             }
         }
         if gaze.reason.is_some() {
-            gaze = XrFrameGaze { origin: GazeOrigin::Centre, age_ns: 0, sample_time_ns: None, pixels: [Vec2::new(size.0 as f32, size.1 as f32) * 0.5; 2], ..gaze };
+            gaze = XrFrameGaze {
+                origin: GazeOrigin::Centre,
+                age_ns: 0,
+                sample_time_ns: None,
+                pixels: [Vec2::new(size.0 as f32, size.1 as f32) * 0.5; 2],
+                ..gaze
+            };
         }
         self.record(render_index, &gaze)?;
         Ok(gaze)
     }
 
     fn record(&mut self, render_index: u32, gaze: &XrFrameGaze) -> Result<()> {
-        let Some(recorder) = self.recorder.as_mut() else { return Ok(()) };
+        let Some(recorder) = self.recorder.as_mut() else {
+            return Ok(());
+        };
         let t = crate::gaze::frame_time(self.record_period_ns, render_index);
         // Held gaze is written as the direction it held, so the replay shows the same pixels; no
         // gaze stays no gaze (the replay's invalid-gaze policy decides again, on its frame times).
@@ -112,7 +142,9 @@ impl XrGaze {
 
     /// Publishes the recording (if any); returns how many samples it holds.
     pub fn finish(self) -> Result<Option<usize>> {
-        let Some(recorder) = self.recorder else { return Ok(None) };
+        let Some(recorder) = self.recorder else {
+            return Ok(None);
+        };
         let written = recorder.samples_written();
         recorder.finish().context("--record")?;
         Ok(Some(written))
@@ -121,15 +153,29 @@ impl XrGaze {
 
 /// `direction` (VIEW space) as a pixel of the eye located at `eye_in_head` with `size`, or why it
 /// has none (`project_gaze`: the same rule as `fovea render`'s).
-pub fn project(direction: Vec3, eye_in_head: &xr::View, size: (u32, u32)) -> Result<Vec2, &'static str> {
+pub fn project(
+    direction: Vec3,
+    eye_in_head: &xr::View,
+    size: (u32, u32),
+) -> Result<Vec2, &'static str> {
     let o = eye_in_head.pose.orientation;
     let in_eye = Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize().inverse() * direction;
     let f = eye_in_head.fov;
     let view = EyeView {
         recommended_width: size.0,
         recommended_height: size.1,
-        fov: Fov { angle_left: f.angle_left, angle_right: f.angle_right, angle_down: f.angle_down, angle_up: f.angle_up },
+        fov: Fov {
+            angle_left: f.angle_left,
+            angle_right: f.angle_right,
+            angle_down: f.angle_down,
+            angle_up: f.angle_up,
+        },
         offset: Vec3::ZERO,
     };
-    project_gaze(&view, in_eye, Vec2::ONE, Vec2::new(size.0 as f32, size.1 as f32))
+    project_gaze(
+        &view,
+        in_eye,
+        Vec2::ONE,
+        Vec2::new(size.0 as f32, size.1 as f32),
+    )
 }

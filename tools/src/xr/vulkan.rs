@@ -15,26 +15,54 @@ pub struct RuntimeDevice(pub Arc<OpenXrRuntime>);
 
 fn loader_gipa(entry: &ash::Entry) -> xr::sys::platform::VkGetInstanceProcAddr {
     // SAFETY: the same C function pointer; OpenXR's binding types Vulkan's handles as void.
-    unsafe { std::mem::transmute::<vk::PFN_vkGetInstanceProcAddr, xr::sys::platform::VkGetInstanceProcAddr>(entry.static_fn().get_instance_proc_addr) }
+    unsafe {
+        std::mem::transmute::<vk::PFN_vkGetInstanceProcAddr, xr::sys::platform::VkGetInstanceProcAddr>(
+            entry.static_fn().get_instance_proc_addr,
+        )
+    }
 }
 
 impl DeviceCreator for RuntimeDevice {
-    unsafe fn create_instance(&self, entry: &ash::Entry, info: &vk::InstanceCreateInfo) -> Result<vk::Instance, String> {
+    unsafe fn create_instance(
+        &self,
+        entry: &ash::Entry,
+        info: &vk::InstanceCreateInfo,
+    ) -> Result<vk::Instance, String> {
         // SAFETY: `info` is valid for the call (the caller's contract).
-        let raw = unsafe { self.0.create_vulkan_instance(loader_gipa(entry), info as *const _ as *const c_void) }.map_err(|e| e.to_string())?;
+        let raw = unsafe {
+            self.0
+                .create_vulkan_instance(loader_gipa(entry), info as *const _ as *const c_void)
+        }
+        .map_err(|e| e.to_string())?;
         Ok(vk::Instance::from_raw(raw as u64))
     }
 
     unsafe fn physical_device(&self, instance: vk::Instance) -> Result<vk::PhysicalDevice, String> {
         // SAFETY: `instance` came from `create_instance` (the caller's contract).
-        let raw = unsafe { self.0.vulkan_physical_device(instance.as_raw() as usize as *const c_void) }.map_err(|e| e.to_string())?;
+        let raw = unsafe {
+            self.0
+                .vulkan_physical_device(instance.as_raw() as usize as *const c_void)
+        }
+        .map_err(|e| e.to_string())?;
         Ok(vk::PhysicalDevice::from_raw(raw as u64))
     }
 
-    unsafe fn create_device(&self, entry: &ash::Entry, physical: vk::PhysicalDevice, info: &vk::DeviceCreateInfo) -> Result<vk::Device, String> {
+    unsafe fn create_device(
+        &self,
+        entry: &ash::Entry,
+        physical: vk::PhysicalDevice,
+        info: &vk::DeviceCreateInfo,
+    ) -> Result<vk::Device, String> {
         let physical = physical.as_raw() as usize as *const c_void;
         // SAFETY: `physical` came from `physical_device`, `info` is valid (the caller's contract).
-        let raw = unsafe { self.0.create_vulkan_device(loader_gipa(entry), physical, info as *const _ as *const c_void) }.map_err(|e| e.to_string())?;
+        let raw = unsafe {
+            self.0.create_vulkan_device(
+                loader_gipa(entry),
+                physical,
+                info as *const _ as *const c_void,
+            )
+        }
+        .map_err(|e| e.to_string())?;
         Ok(vk::Device::from_raw(raw as u64))
     }
 }
@@ -46,7 +74,13 @@ pub fn open_context(rt: &Arc<OpenXrRuntime>, mut options: ContextOptions) -> Res
     let (min, max) = (req.min_api_version_supported, req.max_api_version_supported);
     // The engine asks for Vulkan 1.2 (`Context::new`).
     if (min.major(), min.minor()) > (1, 2) || (max.major(), max.minor()) < (1, 2) {
-        bail!("the OpenXR runtime accepts Vulkan {}.{} to {}.{}; fovea needs 1.2", min.major(), min.minor(), max.major(), max.minor());
+        bail!(
+            "the OpenXR runtime accepts Vulkan {}.{} to {}.{}; fovea needs 1.2",
+            min.major(),
+            min.minor(),
+            max.major(),
+            max.minor()
+        );
     }
     options.creator = Some(Arc::new(RuntimeDevice(rt.clone())));
     // External targets: the swapchain's format is the runtime's choice, not the engine's RGBA8.
@@ -77,7 +111,12 @@ pub struct XrSwapchain {
 }
 
 impl XrSwapchain {
-    pub fn new(ctx: &Arc<Context>, owner: &SessionOwner<xr::Vulkan>, eye_width: u32, height: u32) -> Result<XrSwapchain> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        owner: &SessionOwner<xr::Vulkan>,
+        eye_width: u32,
+        height: u32,
+    ) -> Result<XrSwapchain> {
         let offered = owner.swapchain_formats()?;
         let format = offered
             .iter()
@@ -87,10 +126,25 @@ impl XrSwapchain {
         let width = 2 * eye_width;
         let handle = owner.create_storage_swapchain(format, width, height)?;
         let format = vk::Format::from_raw(format as i32);
-        let mut swapchain = XrSwapchain { ctx: ctx.clone(), handle, images: Vec::new(), format, eye_width, height };
-        for raw in swapchain.handle.enumerate_images().context("xrEnumerateSwapchainImages")? {
+        let mut swapchain = XrSwapchain {
+            ctx: ctx.clone(),
+            handle,
+            images: Vec::new(),
+            format,
+            eye_width,
+            height,
+        };
+        for raw in swapchain
+            .handle
+            .enumerate_images()
+            .context("xrEnumerateSwapchainImages")?
+        {
             let image = vk::Image::from_raw(raw);
-            let info = vk::ImageViewCreateInfo::default().image(image).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(color_range());
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(format)
+                .subresource_range(color_range());
             // SAFETY: a live image of the runtime's swapchain on this device.
             let view = unsafe { ctx.device.create_image_view(&info, None)? };
             swapchain.images.push(ExternalImage {
@@ -123,6 +177,11 @@ impl Drop for XrSwapchain {
 
 fn storage_capable(ctx: &Context, format: vk::Format) -> bool {
     // SAFETY: a query on the context's own physical device.
-    let props = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, format) };
-    props.optimal_tiling_features.contains(vk::FormatFeatureFlags::STORAGE_IMAGE)
+    let props = unsafe {
+        ctx.instance
+            .get_physical_device_format_properties(ctx.physical, format)
+    };
+    props
+        .optimal_tiling_features
+        .contains(vk::FormatFeatureFlags::STORAGE_IMAGE)
 }

@@ -31,7 +31,10 @@ impl InstanceRay {
         let (o, d) = (ray.origin, ray.dir);
         let point = |r: Vec4| r.x * o.x + r.y * o.y + r.z * o.z + r.w;
         let vector = |r: Vec4| r.x * d.x + r.y * d.y + r.z * d.z;
-        Ray { origin: Vec3::new(point(r0), point(r1), point(r2)), dir: Vec3::new(vector(r0), vector(r1), vector(r2)) }
+        Ray {
+            origin: Vec3::new(point(r0), point(r1), point(r2)),
+            dir: Vec3::new(vector(r0), vector(r1), vector(r2)),
+        }
     }
 }
 
@@ -59,11 +62,24 @@ impl SceneBvh {
 
     /// The instance levels around a world tree built by the caller (`fovea bench` compares
     /// builders on it).
-    pub fn with_world(scene: &Scene, world_tris: Vec<[Vec3; 3]>, world: Bvh4, builder: BvhBuilder) -> SceneBvh {
+    pub fn with_world(
+        scene: &Scene,
+        world_tris: Vec<[Vec3; 3]>,
+        world: Bvh4,
+        builder: BvhBuilder,
+    ) -> SceneBvh {
         let inst = &scene.instancing;
-        let mesh_tris: Vec<Vec<[Vec3; 3]>> = (0..inst.meshes.len()).map(|m| inst.mesh_positions(m)).collect();
-        let meshes = mesh_tris.iter().map(|t| Bvh4::from_binary(&Bvh::build_with(t, builder))).collect();
-        let mesh_bounds: Vec<Aabb> = mesh_tris.iter().map(|t| Aabb::of_points(&t.concat())).collect();
+        let mesh_tris: Vec<Vec<[Vec3; 3]>> = (0..inst.meshes.len())
+            .map(|m| inst.mesh_positions(m))
+            .collect();
+        let meshes = mesh_tris
+            .iter()
+            .map(|t| Bvh4::from_binary(&Bvh::build_with(t, builder)))
+            .collect();
+        let mesh_bounds: Vec<Aabb> = mesh_tris
+            .iter()
+            .map(|t| Aabb::of_points(&t.concat()))
+            .collect();
         // Each instance's world box (its mesh box's corners transformed) as a degenerate
         // "triangle" spanning it: the binned builder only looks at the corners' bounds.
         let boxes: Vec<[Vec3; 3]> = inst
@@ -72,7 +88,13 @@ impl SceneBvh {
             .map(|i| {
                 let b = mesh_bounds[i.mesh as usize];
                 let corners: Vec<Vec3> = (0..8)
-                    .map(|k| i.world_from_object.transform_point3(Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min)))
+                    .map(|k| {
+                        i.world_from_object.transform_point3(Vec3::select(
+                            glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0),
+                            b.max,
+                            b.min,
+                        ))
+                    })
                     .collect();
                 let w = Aabb::of_points(&corners);
                 [w.min, w.max, w.max]
@@ -84,17 +106,31 @@ impl SceneBvh {
             .iter()
             .map(|i| {
                 let m = i.object_from_world();
-                InstanceRay { object_from_world: [m.row(0), m.row(1), m.row(2)], mesh: i.mesh, first_id: i.first_id }
+                InstanceRay {
+                    object_from_world: [m.row(0), m.row(1), m.row(2)],
+                    mesh: i.mesh,
+                    first_id: i.first_id,
+                }
             })
             .collect();
-        SceneBvh { world, world_tris, meshes, mesh_tris, top, instances }
+        SceneBvh {
+            world,
+            world_tris,
+            meshes,
+            mesh_tris,
+            top,
+            instances,
+        }
     }
 
     /// Closest hit over the whole scene (smallest `(t, placed id)`) or, with `any_hit`, the first
     /// hit found, for `0 < t < t_max`: the world tree, then the instances.
     pub fn intersect(&self, ray: &Ray, t_max: f32, any_hit: bool) -> Option<Hit> {
         let mut best = None;
-        if let Some(hit) = self.world.intersect_into(&self.world_tris, ray, t_max, any_hit, 0, &mut best) {
+        if let Some(hit) =
+            self.world
+                .intersect_into(&self.world_tris, ray, t_max, any_hit, 0, &mut best)
+        {
             return Some(hit);
         }
         if self.instances.is_empty() {
@@ -118,7 +154,14 @@ impl SceneBvh {
                     let inst = &self.instances[k as usize];
                     let m = inst.mesh as usize;
                     let local = inst.to_object(ray);
-                    if let Some(hit) = self.meshes[m].intersect_into(&self.mesh_tris[m], &local, t_max, any_hit, inst.first_id, &mut best) {
+                    if let Some(hit) = self.meshes[m].intersect_into(
+                        &self.mesh_tris[m],
+                        &local,
+                        t_max,
+                        any_hit,
+                        inst.first_id,
+                        &mut best,
+                    ) {
                         return Some(hit);
                     }
                 }
@@ -129,7 +172,11 @@ impl SceneBvh {
 
     /// The most entries the top level's traversal stack can hold (see [`Bvh4::max_stack`]).
     pub fn top_max_stack(&self) -> u32 {
-        if self.instances.is_empty() { 0 } else { self.top.max_stack() }
+        if self.instances.is_empty() {
+            0
+        } else {
+            self.top.max_stack()
+        }
     }
 }
 
@@ -159,7 +206,11 @@ impl InstancingStats {
         for mesh in &inst.meshes {
             copies_bytes -= (mesh.vertices.len() * 48 + mesh.triangles.len() * (16 + 48)) as i64;
         }
-        let top_nodes = if inst.instances.is_empty() { 0 } else { bvh.top.nodes.len() };
+        let top_nodes = if inst.instances.is_empty() {
+            0
+        } else {
+            bvh.top.nodes.len()
+        };
         let overhead = (inst.instances.len() * (112 + 16) + top_nodes * 128) as i64;
         InstancingStats {
             instances: inst.instances.len(),

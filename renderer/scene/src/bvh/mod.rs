@@ -27,10 +27,10 @@
 
 pub mod instanced;
 mod sbvh;
-mod traverse;
-pub mod wide;
 #[cfg(test)]
 mod tests;
+mod traverse;
+pub mod wide;
 
 use crate::Aabb;
 use glam::{Vec3, Vec3A};
@@ -52,7 +52,12 @@ pub struct NodeOf<const W: usize> {
 pub type BvhNode = NodeOf<2>;
 
 impl<const W: usize> NodeOf<W> {
-    const EMPTY: NodeOf<W> = NodeOf { child_min: [Aabb::EMPTY.min; W], child_max: [Aabb::EMPTY.max; W], child_ref: [0; W], child_count: [0; W] };
+    const EMPTY: NodeOf<W> = NodeOf {
+        child_min: [Aabb::EMPTY.min; W],
+        child_max: [Aabb::EMPTY.max; W],
+        child_ref: [0; W],
+        child_count: [0; W],
+    };
 
     fn set_child(&mut self, slot: usize, bounds: &Aabb, child_ref: u32, count: u32) {
         self.child_min[slot] = bounds.min;
@@ -70,7 +75,10 @@ impl<const W: usize> NodeOf<W> {
     }
 
     pub fn child_bounds(&self, slot: usize) -> Aabb {
-        Aabb { min: self.child_min[slot], max: self.child_max[slot] }
+        Aabb {
+            min: self.child_min[slot],
+            max: self.child_max[slot],
+        }
     }
 }
 
@@ -92,14 +100,23 @@ struct Box3 {
 }
 
 impl Box3 {
-    const EMPTY: Box3 = Box3 { min: Vec3A::splat(1e30), max: Vec3A::splat(-1e30) };
+    const EMPTY: Box3 = Box3 {
+        min: Vec3A::splat(1e30),
+        max: Vec3A::splat(-1e30),
+    };
     #[inline]
     fn union(self, o: Box3) -> Box3 {
-        Box3 { min: self.min.min(o.min), max: self.max.max(o.max) }
+        Box3 {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
     }
     #[inline]
     fn grow(self, p: Vec3A) -> Box3 {
-        Box3 { min: self.min.min(p), max: self.max.max(p) }
+        Box3 {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
     }
     #[inline]
     fn half_area(self) -> f32 {
@@ -107,7 +124,10 @@ impl Box3 {
         d.x * d.y + d.y * d.z + d.z * d.x
     }
     fn to_aabb(self) -> Aabb {
-        Aabb { min: self.min.into(), max: self.max.into() }
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
     }
 }
 
@@ -119,9 +139,15 @@ struct RangeBounds {
 }
 
 impl RangeBounds {
-    const EMPTY: RangeBounds = RangeBounds { bounds: Box3::EMPTY, centroids: Box3::EMPTY };
+    const EMPTY: RangeBounds = RangeBounds {
+        bounds: Box3::EMPTY,
+        centroids: Box3::EMPTY,
+    };
     fn union(self, o: RangeBounds) -> RangeBounds {
-        RangeBounds { bounds: self.bounds.union(o.bounds), centroids: self.centroids.union(o.centroids) }
+        RangeBounds {
+            bounds: self.bounds.union(o.bounds),
+            centroids: self.centroids.union(o.centroids),
+        }
     }
 }
 
@@ -158,21 +184,33 @@ pub struct BvhBuilder {
 }
 
 impl BvhBuilder {
-    pub const BINNED: BvhBuilder = BvhBuilder { spatial_budget: None, leaf_target: 4, node_cost: 1.0 };
-    pub const SBVH: BvhBuilder = BvhBuilder { spatial_budget: Some(0.5), ..BvhBuilder::BINNED };
+    pub const BINNED: BvhBuilder = BvhBuilder {
+        spatial_budget: None,
+        leaf_target: 4,
+        node_cost: 1.0,
+    };
+    pub const SBVH: BvhBuilder = BvhBuilder {
+        spatial_budget: Some(0.5),
+        ..BvhBuilder::BINNED
+    };
     /// What [`Bvh::build`] (and so every scene upload) uses.
     pub const DEFAULT: BvhBuilder = BvhBuilder::SBVH;
 
     /// `binned` or `sbvh[:BUDGET]` (budget 0.5 when not given), optionally followed by
     /// `/leafN` (leaf target, 1 to 8) and `/costC` (node cost, 0.1 to 10).
     pub fn parse(s: &str) -> Result<BvhBuilder, String> {
-        let err = || format!("unknown BVH builder '{s}': binned or sbvh[:BUDGET] (0 to 4), then optionally /leafN (1 to 8), /costC (0.1 to 10)");
+        let err = || {
+            format!("unknown BVH builder '{s}': binned or sbvh[:BUDGET] (0 to 4), then optionally /leafN (1 to 8), /costC (0.1 to 10)")
+        };
         let mut parts = s.split('/');
         let mut b = match parts.next().unwrap_or("") {
             "binned" => BvhBuilder::BINNED,
             "sbvh" => BvhBuilder::SBVH,
             kind => match kind.strip_prefix("sbvh:").map(str::parse::<f32>) {
-                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => BvhBuilder { spatial_budget: Some(budget), ..BvhBuilder::BINNED },
+                Some(Ok(budget)) if (0.0..=4.0).contains(&budget) => BvhBuilder {
+                    spatial_budget: Some(budget),
+                    ..BvhBuilder::BINNED
+                },
                 _ => return Err(err()),
             },
         };
@@ -221,10 +259,17 @@ impl Bvh {
     }
 
     fn build_binned(tris: &[[Vec3; 3]], options: BvhBuilder) -> Bvh {
-        let prim_bounds: Vec<Box3> =
-            tris.iter().map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into()))).collect();
+        let prim_bounds: Vec<Box3> = tris
+            .iter()
+            .map(|t| t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into())))
+            .collect();
         let centroids = prim_bounds.iter().map(|b| (b.min + b.max) * 0.5).collect();
-        let mut b = Builder { prim_bounds, centroids, order: (0..tris.len() as u32).collect(), options };
+        let mut b = Builder {
+            prim_bounds,
+            centroids,
+            order: (0..tris.len() as u32).collect(),
+            options,
+        };
         let n = tris.len();
         let mut nodes = vec![BvhNode::EMPTY];
         let root = b.range_bounds(0, n);
@@ -233,7 +278,10 @@ impl Bvh {
                 if n > 0 {
                     nodes[0].set_child(0, &root.bounds.to_aabb(), 0, n as u32);
                 }
-                return Bvh { nodes, tri_order: b.order };
+                return Bvh {
+                    nodes,
+                    tri_order: b.order,
+                };
             }
             Plan::Split(mid, left, right) => (mid, left, right),
         };
@@ -243,7 +291,9 @@ impl Bvh {
             for (slot, (start, end, range)) in [(0, left), (1, right)] {
                 let bounds = range.bounds.to_aabb();
                 match b.plan(start, end, range) {
-                    Plan::Leaf => nodes[node].set_child(slot, &bounds, start as u32, (end - start) as u32),
+                    Plan::Leaf => {
+                        nodes[node].set_child(slot, &bounds, start as u32, (end - start) as u32)
+                    }
                     Plan::Split(mid, l, r) => {
                         let child = nodes.len();
                         nodes.push(BvhNode::EMPTY);
@@ -253,7 +303,10 @@ impl Bvh {
                 }
             }
         }
-        Bvh { nodes, tri_order: b.order }
+        Bvh {
+            nodes,
+            tri_order: b.order,
+        }
     }
 
     /// Longest root-to-leaf path counted in nodes (the root alone is depth 1). The binary
@@ -309,9 +362,15 @@ pub struct BvhStats {
 impl Bvh {
     /// Counts and costs of the tree over `tris` (the array it was built from).
     pub fn stats(&self, tris: &[[Vec3; 3]]) -> BvhStats {
-        let mut s = BvhStats { nodes: self.nodes.len(), references: self.tri_order.len(), ..Default::default() };
+        let mut s = BvhStats {
+            nodes: self.nodes.len(),
+            references: self.tri_order.len(),
+            ..Default::default()
+        };
         let area = |b: &Aabb| b.surface_area() as f64;
-        let root = (0..2).filter(|&c| !self.nodes[0].is_empty_child(c)).fold(Aabb::EMPTY, |b, c| b.union(&self.nodes[0].child_bounds(c)));
+        let root = (0..2)
+            .filter(|&c| !self.nodes[0].is_empty_child(c))
+            .fold(Aabb::EMPTY, |b, c| b.union(&self.nodes[0].child_bounds(c)));
         let root_area = area(&root).max(f64::MIN_POSITIVE);
         let (mut overlap_sum, mut interior, mut leaf_depth_sum) = (0.0, 0usize, 0.0);
         // (node, depth, area of the node's own box)
@@ -323,7 +382,10 @@ impl Bvh {
             interior += 1;
             if !n.is_empty_child(0) && !n.is_empty_child(1) {
                 let (a, b) = (n.child_bounds(0), n.child_bounds(1));
-                let inter = Aabb { min: a.min.max(b.min), max: a.max.min(b.max) };
+                let inter = Aabb {
+                    min: a.min.max(b.min),
+                    max: a.max.min(b.max),
+                };
                 overlap_sum += area(&inter) / node_area.max(f64::MIN_POSITIVE);
             }
             for c in (0..2).filter(|&c| !n.is_empty_child(c)) {
@@ -346,11 +408,14 @@ impl Bvh {
         s.mean_child_overlap = overlap_sum / interior.max(1) as f64;
         s.mean_leaf_size = s.references as f64 / s.leaves.max(1) as f64;
         s.mean_leaf_depth = leaf_depth_sum / s.references.max(1) as f64;
-        let scene_area = area(&Aabb::of_points(&tris.iter().flatten().copied().collect::<Vec<_>>()));
+        let scene_area = area(&Aabb::of_points(
+            &tris.iter().flatten().copied().collect::<Vec<_>>(),
+        ));
         for t in tris {
             let b = Aabb::of_points(t);
             let d = b.max - b.min;
-            let (longest, [e0, e1, e2]) = (d.max_element(), [t[1] - t[0], t[2] - t[1], t[0] - t[2]]);
+            let (longest, [e0, e1, e2]) =
+                (d.max_element(), [t[1] - t[0], t[2] - t[1], t[0] - t[2]]);
             // Width: twice the area over the longest edge (the triangle's height on it).
             let edge = e0.length().max(e1.length()).max(e2.length());
             let width = e0.cross(-e2).length() / edge.max(f32::MIN_POSITIVE);
@@ -367,10 +432,12 @@ impl Bvh {
 
 impl Builder {
     fn range_bounds(&self, start: usize, end: usize) -> RangeBounds {
-        self.order[start..end].iter().fold(RangeBounds::EMPTY, |r, &p| RangeBounds {
-            bounds: r.bounds.union(self.prim_bounds[p as usize]),
-            centroids: r.centroids.grow(self.centroids[p as usize]),
-        })
+        self.order[start..end]
+            .iter()
+            .fold(RangeBounds::EMPTY, |r, &p| RangeBounds {
+                bounds: r.bounds.union(self.prim_bounds[p as usize]),
+                centroids: r.centroids.grow(self.centroids[p as usize]),
+            })
     }
 
     /// Decides leaf or split for `order[start..end]`, partitioning the range for a split.
@@ -382,8 +449,15 @@ impl Builder {
         let lo = range.centroids.min;
         let extent = range.centroids.max - lo;
         // Bin all three axes in one pass over the triangles (one centroid load for three bins).
-        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(BINS as f32) / extent, Vec3A::ZERO);
-        let mut bins = [[Bin { range: RangeBounds::EMPTY, count: 0 }; BINS]; 3];
+        let scale = Vec3A::select(
+            extent.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(BINS as f32) / extent,
+            Vec3A::ZERO,
+        );
+        let mut bins = [[Bin {
+            range: RangeBounds::EMPTY,
+            count: 0,
+        }; BINS]; 3];
         for &p in &self.order[start..end] {
             let (c, pb) = (self.centroids[p as usize], self.prim_bounds[p as usize]);
             let k = bin_index(c, lo, scale);
@@ -413,7 +487,8 @@ impl Builder {
                 if n == 0 || n as usize == count {
                     continue;
                 }
-                let cost = self.options.node_cost + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
+                let cost = self.options.node_cost
+                    + (acc.half_area() * n as f32 + right_cost[split]) / parent_area;
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, split));
                 }
@@ -425,12 +500,22 @@ impl Builder {
             Some((_, axis, split)) => {
                 let (lo, scale) = (lo[axis], scale[axis]);
                 let centroids = &self.centroids;
-                let mid = start + partition(&mut self.order[start..end], |p| bin_of(centroids[p as usize][axis], lo, scale) < split);
-                let union = |bins: &[Bin]| bins.iter().fold(RangeBounds::EMPTY, |r, b| r.union(b.range));
+                let mid = start
+                    + partition(&mut self.order[start..end], |p| {
+                        bin_of(centroids[p as usize][axis], lo, scale) < split
+                    });
+                let union = |bins: &[Bin]| {
+                    bins.iter()
+                        .fold(RangeBounds::EMPTY, |r, b| r.union(b.range))
+                };
                 if mid == start || mid == end {
                     self.median_split(start, end, range)
                 } else {
-                    Plan::Split(mid, union(&bins[axis][..split]), union(&bins[axis][split..]))
+                    Plan::Split(
+                        mid,
+                        union(&bins[axis][..split]),
+                        union(&bins[axis][split..]),
+                    )
                 }
             }
             None => self.median_split(start, end, range),
@@ -441,7 +526,13 @@ impl Builder {
     /// widest centroid axis (by index when all centroids coincide).
     fn median_split(&mut self, start: usize, end: usize, range: RangeBounds) -> Plan {
         let extent = range.centroids.max - range.centroids.min;
-        let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
         let mid = (end - start) / 2;
         if extent[axis] > 0.0 {
             let centroids = &self.centroids;
@@ -450,7 +541,11 @@ impl Builder {
             });
         }
         let mid = start + mid;
-        Plan::Split(mid, self.range_bounds(start, mid), self.range_bounds(mid, end))
+        Plan::Split(
+            mid,
+            self.range_bounds(start, mid),
+            self.range_bounds(mid, end),
+        )
     }
 }
 

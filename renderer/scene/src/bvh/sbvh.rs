@@ -35,7 +35,11 @@ struct Bin {
     exit: u32,
 }
 
-const EMPTY_BIN: Bin = Bin { bounds: Box3::EMPTY, enter: 0, exit: 0 };
+const EMPTY_BIN: Bin = Bin {
+    bounds: Box3::EMPTY,
+    enter: 0,
+    exit: 0,
+};
 
 struct Candidate {
     cost: f32,
@@ -67,7 +71,10 @@ pub(super) fn build(tris: &[[Vec3; 3]], budget: f32, options: BvhBuilder) -> Bvh
     let refs: Vec<Ref> = tris
         .iter()
         .enumerate()
-        .map(|(i, t)| Ref { prim: i as u32, bounds: t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into())) })
+        .map(|(i, t)| Ref {
+            prim: i as u32,
+            bounds: t.iter().fold(Box3::EMPTY, |b, &p| b.grow(p.into())),
+        })
         .collect();
     let root = bounds_of(&refs);
     let mut b = Builder {
@@ -84,7 +91,10 @@ pub(super) fn build(tris: &[[Vec3; 3]], budget: f32, options: BvhBuilder) -> Bvh
                 nodes[0].set_child(0, &root.to_aabb(), 0, refs.len() as u32);
             }
             b.order.extend(refs.iter().map(|r| r.prim));
-            return Bvh { nodes, tri_order: b.order };
+            return Bvh {
+                nodes,
+                tri_order: b.order,
+            };
         }
         Plan::Split(l, lb, r, rb) => (l, lb, r, rb),
     };
@@ -106,7 +116,10 @@ pub(super) fn build(tris: &[[Vec3; 3]], budget: f32, options: BvhBuilder) -> Bvh
             }
         }
     }
-    Bvh { nodes, tri_order: b.order }
+    Bvh {
+        nodes,
+        tri_order: b.order,
+    }
 }
 
 fn bounds_of(refs: &[Ref]) -> Box3 {
@@ -118,7 +131,10 @@ fn centroid(r: &Ref) -> Vec3A {
 }
 
 fn intersect(a: Box3, b: Box3) -> Box3 {
-    Box3 { min: a.min.max(b.min), max: a.max.min(b.max) }
+    Box3 {
+        min: a.min.max(b.min),
+        max: a.max.min(b.max),
+    }
 }
 
 fn is_empty(b: Box3) -> bool {
@@ -127,7 +143,11 @@ fn is_empty(b: Box3) -> bool {
 
 /// Half area of a box that may be empty (0 then).
 fn area(b: Box3) -> f32 {
-    if is_empty(b) { 0.0 } else { b.half_area() }
+    if is_empty(b) {
+        0.0
+    } else {
+        b.half_area()
+    }
 }
 
 /// The box of the part of triangle `t` with `lo ≤ p[axis] ≤ hi`: its corners inside the slab and
@@ -152,7 +172,11 @@ pub(super) fn clip_triangle(t: &[Vec3; 3], axis: usize, lo: f32, hi: f32) -> Box
         for plane in [lo64, hi64] {
             if (a[axis] < plane && b[axis] > plane) || (a[axis] > plane && b[axis] < plane) {
                 let s = (plane - a[axis]) / (b[axis] - a[axis]);
-                let mut p = [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s, a[2] + (b[2] - a[2]) * s];
+                let mut p = [
+                    a[0] + (b[0] - a[0]) * s,
+                    a[1] + (b[1] - a[1]) * s,
+                    a[2] + (b[2] - a[2]) * s,
+                ];
                 p[axis] = plane;
                 grow(p);
             }
@@ -163,13 +187,24 @@ pub(super) fn clip_triangle(t: &[Vec3; 3], axis: usize, lo: f32, hi: f32) -> Box
     }
     let down = |x: f64| {
         let f = x as f32;
-        if f as f64 > x { step(f, -1.0) } else { f }
+        if f as f64 > x {
+            step(f, -1.0)
+        } else {
+            f
+        }
     };
     let up = |x: f64| {
         let f = x as f32;
-        if (f as f64) < x { step(f, 1.0) } else { f }
+        if (f as f64) < x {
+            step(f, 1.0)
+        } else {
+            f
+        }
     };
-    let mut b = Box3 { min: Vec3A::new(down(min[0]), down(min[1]), down(min[2])), max: Vec3A::new(up(max[0]), up(max[1]), up(max[2])) };
+    let mut b = Box3 {
+        min: Vec3A::new(down(min[0]), down(min[1]), down(min[2])),
+        max: Vec3A::new(up(max[0]), up(max[1]), up(max[2])),
+    };
     // On the split axis the planes themselves bound the part (they are f32 already).
     b.min[axis] = b.min[axis].max(lo);
     b.max[axis] = b.max[axis].min(hi);
@@ -184,7 +219,11 @@ pub(super) fn step(f: f32, dir: f32) -> f32 {
     }
     let bits = f.to_bits();
     // Away from zero is one more in the bit pattern, toward zero one less, for either sign.
-    f32::from_bits(if (f > 0.0) == (dir > 0.0) { bits + 1 } else { bits - 1 })
+    f32::from_bits(if (f > 0.0) == (dir > 0.0) {
+        bits + 1
+    } else {
+        bits - 1
+    })
 }
 
 impl Builder<'_> {
@@ -201,7 +240,9 @@ impl Builder<'_> {
         if let Some(o) = &object {
             let overlap = area(intersect(o.left, o.right));
             if self.spare_refs > 0 && overlap / self.root_area > ALPHA {
-                spatial = self.spatial_split(&refs, bounds, parent_area).filter(|s| s.cost < o.cost);
+                spatial = self
+                    .spatial_split(&refs, bounds, parent_area)
+                    .filter(|s| s.cost < o.cost);
             }
         }
         let best_cost = spatial.as_ref().or(object.as_ref()).map(|c| c.cost);
@@ -216,15 +257,22 @@ impl Builder<'_> {
         if let Some(o) = object {
             let lo = centroids.min[o.axis];
             let scale = BINS as f32 / (centroids.max[o.axis] - lo);
-            let (left, right): (Vec<Ref>, Vec<Ref>) =
-                refs.iter().partition(|r| (((centroid(r)[o.axis] - lo) * scale) as usize).min(BINS - 1) < o.split);
+            let (left, right): (Vec<Ref>, Vec<Ref>) = refs.iter().partition(|r| {
+                (((centroid(r)[o.axis] - lo) * scale) as usize).min(BINS - 1) < o.split
+            });
             if !left.is_empty() && !right.is_empty() {
                 return Plan::Split(left, o.left, right, o.right);
             }
         }
         // No useful split of a range too big for one leaf: halve it along the widest centroid axis.
         let extent = centroids.max - centroids.min;
-        let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
         let mid = count / 2;
         refs.select_nth_unstable_by(mid, |a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]));
         let right = refs.split_off(mid);
@@ -235,7 +283,11 @@ impl Builder<'_> {
     fn object_split(&self, refs: &[Ref], centroids: Box3, parent_area: f32) -> Option<Candidate> {
         let lo = centroids.min;
         let extent = centroids.max - lo;
-        let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), Vec3A::splat(BINS as f32) / extent, Vec3A::ZERO);
+        let scale = Vec3A::select(
+            extent.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(BINS as f32) / extent,
+            Vec3A::ZERO,
+        );
         let mut bins = [[EMPTY_BIN; BINS]; 3];
         for r in refs {
             let k = ((centroid(r) - lo) * scale).min(Vec3A::splat((BINS - 1) as f32));
@@ -256,7 +308,14 @@ impl Builder<'_> {
     /// The SAH sweep over one axis' bins: every boundary with references on both sides (left:
     /// those entering a bin left of it, right: those leaving one right of it) that `allowed`
     /// accepts by (left, right) counts, kept in `best` when cheaper.
-    fn sweep(&self, bins: &[Bin; BINS], axis: usize, parent_area: f32, allowed: impl Fn(u32, u32) -> bool, best: &mut Option<Candidate>) {
+    fn sweep(
+        &self,
+        bins: &[Bin; BINS],
+        axis: usize,
+        parent_area: f32,
+        allowed: impl Fn(u32, u32) -> bool,
+        best: &mut Option<Candidate>,
+    ) {
         let mut right = [(Box3::EMPTY, 0u32); BINS];
         let (mut acc, mut n) = (Box3::EMPTY, 0u32);
         for i in (1..BINS).rev() {
@@ -272,9 +331,17 @@ impl Builder<'_> {
             if n == 0 || rn == 0 || !allowed(n, rn) {
                 continue;
             }
-            let cost = self.options.node_cost + (area(acc) * n as f32 + area(rb) * rn as f32) / parent_area;
+            let cost = self.options.node_cost
+                + (area(acc) * n as f32 + area(rb) * rn as f32) / parent_area;
             if best.as_ref().is_none_or(|b| cost < b.cost) {
-                *best = Some(Candidate { cost, axis, split, left: acc, right: rb, counts: (n, rn) });
+                *best = Some(Candidate {
+                    cost,
+                    axis,
+                    split,
+                    left: acc,
+                    right: rb,
+                    counts: (n, rn),
+                });
             }
         }
     }
@@ -282,7 +349,11 @@ impl Builder<'_> {
     /// The split plane of spatial bin boundary `split` on `axis` of `bounds`.
     fn plane(bounds: Box3, axis: usize, split: usize) -> f32 {
         let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
-        if split == BINS { hi } else { lo + (hi - lo) * (split as f32 / BINS as f32) }
+        if split == BINS {
+            hi
+        } else {
+            lo + (hi - lo) * (split as f32 / BINS as f32)
+        }
     }
 
     fn spatial_split(&self, refs: &[Ref], bounds: Box3, parent_area: f32) -> Option<Candidate> {
@@ -305,14 +376,28 @@ impl Builder<'_> {
                 }
                 let tri = &self.tris[r.prim as usize];
                 for (k, bin) in bins.iter_mut().enumerate().take(last + 1).skip(first) {
-                    let part = intersect(clip_triangle(tri, axis, Self::plane(bounds, axis, k), Self::plane(bounds, axis, k + 1)), r.bounds);
+                    let part = intersect(
+                        clip_triangle(
+                            tri,
+                            axis,
+                            Self::plane(bounds, axis, k),
+                            Self::plane(bounds, axis, k + 1),
+                        ),
+                        r.bounds,
+                    );
                     if !is_empty(part) {
                         bin.bounds = bin.bounds.union(part);
                     }
                 }
             }
             // A reference straddling the plane sits on both sides: within the spare budget only.
-            self.sweep(&bins, axis, parent_area, |n, rn| (n + rn) as usize - refs.len() <= self.spare_refs, &mut best);
+            self.sweep(
+                &bins,
+                axis,
+                parent_area,
+                |n, rn| (n + rn) as usize - refs.len() <= self.spare_refs,
+                &mut best,
+            );
         }
         best
     }
@@ -320,7 +405,10 @@ impl Builder<'_> {
     /// Splits the references at the candidate's plane; `None` when one side would be empty.
     fn apply_spatial(&mut self, refs: &[Ref], bounds: Box3, s: &Candidate) -> Option<Plan> {
         let (axis, plane) = (s.axis, Self::plane(bounds, s.axis, s.split));
-        let (mut left, mut right) = (Vec::with_capacity(s.counts.0 as usize), Vec::with_capacity(s.counts.1 as usize));
+        let (mut left, mut right) = (
+            Vec::with_capacity(s.counts.0 as usize),
+            Vec::with_capacity(s.counts.1 as usize),
+        );
         let (la, ra) = (area(s.left), area(s.right));
         let (nl, nr) = (s.counts.0 as f32, s.counts.1 as f32);
         for r in refs {
@@ -333,8 +421,14 @@ impl Builder<'_> {
                 let lpart = intersect(clip_triangle(tri, axis, f32::NEG_INFINITY, plane), r.bounds);
                 let rpart = intersect(clip_triangle(tri, axis, plane, f32::INFINITY), r.bounds);
                 match (is_empty(lpart), is_empty(rpart)) {
-                    (false, true) => left.push(Ref { prim: r.prim, bounds: lpart }),
-                    (true, false) => right.push(Ref { prim: r.prim, bounds: rpart }),
+                    (false, true) => left.push(Ref {
+                        prim: r.prim,
+                        bounds: lpart,
+                    }),
+                    (true, false) => right.push(Ref {
+                        prim: r.prim,
+                        bounds: rpart,
+                    }),
                     _ => {
                         // Reference unsplitting (Stich et al. §4.3): keep it whole where cheaper.
                         let split = la * nl + ra * nr;
@@ -346,8 +440,14 @@ impl Builder<'_> {
                             right.push(*r);
                         } else if self.spare_refs > 0 {
                             self.spare_refs -= 1;
-                            left.push(Ref { prim: r.prim, bounds: lpart });
-                            right.push(Ref { prim: r.prim, bounds: rpart });
+                            left.push(Ref {
+                                prim: r.prim,
+                                bounds: lpart,
+                            });
+                            right.push(Ref {
+                                prim: r.prim,
+                                bounds: rpart,
+                            });
                         } else if area(lpart) >= area(rpart) {
                             left.push(*r);
                         } else {

@@ -7,12 +7,19 @@ use glam::Vec3;
 
 /// Conservative slack for the slab test, 1 + 2·γ(3) (Ize, "Robust BVH Ray Traversal", JCGT 2013):
 /// without it, a triangle lying exactly on a box face can be culled by rounding.
-pub const SLAB_SLACK: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub const SLAB_SLACK: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// A zero direction component would make `(plane − origin) · (1/0)` NaN when the origin lies on
 /// the plane; a tiny signed component gives the same answer without NaN (the GPU does the same).
 pub fn safe_inverse_dir(dir: Vec3) -> Vec3 {
-    let fix = |d: f32| if d == 0.0 { 1.0 / 1e-30f32.copysign(d) } else { 1.0 / d };
+    let fix = |d: f32| {
+        if d == 0.0 {
+            1.0 / 1e-30f32.copysign(d)
+        } else {
+            1.0 / d
+        }
+    };
     Vec3::new(fix(dir.x), fix(dir.y), fix(dir.z))
 }
 
@@ -32,11 +39,24 @@ pub fn slab_test(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, t_limit: f32
 /// hit is returned at once; otherwise the closest so far (ties by [`crate::intersect`]'s rule) is
 /// kept in `best` and `None` returned.
 /// Hits carry `id_base` + the triangle's index (an instance's placed ids, 0 for the world tree).
-pub(super) fn test_leaf(tris: &[[Vec3; 3]], leaf: &[u32], wray: &WatertightRay, t_max: f32, any_hit: bool, id_base: u32, best: &mut Option<Hit>) -> Option<Hit> {
+pub(super) fn test_leaf(
+    tris: &[[Vec3; 3]],
+    leaf: &[u32],
+    wray: &WatertightRay,
+    t_max: f32,
+    any_hit: bool,
+    id_base: u32,
+    best: &mut Option<Hit>,
+) -> Option<Hit> {
     for &tri in leaf {
         let [a, b, c] = tris[tri as usize];
         if let Some((t, u, v)) = wray.intersect(a, b, c, t_max) {
-            let hit = Hit { t, triangle: id_base + tri, u, v };
+            let hit = Hit {
+                t,
+                triangle: id_base + tri,
+                u,
+                v,
+            };
             if any_hit {
                 return Some(hit);
             }
@@ -55,14 +75,24 @@ impl Bvh {
             .iter()
             .flat_map(|&i| {
                 let [a, b, c] = tris[i as usize];
-                [[a.x, a.y, a.z, f32::from_bits(i)], [b.x, b.y, b.z, 0.0], [c.x, c.y, c.z, 0.0]]
+                [
+                    [a.x, a.y, a.z, f32::from_bits(i)],
+                    [b.x, b.y, b.z, 0.0],
+                    [c.x, c.y, c.z, 0.0],
+                ]
             })
             .collect()
     }
 
     /// Closest hit (ties by the rule in [`crate::intersect`]) or, with `any_hit`, the first hit
     /// found, for `0 < t < t_max`. `tris` must be the array the tree was built from.
-    pub fn intersect(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> Option<Hit> {
+    pub fn intersect(
+        &self,
+        tris: &[[Vec3; 3]],
+        ray: &Ray,
+        t_max: f32,
+        any_hit: bool,
+    ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let inv_dir = safe_inverse_dir(ray.dir);
         let mut best: Option<Hit> = None;
@@ -72,10 +102,18 @@ impl Bvh {
             let n: &BvhNode = &self.nodes[node as usize];
             let limit = best.map_or(t_max, |h| h.t);
             let near = [0, 1].map(|c| {
-                if n.is_empty_child(c) { None } else { slab_test(n.child_min[c], n.child_max[c], ray.origin, inv_dir, limit) }
+                if n.is_empty_child(c) {
+                    None
+                } else {
+                    slab_test(n.child_min[c], n.child_max[c], ray.origin, inv_dir, limit)
+                }
             });
             // Visit the nearer child first; leaves are tested on the spot, interior children queued.
-            let first = if let (Some(a), Some(b)) = (near[0], near[1]) { usize::from(b < a) } else { 0 };
+            let first = if let (Some(a), Some(b)) = (near[0], near[1]) {
+                usize::from(b < a)
+            } else {
+                0
+            };
             let mut next: [Option<u32>; 2] = [None, None];
             for (k, c) in [first, 1 - first].into_iter().enumerate() {
                 if near[c].is_none() {
@@ -86,7 +124,15 @@ impl Bvh {
                     continue;
                 }
                 let start = n.child_ref[c] as usize;
-                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, 0, &mut best) {
+                if let Some(hit) = test_leaf(
+                    tris,
+                    &self.tri_order[start..start + n.child_count[c] as usize],
+                    &wray,
+                    t_max,
+                    any_hit,
+                    0,
+                    &mut best,
+                ) {
                     return Some(hit);
                 }
             }

@@ -35,7 +35,10 @@ impl Bvh4 {
     pub fn from_binary(bvh: &Bvh) -> Bvh4 {
         let children_of = |node: u32| -> Vec<Child> {
             let n: &BvhNode = &bvh.nodes[node as usize];
-            (0..2).filter(|&c| !n.is_empty_child(c)).map(|c| (n.child_bounds(c), n.child_ref[c], n.child_count[c])).collect()
+            (0..2)
+                .filter(|&c| !n.is_empty_child(c))
+                .map(|c| (n.child_bounds(c), n.child_ref[c], n.child_count[c]))
+                .collect()
         };
         let mut nodes = vec![Bvh4Node::EMPTY];
         // (wide node to fill, binary node whose children it takes)
@@ -63,7 +66,10 @@ impl Bvh4 {
                 }
             }
         }
-        Bvh4 { nodes, tri_order: bvh.tri_order.clone() }
+        Bvh4 {
+            nodes,
+            tri_order: bvh.tri_order.clone(),
+        }
     }
 
     /// Longest root-to-leaf path in nodes (the root alone is depth 1).
@@ -88,8 +94,10 @@ impl Bvh4 {
         let mut stack = vec![(0u32, 0u32)];
         while let Some((node, entries)) = stack.pop() {
             let n = &self.nodes[node as usize];
-            let inner: Vec<u32> =
-                (0..WIDTH).filter(|&s| n.child_count[s] == 0 && !n.is_empty_child(s)).map(|s| n.child_ref[s]).collect();
+            let inner: Vec<u32> = (0..WIDTH)
+                .filter(|&s| n.child_count[s] == 0 && !n.is_empty_child(s))
+                .map(|s| n.child_ref[s])
+                .collect();
             let below = entries + (inner.len() as u32).saturating_sub(1);
             most = most.max(if inner.is_empty() { entries } else { below });
             stack.extend(inner.iter().map(|&c| (c, below)));
@@ -125,14 +133,29 @@ impl Bvh4 {
 
     /// The GPU traversal's algorithm on the CPU: closest hit (ties as in [`crate::intersect`])
     /// or, with `any_hit`, the first hit found, for `0 < t < t_max`.
-    pub fn intersect(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool) -> Option<Hit> {
+    pub fn intersect(
+        &self,
+        tris: &[[Vec3; 3]],
+        ray: &Ray,
+        t_max: f32,
+        any_hit: bool,
+    ) -> Option<Hit> {
         let mut best = None;
-        self.intersect_into(tris, ray, t_max, any_hit, 0, &mut best).or(best)
+        self.intersect_into(tris, ray, t_max, any_hit, 0, &mut best)
+            .or(best)
     }
 
     /// [`Bvh4::intersect`] continuing from `best` (boxes beyond it are skipped, closer hits
     /// replace it), hit ids offset by `id_base` (an instance's BLAS); returns the any-hit answer.
-    pub fn intersect_into(&self, tris: &[[Vec3; 3]], ray: &Ray, t_max: f32, any_hit: bool, id_base: u32, best: &mut Option<Hit>) -> Option<Hit> {
+    pub fn intersect_into(
+        &self,
+        tris: &[[Vec3; 3]],
+        ray: &Ray,
+        t_max: f32,
+        any_hit: bool,
+        id_base: u32,
+        best: &mut Option<Hit>,
+    ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let inv_dir = safe_inverse_dir(ray.dir);
         let mut stack: Vec<u32> = Vec::with_capacity(64);
@@ -141,17 +164,34 @@ impl Bvh4 {
             let n = &self.nodes[node as usize];
             let limit = best.map_or(t_max, |h| h.t);
             let near: [Option<f32>; WIDTH] = std::array::from_fn(|c| {
-                if n.is_empty_child(c) { None } else { slab_test(n.child_min[c], n.child_max[c], ray.origin, inv_dir, limit) }
+                if n.is_empty_child(c) {
+                    None
+                } else {
+                    slab_test(n.child_min[c], n.child_max[c], ray.origin, inv_dir, limit)
+                }
             });
             for c in (0..WIDTH).filter(|&c| near[c].is_some() && n.child_count[c] > 0) {
                 let start = n.child_ref[c] as usize;
-                if let Some(hit) = test_leaf(tris, &self.tri_order[start..start + n.child_count[c] as usize], &wray, t_max, any_hit, id_base, best) {
+                if let Some(hit) = test_leaf(
+                    tris,
+                    &self.tri_order[start..start + n.child_count[c] as usize],
+                    &wray,
+                    t_max,
+                    any_hit,
+                    id_base,
+                    best,
+                ) {
                     return Some(hit);
                 }
             }
             // Interior children nearest first: the farther ones are pushed, farthest deepest.
-            let mut inner: Vec<(f32, u32)> =
-                (0..WIDTH).filter_map(|c| near[c].filter(|_| n.child_count[c] == 0).map(|t| (t, n.child_ref[c]))).collect();
+            let mut inner: Vec<(f32, u32)> = (0..WIDTH)
+                .filter_map(|c| {
+                    near[c]
+                        .filter(|_| n.child_count[c] == 0)
+                        .map(|t| (t, n.child_ref[c]))
+                })
+                .collect();
             inner.sort_by(|a, b| a.0.total_cmp(&b.0));
             match inner.split_first() {
                 Some((first, rest)) => {
@@ -168,6 +208,10 @@ impl Bvh4 {
 
     /// 3 texels per leaf reference, as [`Bvh::triangle_texels`] (the same leaf order).
     pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
-        Bvh { nodes: Vec::new(), tri_order: self.tri_order.clone() }.triangle_texels(tris)
+        Bvh {
+            nodes: Vec::new(),
+            tri_order: self.tri_order.clone(),
+        }
+        .triangle_texels(tris)
     }
 }

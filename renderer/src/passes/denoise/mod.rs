@@ -12,13 +12,13 @@ pub mod svgf;
 pub mod taa;
 pub mod taa_screen;
 
-use bmfr::{Bmfr, BmfrSettings};
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
 use crate::layouts::SamplingParams;
 use crate::passes::trace::{GBuffer, GradientTargets, TileList};
 use crate::vk::{Buffer, Context, Image};
 use asvgf::{Asvgf, AsvgfSettings};
+use bmfr::{Bmfr, BmfrSettings};
 use glam::{UVec2, Vec3};
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
@@ -45,7 +45,10 @@ impl DenoiserSettings {
             "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
             "asvgf" => Ok(DenoiserSettings::Asvgf(AsvgfSettings::default())),
             "bmfr" => Ok(DenoiserSettings::Bmfr(BmfrSettings::default())),
-            other => Err(Error::Invalid(format!("denoiser '{other}': expected one of {}", Self::NAMES.join(", ")))),
+            other => Err(Error::Invalid(format!(
+                "denoiser '{other}': expected one of {}",
+                Self::NAMES.join(", ")
+            ))),
         }
     }
 
@@ -99,12 +102,23 @@ pub enum Denoiser {
 
 impl Denoiser {
     /// `variant` is the sampling space's kernel variant (`SamplingSpace::shader_variant`).
-    pub fn new(ctx: &Arc<Context>, settings: &DenoiserSettings, grid: UVec2, variant: &str) -> Result<Option<Denoiser>> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        settings: &DenoiserSettings,
+        grid: UVec2,
+        variant: &str,
+    ) -> Result<Option<Denoiser>> {
         Ok(match settings {
             DenoiserSettings::None => None,
-            DenoiserSettings::Svgf(s) => Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?))),
-            DenoiserSettings::Asvgf(s) => Some(Denoiser::Asvgf(Box::new(Asvgf::new(ctx, grid, variant, *s)?))),
-            DenoiserSettings::Bmfr(s) => Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?))),
+            DenoiserSettings::Svgf(s) => {
+                Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?)))
+            }
+            DenoiserSettings::Asvgf(s) => Some(Denoiser::Asvgf(Box::new(Asvgf::new(
+                ctx, grid, variant, *s,
+            )?))),
+            DenoiserSettings::Bmfr(s) => {
+                Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?)))
+            }
         })
     }
 
@@ -128,7 +142,13 @@ impl Denoiser {
 
     /// Records what must run before the tracer, while `gbuffer` still holds last frame (A-SVGF's
     /// forward projection). `frame_data`: the frame's uniform buffer (both cameras).
-    pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
+    pub fn record_before_trace(
+        &mut self,
+        rec: &mut FrameRecorder,
+        gbuffer: &GBuffer,
+        frame: &DenoiseFrame,
+        frame_data: &Buffer,
+    ) -> Result<()> {
         match self {
             Denoiser::Svgf(_) | Denoiser::Bmfr(_) => Ok(()),
             Denoiser::Asvgf(a) => a.record_before_trace(rec, gbuffer, frame, frame_data),
@@ -144,7 +164,13 @@ impl Denoiser {
     }
 
     /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    pub fn record(&mut self, rec: &mut FrameRecorder, gbuffer: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        gbuffer: &GBuffer,
+        frame: &DenoiseFrame,
+        scene: &DenoiseScene,
+    ) -> Result<&Image> {
         match self {
             Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
             Denoiser::Asvgf(a) => a.record(rec, gbuffer, frame),

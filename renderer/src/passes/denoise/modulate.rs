@@ -12,12 +12,31 @@ pub struct ModulatePass {
 
 impl ModulatePass {
     pub fn new(ctx: &Arc<Context>) -> Result<ModulatePass> {
-        Ok(ModulatePass { pipeline: ComputePipeline::shared(ctx, "passes/denoise/modulate", 0)? })
+        Ok(ModulatePass {
+            pipeline: ComputePipeline::shared(ctx, "passes/denoise/modulate", 0)?,
+        })
     }
 
     /// `pass` names the dispatch in the timing report (e.g. "svgf_modulate").
-    pub fn record(&self, rec: &mut FrameRecorder, pass: &'static str, filtered: &Image, albedo: &Image, dst: &Image) -> Result<()> {
-        let binds = [read_image("filtered", filtered), read_image("albedo", albedo), write_image("dst", dst)];
-        rec.dispatch(pass, &self.pipeline, &binds, &[], [dst.width, dst.height, 1])
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        pass: &'static str,
+        filtered: &Image,
+        albedo: &Image,
+        dst: &Image,
+    ) -> Result<()> {
+        let binds = [
+            read_image("filtered", filtered),
+            read_image("albedo", albedo),
+            write_image("dst", dst),
+        ];
+        rec.dispatch(
+            pass,
+            &self.pipeline,
+            &binds,
+            &[],
+            [dst.width, dst.height, 1],
+        )
     }
 }

@@ -26,7 +26,10 @@ pub struct TaaSettings {
 
 impl Default for TaaSettings {
     fn default() -> Self {
-        TaaSettings { current_weight: 0.1, jitter_points: 16 }
+        TaaSettings {
+            current_weight: 0.1,
+            jitter_points: 16,
+        }
     }
 }
 
@@ -38,7 +41,9 @@ impl TaaSettings {
     pub fn validate(&self) -> Result<()> {
         let w = self.current_weight;
         if !(w.is_finite() && w > 0.0 && w <= 1.0) {
-            return Err(Error::Invalid(format!("taa: current_weight must be in (0, 1], got {w}")));
+            return Err(Error::Invalid(format!(
+                "taa: current_weight must be in (0, 1], got {w}"
+            )));
         }
         if !JITTER_POINTS.contains(&self.jitter_points) {
             return Err(Error::Invalid(format!(
@@ -92,7 +97,10 @@ impl TaaMode {
             "off" => Ok(TaaMode::Off),
             "vp" => Ok(TaaMode::SamplingGrid(TaaSettings::default())),
             "screen" => Ok(TaaMode::Screen(TaaSettings::default())),
-            other => Err(Error::Invalid(format!("taa '{other}': expected one of {}", Self::NAMES.join(", ")))),
+            other => Err(Error::Invalid(format!(
+                "taa '{other}': expected one of {}",
+                Self::NAMES.join(", ")
+            ))),
         }
     }
 
@@ -134,31 +142,57 @@ pub struct Taa {
 
 impl Taa {
     /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: TaaSettings) -> Result<Taa> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        settings: TaaSettings,
+    ) -> Result<Taa> {
         settings.validate()?;
         let image = |name: &str, format| Image::new(ctx, name, grid.x, grid.y, format);
-        let (rgba, surface) = (vk::Format::R32G32B32A32_SFLOAT, vk::Format::R32G32B32A32_UINT);
+        let (rgba, surface) = (
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::Format::R32G32B32A32_UINT,
+        );
         let shader = format!("passes/denoise/taa.{variant}");
         Ok(Taa {
             settings,
             pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
             history: [image("taa.history0", rgba)?, image("taa.history1", rgba)?],
-            surface: [image("taa.surface0", surface)?, image("taa.surface1", surface)?],
+            surface: [
+                image("taa.surface0", surface)?,
+                image("taa.surface1", surface)?,
+            ],
             frames: 0,
         })
     }
 
     /// GPU bytes carried between frames.
     pub fn history_bytes(&self) -> u64 {
-        self.history.iter().chain(&self.surface).map(|i| i.width as u64 * i.height as u64 * i.texel_bytes()).sum()
+        self.history
+            .iter()
+            .chain(&self.surface)
+            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
+            .sum()
     }
 
     /// Resolves `color` (grid-sized radiance) against the history; `jitter` is the offset the
     /// tracer used this frame (`TaaSettings::jitter`). History is dropped on the first frame and
     /// whenever `frame.previous` is `None`. Returns the resolved image (next frame's history).
-    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, color: &Image, frame: &DenoiseFrame, jitter: Vec2) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        color: &Image,
+        frame: &DenoiseFrame,
+        jitter: Vec2,
+    ) -> Result<&Image> {
         let cur = (self.frames % 2) as usize;
-        let previous = if self.frames == 0 { None } else { frame.previous };
+        let previous = if self.frames == 0 {
+            None
+        } else {
+            frame.previous
+        };
         let binds = [
             read_image("color", color),
             read_image("normal_depth", &g.normal_depth),
@@ -179,7 +213,13 @@ impl Taa {
             params: Vec4::new(self.settings.current_weight, reset, jitter.x, jitter.y),
         };
         let out = &self.history[cur];
-        rec.dispatch("taa", &self.pipeline, &binds, push_bytes(&push), [out.width, out.height, 1])?;
+        rec.dispatch(
+            "taa",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [out.width, out.height, 1],
+        )?;
         self.frames += 1;
         Ok(&self.history[cur])
     }
@@ -192,27 +232,65 @@ mod tests {
     #[test]
     fn halton_jitter_is_centred_inside_the_texel_and_cycles() {
         for n in JITTER_POINTS {
-            let s = TaaSettings { jitter_points: n, ..Default::default() };
+            let s = TaaSettings {
+                jitter_points: n,
+                ..Default::default()
+            };
             let points: Vec<Vec2> = (0..n).map(|f| s.jitter(f)).collect();
-            assert!(points.iter().all(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all()), "{points:?}");
+            assert!(
+                points
+                    .iter()
+                    .all(|p| p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all()),
+                "{points:?}"
+            );
             let mean = points.iter().sum::<Vec2>() / n as f32;
-            assert!((mean - 0.5).abs().max_element() < 1e-5, "{n} points: mean {mean}");
+            assert!(
+                (mean - 0.5).abs().max_element() < 1e-5,
+                "{n} points: mean {mean}"
+            );
             assert_eq!(s.jitter(n + 3), s.jitter(3));
         }
-        assert!((radical_inverse(3, 2) - 0.75).abs() < 1e-7 && (radical_inverse(4, 3) - 4.0 / 9.0).abs() < 1e-7);
+        assert!(
+            (radical_inverse(3, 2) - 0.75).abs() < 1e-7
+                && (radical_inverse(4, 3) - 4.0 / 9.0).abs() < 1e-7
+        );
     }
 
     #[test]
     fn settings_and_names_are_checked() {
-        assert!(TaaSettings { current_weight: 0.0, ..Default::default() }.validate().is_err());
-        assert!(TaaSettings { current_weight: f32::NAN, ..Default::default() }.validate().is_err());
-        assert!(TaaSettings { jitter_points: 4, ..Default::default() }.validate().is_err());
+        assert!(TaaSettings {
+            current_weight: 0.0,
+            ..Default::default()
+        }
+        .validate()
+        .is_err());
+        assert!(TaaSettings {
+            current_weight: f32::NAN,
+            ..Default::default()
+        }
+        .validate()
+        .is_err());
+        assert!(TaaSettings {
+            jitter_points: 4,
+            ..Default::default()
+        }
+        .validate()
+        .is_err());
         assert!(TaaSettings::default().validate().is_ok());
         assert_eq!(TaaMode::parse("vp").unwrap().name(), "vp");
         assert_eq!(TaaMode::parse("off").unwrap(), TaaMode::Off);
         assert_eq!(TaaMode::parse("screen").unwrap().name(), "screen");
-        let tuned = TaaSettings { current_weight: 0.2, ..Default::default() };
-        assert_eq!(TaaMode::parse("screen").unwrap().with_settings(tuned).settings(), Some(&tuned));
+        let tuned = TaaSettings {
+            current_weight: 0.2,
+            ..Default::default()
+        };
+        assert_eq!(
+            TaaMode::parse("screen")
+                .unwrap()
+                .with_settings(tuned)
+                .settings(),
+            Some(&tuned)
+        );
         assert!(TaaMode::parse("on").is_err());
     }
 }

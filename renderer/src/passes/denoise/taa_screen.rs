@@ -10,8 +10,8 @@ use super::taa::TaaSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, TaaScreenPush};
-use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::passes::trace::GBuffer;
+use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::{UVec2, Vec4};
@@ -45,10 +45,22 @@ pub struct ScreenTaaFrame<'a> {
 impl ScreenTaa {
     pub fn new(ctx: &Arc<Context>, screen: UVec2, settings: TaaSettings) -> Result<ScreenTaa> {
         settings.validate()?;
-        let image = |name: &str| Image::new(ctx, name, screen.x, screen.y, vk::Format::R32G32B32A32_SFLOAT);
+        let image = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                screen.x,
+                screen.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )
+        };
         Ok(ScreenTaa {
             settings,
-            pipelines: VpLayoutPipelines::new(ctx, "passes/denoise/taa_screen", std::mem::size_of::<TaaScreenPush>() as u32)?,
+            pipelines: VpLayoutPipelines::new(
+                ctx,
+                "passes/denoise/taa_screen",
+                std::mem::size_of::<TaaScreenPush>() as u32,
+            )?,
             history: [image("taa_screen.history0")?, image("taa_screen.history1")?],
             frames: 0,
         })
@@ -56,12 +68,20 @@ impl ScreenTaa {
 
     /// GPU bytes carried between frames.
     pub fn history_bytes(&self) -> u64 {
-        self.history.iter().map(|i| i.width as u64 * i.height as u64 * i.texel_bytes()).sum()
+        self.history
+            .iter()
+            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
+            .sum()
     }
 
     /// Resolves the remapped `color` (screen-sized) against the history; returns the resolved
     /// image (next frame's history).
-    pub fn record(&mut self, rec: &mut FrameRecorder, color: &Image, frame: &ScreenTaaFrame) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        color: &Image,
+        frame: &ScreenTaaFrame,
+    ) -> Result<&Image> {
         let cur = (self.frames % 2) as usize;
         let reset = self.frames == 0 || !frame.has_previous;
         let binds = [
@@ -75,10 +95,21 @@ impl ScreenTaa {
         ];
         let push = TaaScreenPush {
             space: *frame.space,
-            params: Vec4::new(self.settings.current_weight, if reset { 1.0 } else { 0.0 }, 0.0, 0.0),
+            params: Vec4::new(
+                self.settings.current_weight,
+                if reset { 1.0 } else { 0.0 },
+                0.0,
+                0.0,
+            ),
         };
         let out = &self.history[cur];
-        rec.dispatch("taa_screen", self.pipelines.for_space(frame.space), &binds, push_bytes(&push), [out.width, out.height, 1])?;
+        rec.dispatch(
+            "taa_screen",
+            self.pipelines.for_space(frame.space),
+            &binds,
+            push_bytes(&push),
+            [out.width, out.height, 1],
+        )?;
         self.frames += 1;
         Ok(&self.history[cur])
     }

@@ -3,7 +3,9 @@
 //! strata's gradient image the tracer writes.
 
 use crate::error::{Error, Result};
-use crate::graph::{read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder};
+use crate::graph::{
+    read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
+};
 use crate::layouts::{AsvgfForwardPush, SamplingParams};
 use crate::passes::push_bytes;
 use crate::passes::trace::GBuffer;
@@ -18,7 +20,13 @@ pub struct ForwardPass {
 impl ForwardPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<ForwardPass> {
         let shader = format!("passes/denoise/asvgf_forward.{variant}");
-        Ok(ForwardPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<AsvgfForwardPush>() as u32)? })
+        Ok(ForwardPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<AsvgfForwardPush>() as u32,
+            )?,
+        })
     }
 
     /// Reads last frame's samples from `g` (before the tracer overwrites it) and the cameras from
@@ -36,7 +44,10 @@ impl ForwardPass {
         table: &Buffer,
         project: bool,
     ) -> Result<()> {
-        let visibility = g.visibility.as_ref().ok_or_else(|| Error::Invalid("A-SVGF needs a G-buffer with visibility".into()))?;
+        let visibility = g
+            .visibility
+            .as_ref()
+            .ok_or_else(|| Error::Invalid("A-SVGF needs a G-buffer with visibility".into()))?;
         let binds = [
             read_buffer("frame", frame_data),
             read_image("radiance", &g.radiance),
@@ -51,6 +62,12 @@ impl ForwardPass {
             space: *space,
             config: UVec4::new(project as u32, 0, 0, 0),
         };
-        rec.dispatch("asvgf_forward", &self.pipeline, &binds, push_bytes(&push), [gradient.width, gradient.height, 1])
+        rec.dispatch(
+            "asvgf_forward",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [gradient.width, gradient.height, 1],
+        )
     }
 }

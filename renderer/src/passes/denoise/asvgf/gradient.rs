@@ -18,7 +18,13 @@ pub struct GradientPass {
 impl GradientPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<GradientPass> {
         let shader = format!("passes/denoise/asvgf_gradient.{variant}");
-        Ok(GradientPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<AsvgfGradientPush>() as u32)? })
+        Ok(GradientPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<AsvgfGradientPush>() as u32,
+            )?,
+        })
     }
 
     /// `src` → `dst` (strata-sized: δ, max f, confidence), taps `step` strata apart.
@@ -34,12 +40,24 @@ impl GradientPass {
         table: &Buffer,
         s: &AsvgfSettings,
     ) -> Result<()> {
-        let binds = [read_image("src", src), read_image("normal_depth", &g.normal_depth), read_image("position", &g.position), write_image("dst", dst), read_texels("grid_columns", table)];
+        let binds = [
+            read_image("src", src),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            write_image("dst", dst),
+            read_texels("grid_columns", table),
+        ];
         let push = AsvgfGradientPush {
             space: *space,
             params: Vec4::new(s.gradient_sigma_depth, s.gradient_sigma_normal, 0.0, 0.0),
             config: UVec4::new(step, 0, 0, 0),
         };
-        rec.dispatch("asvgf_gradient", &self.pipeline, &binds, push_bytes(&push), [dst.width, dst.height, 1])
+        rec.dispatch(
+            "asvgf_gradient",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [dst.width, dst.height, 1],
+        )
     }
 }

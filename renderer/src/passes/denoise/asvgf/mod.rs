@@ -41,7 +41,12 @@ pub struct AsvgfSettings {
 
 impl Default for AsvgfSettings {
     fn default() -> Self {
-        AsvgfSettings { svgf: SvgfSettings::default(), gradient_iterations: 4, gradient_sigma_depth: 1.0, gradient_sigma_normal: 128.0 }
+        AsvgfSettings {
+            svgf: SvgfSettings::default(),
+            gradient_iterations: 4,
+            gradient_sigma_depth: 1.0,
+            gradient_sigma_normal: 128.0,
+        }
     }
 }
 
@@ -53,11 +58,16 @@ impl AsvgfSettings {
         self.svgf.validate()?;
         let bad = |what: String| Err(Error::Invalid(format!("asvgf: {what}")));
         if !(1..=MAX_GRADIENT_ITERATIONS).contains(&self.gradient_iterations) {
-            return bad(format!("gradient_iterations must be in 1..={MAX_GRADIENT_ITERATIONS}, got {}", self.gradient_iterations));
+            return bad(format!(
+                "gradient_iterations must be in 1..={MAX_GRADIENT_ITERATIONS}, got {}",
+                self.gradient_iterations
+            ));
         }
         let sigmas = [self.gradient_sigma_depth, self.gradient_sigma_normal];
         if !sigmas.iter().all(|s| s.is_finite() && *s > 0.0) {
-            return bad(format!("gradient σ_z, σ_n must be finite and > 0, got {sigmas:?}"));
+            return bad(format!(
+                "gradient σ_z, σ_n must be finite and > 0, got {sigmas:?}"
+            ));
         }
         Ok(())
     }
@@ -81,11 +91,24 @@ pub struct Asvgf {
 
 impl Asvgf {
     /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: AsvgfSettings) -> Result<Asvgf> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        settings: AsvgfSettings,
+    ) -> Result<Asvgf> {
         settings.validate()?;
         let strata = (grid + (ASVGF_STRATUM - 1)) / ASVGF_STRATUM;
         let count = strata.x as u64 * strata.y as u64;
-        let image = |name: &str| Image::new(ctx, name, strata.x, strata.y, vk::Format::R32G32B32A32_SFLOAT);
+        let image = |name: &str| {
+            Image::new(
+                ctx,
+                name,
+                strata.x,
+                strata.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )
+        };
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         let sample_bytes = std::mem::size_of::<AsvgfGradientSample>() as u64;
         Ok(Asvgf {
@@ -93,7 +116,13 @@ impl Asvgf {
             svgf: Svgf::adaptive(ctx, grid, variant, settings.svgf)?,
             forward: ForwardPass::new(ctx, variant)?,
             gradient: GradientPass::new(ctx, variant)?,
-            samples: Buffer::new(ctx, "asvgf.gradient_samples", count * sample_bytes, usage, MemoryLocation::GpuToCpu)?,
+            samples: Buffer::new(
+                ctx,
+                "asvgf.gradient_samples",
+                count * sample_bytes,
+                usage,
+                MemoryLocation::GpuToCpu,
+            )?,
             raw: image("asvgf.gradient_raw")?,
             ping: [image("asvgf.gradient0")?, image("asvgf.gradient1")?],
             visibility_bytes: grid.x as u64 * grid.y as u64 * 16,
@@ -113,24 +142,56 @@ impl Asvgf {
 
     /// Before the tracer: clears the gradient samples and projects last frame's into them (none on
     /// the first frame or without a previous frame). `frame_data` holds both cameras.
-    pub fn record_before_trace(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, frame_data: &Buffer) -> Result<()> {
+    pub fn record_before_trace(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+        frame_data: &Buffer,
+    ) -> Result<()> {
         rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
         let project = self.frames > 0 && frame.previous.is_some();
-        self.forward.record(rec, g, frame_data, &self.samples, &self.raw, &frame.current, frame.sampling_table, project)
+        self.forward.record(
+            rec,
+            g,
+            frame_data,
+            &self.samples,
+            &self.raw,
+            &frame.current,
+            frame.sampling_table,
+            project,
+        )
     }
 
     /// The tracer's gradient-variant inputs and outputs.
     pub fn gradient_targets(&self) -> GradientTargets<'_> {
-        GradientTargets { samples: &self.samples, gradient: &self.raw }
+        GradientTargets {
+            samples: &self.samples,
+            gradient: &self.raw,
+        }
     }
 
     /// After the tracer: reconstructs the gradients, then SVGF with the adaptive α.
-    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+    ) -> Result<&Image> {
         let s = self.settings;
         let mut src = &self.raw;
         for i in 0..s.gradient_iterations {
             let dst = &self.ping[(i % 2) as usize];
-            self.gradient.record(rec, g, src, dst, 1 << i, &frame.current, frame.sampling_table, &s)?;
+            self.gradient.record(
+                rec,
+                g,
+                src,
+                dst,
+                1 << i,
+                &frame.current,
+                frame.sampling_table,
+                &s,
+            )?;
             src = dst;
         }
         let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];

@@ -16,9 +16,17 @@ pub struct AccumulatePass {
 
 /// The push block both temporal passes share: this frame's space, the previous frame's
 /// gaze-dependent slots, the camera shift and the α floor (1 when the history is dropped).
-pub(super) fn temporal_push(current: &SamplingParams, r: &Reprojection, alpha_floor: f32) -> BmfrTemporalPush {
+pub(super) fn temporal_push(
+    current: &SamplingParams,
+    r: &Reprojection,
+    alpha_floor: f32,
+) -> BmfrTemporalPush {
     let p = r.previous.unwrap_or(current);
-    let alpha = if r.previous.is_none() { 1.0 } else { alpha_floor };
+    let alpha = if r.previous.is_none() {
+        1.0
+    } else {
+        alpha_floor
+    };
     BmfrTemporalPush {
         space: *current,
         prev: p.frame(),
@@ -29,7 +37,13 @@ pub(super) fn temporal_push(current: &SamplingParams, r: &Reprojection, alpha_fl
 impl AccumulatePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulatePass> {
         let shader = format!("passes/denoise/bmfr_accumulate.{variant}");
-        Ok(AccumulatePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
+        Ok(AccumulatePass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<BmfrTemporalPush>() as u32,
+            )?,
+        })
     }
 
     /// Reads history half `prev`, writes half `cur` (noisy, normal, position) in the live tiles.
@@ -65,6 +79,12 @@ impl AccumulatePass {
             read_buffer("tiles", tiles.buffer),
         ];
         let push = temporal_push(current, r, alpha_floor);
-        rec.dispatch("bmfr_accumulate", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "bmfr_accumulate",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

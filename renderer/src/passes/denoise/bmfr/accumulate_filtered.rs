@@ -18,7 +18,13 @@ pub struct AccumulateFilteredPass {
 impl AccumulateFilteredPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulateFilteredPass> {
         let shader = format!("passes/denoise/bmfr_accumulate_filtered.{variant}");
-        Ok(AccumulateFilteredPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrTemporalPush>() as u32)? })
+        Ok(AccumulateFilteredPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<BmfrTemporalPush>() as u32,
+            )?,
+        })
     }
 
     /// `fitted` + history half `prev` → history half `cur` and `dst` (re-modulated), live tiles.
@@ -55,6 +61,12 @@ impl AccumulateFilteredPass {
             read_buffer("tiles", tiles.buffer),
         ];
         let push = temporal_push(current, r, alpha_floor);
-        rec.dispatch("bmfr_accumulate_filtered", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "bmfr_accumulate_filtered",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

@@ -16,7 +16,12 @@ pub struct FitPass {
 }
 
 /// The push block of the fit and the weighted sum: the space and the block-grid offset.
-pub(super) fn block_push(space: &SamplingParams, offset: IVec2, seed: u32, noise: f32) -> BmfrBlockPush {
+pub(super) fn block_push(
+    space: &SamplingParams,
+    offset: IVec2,
+    seed: u32,
+    noise: f32,
+) -> BmfrBlockPush {
     BmfrBlockPush {
         space: *space,
         config: IVec4::new(offset.x, offset.y, seed as i32, 0),
@@ -27,7 +32,13 @@ pub(super) fn block_push(space: &SamplingParams, offset: IVec2, seed: u32, noise
 impl FitPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<FitPass> {
         let shader = format!("passes/denoise/bmfr_fit.{variant}");
-        Ok(FitPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+        Ok(FitPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<BmfrBlockPush>() as u32,
+            )?,
+        })
     }
 
     /// Features and noisy colour from history half `cur` → `weights`.
@@ -53,6 +64,12 @@ impl FitPass {
         ];
         let push = block_push(space, offset, seed, noise);
         let blocks = block_count(UVec2::new(space.grid.x, space.grid.y));
-        rec.dispatch("bmfr_fit", &self.pipeline, &binds, push_bytes(&push), [blocks.x * BMFR_FIT_LANES, blocks.y, 1])
+        rec.dispatch(
+            "bmfr_fit",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            [blocks.x * BMFR_FIT_LANES, blocks.y, 1],
+        )
     }
 }

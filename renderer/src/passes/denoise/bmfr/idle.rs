@@ -27,12 +27,25 @@ pub(super) struct IdleTargets<'a> {
 impl IdlePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<IdlePass> {
         let shader = format!("passes/denoise/bmfr_idle.{variant}");
-        Ok(IdlePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrIdlePush>() as u32)? })
+        Ok(IdlePass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<BmfrIdlePush>() as u32,
+            )?,
+        })
     }
 
     /// Writes `targets` in `tiles`' idle tiles (nothing to record without any). Recorded before
     /// the fit, which reads the accumulated features of every texel of a block.
-    pub fn record(&self, rec: &mut FrameRecorder, targets: &IdleTargets, space: &SamplingParams, table: &Buffer, tiles: &TileList) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        targets: &IdleTargets,
+        space: &SamplingParams,
+        table: &Buffer,
+        tiles: &TileList,
+    ) -> Result<()> {
         if tiles.idle == 0 {
             return Ok(());
         }
@@ -47,7 +60,16 @@ impl IdlePass {
             read_texels("grid_columns", table),
             read_buffer("tiles", tiles.buffer),
         ];
-        let push = BmfrIdlePush { space: *space, config: UVec4::new(tiles.live, 0, 0, 0) };
-        rec.dispatch("bmfr_idle", &self.pipeline, &binds, push_bytes(&push), tiles.idle_threads())
+        let push = BmfrIdlePush {
+            space: *space,
+            config: UVec4::new(tiles.live, 0, 0, 0),
+        };
+        rec.dispatch(
+            "bmfr_idle",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.idle_threads(),
+        )
     }
 }

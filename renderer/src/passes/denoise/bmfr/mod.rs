@@ -50,7 +50,11 @@ pub struct BmfrSettings {
 
 impl Default for BmfrSettings {
     fn default() -> Self {
-        BmfrSettings { alpha_noisy: 0.2, alpha_filtered: 0.1, noise: 1e-2 }
+        BmfrSettings {
+            alpha_noisy: 0.2,
+            alpha_filtered: 0.1,
+            noise: 1e-2,
+        }
     }
 }
 
@@ -60,7 +64,10 @@ impl BmfrSettings {
         // α = 1 would mean no accumulation at all; the passes use it to drop the history.
         let open_unit = |a: f32| a > 0.0 && a < 1.0;
         if !open_unit(self.alpha_noisy) || !open_unit(self.alpha_filtered) {
-            return bad(format!("alpha_noisy and alpha_filtered must be in (0, 1), got {} and {}", self.alpha_noisy, self.alpha_filtered));
+            return bad(format!(
+                "alpha_noisy and alpha_filtered must be in (0, 1), got {} and {}",
+                self.alpha_noisy, self.alpha_filtered
+            ));
         }
         if !(self.noise.is_finite() && (0.0..=0.1).contains(&self.noise)) {
             return bad(format!("noise must be in [0, 0.1], got {}", self.noise));
@@ -111,7 +118,10 @@ pub struct BmfrHistory {
 impl BmfrHistory {
     fn new(ctx: &Arc<Context>, grid: UVec2) -> Result<BmfrHistory> {
         let pair = |name: &str, format| -> Result<[Image; 2]> {
-            Ok([Image::new(ctx, &format!("{name}0"), grid.x, grid.y, format)?, Image::new(ctx, &format!("{name}1"), grid.x, grid.y, format)?])
+            Ok([
+                Image::new(ctx, &format!("{name}0"), grid.x, grid.y, format)?,
+                Image::new(ctx, &format!("{name}1"), grid.x, grid.y, format)?,
+            ])
         };
         let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
         Ok(BmfrHistory {
@@ -164,7 +174,12 @@ pub struct Bmfr {
 
 impl Bmfr {
     /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: BmfrSettings) -> Result<Bmfr> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        settings: BmfrSettings,
+    ) -> Result<Bmfr> {
         settings.validate()?;
         let blocks = block_count(grid);
         let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
@@ -176,7 +191,13 @@ impl Bmfr {
             accumulate_filtered: AccumulateFilteredPass::new(ctx, variant)?,
             idle: IdlePass::new(ctx, variant)?,
             history: BmfrHistory::new(ctx, grid)?,
-            weights: Image::new(ctx, "bmfr.weights", blocks.x * BMFR_WEIGHT_TEXELS, blocks.y, rgba32)?,
+            weights: Image::new(
+                ctx,
+                "bmfr.weights",
+                blocks.x * BMFR_WEIGHT_TEXELS,
+                blocks.y,
+                rgba32,
+            )?,
             fitted: Image::new(ctx, "bmfr.fitted", grid.x, grid.y, rgba32)?,
             output: Image::new(ctx, "bmfr.output", grid.x, grid.y, rgba32)?,
         })
@@ -200,22 +221,85 @@ impl Bmfr {
     /// returns `output`. The per-texel passes run over `frame.tiles`' live tiles; the idle pass
     /// writes the idle ones before the fit reads whole blocks. History is dropped on the first frame and whenever `frame.previous` is
     /// `None`.
-    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, scene: &DenoiseScene) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+        scene: &DenoiseScene,
+    ) -> Result<&Image> {
         let camera_origin = scene.camera_origin;
         let s = self.settings;
         let offset = self.next_block_offset();
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
-        let previous = if h.frames == 0 { None } else { frame.previous.as_ref() };
-        let reprojection = Reprojection { previous, camera_shift: h.origin - camera_origin };
+        let previous = if h.frames == 0 {
+            None
+        } else {
+            frame.previous.as_ref()
+        };
+        let reprojection = Reprojection {
+            previous,
+            camera_shift: h.origin - camera_origin,
+        };
         let (table, tiles) = (frame.sampling_table, &frame.tiles);
-        self.accumulate.record(rec, g, scene.materials, h, prev, cur, &frame.current, table, tiles, &reprojection, s.alpha_noisy)?;
-        let idle = IdleTargets { history: h, cur, fitted: &self.fitted, output: &self.output };
+        self.accumulate.record(
+            rec,
+            g,
+            scene.materials,
+            h,
+            prev,
+            cur,
+            &frame.current,
+            table,
+            tiles,
+            &reprojection,
+            s.alpha_noisy,
+        )?;
+        let idle = IdleTargets {
+            history: h,
+            cur,
+            fitted: &self.fitted,
+            output: &self.output,
+        };
         self.idle.record(rec, &idle, &frame.current, table, tiles)?;
         let seed = h.frames as u32;
-        self.fit.record(rec, h, cur, &self.weights, &frame.current, table, offset, seed, s.noise)?;
-        self.weighted_sum.record(rec, h, cur, &self.weights, &self.fitted, &frame.current, table, tiles, offset)?;
-        self.accumulate_filtered.record(rec, g, h, prev, cur, &self.fitted, &self.output, &frame.current, table, tiles, &reprojection, s.alpha_filtered)?;
+        self.fit.record(
+            rec,
+            h,
+            cur,
+            &self.weights,
+            &frame.current,
+            table,
+            offset,
+            seed,
+            s.noise,
+        )?;
+        self.weighted_sum.record(
+            rec,
+            h,
+            cur,
+            &self.weights,
+            &self.fitted,
+            &frame.current,
+            table,
+            tiles,
+            offset,
+        )?;
+        self.accumulate_filtered.record(
+            rec,
+            g,
+            h,
+            prev,
+            cur,
+            &self.fitted,
+            &self.output,
+            &frame.current,
+            table,
+            tiles,
+            &reprojection,
+            s.alpha_filtered,
+        )?;
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)

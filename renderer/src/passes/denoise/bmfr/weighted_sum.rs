@@ -18,7 +18,13 @@ pub struct WeightedSumPass {
 impl WeightedSumPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<WeightedSumPass> {
         let shader = format!("passes/denoise/bmfr_weighted_sum.{variant}");
-        Ok(WeightedSumPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<BmfrBlockPush>() as u32)? })
+        Ok(WeightedSumPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<BmfrBlockPush>() as u32,
+            )?,
+        })
     }
 
     /// Features of history half `cur` and the blocks' `weights` → `fitted`, live tiles.
@@ -45,6 +51,12 @@ impl WeightedSumPass {
             read_buffer("tiles", tiles.buffer),
         ];
         let push = block_push(space, offset, 0, 0.0);
-        rec.dispatch("bmfr_weighted_sum", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "bmfr_weighted_sum",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

@@ -18,7 +18,13 @@ pub struct AtrousPass {
 impl AtrousPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AtrousPass> {
         let shader = format!("passes/denoise/svgf_atrous.{variant}");
-        Ok(AtrousPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfAtrousPush>() as u32)? })
+        Ok(AtrousPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<SvgfAtrousPush>() as u32,
+            )?,
+        })
     }
 
     /// `src` → `dst` (both colour, variance) in the live tiles, taps `step` texels apart.
@@ -48,6 +54,12 @@ impl AtrousPass {
             params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, 0.0),
             config: UVec4::new(step, 0, 0, 0),
         };
-        rec.dispatch("svgf_atrous", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "svgf_atrous",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

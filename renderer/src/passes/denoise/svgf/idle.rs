@@ -19,12 +19,26 @@ pub struct IdlePass {
 impl IdlePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<IdlePass> {
         let shader = format!("passes/denoise/svgf_idle.{variant}");
-        Ok(IdlePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfIdlePush>() as u32)? })
+        Ok(IdlePass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<SvgfIdlePush>() as u32,
+            )?,
+        })
     }
 
     /// Writes history half `cur` and the colour history in `tiles`' idle tiles (nothing to record
     /// without any). Recorded after the temporal pass, which reads the colour history.
-    pub fn record(&self, rec: &mut FrameRecorder, h: &SvgfHistory, cur: usize, space: &SamplingParams, table: &Buffer, tiles: &TileList) -> Result<()> {
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        h: &SvgfHistory,
+        cur: usize,
+        space: &SamplingParams,
+        table: &Buffer,
+        tiles: &TileList,
+    ) -> Result<()> {
         if tiles.idle == 0 {
             return Ok(());
         }
@@ -35,7 +49,16 @@ impl IdlePass {
             read_texels("grid_columns", table),
             read_buffer("tiles", tiles.buffer),
         ];
-        let push = SvgfIdlePush { space: *space, config: UVec4::new(tiles.live, 0, 0, 0) };
-        rec.dispatch("svgf_idle", &self.pipeline, &binds, push_bytes(&push), tiles.idle_threads())
+        let push = SvgfIdlePush {
+            space: *space,
+            config: UVec4::new(tiles.live, 0, 0, 0),
+        };
+        rec.dispatch(
+            "svgf_idle",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.idle_threads(),
+        )
     }
 }

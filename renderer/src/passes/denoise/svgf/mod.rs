@@ -20,8 +20,8 @@ use crate::passes::trace::GBuffer;
 use crate::vk::{Context, Image};
 use ash::vk;
 use atrous::AtrousPass;
-use idle::IdlePass;
 use glam::UVec2;
+use idle::IdlePass;
 use std::sync::Arc;
 use temporal::TemporalPass;
 use variance::VariancePass;
@@ -70,17 +70,25 @@ impl SvgfSettings {
         let bad = |what: String| Err(Error::Invalid(format!("svgf: {what}")));
         let unit = |a: f32| a > 0.0 && a <= 1.0;
         if !unit(self.alpha_color) || !unit(self.alpha_moments) {
-            return bad(format!("alphas must be in (0, 1], got {} and {}", self.alpha_color, self.alpha_moments));
+            return bad(format!(
+                "alphas must be in (0, 1], got {} and {}",
+                self.alpha_color, self.alpha_moments
+            ));
         }
         if self.max_history == 0 {
             return bad("max_history must be at least 1".into());
         }
         if !(1..=MAX_ATROUS_ITERATIONS).contains(&self.atrous_iterations) {
-            return bad(format!("atrous_iterations must be in 1..={MAX_ATROUS_ITERATIONS}, got {}", self.atrous_iterations));
+            return bad(format!(
+                "atrous_iterations must be in 1..={MAX_ATROUS_ITERATIONS}, got {}",
+                self.atrous_iterations
+            ));
         }
         let sigmas = [self.sigma_luminance, self.sigma_depth, self.sigma_normal];
         if !sigmas.iter().all(|s| s.is_finite() && *s > 0.0) {
-            return bad(format!("σ_l, σ_z, σ_n must be finite and > 0, got {sigmas:?}"));
+            return bad(format!(
+                "σ_l, σ_z, σ_n must be finite and > 0, got {sigmas:?}"
+            ));
         }
         Ok(())
     }
@@ -109,7 +117,10 @@ impl SvgfHistory {
         Ok(SvgfHistory {
             color: image("svgf.history_color", rgba)?,
             moments: [image("svgf.moments0", rgba)?, image("svgf.moments1", rgba)?],
-            surface: [image("svgf.surface0", surface)?, image("svgf.surface1", surface)?],
+            surface: [
+                image("svgf.surface0", surface)?,
+                image("svgf.surface1", surface)?,
+            ],
             frames: 0,
         })
     }
@@ -120,10 +131,16 @@ impl SvgfHistory {
 
     /// GPU bytes of the state carried between frames (the per-eye memory cost of the filter).
     pub fn bytes(&self) -> u64 {
-        [&self.color, &self.moments[0], &self.moments[1], &self.surface[0], &self.surface[1]]
-            .iter()
-            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
-            .sum()
+        [
+            &self.color,
+            &self.moments[0],
+            &self.moments[1],
+            &self.surface[0],
+            &self.surface[1],
+        ]
+        .iter()
+        .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
+        .sum()
     }
 }
 
@@ -145,18 +162,35 @@ pub struct Svgf {
 
 impl Svgf {
     /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
-    pub fn new(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: SvgfSettings) -> Result<Svgf> {
+    pub fn new(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        settings: SvgfSettings,
+    ) -> Result<Svgf> {
         Svgf::build(ctx, grid, variant, variant, settings)
     }
 
     /// SVGF whose temporal accumulation takes A-SVGF's reconstructed gradient (`record_adaptive`).
-    pub(crate) fn adaptive(ctx: &Arc<Context>, grid: UVec2, variant: &str, settings: SvgfSettings) -> Result<Svgf> {
+    pub(crate) fn adaptive(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        settings: SvgfSettings,
+    ) -> Result<Svgf> {
         Svgf::build(ctx, grid, variant, &format!("{variant}_adaptive"), settings)
     }
 
-    fn build(ctx: &Arc<Context>, grid: UVec2, variant: &str, temporal_variant: &str, settings: SvgfSettings) -> Result<Svgf> {
+    fn build(
+        ctx: &Arc<Context>,
+        grid: UVec2,
+        variant: &str,
+        temporal_variant: &str,
+        settings: SvgfSettings,
+    ) -> Result<Svgf> {
         settings.validate()?;
-        let image = |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
+        let image =
+            |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(Svgf {
             settings,
             temporal: TemporalPass::new(ctx, temporal_variant)?,
@@ -184,33 +218,80 @@ impl Svgf {
     /// All but the modulation run over `frame.tiles`' live tiles; the idle pass fills in the
     /// history a later frame reads of the idle ones.
     /// History is dropped on the first frame and whenever `frame.previous` is `None`.
-    pub fn record(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame) -> Result<&Image> {
+    pub fn record(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+    ) -> Result<&Image> {
         self.record_with(rec, g, frame, None)
     }
 
     /// `record` for SVGF built by `adaptive`: `gradient` (per 3×3 stratum: δ̂, max f, confidence)
     /// sets each texel's temporal α.
-    pub(crate) fn record_adaptive(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, gradient: &Image) -> Result<&Image> {
+    pub(crate) fn record_adaptive(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+        gradient: &Image,
+    ) -> Result<&Image> {
         self.record_with(rec, g, frame, Some(gradient))
     }
 
-    fn record_with(&mut self, rec: &mut FrameRecorder, g: &GBuffer, frame: &DenoiseFrame, gradient: Option<&Image>) -> Result<&Image> {
+    fn record_with(
+        &mut self,
+        rec: &mut FrameRecorder,
+        g: &GBuffer,
+        frame: &DenoiseFrame,
+        gradient: Option<&Image>,
+    ) -> Result<&Image> {
         let s = self.settings;
         let h = &self.history;
         let (cur, prev) = (h.current(), 1 - h.current());
         let previous = if h.frames == 0 { None } else { frame.previous };
         let (table, tiles) = (frame.sampling_table, &frame.tiles);
-        self.temporal.record(rec, g, h, prev, cur, &self.accum, &frame.current, table, tiles, previous.as_ref(), &s, gradient)?;
-        self.idle.record(rec, h, cur, &frame.current, table, tiles)?;
-        self.variance.record(rec, g, &self.accum, &h.moments[cur], &self.ping[0], &frame.current, table, tiles, &s)?;
+        self.temporal.record(
+            rec,
+            g,
+            h,
+            prev,
+            cur,
+            &self.accum,
+            &frame.current,
+            table,
+            tiles,
+            previous.as_ref(),
+            &s,
+            gradient,
+        )?;
+        self.idle
+            .record(rec, h, cur, &frame.current, table, tiles)?;
+        self.variance.record(
+            rec,
+            g,
+            &self.accum,
+            &h.moments[cur],
+            &self.ping[0],
+            &frame.current,
+            table,
+            tiles,
+            &s,
+        )?;
         // Iteration 0 writes the colour history; then the two ping images alternate.
         let mut src = &self.ping[0];
         for i in 0..s.atrous_iterations {
-            let dst = if i == 0 { &h.color } else { &self.ping[(i % 2) as usize] };
-            self.atrous.record(rec, g, src, dst, 1 << i, &frame.current, table, tiles, &s)?;
+            let dst = if i == 0 {
+                &h.color
+            } else {
+                &self.ping[(i % 2) as usize]
+            };
+            self.atrous
+                .record(rec, g, src, dst, 1 << i, &frame.current, table, tiles, &s)?;
             src = dst;
         }
-        self.modulate.record(rec, "svgf_modulate", src, &g.albedo, &self.output)?;
+        self.modulate
+            .record(rec, "svgf_modulate", src, &g.albedo, &self.output)?;
         self.history.frames += 1;
         Ok(&self.output)
     }

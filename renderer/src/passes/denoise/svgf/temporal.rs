@@ -18,7 +18,13 @@ pub struct TemporalPass {
 impl TemporalPass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<TemporalPass> {
         let shader = format!("passes/denoise/svgf_temporal.{variant}");
-        Ok(TemporalPass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfTemporalPush>() as u32)? })
+        Ok(TemporalPass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<SvgfTemporalPush>() as u32,
+            )?,
+        })
     }
 
     /// Reads history half `prev`, writes half `cur` and `accum` (colour, variance) in the live tiles. `previous`:
@@ -57,7 +63,11 @@ impl TemporalPass {
             read_buffer("tiles", tiles.buffer),
             read_image("gradient", gradient.unwrap_or(&g.radiance)),
         ];
-        let binds = &binds[..if gradient.is_some() { binds.len() } else { binds.len() - 1 }];
+        let binds = &binds[..if gradient.is_some() {
+            binds.len()
+        } else {
+            binds.len() - 1
+        }];
         // The grid and screen never change for one renderer: only the gaze-dependent slots travel.
         let p = previous.unwrap_or(current);
         let reset = if previous.is_none() { 1.0 } else { 0.0 };
@@ -66,6 +76,12 @@ impl TemporalPass {
             prev: p.frame(),
             params: Vec4::new(s.alpha_color, s.alpha_moments, s.max_history as f32, reset),
         };
-        rec.dispatch("svgf_temporal", &self.pipeline, binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "svgf_temporal",
+            &self.pipeline,
+            binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }

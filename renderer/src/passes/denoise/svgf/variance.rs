@@ -18,7 +18,13 @@ pub struct VariancePass {
 impl VariancePass {
     pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<VariancePass> {
         let shader = format!("passes/denoise/svgf_variance.{variant}");
-        Ok(VariancePass { pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<SvgfVariancePush>() as u32)? })
+        Ok(VariancePass {
+            pipeline: ComputePipeline::shared(
+                ctx,
+                &shader,
+                std::mem::size_of::<SvgfVariancePush>() as u32,
+            )?,
+        })
     }
 
     /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance), live tiles.
@@ -46,8 +52,19 @@ impl VariancePass {
         ];
         let push = SvgfVariancePush {
             space: *space,
-            params: Vec4::new(s.sigma_luminance, s.sigma_depth, s.sigma_normal, s.variance_history as f32),
+            params: Vec4::new(
+                s.sigma_luminance,
+                s.sigma_depth,
+                s.sigma_normal,
+                s.variance_history as f32,
+            ),
         };
-        rec.dispatch("svgf_variance", &self.pipeline, &binds, push_bytes(&push), tiles.live_threads())
+        rec.dispatch(
+            "svgf_variance",
+            &self.pipeline,
+            &binds,
+            push_bytes(&push),
+            tiles.live_threads(),
+        )
     }
 }
