@@ -1,4 +1,5 @@
-//! `--gaze center | X,Y | sim[:seed] | gazebase:<file> | <trace path>` for the CLI.
+//! `--gaze center | X,Y | sim[:seed] | gazebase:<file> | degrees:<file> | <trace path>` for the
+//! CLI.
 
 use crate::error::HalError;
 use crate::hmd::HmdDescription;
@@ -25,6 +26,9 @@ pub enum GazeSpec {
     Trace(PathBuf),
     /// A GazeBase-style dataset CSV (`n` ms, `x`/`y` degrees, optional `val`), imported on open.
     GazeBase(PathBuf),
+    /// A recording in degrees from the screen centre (`t_s,x_deg,y_deg,valid`), placed on the
+    /// left eye's view (`trace::import::import_degrees`), imported on open.
+    Degrees(PathBuf),
 }
 
 impl FromStr for GazeSpec {
@@ -38,7 +42,7 @@ impl FromStr for GazeSpec {
         let t = s.trim();
         if t.is_empty() {
             return Err(err(
-                "empty; expected center, X,Y, sim[:seed] or a trace file path",
+                "empty; expected center, X,Y, sim[:seed], gazebase:FILE, degrees:FILE or a trace file path",
             ));
         }
         if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
@@ -60,6 +64,12 @@ impl FromStr for GazeSpec {
                 return Err(err("a file must follow `gazebase:`"));
             }
             return Ok(GazeSpec::GazeBase(PathBuf::from(path)));
+        }
+        if let Some(path) = t.strip_prefix("degrees:") {
+            if path.is_empty() {
+                return Err(err("a file must follow `degrees:`"));
+            }
+            return Ok(GazeSpec::Degrees(PathBuf::from(path)));
         }
         // Something that starts like a number, or two things that parse as numbers (`NaN,5`,
         // `inf,0`), with a comma, is meant as pixel coordinates, never as a trace file name.
@@ -118,6 +128,11 @@ impl GazeSpec {
                     &crate::trace::import::DegreesImport::default(),
                 )?;
                 // Dataset times start anywhere: frame 0 shows the first sample.
+                Box::new(Playback::new(trace, hmd).aligned_to_first_frame())
+            }
+            GazeSpec::Degrees(path) => {
+                let fov = hmd.eye(Eye::Left).fov;
+                let trace = crate::trace::import::import_degrees(path, &fov)?;
                 Box::new(Playback::new(trace, hmd).aligned_to_first_frame())
             }
         })
