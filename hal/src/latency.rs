@@ -75,11 +75,13 @@ impl LatencyModel {
                 ))
             }
         };
+        // The profile's decimal figures as written (14.3, not 14.300000190734863).
+        let decimal = |v: f32| v.to_string().parse::<f64>().unwrap_or(v as f64);
         Ok(LatencyModel {
-            tracker_hz: tracker_hz.unwrap_or(hmd.tracker.rate_hz as f64),
-            tracker_ms: hmd.tracker.latency_ms as f64,
-            render_ms: pipeline.render_ms as f64,
-            display_ms: pipeline.display_ms as f64,
+            tracker_hz: tracker_hz.unwrap_or(decimal(hmd.tracker.rate_hz)),
+            tracker_ms: decimal(hmd.tracker.latency_ms),
+            render_ms: decimal(pipeline.render_ms),
+            display_ms: decimal(pipeline.display_ms),
             total_override_ms: total_ms,
         })
     }
@@ -129,7 +131,7 @@ impl LatencyModel {
                 self.tracker_hz
             ),
             None => format!(
-                "{} ms ({parts}), tracker {} Hz",
+                "{:.1} ms ({parts}), tracker {} Hz",
                 self.total_ms(),
                 self.tracker_hz
             ),

@@ -13,6 +13,7 @@
 
 pub mod error;
 pub mod file;
+pub mod gaze_eval;
 pub mod hmd;
 pub mod latency;
 pub mod predict;

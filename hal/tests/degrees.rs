@@ -65,6 +65,13 @@ fn invalid_rows_follow_the_invalid_gaze_policy() {
     std::fs::write(&file, text).unwrap();
     let spec: GazeSpec = format!("degrees:{}", file.display()).parse().unwrap();
     assert_eq!(spec, GazeSpec::Degrees(file.clone()));
+    // A plain path with the degrees header is the same recording.
+    let plain: GazeSpec = file.display().to_string().parse().unwrap();
+    let hmd = HmdDescription::fove0();
+    assert_eq!(
+        plain.recording(&hmd).unwrap().samples,
+        spec.recording(&hmd).unwrap().samples
+    );
     let mut source = spec.open(HmdDescription::fove0()).unwrap();
     let mut policy = InvalidGazePolicy::new(250.0);
     let mut origin_at = |t: i64| {

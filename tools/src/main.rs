@@ -122,10 +122,39 @@ impl SceneFlags {
     }
 }
 
+/// The latency model (hal): with any of these flags each frame is foveated with the gaze a
+/// headset would have and judged also where the eye is when it is shown.
+#[derive(clap::Args)]
+struct LatencyFlags {
+    /// Gaze-to-photon latency in ms: a frame displayed at T sees the tracker samples taken up to
+    /// T − this (default: the headset profile's tracker + render + display latency).
+    #[arg(long, allow_hyphen_values = true)]
+    latency_ms: Option<f64>,
+    /// Tracker rate of the latency model in Hz (default: the headset profile's).
+    #[arg(long, allow_hyphen_values = true)]
+    tracker_hz: Option<f64>,
+    /// Gaze prediction at the display time: off (the newest sample) | hold | linear | saccade
+    /// (default saccade, chosen by `fovea gaze-eval`; see docs/guide/gaze-latency.md).
+    #[arg(long)]
+    gaze_predict: Option<String>,
+}
+
+impl LatencyFlags {
+    fn timing(&self) -> Result<fovea_tools::gaze::GazeTiming> {
+        fovea_tools::gaze::GazeTiming::from_flags(
+            self.latency_ms,
+            self.tracker_hz,
+            self.gaze_predict.as_deref(),
+        )
+    }
+}
+
 #[derive(clap::Args)]
 struct RenderOpts {
     #[command(flatten)]
     look: SceneFlags,
+    #[command(flatten)]
+    latency: LatencyFlags,
     /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
@@ -135,8 +164,9 @@ struct RenderOpts {
     /// Headset profile: a name from `fovea headsets` or a TOML path.
     #[arg(long, default_value = "fove0")]
     headset: String,
-    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file
-    /// (render: default sim:1; view: default the mouse).
+    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file |
+    /// degrees:FILE (t_s,x_deg,y_deg,valid) | gazebase:FILE (render: default sim:1; view: default
+    /// the mouse).
     #[arg(long)]
     gaze: Option<String>,
     /// Render width (default: the headset's per-eye width × --scale).
@@ -261,6 +291,7 @@ impl RenderOpts {
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
+            gaze_timing: self.latency.timing()?,
         })
     }
 }
@@ -496,7 +527,35 @@ enum Command {
         #[command(flatten)]
         look: SceneFlags,
         #[command(flatten)]
+        latency: LatencyFlags,
+        #[command(flatten)]
         device: DeviceArgs,
+    },
+    /// Gaze error at display time without rendering: recordings through the latency model and
+    /// each predictor, every frame against where the eye is when it is shown (median, p95, p99,
+    /// share above 2.5° and 5°, per-saccade landing error) → DIR/gaze_eval.json + a table.
+    GazeEval {
+        /// Recordings: degrees CSVs (t_s,x_deg,y_deg,valid), fovea gaze traces, degrees:FILE or
+        /// gazebase:FILE.
+        #[arg(required = true)]
+        traces: Vec<String>,
+        /// Headset profile (its left eye's view, tracker and latency).
+        #[arg(long, default_value = "fove0")]
+        headset: String,
+        /// Sample-to-photon latency in ms (default: the profile's tracker + render + display).
+        #[arg(long, allow_hyphen_values = true)]
+        latency_ms: Option<f64>,
+        /// Tracker rate in Hz (default: the profile's).
+        #[arg(long, allow_hyphen_values = true)]
+        tracker_hz: Option<f64>,
+        /// Display rate in Hz (default: the profile's refresh).
+        #[arg(long, allow_hyphen_values = true)]
+        display_hz: Option<f64>,
+        /// Predictors, comma-separated: off, hold, linear, saccade (default: all).
+        #[arg(long, value_delimiter = ',')]
+        gaze_predict: Vec<String>,
+        #[arg(long, default_value = "out/gaze-eval")]
+        out: PathBuf,
     },
     /// Write issue 14's method table into the README (between its method-table markers) from a
     /// `fovea quality` folder and a `fovea bench` report, with a picture row and the papers' claims.
@@ -863,6 +922,7 @@ fn run() -> Result<()> {
             blur_space,
             out,
             look,
+            latency,
             device,
         } => {
             let base = match &profile {
@@ -876,6 +936,7 @@ fn run() -> Result<()> {
                 texture_lod: look.texture_lod.clone(),
                 path_regularisation: look.path_regularisation,
                 offscreen_samples: look.offscreen_samples.clone(),
+                gaze_timing: latency.timing()?,
                 ..Default::default()
             })?;
             let all: Vec<String> = DenoiserSettings::NAMES
@@ -908,6 +969,23 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
+        Command::GazeEval {
+            traces,
+            headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            gaze_predict,
+            out,
+        } => commands::gaze_eval::run(&commands::gaze_eval::GazeEvalArgs {
+            traces: &traces,
+            headset: &headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            predict: &gaze_predict,
+            out: &out,
+        }),
         Command::MethodTable {
             quality,
             bench,

@@ -48,6 +48,8 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
 #[derive(Deserialize, Default)]
@@ -196,6 +198,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -498,6 +502,9 @@ impl RenderProfile {
         if let Some(mode) = &o.offscreen_samples {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
+        }
+        if o.gaze_timing.enabled() {
+            self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
     }

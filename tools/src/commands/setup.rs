@@ -89,7 +89,8 @@ impl Setup {
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
-        let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
+        let timing = &args.profile.gaze_timing;
+        let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
         let (scene, camera) = crate::look::load(
             args.scene,
             args.camera,
