@@ -99,6 +99,24 @@ pub struct FrameLatency {
     pub motion: &'static str,
 }
 
+/// The flags of `timing` as one line (empty without a latency model): what a replay baseline
+/// records of them.
+pub fn describe_timing(timing: &GazeTiming) -> String {
+    if !timing.enabled() {
+        return String::new();
+    }
+    let part = |name: &str, v: Option<f64>| v.map(|v| format!("{name} {v}"));
+    [
+        part("--latency-ms", timing.latency_ms),
+        part("--tracker-hz", timing.tracker_hz),
+        Some(format!("--gaze-predict {}", timing.mode().name())),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>()
+    .join(" ")
+}
+
 /// A run's latency accounting for report.json (`fovea render`; `quality` and `replay` read it).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct LatencyLog {
