@@ -146,18 +146,24 @@ pub struct DelayedFrame {
     /// What the frame uses: the prediction after the invalid-gaze policy.
     pub resolved: ResolvedGaze,
     pub prediction: Prediction,
-    /// The source's own gaze at the display time: where the eye is when the frame is seen.
+    /// The source's own gaze at the display time: where the eye is when the frame is seen (a
+    /// live source's own sample, which is all there is).
     pub truth: GazeSample,
 }
 
 /// A gaze source seen through the latency model: tracker samples at the model's rate, each frame
-/// foveated with the prediction from those measured up to its display time − latency.
+/// foveated with the prediction from those measured up to its display time − latency. Or, for a
+/// live tracker whose latency is real (an OpenXR runtime), [`DelayedGaze::live`]: the predictor
+/// takes each new sample the source gives and predicts to the display time.
 pub struct DelayedGaze {
-    model: LatencyModel,
+    /// `None`: live.
+    model: Option<LatencyModel>,
     predictor: Predictor,
     policy: InvalidGazePolicy,
     /// The next tracker tick to feed the predictor.
     next_tick: Option<i64>,
+    /// Live: the time of the newest sample fed.
+    newest_live: Option<XrTime>,
 }
 
 impl DelayedGaze {
@@ -167,15 +173,35 @@ impl DelayedGaze {
 
     pub fn with_predictor(model: LatencyModel, predictor: Predictor) -> DelayedGaze {
         DelayedGaze {
-            model,
+            model: Some(model),
             predictor,
             policy: InvalidGazePolicy::default(),
             next_tick: None,
+            newest_live: None,
         }
     }
 
-    pub fn model(&self) -> &LatencyModel {
-        &self.model
+    /// A live source: no modelled latency, each new sample fed as the source measured it (a
+    /// sample of unknown time as taken at the display time it was asked for).
+    pub fn live(mode: PredictMode, hmd: &HmdDescription) -> DelayedGaze {
+        DelayedGaze {
+            model: None,
+            ..DelayedGaze::with_predictor(
+                LatencyModel::for_headset(hmd, Some(0.0), None).unwrap_or(LatencyModel {
+                    tracker_hz: hmd.tracker.rate_hz as f64,
+                    tracker_ms: 0.0,
+                    render_ms: 0.0,
+                    display_ms: 0.0,
+                    total_override_ms: Some(0.0),
+                }),
+                Predictor::new(mode, hmd),
+            )
+        }
+    }
+
+    /// The latency model; `None` for a live source.
+    pub fn model(&self) -> Option<&LatencyModel> {
+        self.model.as_ref()
     }
 
     pub fn mode(&self) -> PredictMode {
@@ -191,17 +217,34 @@ impl DelayedGaze {
         display_time: XrTime,
     ) -> Result<DelayedFrame, HalError> {
         source.begin_frame(display_time)?;
-        let newest = self.model.newest_tick(display_time);
-        let warm_up = (WARM_UP_MS * NANOS_PER_MILLI / self.model.tracker_period_ns()).ceil() as i64;
-        let first = self.next_tick.unwrap_or(newest - warm_up);
-        for k in first..=newest {
-            let t = self.model.tick_time(k);
-            let s = source.sample_at(t);
-            let usable = s.valid && s.gaze.direction.is_finite();
-            self.predictor
-                .push(t, usable.then_some(s.gaze.direction.normalize()));
+        let usable = |s: &GazeSample| {
+            let ok = s.valid && s.gaze.direction.is_finite() && s.gaze.direction.length() > 0.0;
+            ok.then(|| s.gaze.direction.normalize())
+        };
+        let mut newest = 0;
+        match &self.model {
+            Some(model) => {
+                newest = model.newest_tick(display_time);
+                let warm_up =
+                    (WARM_UP_MS * NANOS_PER_MILLI / model.tracker_period_ns()).ceil() as i64;
+                let first = self.next_tick.unwrap_or(newest - warm_up);
+                for k in first..=newest {
+                    let t = model.tick_time(k);
+                    let s = source.sample_at(t);
+                    self.predictor.push(t, usable(&s));
+                }
+                self.next_tick = Some(newest.max(first - 1) + 1);
+            }
+            None => {
+                let s = source.sample_at(display_time);
+                let known = s.time != 0 && s.time_kind != SampleTimeKind::Unknown;
+                let t = if known { s.time } else { display_time };
+                if self.newest_live.is_none_or(|n| t > n) {
+                    self.predictor.push(t, usable(&s));
+                    self.newest_live = Some(t);
+                }
+            }
         }
-        self.next_tick = Some(newest.max(first - 1) + 1);
         let prediction = self.predictor.predict(display_time);
         let sample = match prediction.direction {
             Some(direction) => GazeSample {

@@ -252,7 +252,21 @@ impl GazeDriver {
 
     /// The latency model in use, if any.
     pub fn latency_model(&self) -> Option<&LatencyModel> {
-        self.delayed.as_ref().map(DelayedGaze::model)
+        self.delayed.as_ref().and_then(DelayedGaze::model)
+    }
+
+    /// Prediction on a live source (`fovea xr --gaze-predict` with the runtime's eye tracker):
+    /// each new sample feeds `mode`'s predictor, which predicts to the display time.
+    pub fn with_live_prediction(mut self, mode: PredictMode) -> GazeDriver {
+        self.delayed = Some(DelayedGaze::live(mode, &self.hmd));
+        self
+    }
+
+    /// The predictor in use (`off` without one).
+    pub fn predict_mode(&self) -> PredictMode {
+        self.delayed
+            .as_ref()
+            .map_or(PredictMode::Off, DelayedGaze::mode)
     }
 
     /// The last frame through the latency model (`resolve_at` with one).
@@ -325,8 +339,9 @@ impl GazeDriver {
             Some(_) => (GazeOrigin::Centre, [centre; 2]),
             None => (resolved.source, projected.map(|p| p.unwrap_or(centre))),
         };
+        let live = self.latency_model().is_none();
         let (true_pixels, latency) = match (&self.delayed, self.last_delayed) {
-            (Some(delayed), Some(frame)) => {
+            (Some(delayed), Some(frame)) if !live => {
                 let truth = frame.truth;
                 let true_pixels = [Eye::Left, Eye::Right].map(|eye| {
                     let d = truth.gaze.direction;
