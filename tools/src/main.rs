@@ -127,7 +127,8 @@ impl SceneFlags {
 #[derive(clap::Args)]
 struct LatencyFlags {
     /// Gaze-to-photon latency in ms: a frame displayed at T sees the tracker samples taken up to
-    /// T − this (default: the headset profile's tracker + render + display latency).
+    /// T − this (default: the headset profile's tracker + render + display latency). Any of
+    /// --latency-ms, --tracker-hz, --gaze-predict turns this latency model on.
     #[arg(long, allow_hyphen_values = true)]
     latency_ms: Option<f64>,
     /// Tracker rate of the latency model in Hz (default: the headset profile's).

@@ -4,13 +4,15 @@
 //! - `off`: the newest sample as measured (what a renderer without prediction shows).
 //! - `hold`: the median of the current fixation's samples (the last 50 ms since the eye last
 //!   jumped), which averages the tracker's noise away; a sample further from it than the noise
-//!   allows starts a new fixation.
+//!   allows is shown as it is, and starts a new fixation once the next sample confirms it.
 //! - `linear`: `hold` plus the fixation's velocity (a line fitted to its samples) carried to the
 //!   display time when it is significant against the noise and slow enough to be smooth pursuit.
 //! - `saccade`: `linear`, plus saccade onset detection and landing prediction from the first
-//!   samples of the saccade with the ballistic model of [`saccade`]; blinks hold the fixation
-//!   before them (not the samples of the closing lid), then re-acquire once the tracker gives
-//!   two consistent samples.
+//!   samples of the saccade with the ballistic model of [`saccade`].
+//!
+//! In `hold`, `linear` and `saccade` a blink holds the fixation before it (not the samples of a
+//! closing lid, which a saccade running into the blink is taken for), and the first valid sample
+//! after it re-acquires the gaze (`PredictorParams::reacquire_samples`).
 //!
 //! Positions are angles in degrees, (atan(x/−z), atan(y/−z)) of the view-space direction, the
 //! coordinates in which a flat recording screen is rectilinear. Every prediction but `off`'s is
