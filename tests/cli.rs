@@ -204,6 +204,8 @@ fn output_folders_with_user_files_are_refused() {
         device: None,
         validation: true,
         camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        headset: "fove0",
+        eye: fovea_hal::Eye::Left,
         environment: Default::default(),
         path_regularisation: 1.0,
     };
@@ -437,6 +439,8 @@ fn reference_force_refuses_non_regular_targets() {
                 device: None,
                 validation: true,
                 camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+                headset: "fove0",
+                eye: fovea_hal::Eye::Left,
                 environment: Default::default(),
                 path_regularisation: 1.0,
             };
@@ -678,6 +682,8 @@ fn meaningless_values_are_refused_with_the_flag_named() {
             device: None,
             validation: true,
             camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+            headset: "fove0",
+            eye: fovea_hal::Eye::Left,
             environment: Default::default(),
             path_regularisation: 1.0,
         };
@@ -772,6 +778,8 @@ fn camera_path_files_drive_the_camera() {
         look: Some("0,1,0".into()),
         fov: Some(50.0),
         camera: None,
+        projection: fovea_tools::look::Projection::SceneCamera,
+        world_scale: 1.0,
     };
     let out_free = dir.join("free");
     let args = RenderArgs {
@@ -780,8 +788,14 @@ fn camera_path_files_drive_the_camera() {
         ..render_args("cornell-box", &out_free)
     };
     render(&args).unwrap();
+    // The keys' fov is the scene camera's: both runs render through it.
+    let scene_camera = fovea_tools::look::CameraOptions {
+        projection: fovea_tools::look::Projection::SceneCamera,
+        ..Default::default()
+    };
     let out_still = dir.join("still");
     let args = RenderArgs {
+        camera: &scene_camera,
         camera_path: CameraMotion::from_flag(Some(still.to_str().unwrap())).unwrap(),
         ..render_args("cornell-box", &out_still)
     };
@@ -804,6 +818,7 @@ fn camera_path_files_drive_the_camera() {
 
     let out_moving = dir.join("moving");
     let args = RenderArgs {
+        camera: &scene_camera,
         camera_path: CameraMotion::from_flag(Some(moving.to_str().unwrap())).unwrap(),
         ..render_args("cornell-box", &out_moving)
     };

@@ -67,7 +67,7 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
-    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let camera = fovea_tests::cornell_box_far_camera(size);
     let mut reference_renderer = Renderer::new(
         &ctx,
         &scene,

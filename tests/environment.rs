@@ -344,7 +344,7 @@ fn real_scene_luminance(name: &str, file: &str) -> Option<f64> {
         path.to_str().unwrap(),
         &NO_CAMERA_FLAGS,
         &EnvironmentOptions::default(),
-        64.0 / 72.0,
+        look::Framing::aspect(64.0 / 72.0),
     )
     .unwrap();
     let image = reference(&ctx, &scene, &camera, size, 4, 3);

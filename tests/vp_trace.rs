@@ -348,7 +348,7 @@ fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
     };
     let ctx = gpu();
     let scene = cornell();
-    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    let camera = fovea_tests::cornell_box_far_camera(SCREEN);
     let frames = |space: Box<dyn SamplingSpace>, gaze: Vec2, settings: RenderSettings| {
         let mut r = Renderer::new(&ctx, &scene, space, settings).unwrap();
         let (mut pictures, mut stats) = (Vec::new(), Vec::new());

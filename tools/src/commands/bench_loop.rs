@@ -7,8 +7,9 @@
 //! waits per frame, GPU bytes. Each run is made twice, in the order A B C C B A, so that a drift
 //! of the machine's speed (other work on a shared CPU device) hits the three alike.
 
-use super::setup::{eye_pose, filters, space_for, Eyes};
+use super::setup::{filters, space_for};
 use crate::cpu_time::{CpuTimes, CpuUse};
+use crate::projection::{EyeRig, Projection};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context as _, Result};
 use fovea_hal::{Eye, HmdDescription};
@@ -129,6 +130,7 @@ struct LoopSetup {
     settings: RenderSettings,
     screen: glam::UVec2,
     head: CameraPose,
+    rig: EyeRig,
 }
 
 /// `--loop-frames` checked (before the bench's other, slower parts run).
@@ -184,8 +186,17 @@ impl LoopSetup {
         let Some(camera) = scene.default_camera() else {
             bail!("{LOOP_SCENE}: no camera")
         };
-        let head = CameraPose::from_scene_camera(camera, width, height);
+        let rig = EyeRig {
+            projection: Projection::Headset,
+            hmd: hmd.clone(),
+            stereo: true,
+            width,
+            height,
+            metres_per_unit: 1.0,
+        };
+        let head = rig.head(camera);
         Ok(LoopSetup {
+            rig,
             scene,
             hmd,
             profile,
@@ -222,7 +233,7 @@ impl LoopSetup {
         let views: Vec<ViewInput> = eyes
             .iter()
             .map(|&eye| ViewInput {
-                camera: eye_pose(&self.head, &self.hmd, eye, Eyes::Both),
+                camera: self.rig.eye(&self.head, eye),
                 gaze,
             })
             .collect();
