@@ -305,7 +305,7 @@ fn brdf_sampler_follows_its_density() {
                     let mirror = 2.0 * case.view().dot(case.normal) * case.normal - case.view();
                     worst_mirror = worst_mirror.max((l - mirror).length());
                 }
-                w if w == 0.0 => observed[expected.len()] += 1.0,
+                0.0 => observed[expected.len()] += 1.0,
                 w => match cell(&f, l) {
                     Some(c) => {
                         observed[c] += 1.0;

@@ -213,7 +213,7 @@ fn a_mono_frame_equals_the_same_view_of_a_stereo_frame() {
 fn stereo_noise_independent_vs_shared() {
     let ctx = gpu();
     let (scene, head) = cornell();
-    let pair = |noise: StereoNoise, half_ipd: f32, frame: u32| -> f64 {
+    let pair = |noise: StereoNoise, half_ipd: f32, frame: u32| -> (Vec<u8>, Vec<u8>) {
         let settings = RenderSettings {
             stereo_noise: noise,
             ..Default::default()
