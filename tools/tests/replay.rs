@@ -75,11 +75,14 @@ fn failing_frames(out: &Path, report: &Value) -> String {
                 lines.push(format!("{name} {file}: no picture to compare"));
                 continue;
             };
-            let picture = |i: &image::RgbaImage| Picture::rgba8(i.width(), i.height(), i.as_raw());
+            let (now, before) = (
+                Picture::rgba8(now.width(), now.height(), now.as_raw()),
+                Picture::rgba8(before.width(), before.height(), before.as_raw()),
+            );
             lines.push(failure_message(
                 &format!("{name} {file}"),
-                &picture(&now),
-                &picture(&before),
+                &now,
+                &before,
                 format_args!("{name} {file} outside the tolerances"),
             ));
         }
@@ -129,6 +132,21 @@ fn a_planted_regression_fails_naming_frames_and_rings() {
     let report = json(&out.join("replay.json"));
     let trace = &report["traces"][0];
     assert_eq!(trace["failed_frames"].as_array().unwrap().len(), 8);
+    // What the committed-baseline test leaves behind when it fails like this: each failing
+    // frame, its baseline and their FLIP difference, in a folder its message names.
+    let evidence = failing_frames(&out, &report);
+    let folders: Vec<PathBuf> = evidence
+        .lines()
+        .filter(|l| l.contains("FLIP difference"))
+        .filter_map(|l| l.rsplit(" in ").next().map(PathBuf::from))
+        .collect();
+    assert_eq!(folders.len(), 8, "{evidence}");
+    for f in &folders {
+        for picture in ["actual.png", "expected.png", "flip.png"] {
+            assert!(f.join(picture).is_file(), "{picture} missing in {f:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(folders[0].parent().unwrap());
     let worse: usize = trace["frames"]
         .as_array()
         .unwrap()
