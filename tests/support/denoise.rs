@@ -351,14 +351,18 @@ pub fn denoise_over_culled_tiles(
     );
 }
 
-/// Asserts that each named pair of images holds the same bits.
+/// Asserts that each named pair of images (16-byte texels, shown as RGBA floats) holds the same
+/// bits; a failure leaves both pictures and their FLIP difference behind.
 pub fn assert_bit_equal(ctx: &Arc<Context>, what: &str, pairs: &[(&str, &Image, &Image)]) {
     for (name, a, b) in pairs {
-        let (a, b) = (
-            crate::read_image::<[u32; 4]>(ctx, a),
-            crate::read_image::<[u32; 4]>(ctx, b),
+        let (actual, expected) = (
+            crate::read_image::<[f32; 4]>(ctx, a),
+            crate::read_image::<[f32; 4]>(ctx, b),
         );
-        let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
-        assert_eq!(differing, 0, "{what}: {name} differs in {differing} texels");
+        crate::assert_pictures_equal(
+            &format!("{what}, {name}"),
+            &crate::Picture::hdr(a.width, a.height, &actual),
+            &crate::Picture::hdr(b.width, b.height, &expected),
+        );
     }
 }

@@ -56,11 +56,15 @@ pub fn cornell_box_far_camera(size: glam::UVec2) -> fovea_renderer::pipeline::Ca
     fovea_renderer::pipeline::CameraPose::from_scene_camera(&camera, size.x, size.y)
 }
 
-/// A file of the shared reference data, if this checkout has `../shared/` beside it.
-pub fn shared_data(name: &str) -> Option<PathBuf> {
-    let p = repo_root().join("../shared/data").join(name);
-    p.exists().then_some(p)
-}
+/// A file of the reference data under `../shared/data`: missing, it fails the test with its path
+/// under `FOVEA_REQUIRE_DATA=1` and is reported as skipped otherwise (see `fovea_test_kit::data`).
+pub use fovea_test_kit::data::shared_data;
+
+/// Picture comparisons that leave actual, expected and FLIP pictures in
+/// `target/test-failures/<test>/` when they fail (`fovea_test_kit::pictures`).
+pub use fovea_test_kit::pictures::{
+    assert_pictures, assert_pictures_equal, failure_message, Picture,
+};
 
 /// Where tests write images worth looking at when they fail.
 pub fn artifacts_dir() -> PathBuf {
