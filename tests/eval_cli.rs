@@ -183,7 +183,8 @@ fn bad_inputs_are_named_in_the_error() {
         assert!(err.contains(gaze), "{gaze}: {err}");
     }
     // --rings: 1..=1000, and at most the half-diagonal (48.2 px for 64×72) so that no ring is
-    // narrower than a pixel. 10⁸ rings used to abort on allocation, 10⁶ wrote a 256 MB eval.json.
+    // narrower than a pixel. Unchecked, 10⁸ rings abort on allocation and 10⁶ write a 256 MB
+    // eval.json.
     for (rings, needle) in [
         (0, "1..=1000"),
         (1001, "1..=1000"),

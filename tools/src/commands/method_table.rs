@@ -1,4 +1,4 @@
-//! `fovea method-table`: issue 14's one table of every foveation method, generated from a
+//! `fovea method-table`: one table of every foveation method, generated from a
 //! `fovea quality` run (quality per ring band, samples, rays) and a `fovea bench` report (cost:
 //! whole frames of every method interleaved in one run on one device), written into the README
 //! between `<!-- method-table:begin -->` and `<!-- method-table:end -->`, with a picture row
