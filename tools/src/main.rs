@@ -509,8 +509,9 @@ enum Command {
         /// screen gives the table's costs; every screen of every one a figure in the claims.
         #[arg(long, value_delimiter = ',', required = true)]
         bench: Vec<PathBuf>,
-        #[arg(long, default_value = "README.md")]
-        readme: PathBuf,
+        /// The Markdown document to write the table into, between its method-table markers.
+        #[arg(long, alias = "readme", default_value = "docs/quality.md")]
+        doc: PathBuf,
         /// Folder for the picture row's images.
         #[arg(long, default_value = "docs/methods")]
         pictures: PathBuf,
@@ -912,13 +913,13 @@ fn run() -> Result<()> {
         Command::MethodTable {
             quality,
             bench,
-            readme,
+            doc,
             pictures,
             equal_samples,
         } => commands::method_table::run(&commands::method_table::MethodTableArgs {
             quality: &quality,
             bench: &bench,
-            readme: &readme,
+            doc: &doc,
             pictures: &pictures,
             equal_samples: &equal_samples,
         }),
