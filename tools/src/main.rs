@@ -970,3 +970,6 @@ fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
     };
     Ok(glam::Vec2::new(fraction(x)?, fraction(y)?))
 }
+
+#[cfg(test)]
+mod docs_tests;
