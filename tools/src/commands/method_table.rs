@@ -382,30 +382,40 @@ fn write_pictures(
     Ok(())
 }
 
-/// `pictures` as a link from `doc`'s folder: a folder under the document's is linked from there,
-/// another relative one through one `../` per folder of the document's path; an absolute or
-/// `..` path as given.
+/// `pictures` as a link from `doc`'s folder: a folder under the document's is linked from there;
+/// another through `../` steps, compared as the real paths when both exist; a path that cannot be
+/// related (one absolute, one relative, `..` left after resolving) as given.
 fn link_dir(doc: &Path, pictures: &Path) -> String {
-    use std::path::Component;
-    let plain = |p: &Path| -> Option<Vec<String>> {
-        p.components()
-            .filter(|c| !matches!(c, Component::CurDir))
-            .map(|c| match c {
-                Component::Normal(n) => Some(n.to_string_lossy().into_owned()),
-                _ => None,
-            })
-            .collect()
-    };
+    use std::path::{Component, PathBuf};
     let base = doc.parent().unwrap_or(Path::new(""));
-    match (plain(base), plain(pictures)) {
-        (Some(base), Some(pictures)) => {
-            let shared = base
-                .iter()
-                .zip(&pictures)
-                .take_while(|(a, b)| a == b)
-                .count();
-            let mut parts = vec![".."; base.len() - shared];
-            parts.extend(pictures[shared..].iter().map(String::as_str));
+    if let Ok(inner) = pictures.strip_prefix(base) {
+        return inner.display().to_string();
+    }
+    let (base, target): (PathBuf, PathBuf) = match (base.canonicalize(), pictures.canonicalize()) {
+        (Ok(b), Ok(p)) => (b, p),
+        _ => (base.to_path_buf(), pictures.to_path_buf()),
+    };
+    fn plain(p: &Path) -> Option<Vec<Component<'_>>> {
+        let parts: Vec<Component> = p
+            .components()
+            .filter(|c| !matches!(c, Component::CurDir))
+            .collect();
+        (!parts.contains(&Component::ParentDir)).then_some(parts)
+    }
+    let rooted = |parts: &[Component]| {
+        parts
+            .first()
+            .is_some_and(|c| matches!(c, Component::RootDir | Component::Prefix(_)))
+    };
+    match (plain(&base), plain(&target)) {
+        (Some(base), Some(target)) if rooted(&base) == rooted(&target) => {
+            let shared = base.iter().zip(&target).take_while(|(a, b)| a == b).count();
+            let mut parts = vec!["..".to_string(); base.len() - shared];
+            parts.extend(
+                target[shared..]
+                    .iter()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+            );
             parts.join("/")
         }
         _ => pictures.display().to_string(),
@@ -594,5 +604,17 @@ mod tests {
         assert_eq!(link("docs/guide/x.md", "docs/methods"), "../methods");
         assert_eq!(link("a/b.md", "c/d"), "../c/d");
         assert_eq!(link("/abs/q.md", "docs/methods"), "docs/methods");
+        // Real folders are related through their real paths, `..` in the way or not.
+        let root = std::env::temp_dir().join(format!("fovea-link-dir-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("docs/methods")).unwrap();
+        std::fs::create_dir_all(root.join("other")).unwrap();
+        let doc = root.join("other/../docs/quality.md");
+        let pictures = root.join("docs/methods");
+        assert_eq!(link_dir(&doc, &pictures), "methods");
+        assert_eq!(
+            link_dir(&root.join("other/x.md"), &pictures),
+            "../docs/methods"
+        );
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }
