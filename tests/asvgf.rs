@@ -1,4 +1,4 @@
-//! A-SVGF (Schied, Peters, Dachsbacher 2018; issue 5) in Cartesian and Visual-Polar space on the
+//! A-SVGF (Schied, Peters, Dachsbacher 2018) in Cartesian and Visual-Polar space on the
 //! Cornell box: gradient samples re-shade last frame's path exactly (δ = 0 on a still scene, the
 //! sign and ratio of a light change), a light switched off reaches the output within a few frames
 //! where SVGF lags, noise reduction on a still camera comparable to SVGF's, no NaN/Inf/negative

@@ -595,7 +595,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     ));
 }
 
-/// Values that used to render a black, flat or meaningless frame without a word are refused
+/// Values that would render a black, flat or meaningless frame without a word are refused
 /// before the device opens, each error naming its flag and the rule.
 #[test]
 fn meaningless_values_are_refused_with_the_flag_named() {
@@ -971,7 +971,7 @@ fn bench_vp_frames_follow_a_camera_path() {
             && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9,
         "{vp}"
     );
-    // Each denoiser's whole frames hold its own passes and the rest of the frame (issue 17's
+    // Each denoiser's whole frames hold its own passes and the rest of the frame (the frame-ratio
     // target with a denoiser).
     for d in vp["denoisers"].as_array().unwrap() {
         let g = |key: &str| d[key].as_f64().unwrap_or_else(|| panic!("{key} in {d}"));

@@ -1,5 +1,5 @@
-//! One conformance suite for every filter × every sampling space (issue 14; it found the headset
-//! axis's A-SVGF trace kernel missing): each space that supports the temporal filters (its
+//! One conformance suite for every filter × every sampling space (it catches, for example, a trace
+//! kernel variant that was never built): each space that supports the temporal filters (its
 //! `SpaceCapabilities`) runs SVGF, A-SVGF, BMFR and both TAA
 //! modes without validation messages, with finite non-negative output, reducing the noise against
 //! the space's own converged image, and rejecting its history when the camera jumps
@@ -272,7 +272,7 @@ fn blow_up_the_light_and_look_away(
 }
 
 /// Noise: 12 filtered frames against the raw one-sample frame, both against the space's own
-/// converged image on its smooth interiors; bound 1.15× (measured, tenth session: Cartesian
+/// converged image on its smooth interiors; bound 1.15× (measured 2026-12-02: Cartesian
 /// 3.5–5.5×; the polar spaces' SVGF, A-SVGF and BMFR 1.19–1.9×, A-SVGF the least (its gradients
 /// reset the history where the 1-sample noise looks like change) — at 96×108 their grids are
 /// coarse and the spatial filters' smoothing of the periphery is a bias the mean of raw frames

@@ -1,4 +1,4 @@
-//! Denoisers in the sampling grid (issue 5): SVGF in Cartesian and Visual-Polar space.
+//! Denoisers in the sampling grid: SVGF in Cartesian and Visual-Polar space.
 //! Noise reduction against a converged reference on the Cornell box (whole frame, fovea and
 //! eccentricity rings, after the remap for VP); no NaN/Inf/negative output with fireflies, NaNs
 //! and an empty view; no history across a disocclusion (synthetic G-buffers with a moving

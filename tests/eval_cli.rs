@@ -183,7 +183,8 @@ fn bad_inputs_are_named_in_the_error() {
         assert!(err.contains(gaze), "{gaze}: {err}");
     }
     // --rings: 1..=1000, and at most the half-diagonal (48.2 px for 64×72) so that no ring is
-    // narrower than a pixel. 10⁸ rings used to abort on allocation, 10⁶ wrote a 256 MB eval.json.
+    // narrower than a pixel. Unchecked, 10⁸ rings abort on allocation and 10⁶ write a 256 MB
+    // eval.json.
     for (rings, needle) in [
         (0, "1..=1000"),
         (1001, "1..=1000"),
@@ -400,7 +401,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         "{table}"
     );
 
-    // The method table from this run and a bench report, into a README between its markers.
+    // The method table from this run and a bench report, into docs/quality.md between its markers.
     let bench_out = out.join("bench");
     let scenes = strings(&["cornell-box"]);
     fovea_tools::commands::bench::run(&fovea_tools::commands::bench::BenchArgs {
@@ -420,23 +421,26 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         validation: true,
     })
     .unwrap();
-    let docs = temp_dir("method-table");
-    let readme = docs.join("README.md");
-    std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
-    let pictures = docs.join("docs").join("methods");
+    let root = temp_dir("method-table");
+    let docs = root.join("docs");
+    std::fs::create_dir_all(&docs).unwrap();
+    let quality_md = docs.join("quality.md");
+    std::fs::write(&quality_md, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
+    // The pictures beside the document, so it links them as methods/NAME.png.
+    let pictures = docs.join("methods");
     let bench_report = [bench_out.join("report.json")];
-    // The committed equal-samples report of the README's claim (VP against composite at σ = 1.66).
+    // The committed equal-samples report of docs/quality.md's claim (VP against composite, σ 1.66).
     let equal = [std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../docs/methods/quality-equal-samples-composite.json")];
-    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs {
+    let table_args = |doc| fovea_tools::commands::method_table::MethodTableArgs {
         quality: &out,
         bench: &bench_report,
-        readme,
+        doc,
         pictures: &pictures,
         equal_samples: &equal,
     };
-    fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
-    let text = std::fs::read_to_string(&readme).unwrap();
+    fovea_tools::commands::method_table::run(&table_args(&quality_md)).unwrap();
+    let text = std::fs::read_to_string(&quality_md).unwrap();
     assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n") && !text.contains("old"), "{text}");
     for m in &methods {
         assert!(text.contains(&format!("| {m} + none | ")), "{m}: {text}");
@@ -446,7 +450,8 @@ fn quality_methods_all_lists_what_a_method_refuses() {
             "{m}"
         );
         assert!(
-            text.contains(&format!("![{m}](docs/methods/{m}.png)")),
+            text.contains(&format!("![{m}](methods/{m}.png)"))
+                && text.contains(&format!("![{m} FLIP](methods/{m}_flip.png)")),
             "{m}"
         );
     }
@@ -456,14 +461,14 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         "{text}"
     );
     assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034, gaze `sim:1`") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
-    // A report of many methods is no equal-samples pair: named, and the README left as it was.
+    // A report of many methods is no equal-samples pair: named, and the document left as it was.
     let many = [out.join("quality.json")];
     let err = format!(
         "{:#}",
         fovea_tools::commands::method_table::run(
             &fovea_tools::commands::method_table::MethodTableArgs {
                 equal_samples: &many,
-                ..table_args(&readme)
+                ..table_args(&quality_md)
             }
         )
         .unwrap_err()
@@ -472,7 +477,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         err.contains("quality.json") && err.contains("exactly one other method"),
         "{err}"
     );
-    assert_eq!(std::fs::read_to_string(&readme).unwrap(), text);
+    assert_eq!(std::fs::read_to_string(&quality_md).unwrap(), text);
     let bare = docs.join("BARE.md");
     std::fs::write(&bare, "no markers").unwrap();
     let err = format!(

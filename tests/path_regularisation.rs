@@ -133,7 +133,10 @@ fn regularisation_removes_caustic_fireflies_and_keeps_the_brightness() {
         stats.push((mean, variance, count));
     }
     let [(mean_off, var_off, ff_off), (mean_on, var_on, ff_on)] = [stats[0], stats[1]];
-    assert!(ff_off >= 8, "the unregularised caustic should make fireflies (got {ff_off}): the scene no longer tests anything");
+    assert!(
+        ff_off >= 8,
+        "the unregularised caustic should make fireflies (got {ff_off}): the scene tests nothing"
+    );
     assert_eq!(ff_on, 0, "regularised: {ff_on} fireflies");
     assert!(
         var_off > 10.0 * var_on,

@@ -205,10 +205,10 @@ fn a_mono_frame_equals_the_same_view_of_a_stereo_frame() {
     assert_clean(&ctx);
 }
 
-/// How the eyes' 1-spp noise relates (README, "Stereo"): a still Cartesian frame of both eyes,
-/// no denoiser. With both eyes at one position the images differ only by noise: shared seeds
-/// make them identical, independent ones do not. At the FOVE 0's eye distance the inter-eye
-/// difference is printed for both choices beside the converged pair's (parallax alone).
+/// How the eyes' 1-spp noise relates (docs/guide/view.md, "Stereo noise"): a still Cartesian frame
+/// of both eyes, no denoiser. With both eyes at one position the images differ only by noise:
+/// shared seeds make them identical, independent ones do not. At the FOVE 0's eye distance the
+/// inter-eye difference is printed for both choices beside the converged pair's (parallax alone).
 #[test]
 fn stereo_noise_independent_vs_shared() {
     let ctx = gpu();

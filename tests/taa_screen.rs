@@ -1,4 +1,4 @@
-//! TAA after the remap to the screen (`--taa screen`, issue 5; beyond the paper): error against
+//! TAA after the remap to the screen (`--taa screen`, beyond the paper): error against
 //! a converged reference next to the raw frame and to TAA in the sampling grid, fireflies, and
 //! the disocclusion reset. The remap's placement of jittered samples is tested in vp_remap.rs.
 

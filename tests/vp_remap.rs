@@ -1,4 +1,4 @@
-//! Visual-Polar back to the screen (issue 4, pipeline steps 2–4): the φ-only mips match a CPU
+//! Visual-Polar back to the screen (pipeline steps 2–4): the φ-only mips match a CPU
 //! reference, the remap reproduces smooth fields (constants exactly, screen positions to within
 //! the local texel size) for gazes at the centre, an edge and a corner, in the paper's and the
 //! screen-clipped layout (mips that neither wrap nor average across the gaps between a column's

@@ -1,4 +1,4 @@
-//! The tracer fed by the Visual-Polar sampling space (issue 4, pipeline step 1): one traced sample
+//! The tracer fed by the Visual-Polar sampling space (pipeline step 1): one traced sample
 //! per kept VP texel, nothing traced in the clipped fovea triangle, off-screen samples traced and
 //! counted (`FrameStats::samples_offscreen`, ray counter slot 3) when they are traced as in the
 //! paper (`OffscreenSamples::Trace`); culled by default, with the picture unchanged. The screen-clipped layout traces

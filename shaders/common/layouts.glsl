@@ -254,7 +254,7 @@ struct VpProbePush {
     uvec4 config;               // x point count, yzw unused
 };
 
-// ---- Denoisers (issue 5): they run in the sampling grid (texel = sample). Every pass gets the
+// ---- Denoisers: they run in the sampling grid (texel = sample). Every pass gets the
 // space as SamplingParams push constants (see MipPhiPush for why not the buffer); Cartesian
 // kernel variants ignore it.
 

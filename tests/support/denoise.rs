@@ -292,7 +292,7 @@ impl SeamErrors {
     /// of 0.1–0.2 on an 80-row column (estimated, not measured), 20–40× the 0.003–0.006 measured. The φ ≈ π bound is loose
     /// because the filtered error is spatially correlated, so two zero crossings of one run differ:
     /// log-polar's SVGF measures 0.0022 at φ ≈ π and 0.0043–0.0045 in the bins beside it and the
-    /// seam's (tenth/eleventh session).
+    /// seam's (measured 2026-12-02).
     pub fn like_elsewhere(&self) -> bool {
         self.seam <= 3.0 * self.opposite && self.seam <= 1.25 * self.median
     }

@@ -197,8 +197,8 @@ impl EnvironmentOptions {
         }
     }
 
-    /// The settings as replay baselines record them: the sun and sky fields as before environment
-    /// maps existed (so older baselines do not read as changed), the map's fields only when given.
+    /// The settings as replay baselines record them: the sun and sky fields always, the map's
+    /// fields only when given (so baselines made without a map do not read as changed).
     pub fn describe(&self) -> String {
         let base = format!(
             "EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}",

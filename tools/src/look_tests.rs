@@ -90,7 +90,7 @@ fn camera_by_index_and_name_and_clear_errors() {
         "{err}"
     );
     assert!(format!("{:#}", pick("2").unwrap_err()).contains("--camera 2"));
-    // No flag: the file's first camera, as before.
+    // No flag: the file's first camera.
     assert_eq!(
         CameraOptions::default()
             .camera_for(&scene, Framing::aspect(1.0))

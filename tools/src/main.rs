@@ -1,4 +1,5 @@
-//! `fovea`: the command line of the foveated path tracer. See README.md for the contract.
+//! `fovea`: the command line of the foveated path tracer. docs/cli.md is generated from these
+//! definitions (the contract).
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
@@ -188,8 +189,8 @@ struct RenderOpts {
     /// Also write linear EXR frames.
     #[arg(long)]
     exr: bool,
-    /// Move the camera: without a value along the scene's default path (a slow orbit), with a
-    /// TOML file along its keyframes (time, position, look, optional fov; see the README).
+    /// Move the camera: without a value along the scene's default path (a slow orbit), with a TOML
+    /// file along its keyframes (time, position, look, optional fov; see docs/guide/scenes.md).
     #[arg(long, num_args = 0..=1, default_missing_value = "orbit", value_name = "FILE")]
     camera_path: Option<String>,
     #[arg(long, default_value_t = 1)]
@@ -420,8 +421,8 @@ enum Command {
         /// The first also serves the frame and VP figures; several are measured A B … B A.
         #[arg(long, value_delimiter = ',', default_value = "sbvh")]
         bvh: Vec<String>,
-        /// Copy every instance into world space (meshes placed by several nodes flattened, as
-        /// before instancing): the comparison of the two in one build.
+        /// Copy every instance into world space (meshes placed by several nodes copied per
+        /// node, no instancing): the comparison of the two in one build.
         #[arg(long)]
         flatten: bool,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
@@ -530,7 +531,7 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
-    /// Write issue 14's method table into the README (between its method-table markers) from a
+    /// Write the method table into a Markdown file (between its method-table markers) from a
     /// `fovea quality` folder and a `fovea bench` report, with a picture row and the papers' claims.
     MethodTable {
         /// A `fovea quality` output folder (e.g. run with `--methods all`).
@@ -540,8 +541,9 @@ enum Command {
         /// screen gives the table's costs; every screen of every one a figure in the claims.
         #[arg(long, value_delimiter = ',', required = true)]
         bench: Vec<PathBuf>,
-        #[arg(long, default_value = "README.md")]
-        readme: PathBuf,
+        /// The Markdown document to write the table into, between its method-table markers.
+        #[arg(long, alias = "readme", default_value = "docs/quality.md")]
+        doc: PathBuf,
         /// Folder for the picture row's images.
         #[arg(long, default_value = "docs/methods")]
         pictures: PathBuf,
@@ -976,13 +978,13 @@ fn run() -> Result<()> {
         Command::MethodTable {
             quality,
             bench,
-            readme,
+            doc,
             pictures,
             equal_samples,
         } => commands::method_table::run(&commands::method_table::MethodTableArgs {
             quality: &quality,
             bench: &bench,
-            readme: &readme,
+            doc: &doc,
             pictures: &pictures,
             equal_samples: &equal_samples,
         }),
@@ -1033,3 +1035,6 @@ fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
     };
     Ok(glam::Vec2::new(fraction(x)?, fraction(y)?))
 }
+
+#[cfg(test)]
+mod docs_tests;

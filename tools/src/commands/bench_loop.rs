@@ -1,4 +1,4 @@
-//! The real-time loop part of `fovea bench` (issue 12): both eyes of the Cornell box in
+//! The real-time loop part of `fovea bench`: both eyes of the Cornell box in
 //! Visual-Polar space with SVGF, driven the way `fovea render --eyes both` drives them (free the
 //! slot's frame, then record and submit the next), three times on one device:
 //! one stereo renderer with 1 and with 2 frames in flight, and two mono renderers (one scene
@@ -455,7 +455,7 @@ fn collect(tally: &mut Tally, renderer: &Renderer, done: u64, last_renderer: boo
     Ok(())
 }
 
-/// The loop figures as a Markdown table (ready for README.md) and the ratios.
+/// The loop figures as a Markdown table (ready for docs/performance.md) and the ratios.
 fn print_summary(r: &LoopReport, device: &str) {
     println!(
         "loop {} 2 × {}×{} ({} + {}; each run {} × {} timed frames after {} warm-up, order A B C C B A) on {device}:",

@@ -1,9 +1,10 @@
 //! `fovea quality`: image quality over a gaze sequence for every sampling method × denoiser × TAA
-//! mode, with a still and with a moving camera (issue 5's quality table). Each combination is a
-//! `fovea render` run (same scene, gaze source, seed and profile) into `DIR/run_*`; its last
-//! `--eval-frames` frames are compared with converged Cartesian references of the same camera
-//! poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own gaze, and the
-//! ring metrics are averaged over those frames → `DIR/quality.json` + `DIR/quality.md`.
+//! mode, with a still and with a moving camera (the quality tables of docs/quality.md). Each
+//! combination is a `fovea render` run (same scene, gaze source, seed and profile) into
+//! `DIR/run_*`; its last `--eval-frames` frames are compared with converged Cartesian references of
+//! the same camera poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own
+//! gaze, and the ring metrics are averaged over those frames → `DIR/quality.json` +
+//! `DIR/quality.md`.
 
 use super::render::{self, RenderArgs};
 use crate::camera_path;

@@ -169,7 +169,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
     let out_dir = prepare_output_dir(r.out)?;
     let rt = Arc::new(
         OpenXrRuntime::create("fovea")
-            .context("fovea xr needs an OpenXR runtime (see README: On a headset)")?,
+            .context("fovea xr needs an OpenXR runtime (see docs/guide/xr.md)")?,
     );
     let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;
     let settings = render_settings(r, denoiser, taa);
