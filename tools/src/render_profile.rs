@@ -100,6 +100,8 @@ struct EnvironmentSection {
     env_intensity: Option<f32>,
     /// "gradient" or "preetham".
     sky: Option<String>,
+    /// "auto", "on" or "off" (`--default-light`).
+    default_light: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -425,6 +427,12 @@ impl RenderProfile {
                     .map(crate::sky_model::SkyModel::parse)
                     .transpose()
                     .with_context(|| format!("{}.sky", at("environment")))?,
+                default_light: f
+                    .default_light
+                    .as_deref()
+                    .map(crate::look::DefaultLight::parse)
+                    .transpose()
+                    .with_context(|| format!("{}.default_light", at("environment")))?,
             };
             profile
                 .environment

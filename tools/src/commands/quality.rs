@@ -1,9 +1,10 @@
 //! `fovea quality`: image quality over a gaze sequence for every sampling method × denoiser × TAA
-//! mode, with a still and with a moving camera (issue 5's quality table). Each combination is a
-//! `fovea render` run (same scene, gaze source, seed and profile) into `DIR/run_*`; its last
-//! `--eval-frames` frames are compared with converged Cartesian references of the same camera
-//! poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own gaze, and the
-//! ring metrics are averaged over those frames → `DIR/quality.json` + `DIR/quality.md`.
+//! mode, with a still and with a moving camera (the quality tables of docs/quality.md). Each
+//! combination is a `fovea render` run (same scene, gaze source, seed and profile) into
+//! `DIR/run_*`; its last `--eval-frames` frames are compared with converged Cartesian references of
+//! the same camera poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own
+//! gaze, and the ring metrics are averaged over those frames → `DIR/quality.json` +
+//! `DIR/quality.md`.
 
 use super::render::{self, RenderArgs};
 use crate::camera_path;
@@ -16,7 +17,7 @@ use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::pipeline::{RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -297,13 +298,25 @@ pub fn run(args: &QualityArgs) -> Result<()> {
 /// Converged references of the evaluated frames' camera poses (one for a still camera), written
 /// to `DIR/reference_<camera>_NNNN.exr`.
 fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+    let hmd = fovea_hal::HmdDescription::resolve(args.headset)
+        .with_context(|| format!("--headset {}", args.headset))?;
+    // The frames are the left eye's (`fovea render --eyes left`): the same eye through the same
+    // projection.
+    let rig = crate::projection::EyeRig {
+        projection: args.camera.projection,
+        hmd,
+        stereo: false,
+        width: args.width,
+        height: args.height,
+        metres_per_unit: args.camera.world_scale,
+    };
     let (scene, camera) = crate::look::load(
         args.scene,
         args.camera,
         &args.profile.environment,
-        args.width as f32 / args.height as f32,
+        rig.framing(),
     )?;
-    let start = CameraPose::from_scene_camera(&camera, args.width, args.height);
+    let start = rig.head(&camera);
     let centre = scene.bounds().center();
     let ctx = super::open_device(args.device, args.validation)?;
     let size = UVec2::new(args.width, args.height);
@@ -315,11 +328,12 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
     let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
     let mut out = Vec::new();
     for &f in &poses {
-        let pose = if moving {
+        let head = if moving {
             camera_path::orbit(&start, centre, f, args.frames)
         } else {
             start
         };
+        let pose = rig.eye(&head, fovea_hal::Eye::Left);
         let reference = renderer.render_reference(
             &pose,
             args.reference_spp,

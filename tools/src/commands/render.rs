@@ -66,6 +66,9 @@ struct Report {
     offscreen_samples: &'static str,
     scene: String,
     headset: String,
+    /// `headset` (each eye through the profile's frustum, the camera the head) or
+    /// `scene-camera` (`--projection`).
+    projection: &'static str,
     /// "left", "right" or "both".
     eyes: String,
     frames_in_flight: usize,
@@ -272,6 +275,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         offscreen_samples: args.profile.offscreen_samples.name(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
+        projection: args.camera.projection.name(),
         eyes: eyes.name().to_string(),
         frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),

@@ -13,7 +13,7 @@ use crate::output::{
 use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
 use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::pipeline::{RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -402,12 +402,16 @@ fn reference_for(
     width: u32,
     height: u32,
 ) -> Result<Vec<[f32; 4]>> {
-    let (scene, camera) = crate::look::load(
-        r.scene,
-        r.camera,
-        &r.profile.environment,
-        width as f32 / height as f32,
-    )?;
+    let rig = crate::projection::EyeRig {
+        projection: r.camera.projection,
+        hmd: fovea_hal::HmdDescription::resolve(r.headset)?,
+        stereo: false,
+        width,
+        height,
+        metres_per_unit: r.camera.world_scale,
+    };
+    let (scene, camera) =
+        crate::look::load(r.scene, r.camera, &r.profile.environment, rig.framing())?;
     let ctx = super::open_device(r.device, r.validation)?;
     let settings = RenderSettings {
         seed: r.seed.wrapping_add(0x5eed),
@@ -419,7 +423,8 @@ fn reference_for(
         Box::new(Cartesian::new(UVec2::new(width, height))),
         settings,
     )?;
-    let pose = CameraPose::from_scene_camera(&camera, width, height);
+    // The replayed frames are the left eye's.
+    let pose = rig.eye(&rig.head(&camera), fovea_hal::Eye::Left);
     let reference = renderer.render_reference(&pose, args.reference_spp, r.max_depth, |_| {})?;
     super::check_validation(&ctx)?;
     Ok(reference)

@@ -10,7 +10,7 @@ use baseline::FrameRecord;
 use glam::Vec2;
 use serde::Serialize;
 
-/// What counts as a regression (documented in the README; flags override).
+/// What counts as a regression (documented in docs/guide/replay.md; flags override).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Tolerances {
     /// Largest mean FLIP of a ring against the baseline's frame.

@@ -1,4 +1,4 @@
-//! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
+//! Denoisers (design: shared/design/denoisers.md). They run in the sampling grid between the
 //! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
 //! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
 //! which runs after the denoiser; BMFR; A-SVGF fits beside them), one pass = one module + one

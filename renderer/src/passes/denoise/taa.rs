@@ -1,4 +1,4 @@
-//! TAA (Karis 2014; denoisers.md) in the sampling grid, as the paper does (issue 5): the tracer
+//! TAA (Karis 2014; denoisers.md) in the sampling grid, as the paper does: the tracer
 //! jitters each frame by a Halton(2, 3) offset inside the grid texel (Visual-Polar: inside the VP
 //! texel), and one pass reprojects the history through the previous frame's grid, clips it toward
 //! this frame's 3×3 YCoCg neighbourhood and blends it with luma weights. It runs after the
