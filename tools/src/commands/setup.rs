@@ -71,7 +71,7 @@ pub struct Setup {
     pub start_pose: CameraPose,
     /// Turns the head into each eye's camera (`--projection`).
     pub rig: EyeRig,
-    scene_centre: Vec3,
+    pub scene_centre: Vec3,
     frames: u32,
     camera_path: camera_path::CameraMotion,
 }
@@ -148,15 +148,27 @@ impl Setup {
     /// Frame `frame`'s input: each eye's camera (the head pose on the camera path, offset by the
     /// eye's position) and gaze (the combined gaze direction projected into that eye).
     pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
+        self.frame_input_from(frame, None)
+    }
+
+    /// As `frame_input`, the head at `head` instead of on the camera path when given (the
+    /// viewer's free camera).
+    pub fn frame_input_from(
+        &mut self,
+        frame: u32,
+        head: Option<CameraPose>,
+    ) -> Result<(FrameInput, FrameGaze)> {
         let gaze = self.gaze.frame(frame, self.eyes.list())?;
-        let head = camera_path::pose(
-            &self.start_pose,
-            self.scene_centre,
-            frame,
-            self.frames,
-            &self.camera_path,
-            self.hmd.refresh_hz,
-        );
+        let head = head.unwrap_or_else(|| {
+            camera_path::pose(
+                &self.start_pose,
+                self.scene_centre,
+                frame,
+                self.frames,
+                &self.camera_path,
+                self.hmd.refresh_hz,
+            )
+        });
         let mut views = [ViewInput {
             camera: head,
             gaze: None,
