@@ -5,11 +5,12 @@
 //! output with fireflies or an empty view; run-time emission scaling keeps the light table
 //! consistent; a space without temporal filters refuses it, the screen-clipped VP layout runs it.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::layouts::{AsvgfGradientSample, ASVGF_NO_LUMINANCE};
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
 };

@@ -4,12 +4,14 @@
 //! history across a disocclusion (synthetic G-buffers, moving camera); the `--denoiser bmfr` flag
 //! end to end. The φ seam is the conformance suite's (tests/conformance.rs), for every filter.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::BMFR_BLOCK;
 use fovea_renderer::passes::denoise::bmfr::{Bmfr, BmfrSettings, BLOCK_OFFSETS};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::passes::grid::{DenoiseFrame, DenoiseScene};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};

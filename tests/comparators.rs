@@ -4,13 +4,12 @@
 //! keeps the traced pixels, it converges to the image one sample per pixel gives, it refuses the
 //! filters it cannot run, and `fovea render --method NAME` reports it end to end.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, OffscreenSamples, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::fill::FillPass;
 use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams,
     FALLOFF_BUDGET_OF_VP,

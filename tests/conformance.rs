@@ -8,12 +8,14 @@
 //! does not refuses every filter by name. Adding a space means adding it to `spaces()`, not
 //! copying these tests.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::taa::Taa;
 use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
+use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::passes::grid::{DenoiseFrame, DenoiseScene};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation,
     LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace,

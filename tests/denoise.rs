@@ -6,12 +6,14 @@
 //! TAA in the sampling grid (Karis 2014): noise and edge aliasing reduced against the reference,
 //! fireflies, disocclusion resets, the tracer's Halton jitter, the `--taa` flag.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
 use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::DenoiseFrame;
+use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};

@@ -3,12 +3,13 @@
 //! the disocclusion reset. The remap's placement of jittered samples is tested in vp_remap.rs.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::FrameData;
 use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
 use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};

@@ -7,12 +7,13 @@
 //! Then the whole VP frame through `Renderer`.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::blur::{BlurPass, BlurShape};
 use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
 use fovea_renderer::passes::remap::RemapPass;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, InverseCdf, SamplingSpace, VisualPolar,
     VisualPolarParams, VpLayout,

@@ -10,6 +10,7 @@
 pub mod environment;
 pub mod error;
 pub mod fill_to_screen;
+pub mod frame;
 pub mod frames;
 pub mod gpu_scene;
 pub mod graph;

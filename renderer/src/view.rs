@@ -5,15 +5,16 @@
 
 use crate::error::{Error, Result};
 use crate::fill_to_screen::FillToScreen;
+use crate::frame::{CameraPose, FrameStats, RenderSettings};
 use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::block_fill::BlockFillPass;
 use crate::passes::blur_grid::GridBlurPass;
 use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
+use crate::passes::grid::GBuffer;
 use crate::passes::splat::SplatPass;
-use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
+use crate::passes::trace::{TracePass, RAY_COUNTERS};
 use crate::passes::upscale::UpscalePass;
-use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
 use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
 use crate::to_screen::{BlurSpace, ToScreen};
 use crate::vk::{Buffer, Context, Image};

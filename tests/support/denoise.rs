@@ -2,10 +2,12 @@
 //! G-buffer data, masks and metrics.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::{GBuffer, OwnedTileList};
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::DenoiseFrame;
+use fovea_renderer::passes::grid::{GBuffer, OwnedTileList};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use glam::{UVec2, Vec2};

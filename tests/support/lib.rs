@@ -178,7 +178,7 @@ pub fn small_render_args<'a>(
 /// the gaze at `gaze`; each frame's HDR screen goes to `check` first.
 pub fn mean_over_frames(
     renderer: &mut fovea_renderer::pipeline::Renderer,
-    camera: fovea_renderer::pipeline::CameraPose,
+    camera: fovea_renderer::frame::CameraPose,
     gaze: Option<glam::Vec2>,
     frames: u32,
     mut check: impl FnMut(u32, &[[f32; 4]]),
@@ -187,9 +187,7 @@ pub fn mean_over_frames(
     let mut hdr = Vec::new();
     for f in 0..frames {
         renderer
-            .render_frame(
-                &fovea_renderer::pipeline::FrameInput::mono(camera, f, gaze).with_hdr(true),
-            )
+            .render_frame(&fovea_renderer::frame::FrameInput::mono(camera, f, gaze).with_hdr(true))
             .unwrap();
         renderer.read_hdr(&mut hdr).unwrap();
         check(f, &hdr);
@@ -232,7 +230,7 @@ pub struct SpaceBuffers {
     pub sampling: Buffer,
     pub table: Buffer,
     /// Every tile holding a sample (`grid_tiles`).
-    pub tiles: fovea_renderer::passes::trace::OwnedTileList,
+    pub tiles: fovea_renderer::passes::grid::OwnedTileList,
 }
 
 impl SpaceBuffers {
@@ -273,8 +271,8 @@ pub fn grid_table(
 pub fn grid_tiles(
     ctx: &Arc<Context>,
     space: &dyn fovea_renderer::sampling::SamplingSpace,
-) -> fovea_renderer::passes::trace::OwnedTileList {
-    fovea_renderer::passes::trace::OwnedTileList::new(ctx, space, false).unwrap()
+) -> fovea_renderer::passes::grid::OwnedTileList {
+    fovea_renderer::passes::grid::OwnedTileList::new(ctx, space, false).unwrap()
 }
 
 /// One texel as the GPU's space sees it (passes/space_probe): its sample's screen position at
@@ -358,7 +356,7 @@ pub fn assert_refuses_svgf(
 ) {
     use fovea_renderer::passes::denoise::{svgf::SvgfSettings, DenoiserSettings};
     let name = space.name();
-    let svgf = fovea_renderer::pipeline::RenderSettings {
+    let svgf = fovea_renderer::frame::RenderSettings {
         denoiser: DenoiserSettings::Svgf(SvgfSettings::default()),
         ..Default::default()
     };
@@ -375,12 +373,13 @@ pub fn assert_mean_like_cartesian(
     ctx: &Arc<Context>,
     scene: &fovea_scene::Scene,
     renderer: &mut fovea_renderer::pipeline::Renderer,
-    camera: fovea_renderer::pipeline::CameraPose,
+    camera: fovea_renderer::frame::CameraPose,
     gaze: glam::Vec2,
     frames: u32,
     mut check: impl FnMut(u32, &[[f32; 4]]),
 ) {
-    use fovea_renderer::pipeline::{RenderSettings, Renderer};
+    use fovea_renderer::frame::RenderSettings;
+    use fovea_renderer::pipeline::Renderer;
     let name = renderer.space().name();
     let screen = renderer.space().screen_size();
     let a = mean_over_frames(renderer, camera, Some(gaze), frames, &mut check);

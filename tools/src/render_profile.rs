@@ -8,11 +8,11 @@
 
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
+use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::taa::TaaSettings;
-use fovea_renderer::pipeline::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
 use fovea_renderer::sampling::{
     CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent,
     LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout,

@@ -7,6 +7,7 @@ pub mod blur;
 pub mod blur_grid;
 pub mod denoise;
 pub mod fill;
+pub mod grid;
 pub mod mip_phi;
 pub mod raycast;
 pub mod remap;

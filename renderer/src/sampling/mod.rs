@@ -17,6 +17,7 @@ mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 mod visual_polar_screen_axis;
+mod visual_polar_space;
 mod vrs_tiles;
 
 pub use cartesian::Cartesian;

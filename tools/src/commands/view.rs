@@ -10,11 +10,10 @@ use crate::viewer::debug::{compose, DebugView};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
+use fovea_renderer::frame::{FrameInput, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::{
-    FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{UVec2, Vec2};
 use gpu_allocator::MemoryLocation;
@@ -283,7 +282,7 @@ impl Viewer<'_> {
         if self.args.frames.is_none() && eye != self.setup.screen() && eye.x > 0 {
             self.setup.width = eye.x;
             self.setup.height = eye.y;
-            self.setup.start_pose = fovea_renderer::pipeline::CameraPose {
+            self.setup.start_pose = fovea_renderer::frame::CameraPose {
                 fov_tan: scaled_fov(self.setup.start_pose.fov_tan, eye),
                 ..self.setup.start_pose
             };

@@ -14,12 +14,11 @@ pub mod taa_screen;
 
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
-use crate::layouts::SamplingParams;
-use crate::passes::trace::{GBuffer, GradientTargets, TileList};
+use crate::passes::grid::{DenoiseFrame, DenoiseScene, GBuffer, GradientTargets};
 use crate::vk::{Buffer, Context, Image};
 use asvgf::{Asvgf, AsvgfSettings};
 use bmfr::{Bmfr, BmfrSettings};
-use glam::{UVec2, Vec3};
+use glam::UVec2;
 use std::sync::Arc;
 use svgf::{Svgf, SvgfSettings};
 
@@ -66,31 +65,6 @@ impl DenoiserSettings {
     pub fn needs_gradients(&self) -> bool {
         matches!(self, DenoiserSettings::Asvgf(_))
     }
-}
-
-/// The sampling space of this frame and of the previous one (its gaze differs; `None` when there
-/// is no usable previous frame, which drops all history).
-#[derive(Clone, Copy)]
-pub struct DenoiseFrame<'a> {
-    pub current: SamplingParams,
-    pub previous: Option<SamplingParams>,
-    /// The view's sampling table: this frame's (`SamplingSpace::sampling_table`) followed by the
-    /// previous frame's of the same length (the screen-clipped layout's kernels read both
-    /// frames' arcs from it).
-    pub sampling_table: &'a Buffer,
-    /// The trace's tiles this frame: filters that work per texel run over the live ones (the
-    /// idle ones hold no traced sample) and write what later frames read of the idle ones.
-    pub tiles: TileList<'a>,
-}
-
-/// What a denoiser may need from the scene besides the G-buffer.
-#[derive(Clone, Copy)]
-pub struct DenoiseScene<'a> {
-    /// This frame's camera position in world space (the G-buffer's positions are relative to it;
-    /// BMFR accumulates positions across frames).
-    pub camera_origin: Vec3,
-    /// The scene's materials (`MaterialGpu`; BMFR keeps emitters out of its fits).
-    pub materials: &'a Buffer,
 }
 
 /// A denoiser with its per-eye state.

@@ -4,12 +4,11 @@
 //! this frame's 3×3 YCoCg neighbourhood and blends it with luma weights. It runs after the
 //! denoiser (or on the raw colour) and before the way to the screen.
 
-use super::DenoiseFrame;
 use crate::error::{Error, Result};
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::TaaPush;
+use crate::passes::grid::{DenoiseFrame, GBuffer};
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
 use crate::vk::{ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, Vec2, Vec4};

@@ -10,7 +10,7 @@ use super::taa::TaaSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, TaaScreenPush};
-use crate::passes::trace::GBuffer;
+use crate::passes::grid::GBuffer;
 use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;

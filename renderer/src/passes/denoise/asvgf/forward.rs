@@ -7,8 +7,8 @@ use crate::graph::{
     read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
 };
 use crate::layouts::{AsvgfForwardPush, SamplingParams};
+use crate::passes::grid::GBuffer;
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::UVec4;
 use std::sync::Arc;

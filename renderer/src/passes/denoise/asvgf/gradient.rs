@@ -1,12 +1,12 @@
 //! One iteration of A-SVGF's gradient reconstruction: joint-bilateral à-trous on the strata grid
 //! (the first iteration reads the tracer's gradient image, the others the previous iteration).
 
-use super::AsvgfSettings;
+use super::settings::AsvgfSettings;
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{AsvgfGradientPush, SamplingParams};
+use crate::passes::grid::GBuffer;
 use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{UVec4, Vec4};
 use std::sync::Arc;

@@ -12,13 +12,15 @@
 
 mod forward;
 mod gradient;
+mod settings;
 
-use super::svgf::{Svgf, SvgfSettings};
-use super::DenoiseFrame;
-use crate::error::{Error, Result};
+pub use settings::{AsvgfSettings, MAX_GRADIENT_ITERATIONS};
+
+use super::svgf::Svgf;
+use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
-use crate::passes::trace::{GBuffer, GradientTargets};
+use crate::passes::grid::{DenoiseFrame, GBuffer, GradientTargets};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use forward::ForwardPass;
@@ -26,52 +28,6 @@ use glam::UVec2;
 use gpu_allocator::MemoryLocation;
 use gradient::GradientPass;
 use std::sync::Arc;
-
-/// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AsvgfSettings {
-    pub svgf: SvgfSettings,
-    /// À-trous iterations of the gradient reconstruction (5×5 taps, spacing 2^i strata).
-    pub gradient_iterations: u32,
-    /// Depth edge-stop σ_z of the reconstruction (as SVGF's).
-    pub gradient_sigma_depth: f32,
-    /// Normal edge-stop exponent σ_n of the reconstruction.
-    pub gradient_sigma_normal: f32,
-}
-
-impl Default for AsvgfSettings {
-    fn default() -> Self {
-        AsvgfSettings {
-            svgf: SvgfSettings::default(),
-            gradient_iterations: 4,
-            gradient_sigma_depth: 1.0,
-            gradient_sigma_normal: 128.0,
-        }
-    }
-}
-
-/// Most reconstruction iterations accepted: 2^7 strata apart spans any grid.
-pub const MAX_GRADIENT_ITERATIONS: u32 = 8;
-
-impl AsvgfSettings {
-    pub fn validate(&self) -> Result<()> {
-        self.svgf.validate()?;
-        let bad = |what: String| Err(Error::Invalid(format!("asvgf: {what}")));
-        if !(1..=MAX_GRADIENT_ITERATIONS).contains(&self.gradient_iterations) {
-            return bad(format!(
-                "gradient_iterations must be in 1..={MAX_GRADIENT_ITERATIONS}, got {}",
-                self.gradient_iterations
-            ));
-        }
-        let sigmas = [self.gradient_sigma_depth, self.gradient_sigma_normal];
-        if !sigmas.iter().all(|s| s.is_finite() && *s > 0.0) {
-            return bad(format!(
-                "gradient σ_z, σ_n must be finite and > 0, got {sigmas:?}"
-            ));
-        }
-        Ok(())
-    }
-}
 
 pub struct Asvgf {
     pub settings: AsvgfSettings,

@@ -1,12 +1,12 @@
 //! BMFR accumulation before the fit: noisy demodulated radiance, normal and camera-relative
 //! position blended with their reprojected history (α = max(α_floor, 1/history)).
 
-use super::{BmfrHistory, Reprojection};
+use super::history::{BmfrHistory, Reprojection};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context};
 use std::sync::Arc;
 

@@ -2,12 +2,12 @@
 //! reprojection as before the fit (α = max(α_floor, 1/history)), then re-modulated by albedo.
 
 use super::accumulate::temporal_push;
-use super::{BmfrHistory, Reprojection};
+use super::history::{BmfrHistory, Reprojection};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use std::sync::Arc;
 

@@ -2,14 +2,34 @@
 //! (10 features with stochastic regularisation | RGB) and solves it by Householder QR into 10
 //! weights per channel.
 
-use super::{block_count, BmfrHistory};
+use super::history::BmfrHistory;
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
-use crate::layouts::{BmfrBlockPush, SamplingParams, BMFR_FIT_LANES};
+use crate::layouts::{BmfrBlockPush, SamplingParams, BMFR_BLOCK, BMFR_FIT_LANES};
 use crate::passes::push_bytes;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{IVec2, IVec4, UVec2, Vec4};
 use std::sync::Arc;
+
+/// Block-grid offsets in texels, one per frame (frame % 16): every even value of [−16, 14] once
+/// per axis, in an order that spreads consecutive offsets (x bit-reversed, y stepping by 5).
+pub const BLOCK_OFFSETS: [[i32; 2]; 16] = block_offsets();
+
+const fn block_offsets() -> [[i32; 2]; 16] {
+    let mut table = [[0; 2]; 16];
+    let mut i = 0;
+    while i < 16 {
+        let reversed = ((i & 1) << 3 | (i & 2) << 1 | (i & 4) >> 1 | (i & 8) >> 3) as i32;
+        table[i] = [2 * reversed - 16, 2 * ((5 * i as i32 + 3) % 16) - 16];
+        i += 1;
+    }
+    table
+}
+
+/// Blocks per axis of a grid: one more than the grid needs, so that every offset covers it.
+pub fn block_count(grid: UVec2) -> UVec2 {
+    grid.map(|v| v.div_ceil(BMFR_BLOCK) + 1)
+}
 
 pub struct FitPass {
     pipeline: std::sync::Arc<ComputePipeline>,

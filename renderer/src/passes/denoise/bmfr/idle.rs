@@ -2,12 +2,12 @@
 //! over the live tiles only, so this writes what they would write there — the history a later
 //! frame reads, the features the fit reads over whole blocks, the fitted colour and the output.
 
-use super::BmfrHistory;
+use super::history::BmfrHistory;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrIdlePush, SamplingParams};
+use crate::passes::grid::TileList;
 use crate::passes::push_bytes;
-use crate::passes::trace::TileList;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::UVec4;
 use std::sync::Arc;

@@ -1,12 +1,12 @@
 //! BMFR weighted sum: each texel evaluates its block's fit on its own features, clamped ≥ 0.
 
 use super::fit::block_push;
-use super::BmfrHistory;
+use super::history::BmfrHistory;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrBlockPush, SamplingParams};
+use crate::passes::grid::TileList;
 use crate::passes::push_bytes;
-use crate::passes::trace::TileList;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::IVec2;
 use std::sync::Arc;

@@ -1,12 +1,12 @@
 //! One SVGF à-trous iteration: 5×5 B3-spline taps `step` texels apart, edge-stopped by depth,
 //! normal and variance-scaled luminance; variance filtered with the squared weights.
 
-use super::SvgfSettings;
+use super::settings::SvgfSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfAtrousPush};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::{UVec4, Vec4};
 use std::sync::Arc;

@@ -2,12 +2,12 @@
 //! this writes what they would write there and a later frame reads (moments, surfaces, the colour
 //! history) — a texel there holds no sample or one culled off the screen.
 
-use super::SvgfHistory;
+use super::history::SvgfHistory;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfIdlePush};
+use crate::passes::grid::TileList;
 use crate::passes::push_bytes;
-use crate::passes::trace::TileList;
 use crate::vk::{Buffer, ComputePipeline, Context};
 use glam::UVec4;
 use std::sync::Arc;

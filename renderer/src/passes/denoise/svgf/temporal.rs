@@ -1,12 +1,13 @@
 //! SVGF temporal accumulation: reprojection with bilinear same-surface taps (3×3 search when they
 //! all fail), colour and luminance moments blended with α = max(α_min, 1/history).
 
-use super::{SvgfHistory, SvgfSettings};
+use super::history::SvgfHistory;
+use super::settings::SvgfSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfTemporalPush};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;

@@ -1,12 +1,12 @@
 //! SVGF variance: temporal where the history is long enough, else a 7×7 edge-stopped spatial
 //! estimate from the moments.
 
-use super::SvgfSettings;
+use super::settings::SvgfSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, SvgfVariancePush};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use glam::Vec4;
 use std::sync::Arc;
