@@ -14,7 +14,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::BlurSettings;
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::{
     assert_clean, gpu, light_material, mean_rgb, owned_scene, read_image, rmse, save_preview,
 };
@@ -478,7 +478,7 @@ fn emission_scale_switches_a_light_consistently() {
 #[test]
 fn the_renderer_refuses_filters_a_space_cannot_run() {
     use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
-    use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
+    use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
     use fovea_renderer::sampling::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
     let ctx = gpu();
     let scene = owned_scene("cornell-box");

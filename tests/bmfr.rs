@@ -13,8 +13,8 @@ use fovea_renderer::passes::grid::GBuffer;
 use fovea_renderer::passes::grid::{DenoiseFrame, DenoiseScene};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials,
     rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,

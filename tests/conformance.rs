@@ -10,19 +10,19 @@
 
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::denoise::taa::Taa;
-use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
 use fovea_renderer::passes::grid::GBuffer;
 use fovea_renderer::passes::grid::{DenoiseFrame, DenoiseScene};
+use fovea_renderer::passes::taa::Taa;
+use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation,
     LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace,
     UniformBudget, VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer,
     SeamErrors,

@@ -9,14 +9,14 @@
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
-use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::grid::DenoiseFrame;
 use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::passes::taa::{Taa, TaaMode, TaaSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, rmse_where,
     surface_interiors, texel_screens, upload,

@@ -5,8 +5,8 @@
 //! thread while a frame is recorded, submitted and read back.
 
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
-use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,

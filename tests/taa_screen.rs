@@ -6,13 +6,13 @@ use ash::vk;
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::FrameData;
-use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
 use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::passes::taa::{ScreenTaa, ScreenTaaFrame};
+use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
 use fovea_tests::{
     assert_clean, gpu, grid_table, inject_fireflies, owned_scene, read_image, save_preview,

@@ -9,17 +9,17 @@
 use ash::vk;
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::blur::{BlurPass, BlurShape};
-use fovea_renderer::passes::denoise::taa::TaaMode;
-use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
-use fovea_renderer::passes::remap::RemapPass;
+use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, InverseCdf, SamplingSpace, VisualPolar,
     VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
 use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::way_back::blur::{BlurPass, BlurShape};
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
+use fovea_renderer::way_back::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
+use fovea_renderer::way_back::remap::RemapPass;
 use fovea_tests::{assert_clean, gpu, read_image, save_preview, unit_hash, write_image};
 use glam::{UVec2, Vec2};
 use std::sync::Arc;
@@ -418,7 +418,7 @@ fn blur(ctx: &Arc<Context>, shape: &BlurShape, src: &[[f32; 4]]) -> Vec<[f32; 4]
         shape,
         &a,
         &b,
-        fovea_renderer::passes::blur::BlurTarget::Radiance(&c),
+        fovea_renderer::way_back::blur::BlurTarget::Radiance(&c),
     )
     .unwrap();
     rec.submit_and_wait().unwrap();

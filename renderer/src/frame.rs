@@ -4,12 +4,12 @@
 
 use crate::error::{Error, Result};
 use crate::graph::{ExternalImage, SubmitSync};
-use crate::passes::denoise::taa::TaaMode;
 use crate::passes::denoise::DenoiserSettings;
+use crate::passes::taa::TaaMode;
 use crate::passes::tonemap::ToneCurve;
 use crate::scene::Camera;
-use crate::to_screen::BlurSettings;
 use crate::vk::Buffer;
+use crate::way_back::blur::BlurSettings;
 use glam::{Mat4, UVec2, Vec2, Vec4};
 
 /// The real-time path: primary ray, one indirect bounce, next-event estimation at both hits.

@@ -15,18 +15,16 @@ use crate::layouts::{
     FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD,
 };
 use crate::passes::accumulate::AccumulatePass;
-use crate::passes::denoise::taa::Taa;
-use crate::passes::denoise::taa_screen::ScreenTaaFrame;
 use crate::passes::denoise::Denoiser;
 use crate::passes::grid::TileList;
 use crate::passes::grid::{DenoiseFrame, DenoiseScene};
-use crate::passes::splat::SplatInputs;
+use crate::passes::taa::{ScreenTaaFrame, Taa};
 use crate::passes::tonemap::{LdrTarget, ToneTarget, TonemapPass};
 use crate::sampling::SamplingSpace;
 use crate::scene::Scene;
-use crate::to_screen::ScreenOut;
-use crate::view::{BackPasses, View};
+use crate::view::View;
 use crate::vk::{Buffer, Context, Image};
+use crate::way_back::{ScreenOut, WayBackFrame};
 use ash::vk;
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
@@ -717,38 +715,20 @@ fn record_view(
     // Unless the frame's radiance is read back, the remap's blur writes the display image itself
     // (one full-screen pass fewer).
     let fused = (!input.read_hdr).then_some(display);
-    let screen = match (&mut view.back, view.space.visual_polar()) {
-        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(
-            rec,
-            vp,
-            &s.sampling_table,
-            grid_hdr,
-            &settings.blur,
-            screen_taa.as_ref(),
-            fused,
-        )?,
-        (BackPasses::Upscale(upscale, screen), _) => {
-            upscale.record(rec, grid_hdr, screen)?;
-            ScreenOut::Radiance(screen)
-        }
-        (BackPasses::Fill(fill), _) => {
-            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?)
-        }
-        (BackPasses::BlockFill(fill, screen), _) => {
-            fill.record(rec, &s.sampling, grid_hdr, screen)?;
-            ScreenOut::Radiance(screen)
-        }
-        (BackPasses::Splat(splat, fill), _) => {
-            let inputs = SplatInputs {
-                frame_data: &s.frame_data,
-                sampling: &s.sampling,
-                sampling_table: &s.sampling_table,
-            };
-            let sparse = splat.record(rec, &inputs, grid_hdr)?;
-            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?)
-        }
-        _ => ScreenOut::Radiance(grid_hdr),
-    };
+    let screen = view.back.record(
+        rec,
+        &WayBackFrame {
+            space: view.space.as_ref(),
+            params: space,
+            grid: grid_hdr,
+            frame_data: &s.frame_data,
+            sampling: &s.sampling,
+            sampling_table: &s.sampling_table,
+            blur: &settings.blur,
+            taa: screen_taa,
+            display: fused,
+        },
+    )?;
     if let ScreenOut::Radiance(screen_hdr) = screen {
         tonemap.record(rec, "tonemap", screen_hdr, &display)?;
         if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {

@@ -12,12 +12,12 @@ use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARIS
 use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
 use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::taa::TaaSettings;
+use fovea_renderer::passes::taa::TaaSettings;
 use fovea_renderer::sampling::{
     CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent,
     LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
 use serde::Deserialize;
 use std::path::Path;
 

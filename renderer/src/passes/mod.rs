@@ -1,21 +1,15 @@
-//! One module per compute pass: each owns its pipeline and params struct, takes typed inputs and
-//! records into a `FrameRecorder`.
+//! One module per compute pass (or pass group: the denoisers, TAA): each owns its pipeline and
+//! params struct, takes typed inputs and records into a `FrameRecorder`. The passes of the way
+//! back to the screen are `crate::way_back`'s.
 
 pub mod accumulate;
-pub mod block_fill;
-pub mod blur;
-pub mod blur_grid;
 pub mod denoise;
-pub mod fill;
 pub mod grid;
-pub mod mip_phi;
 pub mod raycast;
-pub mod remap;
-pub mod splat;
+pub mod taa;
 pub mod tonemap;
 pub mod trace;
 pub mod trace_clear;
-pub mod upscale;
 
 /// One Visual-Polar kernel compiled for each layout (`//! variant paper` / `clipped`): lavapipe
 /// pays for both sides of a branch, so the paper's layout gets a kernel without the

@@ -105,6 +105,9 @@ impl SamplingSpace for VisualPolar {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         Some(self)
     }
+    fn blur_axis(&self) -> Option<&VisualPolar> {
+        Some(self)
+    }
     /// The fovea's clipped tiles and, in the paper's layout, tiles far off the screen are idle.
     fn trace_tiles(&self, cull: bool, tiles: &mut TraceTiles) {
         visual_polar_tiles(self, cull, tiles);

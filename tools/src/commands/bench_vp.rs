@@ -14,7 +14,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;

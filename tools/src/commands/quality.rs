@@ -15,8 +15,8 @@ use crate::output::{
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::{CameraPose, RenderSettings};
-use fovea_renderer::passes::denoise::taa::TaaMode;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};

@@ -1,7 +1,7 @@
 //! Denoisers (issue 5; shared/design/denoisers.md). They run in the sampling grid between the
 //! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
-//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
-//! which runs after the denoiser; BMFR; A-SVGF fits beside them), one pass = one module + one
+//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF,
+//! A-SVGF, BMFR; TAA, which runs after them, is `passes::taa`), one pass = one module + one
 //! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
 //! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
 
@@ -9,8 +9,6 @@ pub mod asvgf;
 pub mod bmfr;
 pub mod modulate;
 pub mod svgf;
-pub mod taa;
-pub mod taa_screen;
 
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;

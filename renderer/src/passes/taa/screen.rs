@@ -6,7 +6,7 @@
 //! is spaced by the local texel footprint (see `taa_screen.comp`). Runs between the remap and
 //! the foveated blur; the history is screen-sized and unblurred.
 
-use super::taa::TaaSettings;
+use super::TaaSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{SamplingParams, TaaScreenPush};
@@ -58,7 +58,7 @@ impl ScreenTaa {
             settings,
             pipelines: VpLayoutPipelines::new(
                 ctx,
-                "passes/denoise/taa_screen",
+                "passes/taa_screen",
                 std::mem::size_of::<TaaScreenPush>() as u32,
             )?,
             history: [image("taa_screen.history0")?, image("taa_screen.history1")?],

@@ -2,9 +2,12 @@
 //! units in the atlas — its own pixel in the fovea, bilinear between the four nearest block
 //! centres beyond.
 
+use super::frame::{ScreenOut, WayBackFrame, WayBackPasses};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use ash::vk;
+use glam::UVec2;
 use std::sync::Arc;
 
 pub struct BlockFillPass {
@@ -40,5 +43,40 @@ impl BlockFillPass {
             &[],
             [screen.width, screen.height, 1],
         )
+    }
+}
+
+/// The way back of an atlas of pixel blocks (`WayBack::BlockFill`): the block fill into a
+/// screen-sized image, no blur.
+pub struct BlockFillWayBack {
+    pass: BlockFillPass,
+    screen: Image,
+}
+
+impl BlockFillWayBack {
+    /// `variant`: the space's kernel variant.
+    pub fn new(ctx: &Arc<Context>, variant: &str, screen: UVec2) -> Result<BlockFillWayBack> {
+        Ok(BlockFillWayBack {
+            pass: BlockFillPass::new(ctx, variant)?,
+            screen: Image::new(
+                ctx,
+                "block_filled",
+                screen.x,
+                screen.y,
+                vk::Format::R32G32B32A32_SFLOAT,
+            )?,
+        })
+    }
+}
+
+impl WayBackPasses for BlockFillWayBack {
+    fn record<'a>(
+        &'a mut self,
+        rec: &mut FrameRecorder,
+        frame: &WayBackFrame<'a>,
+    ) -> Result<ScreenOut<'a>> {
+        self.pass
+            .record(rec, frame.sampling, frame.grid, &self.screen)?;
+        Ok(ScreenOut::Radiance(&self.screen))
     }
 }
