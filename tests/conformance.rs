@@ -11,8 +11,7 @@
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
-use fovea_renderer::passes::grid::GBuffer;
-use fovea_renderer::passes::grid::{DenoiseFrame, DenoiseScene};
+use fovea_renderer::passes::grid::{GBuffer, GridFrame};
 use fovea_renderer::passes::taa::Taa;
 use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
 use fovea_renderer::pipeline::Renderer;
@@ -21,14 +20,14 @@ use fovea_renderer::sampling::{
     LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace,
     UniformBudget, VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
-use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::vk::{Context, Image};
 use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer,
     SeamErrors,
 };
 use fovea_tests::{assert_clean, gpu, light_material, owned_scene, read_image, SpaceBuffers};
-use glam::{Mat4, UVec2, Vec3};
+use glam::{Mat4, UVec2};
 use std::sync::Arc;
 
 const SIZE: UVec2 = UVec2::new(96, 108);
@@ -399,34 +398,19 @@ impl GridFilter {
         }
     }
 
-    fn run(
-        &mut self,
-        ctx: &Arc<Context>,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        buffers: &SpaceBuffers,
-        materials: &Buffer,
-    ) -> Vec<[f32; 4]> {
+    fn run(&mut self, ctx: &Arc<Context>, frame: &GridFrame) -> Vec<[f32; 4]> {
         let mut rec = FrameRecorder::new(ctx, 32).unwrap();
         rec.begin().unwrap();
         let out: &Image = match self {
             GridFilter::Denoiser(d) => {
-                d.record_before_trace(&mut rec, g, frame, &buffers.frame)
-                    .unwrap();
-                d.record(
-                    &mut rec,
-                    g,
-                    frame,
-                    &DenoiseScene {
-                        camera_origin: Vec3::ZERO,
-                        materials,
-                    },
-                )
-                .unwrap()
+                d.record_before_trace(&mut rec, frame).unwrap();
+                d.record(&mut rec, frame).unwrap()
             }
-            GridFilter::Taa(t) => t
-                .record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5))
-                .unwrap(),
+            GridFilter::Taa(t) => {
+                let color = &frame.gbuffer.color;
+                t.record(&mut rec, color, frame, glam::Vec2::splat(0.5))
+                    .unwrap()
+            }
         };
         rec.submit_and_wait().unwrap();
         read_image(ctx, out)
@@ -473,17 +457,10 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
             let mut out = Vec::new();
             for frame in 0..8u32 {
                 upload_gbuffer(&ctx, &g, &seam_texels(&vp, frame));
+                let previous = (frame > 0).then_some(params);
                 out = f.run(
                     &ctx,
-                    &g,
-                    &DenoiseFrame {
-                        current: params,
-                        previous: (frame > 0).then_some(params),
-                        sampling_table: &buffers.table,
-                        tiles: buffers.tiles.list(),
-                    },
-                    &buffers,
-                    &materials,
+                    &buffers.grid_frame(&g, (params, previous), &materials),
                 );
             }
             assert_finite_non_negative(&format!("{space_name} + {filter} at the seam"), &out);
@@ -607,13 +584,15 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
                     &vp,
                     previous_arcs.then_some(&prev as &dyn SamplingSpace),
                 );
-                let frame_in = DenoiseFrame {
-                    current: vp.sampling_params(),
-                    previous: (frame > 0).then(|| prev.sampling_params()),
+                let sequence = (
+                    vp.sampling_params(),
+                    (frame > 0).then(|| prev.sampling_params()),
+                );
+                let frame_in = GridFrame {
                     sampling_table: &table,
-                    tiles: buffers.tiles.list(),
+                    ..buffers.grid_frame(&g, sequence, &materials)
                 };
-                let out = f.run(&ctx, &g, &frame_in, &buffers, &materials);
+                let out = f.run(&ctx, &frame_in);
                 if frame == FRAMES - 1 {
                     assert_finite_non_negative(&format!("{layout:?} + {filter}"), &out);
                     errors[run] = error(&vp, &|i| out[i][1]);

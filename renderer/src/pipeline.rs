@@ -16,9 +16,8 @@ use crate::layouts::{
 };
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::Denoiser;
-use crate::passes::grid::TileList;
-use crate::passes::grid::{DenoiseFrame, DenoiseScene};
-use crate::passes::taa::{ScreenTaaFrame, Taa};
+use crate::passes::grid::{GridFrame, TileList};
+use crate::passes::taa::Taa;
 use crate::passes::tonemap::{LdrTarget, ToneTarget, TonemapPass};
 use crate::sampling::SamplingSpace;
 use crate::scene::Scene;
@@ -31,6 +30,18 @@ use std::sync::Arc;
 
 /// Passes one reference submission may hold (trace + accumulate per sample).
 const REFERENCE_SAMPLES_PER_SUBMIT: u32 = 8;
+
+/// What one view's frame uniforms (`FrameData`) are made from besides the scene and settings.
+#[derive(Clone, Copy)]
+struct FrameUniforms {
+    camera: CameraPose,
+    index: u32,
+    max_depth: u32,
+    /// `FRAME_FLAG_*`.
+    flags: u32,
+    /// The TAA jitter inside the texel (zero without TAA).
+    jitter: Vec2,
+}
 
 /// The real-time engine: one scene upload and one set of pipelines shared by every view, each
 /// view with its own space and history, all views of a frame recorded into one command buffer
@@ -94,7 +105,7 @@ impl Renderer {
         let views = build_views(ctx, spaces, &settings, frames_in_flight)?;
         let ring = FrameRing::new(ctx, frames_in_flight, max_passes(&views))?;
         Ok(Renderer {
-            accumulate: AccumulatePass::new(ctx)?,
+            accumulate: AccumulatePass::single(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
             ctx: ctx.clone(),
             scene,
@@ -200,20 +211,18 @@ impl Renderer {
         self.views[0].taa_history_bytes()
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn write_frame_data(
-        &self,
-        view: usize,
-        slot: usize,
-        camera: &CameraPose,
-        frame_index: u32,
-        max_depth: u32,
-        flags: u32,
-        jitter: Vec2,
-    ) -> Result<()> {
+    /// Writes `frame`'s uniforms into view `view`'s buffer of `slot`.
+    fn write_frame_data(&self, view: usize, slot: usize, frame: &FrameUniforms) -> Result<()> {
+        let FrameUniforms {
+            camera,
+            index: frame_index,
+            max_depth,
+            flags,
+            jitter,
+        } = *frame;
         let v = &self.views[view];
         let screen = v.space.screen_size().as_vec2();
-        let prev = v.prev_camera.unwrap_or(*camera);
+        let prev = v.prev_camera.unwrap_or(camera);
         let seed = match self.settings.stereo_noise {
             StereoNoise::Independent => {
                 self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9)
@@ -309,17 +318,14 @@ impl Renderer {
         for (v, view_input) in inputs.iter().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
-            record_view(
-                rec,
-                &mut self.views[v],
-                slot,
-                &self.scene,
-                (&self.tonemap, &self.accumulate),
-                &self.settings,
-                view_input,
+            let shared = FrameShared {
+                scene: &self.scene,
+                tonemap: &self.tonemap,
+                accumulate: &self.accumulate,
+                settings: &self.settings,
                 input,
-                external,
-            )?;
+            };
+            record_view(rec, &mut self.views[v], slot, &shared, view_input, external)?;
         }
         let sync = match target {
             Some(t) => {
@@ -370,15 +376,14 @@ impl Renderer {
         } else {
             0
         };
-        self.write_frame_data(
-            v,
-            slot,
-            &view_input.camera,
-            input.frame_index,
-            self.settings.max_depth,
+        let uniforms = FrameUniforms {
+            camera: view_input.camera,
+            index: input.frame_index,
+            max_depth: self.settings.max_depth,
             flags,
-            jitter.unwrap_or(Vec2::ZERO),
-        )?;
+            jitter: jitter.unwrap_or(Vec2::ZERO),
+        };
+        self.write_frame_data(v, slot, &uniforms)?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;
         let s = &view.slots[slot];
@@ -520,15 +525,14 @@ impl Renderer {
             } else {
                 0
             };
-            self.write_frame_data(
-                0,
-                slot,
-                camera,
-                0,
+            let uniforms = FrameUniforms {
+                camera: *camera,
+                index: 0,
                 max_depth,
-                FRAME_FLAG_REFERENCE | alpha,
-                Vec2::ZERO,
-            )?;
+                flags: FRAME_FLAG_REFERENCE | alpha,
+                jitter: Vec2::ZERO,
+            };
+            self.write_frame_data(0, slot, &uniforms)?;
             self.views[0].slots[slot]
                 .sampling
                 .write(&[self.views[0].space.params()])?;
@@ -536,20 +540,20 @@ impl Renderer {
             let (_, rec) = self.ring.begin_next()?;
             let view = &self.views[0];
             let (s, accum) = (&view.slots[slot], view.accum.as_ref().expect("made above"));
-            let tiles = TileList::new(&s.trace_tiles, &view.tiles);
+            let frame = GridFrame {
+                gbuffer: &view.gbuffer,
+                frame_data: &s.frame_data,
+                sampling: &s.sampling,
+                current: view.space.params(),
+                previous: None,
+                sampling_table: &s.sampling_table,
+                tiles: TileList::new(&s.trace_tiles, &view.tiles),
+                camera_origin: camera.world_from_view.w_axis.truncate(),
+                materials: &self.scene.materials,
+            };
             for i in done..done + batch {
-                view.trace.record(
-                    rec,
-                    &self.scene,
-                    &s.frame_data,
-                    &s.sampling,
-                    &s.sampling_table,
-                    &s.ray_counters,
-                    &view.gbuffer,
-                    &tiles,
-                    i,
-                    None,
-                )?;
+                view.trace
+                    .record(rec, &frame, &self.scene, &s.ray_counters, i, None)?;
                 self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {
@@ -613,67 +617,61 @@ fn read_optional<T: bytemuck::Pod>(
     b.read_into(out)
 }
 
+/// What every view of one frame records with: the scene, the shared passes and settings, and
+/// the frame's input.
+struct FrameShared<'a> {
+    scene: &'a GpuScene,
+    tonemap: &'a TonemapPass,
+    accumulate: &'a AccumulatePass,
+    settings: &'a RenderSettings,
+    input: &'a FrameInput,
+}
+
 /// Records one view's frame: trace → denoiser → TAA → the way back to the screen → tonemap into
 /// the view's own LDR image (read back into the slot) or into `external` at its offset.
-#[allow(clippy::too_many_arguments)]
 fn record_view(
     rec: &mut FrameRecorder,
     view: &mut View,
     slot: usize,
-    scene: &GpuScene,
-    (tonemap, accumulate): (&TonemapPass, &AccumulatePass),
-    settings: &RenderSettings,
+    shared: &FrameShared,
     view_input: &ViewInput,
-    input: &FrameInput,
     external: Option<(&ExternalImage, UVec2)>,
 ) -> Result<()> {
-    let space = view.space.params();
+    let FrameShared {
+        scene,
+        tonemap,
+        accumulate,
+        settings,
+        input,
+    } = *shared;
     let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
     let s = &view.slots[slot];
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
-    let tiles = TileList::new(&s.trace_tiles, &view.tiles);
-    let denoise_frame = DenoiseFrame {
-        current: space,
+    let frame = GridFrame {
+        gbuffer: &view.gbuffer,
+        frame_data: &s.frame_data,
+        sampling: &s.sampling,
+        current: view.space.params(),
         previous: view.prev_sampling,
         sampling_table: &s.sampling_table,
-        tiles,
+        tiles: TileList::new(&s.trace_tiles, &view.tiles),
+        camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
+        materials: &scene.materials,
     };
     if let Some(d) = &mut view.denoiser {
-        d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
+        d.record_before_trace(rec, &frame)?;
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
-    trace.record(
-        rec,
-        scene,
-        &s.frame_data,
-        &s.sampling,
-        &s.sampling_table,
-        &s.ray_counters,
-        &view.gbuffer,
-        &tiles,
-        0,
-        gradients,
-    )?;
+    trace.record(rec, &frame, scene, &s.ray_counters, 0, gradients)?;
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
     let traced = match &view.sample_mean {
         Some(mean) => {
             accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
             for k in 1..view.space.samples_per_texel() {
-                trace.record(
-                    rec,
-                    scene,
-                    &s.frame_data,
-                    &s.sampling,
-                    &s.sampling_table,
-                    &s.ray_counters,
-                    &view.gbuffer,
-                    &tiles,
-                    k,
-                    None,
-                )?;
+                trace.record(rec, &frame, scene, &s.ray_counters, k, None)?;
                 accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
             }
             mean
@@ -681,29 +679,13 @@ fn record_view(
         None => &view.gbuffer.color,
     };
     let denoised = match &mut view.denoiser {
-        Some(d) => {
-            let scene = DenoiseScene {
-                camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
-                materials: &scene.materials,
-            };
-            d.record(rec, &view.gbuffer, &denoise_frame, &scene)?
-        }
+        Some(d) => d.record(rec, &frame)?,
         None => traced,
     };
     let grid_hdr = match (&mut view.taa, jitter) {
-        (Some(taa), Some(jitter)) => {
-            taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?
-        }
+        (Some(taa), Some(jitter)) => taa.record(rec, denoised, &frame, jitter)?,
         _ => denoised,
     };
-    let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
-        frame_data: &s.frame_data,
-        gbuffer: &view.gbuffer,
-        space: &denoise_frame.current,
-        columns: &s.sampling_table,
-        has_previous: denoise_frame.previous.is_some(),
-        jitter,
-    });
     let display = ToneTarget {
         ldr: match external {
             Some((image, offset)) => LdrTarget::External { image, offset },
@@ -719,13 +701,10 @@ fn record_view(
         rec,
         &WayBackFrame {
             space: view.space.as_ref(),
-            params: space,
-            grid: grid_hdr,
-            frame_data: &s.frame_data,
-            sampling: &s.sampling,
-            sampling_table: &s.sampling_table,
+            grid: frame,
+            radiance: grid_hdr,
             blur: &settings.blur,
-            taa: screen_taa,
+            jitter,
             display: fused,
         },
     )?;

@@ -254,6 +254,33 @@ impl SpaceBuffers {
     }
 }
 
+impl SpaceBuffers {
+    /// These buffers' grid frame over `gbuffer`: `current` this frame's space (as `sampling`
+    /// holds it), `previous` the previous frame's (`None`: no history), the camera at the
+    /// origin, the scene's `materials`.
+    pub fn grid_frame<'a>(
+        &'a self,
+        gbuffer: &'a fovea_renderer::passes::grid::GBuffer,
+        (current, previous): (
+            fovea_renderer::layouts::SamplingParams,
+            Option<fovea_renderer::layouts::SamplingParams>,
+        ),
+        materials: &'a Buffer,
+    ) -> fovea_renderer::passes::grid::GridFrame<'a> {
+        fovea_renderer::passes::grid::GridFrame {
+            gbuffer,
+            frame_data: &self.frame,
+            sampling: &self.sampling,
+            current,
+            previous,
+            sampling_table: &self.table,
+            tiles: self.tiles.list(),
+            camera_origin: glam::Vec3::ZERO,
+            materials,
+        }
+    }
+}
+
 /// A view's sampling table as the renderer keeps it: `current`'s, then `previous`'s (`current`'s
 /// again without one) — what the trace and `DenoiseFrame::sampling_table` read.
 pub fn grid_table(

@@ -1,5 +1,5 @@
 //! The sampling grid's per-frame state that the tracer writes and the passes after it read: the
-//! G-buffer, the trace's tile list, and what the denoisers are given of the frame.
+//! G-buffer, the trace's tile list, and the frame context every grid pass takes (`GridFrame`).
 
 use crate::error::Result;
 use crate::graph::{write_image, Bind};
@@ -146,26 +146,31 @@ impl OwnedTileList {
     }
 }
 
-/// The sampling space of this frame and of the previous one (its gaze differs; `None` when there
-/// is no usable previous frame, which drops all history).
+/// One frame of the sampling grid as the passes from the tracer on read it: the G-buffer, the
+/// frame's buffers, this frame's space and the previous one's, the space's table and the trace's
+/// tiles. A view makes one per frame; every grid pass (trace, denoisers, TAA) takes it.
 #[derive(Clone, Copy)]
-pub struct DenoiseFrame<'a> {
+pub struct GridFrame<'a> {
+    /// What the tracer writes this frame (before the trace: last frame's, which A-SVGF
+    /// projects).
+    pub gbuffer: &'a GBuffer,
+    /// The frame's uniform buffer (`FrameData`: this camera and the previous one).
+    pub frame_data: &'a Buffer,
+    /// The space's uniform buffer (`current`, binding `sampling`).
+    pub sampling: &'a Buffer,
+    /// This frame's space (its gaze) and the previous frame's; `None` when there is no usable
+    /// previous frame, which drops all history.
     pub current: SamplingParams,
     pub previous: Option<SamplingParams>,
     /// The view's sampling table: this frame's (`SamplingSpace::sampling_table`) followed by the
     /// previous frame's of the same length (the screen-clipped layout's kernels read both
     /// frames' arcs from it).
     pub sampling_table: &'a Buffer,
-    /// The trace's tiles this frame: filters that work per texel run over the live ones (the
+    /// The trace's tiles this frame: passes that work per texel run over the live ones (the
     /// idle ones hold no traced sample) and write what later frames read of the idle ones.
     pub tiles: TileList<'a>,
-}
-
-/// What a denoiser may need from the scene besides the G-buffer.
-#[derive(Clone, Copy)]
-pub struct DenoiseScene<'a> {
-    /// This frame's camera position in world space (the G-buffer's positions are relative to it;
-    /// BMFR accumulates positions across frames).
+    /// This frame's camera position in world space (the G-buffer's positions are relative to
+    /// it; BMFR accumulates positions across frames).
     pub camera_origin: Vec3,
     /// The scene's materials (`MaterialGpu`; BMFR keeps emitters out of its fits).
     pub materials: &'a Buffer,

@@ -1,19 +1,27 @@
 //! The path-tracing pass: one sample per sampling-grid texel, writing the per-sample G-buffer.
 //! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf).
 
-use super::grid::{GBuffer, GradientTargets, TileList};
-use super::push_bytes;
+use super::grid::{GradientTargets, GridFrame};
 use super::trace_clear::TraceClearPass;
+use super::{Kernel, Pass};
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, write_image, FrameRecorder};
 use crate::layouts::TracePush;
-use crate::vk::{Buffer, ComputePipeline, Context};
+use crate::vk::{Buffer, Context};
 use glam::UVec4;
 use std::sync::Arc;
 
+/// The trace kernel (`shaders/passes/trace.comp`, a variant per trace space).
+pub struct Trace;
+
+impl Kernel for Trace {
+    const SHADER: &'static str = "passes/trace";
+    type Push = TracePush;
+}
+
 pub struct TracePass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+    trace: Pass<Trace>,
     clear: TraceClearPass,
 }
 
@@ -22,37 +30,29 @@ pub struct TracePass {
 pub const RAY_COUNTERS: usize = 5;
 
 impl TracePass {
-    pub fn new(ctx: &Arc<Context>, sampling_variant: &str) -> Result<TracePass> {
-        let shader = format!("passes/trace.{sampling_variant}");
+    /// `trace_variant`: the space's (`SamplingSpace::trace_variant`).
+    pub fn new(ctx: &Arc<Context>, trace_variant: &str) -> Result<TracePass> {
         Ok(TracePass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                &shader,
-                std::mem::size_of::<TracePush>() as u32,
-            )?,
+            trace: Pass::new(ctx, trace_variant)?,
             clear: TraceClearPass::new(ctx)?,
         })
     }
 
-    /// Records one sample per grid texel. `sample_index` decorrelates several samples of one
-    /// frame (reference accumulation); real-time frames use 0. `sampling_table` holds the space's
-    /// `SamplingSpace::sampling_table` (Visual-Polar: its per-column arcs). `gradients`: A-SVGF's,
-    /// for the `*_gradients` variants (which also write `out.visibility`). Only `tiles`' live tiles
-    /// are traced; its idle ones are cleared to "not traced".
-    #[allow(clippy::too_many_arguments)]
+    /// Records one sample per grid texel into `frame.gbuffer`, counting rays in `ray_counters`.
+    /// `sample_index` decorrelates several samples of one frame (reference accumulation);
+    /// real-time frames use 0. `gradients`: A-SVGF's, for the `*_gradients` variants (which also
+    /// write the G-buffer's visibility). Only the frame's live tiles are traced; its idle ones
+    /// are cleared to "not traced".
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
+        frame: &GridFrame,
         scene: &GpuScene,
-        frame: &Buffer,
-        sampling: &Buffer,
-        sampling_table: &Buffer,
         ray_counters: &Buffer,
-        out: &GBuffer,
-        tiles: &TileList,
         sample_index: u32,
         gradients: Option<GradientTargets>,
     ) -> Result<()> {
+        let (out, tiles) = (frame.gbuffer, &frame.tiles);
         // The idle tiles hold the same not-traced values for every sample of a frame (or of a
         // reference): cleared, and their culled samples counted, with the first.
         if sample_index == 0 {
@@ -71,22 +71,22 @@ impl TracePass {
             ]),
             _ => None,
         };
-        let extra = gradient_binds.unwrap_or([s[0]; 3]);
+        let extra = gradient_binds.unwrap_or([s.bvh_nodes; 3]);
         let g = out.write_binds();
         let binds = [
-            s[0],
-            s[1],
-            s[2],
-            s[3],
-            s[4],
-            s[5],
-            s[6],
-            s[7],
-            s[8],
-            s[9],
-            read_buffer("frame", frame),
-            read_buffer("sampling", sampling),
-            read_texels("sampling_table", sampling_table),
+            s.bvh_nodes,
+            s.bvh_triangles,
+            s.vertices,
+            s.triangles,
+            s.materials,
+            s.textures,
+            s.texels,
+            s.lights,
+            s.environment,
+            s.instances,
+            read_buffer("frame", frame.frame_data),
+            read_buffer("sampling", frame.sampling),
+            read_texels("sampling_table", frame.sampling_table),
             write_buffer("ray_counters", ray_counters),
             g[0],
             g[1],
@@ -109,12 +109,7 @@ impl TracePass {
         let push = TracePush {
             config: UVec4::new(sample_index, 0, 0, 0),
         };
-        rec.dispatch(
-            "trace",
-            &self.pipeline,
-            binds,
-            push_bytes(&push),
-            tiles.live_threads(),
-        )
+        self.trace
+            .dispatch(rec, "trace", binds, &push, tiles.live_threads())
     }
 }

@@ -5,23 +5,23 @@
 use super::frame::{ScreenOut, WayBackFrame, WayBackPasses};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, write_image, FrameRecorder};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::passes::{Kernel, Pass};
+use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::UVec2;
 use std::sync::Arc;
 
-pub struct BlockFillPass {
-    pipeline: Arc<ComputePipeline>,
+pub struct BlockFill;
+
+impl Kernel for BlockFill {
+    const SHADER: &'static str = "passes/block_fill";
+    type Push = ();
 }
 
-impl BlockFillPass {
-    /// `variant`: the space's kernel (`passes/block_fill.<variant>`).
-    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<BlockFillPass> {
-        Ok(BlockFillPass {
-            pipeline: ComputePipeline::shared(ctx, &format!("passes/block_fill.{variant}"), 0)?,
-        })
-    }
+/// The block fill, made for a space's kernel variant (`BlockFillPass::new(ctx, variant)`).
+pub type BlockFillPass = Pass<BlockFill>;
 
+impl Pass<BlockFill> {
     /// `grid`: the atlas (each unit's mean colour, alpha 1 where traced); `sampling`: the
     /// space's parameters.
     pub fn record(
@@ -36,13 +36,8 @@ impl BlockFillPass {
             read_image("grid", grid),
             write_image("screen", screen),
         ];
-        rec.dispatch(
-            "block_fill",
-            &self.pipeline,
-            &binds,
-            &[],
-            [screen.width, screen.height, 1],
-        )
+        let size = [screen.width, screen.height, 1];
+        self.dispatch(rec, "block_fill", &binds, &(), size)
     }
 }
 
@@ -57,7 +52,7 @@ impl BlockFillWayBack {
     /// `variant`: the space's kernel variant.
     pub fn new(ctx: &Arc<Context>, variant: &str, screen: UVec2) -> Result<BlockFillWayBack> {
         Ok(BlockFillWayBack {
-            pass: BlockFillPass::new(ctx, variant)?,
+            pass: Pass::new(ctx, variant)?,
             screen: Image::new(
                 ctx,
                 "block_filled",
@@ -76,7 +71,7 @@ impl WayBackPasses for BlockFillWayBack {
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
         self.pass
-            .record(rec, frame.sampling, frame.grid, &self.screen)?;
+            .record(rec, frame.grid.sampling, frame.radiance, &self.screen)?;
         Ok(ScreenOut::Radiance(&self.screen))
     }
 }

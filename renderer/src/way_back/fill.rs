@@ -152,7 +152,8 @@ impl WayBackPasses for FillWayBack {
         rec: &mut FrameRecorder,
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
-        let screen = self.fill_and_blur(rec, frame.grid, frame.space.blur_axis(), frame.blur)?;
+        let screen =
+            self.fill_and_blur(rec, frame.radiance, frame.space.blur_axis(), frame.blur)?;
         Ok(ScreenOut::Radiance(screen))
     }
 

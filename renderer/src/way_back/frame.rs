@@ -3,27 +3,25 @@
 use super::blur::BlurSettings;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
-use crate::layouts::SamplingParams;
-use crate::passes::taa::ScreenTaaFrame;
+use crate::passes::grid::GridFrame;
 use crate::passes::tonemap::ToneTarget;
 use crate::sampling::SamplingSpace;
-use crate::vk::{Buffer, Image};
+use crate::vk::Image;
+use glam::Vec2;
 
 /// One frame of one view, as its way back reads it.
 pub struct WayBackFrame<'a> {
     /// The view's space this frame (its gaze, its blur axis).
     pub space: &'a dyn SamplingSpace,
-    /// `space.params()`, as the `sampling` buffer holds them.
-    pub params: SamplingParams,
+    /// The sampling grid's frame: its buffers, its G-buffer and this frame's space parameters
+    /// (`current`, as the `sampling` buffer holds them).
+    pub grid: GridFrame<'a>,
     /// The grid's radiance: the trace's, denoised and resolved where those ran.
-    pub grid: &'a Image,
-    /// The frame's uniform buffers and the space's table (the space's kernels read them).
-    pub frame_data: &'a Buffer,
-    pub sampling: &'a Buffer,
-    pub sampling_table: &'a Buffer,
+    pub radiance: &'a Image,
     pub blur: &'a BlurSettings,
-    /// The screen-space TAA's inputs, on frames jittered for TAA.
-    pub taa: Option<ScreenTaaFrame<'a>>,
+    /// Where the tracer put this frame's samples inside their texel (`TaaSettings::jitter`), on
+    /// frames jittered for TAA.
+    pub jitter: Option<Vec2>,
     /// The display image, when nothing reads the screen's radiance: a way back whose last pass
     /// can tone-map (the foveated blur) writes it there itself.
     pub display: Option<ToneTarget<'a>>,

@@ -61,6 +61,6 @@ impl WayBackPasses for Direct {
         _: &mut FrameRecorder,
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
-        Ok(ScreenOut::Radiance(frame.grid))
+        Ok(ScreenOut::Radiance(frame.radiance))
     }
 }

@@ -120,17 +120,17 @@ impl WayBackPasses for RemapWayBack {
         rec: &mut FrameRecorder,
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
-        let (params, columns, blur) = (&frame.params, frame.sampling_table, frame.blur);
+        let (params, columns, blur) = (&frame.grid.current, frame.grid.sampling_table, frame.blur);
         let axis = frame.space.blur_axis().filter(|_| blur.sigma_at_30 > 0.0);
         let vp_color = match (&self.grid_blur, axis) {
-            (Some(g), Some(axis)) => g.record(rec, params, &blur.shape(axis), frame.grid)?,
-            _ => frame.grid,
+            (Some(g), Some(axis)) => g.record(rec, params, &blur.shape(axis), frame.radiance)?,
+            _ => frame.radiance,
         };
         self.mip_phi
             .record(rec, params, columns, vp_color, &self.mips)?;
         // Samples jittered for the screen-space TAA are read where they were traced.
-        let sample_offset = match (&self.taa, &frame.taa) {
-            (Some(_), Some(taa)) => taa.jitter - Vec2::splat(0.5),
+        let sample_offset = match (&self.taa, frame.jitter) {
+            (Some(_), Some(jitter)) => jitter - Vec2::splat(0.5),
             _ => Vec2::ZERO,
         };
         self.remap.record(
@@ -141,8 +141,8 @@ impl WayBackPasses for RemapWayBack {
             &self.remapped,
             sample_offset,
         )?;
-        let resolved = match (&mut self.taa, &frame.taa) {
-            (Some(resolver), Some(taa)) => resolver.record(rec, &self.remapped, taa)?,
+        let resolved = match (&mut self.taa, frame.jitter) {
+            (Some(resolver), Some(_)) => resolver.record(rec, &self.remapped, &frame.grid)?,
             _ => &self.remapped,
         };
         match (axis, frame.display) {

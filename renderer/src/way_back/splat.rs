@@ -121,11 +121,11 @@ impl WayBackPasses for SplatWayBack {
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
         let inputs = SplatInputs {
-            frame_data: frame.frame_data,
-            sampling: frame.sampling,
-            sampling_table: frame.sampling_table,
+            frame_data: frame.grid.frame_data,
+            sampling: frame.grid.sampling,
+            sampling_table: frame.grid.sampling_table,
         };
-        let sparse = self.splat.record(rec, &inputs, frame.grid)?;
+        let sparse = self.splat.record(rec, &inputs, frame.radiance)?;
         let screen = self
             .fill
             .fill_and_blur(rec, sparse, frame.space.blur_axis(), frame.blur)?;

@@ -4,31 +4,26 @@
 use super::frame::{ScreenOut, WayBackFrame, WayBackPasses};
 use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::passes::{Kernel, Pass};
+use crate::vk::{Context, Image};
 use ash::vk;
 use glam::UVec2;
 use std::sync::Arc;
 
-pub struct UpscalePass {
-    pipeline: Arc<ComputePipeline>,
+pub struct Upscale;
+
+impl Kernel for Upscale {
+    const SHADER: &'static str = "passes/upscale";
+    type Push = ();
 }
 
-impl UpscalePass {
-    pub fn new(ctx: &Arc<Context>) -> Result<UpscalePass> {
-        Ok(UpscalePass {
-            pipeline: ComputePipeline::shared(ctx, "passes/upscale", 0)?,
-        })
-    }
+pub type UpscalePass = Pass<Upscale>;
 
+impl Pass<Upscale> {
     pub fn record(&self, rec: &mut FrameRecorder, grid: &Image, screen: &Image) -> Result<()> {
         let binds = [read_image("grid", grid), write_image("screen", screen)];
-        rec.dispatch(
-            "upscale",
-            &self.pipeline,
-            &binds,
-            &[],
-            [screen.width, screen.height, 1],
-        )
+        let size = [screen.width, screen.height, 1];
+        self.dispatch(rec, "upscale", &binds, &(), size)
     }
 }
 
@@ -42,7 +37,7 @@ pub struct UpscaleWayBack {
 impl UpscaleWayBack {
     pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<UpscaleWayBack> {
         Ok(UpscaleWayBack {
-            pass: UpscalePass::new(ctx)?,
+            pass: Pass::single(ctx)?,
             screen: Image::new(
                 ctx,
                 "upscaled",
@@ -60,7 +55,7 @@ impl WayBackPasses for UpscaleWayBack {
         rec: &mut FrameRecorder,
         frame: &WayBackFrame<'a>,
     ) -> Result<ScreenOut<'a>> {
-        self.pass.record(rec, frame.grid, &self.screen)?;
+        self.pass.record(rec, frame.radiance, &self.screen)?;
         Ok(ScreenOut::Radiance(&self.screen))
     }
 }

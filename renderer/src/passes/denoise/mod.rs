@@ -12,8 +12,8 @@ pub mod svgf;
 
 use crate::error::{Error, Result};
 use crate::graph::FrameRecorder;
-use crate::passes::grid::{DenoiseFrame, DenoiseScene, GBuffer, GradientTargets};
-use crate::vk::{Buffer, Context, Image};
+use crate::passes::grid::{GradientTargets, GridFrame};
+use crate::vk::{Context, Image};
 use asvgf::{Asvgf, AsvgfSettings};
 use bmfr::{Bmfr, BmfrSettings};
 use glam::UVec2;
@@ -112,18 +112,16 @@ impl Denoiser {
         }
     }
 
-    /// Records what must run before the tracer, while `gbuffer` still holds last frame (A-SVGF's
-    /// forward projection). `frame_data`: the frame's uniform buffer (both cameras).
+    /// Records what must run before the tracer, while the G-buffer still holds last frame (A-SVGF's
+    /// forward projection).
     pub fn record_before_trace(
         &mut self,
         rec: &mut FrameRecorder,
-        gbuffer: &GBuffer,
-        frame: &DenoiseFrame,
-        frame_data: &Buffer,
+        frame: &GridFrame,
     ) -> Result<()> {
         match self {
             Denoiser::Svgf(_) | Denoiser::Bmfr(_) => Ok(()),
-            Denoiser::Asvgf(a) => a.record_before_trace(rec, gbuffer, frame, frame_data),
+            Denoiser::Asvgf(a) => a.record_before_trace(rec, frame),
         }
     }
 
@@ -136,17 +134,11 @@ impl Denoiser {
     }
 
     /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        gbuffer: &GBuffer,
-        frame: &DenoiseFrame,
-        scene: &DenoiseScene,
-    ) -> Result<&Image> {
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
         match self {
-            Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
-            Denoiser::Asvgf(a) => a.record(rec, gbuffer, frame),
-            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, scene),
+            Denoiser::Svgf(s) => s.record(rec, frame),
+            Denoiser::Asvgf(a) => a.record(rec, frame),
+            Denoiser::Bmfr(b) => b.record(rec, frame),
         }
     }
 }

@@ -8,17 +8,25 @@ use super::TaaSettings;
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::TaaPush;
-use crate::passes::grid::{DenoiseFrame, GBuffer};
-use crate::passes::push_bytes;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
+use crate::vk::{Context, Image};
 use ash::vk;
 use glam::{UVec2, Vec2, Vec4};
 use std::sync::Arc;
 
+/// The grid TAA's resolve (`shaders/passes/taa.comp`, a variant per sampling space).
+pub struct TaaKernel;
+
+impl Kernel for TaaKernel {
+    const SHADER: &'static str = "passes/taa";
+    type Push = TaaPush;
+}
+
 /// Per-eye TAA: the pass and its ping-pong history, allocated once.
 pub struct Taa {
     pub settings: TaaSettings,
-    pipeline: std::sync::Arc<ComputePipeline>,
+    pass: Pass<TaaKernel>,
     /// Resolved colour by frame parity; this frame's half is also the pass's output.
     history: [Image; 2],
     /// The packed surface each history texel belongs to (disocclusion test).
@@ -40,10 +48,9 @@ impl Taa {
             vk::Format::R32G32B32A32_SFLOAT,
             vk::Format::R32G32B32A32_UINT,
         );
-        let shader = format!("passes/taa.{variant}");
         Ok(Taa {
             settings,
-            pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
+            pass: Pass::new(ctx, variant)?,
             history: [image("taa.history0", rgba)?, image("taa.history1", rgba)?],
             surface: [
                 image("taa.surface0", surface)?,
@@ -68,11 +75,11 @@ impl Taa {
     pub fn record(
         &mut self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
         color: &Image,
-        frame: &DenoiseFrame,
+        frame: &GridFrame,
         jitter: Vec2,
     ) -> Result<&Image> {
+        let g = frame.gbuffer;
         let cur = (self.frames % 2) as usize;
         let previous = if self.frames == 0 {
             None
@@ -99,13 +106,8 @@ impl Taa {
             params: Vec4::new(self.settings.current_weight, reset, jitter.x, jitter.y),
         };
         let out = &self.history[cur];
-        rec.dispatch(
-            "taa",
-            &self.pipeline,
-            &binds,
-            push_bytes(&push),
-            [out.width, out.height, 1],
-        )?;
+        self.pass
+            .dispatch(rec, "taa", &binds, &push, [out.width, out.height, 1])?;
         self.frames += 1;
         Ok(&self.history[cur])
     }

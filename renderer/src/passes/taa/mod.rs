@@ -8,7 +8,7 @@ mod grid;
 mod screen;
 
 pub use grid::Taa;
-pub use screen::{ScreenTaa, ScreenTaaFrame};
+pub use screen::ScreenTaa;
 
 use crate::error::{Error, Result};
 use glam::Vec2;

@@ -20,20 +20,21 @@ use super::svgf::Svgf;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
-use crate::passes::grid::{DenoiseFrame, GBuffer, GradientTargets};
+use crate::passes::grid::{GradientTargets, GridFrame};
+use crate::passes::Pass;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
-use forward::ForwardPass;
+use forward::Forward;
 use glam::UVec2;
 use gpu_allocator::MemoryLocation;
-use gradient::GradientPass;
+use gradient::Gradient;
 use std::sync::Arc;
 
 pub struct Asvgf {
     pub settings: AsvgfSettings,
     pub svgf: Svgf,
-    forward: ForwardPass,
-    gradient: GradientPass,
+    forward: Pass<Forward>,
+    gradient: Pass<Gradient>,
     /// One `AsvgfGradientSample` per stratum, cleared every frame (host-visible for inspection).
     pub samples: Buffer,
     /// Per stratum: δ, max f, 1 where the tracer re-shaded a sample (zeros elsewhere).
@@ -70,8 +71,8 @@ impl Asvgf {
         Ok(Asvgf {
             settings,
             svgf: Svgf::adaptive(ctx, grid, variant, settings.svgf)?,
-            forward: ForwardPass::new(ctx, variant)?,
-            gradient: GradientPass::new(ctx, variant)?,
+            forward: Pass::new(ctx, variant)?,
+            gradient: Pass::new(ctx, variant)?,
             samples: Buffer::new(
                 ctx,
                 "asvgf.gradient_samples",
@@ -97,26 +98,16 @@ impl Asvgf {
     }
 
     /// Before the tracer: clears the gradient samples and projects last frame's into them (none on
-    /// the first frame or without a previous frame). `frame_data` holds both cameras.
+    /// the first frame or without a previous frame).
     pub fn record_before_trace(
         &mut self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        frame_data: &Buffer,
+        frame: &GridFrame,
     ) -> Result<()> {
         rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
         let project = self.frames > 0 && frame.previous.is_some();
-        self.forward.record(
-            rec,
-            g,
-            frame_data,
-            &self.samples,
-            &self.raw,
-            &frame.current,
-            frame.sampling_table,
-            project,
-        )
+        self.forward
+            .record(rec, frame, &self.gradient_targets(), project)
     }
 
     /// The tracer's gradient-variant inputs and outputs.
@@ -128,31 +119,17 @@ impl Asvgf {
     }
 
     /// After the tracer: reconstructs the gradients, then SVGF with the adaptive α.
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-    ) -> Result<&Image> {
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
         let s = self.settings;
         let mut src = &self.raw;
         for i in 0..s.gradient_iterations {
             let dst = &self.ping[(i % 2) as usize];
-            self.gradient.record(
-                rec,
-                g,
-                src,
-                dst,
-                1 << i,
-                &frame.current,
-                frame.sampling_table,
-                &s,
-            )?;
+            self.gradient.record(rec, frame, (src, dst), 1 << i, &s)?;
             src = dst;
         }
         let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];
         self.frames += 1;
-        self.svgf.record_adaptive(rec, g, frame, gradient)
+        self.svgf.record_adaptive(rec, frame, gradient)
     }
 
     /// The gradient samples of the last recorded frame.

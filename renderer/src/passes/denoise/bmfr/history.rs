@@ -67,3 +67,11 @@ pub(super) struct Reprojection<'a> {
     /// Previous camera origin − this one (positions are camera-relative).
     pub camera_shift: Vec3,
 }
+
+/// The images BMFR writes per texel in a frame: this frame's history half, the evaluated fit and
+/// the output.
+pub(super) struct FrameTargets<'a> {
+    pub history: &'a BmfrHistory,
+    pub fitted: &'a Image,
+    pub output: &'a Image,
+}

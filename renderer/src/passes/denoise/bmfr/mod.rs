@@ -30,25 +30,26 @@ pub use settings::BmfrSettings;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::BMFR_WEIGHT_TEXELS;
-use crate::passes::grid::{DenoiseFrame, DenoiseScene, GBuffer};
+use crate::passes::grid::GridFrame;
+use crate::passes::Pass;
 use crate::vk::{Context, Image};
-use accumulate::AccumulatePass;
-use accumulate_filtered::AccumulateFilteredPass;
+use accumulate::Accumulate;
+use accumulate_filtered::AccumulateFiltered;
 use ash::vk;
-use fit::FitPass;
+use fit::{Blocks, Fit};
 use glam::{IVec2, UVec2};
-use history::Reprojection;
-use idle::{IdlePass, IdleTargets};
+use history::{FrameTargets, Reprojection};
+use idle::Idle;
 use std::sync::Arc;
-use weighted_sum::WeightedSumPass;
+use weighted_sum::WeightedSum;
 
 pub struct Bmfr {
     pub settings: BmfrSettings,
-    accumulate: AccumulatePass,
-    fit: FitPass,
-    weighted_sum: WeightedSumPass,
-    accumulate_filtered: AccumulateFilteredPass,
-    idle: IdlePass,
+    accumulate: Pass<Accumulate>,
+    fit: Pass<Fit>,
+    weighted_sum: Pass<WeightedSum>,
+    accumulate_filtered: Pass<AccumulateFiltered>,
+    idle: Pass<Idle>,
     pub history: BmfrHistory,
     /// Per block: BMFR_WEIGHT_TEXELS texels (10 × rgb weights, position offset, position scale).
     pub weights: Image,
@@ -71,11 +72,11 @@ impl Bmfr {
         let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Bmfr {
             settings,
-            accumulate: AccumulatePass::new(ctx, variant)?,
-            fit: FitPass::new(ctx, variant)?,
-            weighted_sum: WeightedSumPass::new(ctx, variant)?,
-            accumulate_filtered: AccumulateFilteredPass::new(ctx, variant)?,
-            idle: IdlePass::new(ctx, variant)?,
+            accumulate: Pass::new(ctx, variant)?,
+            fit: Pass::new(ctx, variant)?,
+            weighted_sum: Pass::new(ctx, variant)?,
+            accumulate_filtered: Pass::new(ctx, variant)?,
+            idle: Pass::new(ctx, variant)?,
             history: BmfrHistory::new(ctx, grid)?,
             weights: Image::new(
                 ctx,
@@ -107,85 +108,36 @@ impl Bmfr {
     /// returns `output`. The per-texel passes run over `frame.tiles`' live tiles; the idle pass
     /// writes the idle ones before the fit reads whole blocks. History is dropped on the first frame and whenever `frame.previous` is
     /// `None`.
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        scene: &DenoiseScene,
-    ) -> Result<&Image> {
-        let camera_origin = scene.camera_origin;
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        let camera_origin = frame.camera_origin;
         let s = self.settings;
-        let offset = self.next_block_offset();
-        let h = &self.history;
-        let (cur, prev) = (h.current(), 1 - h.current());
-        let previous = if h.frames == 0 {
-            None
-        } else {
-            frame.previous.as_ref()
+        let blocks = Blocks {
+            offset: self.next_block_offset(),
+            seed: self.history.frames as u32,
+            noise: s.noise,
         };
+        let h = &self.history;
         let reprojection = Reprojection {
-            previous,
+            previous: if h.frames == 0 {
+                None
+            } else {
+                frame.previous.as_ref()
+            },
             camera_shift: h.origin - camera_origin,
         };
-        let (table, tiles) = (frame.sampling_table, &frame.tiles);
-        self.accumulate.record(
-            rec,
-            g,
-            scene.materials,
-            h,
-            prev,
-            cur,
-            &frame.current,
-            table,
-            tiles,
-            &reprojection,
-            s.alpha_noisy,
-        )?;
-        let idle = IdleTargets {
+        let targets = FrameTargets {
             history: h,
-            cur,
             fitted: &self.fitted,
             output: &self.output,
         };
-        self.idle.record(rec, &idle, &frame.current, table, tiles)?;
-        let seed = h.frames as u32;
-        self.fit.record(
-            rec,
-            h,
-            cur,
-            &self.weights,
-            &frame.current,
-            table,
-            offset,
-            seed,
-            s.noise,
-        )?;
-        self.weighted_sum.record(
-            rec,
-            h,
-            cur,
-            &self.weights,
-            &self.fitted,
-            &frame.current,
-            table,
-            tiles,
-            offset,
-        )?;
-        self.accumulate_filtered.record(
-            rec,
-            g,
-            h,
-            prev,
-            cur,
-            &self.fitted,
-            &self.output,
-            &frame.current,
-            table,
-            tiles,
-            &reprojection,
-            s.alpha_filtered,
-        )?;
+        self.accumulate
+            .record(rec, frame, h, &reprojection, s.alpha_noisy)?;
+        self.idle.record(rec, frame, &targets)?;
+        self.fit.record(rec, frame, h, &self.weights, &blocks)?;
+        self.weighted_sum
+            .record(rec, frame, h, (&self.weights, &self.fitted), &blocks)?;
+        self.accumulate_filtered
+            .record(rec, frame, &targets, &reprojection, s.alpha_filtered)?;
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)

@@ -17,26 +17,27 @@ mod variance;
 pub use history::SvgfHistory;
 pub use settings::{SvgfSettings, MAX_ATROUS_ITERATIONS};
 
-use super::modulate::ModulatePass;
+use super::modulate::Modulate;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
-use crate::passes::grid::{DenoiseFrame, GBuffer};
+use crate::passes::grid::GridFrame;
+use crate::passes::Pass;
 use crate::vk::{Context, Image};
 use ash::vk;
-use atrous::AtrousPass;
+use atrous::Atrous;
 use glam::UVec2;
-use idle::IdlePass;
+use idle::Idle;
 use std::sync::Arc;
-use temporal::TemporalPass;
-use variance::VariancePass;
+use temporal::Temporal;
+use variance::Variance;
 
 pub struct Svgf {
     pub settings: SvgfSettings,
-    temporal: TemporalPass,
-    variance: VariancePass,
-    atrous: AtrousPass,
-    idle: IdlePass,
-    modulate: ModulatePass,
+    temporal: Pass<Temporal>,
+    variance: Pass<Variance>,
+    atrous: Pass<Atrous>,
+    idle: Pass<Idle>,
+    modulate: Pass<Modulate>,
     pub history: SvgfHistory,
     /// Temporal output: accumulated colour, variance.
     accum: Image,
@@ -79,11 +80,11 @@ impl Svgf {
             |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(Svgf {
             settings,
-            temporal: TemporalPass::new(ctx, temporal_variant)?,
-            variance: VariancePass::new(ctx, variant)?,
-            atrous: AtrousPass::new(ctx, variant)?,
-            idle: IdlePass::new(ctx, variant)?,
-            modulate: ModulatePass::new(ctx)?,
+            temporal: Pass::new(ctx, temporal_variant)?,
+            variance: Pass::new(ctx, variant)?,
+            atrous: Pass::new(ctx, variant)?,
+            idle: Pass::new(ctx, variant)?,
+            modulate: Pass::single(ctx)?,
             history: SvgfHistory::new(ctx, grid)?,
             accum: image("svgf.accum")?,
             ping: [image("svgf.ping0")?, image("svgf.ping1")?],
@@ -104,13 +105,8 @@ impl Svgf {
     /// All but the modulation run over `frame.tiles`' live tiles; the idle pass fills in the
     /// history a later frame reads of the idle ones.
     /// History is dropped on the first frame and whenever `frame.previous` is `None`.
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-    ) -> Result<&Image> {
-        self.record_with(rec, g, frame, None)
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        self.record_with(rec, frame, None)
     }
 
     /// `record` for SVGF built by `adaptive`: `gradient` (per 3×3 stratum: δ̂, max f, confidence)
@@ -118,52 +114,29 @@ impl Svgf {
     pub(crate) fn record_adaptive(
         &mut self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
+        frame: &GridFrame,
         gradient: &Image,
     ) -> Result<&Image> {
-        self.record_with(rec, g, frame, Some(gradient))
+        self.record_with(rec, frame, Some(gradient))
     }
 
     fn record_with(
         &mut self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
+        frame: &GridFrame,
         gradient: Option<&Image>,
     ) -> Result<&Image> {
         let s = self.settings;
         let h = &self.history;
-        let (cur, prev) = (h.current(), 1 - h.current());
-        let previous = if h.frames == 0 { None } else { frame.previous };
-        let (table, tiles) = (frame.sampling_table, &frame.tiles);
-        self.temporal.record(
-            rec,
-            g,
-            h,
-            prev,
-            cur,
-            &self.accum,
-            &frame.current,
-            table,
-            tiles,
-            previous.as_ref(),
-            &s,
-            gradient,
-        )?;
-        self.idle
-            .record(rec, h, cur, &frame.current, table, tiles)?;
-        self.variance.record(
-            rec,
-            g,
-            &self.accum,
-            &h.moments[cur],
-            &self.ping[0],
-            &frame.current,
-            table,
-            tiles,
-            &s,
-        )?;
+        let frame = &GridFrame {
+            previous: if h.frames == 0 { None } else { frame.previous },
+            ..*frame
+        };
+        self.temporal
+            .record(rec, frame, (h, &self.accum), &s, gradient)?;
+        self.idle.record(rec, frame, h)?;
+        self.variance
+            .record(rec, frame, h, (&self.accum, &self.ping[0]), &s)?;
         // Iteration 0 writes the colour history; then the two ping images alternate.
         let mut src = &self.ping[0];
         for i in 0..s.atrous_iterations {
@@ -172,12 +145,12 @@ impl Svgf {
             } else {
                 &self.ping[(i % 2) as usize]
             };
-            self.atrous
-                .record(rec, g, src, dst, 1 << i, &frame.current, table, tiles, &s)?;
+            self.atrous.record(rec, frame, (src, dst), 1 << i, &s)?;
             src = dst;
         }
+        let albedo = &frame.gbuffer.albedo;
         self.modulate
-            .record(rec, "svgf_modulate", src, &g.albedo, &self.output)?;
+            .record(rec, "svgf_modulate", src, albedo, &self.output)?;
         self.history.frames += 1;
         Ok(&self.output)
     }
