@@ -7,9 +7,9 @@
 
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::layouts::{AsvgfGradientSample, ASVGF_NO_LUMINANCE};
-use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
+use fovea_renderer::passes::denoise::asvgf::{Asvgf, AsvgfSettings};
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
+use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
@@ -67,7 +67,7 @@ fn mean_luminance(pixels: &[[f32; 4]]) -> f64 {
 
 /// Gradient samples the tracer re-shaded last frame: (last luminance, this frame's).
 fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
-    let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+    let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
         panic!("A-SVGF expected")
     };
     let samples: Vec<AsvgfGradientSample> = a.read_samples().unwrap();
@@ -93,7 +93,7 @@ fn gradient_samples_reshade_last_frames_path() {
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     for name in SPACES {
         let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(asvgf())).unwrap();
-        let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+        let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
             panic!()
         };
         let strata = a.strata();
@@ -149,7 +149,7 @@ fn gradient_samples_reshade_last_frames_path() {
                 lit.len() - sign
             );
             // The reconstruction averages δ and max f alike: λ = |δ̂| / max f̂ is the ratio's.
-            let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+            let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
                 panic!()
             };
             let gradient: Vec<[f32; 4]> = read_image(&ctx, a.gradient());

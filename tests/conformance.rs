@@ -377,7 +377,7 @@ fn every_filter_on_every_space_that_supports_it() {
 /// One grid filter run on its own over a synthetic G-buffer (the seam test's), as the renderer
 /// records it: a denoiser (A-SVGF's forward projection first) or TAA in the grid.
 enum GridFilter {
-    Denoiser(Box<Denoiser>),
+    Denoiser(Box<dyn Denoiser>),
     Taa(Box<Taa>),
 }
 
@@ -389,8 +389,8 @@ impl GridFilter {
         space: &dyn SamplingSpace,
     ) -> GridFilter {
         let (grid, variant) = (space.grid_size(), space.shader_variant());
-        match (Denoiser::new(ctx, denoiser, grid, variant).unwrap(), taa) {
-            (Some(d), _) => GridFilter::Denoiser(Box::new(d)),
+        match (denoiser.build(ctx, grid, variant).unwrap(), taa) {
+            (Some(d), _) => GridFilter::Denoiser(d),
             (None, TaaMode::SamplingGrid(s)) => {
                 GridFilter::Taa(Box::new(Taa::new(ctx, grid, variant, s).unwrap()))
             }

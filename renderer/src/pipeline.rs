@@ -184,7 +184,7 @@ impl Renderer {
     }
 
     /// The first view's denoiser and its state, when `settings.denoiser` names one.
-    pub fn denoiser(&self) -> Option<&Denoiser> {
+    pub fn denoiser(&self) -> Option<&dyn Denoiser> {
         self.views[0].denoiser()
     }
 

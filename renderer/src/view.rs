@@ -115,7 +115,7 @@ pub struct View {
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
     pub(crate) accum: Option<Image>,
-    pub(crate) denoiser: Option<Denoiser>,
+    pub(crate) denoiser: Option<Box<dyn Denoiser>>,
     pub(crate) taa: Option<Taa>,
     pub(crate) prev_camera: Option<CameraPose>,
     /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
@@ -159,7 +159,7 @@ impl View {
             (mode, _) => (mode.settings().copied(), None),
         };
         let back = way_back::build(ctx, space.as_ref(), screen_taa, settings.blur.space)?;
-        let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
+        let denoiser = settings.denoiser.build(ctx, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
         let trace_gradients = match gradients {
             false => None,
@@ -231,8 +231,8 @@ impl View {
         grid + self.back.taa_history_bytes()
     }
 
-    pub fn denoiser(&self) -> Option<&Denoiser> {
-        self.denoiser.as_ref()
+    pub fn denoiser(&self) -> Option<&dyn Denoiser> {
+        self.denoiser.as_deref()
     }
 
     pub fn taa(&self) -> Option<&Taa> {

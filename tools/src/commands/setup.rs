@@ -319,12 +319,7 @@ pub fn filters(
     taa: &str,
     profile: &RenderProfile,
 ) -> Result<(DenoiserSettings, TaaMode)> {
-    let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
-        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
-        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
-        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
-        other => other,
-    };
+    let denoiser_settings = profile.denoisers.get(denoiser).context("--denoiser")?;
     let taa_mode = TaaMode::parse(taa)
         .context("--taa")?
         .with_settings(profile.taa);

@@ -13,6 +13,7 @@ use ash::vk;
 use fovea_renderer::frame::{FrameInput, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
+use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{UVec2, Vec2};
@@ -40,7 +41,8 @@ pub struct ViewArgs<'a> {
     pub debug_view: DebugView,
 }
 
-const DENOISERS: &[&str] = &["none", "svgf", "asvgf", "bmfr"];
+/// Key d cycles through every registered denoiser (and none).
+const DENOISERS: &[&str] = DenoiserSettings::NAMES;
 const TAAS: &[&str] = &["off", "vp", "screen"];
 
 pub fn run(args: &ViewArgs) -> Result<()> {

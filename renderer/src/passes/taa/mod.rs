@@ -13,8 +13,9 @@ pub use screen::ScreenTaa;
 use crate::error::{Error, Result};
 use glam::Vec2;
 
-/// Filter parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Filter parameters (`Default`, and a render profile's `[taa]` keys' defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TaaSettings {
     /// Blend weight of the current frame (the history keeps 1 − this), before luma weighting.
     pub current_weight: f32,

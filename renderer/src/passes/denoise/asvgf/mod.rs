@@ -20,6 +20,8 @@ use super::svgf::Svgf;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
+use crate::passes::denoise::svgf::SvgfSettings;
+use crate::passes::denoise::{Denoiser, DenoiserParams, OtherParams};
 use crate::passes::grid::{GradientTargets, GridFrame};
 use crate::passes::Pass;
 use crate::vk::{Buffer, Context, Image};
@@ -148,5 +150,52 @@ impl Asvgf {
     /// Size of the strata grid.
     pub fn strata(&self) -> UVec2 {
         UVec2::new(self.raw.width, self.raw.height)
+    }
+}
+
+impl DenoiserParams for AsvgfSettings {
+    const NAME: &'static str = "asvgf";
+    const NEEDS_GRADIENTS: bool = true;
+
+    fn validate(&self) -> Result<()> {
+        AsvgfSettings::validate(self)
+    }
+
+    fn build(&self, ctx: &Arc<Context>, grid: UVec2, variant: &str) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Asvgf::new(ctx, grid, variant, *self)?))
+    }
+
+    /// The SVGF stages take SVGF's parameters (a render profile's `[svgf]`).
+    fn complete(&mut self, others: &dyn OtherParams) {
+        let svgf = others.params(SvgfSettings::NAME);
+        if let Some(svgf) = svgf.and_then(|p| p.downcast_ref::<SvgfSettings>()) {
+            self.svgf = *svgf;
+        }
+    }
+}
+
+impl Denoiser for Asvgf {
+    fn history_bytes(&self) -> u64 {
+        Asvgf::history_bytes(self)
+    }
+
+    fn max_passes(&self) -> u32 {
+        Asvgf::max_passes(self)
+    }
+
+    fn record_before_trace(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<()> {
+        Asvgf::record_before_trace(self, rec, frame)
+    }
+
+    fn gradient_targets(&self) -> Option<GradientTargets<'_>> {
+        Some(Asvgf::gradient_targets(self))
+    }
+
+    fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        Asvgf::record(self, rec, frame)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

@@ -3,9 +3,12 @@
 use crate::error::{Error, Result};
 use crate::passes::denoise::svgf::SvgfSettings;
 
-/// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α. A render
+/// profile's `[asvgf]` gives the gradient keys; `svgf` comes from its `[svgf]`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct AsvgfSettings {
+    #[serde(skip)]
     pub svgf: SvgfSettings,
     /// À-trous iterations of the gradient reconstruction (5×5 taps, spacing 2^i strata).
     pub gradient_iterations: u32,

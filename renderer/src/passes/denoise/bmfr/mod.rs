@@ -30,6 +30,7 @@ pub use settings::BmfrSettings;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::BMFR_WEIGHT_TEXELS;
+use crate::passes::denoise::{Denoiser, DenoiserParams};
 use crate::passes::grid::GridFrame;
 use crate::passes::Pass;
 use crate::vk::{Context, Image};
@@ -141,5 +142,35 @@ impl Bmfr {
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)
+    }
+}
+
+impl DenoiserParams for BmfrSettings {
+    const NAME: &'static str = "bmfr";
+
+    fn validate(&self) -> Result<()> {
+        BmfrSettings::validate(self)
+    }
+
+    fn build(&self, ctx: &Arc<Context>, grid: UVec2, variant: &str) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Bmfr::new(ctx, grid, variant, *self)?))
+    }
+}
+
+impl Denoiser for Bmfr {
+    fn history_bytes(&self) -> u64 {
+        self.history.bytes()
+    }
+
+    fn max_passes(&self) -> u32 {
+        Bmfr::max_passes(self)
+    }
+
+    fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        Bmfr::record(self, rec, frame)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

@@ -2,8 +2,9 @@
 
 use crate::error::{Error, Result};
 
-/// Filter parameters; `Default` is the paper's.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Filter parameters; `Default` is the paper's (and a render profile's `[bmfr]` keys' defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct BmfrSettings {
     /// Smallest blend weight of the new noisy sample and features before the fit
     /// (α = max(this, 1/history)).

@@ -20,6 +20,7 @@ pub use settings::{SvgfSettings, MAX_ATROUS_ITERATIONS};
 use super::modulate::Modulate;
 use crate::error::Result;
 use crate::graph::FrameRecorder;
+use crate::passes::denoise::{Denoiser, DenoiserParams};
 use crate::passes::grid::GridFrame;
 use crate::passes::Pass;
 use crate::vk::{Context, Image};
@@ -153,5 +154,35 @@ impl Svgf {
             .record(rec, "svgf_modulate", src, albedo, &self.output)?;
         self.history.frames += 1;
         Ok(&self.output)
+    }
+}
+
+impl DenoiserParams for SvgfSettings {
+    const NAME: &'static str = "svgf";
+
+    fn validate(&self) -> Result<()> {
+        SvgfSettings::validate(self)
+    }
+
+    fn build(&self, ctx: &Arc<Context>, grid: UVec2, variant: &str) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Svgf::new(ctx, grid, variant, *self)?))
+    }
+}
+
+impl Denoiser for Svgf {
+    fn history_bytes(&self) -> u64 {
+        self.history.bytes()
+    }
+
+    fn max_passes(&self) -> u32 {
+        Svgf::max_passes(self)
+    }
+
+    fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        Svgf::record(self, rec, frame)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

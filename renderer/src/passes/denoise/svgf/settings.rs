@@ -2,8 +2,9 @@
 
 use crate::error::{Error, Result};
 
-/// Filter parameters; `Default` is the paper's.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Filter parameters; `Default` is the paper's (and a render profile's `[svgf]` keys' defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SvgfSettings {
     /// Smallest blend weight of the new colour sample (α = max(this, 1/history)).
     pub alpha_color: f32,
