@@ -1,4 +1,4 @@
-//! A-SVGF (Schied, Peters, Dachsbacher 2018; issue 5) in Cartesian and Visual-Polar space on the
+//! A-SVGF (Schied, Peters, Dachsbacher 2018) in Cartesian and Visual-Polar space on the
 //! Cornell box: gradient samples re-shade last frame's path exactly (δ = 0 on a still scene, the
 //! sign and ratio of a light change), a light switched off reaches the output within a few frames
 //! where SVGF lags, noise reduction on a still camera comparable to SVGF's, no NaN/Inf/negative
@@ -16,7 +16,8 @@ use fovea_renderer::sampling::{
 };
 use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::{
-    assert_clean, gpu, light_material, mean_rgb, owned_scene, read_image, rmse, save_preview,
+    assert_clean, assert_pictures, gpu, light_material, mean_rgb, owned_scene, read_image, rmse,
+    save_preview, Picture,
 };
 use glam::{Mat4, UVec2};
 
@@ -337,6 +338,7 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
     );
     for name in SPACES {
         let mut errors = Vec::new();
+        let mut last = Vec::new();
         for (label, denoiser, frames) in [
             ("raw", DenoiserSettings::None, 1),
             ("svgf", svgf(), 16),
@@ -353,7 +355,13 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
                 rmse_where(&hdr, &reference, &smooth),
                 rmse_where(&hdr, &reference, &centre),
             ]);
+            last = hdr;
         }
+        // A-SVGF's picture (the last rendered) against the reference.
+        let (actual, expected) = (
+            Picture::hdr(size.x, size.y, &last),
+            Picture::hdr(size.x, size.y, &reference),
+        );
         for (region, k) in [("whole frame", 0), ("centre", 1)] {
             let (svgf_factor, asvgf_factor) =
                 (errors[0][k] / errors[1][k], errors[0][k] / errors[2][k]);
@@ -361,14 +369,24 @@ fn asvgf_noise_reduction_is_comparable_to_svgf() {
                 "{name} {region}: RMSE raw {:.4}, SVGF {:.4} ({svgf_factor:.2}×), A-SVGF {:.4} ({asvgf_factor:.2}×) after 16 frames",
                 errors[0][k], errors[1][k], errors[2][k]
             );
-            assert!(
+            assert_pictures(
                 asvgf_factor >= 0.8 * svgf_factor,
-                "{name} {region}: A-SVGF {asvgf_factor:.2}× vs SVGF {svgf_factor:.2}×"
+                name,
+                &actual,
+                &expected,
+                format_args!(
+                    "{name} {region}: A-SVGF {asvgf_factor:.2}× vs SVGF {svgf_factor:.2}×"
+                ),
             );
             if name == "cartesian" || region == "centre" {
-                assert!(
+                assert_pictures(
                     asvgf_factor >= 3.0,
-                    "{name} {region}: A-SVGF reduces the RMSE only {asvgf_factor:.2}×"
+                    name,
+                    &actual,
+                    &expected,
+                    format_args!(
+                        "{name} {region}: A-SVGF reduces the RMSE only {asvgf_factor:.2}×"
+                    ),
                 );
             }
         }

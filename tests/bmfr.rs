@@ -19,8 +19,8 @@ use fovea_tests::denoise::{
     rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,
 };
 use fovea_tests::{
-    assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash,
-    SpaceBuffers,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, Picture, SpaceBuffers,
 };
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
@@ -499,11 +499,24 @@ fn bmfr_reduces_noise_in_both_spaces() {
              rings {}; with edges {ea:.4} → {eb:.4} ({with_edges:.2}×); bmfr passes {ms:.1} ms",
             rings.join(", ")
         );
-        assert!(
-            whole >= 4.0,
-            "{name}: whole-frame RMSE fell only {whole:.2}×"
+        let (actual, expected) = (
+            Picture::hdr(size.x, size.y, &denoised),
+            Picture::hdr(size.x, size.y, &reference),
         );
-        assert!(fovea >= 4.0, "{name}: fovea RMSE fell only {fovea:.2}×");
+        assert_pictures(
+            whole >= 4.0,
+            name,
+            &actual,
+            &expected,
+            format_args!("{name}: whole-frame RMSE fell only {whole:.2}×"),
+        );
+        assert_pictures(
+            fovea >= 4.0,
+            name,
+            &actual,
+            &expected,
+            format_args!("{name}: fovea RMSE fell only {fovea:.2}×"),
+        );
         let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
         for pass in [
             "bmfr_accumulate",

@@ -204,6 +204,8 @@ fn output_folders_with_user_files_are_refused() {
         device: None,
         validation: true,
         camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        headset: "fove0",
+        eye: fovea_hal::Eye::Left,
         environment: Default::default(),
         path_regularisation: 1.0,
     };
@@ -437,6 +439,8 @@ fn reference_force_refuses_non_regular_targets() {
                 device: None,
                 validation: true,
                 camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+                headset: "fove0",
+                eye: fovea_hal::Eye::Left,
                 environment: Default::default(),
                 path_regularisation: 1.0,
             };
@@ -591,7 +595,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
     ));
 }
 
-/// Values that used to render a black, flat or meaningless frame without a word are refused
+/// Values that would render a black, flat or meaningless frame without a word are refused
 /// before the device opens, each error naming its flag and the rule.
 #[test]
 fn meaningless_values_are_refused_with_the_flag_named() {
@@ -678,6 +682,8 @@ fn meaningless_values_are_refused_with_the_flag_named() {
             device: None,
             validation: true,
             camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+            headset: "fove0",
+            eye: fovea_hal::Eye::Left,
             environment: Default::default(),
             path_regularisation: 1.0,
         };
@@ -772,6 +778,8 @@ fn camera_path_files_drive_the_camera() {
         look: Some("0,1,0".into()),
         fov: Some(50.0),
         camera: None,
+        projection: fovea_tools::look::Projection::SceneCamera,
+        world_scale: 1.0,
     };
     let out_free = dir.join("free");
     let args = RenderArgs {
@@ -780,8 +788,14 @@ fn camera_path_files_drive_the_camera() {
         ..render_args("cornell-box", &out_free)
     };
     render(&args).unwrap();
+    // The keys' fov is the scene camera's: both runs render through it.
+    let scene_camera = fovea_tools::look::CameraOptions {
+        projection: fovea_tools::look::Projection::SceneCamera,
+        ..Default::default()
+    };
     let out_still = dir.join("still");
     let args = RenderArgs {
+        camera: &scene_camera,
         camera_path: CameraMotion::from_flag(Some(still.to_str().unwrap())).unwrap(),
         ..render_args("cornell-box", &out_still)
     };
@@ -804,6 +818,7 @@ fn camera_path_files_drive_the_camera() {
 
     let out_moving = dir.join("moving");
     let args = RenderArgs {
+        camera: &scene_camera,
         camera_path: CameraMotion::from_flag(Some(moving.to_str().unwrap())).unwrap(),
         ..render_args("cornell-box", &out_moving)
     };
@@ -956,7 +971,7 @@ fn bench_vp_frames_follow_a_camera_path() {
             && (f("vp_ray_cost_shuffled") / shuffled - 1.0).abs() < 1e-9,
         "{vp}"
     );
-    // Each denoiser's whole frames hold its own passes and the rest of the frame (issue 17's
+    // Each denoiser's whole frames hold its own passes and the rest of the frame (the frame-ratio
     // target with a denoiser).
     for d in vp["denoisers"].as_array().unwrap() {
         let g = |key: &str| d[key].as_f64().unwrap_or_else(|| panic!("{key} in {d}"));

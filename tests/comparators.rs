@@ -181,10 +181,10 @@ fn random_acuity_draws_agree_between_rust_and_glsl() {
     assert_clean(&ctx);
 }
 
-/// The draws follow Visual-Polar's sample density: per ring of eccentricity, the samples of eight
-/// frames against eight times VP's samples there (each texel as four quarter samples at the
-/// 2×2 stratified jitter), within 3 % in every ring that expects at least 2 000 (measured ≤ 1.4 %:
-/// the quarter samples are still a discretisation; the draws' own noise is ≈ 0.4 %).
+/// The draws follow Visual-Polar's sample density: per ring of distance from the gaze, the
+/// samples of eight frames against the probability that a position uniform over VP's kept texels
+/// (the density VP's grid stands for) lies in the ring — exact: a ring is a span of the ρ axis,
+/// so its probability is the kept texels' area over that span — held by Pearson's χ² at 1 %.
 #[test]
 fn random_acuity_samples_follow_visual_polars_density_per_ring() {
     let screen = UVec2::new(320, 360);
@@ -196,41 +196,47 @@ fn random_acuity_samples_follow_visual_polars_density_per_ring() {
     let ring = |p: Vec2| {
         (((p - gaze).length() / r_max).sqrt() * rings as f32).min(rings as f32 - 1.0) as usize
     };
-    let (mut drawn, mut expected) = (vec![0u64; rings], vec![0u64; rings]);
     let g = vp.grid_size();
+    // Ring k spans r ∈ [(k/8)², ((k+1)/8)²]·r_max, i.e. the grid's x from x(r_lo) to x(r_hi).
+    let x_of_r = |r: f32| {
+        if r <= 0.0 {
+            0.0
+        } else if r >= r_max {
+            g.x as f64
+        } else {
+            vp.screen_to_vp(gaze + Vec2::new(r, 0.0)).x as f64
+        }
+    };
+    let kept = vp.sample_count() as f64;
+    let probability: Vec<f64> = (0..rings)
+        .map(|k| {
+            let edge = |k: usize| (k as f32 / rings as f32).powi(2) * r_max;
+            let (a, b) = (x_of_r(edge(k)), x_of_r(edge(k + 1)));
+            (0..g.x)
+                .map(|c| {
+                    let overlap = (b.min(c as f64 + 1.0) - a.max(c as f64)).max(0.0);
+                    overlap * vp.rows_in_column(c) as f64
+                })
+                .sum::<f64>()
+                / kept
+        })
+        .collect();
+    let mut drawn = vec![0f64; rings];
     for y in 0..g.y {
         for x in 0..g.x {
-            let t = UVec2::new(x, y);
-            for sub in [
-                Vec2::new(0.25, 0.25),
-                Vec2::new(0.75, 0.25),
-                Vec2::new(0.25, 0.75),
-                Vec2::new(0.75, 0.75),
-            ] {
-                if let Some(p) = vp.grid_to_screen(t.as_vec2() + sub) {
-                    expected[ring(p)] += 2;
-                }
-            }
             for frame in 0..8 {
-                if let Some(p) = space.screen_position(t, frame, 1) {
-                    drawn[ring(p)] += 1;
+                if let Some(p) = space.screen_position(UVec2::new(x, y), frame, 1) {
+                    drawn[ring(p)] += 1.0;
                 }
             }
         }
     }
-    println!("per ring drawn {drawn:?} vs VP {expected:?}");
-    for i in 0..rings {
-        if expected[i] >= 2000 {
-            let ratio = drawn[i] as f64 / expected[i] as f64;
-            assert!(
-                (ratio - 1.0).abs() < 0.03,
-                "ring {i}: {} drawn vs {} VP samples",
-                drawn[i],
-                expected[i]
-            );
-        }
-    }
-    assert_eq!(drawn.iter().sum::<u64>(), 8 * vp.sample_count());
+    let total: f64 = drawn.iter().sum();
+    assert_eq!(total as u64, 8 * vp.sample_count());
+    let expected: Vec<f64> = probability.iter().map(|p| p * total).collect();
+    let fit = fovea_test_kit::chi2::chi2_test(&drawn, &expected, 0.01);
+    println!("per ring drawn {drawn:?} vs VP's density {expected:.0?}: {fit:?}");
+    assert!(fit.is_ok(), "{}", fit.unwrap_err());
 }
 
 /// A constant grid splats to exactly that constant wherever a sample landed (the pixels the host

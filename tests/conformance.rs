@@ -1,5 +1,5 @@
-//! One conformance suite for every filter × every sampling space (issue 14; it found the headset
-//! axis's A-SVGF trace kernel missing): each space that supports the temporal filters (its
+//! One conformance suite for every filter × every sampling space (it catches, for example, a trace
+//! kernel variant that was never built): each space that supports the temporal filters (its
 //! `SpaceCapabilities`) runs SVGF, A-SVGF, BMFR and both TAA
 //! modes without validation messages, with finite non-negative output, reducing the noise against
 //! the space's own converged image, and rejecting its history when the camera jumps
@@ -23,10 +23,13 @@ use fovea_renderer::sampling::{
 use fovea_renderer::vk::{Context, Image};
 use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
-    assert_finite_non_negative, plain_materials, rmse_where, seam_texels, upload, upload_gbuffer,
-    SeamErrors,
+    assert_finite_non_negative, plain_materials, rmse_where, seam_texels, seam_truth, upload,
+    upload_gbuffer, SeamErrors,
 };
-use fovea_tests::{assert_clean, gpu, light_material, owned_scene, read_image, SpaceBuffers};
+use fovea_tests::{
+    assert_clean, failure_message, gpu, light_material, owned_scene, read_image, Picture,
+    SpaceBuffers,
+};
 use glam::{Mat4, UVec2};
 use std::sync::Arc;
 
@@ -270,7 +273,7 @@ fn blow_up_the_light_and_look_away(
 }
 
 /// Noise: 12 filtered frames against the raw one-sample frame, both against the space's own
-/// converged image on its smooth interiors; bound 1.15× (measured, tenth session: Cartesian
+/// converged image on its smooth interiors; bound 1.15× (measured 2026-12-02: Cartesian
 /// 3.5–5.5×; the polar spaces' SVGF, A-SVGF and BMFR 1.19–1.9×, A-SVGF the least (its gradients
 /// reset the history where the 1-sample noise looks like change) — at 96×108 their grids are
 /// coarse and the spatial filters' smoothing of the periphery is a bias the mean of raw frames
@@ -340,6 +343,7 @@ fn every_filter_on_every_space_that_supports_it() {
                 rmse_where(&raw, &reference, |i| interior[i]),
                 rmse_where(&out, &reference, |i| interior[i]),
             );
+            let filtered = out.clone();
             r.render_frame(&FrameInput::mono(jumped, FILTERED_FRAMES, gaze).with_hdr(true))
                 .unwrap();
             r.read_hdr(&mut out).unwrap();
@@ -352,14 +356,25 @@ fn every_filter_on_every_space_that_supports_it() {
                 "{space_name} + {filter}: noise {before:.4} → {after:.4} ({:.2}×); after the jump {filtered_jump:.4} vs raw {raw_jump:.4}",
                 before / after
             );
+            let picture = |texels| Picture::hdr(SIZE.x, SIZE.y, texels);
             if before / after < 1.15 {
-                failures.push(format!(
-                    "{space_name} + {filter}: RMSE fell only {:.2}× ({before:.4} → {after:.4})",
-                    before / after
+                failures.push(failure_message(
+                    &format!("{space_name} + {filter}"),
+                    &picture(&filtered),
+                    &picture(&reference),
+                    format_args!(
+                        "{space_name} + {filter}: RMSE fell only {:.2}× ({before:.4} → {after:.4})",
+                        before / after
+                    ),
                 ));
             }
             if filtered_jump > 1.5 * raw_jump {
-                failures.push(format!("{space_name} + {filter}: the first frame after the jump {filtered_jump:.4} vs raw {raw_jump:.4}"));
+                failures.push(failure_message(
+                    &format!("{space_name} + {filter} after the jump"),
+                    &picture(&out),
+                    &picture(&jumped_reference),
+                    format_args!("{space_name} + {filter}: the first frame after the jump {filtered_jump:.4} vs raw {raw_jump:.4}"),
+                ));
             }
             blow_up_the_light_and_look_away(
                 &mut r,
@@ -467,9 +482,20 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
             let e = SeamErrors::of(&vp, &out);
             println!("{space_name} + {filter}: seam rows RMSE {:.4}, at φ ≈ π {:.4}, median row bin {:.4}; per bin {:.4?}", e.seam, e.opposite, e.median, e.bins);
             if !e.like_elsewhere() {
-                failures.push(format!(
-                    "{space_name} + {filter}: seam {:.4} vs {:.4} at φ ≈ π, median {:.4}",
-                    e.seam, e.opposite, e.median
+                let truth: Vec<[f32; 4]> = (0..grid.x * grid.y)
+                    .map(|i| {
+                        let t = seam_truth(&vp, i % grid.x, i / grid.x);
+                        [t, t, t, 1.0]
+                    })
+                    .collect();
+                failures.push(failure_message(
+                    &format!("{space_name} + {filter} at the seam"),
+                    &Picture::hdr(grid.x, grid.y, &out),
+                    &Picture::hdr(grid.x, grid.y, &truth),
+                    format_args!(
+                        "{space_name} + {filter}: seam {:.4} vs {:.4} at φ ≈ π, median {:.4}",
+                        e.seam, e.opposite, e.median
+                    ),
                 ));
             }
             assert_clean(&ctx);

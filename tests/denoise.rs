@@ -1,4 +1,4 @@
-//! Denoisers in the sampling grid (issue 5): SVGF in Cartesian and Visual-Polar space.
+//! Denoisers in the sampling grid: SVGF in Cartesian and Visual-Polar space.
 //! Noise reduction against a converged reference on the Cornell box (whole frame, fovea and
 //! eccentricity rings, after the remap for VP); no NaN/Inf/negative output with fireflies, NaNs
 //! and an empty view; no history across a disocclusion (synthetic G-buffers with a moving
@@ -22,8 +22,8 @@ use fovea_tests::denoise::{
     rmse_where, surface_interiors, texel_screens, upload,
 };
 use fovea_tests::{
-    assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash,
-    write_image, SpaceBuffers,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image, Picture, SpaceBuffers,
 };
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
@@ -69,7 +69,7 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
-    let camera = CameraPose::from_scene_camera(&scene.cameras[0], size.x, size.y);
+    let camera = fovea_tests::cornell_box_far_camera(size);
     let mut reference_renderer = Renderer::new(
         &ctx,
         &scene,
@@ -156,11 +156,24 @@ fn svgf_reduces_noise_fourfold_in_both_spaces() {
              rings {}; with edges {ea:.4} → {eb:.4} ({with_edges:.2}×)",
             rings.join(", ")
         );
-        assert!(
-            whole >= 4.0,
-            "{name}: whole-frame RMSE fell only {whole:.2}×"
+        let (actual, expected) = (
+            Picture::hdr(size.x, size.y, &denoised),
+            Picture::hdr(size.x, size.y, &reference),
         );
-        assert!(fovea >= 4.0, "{name}: fovea RMSE fell only {fovea:.2}×");
+        assert_pictures(
+            whole >= 4.0,
+            name,
+            &actual,
+            &expected,
+            format_args!("{name}: whole-frame RMSE fell only {whole:.2}×"),
+        );
+        assert_pictures(
+            fovea >= 4.0,
+            name,
+            &actual,
+            &expected,
+            format_args!("{name}: fovea RMSE fell only {fovea:.2}×"),
+        );
         let names: Vec<&str> = r.timings().iter().map(|t| t.name).collect();
         for pass in [
             "svgf_temporal",
@@ -617,15 +630,23 @@ fn taa_reduces_noise_and_edge_aliasing_in_both_spaces() {
              light pixels {la:.4} → {lb:.4} ({light:.2}×); everything {aa:.4} → {ab:.4} ({all:.2}×); taa pass {taa_ms:.3} ms",
             size.x, size.y
         );
-        assert!(whole >= 2.5, "{name}: RMSE fell only {whole:.2}×");
-        assert!(
-            inner >= 2.5,
-            "{name}: surface-interior RMSE fell only {inner:.2}×"
+        let (actual, expected) = (
+            Picture::hdr(size.x, size.y, &resolved),
+            Picture::hdr(size.x, size.y, &reference),
         );
-        assert!(
-            edges >= 2.0,
-            "{name}: geometric-edge RMSE fell only {edges:.2}×"
-        );
+        for (ok, what) in [
+            (whole >= 2.5, format!("RMSE fell only {whole:.2}×")),
+            (
+                inner >= 2.5,
+                format!("surface-interior RMSE fell only {inner:.2}×"),
+            ),
+            (
+                edges >= 2.0,
+                format!("geometric-edge RMSE fell only {edges:.2}×"),
+            ),
+        ] {
+            assert_pictures(ok, name, &actual, &expected, format_args!("{name}: {what}"));
+        }
         assert!(
             edge_count > 100,
             "{name}: too few edge pixels ({edge_count})"

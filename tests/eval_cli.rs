@@ -183,7 +183,8 @@ fn bad_inputs_are_named_in_the_error() {
         assert!(err.contains(gaze), "{gaze}: {err}");
     }
     // --rings: 1..=1000, and at most the half-diagonal (48.2 px for 64×72) so that no ring is
-    // narrower than a pixel. 10⁸ rings used to abort on allocation, 10⁶ wrote a 256 MB eval.json.
+    // narrower than a pixel. Unchecked, 10⁸ rings abort on allocation and 10⁶ write a 256 MB
+    // eval.json.
     for (rings, needle) in [
         (0, "1..=1000"),
         (1001, "1..=1000"),
@@ -400,7 +401,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         "{table}"
     );
 
-    // The method table from this run and a bench report, into a README between its markers.
+    // The method table from this run and a bench report, into docs/quality.md between its markers.
     let bench_out = out.join("bench");
     let scenes = strings(&["cornell-box"]);
     fovea_tools::commands::bench::run(&fovea_tools::commands::bench::BenchArgs {
@@ -420,23 +421,26 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         validation: true,
     })
     .unwrap();
-    let docs = temp_dir("method-table");
-    let readme = docs.join("README.md");
-    std::fs::write(&readme, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
-    let pictures = docs.join("docs").join("methods");
+    let root = temp_dir("method-table");
+    let docs = root.join("docs");
+    std::fs::create_dir_all(&docs).unwrap();
+    let quality_md = docs.join("quality.md");
+    std::fs::write(&quality_md, "# mine\n\n<!-- method-table:begin -->\nold\n<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n").unwrap();
+    // The pictures beside the document, so it links them as methods/NAME.png.
+    let pictures = docs.join("methods");
     let bench_report = [bench_out.join("report.json")];
-    // The committed equal-samples report of the README's claim (VP against composite at σ = 1.66).
+    // The committed equal-samples report of docs/quality.md's claim (VP against composite, σ 1.66).
     let equal = [std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../docs/methods/quality-equal-samples-composite.json")];
-    let table_args = |readme| fovea_tools::commands::method_table::MethodTableArgs {
+    let table_args = |doc| fovea_tools::commands::method_table::MethodTableArgs {
         quality: &out,
         bench: &bench_report,
-        readme,
+        doc,
         pictures: &pictures,
         equal_samples: &equal,
     };
-    fovea_tools::commands::method_table::run(&table_args(&readme)).unwrap();
-    let text = std::fs::read_to_string(&readme).unwrap();
+    fovea_tools::commands::method_table::run(&table_args(&quality_md)).unwrap();
+    let text = std::fs::read_to_string(&quality_md).unwrap();
     assert!(text.starts_with("# mine\n\n<!-- method-table:begin -->\n") && text.ends_with("<!-- method-table:end -->\n\nafter: quoting `<!-- method-table:begin -->` keeps it\n") && !text.contains("old"), "{text}");
     for m in &methods {
         assert!(text.contains(&format!("| {m} + none | ")), "{m}: {text}");
@@ -446,7 +450,8 @@ fn quality_methods_all_lists_what_a_method_refuses() {
             "{m}"
         );
         assert!(
-            text.contains(&format!("![{m}](docs/methods/{m}.png)")),
+            text.contains(&format!("![{m}](methods/{m}.png)"))
+                && text.contains(&format!("![{m} FLIP](methods/{m}_flip.png)")),
             "{m}"
         );
     }
@@ -456,14 +461,14 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         "{text}"
     );
     assert!(text.contains("Visual-Polar vs composite (Andersson & Hansson 2020) at equal samples (44985 vs 45034, gaze `sim:1`") && text.contains("none 0.349 / 0.221 / 0.184 vs 0.347 / 0.310 / 0.240"), "{text}");
-    // A report of many methods is no equal-samples pair: named, and the README left as it was.
+    // A report of many methods is no equal-samples pair: named, and the document left as it was.
     let many = [out.join("quality.json")];
     let err = format!(
         "{:#}",
         fovea_tools::commands::method_table::run(
             &fovea_tools::commands::method_table::MethodTableArgs {
                 equal_samples: &many,
-                ..table_args(&readme)
+                ..table_args(&quality_md)
             }
         )
         .unwrap_err()
@@ -472,7 +477,7 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         err.contains("quality.json") && err.contains("exactly one other method"),
         "{err}"
     );
-    assert_eq!(std::fs::read_to_string(&readme).unwrap(), text);
+    assert_eq!(std::fs::read_to_string(&quality_md).unwrap(), text);
     let bare = docs.join("BARE.md");
     std::fs::write(&bare, "no markers").unwrap();
     let err = format!(
@@ -617,11 +622,20 @@ fn flip_whole_frame_and_per_ring_for_exr_and_png() {
     assert!((ppd - 64.0 / 90.0).abs() < 1e-3, "{ppd}");
     let flip = j["frame"]["flip"].as_f64().unwrap();
     assert!(flip > 0.05 && flip < 1.0, "{flip}");
-    assert!(j["rings"]
-        .as_array()
-        .unwrap()
+    let rings = j["rings"].as_array().unwrap();
+    assert!(rings
         .iter()
         .all(|r| r["flip"].as_f64().is_some_and(|f| f > 0.0)));
+    // The rings partition the frame: their pixel-weighted FLIP is the frame's.
+    let weighted: f64 = rings
+        .iter()
+        .map(|r| r["flip"].as_f64().unwrap() * r["pixels"].as_f64().unwrap())
+        .sum::<f64>()
+        / (W * H) as f64;
+    assert!(
+        (weighted - flip).abs() < 1e-9,
+        "rings {weighted} vs frame {flip}"
+    );
 
     // The same pictures as PNGs (tonemapped like the EXRs were): the same FLIP; identical → 0.
     let png = |name: &str, texels: &[[f32; 4]]| {
@@ -708,6 +722,148 @@ fn flip_matches_nvidias_tool_on_a_known_pair() {
         assert!(
             (flip - expected).abs() < 2e-6,
             "{test} at {ppd} ppd: {flip} vs NVIDIA's {expected}"
+        );
+    }
+}
+
+/// FLIP of two uniform sRGB colours in closed form (Andersson et al. 2020, LDR-FLIP), written out
+/// here from the paper: a uniform image has no edges or points (the feature term is 0, so the
+/// error is the colour term alone) and the normalised CSF filters leave it as it is; the error is
+/// the HyAB distance of the Hunt-adjusted CIELAB colours raised to q_c = 0.7, remapped with
+/// p_c = 0.4, p_t = 0.95 against c_max, the same distance between pure green and pure blue.
+fn uniform_flip(a: [u8; 3], b: [u8; 3]) -> f64 {
+    fn linear(c: f64) -> f64 {
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    }
+    // sRGB (D65) to XYZ, and CIELAB against the D65 white.
+    fn lab(rgb: [f64; 3]) -> [f64; 3] {
+        let [r, g, b] = rgb;
+        let xyz = [
+            0.4124564 * r + 0.3575761 * g + 0.1804375 * b,
+            0.2126729 * r + 0.7151522 * g + 0.0721750 * b,
+            0.0193339 * r + 0.1191920 * g + 0.9503041 * b,
+        ];
+        let white = [0.95047, 1.0, 1.08883];
+        let f = |t: f64| {
+            let d: f64 = 6.0 / 29.0;
+            if t > d.powi(3) {
+                t.cbrt()
+            } else {
+                t / (3.0 * d * d) + 4.0 / 29.0
+            }
+        };
+        let [fx, fy, fz] = [0, 1, 2].map(|i| f(xyz[i] / white[i]));
+        [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
+    }
+    let hunt = |[l, a, b]: [f64; 3]| [l, 0.01 * l * a, 0.01 * l * b];
+    let hyab = |p: [f64; 3], q: [f64; 3]| (p[0] - q[0]).abs() + (p[1] - q[1]).hypot(p[2] - q[2]);
+    let colour = |c: [u8; 3]| hunt(lab(c.map(|v| linear(v as f64 / 255.0))));
+    let (qc, pc, pt) = (0.7, 0.4, 0.95);
+    let cmax = hyab(hunt(lab([0.0, 1.0, 0.0])), hunt(lab([0.0, 0.0, 1.0]))).powf(qc);
+    let e = hyab(colour(a), colour(b)).powf(qc);
+    if e < pc * cmax {
+        e * pt / (pc * cmax)
+    } else {
+        pt + (e - pc * cmax) / (cmax - pc * cmax) * (1.0 - pt)
+    }
+}
+
+/// `fovea eval` on uniform images gives the closed-form FLIP of their two colours, for the whole
+/// frame and in every ring: small differences on the linear part of the remap, large ones beyond
+/// p_c, a pure hue change and black against white.
+#[test]
+fn flip_of_uniform_images_has_its_closed_form() {
+    let dir = temp_dir("flip-uniform");
+    let png = |name: &str, c: [u8; 3]| {
+        let path = dir.join(name);
+        let bytes = [c[0], c[1], c[2], 255].repeat((W * H) as usize);
+        fovea_tools::output::write_png(&path, W, H, &bytes).unwrap();
+        path
+    };
+    let pairs = [
+        ([128, 128, 128], [136, 136, 136]),
+        ([40, 90, 160], [40, 100, 150]),
+        ([200, 60, 60], [60, 200, 60]),
+        ([0, 0, 0], [255, 255, 255]),
+    ];
+    for (k, (a, b)) in pairs.into_iter().enumerate() {
+        let (reference, test) = (png(&format!("a{k}.png"), a), png(&format!("b{k}.png"), b));
+        let out = dir.join(format!("out{k}"));
+        eval(&EvalArgs {
+            ppd: Some(30.0),
+            ..args(&reference, &test, "center", &out)
+        })
+        .unwrap();
+        let j = read_json(&out);
+        let want = uniform_flip(a, b);
+        let frame = j["frame"]["flip"].as_f64().unwrap();
+        println!("{a:?} vs {b:?}: fovea eval {frame:.6}, closed form {want:.6}");
+        // Measured within 2e-5 (the tool computes in f32, with its own matrix digits).
+        assert!(
+            (frame - want).abs() < 1e-4,
+            "{a:?} vs {b:?}: FLIP {frame}, closed form {want}"
+        );
+        for ring in j["rings"].as_array().unwrap() {
+            let f = ring["flip"].as_f64().unwrap();
+            assert!((f - want).abs() < 1e-4, "{a:?} vs {b:?}: ring {ring}");
+        }
+    }
+}
+
+/// The per-pixel FLIP map against NVIDIA's tool at the pixels its README records (tests/data/flip:
+/// (0, 0), (80, 90), (159, 179) and the maximum of `flip -r reference.png -t TEST -ppd PPD`).
+#[test]
+fn flip_map_matches_nvidias_tool_pixel_by_pixel() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/flip");
+    let rgba = |name: &str| image::open(data.join(name)).unwrap().to_rgba8();
+    let reference = rgba("reference.png");
+    // (test image, ppd, [(0,0), (80,90), (159,179)], max)
+    let cases = [
+        (
+            "test.png",
+            67.0206,
+            [
+                0.45378413796424866,
+                0.1099155992269516,
+                0.023592688143253326,
+            ],
+            0.6221623420715332,
+        ),
+        (
+            "test.png",
+            10.0,
+            [
+                0.43456751108169556,
+                0.5752170085906982,
+                0.042438384145498276,
+            ],
+            0.9760982394218445,
+        ),
+        (
+            "test_blocks.png",
+            14.2222,
+            [0.30537059903144836, 0.5236210823059082, 0.0674961730837822],
+            0.9726236462593079,
+        ),
+    ];
+    let (w, h) = reference.dimensions();
+    for (test, ppd, pixels, max) in cases {
+        let map = fovea_tools::flip::flip_map(&reference, &rgba(test), w, h, ppd);
+        for ((x, y), want) in [(0, 0), (80, 90), (159, 179)].into_iter().zip(pixels) {
+            let got = map[(y * w + x) as usize];
+            assert!(
+                (got - want).abs() < 1e-4,
+                "{test} at {ppd} ppd, pixel ({x}, {y}): {got} vs NVIDIA's {want}"
+            );
+        }
+        let got_max = map.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            (got_max - max).abs() < 1e-4,
+            "{test} at {ppd} ppd: max {got_max} vs NVIDIA's {max}"
         );
     }
 }

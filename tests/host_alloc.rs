@@ -1,4 +1,4 @@
-//! No host (heap) allocations in the render loop (issue 2's benchmark section): after the first
+//! No host (heap) allocations in the render loop: after the first
 //! frame has sized everything, `Renderer::render_frame` allocates nothing on the CPU side, for
 //! Cartesian and Visual-Polar frames with a moving gaze, with and without a denoiser and TAA.
 //! A counting global allocator (this test binary only) counts the allocations made by this

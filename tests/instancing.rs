@@ -14,7 +14,7 @@ use fovea_scene::bvh::instanced::SceneBvh;
 use fovea_scene::bvh::BvhBuilder;
 use fovea_scene::intersect::Ray;
 use fovea_scene::Scene;
-use fovea_tests::{artifacts_dir, assert_clean, gpu, rmse};
+use fovea_tests::{artifacts_dir, assert_clean, assert_pictures, gpu, rmse, Picture};
 use glam::{Quat, UVec2, Vec3};
 use serde_json::{json, Value};
 
@@ -227,14 +227,24 @@ fn assert_renders_alike(look: Look) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
         .filter(|(p, q)| (0..3).all(|c| (p[c] - q[c]).abs() <= 1e-3 * q[c].abs().max(1.0)))
         .count();
     println!("look {}: rmse instanced vs by hand {apart:.3e}, seed noise {noise:.3e}, {close}/{} pixels equal to 1e-3", look as u8, a.len());
-    assert!(
-        apart < noise / 20.0,
-        "instanced vs by hand {apart}, two seeds {noise}"
+    let (instanced, by_hand) = (
+        Picture::hdr(SIZE.x, SIZE.y, &a),
+        Picture::hdr(SIZE.x, SIZE.y, &b),
     );
-    assert!(
+    let label = format!("look {} instanced against by hand", look as u8);
+    assert_pictures(
+        apart < noise / 20.0,
+        &label,
+        &instanced,
+        &by_hand,
+        format_args!("instanced vs by hand {apart}, two seeds {noise}"),
+    );
+    assert_pictures(
         close * 10 >= a.len() * 9,
-        "{close} of {} pixels agree",
-        a.len()
+        &label,
+        &instanced,
+        &by_hand,
+        format_args!("{close} of {} pixels agree", a.len()),
     );
     (a, b)
 }

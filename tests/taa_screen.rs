@@ -1,4 +1,4 @@
-//! TAA after the remap to the screen (`--taa screen`, issue 5; beyond the paper): error against
+//! TAA after the remap to the screen (`--taa screen`, beyond the paper): error against
 //! a converged reference next to the raw frame and to TAA in the sampling grid, fireflies, and
 //! the disocclusion reset. The remap's placement of jittered samples is tested in vp_remap.rs.
 
@@ -15,8 +15,8 @@ use fovea_renderer::vk::{Buffer, Context, Image};
 use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{assert_finite_non_negative, plain_materials, rmse_where};
 use fovea_tests::{
-    assert_clean, gpu, inject_fireflies, owned_scene, read_image, save_preview, unit_hash,
-    write_image, SpaceBuffers,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image, Picture, SpaceBuffers,
 };
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
@@ -109,10 +109,15 @@ fn screen_taa_reduces_error_beside_grid_taa() {
         e_raw / e_screen,
         e_raw / e_grid
     );
-    assert!(
+    assert_pictures(
         e_raw / e_screen >= 2.0,
-        "screen-space TAA cut the error only {:.2}×",
-        e_raw / e_screen
+        "screen taa",
+        &Picture::hdr(SCREEN.x, SCREEN.y, &screen),
+        &Picture::hdr(SCREEN.x, SCREEN.y, &reference),
+        format_args!(
+            "screen-space TAA cut the error only {:.2}×",
+            e_raw / e_screen
+        ),
     );
     assert_clean(&ctx);
 }

@@ -1,14 +1,14 @@
 //! The Visual-Polar mapping on the device: `shaders/sampling/visual_polar_math.glsl` and
 //! `visual_polar_clipped.glsl` (run through the `passes/vp_mapping_probe` kernel, reading the
 //! per-column arc table) agree with the Rust twin `VisualPolar` on ≥ 10⁴ points per case, in both
-//! directions, for the paper's and the screen-clipped layout (issue 4: max error < 10⁻³ px).
+//! directions, for the paper's and the screen-clipped layout (max error < 10⁻³ px).
 //!
 //! Bounds:
-//! - grid → screen, paper axis, either inverse CDF: < 1e-3 px, the issue's bound. The exact
+//! - grid → screen, paper axis, either inverse CDF: < 1e-3 px, the required bound. The exact
 //!   inverse solves for the CDF's tail beyond e (`cdf_tail`), not cdf(e) itself: near e = 80 the
 //!   CDF is flat (cdf ≈ 1091, one f32 ulp of it moves e by 2e-5°, ~5e-4 px at r_max ≈ 1926 px),
-//!   so the plain difference let Rust and GLSL land a few such steps apart (2.0e-3 px measured
-//!   before); the tail is accurate relative to itself there. Measured worst now 5.0e-4 px.
+//!   so the plain difference lets Rust and GLSL land a few such steps apart (2.0e-3 px measured);
+//!   the tail is accurate relative to itself there. Measured worst: 5.0e-4 px.
 //! - grid → screen, headset eccentricity axis (always the exact inverse CDF): < 1e-3 px for
 //!   samples on the screen (measured worst 4.4e-4 px at 1280×1440). Samples off the screen are
 //!   held to 1e-5 of their distance from the gaze instead (measured ≤ 4.3e-6, i.e. up to 2.4e-3 px

@@ -1,4 +1,4 @@
-//! Visual-Polar back to the screen (issue 4, pipeline steps 2–4): the φ-only mips match a CPU
+//! Visual-Polar back to the screen (pipeline steps 2–4): the φ-only mips match a CPU
 //! reference, the remap reproduces smooth fields (constants exactly, screen positions to within
 //! the local texel size) for gazes at the centre, an edge and a corner, in the paper's and the
 //! screen-clipped layout (mips that neither wrap nor average across the gaps between a column's
@@ -20,7 +20,10 @@ use fovea_renderer::way_back::blur::{BlurPass, BlurShape};
 use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
 use fovea_renderer::way_back::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
 use fovea_renderer::way_back::remap::RemapPass;
-use fovea_tests::{assert_clean, gpu, read_image, save_preview, unit_hash, write_image};
+use fovea_tests::{
+    assert_clean, assert_pictures, assert_pictures_equal, gpu, read_image, save_preview, unit_hash,
+    write_image, Picture,
+};
 use glam::{UVec2, Vec2};
 use std::sync::Arc;
 
@@ -446,15 +449,22 @@ fn foveated_blur_spares_the_fovea_and_spreads_by_sigma() {
         .map(|i| [unit_hash(i as u32), unit_hash(i as u32 + 7), 0.5, 1.0])
         .collect();
     let out = blur(&ctx, &shape, &noise);
-    let mut blurred_outside = 0;
+    let (mut blurred_outside, mut changed_inside) = (0, 0);
     for i in 0..n {
         let r = (at(i) - gaze).length();
         if r <= shape.fovea_radius {
-            assert_eq!(out[i], noise[i], "pixel {i} inside the fovea changed");
+            changed_inside += (out[i] != noise[i]) as usize;
         } else if shape.sigma_at(r) > 0.5 && out[i] != noise[i] {
             blurred_outside += 1;
         }
     }
+    assert_pictures(
+        changed_inside == 0,
+        "blurred noise",
+        &Picture::hdr(SCREEN.x, SCREEN.y, &out),
+        &Picture::hdr(SCREEN.x, SCREEN.y, &noise),
+        format_args!("{changed_inside} pixels inside the fovea changed"),
+    );
     assert!(
         blurred_outside > n / 2,
         "only {blurred_outside} periphery pixels blurred"
@@ -631,10 +641,10 @@ fn fused_blur_and_tonemap_match_the_separate_passes() {
             "{separate_passes:?}"
         );
         assert!(fused.iter().any(|&v| v > 0), "a black frame");
-        let differing = fused.iter().zip(&separate).filter(|(a, b)| a != b).count();
-        assert_eq!(
-            differing, 0,
-            "gaze {gaze} {taa:?}: {differing} bytes differ"
+        assert_pictures_equal(
+            &format!("gaze {gaze} {taa:?}, fused against separate"),
+            &Picture::rgba8(SCREEN.x, SCREEN.y, &fused),
+            &Picture::rgba8(SCREEN.x, SCREEN.y, &separate),
         );
     }
     assert_clean(&ctx);
@@ -699,11 +709,21 @@ fn grid_blur_matches_the_screen_blur() {
             .length()
     };
     let luma = |p: &[f32; 4]| (p[0] + p[1] + p[2]) as f64 / 3.0;
-    for (i, (a, b)) in none.iter().zip(&in_grid).enumerate() {
-        if radius(i) < 0.5 * start {
-            assert_eq!(a, b, "fovea pixel {i} changed by the grid blur");
-        }
-    }
+    let changed_fovea = (none.iter().zip(&in_grid).enumerate())
+        .filter(|(i, (a, b))| radius(*i) < 0.5 * start && a != b)
+        .count();
+    let (unblurred, grid_blurred, screen_blurred) = (
+        Picture::hdr(screen.x, screen.y, &none),
+        Picture::hdr(screen.x, screen.y, &in_grid),
+        Picture::hdr(screen.x, screen.y, &on_screen),
+    );
+    assert_pictures(
+        changed_fovea == 0,
+        "grid blur against none",
+        &grid_blurred,
+        &unblurred,
+        format_args!("{changed_fovea} fovea pixels changed by the grid blur"),
+    );
     let periphery: Vec<usize> = (0..none.len())
         .filter(|&i| radius(i) > 2.0 * start && (i as u32 % screen.x) + 1 < screen.x)
         .collect();
@@ -727,9 +747,14 @@ fn grid_blur_matches_the_screen_blur() {
     );
     let (r_none, r_screen, r_grid) = (roughness(&none), roughness(&on_screen), roughness(&in_grid));
     println!("periphery: |grid − screen| {grid_vs_screen:.4}, |none − screen| {none_vs_screen:.4}; roughness none {r_none:.4}, screen {r_screen:.4}, grid {r_grid:.4}");
-    assert!(
+    assert_pictures(
         grid_vs_screen < 0.5 * none_vs_screen,
-        "grid blur {grid_vs_screen} vs unblurred {none_vs_screen} from the screen blur"
+        "grid blur against the screen blur",
+        &grid_blurred,
+        &screen_blurred,
+        format_args!(
+            "grid blur {grid_vs_screen} vs unblurred {none_vs_screen} from the screen blur"
+        ),
     );
     assert!(
         r_grid < 0.8 * r_none && r_grid < 1.25 * r_screen,

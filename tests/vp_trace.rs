@@ -1,4 +1,4 @@
-//! The tracer fed by the Visual-Polar sampling space (issue 4, pipeline step 1): one traced sample
+//! The tracer fed by the Visual-Polar sampling space (pipeline step 1): one traced sample
 //! per kept VP texel, nothing traced in the clipped fovea triangle, off-screen samples traced and
 //! counted (`FrameStats::samples_offscreen`, ray counter slot 3) when they are traced as in the
 //! paper (`OffscreenSamples::Trace`); culled by default, with the picture unchanged. The screen-clipped layout traces
@@ -347,7 +347,7 @@ fn offscreen_culling_keeps_the_picture_and_counts_what_it_skips() {
     };
     let ctx = gpu();
     let scene = cornell();
-    let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
+    let camera = fovea_tests::cornell_box_far_camera(SCREEN);
     let frames = |space: Box<dyn SamplingSpace>, gaze: Vec2, settings: RenderSettings| {
         let mut r = Renderer::new(&ctx, &scene, space, settings).unwrap();
         let (mut pictures, mut stats) = (Vec::new(), Vec::new());

@@ -163,8 +163,8 @@ fn missing_runtime_is_a_clear_error() {
     }
 }
 
-/// Old code: begin/end ran after every event, so the InteractionProfileChanged Monado queues
-/// after READY made xrBeginSession run twice (XR_ERROR_SESSION_RUNNING).
+/// Begin/end run on state changes only: run after every event, the InteractionProfileChanged
+/// Monado queues after READY would call xrBeginSession twice (XR_ERROR_SESSION_RUNNING).
 #[test]
 fn begin_runs_once_with_interaction_profile_changed_queued() {
     let Some(_env) = runtime_env() else { return };
@@ -202,7 +202,8 @@ fn begin_runs_once_with_interaction_profile_changed_queued() {
     );
 }
 
-/// Old code: a self-managed (headless) source's first begin_frame failed with SESSION_RUNNING.
+/// A self-managed (headless) source's begin_frame succeeds from the first frame on (a second
+/// xrBeginSession would fail with SESSION_RUNNING).
 #[test]
 fn headless_source_begin_frame_succeeds_every_frame() {
     let Some(_env) = runtime_env() else { return };
@@ -222,8 +223,9 @@ fn headless_source_begin_frame_succeeds_every_frame() {
     assert!(valid >= 20, "only {valid} valid samples in {frames} frames");
 }
 
-/// Old code with manage_session = false: the source polled the event queue itself, so either it
-/// swallowed the renderer's events or (renderer polls) never saw FOCUSED: 100/100 invalid.
+/// A source on a renderer-owned session reads the owner's state instead of polling the event
+/// queue itself (which would swallow the renderer's events, or never see FOCUSED: 100/100
+/// invalid).
 #[test]
 fn renderer_owned_session_gives_valid_gaze_with_state_passed_in() {
     let Some(_env) = runtime_env() else { return };
@@ -326,8 +328,8 @@ fn gaze_set_must_be_in_the_owners_attach() {
     assert!(err.contains("attach_action_sets"), "{err}");
 }
 
-/// Old code never enabled XR_KHR_vulkan_enable2. Now the renderer's Vulkan instance and device
-/// are created through the runtime, a Vulkan session runs frames, and gaze works on it.
+/// XR_KHR_vulkan_enable2: the renderer's Vulkan instance and device are created through the
+/// runtime, a Vulkan session runs frames, and gaze works on it.
 #[test]
 fn vulkan_session_through_the_runtime() {
     let Some(_env) = runtime_env() else { return };
@@ -438,7 +440,7 @@ fn vulkan_session_through_the_runtime() {
     vk.destroy();
 }
 
-/// Old code refused runtimes without XR_EXT_eye_gaze_interaction support.
+/// A runtime without XR_EXT_eye_gaze_interaction support is accepted (gaze at the centre).
 #[test]
 fn runtime_without_eye_tracker_runs_with_centre_fallback() {
     let Some(_env) = runtime_env() else { return };
@@ -477,7 +479,7 @@ fn runtime_without_eye_tracker_runs_with_centre_fallback() {
     }
 }
 
-/// Old code labelled a sample measured exactly at the query time `Interpolated`.
+/// A sample measured exactly at the query time is labelled `Measured`, not `Interpolated`.
 #[test]
 fn sample_at_a_measurement_time_is_measured() {
     let Some(_env) = runtime_env() else { return };
@@ -499,8 +501,8 @@ fn sample_at_a_measurement_time_is_measured() {
     );
 }
 
-/// Old code: numbers went backwards for older queries, changed for the same measurement, and
-/// invalid samples bumped them.
+/// Sequence numbers never go backwards for older queries, stay the same for the same
+/// measurement, and invalid samples do not bump them.
 #[test]
 fn sequence_numbers_are_stable_monotone_and_skip_invalid() {
     let Some(_env) = runtime_env() else { return };
@@ -539,7 +541,8 @@ fn sequence_numbers_are_stable_monotone_and_skip_invalid() {
     );
 }
 
-/// Old code kept fove0's id, refresh and FOV until the first frame.
+/// The description (id, refresh, FOV) comes from the runtime before the first frame, not from
+/// the fove0 fallback.
 #[test]
 fn describe_comes_from_the_runtime_before_any_frame() {
     let Some(_env) = runtime_env() else { return };
@@ -629,7 +632,7 @@ fn describe_comes_from_the_runtime_before_any_frame() {
     assert!(hmd.capabilities.eye_gaze);
 }
 
-/// Old code: latest() only moved in sample_at.
+/// latest() is refreshed by begin_frame, not only by sample_at.
 #[test]
 fn latest_is_refreshed_by_begin_frame() {
     let Some(_env) = runtime_env() else { return };

@@ -411,7 +411,7 @@ impl Renderer {
                 "frame {frame} is still in flight (wait for it first)"
             ))),
             None => Err(Error::Invalid(format!(
-                "frame {frame} is no longer held: its slot was reused"
+                "frame {frame} is not held: its slot holds a later frame"
             ))),
         }
     }

@@ -82,6 +82,15 @@ struct EnvProbePush {
     uvec4 config;               // x point count, yzw unused
 };
 
+// Push constants of the BRDF sampling probe (device χ² test of brdf.glsl's sampler).
+struct BrdfProbePush {
+    vec4 base_color_metallic;   // xyz base colour, w metallic
+    vec4 f0_specular;           // xyz dielectric F0, w specular factor
+    vec4 view_roughness;        // xyz unit direction toward the viewer, w roughness
+    vec4 normal;                // xyz unit shading and geometric normal
+    uvec4 config;               // x sample count, yzw unused
+};
+
 // Where samples lie on the screen; each sampling space gives the slots its own meaning.
 // Visual-Polar packing (VisualPolar::sampling_params, unpacked by vp_unpack): shape1.y = flags
 // (1 exact inverse CDF, 2 screen-clipped layout, 4 headset eccentricity axis); paper axis: gaze.zw
@@ -245,7 +254,7 @@ struct VpProbePush {
     uvec4 config;               // x point count, yzw unused
 };
 
-// ---- Denoisers (issue 5): they run in the sampling grid (texel = sample). Every pass gets the
+// ---- Denoisers: they run in the sampling grid (texel = sample). Every pass gets the
 // space as SamplingParams push constants (see MipPhiPush for why not the buffer); Cartesian
 // kernel variants ignore it.
 

@@ -1,6 +1,6 @@
 #version 460
 // The foveated blur (visual-polar.md §7) applied in the Visual-Polar grid before the remap
-// (`--blur-space grid`, issue 17: a way back that shrinks), one axis per dispatch: along φ inside
+// (`--blur-space grid`: no full-screen blur pass), one axis per dispatch: along φ inside
 // a column (wrapped) and along ρ across columns at the same angle. Radial and tangential steps are
 // orthogonal on the screen, so the two axes together are the screen blur's isotropic Gaussian of
 // σ(r) pixels, measured in each axis' own texels. The grid holds 0.39–0.44 of the screen's

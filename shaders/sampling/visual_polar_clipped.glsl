@@ -1,4 +1,4 @@
-// Screen-clipped Visual-Polar layout (issue 4, beyond the paper): GLSL twin of
+// Screen-clipped Visual-Polar layout (beyond the paper): GLSL twin of
 // renderer/src/sampling/visual_polar_clipped.rs, function by function, same f32 operations.
 // Each column keeps its rows but lays them on the on-screen part of its circle only: up to 4
 // angular intervals, concatenated into an arc of total angle A; row y of a column with n rows sits

@@ -294,7 +294,7 @@ impl SeamErrors {
     /// of 0.1–0.2 on an 80-row column (estimated, not measured), 20–40× the 0.003–0.006 measured. The φ ≈ π bound is loose
     /// because the filtered error is spatially correlated, so two zero crossings of one run differ:
     /// log-polar's SVGF measures 0.0022 at φ ≈ π and 0.0043–0.0045 in the bins beside it and the
-    /// seam's (tenth/eleventh session).
+    /// seam's (measured 2026-12-02).
     pub fn like_elsewhere(&self) -> bool {
         self.seam <= 3.0 * self.opposite && self.seam <= 1.25 * self.median
     }
@@ -351,14 +351,18 @@ pub fn denoise_over_culled_tiles(
     );
 }
 
-/// Asserts that each named pair of images holds the same bits.
+/// Asserts that each named pair of images (16-byte texels, shown as RGBA floats) holds the same
+/// bits; a failure leaves both pictures and their FLIP difference behind.
 pub fn assert_bit_equal(ctx: &Arc<Context>, what: &str, pairs: &[(&str, &Image, &Image)]) {
     for (name, a, b) in pairs {
-        let (a, b) = (
-            crate::read_image::<[u32; 4]>(ctx, a),
-            crate::read_image::<[u32; 4]>(ctx, b),
+        let (actual, expected) = (
+            crate::read_image::<[f32; 4]>(ctx, a),
+            crate::read_image::<[f32; 4]>(ctx, b),
         );
-        let differing = a.iter().zip(b.iter()).filter(|(x, y)| x != y).count();
-        assert_eq!(differing, 0, "{what}: {name} differs in {differing} texels");
+        crate::assert_pictures_equal(
+            &format!("{what}, {name}"),
+            &crate::Picture::hdr(a.width, a.height, &actual),
+            &crate::Picture::hdr(b.width, b.height, &expected),
+        );
     }
 }

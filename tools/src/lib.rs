@@ -14,6 +14,7 @@ pub mod look;
 pub mod metrics;
 pub mod output;
 pub mod plot;
+pub mod projection;
 pub mod render_profile;
 pub mod replay;
 pub mod scenegen;

@@ -4,17 +4,23 @@
 //! Every command that renders the scene camera (render, view, xr, replay, quality, reference)
 //! loads its scene through [`load`], so they all see the same thing.
 //!
-//! The environment rule:
-//! - a scene with no punctual light and no emissive material gets the default sun (a directional
-//!   light in the light table, so next-event estimation samples it) and the default sky;
-//! - a scene with its own lights gets no sun, and the sky only when `--sky-intensity` (or the
+//! The environment rule (`--default-light auto`, the default), by power rather than presence:
+//! - a scene whose own emitters (emissive triangles, punctual lights) send out less than
+//!   `MIN_OWN_LIGHT_SHARE` of the power the default sun sends through the scene's bounding sphere
+//!   (`own_light_share`; powers as the light table counts them) is not lit by them — a model whose
+//!   only emitters are small details (indicator lights, screens) would render near-black — and
+//!   gets the default sun (a directional light in the light table, so next-event estimation
+//!   samples it) and the default sky, as a scene without any light does;
+//! - a scene lit by its own lights gets no sun, and the sky only when `--sky-intensity` (or the
 //!   profile's `environment.sky_intensity`) is given explicitly and > 0;
+//! - `--default-light on` adds the default sun and sky whatever the scene holds, `off` never;
 //! - `--sun-intensity 0` / `--sky-intensity 0` turn either part off;
 //! - `--env FILE` (an HDR environment map, `crate::env_map`) replaces the sky in every scene; the
 //!   sun then stays off unless `--sun` (or the profile's `sun`) is given, because a captured map
-//!   usually holds its own sun — adding one would light the scene twice. Scenes with lights of
-//!   their own never get the sun.
+//!   usually holds its own sun — adding one would light the scene twice. Scenes lit by their own
+//!   lights never get the sun.
 
+pub use crate::projection::{Framing, Projection};
 use crate::sky_model::{preetham_map, SkyModel};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
@@ -31,6 +37,11 @@ pub const DEFAULT_SUN_INTENSITY: f32 = 3.0;
 /// Scale of the default sky's radiance (see [`default_sky`]): with the default sun, sky light on
 /// an open floor is about a sixth of the sun's.
 pub const DEFAULT_SKY_INTENSITY: f32 = 0.5;
+/// A scene's own emitters light it when they send out at least this share of the default sun's
+/// power through the scene's bounding sphere. The Cornell box's ceiling light sends 25 % of it,
+/// a car model's 10 cm² of indicator lights at emissive strength 1 about 0.02 %: 2 % keeps any
+/// scene whose emitters are meant to light it, lamps in a room included, and lights the rest.
+pub const MIN_OWN_LIGHT_SHARE: f32 = 0.02;
 /// Largest sun illuminance / sky radiance scale: far beyond anything useful, small enough that
 /// radiance sums stay finite in f32.
 pub const MAX_INTENSITY: f32 = 1e6;
@@ -59,6 +70,84 @@ pub struct EnvironmentOptions {
     pub env_intensity: Option<f32>,
     /// The sky's model (`--sky`; default the gradient).
     pub sky: Option<SkyModel>,
+    /// When the default sun and sky light the scene (`--default-light`; default `Auto`).
+    pub default_light: Option<DefaultLight>,
+}
+
+/// `--default-light`: when a scene gets the default sun and sky (see the module's rule).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DefaultLight {
+    /// When the scene's own emitters send out less than `MIN_OWN_LIGHT_SHARE` of the sun's power.
+    #[default]
+    Auto,
+    /// Always, beside the scene's own lights.
+    On,
+    /// Never: the scene as authored.
+    Off,
+}
+
+impl DefaultLight {
+    pub const NAMES: &'static [&'static str] = &["auto", "on", "off"];
+
+    pub fn parse(name: &str) -> Result<DefaultLight> {
+        match name {
+            "auto" => Ok(DefaultLight::Auto),
+            "on" => Ok(DefaultLight::On),
+            "off" => Ok(DefaultLight::Off),
+            other => bail!(
+                "--default-light {other}: expected one of {}",
+                DefaultLight::NAMES.join(", ")
+            ),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DefaultLight::Auto => "auto",
+            DefaultLight::On => "on",
+            DefaultLight::Off => "off",
+        }
+    }
+}
+
+/// The power `scene`'s own emitters send out (emissive triangles with their mean emissive
+/// texture colour, punctual lights; the light table's rule) over the power of the default sun
+/// through the scene's bounding sphere. 0 for a scene without emitters.
+pub fn own_light_share(scene: &Scene) -> f32 {
+    let own = fovea_renderer::scene::lights::build_light_table(scene).total_power;
+    let r = scene.bounds().bounding_sphere_radius();
+    let sun = DEFAULT_SUN_INTENSITY * std::f32::consts::PI * r * r;
+    if sun > 0.0 {
+        own / sun
+    } else {
+        0.0
+    }
+}
+
+/// Whether the scene's own lights light it (no default sun and sky), by `env.default_light`.
+/// The second value is the measured share, for the notice.
+fn lit_by_its_own_lights(scene: &Scene, env: &EnvironmentOptions) -> (bool, f32) {
+    let share = own_light_share(scene);
+    let lit = match env.default_light.unwrap_or_default() {
+        DefaultLight::Auto => share >= MIN_OWN_LIGHT_SHARE,
+        DefaultLight::On => false,
+        DefaultLight::Off => true,
+    };
+    (lit, share)
+}
+
+/// Why the default light is on, for the notice.
+fn default_light_reason(share: f32, env: &EnvironmentOptions) -> String {
+    match env.default_light.unwrap_or_default() {
+        DefaultLight::On => "--default-light on".into(),
+        _ if share <= 0.0 => "no lights in the scene".into(),
+        _ => format!(
+            "the scene's own emitters send out {:.2} % of the default sun's power through its bounds \
+             (they light a scene from {:.0} %; --default-light off keeps the scene as authored)",
+            share * 100.0,
+            MIN_OWN_LIGHT_SHARE * 100.0
+        ),
+    }
 }
 
 /// The names used in error messages: the flags, or a profile's keys.
@@ -104,11 +193,12 @@ impl EnvironmentOptions {
             env_rotation: over.env_rotation.or(self.env_rotation),
             env_intensity: over.env_intensity.or(self.env_intensity),
             sky: over.sky.or(self.sky),
+            default_light: over.default_light.or(self.default_light),
         }
     }
 
-    /// The settings as replay baselines record them: the sun and sky fields as before environment
-    /// maps existed (so older baselines do not read as changed), the map's fields only when given.
+    /// The settings as replay baselines record them: the sun and sky fields always, the map's
+    /// fields only when given (so baselines made without a map do not read as changed).
     pub fn describe(&self) -> String {
         let base = format!(
             "EnvironmentOptions {{ sun: {:?}, sun_intensity: {:?}, sky_intensity: {:?}",
@@ -117,11 +207,14 @@ impl EnvironmentOptions {
         let sky = self
             .sky
             .map_or(String::new(), |m| format!(", sky: {}", m.name()));
+        let light = self
+            .default_light
+            .map_or(String::new(), |d| format!(", default_light: {}", d.name()));
         if self.env.is_none() && self.env_rotation.is_none() && self.env_intensity.is_none() {
-            return format!("{base}{sky} }}");
+            return format!("{base}{sky}{light} }}");
         }
         format!(
-            "{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?}{sky} }}",
+            "{base}, env: {:?}, env_rotation: {:?}, env_intensity: {:?}{sky}{light} }}",
             self.env, self.env_rotation, self.env_intensity
         )
     }
@@ -203,7 +296,8 @@ pub fn default_sky(intensity: f32) -> Sky {
 /// Adds the default sun and sky where the rule of this module says so; returns the one-line
 /// notice to print when it did.
 pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<String> {
-    if scene.has_lights() {
+    let (lit, share) = lit_by_its_own_lights(scene, env);
+    if lit {
         // The scene's own lighting stays as authored; only an explicit sky is added.
         if let Some(s) = env.sky_intensity.filter(|&s| s > 0.0) {
             set_sky(scene, env, s);
@@ -223,8 +317,9 @@ pub fn apply_environment(scene: &mut Scene, env: &EnvironmentOptions) -> Option<
     set_sky(scene, env, sky);
     let model = env.sky.unwrap_or_default().name();
     Some(format!(
-        "no lights in the scene: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; {model} sky, intensity {sky}; \
-         change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity, --sky gradient|preetham or a profile's [environment]; 0 turns either off)"
+        "{}: using the default sun and sky (sun at azimuth {azimuth}°, elevation {elevation}°, intensity {sun}; {model} sky, intensity {sky}; \
+         change with --sun AZIMUTH,ELEVATION, --sun-intensity, --sky-intensity, --sky gradient|preetham or a profile's [environment]; 0 turns either off)",
+        default_light_reason(share, env)
     ))
 }
 
@@ -256,9 +351,10 @@ pub fn apply_environment_map(
         env.env_rotation.unwrap_or(0.0),
         env.env_intensity.unwrap_or(1.0),
     )?;
+    let (lit, share) = lit_by_its_own_lights(scene, env);
     scene.environment = Some(map);
     scene.sky = Sky::default();
-    if scene.has_lights() {
+    if lit {
         return Ok(None);
     }
     let sun = match env.sun {
@@ -273,22 +369,38 @@ pub fn apply_environment_map(
         _ => "no sun: --sun AZIMUTH,ELEVATION adds one".into(),
     };
     Ok(Some(format!(
-        "no lights in the scene: lit by the environment map {} ({sun})",
+        "{}: lit by the environment map {} ({sun})",
+        default_light_reason(share, env),
         path.display()
     )))
 }
 
 /// How the camera is chosen (`--camera`, `--camera-pos`, `--camera-look`, `--fov`), as given.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CameraOptions {
     /// A glTF camera by index or name.
     pub camera: Option<String>,
     /// The free camera's position and the point it looks at, `X,Y,Z` each.
     pub position: Option<String>,
     pub look: Option<String>,
-    /// Vertical FOV in degrees: the free or framing camera's, or overriding a glTF camera's.
+    /// Vertical FOV in degrees: the free or framing camera's, or overriding a glTF camera's
+    /// (only `Projection::SceneCamera` renders through it).
     pub fov: Option<f32>,
+    /// Each eye through its headset frustum (the camera is the head) or the camera's own FOV.
+    pub projection: Projection,
+    /// Metres per scene unit (`--world-scale`; glTF's metre is 1): the eyes' offsets and a
+    /// headset's movements are metres, the scene's coordinates its own units.
+    pub world_scale: f32,
 }
+
+impl Default for CameraOptions {
+    fn default() -> Self {
+        NO_CAMERA_FLAGS.clone()
+    }
+}
+
+/// `--world-scale` range: from micrometre to kilometre units.
+pub const WORLD_SCALE_RANGE: (f32, f32) = (1e-6, 1e3);
 
 /// No camera flag: the file's first camera, else the framing one (code that builds arguments).
 pub static NO_CAMERA_FLAGS: CameraOptions = CameraOptions {
@@ -296,6 +408,8 @@ pub static NO_CAMERA_FLAGS: CameraOptions = CameraOptions {
     position: None,
     look: None,
     fov: None,
+    projection: Projection::Headset,
+    world_scale: 1.0,
 };
 
 /// A checked camera choice.
@@ -311,10 +425,23 @@ enum Choice {
 
 impl CameraOptions {
     fn choice(&self) -> Result<Choice> {
+        let (lo, hi) = WORLD_SCALE_RANGE;
+        if !(self.world_scale.is_finite() && (lo..=hi).contains(&self.world_scale)) {
+            bail!(
+                "--world-scale {:?}: metres per scene unit must be in [{lo:e}, {hi:e}] (1 for glTF's metres, 0.01 for a scene in centimetres)",
+                self.world_scale
+            );
+        }
         if let Some(fov) = self.fov {
             let (lo, hi) = FOV_RANGE_DEG;
             if !(fov.is_finite() && fov > lo && fov < hi) {
                 bail!("--fov {fov:?}: the vertical field of view must be in ({lo}, {hi}) degrees");
+            }
+            if self.projection == Projection::Headset {
+                bail!(
+                    "--fov {fov}: each eye is rendered through its headset profile's field of view \
+                     (--projection headset, the default); --fov applies with --projection scene-camera"
+                );
             }
         }
         match (&self.camera, &self.position, &self.look) {
@@ -338,11 +465,12 @@ impl CameraOptions {
         self.choice().map(|_| ())
     }
 
-    /// The camera these options choose in `scene`; `aspect` (width / height) sizes the framing
-    /// camera so the scene fits both ways. The bool is true when the framing camera stands in for
-    /// a file without one.
-    pub fn camera_for(&self, scene: &Scene, aspect: f32) -> Result<(Camera, bool)> {
+    /// The camera these options choose in `scene`; `framing` sizes the framing camera so the
+    /// scene fits both ways. The bool is true when the framing camera stands in for a file
+    /// without one.
+    pub fn camera_for(&self, scene: &Scene, framing: Framing) -> Result<(Camera, bool)> {
         let fov = self.fov.map(f32::to_radians);
+        let aspect = framing.aspect;
         match self.choice()? {
             Choice::Free { position, look } => Ok((
                 Camera::look_at(
@@ -367,8 +495,9 @@ impl CameraOptions {
                     false,
                 )),
                 None => {
+                    let yfov = fov.or(framing.yfov);
                     let framing =
-                        scene.framing_camera(fov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), aspect);
+                        scene.framing_camera(yfov.unwrap_or(DEFAULT_FOV_DEG.to_radians()), aspect);
                     let framing = framing.with_context(|| {
                         format!(
                             "{}: the scene is empty: no camera can frame it",
@@ -434,7 +563,7 @@ pub fn load(
     scene_name: &str,
     camera: &CameraOptions,
     env: &EnvironmentOptions,
-    aspect: f32,
+    framing: Framing,
 ) -> Result<(Scene, Camera)> {
     camera.check()?;
     env.validate(&EnvironmentNames::flags())?;
@@ -442,8 +571,8 @@ pub fn load(
     if let Some(notice) = apply_environment_map(&mut scene, env)? {
         notice_once(&ENVIRONMENT_NOTICE, &notice);
     }
-    let (chosen, framing) = camera.camera_for(&scene, aspect)?;
-    if framing {
+    let (chosen, framed) = camera.camera_for(&scene, framing)?;
+    if framed {
         notice_once(
             &CAMERA_NOTICE,
             &format!(

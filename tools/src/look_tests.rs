@@ -58,7 +58,9 @@ fn framing_camera_sees_every_bound_corner_at_any_aspect() {
     for (lo, hi) in boxes {
         let scene = scene_with(lo, hi, Material::default());
         for aspect in [0.5, 0.889, 1.0, 16.0 / 9.0] {
-            let (camera, framing) = CameraOptions::default().camera_for(&scene, aspect).unwrap();
+            let (camera, framing) = CameraOptions::default()
+                .camera_for(&scene, Framing::aspect(aspect))
+                .unwrap();
             assert!(framing);
             assert!((camera.yfov - 60f32.to_radians()).abs() < 1e-6);
             assert!(
@@ -78,7 +80,7 @@ fn camera_by_index_and_name_and_clear_errors() {
             camera: Some(c.into()),
             ..Default::default()
         }
-        .camera_for(&scene, 1.0)
+        .camera_for(&scene, Framing::aspect(1.0))
     };
     assert_eq!(pick("1").unwrap().0.name, "back");
     assert_eq!(pick("front").unwrap().0.name, "front");
@@ -88,10 +90,10 @@ fn camera_by_index_and_name_and_clear_errors() {
         "{err}"
     );
     assert!(format!("{:#}", pick("2").unwrap_err()).contains("--camera 2"));
-    // No flag: the file's first camera, as before.
+    // No flag: the file's first camera.
     assert_eq!(
         CameraOptions::default()
-            .camera_for(&scene, 1.0)
+            .camera_for(&scene, Framing::aspect(1.0))
             .unwrap()
             .0
             .name,
@@ -100,9 +102,13 @@ fn camera_by_index_and_name_and_clear_errors() {
     let fov = CameraOptions {
         camera: Some("back".into()),
         fov: Some(90.0),
+        projection: Projection::SceneCamera,
         ..Default::default()
     };
-    assert!((fov.camera_for(&scene, 1.0).unwrap().0.yfov - 90f32.to_radians()).abs() < 1e-6);
+    assert!(
+        (fov.camera_for(&scene, Framing::aspect(1.0)).unwrap().0.yfov - 90f32.to_radians()).abs()
+            < 1e-6
+    );
 }
 
 #[test]
@@ -112,17 +118,18 @@ fn free_camera_looks_at_its_point_and_bad_values_are_refused() {
         position: Some(p.into()),
         look: Some(l.into()),
         fov,
+        projection: Projection::SceneCamera,
         ..Default::default()
     };
     let (camera, _) = free("0,1,5", "0,1,0", Some(45.0))
-        .camera_for(&scene, 1.0)
+        .camera_for(&scene, Framing::aspect(1.0))
         .unwrap();
     let forward = camera.world_from_view.transform_vector3(-Vec3::Z);
     assert!((forward - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-5);
     assert!((camera.world_from_view.w_axis.truncate() - Vec3::new(0.0, 1.0, 5.0)).length() < 1e-5);
     // Straight down: no degenerate basis.
     let (down, _) = free("0,10,0", "0,0,0", None)
-        .camera_for(&scene, 1.0)
+        .camera_for(&scene, Framing::aspect(1.0))
         .unwrap();
     assert!(down.world_from_view.is_finite());
     for (opts, needle) in [
@@ -148,7 +155,10 @@ fn free_camera_looks_at_its_point_and_bad_values_are_refused() {
             "one or the other",
         ),
     ] {
-        let err = format!("{:#}", opts.camera_for(&scene, 1.0).unwrap_err());
+        let err = format!(
+            "{:#}",
+            opts.camera_for(&scene, Framing::aspect(1.0)).unwrap_err()
+        );
         assert!(err.contains(needle), "{err}");
     }
 }
@@ -407,4 +417,132 @@ fn replay_description_of_the_default_environment_is_unchanged() {
     }
     .describe()
     .contains("env_intensity: Some(2.0)"));
+}
+
+/// A 2 m floor (no emission) with one emissive triangle of `emitter_area` m² and strength 1.
+fn model_with_a_small_emitter(emitter_area: f32) -> Scene {
+    let mut scene = scene_with(
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Material::default(),
+    );
+    scene.materials.push(Material {
+        emissive: Vec3::ONE,
+        ..Default::default()
+    });
+    // A right triangle of legs a: area a²/2.
+    let a = (2.0 * emitter_area).sqrt();
+    let v = |p: Vec3| Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    };
+    let base = scene.vertices.len() as u32;
+    scene.vertices.extend([
+        v(Vec3::new(0.0, 0.5, 0.0)),
+        v(Vec3::new(a, 0.5, 0.0)),
+        v(Vec3::new(0.0, 0.5 + a, 0.0)),
+    ]);
+    scene.triangles.push(Triangle {
+        indices: [base, base + 1, base + 2],
+        material: 1,
+        mesh: 0,
+    });
+    scene
+}
+
+#[test]
+fn the_default_light_follows_the_scenes_own_power_not_its_presence() {
+    // 10 cm² of emitters on a 2 m model: present, but far too weak to light it.
+    let mut detail = model_with_a_small_emitter(1e-3);
+    assert!(detail.has_lights());
+    let share = own_light_share(&detail);
+    assert!(share > 0.0 && share < MIN_OWN_LIGHT_SHARE, "{share}");
+    let notice = apply_environment(&mut detail, &EnvironmentOptions::default())
+        .expect("the default light is added");
+    assert!(
+        notice.contains("default sun and sky") && notice.contains("% of the default sun's power"),
+        "{notice}"
+    );
+    assert_eq!(detail.punctual_lights.len(), 1);
+    assert_eq!(detail.sky, default_sky(DEFAULT_SKY_INTENSITY));
+
+    // A third of a square metre at strength 1 lights the same model.
+    let mut lamp = model_with_a_small_emitter(0.3);
+    assert!(own_light_share(&lamp) >= MIN_OWN_LIGHT_SHARE);
+    assert!(apply_environment(&mut lamp, &EnvironmentOptions::default()).is_none());
+    assert!(lamp.punctual_lights.is_empty() && lamp.sky.is_black());
+
+    // The share is the emitted power over the sun's through the bounding sphere: 1e-3 m² at
+    // radiance 1 sends out π·1e-3; the sun 3·π·r², r = half the bounds' diagonal.
+    let r = detail.bounds().bounding_sphere_radius();
+    let expected = 1e-3 / (DEFAULT_SUN_INTENSITY * r * r);
+    assert!(
+        (share - expected).abs() < 1e-3 * expected,
+        "{share} vs {expected}"
+    );
+}
+
+#[test]
+fn default_light_on_and_off_override_the_rule() {
+    let on = EnvironmentOptions {
+        default_light: Some(DefaultLight::On),
+        ..Default::default()
+    };
+    let mut lamp = model_with_a_small_emitter(0.3);
+    let notice = apply_environment(&mut lamp, &on).expect("forced on");
+    assert!(notice.contains("--default-light on"), "{notice}");
+    assert_eq!(lamp.punctual_lights.len(), 1);
+
+    let off = EnvironmentOptions {
+        default_light: Some(DefaultLight::Off),
+        ..Default::default()
+    };
+    let mut dark = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    assert!(apply_environment(&mut dark, &off).is_none());
+    assert!(dark.punctual_lights.is_empty() && dark.sky.is_black());
+    assert_eq!(DefaultLight::parse("on").unwrap(), DefaultLight::On);
+    let err = DefaultLight::parse("bright").unwrap_err().to_string();
+    assert!(
+        err.contains("--default-light bright") && err.contains("auto"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_cornell_box_is_lit_by_its_own_ceiling_light() {
+    let scene = crate::scenes::load("cornell-box").unwrap();
+    let share = own_light_share(&scene);
+    assert!((0.1..0.5).contains(&share), "{share}");
+}
+
+#[test]
+fn fov_belongs_to_the_scene_camera_projection() {
+    let scene = scene_with(Vec3::ZERO, Vec3::ONE, Material::default());
+    let headset = CameraOptions {
+        fov: Some(50.0),
+        ..Default::default()
+    };
+    let err = format!(
+        "{:#}",
+        headset
+            .camera_for(&scene, Framing::aspect(1.0))
+            .unwrap_err()
+    );
+    assert!(
+        err.contains("--fov 50") && err.contains("scene-camera"),
+        "{err}"
+    );
+    // The framing camera fits the scene into the view it is given (a headset's inscribed one).
+    let framing = Framing {
+        yfov: Some(100f32.to_radians()),
+        aspect: 0.9,
+    };
+    let (camera, framed) = CameraOptions::default()
+        .camera_for(&scene, framing)
+        .unwrap();
+    assert!(framed);
+    assert!((camera.yfov - 100f32.to_radians()).abs() < 1e-6);
+    assert!(corners_inside(&camera, &scene.bounds(), 0.9));
 }

@@ -1,4 +1,5 @@
-//! `fovea`: the command line of the foveated path tracer. See README.md for the contract.
+//! `fovea`: the command line of the foveated path tracer. docs/cli.md is generated from these
+//! definitions (the contract).
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
@@ -43,10 +44,19 @@ struct SceneFlags {
     /// The point X,Y,Z the free camera looks at (+Y up).
     #[arg(long, allow_hyphen_values = true)]
     camera_look: Option<String>,
-    /// Vertical field of view in degrees, in (1, 170): of the free or framing camera (default 60),
-    /// or replacing the chosen glTF camera's.
+    /// Vertical field of view in degrees, in (1, 170), with --projection scene-camera: of the free
+    /// or framing camera (default 60), or replacing the chosen glTF camera's.
     #[arg(long)]
     fov: Option<f32>,
+    /// How each eye sees the scene: headset (the default: through the headset profile's
+    /// asymmetric per-eye FOV and eye offset, the camera being the head) or scene-camera (the
+    /// camera's own symmetric FOV at the output's aspect ratio).
+    #[arg(long, default_value = "headset")]
+    projection: String,
+    /// Metres per scene unit (default 1, glTF's metre; 0.01 for a scene authored in
+    /// centimetres): the eyes' offsets and a headset's movements are metres.
+    #[arg(long, default_value_t = 1.0)]
+    world_scale: f32,
     /// The default sun's AZIMUTH,ELEVATION in degrees (azimuth from +Z toward +X; default 30,60);
     /// only for scenes without lights of their own.
     #[arg(long, allow_hyphen_values = true)]
@@ -88,16 +98,23 @@ struct SceneFlags {
     /// The environment map's radiance scale (default 1).
     #[arg(long)]
     env_intensity: Option<f32>,
+    /// When the default sun and sky light the scene: auto (the default: when the scene's own
+    /// emitters send out less than 2 % of the default sun's power through its bounds), on
+    /// (always), off (never: the scene as authored).
+    #[arg(long)]
+    default_light: Option<String>,
 }
 
 impl SceneFlags {
-    fn camera(&self) -> fovea_tools::look::CameraOptions {
-        fovea_tools::look::CameraOptions {
+    fn camera(&self) -> Result<fovea_tools::look::CameraOptions> {
+        Ok(fovea_tools::look::CameraOptions {
             camera: self.camera.clone(),
             position: self.camera_pos.clone(),
             look: self.camera_look.clone(),
             fov: self.fov,
-        }
+            projection: fovea_tools::look::Projection::parse(&self.projection)?,
+            world_scale: self.world_scale,
+        })
     }
 
     fn environment(&self) -> Result<fovea_tools::look::EnvironmentOptions> {
@@ -118,7 +135,40 @@ impl SceneFlags {
                 .map(fovea_tools::sky_model::SkyModel::parse)
                 .transpose()
                 .context("--sky")?,
+            default_light: self
+                .default_light
+                .as_deref()
+                .map(fovea_tools::look::DefaultLight::parse)
+                .transpose()?,
         })
+    }
+}
+
+/// The latency model (hal): with any of these flags each frame is foveated with the gaze a
+/// headset would have and judged also where the eye is when it is shown.
+#[derive(clap::Args)]
+struct LatencyFlags {
+    /// Gaze-to-photon latency in ms: a frame displayed at T sees the tracker samples taken up to
+    /// T − this (default: the headset profile's tracker + render + display latency). Any of
+    /// --latency-ms, --tracker-hz, --gaze-predict turns this latency model on.
+    #[arg(long, allow_hyphen_values = true)]
+    latency_ms: Option<f64>,
+    /// Tracker rate of the latency model in Hz (default: the headset profile's).
+    #[arg(long, allow_hyphen_values = true)]
+    tracker_hz: Option<f64>,
+    /// Gaze prediction at the display time: off (the newest sample) | hold | linear | saccade
+    /// (default saccade, chosen by `fovea gaze-eval`; see docs/guide/gaze-latency.md).
+    #[arg(long)]
+    gaze_predict: Option<String>,
+}
+
+impl LatencyFlags {
+    fn timing(&self) -> Result<fovea_tools::gaze::GazeTiming> {
+        fovea_tools::gaze::GazeTiming::from_flags(
+            self.latency_ms,
+            self.tracker_hz,
+            self.gaze_predict.as_deref(),
+        )
     }
 }
 
@@ -126,6 +176,8 @@ impl SceneFlags {
 struct RenderOpts {
     #[command(flatten)]
     look: SceneFlags,
+    #[command(flatten)]
+    latency: LatencyFlags,
     /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
@@ -135,8 +187,9 @@ struct RenderOpts {
     /// Headset profile: a name from `fovea headsets` or a TOML path.
     #[arg(long, default_value = "fove0")]
     headset: String,
-    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file
-    /// (render: default sim:1; view: default the mouse).
+    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file |
+    /// degrees:FILE (t_s,x_deg,y_deg,valid) | gazebase:FILE (render: default sim:1; view: default
+    /// the mouse).
     #[arg(long)]
     gaze: Option<String>,
     /// Render width (default: the headset's per-eye width × --scale).
@@ -146,9 +199,10 @@ struct RenderOpts {
     #[arg(long)]
     height: Option<u32>,
     /// Fraction of the headset's per-eye resolution when --width/--height are not given
-    /// (0.25 keeps the default run near a minute on lavapipe; 1 is the full 1280×1440 FOVE eye).
-    #[arg(long, default_value_t = 0.25)]
-    scale: f32,
+    /// (render, view: default 0.25, which keeps the default run near a minute on a CPU driver;
+    /// xr: default 1, the runtime's recommended size).
+    #[arg(long)]
+    scale: Option<f32>,
     /// Frames to render (render: default 24; view: default until the window is closed).
     #[arg(long)]
     frames: Option<u32>,
@@ -166,8 +220,8 @@ struct RenderOpts {
     /// Also write linear EXR frames.
     #[arg(long)]
     exr: bool,
-    /// Move the camera: without a value along the scene's default path (a slow orbit), with a
-    /// TOML file along its keyframes (time, position, look, optional fov; see the README).
+    /// Move the camera: without a value along the scene's default path (a slow orbit), with a TOML
+    /// file along its keyframes (time, position, look, optional fov; see docs/guide/scenes.md).
     #[arg(long, num_args = 0..=1, default_missing_value = "orbit", value_name = "FILE")]
     camera_path: Option<String>,
     #[arg(long, default_value_t = 1)]
@@ -261,6 +315,7 @@ impl RenderOpts {
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
+            gaze_timing: self.latency.timing()?,
         })
     }
 }
@@ -314,6 +369,10 @@ enum Command {
         /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs --frames.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// The runtime space the scene camera stands in: local (the default: where the head was
+        /// when the session started) or stage (the play area's floor is the scene's y = 0).
+        #[arg(long, default_value = "local")]
+        reference_space: String,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -369,6 +428,12 @@ enum Command {
         out: PathBuf,
         #[command(flatten)]
         look: SceneFlags,
+        /// Headset profile whose eye is rendered (with --projection headset, the default).
+        #[arg(long, default_value = "fove0")]
+        headset: String,
+        /// The eye: left (as `fovea render` writes by default) or right.
+        #[arg(long, default_value = "left")]
+        eye: String,
         /// Replace FILE if it exists.
         #[arg(long)]
         force: bool,
@@ -388,8 +453,8 @@ enum Command {
         /// The first also serves the frame and VP figures; several are measured A B … B A.
         #[arg(long, value_delimiter = ',', default_value = "sbvh")]
         bvh: Vec<String>,
-        /// Copy every instance into world space (meshes placed by several nodes flattened, as
-        /// before instancing): the comparison of the two in one build.
+        /// Copy every instance into world space (meshes placed by several nodes copied per
+        /// node, no instancing): the comparison of the two in one build.
         #[arg(long)]
         flatten: bool,
         /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
@@ -496,9 +561,37 @@ enum Command {
         #[command(flatten)]
         look: SceneFlags,
         #[command(flatten)]
+        latency: LatencyFlags,
+        #[command(flatten)]
         device: DeviceArgs,
     },
-    /// Write issue 14's method table into the README (between its method-table markers) from a
+    /// Gaze error at display time without rendering: recordings through the latency model and
+    /// each predictor, every frame against where the eye is when it is shown (median, p95, p99,
+    /// share above 2.5° and 5°, per-saccade landing error) → DIR/gaze_eval.json + a table.
+    GazeEval {
+        /// Recordings: degrees CSVs (t_s,x_deg,y_deg,valid), fovea gaze traces, degrees:FILE or
+        /// gazebase:FILE.
+        #[arg(required = true)]
+        traces: Vec<String>,
+        /// Headset profile (its left eye's view, tracker and latency).
+        #[arg(long, default_value = "fove0")]
+        headset: String,
+        /// Sample-to-photon latency in ms (default: the profile's tracker + render + display).
+        #[arg(long, allow_hyphen_values = true)]
+        latency_ms: Option<f64>,
+        /// Tracker rate in Hz (default: the profile's).
+        #[arg(long, allow_hyphen_values = true)]
+        tracker_hz: Option<f64>,
+        /// Display rate in Hz (default: the profile's refresh).
+        #[arg(long, allow_hyphen_values = true)]
+        display_hz: Option<f64>,
+        /// Predictors, comma-separated: off, hold, linear, saccade (default: all).
+        #[arg(long, value_delimiter = ',')]
+        gaze_predict: Vec<String>,
+        #[arg(long, default_value = "out/gaze-eval")]
+        out: PathBuf,
+    },
+    /// Write the method table into a Markdown file (between its method-table markers) from a
     /// `fovea quality` folder and a `fovea bench` report, with a picture row and the papers' claims.
     MethodTable {
         /// A `fovea quality` output folder (e.g. run with `--methods all`).
@@ -508,8 +601,9 @@ enum Command {
         /// screen gives the table's costs; every screen of every one a figure in the claims.
         #[arg(long, value_delimiter = ',', required = true)]
         bench: Vec<PathBuf>,
-        #[arg(long, default_value = "README.md")]
-        readme: PathBuf,
+        /// The Markdown document to write the table into, between its method-table markers.
+        #[arg(long, alias = "readme", default_value = "docs/quality.md")]
+        doc: PathBuf,
         /// Folder for the picture row's images.
         #[arg(long, default_value = "docs/methods")]
         pictures: PathBuf,
@@ -552,29 +646,38 @@ const DEFAULT_REPLAY_FRAMES: u32 = commands::replay::DEFAULT_FRAMES;
 /// `fovea render`'s length without `--frames`.
 const DEFAULT_RENDER_FRAMES: u32 = 24;
 
+/// What a command takes when a render flag is not given.
+struct RenderDefaults {
+    frames: u32,
+    gaze: &'static str,
+    out: &'static str,
+    scale: f32,
+}
+
+/// `--scale` of `fovea render`, `view` and `replay` without the flag.
+const DEFAULT_SCALE: f32 = 0.25;
+
 /// The flags `fovea render` and `fovea view` share, checked.
 fn render_args<'a>(
     opts: &'a RenderOpts,
     camera: &'a fovea_tools::look::CameraOptions,
     device: &'a DeviceArgs,
     profile: &RenderProfile,
-    default_frames: u32,
-    default_gaze: &'a str,
-    default_out: &'static str,
+    defaults: RenderDefaults,
 ) -> Result<commands::render::RenderArgs<'a>> {
     Ok(commands::render::RenderArgs {
         scene: &opts.scene,
         method: &opts.method,
         width: opts.width,
         height: opts.height,
-        scale: opts.scale,
+        scale: opts.scale.unwrap_or(defaults.scale),
         headset: &opts.headset,
-        gaze: opts.gaze.as_deref().unwrap_or(default_gaze),
-        frames: opts.frames.unwrap_or(default_frames),
+        gaze: opts.gaze.as_deref().unwrap_or(defaults.gaze),
+        frames: opts.frames.unwrap_or(defaults.frames),
         out: opts
             .out
             .as_deref()
-            .unwrap_or(std::path::Path::new(default_out)),
+            .unwrap_or(std::path::Path::new(defaults.out)),
         exr: opts.exr,
         camera_path: fovea_tools::camera_path::CameraMotion::from_flag(
             opts.camera_path.as_deref(),
@@ -628,15 +731,18 @@ fn run() -> Result<()> {
     match command {
         Command::Render { opts, device } => {
             let profile = opts.profile()?;
-            let camera = opts.look.camera();
+            let camera = opts.look.camera()?;
             commands::render::run(&render_args(
                 &opts,
                 &camera,
                 &device,
                 &profile,
-                DEFAULT_RENDER_FRAMES,
-                "sim:1",
-                "out/render",
+                RenderDefaults {
+                    frames: DEFAULT_RENDER_FRAMES,
+                    gaze: "sim:1",
+                    out: "out/render",
+                    scale: DEFAULT_SCALE,
+                },
             )?)
         }
         Command::View {
@@ -647,16 +753,19 @@ fn run() -> Result<()> {
             device,
         } => {
             let profile = opts.profile()?;
-            let camera = opts.look.camera();
+            let camera = opts.look.camera()?;
             // Without --frames the run has no length: the camera path's period is a long one.
             let render = render_args(
                 &opts,
                 &camera,
                 &device,
                 &profile,
-                u32::MAX,
-                "center",
-                "out/render",
+                RenderDefaults {
+                    frames: u32::MAX,
+                    gaze: "center",
+                    out: "out/render",
+                    scale: DEFAULT_SCALE,
+                },
             )?;
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
@@ -671,19 +780,23 @@ fn run() -> Result<()> {
             opts,
             record,
             screenshot,
+            reference_space,
             device,
         } => {
             let profile = opts.profile()?;
-            let camera = opts.look.camera();
+            let camera = opts.look.camera()?;
             // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
             let render = render_args(
                 &opts,
                 &camera,
                 &device,
                 &profile,
-                u32::MAX,
-                "center",
-                "out/xr",
+                RenderDefaults {
+                    frames: u32::MAX,
+                    gaze: "center",
+                    out: "out/xr",
+                    scale: 1.0,
+                },
             )?;
             if opts.eyes != "left" && opts.eyes != "both" {
                 anyhow::bail!(
@@ -697,6 +810,7 @@ fn run() -> Result<()> {
                 gaze: opts.gaze.as_deref(),
                 record: record.as_deref(),
                 screenshot: screenshot.as_deref(),
+                reference_space: commands::xr::ReferenceSpace::parse(&reference_space)?,
             })
         }
         Command::Replay {
@@ -713,15 +827,18 @@ fn run() -> Result<()> {
             device,
         } => {
             let profile = opts.profile()?;
-            let camera = opts.look.camera();
+            let camera = opts.look.camera()?;
             let mut render = render_args(
                 &opts,
                 &camera,
                 &device,
                 &profile,
-                DEFAULT_REPLAY_FRAMES,
-                "center",
-                "out/replay",
+                RenderDefaults {
+                    frames: DEFAULT_REPLAY_FRAMES,
+                    gaze: "center",
+                    out: "out/replay",
+                    scale: DEFAULT_SCALE,
+                },
             )?;
             // Small by default: replays run in the test suite.
             render.width = Some(opts.width.unwrap_or(64));
@@ -754,11 +871,21 @@ fn run() -> Result<()> {
             seed,
             out,
             look,
+            headset,
+            eye,
             force,
             preview,
             device,
         } => commands::reference::run(&commands::reference::ReferenceArgs {
-            camera: &look.camera(),
+            camera: &look.camera()?,
+            headset: &headset,
+            eye: match commands::setup::Eyes::parse(&eye)? {
+                commands::setup::Eyes::Left => fovea_hal::Eye::Left,
+                commands::setup::Eyes::Right => fovea_hal::Eye::Right,
+                commands::setup::Eyes::Both => {
+                    anyhow::bail!("--eye both: a reference is one eye (left or right)")
+                }
+            },
             environment: look.environment()?,
             path_regularisation: fovea_tools::render_profile::check_path_regularisation(
                 look.path_regularisation,
@@ -863,6 +990,7 @@ fn run() -> Result<()> {
             blur_space,
             out,
             look,
+            latency,
             device,
         } => {
             let base = match &profile {
@@ -876,6 +1004,7 @@ fn run() -> Result<()> {
                 texture_lod: look.texture_lod.clone(),
                 path_regularisation: look.path_regularisation,
                 offscreen_samples: look.offscreen_samples.clone(),
+                gaze_timing: latency.timing()?,
                 ..Default::default()
             })?;
             let all: Vec<String> = DenoiserSettings::NAMES
@@ -902,22 +1031,39 @@ fn run() -> Result<()> {
                 rings,
                 seed,
                 profile,
-                camera: &look.camera(),
+                camera: &look.camera()?,
                 out: &out,
                 device: device.device.as_deref(),
                 validation: device.validation,
             })
         }
+        Command::GazeEval {
+            traces,
+            headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            gaze_predict,
+            out,
+        } => commands::gaze_eval::run(&commands::gaze_eval::GazeEvalArgs {
+            traces: &traces,
+            headset: &headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            predict: &gaze_predict,
+            out: &out,
+        }),
         Command::MethodTable {
             quality,
             bench,
-            readme,
+            doc,
             pictures,
             equal_samples,
         } => commands::method_table::run(&commands::method_table::MethodTableArgs {
             quality: &quality,
             bench: &bench,
-            readme: &readme,
+            doc: &doc,
             pictures: &pictures,
             equal_samples: &equal_samples,
         }),
@@ -968,3 +1114,6 @@ fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
     };
     Ok(glam::Vec2::new(fraction(x)?, fraction(y)?))
 }
+
+#[cfg(test)]
+mod docs_tests;

@@ -47,6 +47,8 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
 /// A render profile as written: the fixed sections, and the registered denoisers' sections
@@ -177,6 +179,8 @@ struct EnvironmentSection {
     env_intensity: Option<f32>,
     /// "gradient" or "preetham".
     sky: Option<String>,
+    /// "auto", "on" or "off" (`--default-light`).
+    default_light: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -239,6 +243,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -442,6 +448,12 @@ impl RenderProfile {
                     .map(crate::sky_model::SkyModel::parse)
                     .transpose()
                     .with_context(|| format!("{}.sky", at("environment")))?,
+                default_light: f
+                    .default_light
+                    .as_deref()
+                    .map(crate::look::DefaultLight::parse)
+                    .transpose()
+                    .with_context(|| format!("{}.default_light", at("environment")))?,
             };
             profile
                 .environment
@@ -519,6 +531,9 @@ impl RenderProfile {
         if let Some(mode) = &o.offscreen_samples {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
+        }
+        if o.gaze_timing.enabled() {
+            self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
     }

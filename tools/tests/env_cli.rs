@@ -39,6 +39,8 @@ fn render(map: &Path, rotation: &str, out: &Path) -> std::process::Output {
             "100,0.5,0",
             "--fov",
             "20",
+            "--projection",
+            "scene-camera",
         ])
         .arg("--env")
         .arg(map)

@@ -4,6 +4,7 @@
 //! baselines and traces are exit status 2 naming the file. Validation on.
 
 use fovea_hal::{GazeSample, HmdDescription, TraceWriter};
+use fovea_test_kit::pictures::{failure_message, Picture};
 use glam::Vec3;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -56,18 +57,56 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Each failing frame of a replay report as a picture comparison (`fovea_test_kit::pictures`):
+/// the frame rendered now, the baseline's and their FLIP difference under target/test-failures;
+/// one line per frame naming its folder.
+fn failing_frames(out: &Path, report: &Value) -> String {
+    let mut lines = Vec::new();
+    for t in report["traces"].as_array().into_iter().flatten() {
+        let baseline = PathBuf::from(t["baseline"].as_str().unwrap_or_default());
+        let name = baseline.file_name().unwrap_or_default().to_string_lossy();
+        for frame in t["failed_frames"].as_array().into_iter().flatten() {
+            let file = format!("frame_{:04}.png", frame.as_u64().unwrap_or_default());
+            let read = |p: PathBuf| image::open(&p).map(|i| i.to_rgba8());
+            let (Ok(now), Ok(before)) = (
+                read(out.join(format!("run_{name}")).join(&file)),
+                read(baseline.join(&file)),
+            ) else {
+                lines.push(format!("{name} {file}: no picture to compare"));
+                continue;
+            };
+            let (now, before) = (
+                Picture::rgba8(now.width(), now.height(), now.as_raw()),
+                Picture::rgba8(before.width(), before.height(), before.as_raw()),
+            );
+            lines.push(failure_message(
+                &format!("{name} {file}"),
+                &now,
+                &before,
+                format_args!("{name} {file} outside the tolerances"),
+            ));
+        }
+    }
+    lines.join("\n")
+}
+
 #[test]
 fn the_committed_baselines_replay_within_tolerance() {
     let out = temp_dir("committed");
     let done = replay(&TRACES, &committed(), &out, &[]);
+    let report_path = out.join("replay.json");
+    let pictures = match report_path.is_file() {
+        true => failing_frames(&out, &json(&report_path)),
+        false => String::new(),
+    };
     assert_eq!(
         done.status.code(),
         Some(0),
-        "{}\n{}",
+        "{}\n{}\n{pictures}",
         String::from_utf8_lossy(&done.stdout),
         stderr(&done)
     );
-    let report = json(&out.join("replay.json"));
+    let report = json(&report_path);
     assert_eq!(report["passed"], true);
     for t in report["traces"].as_array().unwrap() {
         assert_eq!(t["frames"].as_array().unwrap().len(), 8);
@@ -93,6 +132,21 @@ fn a_planted_regression_fails_naming_frames_and_rings() {
     let report = json(&out.join("replay.json"));
     let trace = &report["traces"][0];
     assert_eq!(trace["failed_frames"].as_array().unwrap().len(), 8);
+    // What the committed-baseline test leaves behind when it fails like this: each failing
+    // frame, its baseline and their FLIP difference, in a folder its message names.
+    let evidence = failing_frames(&out, &report);
+    let folders: Vec<PathBuf> = evidence
+        .lines()
+        .filter(|l| l.contains("FLIP difference"))
+        .filter_map(|l| l.rsplit(" in ").next().map(PathBuf::from))
+        .collect();
+    assert_eq!(folders.len(), 8, "{evidence}");
+    for f in &folders {
+        for picture in ["actual.png", "expected.png", "flip.png"] {
+            assert!(f.join(picture).is_file(), "{picture} missing in {f:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(folders[0].parent().unwrap());
     let worse: usize = trace["frames"]
         .as_array()
         .unwrap()

@@ -1,7 +1,7 @@
 //! `fovea view` in a real window: an Xvfb display (installed by scripts/setup), lavapipe,
 //! validation on (the binary fails on any message). Its `--frames N --screenshot` image, copied
-//! from the presented swapchain image, must equal `fovea render`'s frame N − 1 of the same
-//! camera, gaze and settings (threshold: every channel within 1 of 255, documented in the README;
+//! from the presented swapchain image, must equal `fovea render`'s frame N − 1 of the same camera,
+//! gaze and settings (threshold: every channel within 1 of 255, documented in docs/guide/view.md;
 //! on lavapipe the images are byte-identical).
 
 use std::path::{Path, PathBuf};

@@ -117,14 +117,23 @@ fn sixty_frames_on_the_runtime_with_gaze_at_display_time() {
     let (out, side) = (temp_dir("sixty"), temp_dir("sixty-side"));
     let (trace, shot) = (side.join("gaze.csv"), side.join("shot.png"));
     let started = Instant::now();
-    run(
-        fovea(&["xr", "--frames", "60", "--validation", "--out"], true)
-            .arg(&out)
-            .arg("--record")
-            .arg(&trace)
-            .arg("--screenshot")
-            .arg(&shot),
-    );
+    run(fovea(
+        &[
+            "xr",
+            "--frames",
+            "60",
+            "--scale",
+            "0.25",
+            "--validation",
+            "--out",
+        ],
+        true,
+    )
+    .arg(&out)
+    .arg("--record")
+    .arg(&trace)
+    .arg("--screenshot")
+    .arg(&shot));
     eprintln!(
         "fovea xr --frames 60: {:.0} s",
         started.elapsed().as_secs_f64()
@@ -348,10 +357,15 @@ fn without_an_eye_tracker_the_centre_is_used_and_said_once() {
         .as_str()
         .unwrap()
         .contains("no eye tracker"));
-    let refused = fovea(&["xr", "--frames", "1", "--gaze", "openxr", "--out"], false)
-        .arg(temp_dir("no-tracker-openxr"))
-        .output()
-        .unwrap();
+    let refused = fovea(
+        &[
+            "xr", "--frames", "1", "--scale", "0.25", "--gaze", "openxr", "--out",
+        ],
+        false,
+    )
+    .arg(temp_dir("no-tracker-openxr"))
+    .output()
+    .unwrap();
     assert!(!refused.status.success());
     assert!(
         String::from_utf8_lossy(&refused.stderr).contains("--gaze openxr"),

@@ -751,21 +751,18 @@ mod fuzz {
     }
 }
 
-/// The shared real scenes (when this checkout has `../shared/`) load within the default budgets,
-/// with no warnings, exactly as their README describes them.
+/// The shared real scenes (`../shared/data/scenes`) load within the default budgets, with no
+/// warnings, exactly as their README describes them.
 #[test]
 fn shared_real_scenes_load_within_the_default_budgets() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/scenes");
     for (file, triangles, cameras) in [
         ("sponza/Sponza.gltf", 262_087, 4),
         ("breakfast-room/BreakfastRoom.gltf", 262_687, 3),
         ("flight-helmet/FlightHelmet.gltf", 94_722, 0),
     ] {
-        let path = root.join(file);
-        if !path.exists() {
-            println!("note: {} not found; skipping", path.display());
+        let Some(path) = fovea_test_kit::data::shared_data(&format!("scenes/{file}")) else {
             continue;
-        }
+        };
         let scene = load(&path).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(
             (scene.placed_triangle_count(), scene.cameras.len()),

@@ -103,23 +103,19 @@ pub fn quad_grid(n: u32) -> Vec<[Vec3; 3]> {
     tris
 }
 
-/// The shared Stanford bunny (ASCII PLY), or None with a printed note when it is absent.
+/// The shared Stanford bunny (ASCII PLY), or None when it is absent and not required (the rule of
+/// `fovea_test_kit::data::shared_data`).
 pub fn bunny() -> Option<Vec<[Vec3; 3]>> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/bunny.ply");
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        println!(
-            "note: {} not found; skipping the bunny mesh",
-            path.display()
-        );
-        return None;
-    };
+    let path = fovea_test_kit::data::shared_data("bunny.ply")?;
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let mut lines = text.lines();
     let (mut vertex_count, mut face_count) = (0usize, 0usize);
     for line in lines.by_ref() {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
-            ["element", "vertex", n] => vertex_count = n.parse().ok()?,
-            ["element", "face", n] => face_count = n.parse().ok()?,
+            ["element", "vertex", n] => vertex_count = n.parse().expect("bunny.ply: vertex count"),
+            ["element", "face", n] => face_count = n.parse().expect("bunny.ply: face count"),
             ["end_header"] => break,
             _ => {}
         }

@@ -275,11 +275,15 @@ mod tests {
     }
 
     /// Samples per ring around a centred gaze (full rings, inside the inscribed circle) against
-    /// the integral of the paper's density ρ(r)·2πr (f64 midpoint rule), within one column's rows
-    /// (the rings' edges cut columns) and 1 %.
+    /// the integral of the paper's density ρ(r)·2πr (f64 midpoint rule): Pearson's χ² over the
+    /// rings and the rest of the screen (`test_draws`: samples drawn with the grid's density),
+    /// at 1 % over both exponents.
     #[test]
     fn samples_per_ring_follow_the_papers_density() {
-        for alpha in [1.0f32, 4.0] {
+        use crate::sampling::test_draws::{draw_screen_samples, DENSITY_DRAWS};
+        let alphas = [1.0f32, 4.0];
+        let significance = fovea_test_kit::chi2::sidak(0.01, alphas.len());
+        for alpha in alphas {
             let s = space(
                 UVec2::new(320, 360),
                 Vec2::new(160.0, 180.0),
@@ -289,32 +293,36 @@ mod tests {
                 },
             );
             let (g, law) = (s.grid_size(), *s.log_polar().unwrap());
-            let radii: Vec<f32> = (0..g.x)
-                .map(|x| {
-                    (s.grid_to_screen(Vec2::new(x as f32 + 0.5, 0.5)).unwrap() - s.gaze()).length()
+            assert_eq!(
+                s.sample_count(),
+                g.x as u64 * g.y as u64,
+                "no texel clipped"
+            );
+            let edges = [2.0f64, 8.0, 20.0, 45.0, 80.0, 120.0, 159.0];
+            let rings = edges.len() - 1;
+            let mut observed = vec![0f64; rings + 1];
+            for p in draw_screen_samples(&s, DENSITY_DRAWS, 5) {
+                let r = (p - s.gaze()).length() as f64;
+                let ring = edges.windows(2).position(|e| r >= e[0] && r < e[1]);
+                observed[ring.unwrap_or(rings)] += 1.0;
+            }
+            let draws = DENSITY_DRAWS as f64;
+            let mut expected: Vec<f64> = edges
+                .windows(2)
+                .map(|e| {
+                    let n = 20_000;
+                    let dr = (e[1] - e[0]) / n as f64;
+                    let samples: f64 = (0..n)
+                        .map(|i| e[0] + (i as f64 + 0.5) * dr)
+                        .map(|r| law.density(r, g) * std::f64::consts::TAU * r * dr)
+                        .sum();
+                    draws * samples / s.sample_count() as f64
                 })
                 .collect();
-            let edges = [2.0f64, 8.0, 20.0, 45.0, 80.0, 120.0, 159.0];
-            for e in edges.windows(2) {
-                let counted = radii
-                    .iter()
-                    .filter(|&&r| (r as f64) >= e[0] && (r as f64) < e[1])
-                    .count() as f64
-                    * g.y as f64;
-                let n = 20_000;
-                let dr = (e[1] - e[0]) / n as f64;
-                let expected: f64 = (0..n)
-                    .map(|i| e[0] + (i as f64 + 0.5) * dr)
-                    .map(|r| law.density(r, g) * std::f64::consts::TAU * r * dr)
-                    .sum();
-                let tolerance = g.y as f64 + 0.01 * expected;
-                assert!(
-                    (counted - expected).abs() <= tolerance,
-                    "α {alpha} ring [{}, {}) px: {counted} samples, density gives {expected:.0}",
-                    e[0],
-                    e[1]
-                );
-            }
+            expected.push(draws - expected.iter().sum::<f64>());
+            let fit = fovea_test_kit::chi2::chi2_test(&observed, &expected, significance);
+            println!("α {alpha}: per ring {observed:?} vs {expected:.0?}: {fit:?}");
+            assert!(fit.is_ok(), "α {alpha}: {}", fit.unwrap_err());
         }
     }
 

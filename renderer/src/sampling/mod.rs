@@ -11,6 +11,8 @@ mod log_polar;
 mod pixel_blocks;
 pub mod random;
 mod random_acuity;
+#[cfg(test)]
+mod test_draws;
 mod trace_tiles;
 mod uniform_budget;
 mod visual_polar;

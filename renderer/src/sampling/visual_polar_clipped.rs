@@ -1,4 +1,4 @@
-//! The screen-clipped Visual-Polar layout's geometry (issue 4, beyond the paper): the part of a
+//! The screen-clipped Visual-Polar layout's geometry (beyond the paper): the part of a
 //! circle around the gaze that lies on the screen, as up to 4 angular intervals, and the map
 //! between a column's arc position and φ. `shaders/sampling/visual_polar_clipped.glsl` mirrors
 //! `ColumnArcs::{phi_of_arc, arc_of_phi}` op for op; the intervals themselves are computed only

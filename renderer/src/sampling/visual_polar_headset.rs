@@ -1,4 +1,4 @@
-//! The headset-aware eccentricity axis of the Visual-Polar space (issue 4, beyond the paper): the
+//! The headset-aware eccentricity axis of the Visual-Polar space (beyond the paper): the
 //! paper's ρ axis is a normalised screen distance (80 ↦ r_max); this one is the true angle in
 //! degrees between a pixel's view direction and the gaze direction, through the eye's FOV
 //! tangents. `visual_polar_math.glsl` mirrors `HeadsetAxis::{eccentricity, distance}` op for op

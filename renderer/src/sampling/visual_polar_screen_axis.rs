@@ -1,4 +1,4 @@
-//! The screen-aware ρ axis (`VpLayout::ScreenAware`, issue 17): the screen-clipped layout's rows
+//! The screen-aware ρ axis (`VpLayout::ScreenAware`): the screen-clipped layout's rows
 //! with the periphery's columns placed by the acuity mass that lies on the screen.
 //!
 //! The paper places columns by V(e)^k·e (the acuity mass of the whole circle at e). Once each

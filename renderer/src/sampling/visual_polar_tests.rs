@@ -1,6 +1,7 @@
 //! Tests of the Visual-Polar mapping (`visual_polar.rs`).
 
 use super::*;
+use crate::sampling::test_draws::{draw_screen_samples, DENSITY_DRAWS};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -41,14 +42,11 @@ fn bisect_inverse(p: f64, k: f32) -> f64 {
 
 #[test]
 fn csv_vectors_reproduced() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/data/vp_mapping_vectors.csv"
-    );
-    let Ok(text) = std::fs::read_to_string(path) else {
-        println!("note: {path} absent, skipping the Visual-Polar vector test");
+    let Some(path) = fovea_test_kit::data::shared_data("vp_mapping_vectors.csv") else {
         return;
     };
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let (mut rows, mut worst) = (0, 0.0f32);
     for line in text
         .lines()
@@ -263,10 +261,9 @@ fn ring_edges(fovea: f32, e_end: f32, rings_periphery: usize) -> Vec<f32> {
         .collect()
 }
 
-/// Screen-space sample density per eccentricity ring (ρ = distance / r_max · 80), on screen only:
-/// samples (4 jitters along ρ per texel, so ring edges do not quantise whole columns) against
-/// the target integrated over the ring's on-screen pixels. Returns (ρ_lo, measured/target, density).
-fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)>, f32) {
+/// Screen-space sample density per eccentricity ring (ρ = distance / r_max · 80), on screen, held
+/// to the target integrated over the ring's on-screen pixels by [`ring_counts`]' χ² test.
+fn ring_density(s: &VisualPolar, rings_periphery: usize, significance: f64) -> RingFit {
     let k = s.params().density_exponent;
     let f = s.params().fovea_deg;
     let edges = ring_edges(f, E_MAX_DEG, rings_periphery);
@@ -284,68 +281,85 @@ fn ring_density(s: &VisualPolar, rings_periphery: usize) -> (Vec<(f32, f32, f32)
         }
     };
     let rho_of = |p: Vec2| (p - s.gaze()).length() / s.r_max() * E_MAX_DEG;
-    ring_counts(s, &edges, &rho_of, &|p| target(rho_of(p)) as f64)
+    ring_counts(
+        s,
+        &edges,
+        &rho_of,
+        &|p| target(rho_of(p)) as f64,
+        significance,
+    )
 }
 
-/// Per ring of `ecc` (a screen position's ring coordinate), on screen only: the grid's samples
-/// (4 jitters along ρ per texel) against `expected` (target samples in the pixel at a position)
-/// summed over the ring's pixels. Returns (ring start, measured/target, samples per pixel) for
-/// rings with ≥ 500 pixels, and the off-screen share of the samples.
+/// The grid's samples per ring of `ecc` (a screen position's ring coordinate) against `expected`
+/// (the target samples in the pixel at a position, summed over the ring's on-screen pixels), as
+/// a χ² goodness-of-fit test (`fovea_test_kit::chi2`): [`DENSITY_DRAWS`] samples drawn with the
+/// grid's density (`draw_screen_samples`) are counted per ring on screen, the rest off screen;
+/// each ring expects its share of the target, the off-screen cell the remainder.
+struct RingFit {
+    /// (ring start, measured/target, samples per pixel) for rings with ≥ 500 pixels.
+    rows: Vec<(f32, f32, f32)>,
+    /// The off-screen share of the samples.
+    offscreen: f32,
+    fit: Result<fovea_test_kit::chi2::Chi2, String>,
+}
+
 fn ring_counts(
     s: &VisualPolar,
     edges: &[f32],
     ecc: &dyn Fn(Vec2) -> f32,
     expected_in_pixel: &dyn Fn(Vec2) -> f64,
-) -> (Vec<(f32, f32, f32)>, f32) {
+    significance: f64,
+) -> RingFit {
     let (w, h) = (s.screen().x as usize, s.screen().y as usize);
-    let ring = |rho: f32| {
-        edges
-            .iter()
-            .rposition(|&e| e <= rho)
-            .filter(|&i| i + 1 < edges.len())
-    };
-    let grid = s.grid_size();
-    let mut expected = vec![0f64; edges.len()];
-    let mut pixels = vec![0u64; edges.len()];
+    let rings = edges.len() - 1;
+    let ring = |rho: f32| edges.iter().rposition(|&e| e <= rho).filter(|&i| i < rings);
+    let mut target = vec![0f64; rings];
+    let mut pixels = vec![0u64; rings];
     for y in 0..h {
         for x in 0..w {
             let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             if let Some(i) = ring(ecc(p)) {
-                expected[i] += expected_in_pixel(p);
+                target[i] += expected_in_pixel(p);
                 pixels[i] += 1;
             }
         }
     }
-    let mut got = vec![0f64; edges.len()];
-    let (mut onscreen, mut total) = (0f64, 0f64);
-    for c in 0..grid.x {
-        for j in 0..s.rows_in_column(c) {
-            for jx in 0..4 {
-                let p = s.vp_to_screen(Vec2::new(
-                    c as f32 + (jx as f32 + 0.5) / 4.0,
-                    j as f32 + 0.5,
-                ));
-                total += 0.25;
-                if p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32 {
-                    onscreen += 0.25;
-                    if let Some(i) = ring(ecc(p)) {
-                        got[i] += 0.25;
-                    }
-                }
-            }
+    let kept = s.sample_count();
+    // Per ring on screen, then off screen (or beyond the last ring).
+    let mut observed = vec![0f64; rings + 1];
+    for p in draw_screen_samples(s, DENSITY_DRAWS, 17) {
+        let on_screen = p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32;
+        match ring(ecc(p)).filter(|_| on_screen) {
+            Some(i) => observed[i] += 1.0,
+            None => observed[rings] += 1.0,
         }
     }
-    let rows = (0..edges.len() - 1)
-        .filter(|&i| pixels[i] >= 500) // rings barely on screen say nothing
+    let n = DENSITY_DRAWS as f64;
+    let mut expected: Vec<f64> = target.iter().map(|t| n * t / kept as f64).collect();
+    let on_screen: f64 = expected.iter().sum();
+    expected.push(n - on_screen);
+    let fit = if on_screen > n * (1.0 + 1e-3) {
+        Err(format!(
+            "the target puts {on_screen:.0} of {n} samples on screen"
+        ))
+    } else {
+        fovea_test_kit::chi2::chi2_test(&observed, &expected, significance)
+    };
+    let rows = (0..rings)
+        .filter(|&i| pixels[i] >= 500) // rings barely on screen: their ratio says little
         .map(|i| {
             (
                 edges[i],
-                (got[i] / expected[i]) as f32,
-                (got[i] / pixels[i] as f64) as f32,
+                (observed[i] / expected[i]) as f32,
+                (observed[i] / n * kept as f64 / pixels[i] as f64) as f32,
             )
         })
         .collect();
-    (rows, (1.0 - onscreen / total) as f32)
+    RingFit {
+        rows,
+        offscreen: (observed[rings] / n) as f32,
+        fit,
+    }
 }
 
 #[test]
@@ -366,26 +380,34 @@ fn ring_density_follows_acuity() {
             },
         ),
     ];
+    let significance = fovea_test_kit::chi2::sidak(0.01, cases.len());
+    let mut failures = Vec::new();
     for (w, h, (gx, gy), params) in cases {
         let s = vp(w, h, gx, gy, params);
-        let (rows, offscreen) = ring_density(&s, 16);
+        let RingFit {
+            rows,
+            offscreen,
+            fit,
+        } = ring_density(&s, 16, significance);
         let fovea: Vec<f32> = rows
             .iter()
             .filter(|r| r.0 < params.fovea_deg)
             .map(|r| r.2)
             .collect();
+        let case = format!("{w}x{h} gaze ({gx},{gy}) k {}", params.density_exponent);
         println!(
-            "{w}x{h} gaze ({gx},{gy}) k {}: off-screen {:.1} %, fovea spp {:?}, periphery ratio {:?}",
-            params.density_exponent,
+            "{case}: off-screen {:.1} %, fovea spp {:?}, periphery ratio {:?}, {fit:?}",
             100.0 * offscreen,
             fovea.iter().map(|d| format!("{d:.2}")).collect::<Vec<_>>(),
-            rows.iter().filter(|r| r.0 >= params.fovea_deg).map(|r| format!("{:.3}", r.1)).collect::<Vec<_>>()
+            rows.iter()
+                .filter(|r| r.0 >= params.fovea_deg)
+                .map(|r| format!("{:.3}", r.1))
+                .collect::<Vec<_>>()
         );
-        for &(rho, ratio, density) in &rows {
-            assert!(
-                (ratio - 1.0).abs() < 0.10,
-                "ring at ρ {rho}: measured/target {ratio}"
-            );
+        if let Err(e) = fit {
+            failures.push(format!("{case}: {e}"));
+        }
+        for &(rho, _, density) in &rows {
             if rho < params.fovea_deg {
                 assert!(
                     density >= 1.0,
@@ -394,6 +416,7 @@ fn ring_density_follows_acuity() {
             }
         }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// Bad user parameters are errors naming the parameter, never panics.
@@ -522,8 +545,53 @@ fn invalid_parameters_are_errors() {
     VisualPolar::new(screen, Vec2::new(-50.0, 900.0), Default::default()).unwrap();
 }
 
-/// The `SamplingSpace` view: names, sizes and mappings delegate to the VP mapping; clipped and
-/// out-of-grid positions have no sample.
+/// The paper's Eq. 3 (`shared/design/visual-polar.md` §3) in f64, written out here so the
+/// mapping is checked against the paper rather than against itself.
+fn paper_eq3(p: f64) -> f64 {
+    25.09 * p.powi(4) + 0.1680 * p.powi(3) + 27.61 * p * p + 23.87 * p + 3.232
+}
+
+/// The paper's default layout (§4) by hand, for a grid `grid` around `gaze` at `r_max`: column
+/// c keeps all rows beyond u_f = 0.24 (the 12 % triangular clip) and round(H·u/u_f) rows inside
+/// it; the texel centre (x, y) lies at φ = 2π·y/rows, at r = u/u_f · r_f in the fovea and at
+/// r = e(p)/e(1) · r_max beyond, p running linearly from p_f = CDF(5.79)/CDF(80) to 1.
+struct PaperLayout {
+    grid: (u32, u32),
+    gaze: (f64, f64),
+    r_max: f64,
+}
+
+impl PaperLayout {
+    const U_F: f64 = 0.24;
+    const P_F: f64 = 0.096257; // the vectors' header (vp_mapping_vectors.csv)
+
+    fn rows(&self, col: u32) -> u32 {
+        let (w, h) = self.grid;
+        let u = (col as f64 + 0.5) / w as f64;
+        if u >= Self::U_F {
+            h
+        } else {
+            ((h as f64 * u / Self::U_F + 0.5).floor() as u32).clamp(1, h)
+        }
+    }
+
+    fn screen(&self, x: f64, y: f64) -> (f64, f64) {
+        let u = x / self.grid.0 as f64;
+        let r_f = paper_eq3(Self::P_F) / paper_eq3(1.0) * self.r_max;
+        let r = if u < Self::U_F {
+            u / Self::U_F * r_f
+        } else {
+            let p = Self::P_F + (u - Self::U_F) / (1.0 - Self::U_F) * (1.0 - Self::P_F);
+            paper_eq3(p) / paper_eq3(1.0) * self.r_max
+        };
+        let phi = y / self.rows(x as u32) as f64 * std::f64::consts::TAU;
+        (self.gaze.0 + r * phi.cos(), self.gaze.1 + r * phi.sin())
+    }
+}
+
+/// The `SamplingSpace` view of the paper's layout on 160×180 against the layout worked out by
+/// hand from the paper: sizes, the sample count, the GPU parameters and every texel's screen
+/// position; clipped and out-of-grid positions have no sample.
 #[test]
 fn sampling_space_impl() {
     use crate::sampling::SamplingSpace;
@@ -531,19 +599,58 @@ fn sampling_space_impl() {
     let space: &dyn SamplingSpace = &s;
     assert_eq!(space.name(), "vp");
     assert_eq!(space.shader_variant(), "visual_polar");
+    // Each axis × 2/3, rounded.
     assert_eq!(space.grid_size(), UVec2::new(107, 120));
     assert_eq!(space.screen_size(), UVec2::new(160, 180));
-    assert_eq!(space.sample_count(), s.sample_count());
-    assert_eq!(space.params().gaze, s.sampling_params().gaze);
+    // Every corner is hypot(80, 90) from the centred gaze.
+    let r_max = 80f64.hypot(90.0);
+    let paper = PaperLayout {
+        grid: (107, 120),
+        gaze: (80.0, 90.0),
+        r_max,
+    };
+    // 26 fovea columns (u < 0.24) keep 1 577 rows between them, the other 81 all 120: 11 297
+    // texels, the 12 % clip of 107 × 120 = 11 299.2 up to rounding.
+    let by_hand: u64 = (0..107).map(|c| paper.rows(c) as u64).sum();
+    assert_eq!(by_hand, 11_297);
+    assert_eq!(space.sample_count(), by_hand);
+    // The GPU parameters: gaze, r_max, k; u_f, p_f, r_f (the fovea edge, 5.79° on Eq. 3's axis)
+    // and e(1) of Eq. 3 (the polynomial's own normaliser).
+    let params = space.params();
+    let close = |got: f32, want: f64, tol: f64| (got as f64 - want).abs() <= tol;
+    assert!(
+        close(params.gaze.x, 80.0, 0.0)
+            && close(params.gaze.y, 90.0, 0.0)
+            && close(params.gaze.z, r_max, 1e-4)
+            && close(params.gaze.w, 1.0, 0.0),
+        "gaze {:?}",
+        params.gaze
+    );
+    let r_f = paper_eq3(PaperLayout::P_F) / paper_eq3(1.0) * r_max;
+    assert!(
+        close(params.shape0.x, PaperLayout::U_F, 1e-6)
+            && close(params.shape0.y, PaperLayout::P_F, 1e-5)
+            && close(params.shape0.z, r_f, 1e-3)
+            && close(params.shape0.w, paper_eq3(1.0), 1e-4),
+        "shape0 {:?} (want u_f 0.24, p_f {}, r_f {r_f}, e(1) {})",
+        params.shape0,
+        PaperLayout::P_F,
+        paper_eq3(1.0)
+    );
     let g = s.grid_size();
+    let (mut mapped, mut worst) = (0u64, 0f64);
     for x in 0..g.x {
         for y in 0..g.y {
             let t = Vec2::new(x as f32, y as f32) + 0.5;
-            let valid = s.is_valid_texel(IVec2::new(x as i32, y as i32));
+            let valid = y < paper.rows(x);
             match space.grid_to_screen(t) {
                 Some(p) => {
                     assert!(valid, "clipped texel ({x}, {y}) mapped");
-                    assert!((p - s.vp_to_screen(t)).length() < 1e-6);
+                    mapped += 1;
+                    let (px, py) = paper.screen(x as f64 + 0.5, y as f64 + 0.5);
+                    let err = (p.x as f64 - px).hypot(p.y as f64 - py);
+                    worst = worst.max(err);
+                    assert!(err < 2e-3, "texel ({x}, {y}): {p}, by hand ({px}, {py})");
                     let back = space
                         .screen_to_grid(p)
                         .expect("a sample's position has a grid position");
@@ -558,6 +665,8 @@ fn sampling_space_impl() {
             }
         }
     }
+    assert_eq!(mapped, by_hand);
+    println!("160x180: every texel within {worst:.1e} px of the paper's layout by hand");
     for bad in [
         Vec2::new(-0.5, 0.5),
         Vec2::new(0.5, -0.5),

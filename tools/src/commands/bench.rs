@@ -37,7 +37,7 @@ pub struct BenchArgs<'a> {
     /// Screen sizes of the VP vs Cartesian comparison (empty: skip it).
     pub vp_sizes: &'a [(u32, u32)],
     /// Where the gaze rests in the VP vs Cartesian frames, as a fraction of the screen per axis
-    /// (`--vp-gaze`; `CENTRED_GAZE` by default, issue 17's targets).
+    /// (`--vp-gaze`; `CENTRED_GAZE` by default, as the performance targets are stated).
     pub vp_gaze: glam::Vec2,
     pub frames: u32,
     /// Per-eye size of the real-time loop section (`None`: skip it); its scene is the Cornell box.

@@ -1,4 +1,4 @@
-//! The real-time loop part of `fovea bench` (issue 12): both eyes of the Cornell box in
+//! The real-time loop part of `fovea bench`: both eyes of the Cornell box in
 //! Visual-Polar space with SVGF, driven the way `fovea render --eyes both` drives them (free the
 //! slot's frame, then record and submit the next), three times on one device:
 //! one stereo renderer with 1 and with 2 frames in flight, and two mono renderers (one scene
@@ -7,8 +7,9 @@
 //! waits per frame, GPU bytes. Each run is made twice, in the order A B C C B A, so that a drift
 //! of the machine's speed (other work on a shared CPU device) hits the three alike.
 
-use super::setup::{eye_pose, filters, space_for, Eyes};
+use super::setup::{filters, space_for};
 use crate::cpu_time::{CpuTimes, CpuUse};
+use crate::projection::{EyeRig, Projection};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context as _, Result};
 use fovea_hal::{Eye, HmdDescription};
@@ -130,6 +131,7 @@ struct LoopSetup {
     settings: RenderSettings,
     screen: glam::UVec2,
     head: CameraPose,
+    rig: EyeRig,
 }
 
 /// `--loop-frames` checked (before the bench's other, slower parts run).
@@ -185,8 +187,17 @@ impl LoopSetup {
         let Some(camera) = scene.default_camera() else {
             bail!("{LOOP_SCENE}: no camera")
         };
-        let head = CameraPose::from_scene_camera(camera, width, height);
+        let rig = EyeRig {
+            projection: Projection::Headset,
+            hmd: hmd.clone(),
+            stereo: true,
+            width,
+            height,
+            metres_per_unit: 1.0,
+        };
+        let head = rig.head(camera);
         Ok(LoopSetup {
+            rig,
             scene,
             hmd,
             profile,
@@ -223,7 +234,7 @@ impl LoopSetup {
         let views: Vec<ViewInput> = eyes
             .iter()
             .map(|&eye| ViewInput {
-                camera: eye_pose(&self.head, &self.hmd, eye, Eyes::Both),
+                camera: self.rig.eye(&self.head, eye),
                 gaze,
             })
             .collect();
@@ -445,7 +456,7 @@ fn collect(tally: &mut Tally, renderer: &Renderer, done: u64, last_renderer: boo
     Ok(())
 }
 
-/// The loop figures as a Markdown table (ready for README.md) and the ratios.
+/// The loop figures as a Markdown table (ready for docs/performance.md) and the ratios.
 fn print_summary(r: &LoopReport, device: &str) {
     println!(
         "loop {} 2 × {}×{} ({} + {}; each run {} × {} timed frames after {} warm-up, order A B C C B A) on {device}:",

@@ -1,4 +1,4 @@
-//! The Visual-Polar part of `fovea bench` (issue 4): whole frames in VP vs Cartesian at full
+//! The Visual-Polar part of `fovea bench`: whole frames in VP vs Cartesian at full
 //! resolution on the same scene, gaze and device, per pass; the share of the way back to the
 //! screen (φ-mips + remap + blur); and primary-ray coherence: the VP samples traced in VP order
 //! vs the same rays shuffled.
@@ -66,11 +66,11 @@ pub struct VpFrameReport {
     pub frame_ratio: f64,
     /// VP trace / Cartesian trace.
     pub trace_ratio: f64,
-    /// (φ-mips + remap + blur) / VP frame (issue target ≤ 0.10 on lavapipe).
+    /// (φ-mips + remap + blur) / VP frame (target ≤ 0.10 on lavapipe).
     pub to_screen_share: f64,
     /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
     pub denoisers: Vec<DenoiserCost>,
-    /// Every other method of `--method` (issue 14's comparators, VP's variants, fixed foveation)
+    /// Every other method of `--method` (the comparators, VP's variants, fixed foveation)
     /// in the same interleaved run as the VP and Cartesian frames above, no denoiser, each with
     /// its paper's defaults (`comparator_spaces`; `linear-falloff`'s samples: the expected count).
     pub comparators: Vec<MethodCost>,
@@ -122,7 +122,7 @@ pub struct DenoiserCost {
     /// Whole frames with this denoiser (every pass of the frame, as `vp_frame_ms` without one).
     pub cartesian_frame_ms: f64,
     pub vp_frame_ms: f64,
-    /// VP / Cartesian whole frame with this denoiser: issue 17's target with a denoiser.
+    /// VP / Cartesian whole frame with this denoiser (the frame-ratio target with a denoiser).
     pub frame_ratio: f64,
     pub cartesian_history_bytes: u64,
     pub vp_history_bytes: u64,
@@ -225,7 +225,7 @@ pub fn interleaved_pass_medians(
 /// Methods the bench measures itself (the VP and Cartesian frames every ratio divides).
 const MEASURED_APART: &[&str] = &["vp", "cartesian"];
 
-/// Every other method of the registry (`methods::METHODS`: the comparators of issue 14 with
+/// Every other method of the registry (`methods::METHODS`: the comparators with
 /// their papers' defaults, VP's variants, fixed foveation), as `fovea render` builds it with the
 /// default profile for the FOVE 0's left eye, around `gaze`; each one measured beside `vp`.
 fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSpace>>> {

@@ -1,7 +1,7 @@
-//! `fovea method-table`: issue 14's one table of every foveation method, generated from a
+//! `fovea method-table`: one table of every foveation method, generated from a
 //! `fovea quality` run (quality per ring band, samples, rays) and a `fovea bench` report (cost:
-//! whole frames of every method interleaved in one run on one device), written into the README
-//! between `<!-- method-table:begin -->` and `<!-- method-table:end -->`, with a picture row
+//! whole frames of every method interleaved in one run on one device), written into a Markdown
+//! document (docs/quality.md by default) between `<!-- method-table:begin -->` and `<!-- method-table:end -->`, with a picture row
 //! (each method's last evaluated still frame and its FLIP map against the reference) and the
 //! papers' claims each figure confirms or refutes.
 
@@ -109,8 +109,9 @@ pub struct MethodTableArgs<'a> {
     /// `fovea bench` report.json files: the first gives the table's costs, every one a figure per
     /// scene in the claims.
     pub bench: &'a [std::path::PathBuf],
-    pub readme: &'a Path,
-    /// Where the picture row's images go (relative to the README's folder in the links).
+    /// The Markdown document the table goes into, between its markers.
+    pub doc: &'a Path,
+    /// Where the picture row's images go (linked relative to the document's folder).
     pub pictures: &'a Path,
     /// `fovea quality` reports of `vp` and one other method at VP's sample count: a claim each.
     pub equal_samples: &'a [std::path::PathBuf],
@@ -140,19 +141,19 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
         bail!("--bench: at least one fovea bench report")
     };
     let size = &bench.visual_polar[0];
-    let readme = std::fs::read_to_string(args.readme)
-        .with_context(|| format!("reading {}", args.readme.display()))?;
-    // The markers on lines of their own (the README may quote them elsewhere).
+    let doc = std::fs::read_to_string(args.doc)
+        .with_context(|| format!("reading {}", args.doc.display()))?;
+    // The markers on lines of their own (the document may quote them elsewhere).
     let line_of = |marker: &str| {
-        readme.match_indices(marker).map(|(i, _)| i).find(|&i| {
-            (i == 0 || readme[..i].ends_with('\n')) && readme[i + marker.len()..].starts_with('\n')
+        doc.match_indices(marker).map(|(i, _)| i).find(|&i| {
+            (i == 0 || doc[..i].ends_with('\n')) && doc[i + marker.len()..].starts_with('\n')
         })
     };
     let (Some(begin), Some(end)) = (line_of(BEGIN), line_of(END)) else {
-        bail!("{}: needs the markers {BEGIN} and {END}, each on a line of its own, around the table's place", args.readme.display())
+        bail!("{}: needs the markers {BEGIN} and {END}, each on a line of its own, around the table's place", args.doc.display())
     };
     if end < begin {
-        bail!("{}: {END} comes before {BEGIN}", args.readme.display());
+        bail!("{}: {END} comes before {BEGIN}", args.doc.display());
     }
     let costs = costs(size);
     let pictures = pictures(args, &quality)?;
@@ -174,8 +175,8 @@ pub fn run(args: &MethodTableArgs) -> Result<()> {
         write_equal_samples_claim(&mut table, path, &read(path)?)?;
     }
     table.push('\n');
-    let updated = format!("{}{BEGIN}\n{table}{}", &readme[..begin], &readme[end..]);
-    write_text(args.readme, &updated)?;
+    let updated = format!("{}{BEGIN}\n{table}{}", &doc[..begin], &doc[end..]);
+    write_text(args.doc, &updated)?;
     println!("{table}");
     Ok(())
 }
@@ -348,13 +349,7 @@ fn write_pictures(
     pictures: &[(String, String, String)],
     args: &MethodTableArgs,
 ) -> Result<()> {
-    let base = args.readme.parent().unwrap_or(Path::new("."));
-    let dir = args
-        .pictures
-        .strip_prefix(base)
-        .unwrap_or(args.pictures)
-        .display()
-        .to_string();
+    let dir = link_dir(args.doc, args.pictures);
     let _ = writeln!(s, "Still camera, no denoiser, the last evaluated frame (same gaze for every method); below each, its FLIP map against the reference (`{dir}/reference.png`).\n");
     let _ = writeln!(
         s,
@@ -385,6 +380,46 @@ fn write_pictures(
             .join(" | ")
     );
     Ok(())
+}
+
+/// `pictures` as a link from `doc`'s folder: a folder under the document's is linked from there;
+/// another through `../` steps, compared as the real paths when both exist; a path that cannot be
+/// related (one absolute, one relative, `..` left after resolving) as given.
+fn link_dir(doc: &Path, pictures: &Path) -> String {
+    use std::path::{Component, PathBuf};
+    let base = doc.parent().unwrap_or(Path::new(""));
+    if let Ok(inner) = pictures.strip_prefix(base) {
+        return inner.display().to_string();
+    }
+    let (base, target): (PathBuf, PathBuf) = match (base.canonicalize(), pictures.canonicalize()) {
+        (Ok(b), Ok(p)) => (b, p),
+        _ => (base.to_path_buf(), pictures.to_path_buf()),
+    };
+    fn plain(p: &Path) -> Option<Vec<Component<'_>>> {
+        let parts: Vec<Component> = p
+            .components()
+            .filter(|c| !matches!(c, Component::CurDir))
+            .collect();
+        (!parts.contains(&Component::ParentDir)).then_some(parts)
+    }
+    let rooted = |parts: &[Component]| {
+        parts
+            .first()
+            .is_some_and(|c| matches!(c, Component::RootDir | Component::Prefix(_)))
+    };
+    match (plain(&base), plain(&target)) {
+        (Some(base), Some(target)) if rooted(&base) == rooted(&target) => {
+            let shared = base.iter().zip(&target).take_while(|(a, b)| a == b).count();
+            let mut parts = vec!["..".to_string(); base.len() - shared];
+            parts.extend(
+                target[shared..]
+                    .iter()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+            );
+            parts.join("/")
+        }
+        _ => pictures.display().to_string(),
+    }
 }
 
 /// A scene path's file stem (reports name scenes by path or by name).
@@ -553,4 +588,33 @@ fn write_equal_samples_claim(s: &mut String, path: &Path, q: &Quality) -> Result
         figures.join("; ")
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::link_dir;
+    use std::path::Path;
+
+    #[test]
+    fn pictures_are_linked_from_the_documents_folder() {
+        let link = |doc: &str, pictures: &str| link_dir(Path::new(doc), Path::new(pictures));
+        assert_eq!(link("docs/quality.md", "docs/methods"), "methods");
+        assert_eq!(link("README.md", "docs/methods"), "docs/methods");
+        assert_eq!(link("./docs/quality.md", "docs/methods"), "methods");
+        assert_eq!(link("docs/guide/x.md", "docs/methods"), "../methods");
+        assert_eq!(link("a/b.md", "c/d"), "../c/d");
+        assert_eq!(link("/abs/q.md", "docs/methods"), "docs/methods");
+        // Real folders are related through their real paths, `..` in the way or not.
+        let root = std::env::temp_dir().join(format!("fovea-link-dir-{}", std::process::id()));
+        std::fs::create_dir_all(root.join("docs/methods")).unwrap();
+        std::fs::create_dir_all(root.join("other")).unwrap();
+        let doc = root.join("other/../docs/quality.md");
+        let pictures = root.join("docs/methods");
+        assert_eq!(link_dir(&doc, &pictures), "methods");
+        assert_eq!(
+            link_dir(&root.join("other/x.md"), &pictures),
+            "../docs/methods"
+        );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 }

@@ -1,8 +1,8 @@
 //! `fovea reference`: a converged linear-radiance EXR (many samples per pixel, chosen depth).
 
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
-use anyhow::{bail, Result};
-use fovea_renderer::frame::{CameraPose, RenderSettings};
+use anyhow::{bail, Context, Result};
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::UVec2;
@@ -23,6 +23,9 @@ pub struct ReferenceArgs<'a> {
     pub device: Option<&'a str>,
     pub validation: bool,
     pub camera: &'a crate::look::CameraOptions,
+    /// The headset whose eye is rendered (`--projection headset`) and which eye.
+    pub headset: &'a str,
+    pub eye: fovea_hal::Eye,
     pub environment: crate::look::EnvironmentOptions,
     /// `RenderSettings::path_regularisation` (already checked).
     pub path_regularisation: f32,
@@ -44,13 +47,18 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     if args.preview {
         check_new_file(&preview, args.force)?;
     }
-    let (scene, camera) = crate::look::load(
-        args.scene,
-        args.camera,
-        &args.environment,
-        args.width as f32 / args.height as f32,
-    )?;
-    let pose = CameraPose::from_scene_camera(&camera, args.width, args.height);
+    let rig = crate::projection::EyeRig {
+        projection: args.camera.projection,
+        hmd: fovea_hal::HmdDescription::resolve(args.headset)
+            .with_context(|| format!("--headset {}", args.headset))?,
+        stereo: false,
+        width: args.width,
+        height: args.height,
+        metres_per_unit: args.camera.world_scale,
+    };
+    let (scene, camera) =
+        crate::look::load(args.scene, args.camera, &args.environment, rig.framing())?;
+    let pose = rig.eye(&rig.head(&camera), args.eye);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings {
         max_depth: args.max_depth,

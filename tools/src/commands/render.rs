@@ -67,6 +67,9 @@ struct Report {
     offscreen_samples: &'static str,
     scene: String,
     headset: String,
+    /// `headset` (each eye through the profile's frustum, the camera the head) or
+    /// `scene-camera` (`--projection`).
+    projection: &'static str,
     /// "left", "right" or "both".
     eyes: String,
     frames_in_flight: usize,
@@ -83,6 +86,13 @@ struct Report {
     /// Of `gaze_centre`: frames whose gaze lay behind or outside a rendered eye's view (the
     /// source gave one, the frame foveated at the image centre).
     gaze_outside_view: u32,
+    /// With the latency model (`--latency-ms`, `--tracker-hz`, `--gaze-predict`): per frame
+    /// where the eye is at its display time (left eye's render pixels, null without gaze or off
+    /// the image), and the latency accounting.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_true: Option<Vec<Option<[f32; 2]>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_latency: Option<crate::gaze::LatencyLog>,
     device: String,
     width: u32,
     height: u32,
@@ -197,6 +207,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut outside_view = 0u32;
+    let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
@@ -211,6 +222,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Centre => 2,
         }] += 1;
         outside_view += u32::from(frame_gaze.reason.is_some());
+        if let Some(log) = &mut latency_log {
+            log.push(&frame_gaze);
+        }
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
@@ -262,6 +276,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         offscreen_samples: args.profile.offscreen_samples.name(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
+        projection: args.camera.projection.name(),
         eyes: eyes.name().to_string(),
         frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),
@@ -271,6 +286,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         gaze_held: origins[1],
         gaze_centre: origins[2],
         gaze_outside_view: outside_view,
+        gaze_true: latency_log.as_ref().map(|l| l.true_pixels.clone()),
+        gaze_latency: latency_log,
         device: ctx.info.name.clone(),
         width,
         height,

@@ -6,6 +6,7 @@
 use super::render::RenderArgs;
 use crate::camera_path;
 use crate::gaze::{FrameGaze, GazeDriver};
+use crate::projection::EyeRig;
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::{Eye, EyeView, HmdDescription};
@@ -14,7 +15,7 @@ use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
-use glam::{Mat4, UVec2, Vec3};
+use glam::{UVec2, Vec3};
 
 pub use super::methods::{method, names as method_names};
 use super::methods::{ScreenNeeds, SpaceInputs};
@@ -68,7 +69,9 @@ pub struct Setup {
     pub gaze: GazeDriver,
     /// The scene camera fitted to the render size (the head; each eye is offset from it).
     pub start_pose: CameraPose,
-    scene_centre: Vec3,
+    /// Turns the head into each eye's camera (`--projection`).
+    pub rig: EyeRig,
+    pub scene_centre: Vec3,
     frames: u32,
     camera_path: camera_path::CameraMotion,
 }
@@ -89,14 +92,23 @@ impl Setup {
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
-        let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
+        let timing = &args.profile.gaze_timing;
+        let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
+        let rig = EyeRig {
+            projection: args.camera.projection,
+            hmd: hmd.clone(),
+            stereo: args.eyes == Eyes::Both,
+            width,
+            height,
+            metres_per_unit: args.camera.world_scale,
+        };
         let (scene, camera) = crate::look::load(
             args.scene,
             args.camera,
             &args.profile.environment,
-            width as f32 / height as f32,
+            rig.framing(),
         )?;
-        let start_pose = CameraPose::from_scene_camera(&camera, width, height);
+        let start_pose = rig.head(&camera);
         let settings = render_settings(args, denoiser, taa);
         Ok(Setup {
             scene_centre: scene.bounds().center(),
@@ -110,6 +122,7 @@ impl Setup {
             scene,
             gaze,
             start_pose,
+            rig,
             frames,
             camera_path: args.camera_path.clone(),
         })
@@ -135,15 +148,27 @@ impl Setup {
     /// Frame `frame`'s input: each eye's camera (the head pose on the camera path, offset by the
     /// eye's position) and gaze (the combined gaze direction projected into that eye).
     pub fn frame_input(&mut self, frame: u32) -> Result<(FrameInput, FrameGaze)> {
+        self.frame_input_from(frame, None)
+    }
+
+    /// As `frame_input`, the head at `head` instead of on the camera path when given (the
+    /// viewer's free camera).
+    pub fn frame_input_from(
+        &mut self,
+        frame: u32,
+        head: Option<CameraPose>,
+    ) -> Result<(FrameInput, FrameGaze)> {
         let gaze = self.gaze.frame(frame, self.eyes.list())?;
-        let head = camera_path::pose(
-            &self.start_pose,
-            self.scene_centre,
-            frame,
-            self.frames,
-            &self.camera_path,
-            self.hmd.refresh_hz,
-        );
+        let head = head.unwrap_or_else(|| {
+            camera_path::pose(
+                &self.start_pose,
+                self.scene_centre,
+                frame,
+                self.frames,
+                &self.camera_path,
+                self.hmd.refresh_hz,
+            )
+        });
         let mut views = [ViewInput {
             camera: head,
             gaze: None,
@@ -151,28 +176,11 @@ impl Setup {
         let eyes = self.eyes.list();
         for (view, &eye) in views.iter_mut().zip(eyes) {
             *view = ViewInput {
-                camera: eye_pose(&head, &self.hmd, eye, self.eyes),
+                camera: self.rig.eye(&head, eye),
                 gaze: Some(gaze.pixels[eye.index()]),
             };
         }
         Ok((FrameInput::views(&views[..eyes.len()], frame)?, gaze))
-    }
-}
-
-/// The head pose for one eye: a mono run keeps the head pose (the scene camera, as before
-/// stereo); a stereo run offsets each eye by its position in the headset (metres = glTF units).
-pub(crate) fn eye_pose(
-    head: &CameraPose,
-    hmd: &HmdDescription,
-    eye: Eye,
-    eyes: Eyes,
-) -> CameraPose {
-    match eyes {
-        Eyes::Both => CameraPose {
-            world_from_view: head.world_from_view * Mat4::from_translation(hmd.eye(eye).offset),
-            fov_tan: head.fov_tan,
-        },
-        _ => *head,
     }
 }
 

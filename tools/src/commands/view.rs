@@ -1,8 +1,10 @@
 //! `fovea view`: the real-time engine in a desktop window (winit + VK_KHR_swapchain). One eye or
 //! both side by side, written by the engine's last pass straight into the swapchain image; gaze
-//! from the mouse (or any `--gaze` source); keys switch method, denoiser and TAA live and freeze
-//! the gaze; fps and per-pass GPU ms in the title. `--frames N --screenshot FILE` renders frames
-//! 0…N−1 exactly as `fovea render` does and saves the last presented image.
+//! from the mouse (or any `--gaze` source); a free camera (W A S D move, Space and C rise and
+//! sink, Shift runs, dragging with the right button turns the head); keys switch method, denoiser
+//! and TAA live and freeze the gaze; fps and GPU ms in the title, with a refused switch named
+//! there. `--frames N --screenshot FILE` renders frames 0…N−1 exactly as `fovea render` does and
+//! saves the last presented image.
 
 use super::render::RenderArgs;
 use super::setup::{method_names, space_for, Setup};
@@ -10,22 +12,25 @@ use crate::viewer::debug::{compose, DebugView};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
-use fovea_renderer::frame::{FrameInput, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS};
+use fovea_renderer::frame::{
+    CameraPose, FrameInput, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
-use glam::{UVec2, Vec2};
+use glam::{Mat4, Quat, UVec2, Vec2, Vec3};
 use gpu_allocator::MemoryLocation;
+use std::collections::HashSet;
 use std::ffi::CString;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, WindowEvent};
+use winit::event::{ElementState, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::{Key, NamedKey};
+use winit::keyboard::{Key, KeyCode, NamedKey, PhysicalKey};
 use winit::raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::window::{Window, WindowId};
 
@@ -98,6 +103,13 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         debug: args.debug_view,
         title_at: Instant::now(),
         frames_since_title: 0,
+        gpu_ms: None,
+        refused: None,
+        free: None,
+        keys_held: HashSet::new(),
+        cursor: None,
+        drag: None,
+        moved_at: Instant::now(),
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.error.take() {
@@ -137,6 +149,90 @@ struct Viewer<'a> {
     debug: DebugView,
     title_at: Instant,
     frames_since_title: u32,
+    /// The newest completed frame's GPU ms (all passes, the trace's), read when its slot is retired.
+    gpu_ms: Option<(f64, f64)>,
+    /// The last switch the renderer refused, and when (shown in the title for a while).
+    refused: Option<(String, Instant)>,
+    /// The free camera, made by the first move (until then the head follows `--camera-path`).
+    free: Option<FreeCamera>,
+    keys_held: HashSet<KeyCode>,
+    /// The cursor in window pixels, and where the right-button drag last turned the camera.
+    cursor: Option<Vec2>,
+    drag: Option<Vec2>,
+    /// When the free camera last moved (its speed is per second).
+    moved_at: Instant,
+}
+
+/// The viewer's head when the user moves it: a position and a heading with pitch, turned by
+/// dragging and moved along the view with the keys (rolls are not a desktop habit).
+#[derive(Clone, Copy, Debug)]
+struct FreeCamera {
+    position: Vec3,
+    yaw: f32,
+    pitch: f32,
+    /// The head pose's FOV (the scene camera's; the eyes take the headset's under
+    /// `--projection headset`).
+    fov_tan: glam::Vec4,
+}
+
+/// Radians of turn per pixel dragged.
+const TURN_PER_PIXEL: f32 = 0.004;
+/// Scene diagonals per second of free-camera movement (Shift: four times faster).
+const MOVE_DIAGONALS_PER_SECOND: f32 = 0.15;
+/// How long a refused switch stays in the title.
+const REFUSED_SHOWN_FOR: std::time::Duration = std::time::Duration::from_secs(4);
+
+impl FreeCamera {
+    fn from_pose(pose: &CameraPose) -> FreeCamera {
+        let forward = pose
+            .world_from_view
+            .transform_vector3(Vec3::NEG_Z)
+            .normalize();
+        FreeCamera {
+            position: pose.world_from_view.w_axis.truncate(),
+            yaw: (-forward.x).atan2(-forward.z),
+            pitch: forward.y.clamp(-1.0, 1.0).asin(),
+            fov_tan: pose.fov_tan,
+        }
+    }
+
+    fn rotation(&self) -> Quat {
+        Quat::from_rotation_y(self.yaw) * Quat::from_rotation_x(self.pitch)
+    }
+
+    fn pose(&self) -> CameraPose {
+        CameraPose {
+            world_from_view: Mat4::from_rotation_translation(self.rotation(), self.position),
+            fov_tan: self.fov_tan,
+        }
+    }
+
+    fn turn(&mut self, pixels: Vec2) {
+        self.yaw -= pixels.x * TURN_PER_PIXEL;
+        let limit = 89f32.to_radians();
+        self.pitch = (self.pitch - pixels.y * TURN_PER_PIXEL).clamp(-limit, limit);
+    }
+
+    /// Moves by `step` scene units along the held keys' directions (view-relative, up is +Y).
+    fn travel(&mut self, keys: &HashSet<KeyCode>, step: f32) {
+        let r = self.rotation();
+        let axes = [
+            (KeyCode::KeyW, r * Vec3::NEG_Z),
+            (KeyCode::KeyS, r * Vec3::Z),
+            (KeyCode::KeyA, r * Vec3::NEG_X),
+            (KeyCode::KeyD, r * Vec3::X),
+            (KeyCode::Space, Vec3::Y),
+            (KeyCode::KeyC, Vec3::NEG_Y),
+        ];
+        let direction: Vec3 = axes
+            .iter()
+            .filter(|(k, _)| keys.contains(k))
+            .map(|(_, d)| *d)
+            .sum();
+        if direction.length_squared() > 0.0 {
+            self.position += direction.normalize() * step;
+        }
+    }
 }
 
 impl ApplicationHandler for Viewer<'_> {
@@ -159,13 +255,42 @@ impl ApplicationHandler for Viewer<'_> {
             WindowEvent::CursorMoved { position, .. } => {
                 let eye_width = self.setup.width as f32;
                 let p = Vec2::new(position.x as f32, position.y as f32);
-                if !self.frozen {
+                self.cursor = Some(p);
+                if let Some(from) = self.drag.replace(p) {
+                    self.free_camera().turn(p - from);
+                } else if !self.frozen {
                     self.mouse = Some(Vec2::new(p.x % eye_width, p.y));
                 }
                 Ok(())
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                self.key(event_loop, &event.logical_key)
+            WindowEvent::MouseInput {
+                button: MouseButton::Right,
+                state,
+                ..
+            } => {
+                // Dragging turns the head; the gaze stays where the cursor was.
+                self.drag = None;
+                if state == ElementState::Pressed && self.args.frames.is_none() {
+                    self.drag = self.cursor;
+                }
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    match event.state {
+                        ElementState::Pressed => self.keys_held.insert(code),
+                        ElementState::Released => self.keys_held.remove(&code),
+                    };
+                }
+                match event.state {
+                    ElementState::Pressed => self.key(event_loop, &event.logical_key),
+                    ElementState::Released => Ok(()),
+                }
+            }
+            WindowEvent::Focused(false) => {
+                self.keys_held.clear();
+                self.drag = None;
+                Ok(())
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
             _ => Ok(()),
@@ -340,6 +465,7 @@ impl Viewer<'_> {
             list[(list.iter().position(|m| *m == current).unwrap_or(0) + 1) % list.len()]
                 .to_string()
         };
+        let before = (self.method.clone(), self.denoiser.clone(), self.taa.clone());
         match key.as_ref() {
             Key::Named(NamedKey::Escape) | Key::Character("q") => {
                 event_loop.exit();
@@ -359,9 +485,67 @@ impl Viewer<'_> {
             _ => return Ok(()),
         }
         if let Err(e) = self.rebuild_views() {
-            // An unsupported combination is reported, not fatal: the old views stay.
-            eprintln!("view: {e:#}");
+            // An unsupported combination is reported, not fatal: the old views stay, and the
+            // title names what runs and what was refused.
+            let asked = format!("{} · {} · taa {}", self.method, self.denoiser, self.taa);
+            eprintln!("view: {asked} refused: {e:#}");
+            (self.method, self.denoiser, self.taa) = before;
+            self.refused = Some((asked, Instant::now()));
+            self.title_at = Instant::now() - std::time::Duration::from_secs(1);
         }
+        Ok(())
+    }
+
+    /// The free camera, made at the head's pose of this frame on its first use.
+    fn free_camera(&mut self) -> &mut FreeCamera {
+        if self.free.is_none() {
+            let head = crate::camera_path::pose(
+                &self.setup.start_pose,
+                self.setup.scene_centre,
+                self.frame,
+                u32::MAX,
+                &self.args.render.camera_path,
+                self.setup.hmd.refresh_hz,
+            );
+            self.free = Some(FreeCamera::from_pose(&head));
+        }
+        self.free.as_mut().expect("made above")
+    }
+
+    /// Moves the free camera by the keys held since the last frame.
+    fn travel(&mut self) {
+        let now = Instant::now();
+        let seconds = (now - self.moved_at).as_secs_f32().min(0.1);
+        self.moved_at = now;
+        let moving = [
+            KeyCode::KeyW,
+            KeyCode::KeyA,
+            KeyCode::KeyS,
+            KeyCode::KeyD,
+            KeyCode::Space,
+            KeyCode::KeyC,
+        ];
+        if self.args.frames.is_some() || !moving.iter().any(|k| self.keys_held.contains(k)) {
+            return;
+        }
+        let fast = self.keys_held.contains(&KeyCode::ShiftLeft)
+            || self.keys_held.contains(&KeyCode::ShiftRight);
+        let diagonal = self.setup.scene.bounds().bounding_sphere_radius() * 2.0;
+        let step = diagonal * MOVE_DIAGONALS_PER_SECOND * seconds * if fast { 4.0 } else { 1.0 };
+        let keys = self.keys_held.clone();
+        self.free_camera().travel(&keys, step);
+    }
+
+    /// GPU ms of a completed frame, kept for the title.
+    fn note_timings(&mut self, frame: u64) -> Result<()> {
+        let timings = self.renderer.frame_timings(frame)?;
+        let total = timings.iter().map(|t| t.ms).sum();
+        let trace = timings
+            .iter()
+            .filter(|t| t.name == "trace")
+            .map(|t| t.ms)
+            .sum();
+        self.gpu_ms = Some((total, trace));
         Ok(())
     }
 
@@ -374,8 +558,11 @@ impl Viewer<'_> {
         if self.debug != DebugView::Off {
             return self.redraw_debug();
         }
-        // The slot's previous frame must be done before its acquire semaphore is reused.
-        self.renderer.retire_next()?;
+        // The slot's previous frame must be done before its acquire semaphore is reused; its GPU
+        // times are read now, before the slot takes the next frame.
+        if let Some(done) = self.renderer.retire_next()? {
+            self.note_timings(done)?;
+        }
         let slot = self.renderer.ring().next_slot();
         let Some(w) = &self.window else { return Ok(()) };
         let Some(swapchain) = &w.swapchain else {
@@ -442,6 +629,7 @@ impl Viewer<'_> {
         let input = self.frame_input()?.with_grid(self.debug == DebugView::Grid);
         let frame = self.renderer.submit(&input, None)?;
         self.renderer.finish()?;
+        self.note_timings(frame)?;
         let eye = self.setup.screen();
         let pixels = compose(
             self.debug,
@@ -492,7 +680,9 @@ impl Viewer<'_> {
     /// Frame k's input: exactly `fovea render`'s for `--frames` runs and gaze sources; the
     /// mouse (or the frozen gaze) otherwise.
     fn frame_input(&mut self) -> Result<FrameInput> {
-        let (input, _) = self.setup.frame_input(self.frame)?;
+        self.travel();
+        let head = self.free.as_ref().map(FreeCamera::pose);
+        let (input, _) = self.setup.frame_input_from(self.frame, head)?;
         if !self.args.mouse_gaze || self.args.frames.is_some() {
             return Ok(input);
         }
@@ -521,22 +711,22 @@ impl Viewer<'_> {
             return;
         }
         let fps = self.frames_since_title as f64 / elapsed;
-        let total: f64 = self.renderer.timings().iter().map(|t| t.ms).sum();
-        let trace: f64 = self
-            .renderer
-            .timings()
-            .iter()
-            .filter(|t| t.name == "trace")
-            .map(|t| t.ms)
-            .sum();
+        let gpu = match self.gpu_ms {
+            Some((total, trace)) => format!("GPU {total:.1} ms (trace {trace:.1})"),
+            None => "GPU … ms".into(),
+        };
+        let refused = match &self.refused {
+            Some((asked, at)) if at.elapsed() < REFUSED_SHOWN_FOR => {
+                format!("REFUSED {asked} (see the terminal) · ")
+            }
+            _ => String::new(),
+        };
         let title = format!(
-            "fovea — {} · {} · taa {} · {:.1} fps · GPU {:.1} ms (trace {:.1}) · {}{}[m d t f v: method denoiser taa freeze debug view]",
+            "fovea — {} · {} · taa {} · {:.1} fps · {gpu} · {refused}{}{}[m d t f v: method denoiser taa freeze debug view · WASD Space C, right-drag: move]",
             self.method,
             self.denoiser,
             self.taa,
             fps,
-            total,
-            trace,
             if self.frozen { "gaze frozen · " } else { "" },
             if self.debug != DebugView::Off { format!("debug view {} · ", self.debug.name()) } else { String::new() }
         );
@@ -579,4 +769,44 @@ fn scaled_fov(fov: glam::Vec4, eye: UVec2) -> glam::Vec4 {
     let ty = fov.w;
     let tx = ty * eye.x as f32 / eye.y as f32;
     glam::Vec4::new(-tx, tx, fov.z, fov.w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_free_camera_starts_at_the_head_moves_along_the_view_and_turns_without_rolling() {
+        let head = CameraPose {
+            world_from_view: Mat4::from_rotation_translation(
+                Quat::from_rotation_y(0.5) * Quat::from_rotation_x(-0.2),
+                Vec3::new(1.0, 2.0, 3.0),
+            ),
+            fov_tan: glam::Vec4::new(-1.0, 1.0, -1.0, 1.0),
+        };
+        let mut free = FreeCamera::from_pose(&head);
+        let pose = free.pose();
+        assert!(
+            pose.world_from_view.abs_diff_eq(head.world_from_view, 1e-5),
+            "{pose:?}"
+        );
+        let forward = head.world_from_view.transform_vector3(Vec3::NEG_Z);
+        free.travel(&HashSet::from([KeyCode::KeyW]), 2.0);
+        assert!((free.position - (Vec3::new(1.0, 2.0, 3.0) + forward * 2.0)).length() < 1e-5);
+        free.travel(&HashSet::from([KeyCode::Space]), 1.0);
+        assert!((free.position.y - (2.0 + forward.y * 2.0 + 1.0)).abs() < 1e-5);
+        // Opposite keys cancel; no key, no move.
+        let at = free.position;
+        free.travel(&HashSet::from([KeyCode::KeyA, KeyCode::KeyD]), 1.0);
+        free.travel(&HashSet::new(), 1.0);
+        assert_eq!(free.position, at);
+        // Dragging right turns right; the horizon stays level and the pitch stops short of 90°.
+        let yaw = free.yaw;
+        free.turn(Vec2::new(100.0, 0.0));
+        assert!(free.yaw < yaw);
+        free.turn(Vec2::new(0.0, -1e6));
+        assert!(free.pitch < 90f32.to_radians());
+        let right = free.pose().world_from_view.transform_vector3(Vec3::X);
+        assert!(right.y.abs() < 1e-5, "no roll: {right}");
+    }
 }

@@ -41,6 +41,69 @@ pub struct XrArgs<'a> {
     pub gaze: Option<&'a str>,
     pub record: Option<&'a Path>,
     pub screenshot: Option<&'a Path>,
+    /// The runtime space the scene camera is placed in (`--reference-space`).
+    pub reference_space: ReferenceSpace,
+}
+
+/// Where the scene meets the runtime's tracking space (`--reference-space`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ReferenceSpace {
+    /// LOCAL: the origin is the head where the session started; the scene camera stands there.
+    #[default]
+    Local,
+    /// STAGE: the origin is on the floor of the play area; the scene camera's point on the
+    /// ground (y = 0) stands there, so the scene's floor is the room's floor.
+    Stage,
+}
+
+impl ReferenceSpace {
+    pub const NAMES: &'static [&'static str] = &["local", "stage"];
+
+    pub fn parse(name: &str) -> Result<ReferenceSpace> {
+        match name {
+            "local" => Ok(ReferenceSpace::Local),
+            "stage" => Ok(ReferenceSpace::Stage),
+            other => bail!(
+                "--reference-space {other}: expected one of {}",
+                ReferenceSpace::NAMES.join(", ")
+            ),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ReferenceSpace::Local => "local",
+            ReferenceSpace::Stage => "stage",
+        }
+    }
+
+    fn openxr(self) -> xr::ReferenceSpaceType {
+        match self {
+            ReferenceSpace::Local => xr::ReferenceSpaceType::LOCAL,
+            ReferenceSpace::Stage => xr::ReferenceSpaceType::STAGE,
+        }
+    }
+}
+
+/// World (scene units) from the runtime's tracking space: the scene camera's position (STAGE: its
+/// point on the ground) and heading, but not its pitch or roll — the runtime's spaces are
+/// gravity-aligned, and a tilted world would tilt under the viewer's feet. Positions the runtime
+/// gives in metres become scene units through `metres_per_unit` (`--world-scale`).
+pub fn world_from_tracking(camera: Mat4, space: ReferenceSpace) -> Mat4 {
+    let position = camera.w_axis.truncate();
+    let forward = camera.transform_vector3(Vec3::NEG_Z);
+    // The heading: −Z turned toward the camera's forward projected on the ground (looking
+    // straight up or down keeps −Z).
+    let yaw = if forward.x.abs() + forward.z.abs() > 1e-6 {
+        (-forward.x).atan2(-forward.z)
+    } else {
+        0.0
+    };
+    let origin = match space {
+        ReferenceSpace::Local => position,
+        ReferenceSpace::Stage => Vec3::new(position.x, 0.0, position.z),
+    };
+    Mat4::from_rotation_translation(Quat::from_rotation_y(yaw), origin)
 }
 
 /// The session, the engine on the runtime's device, and what one frame needs.
@@ -53,8 +116,10 @@ struct XrRun<'a> {
     swapchain: XrSwapchain,
     renderer: Renderer,
     gaze: XrGaze,
-    /// World from the runtime's LOCAL space: the scene camera is where the head starts.
+    /// World from the runtime's tracking space (`world_from_tracking`).
     world_from_local: Mat4,
+    /// Metres per scene unit (`--world-scale`).
+    metres_per_unit: f32,
     log: FrameLog,
     screenshot: Option<Buffer>,
     tally: Tally,
@@ -94,15 +159,18 @@ pub fn run(args: &XrArgs) -> Result<()> {
     let (denoiser, taa) = filters(r.denoiser, r.taa, &r.profile)?;
     let base =
         HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
-    let eye = base.eye(fovea_hal::Eye::Left);
-    // The runtime's size is known only later; the headset's recommended eye frames the scene.
-    let aspect = eye.recommended_width as f32 / eye.recommended_height.max(1) as f32;
-    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, aspect)?;
+    // The runtime's views are known only later; the profile's frustums frame the scene.
+    let (yfov, aspect) = crate::projection::inscribed_view(&base);
+    let framing = crate::look::Framing {
+        yfov: Some(yfov),
+        aspect,
+    };
+    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, framing)?;
     let camera = &camera;
     let out_dir = prepare_output_dir(r.out)?;
     let rt = Arc::new(
         OpenXrRuntime::create("fovea")
-            .context("fovea xr needs an OpenXR runtime (see README: On a headset)")?,
+            .context("fovea xr needs an OpenXR runtime (see docs/guide/xr.md)")?,
     );
     let ctx = open_context(&rt, super::device_options(r.device, r.validation))?;
     let settings = render_settings(r, denoiser, taa);
@@ -113,7 +181,7 @@ pub fn run(args: &XrArgs) -> Result<()> {
         ctx,
         &base,
         &scene,
-        camera.world_from_view,
+        world_from_tracking(camera.world_from_view, args.reference_space),
         settings,
     )?;
     let end = run.frame_loop()?;
@@ -172,23 +240,41 @@ impl<'a> XrRun<'a> {
             (hmd, figures, None)
         };
         let eye_size = scaled_eye_size(hmd.eye(Eye::Left), r.scale);
+        let timing = &r.profile.gaze_timing;
         let (driver, timebase, gaze_source) = match source {
-            Some(gaze) => (
-                GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1),
-                Timebase::Runtime,
-                "openxr".to_string(),
-            ),
+            Some(gaze) => {
+                if timing.latency_ms.is_some() || timing.tracker_hz.is_some() {
+                    bail!("--latency-ms and --tracker-hz model the latency of recorded or simulated gaze; the runtime's eye tracker has its own (--gaze-predict applies)");
+                }
+                let driver = GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1);
+                let driver = match timing.predict {
+                    Some(mode) => driver.with_live_prediction(mode),
+                    None => driver,
+                };
+                (driver, Timebase::Runtime, "openxr".to_string())
+            }
             None => {
                 let spec = args.gaze.unwrap_or("center");
                 (
-                    GazeDriver::open(spec, &hmd, eye_size.0, eye_size.1)?,
+                    GazeDriver::open_timed(spec, &hmd, eye_size.0, eye_size.1, timing)?,
                     Timebase::FromFirstFrame,
                     spec.to_string(),
                 )
             }
         };
         let gaze = XrGaze::new(driver, timebase, base, args.record)?;
-        let local = owner.create_reference_space(xr::ReferenceSpaceType::LOCAL)?;
+        let offered = owner
+            .session()
+            .enumerate_reference_spaces()
+            .context("xrEnumerateReferenceSpaces")?;
+        let wanted = args.reference_space.openxr();
+        if !offered.contains(&wanted) {
+            bail!(
+                "--reference-space {}: the runtime offers only {offered:?}",
+                args.reference_space.name()
+            );
+        }
+        let local = owner.create_reference_space(wanted)?;
         let view_space = owner.create_reference_space(xr::ReferenceSpaceType::VIEW)?;
         let swapchain = XrSwapchain::new(&ctx, &owner, eye_size.0, eye_size.1)?;
         eprintln!(
@@ -228,6 +314,7 @@ impl<'a> XrRun<'a> {
             renderer,
             gaze,
             world_from_local,
+            metres_per_unit: r.camera.world_scale,
             log,
             screenshot,
             tally: Tally::default(),
@@ -273,6 +360,7 @@ impl<'a> XrRun<'a> {
                 }
             };
             row.frame = self.tally.frames;
+            row.predicted_display_period_ns = state.predicted_display_period.as_nanos();
             row.cpu_ms = host.elapsed().as_secs_f64() * 1e3;
             self.tally.frames += 1;
             if engine_frame.is_some() {
@@ -345,6 +433,7 @@ impl<'a> XrRun<'a> {
         let row = FrameRow {
             frame: 0,
             predicted_display_time_ns: t,
+            predicted_display_period_ns: 0,
             should_render: true,
             rendered: true,
             views: vec![
@@ -394,12 +483,12 @@ impl<'a> XrRun<'a> {
         Ok(())
     }
 
-    /// An eye's camera: its located pose (LOCAL space) placed at the scene camera, its FOV.
+    /// An eye's camera: its located pose (the tracking space) placed at the scene camera, its FOV.
     fn camera(&self, view: &xr::View) -> CameraPose {
         let (p, o, f) = (view.pose.position, view.pose.orientation, view.fov);
         let local_from_eye = Mat4::from_rotation_translation(
             Quat::from_xyzw(o.x, o.y, o.z, o.w).normalize(),
-            Vec3::new(p.x, p.y, p.z),
+            Vec3::new(p.x, p.y, p.z) / self.metres_per_unit,
         );
         CameraPose {
             world_from_view: self.world_from_local * local_from_eye,
@@ -545,5 +634,38 @@ fn gaze_row(g: &XrFrameGaze) -> GazeRow {
         age_ns: g.age_ns,
         pixels: [g.pixels[0].to_array(), g.pixels[1].to_array()],
         reason: g.reason,
+        latency: g.latency,
+    }
+}
+
+#[cfg(test)]
+mod placement_tests {
+    use super::*;
+
+    #[test]
+    fn the_tracking_space_keeps_the_cameras_place_and_heading_but_not_its_tilt() {
+        // A camera at (1, 2, 3) turned 90° to the left (looking down −X), then pitched 30° down.
+        let camera = Mat4::from_rotation_translation(
+            Quat::from_rotation_y(90f32.to_radians()) * Quat::from_rotation_x(-30f32.to_radians()),
+            Vec3::new(1.0, 2.0, 3.0),
+        );
+        let local = world_from_tracking(camera, ReferenceSpace::Local);
+        assert!((local.w_axis.truncate() - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
+        let forward = local.transform_vector3(Vec3::NEG_Z);
+        assert!((forward - Vec3::NEG_X).length() < 1e-5, "{forward}");
+        assert!((local.transform_vector3(Vec3::Y) - Vec3::Y).length() < 1e-6);
+        let stage = world_from_tracking(camera, ReferenceSpace::Stage);
+        assert!((stage.w_axis.truncate() - Vec3::new(1.0, 0.0, 3.0)).length() < 1e-6);
+        // Looking straight down: no heading to keep, no NaN.
+        let down = Mat4::from_rotation_x(-90f32.to_radians());
+        assert!(world_from_tracking(down, ReferenceSpace::Local).is_finite());
+        assert_eq!(
+            ReferenceSpace::parse("stage").unwrap(),
+            ReferenceSpace::Stage
+        );
+        assert!(ReferenceSpace::parse("floor")
+            .unwrap_err()
+            .to_string()
+            .contains("local, stage"));
     }
 }

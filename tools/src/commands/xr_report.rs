@@ -104,6 +104,10 @@ pub struct XrReport {
     /// Per eye.
     width: u32,
     height: u32,
+    /// The runtime space the scene camera stands in: local | stage.
+    reference_space: &'static str,
+    /// Metres per scene unit (`--world-scale`).
+    world_scale: f32,
     /// Frames of the loop (xrWaitFrame … xrEndFrame), rendered or not.
     frames: u64,
     frames_rendered: u32,
@@ -201,6 +205,8 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
         swapchain_format: format!("{:?}", i.swapchain_format),
         width: i.eye_size.0,
         height: i.eye_size.1,
+        reference_space: i.args.reference_space.name(),
+        world_scale: r.camera.world_scale,
         frames: t.frames,
         frames_rendered: t.rendered,
         frames_logged: i.logged,

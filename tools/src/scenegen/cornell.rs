@@ -93,12 +93,15 @@ pub fn build() -> GltfWriter {
         ));
         w.add_root_node(json!({"name": name, "mesh": cube, "translation": t.to_array(), "rotation": r.to_array(), "scale": size.to_array()}));
     }
-    // The original camera: 800 mm in front of the opening, centred, 39.3° vertical field of view.
+    // A viewer's eyes 0.3 m in front of the 1 m opening, centred: the opening spans ±59°, so a
+    // headset's 90–100° field of view (`--projection headset`) sees the room and not the void
+    // around it. The 70° vertical field of view (`--projection scene-camera`) shows the back
+    // wall, both blocks and the side walls, as the original camera (1.44 m out, 39.3°) did.
     w.add_camera(
         "camera",
-        39.3f32.to_radians(),
+        70f32.to_radians(),
         1.0,
-        [0.0, 0.5, z1 + 800.0 / 555.0],
+        [0.0, 0.5, z1 + 0.3],
         [0.0, 0.0, 0.0, 1.0],
     );
     w

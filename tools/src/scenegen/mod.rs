@@ -7,9 +7,9 @@
 //! The large scene is generated on demand (`fovea gen-scene`, benchmarks), never stored.
 
 mod cornell;
-mod gltf_writer;
+pub mod gltf_writer;
 mod large;
-mod shapes;
+pub mod shapes;
 mod stress;
 mod textures;
 

@@ -55,7 +55,14 @@ fn cornell_box_loads_with_its_light_camera_and_lambertian_materials() {
         );
     }
     let camera = scene.default_camera().expect("a camera");
-    assert!((camera.yfov.to_degrees() - 39.3).abs() < 1e-3);
+    assert!((camera.yfov.to_degrees() - 70.0).abs() < 1e-3);
+    // 0.3 m before the 1 m opening: the opening spans ±59°, wider than a headset's view.
+    let eye = camera.world_from_view.w_axis.truncate();
+    assert!(
+        (eye - glam::Vec3::new(0.0, 0.5, 0.8)).length() < 1e-5,
+        "{eye}"
+    );
+    assert!((0.5f32 / (eye.z - 0.5)).atan().to_degrees() > 55.0);
     let b = scene.bounds();
     assert!(
         (b.min - glam::Vec3::new(-0.5, 0.0, -0.5)).length() < 1e-5

@@ -19,8 +19,7 @@
 //!   extra leaf references; a triangle may sit in several leaves, each leaf box bounding only its
 //!   clipped part. About 6–8× slower to build (Sponza: 1.18 s vs 0.19 s) for a tree of 18 % lower
 //!   SAH cost on Sponza and 19 % on the Breakfast Room, +21 / +18 % references, and 1.5–1.6× their
-//!   primary-ray rate (`fovea bench --bvh sbvh,binned`, README Performance). The default since
-//!   the seventh session.
+//!   primary-ray rate (`fovea bench --bvh sbvh,binned`, docs/performance.md). The default.
 //!
 //! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
 //! long thin and large triangles); `fovea bench` prints it for each scene and builder.

@@ -1,4 +1,4 @@
-//! Denoisers (shared/design/denoisers.md). They run in the sampling grid between the tracer and
+//! Denoisers (design: shared/design/denoisers.md). They run in the sampling grid between the tracer and
 //! the way back to the screen — texel = sample, in Cartesian and Visual-Polar space alike — and
 //! return re-modulated radiance of the grid's size. A denoiser is one module here (SVGF, A-SVGF,
 //! BMFR; TAA, which runs after them, is `passes::taa`) whose parameters implement

@@ -1,10 +1,10 @@
-//! TAA after the remap, in screen space (issue 5; beyond the paper, listed there as future
-//! work). The tracer jitters each Visual-Polar sample by the frame's Halton offset inside its VP
-//! texel, the remap reads the samples where they were traced (`RemapPass` sample offset), and
-//! this pass accumulates the screen images: one jitter cycle sweeps each pixel over a whole VP
-//! texel, which in the periphery spans many pixels — so the neighbourhood that clips the history
-//! is spaced by the local texel footprint (see `taa_screen.comp`). Runs between the remap and
-//! the foveated blur; the history is screen-sized and unblurred.
+//! TAA after the remap, in screen space (beyond the paper, which lists it as future work). The
+//! tracer jitters each Visual-Polar sample by the frame's Halton offset inside its VP texel, the
+//! remap reads the samples where they were traced (`RemapPass` sample offset), and this pass
+//! accumulates the screen images: one jitter cycle sweeps each pixel over a whole VP texel, which
+//! in the periphery spans many pixels — so the neighbourhood that clips the history is spaced by
+//! the local texel footprint (see `taa_screen.comp`). Runs between the remap and the foveated blur;
+//! the history is screen-sized and unblurred.
 
 use super::TaaSettings;
 use crate::error::Result;
