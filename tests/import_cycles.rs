@@ -7,7 +7,7 @@
 //! is not a dependency). A cycle is a strongly connected component of that graph.
 //!
 //! The tools' cycles that exist are listed in `KNOWN_TOOLS_CYCLES`, to be broken and removed from
-//! the list; the test fails on any other cycle and on a listed one that no longer exists. The
+//! the list; the test fails on any other cycle and on a listed one it cannot find. The
 //! engine has none.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -491,7 +491,7 @@ fn the_tools_have_no_import_cycle_but_the_listed_ones() {
     );
     assert!(
         gone.is_empty(),
-        "KNOWN_TOOLS_CYCLES lists cycles that no longer exist (remove them): {}",
+        "KNOWN_TOOLS_CYCLES lists cycles the tools do not have (remove them): {}",
         gone.join("; ")
     );
 }
