@@ -15,9 +15,10 @@ use crate::output::{
 };
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -243,7 +244,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                             camera_path::CameraMotion::Still
                         },
                         seed: args.seed,
-                        max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+                        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
                         exposure: 1.0,
                         profile: args.profile.clone(),
                         debug_views: false,
@@ -337,7 +338,7 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
         let reference = renderer.render_reference(
             &pose,
             args.reference_spp,
-            fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+            fovea_renderer::frame::REALTIME_MAX_DEPTH,
             |_| {},
         )?;
         let name = format!(
