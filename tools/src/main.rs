@@ -229,9 +229,15 @@ struct RenderOpts {
     /// Path vertices: 1 = emission seen directly, 2 = + direct light, 3 = + one indirect bounce.
     #[arg(long, default_value_t = 3)]
     max_depth: u32,
-    /// Linear exposure multiplier before tonemapping.
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Exposure: auto (metered from each frame's radiance with more weight around the gaze,
+    /// adapted over time like an eye, one exposure for both eyes), auto+EV / auto-EV (metered,
+    /// then compensated by EV stops), or EV (fixed, in stops: 0 displays radiance as it is).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    exposure: String,
+    /// Display transform: neutral (Khronos PBR Neutral: base colours as authored, highlights
+    /// compressed), aces (fitted ACES filmic) or clamp.
+    #[arg(long, default_value = "neutral")]
+    tone: String,
     /// Render profile TOML (Visual-Polar parameters, blur); see config/render/default.toml.
     #[arg(long)]
     profile: Option<PathBuf>,
@@ -684,7 +690,8 @@ fn render_args<'a>(
         )?,
         seed: opts.seed,
         max_depth: opts.max_depth,
-        exposure: opts.exposure,
+        exposure: commands::setup::parse_exposure(&opts.exposure)?,
+        tone: commands::setup::parse_tone(&opts.tone)?,
         profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,

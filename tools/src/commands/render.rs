@@ -32,7 +32,10 @@ pub struct RenderArgs<'a> {
     pub camera_path: crate::camera_path::CameraMotion,
     pub seed: u32,
     pub max_depth: u32,
-    pub exposure: f32,
+    /// `--exposure`: automatic (the default) or fixed.
+    pub exposure: fovea_renderer::passes::exposure::Exposure,
+    /// `--tone`: the display transform.
+    pub tone: fovea_renderer::passes::tonemap::ToneCurve,
     /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
@@ -112,6 +115,12 @@ struct Report {
     rays: RayReport,
     max_depth: u32,
     seed: u32,
+    /// `auto` (metered and adapted), `auto+EV`/`auto-EV`, or the fixed exposure in stops.
+    exposure_mode: String,
+    /// The display transform (`--tone`).
+    tone: &'static str,
+    /// Per frame: the exposure multiplier its pixels were displayed with (both eyes share it).
+    exposure: Vec<f32>,
     /// Whether the camera moved (`camera_motion` says how).
     camera_path: bool,
     /// `still`, `orbit` or `keys` (a `--camera-path` file).
@@ -196,6 +205,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         totals: FrameStats::default(),
         ldr: Vec::new(),
         hdr: Vec::new(),
+        exposures: Vec::with_capacity(frames as usize),
     };
 
     let bar = ProgressBar::new(frames as u64);
@@ -302,6 +312,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         rays,
         max_depth: args.max_depth,
         seed: args.seed,
+        exposure_mode: exposure_name(&args.exposure),
+        tone: args.tone.name(),
+        exposure: out.exposures,
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
         visual_polar: match method.report {
@@ -361,10 +374,12 @@ struct FrameWriter<'a> {
     totals: FrameStats,
     ldr: Vec<u8>,
     hdr: Vec<[f32; 4]>,
+    exposures: Vec<f32>,
 }
 
 impl FrameWriter<'_> {
     fn write(&mut self, renderer: &Renderer, frame: u64) -> Result<()> {
+        self.exposures.push(renderer.frame_exposure(frame)?);
         for t in renderer.frame_timings(frame)? {
             *self.pass_sums.entry(t.name.to_string()).or_default() += t.ms;
         }
@@ -402,6 +417,16 @@ impl FrameWriter<'_> {
             debug.frame(frame as u32, renderer)?;
         }
         Ok(())
+    }
+}
+
+/// `--exposure` as the report names it: `auto`, `auto+EV`, or the fixed exposure in stops.
+pub fn exposure_name(exposure: &fovea_renderer::passes::exposure::Exposure) -> String {
+    use fovea_renderer::passes::exposure::Exposure;
+    match exposure {
+        Exposure::Auto(a) if a.compensation_ev == 0.0 => "auto".into(),
+        Exposure::Auto(a) => format!("auto{:+}", a.compensation_ev),
+        Exposure::Manual(m) => format!("{}", m.log2()),
     }
 }
 
