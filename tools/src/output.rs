@@ -249,6 +249,7 @@ fn is_fovea_file(name: &str) -> bool {
             | "frames.jsonl"
             | "replay.json"
             | "replay.md"
+            | "overview.png"
     ) || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_")

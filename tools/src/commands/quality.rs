@@ -250,6 +250,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         // reference's (`tonemap_preview`).
                         exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
                         tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+                        overview: false,
                         profile: args.profile.clone(),
                         debug_views: false,
                         denoiser,

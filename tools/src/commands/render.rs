@@ -34,15 +34,17 @@ pub struct RenderArgs<'a> {
     pub max_depth: u32,
     /// `--exposure`: automatic (the default) or fixed.
     pub exposure: fovea_renderer::passes::exposure::Exposure,
+    /// Write `overview.png` (the last frame, the same frame at full cost, the sample density).
+    pub overview: bool,
     /// `--tone`: the display transform.
     pub tone: fovea_renderer::passes::tonemap::ToneCurve,
     /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
     pub debug_views: bool,
-    /// `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
+    /// `auto` (`setup::AUTO`), `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
     pub denoiser: &'a str,
-    /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
+    /// `auto`, `off`, `vp` or `screen` (`TaaMode::NAMES`).
     pub taa: &'a str,
     pub device: Option<&'a str>,
     pub validation: bool,
@@ -219,6 +221,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut outside_view = 0u32;
     let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
+    let mut recent = super::overview::RecentFrames::default();
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
             break; // finish the frames in flight below; report what was rendered
@@ -236,6 +239,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             log.push(&frame_gaze);
         }
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
+        recent.push(input);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
             out.write(&renderer, done)?;
@@ -261,6 +265,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
     }
+    let overview = match args.overview && interrupted.is_none() {
+        true => Some(
+            super::overview::Overview {
+                ctx: &ctx,
+                setup: &setup,
+                renderer: &renderer,
+                last_frame: frames as u64 - 1,
+                recent: &recent,
+            }
+            .write(args.out)?,
+        ),
+        false => None,
+    };
     super::check_validation(&ctx)?;
 
     let views = eyes.list().len() as u64;
@@ -360,6 +377,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         report.rays_traced,
         args.out.display()
     );
+    if let Some(path) = overview {
+        println!(
+            "overview: {} (left: the last frame; middle: the same frame at full cost, every pixel traced; right: samples per pixel, the gaze marked)",
+            path.display()
+        );
+    }
     Ok(())
 }
 

@@ -93,7 +93,8 @@ impl Setup {
         }
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
-        let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
+        let (denoiser, taa) =
+            filters_for_method(args.denoiser, args.taa, args.method, &args.profile, &hmd)?;
         let timing = &args.profile.gaze_timing;
         let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
         let rig = EyeRig {
@@ -385,6 +386,39 @@ pub fn filters(
         .context("--taa")?
         .with_settings(profile.taa);
     Ok((denoiser_settings, taa_mode))
+}
+
+/// `--denoiser auto` / `--taa auto` (the defaults): what the method table shows best for
+/// Visual-Polar (docs/quality.md: BMFR with TAA in the sampling grid), where the method's grid
+/// runs temporal filters; none and off where it cannot.
+pub const AUTO: &str = "auto";
+pub const AUTO_DENOISER: &str = "bmfr";
+pub const AUTO_TAA: &str = "vp";
+
+/// `filters` with `auto` resolved for `method` (see `AUTO`).
+pub fn filters_for_method(
+    denoiser: &str,
+    taa: &str,
+    method_name: &str,
+    profile: &RenderProfile,
+    hmd: &HmdDescription,
+) -> Result<(DenoiserSettings, TaaMode)> {
+    let runs_filters = || -> Result<bool> {
+        // The capabilities do not depend on the size: a small probe screen.
+        let probe = space_for(method_name, profile, hmd, Eye::Left, UVec2::new(64, 72))?;
+        Ok(probe.capabilities().temporal_filters)
+    };
+    let auto = (denoiser == AUTO || taa == AUTO) && runs_filters()?;
+    let pick = |given: &'static str, off: &'static str| if auto { given } else { off };
+    let denoiser = match denoiser {
+        AUTO => pick(AUTO_DENOISER, "none"),
+        name => name,
+    };
+    let taa = match taa {
+        AUTO => pick(AUTO_TAA, "off"),
+        name => name,
+    };
+    filters(denoiser, taa, profile)
 }
 
 /// The sampling space of `method_name` for one eye of `hmd` (its FOV drives the headset ρ axis).
