@@ -5,7 +5,7 @@
 //! before the texels are decoded), a non-finite or negative texel.
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::scene::environment::{check_size, EnvironmentMap};
+use fovea_renderer::scene::environment::{check_size, EnvironmentMap, MAX_ENVIRONMENT_SIZE};
 use glam::Vec3;
 use std::path::Path;
 
@@ -46,49 +46,37 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
     Ok(map)
 }
 
+/// Most texels a map file may declare (the supported 8192 × 4096), checked from its header.
+const MAX_TEXELS: u64 = MAX_ENVIRONMENT_SIZE.0 as u64 * MAX_ENVIRONMENT_SIZE.1 as u64;
+
 fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
-    use exr::prelude::*;
-    let meta = MetaData::read_from_file(path, false).context("not a readable OpenEXR file")?;
+    let bytes =
+        crate::decode::read_bounded(path, crate::decode::MAX_IMAGE_FILE_BYTES, "environment map")?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&bytes), false)
+        .context("not a readable OpenEXR file")?;
     let size = meta
         .headers
         .first()
         .context("the OpenEXR file has no layer")?
         .layer_size;
     check_size(size.width() as u32, size.height() as u32).map_err(anyhow::Error::msg)?;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| {
-            (
-                resolution.width(),
-                vec![Vec3::ZERO; resolution.width() * resolution.height()],
-            )
-        },
-        |(w, texels), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            texels[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
-        },
-    )
-    .context("cannot read its RGB channels")?;
-    let size = image.layer_data.size;
+    let (w, h, texels) = crate::decode::decode_exr(&bytes, "the file", MAX_TEXELS, None)
+        .context("cannot read its RGB channels")?;
     Ok((
-        size.width() as u32,
-        size.height() as u32,
-        image.layer_data.channel_data.pixels.1,
+        w,
+        h,
+        texels.iter().map(|t| Vec3::new(t[0], t[1], t[2])).collect(),
     ))
 }
 
 fn read_hdr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
-    use image::ImageDecoder;
-    let file = std::io::BufReader::new(std::fs::File::open(path)?);
-    let decoder =
-        image::codecs::hdr::HdrDecoder::new(file).context("not a readable Radiance HDR file")?;
-    let (width, height) = decoder.dimensions();
+    let bytes =
+        crate::decode::read_bounded(path, crate::decode::MAX_IMAGE_FILE_BYTES, "environment map")?;
+    let mut header = std::io::Cursor::new(&bytes);
+    let decoder = image::codecs::hdr::HdrDecoder::new(&mut header)
+        .context("not a readable Radiance HDR file")?;
+    let (width, height) = image::ImageDecoder::dimensions(&decoder);
     check_size(width, height).map_err(anyhow::Error::msg)?;
-    let pixels = image::DynamicImage::from_decoder(decoder)
-        .context("cannot decode its pixels")?
-        .into_rgb32f();
-    Ok((
-        width,
-        height,
-        pixels.pixels().map(|p| Vec3::from_array(p.0)).collect(),
-    ))
+    let (w, h, texels) = crate::decode::decode_hdr(&bytes, "the file", MAX_TEXELS)?;
+    Ok((w, h, texels.into_iter().map(Vec3::from_array).collect()))
 }

@@ -10,9 +10,7 @@ use super::render::{self, RenderArgs};
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
-use crate::output::{
-    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text,
-};
+use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::denoise::taa::TaaMode;
@@ -383,12 +381,16 @@ fn measure(
             gaze[1].as_f64().unwrap_or(0.0) as f32,
         );
         let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
-        let (_, _, test) = read_exr(&path)?;
+        let size = Some((args.width, args.height));
+        let (_, _, test) = crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?
-            .to_rgba8()
-            .into_raw();
+        let displayed = crate::decode::read_rgba8(
+            &dir.join(format!("frame_{f:04}.png")),
+            crate::decode::MAX_IMAGE_PIXELS,
+            size,
+        )?
+        .2;
         let reference_displayed = tonemap_preview(reference, 1.0);
         let flip = flip_map(
             &reference_displayed,
