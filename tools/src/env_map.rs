@@ -43,6 +43,9 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
         .map_err(|e| anyhow::anyhow!("environment map {name}: {e}"))?;
     map.rotation = rotation_deg.to_radians();
     map.intensity = intensity;
+    map.check_radiance().map_err(|e| {
+        anyhow::anyhow!("environment map {name}: {e}; lower --env-intensity (or the profile's env_intensity) or scale the map")
+    })?;
     Ok(map)
 }
 
@@ -79,4 +82,43 @@ fn read_hdr(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     check_size(width, height).map_err(anyhow::Error::msg)?;
     let (w, h, texels) = crate::decode::decode_hdr(&bytes, "the file", MAX_TEXELS)?;
     Ok((w, h, texels.into_iter().map(Vec3::from_array).collect()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Radiance HDR file of `w` × `h` texels, each the RGBE bytes `rgbe`.
+    fn hdr(name: &str, rgbe: [u8; 4]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("fovea-env-map-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+        for i in 0..8 {
+            bytes.extend(if i == 5 { rgbe } else { [128, 128, 128, 129] });
+        }
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
+    /// Finite texels of 1e20 and above, an RGBE exponent of 255, or 1e15 × the allowed
+    /// --env-intensity 1e6 passed every check and rendered a black frame (exit 0).
+    #[test]
+    fn radiance_a_frame_cannot_show_is_refused() {
+        // RGBE (m, e) is m / 256 × 2^(e − 128): 0.5 × 2^68 ≈ 1.5e20; exponent 255 ≈ 1.3e38;
+        // 0.5 × 2^51 ≈ 1.1e15.
+        for (name, rgbe, intensity) in [
+            ("1e20.hdr", [128, 128, 128, 196], 1.0),
+            ("e255.hdr", [200, 200, 200, 255], 1.0),
+            ("1e15.hdr", [128, 128, 128, 179], 1e6),
+        ] {
+            let err = format!("{:#}", load(&hdr(name, rgbe), 0.0, intensity).unwrap_err());
+            assert!(
+                err.contains(name) && err.contains("texel (1, 1)") && err.contains("--env-intensity"),
+                "{name}: {err}"
+            );
+        }
+        // A sun-bright 5.4e8 at intensity 1000 (5.4e11) loads.
+        load(&hdr("5e8.hdr", [128, 128, 128, 158]), 0.0, 1e3).unwrap();
+    }
 }

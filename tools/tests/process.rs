@@ -366,3 +366,53 @@ fn a_signal_during_start_up_ends_the_process() {
     };
     assert_eq!(status.code(), Some(143));
 }
+
+/// `fovea view --screenshot FILE` replaced an existing file without `--force`; it is refused
+/// before a window opens (so no display is needed to see it).
+#[test]
+fn a_view_screenshot_does_not_replace_a_file_without_force() {
+    let dir = temp_dir("screenshot");
+    let shot = dir.join("shot.png");
+    std::fs::write(&shot, "MY PICTURE").unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_fovea"))
+        .args(["view", "--scene", &cornell(), "--frames", "1", "--screenshot"])
+        .arg(&shot)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains("shot.png already exists; pass --force"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&shot).unwrap(), "MY PICTURE");
+}
+
+/// `gen-scene large --min-triangles 1e11` took 18.8 GB and wrote a file fovea could not load:
+/// the count is bounded by the loader's triangle budget, checked before anything is built.
+#[test]
+fn gen_scene_triangles_are_bounded_by_the_loader_budget() {
+    let dir = temp_dir("gen-scene");
+    let out = dir.join("large.gltf");
+    let output = Command::new("sh")
+        .args([
+            "-c",
+            &format!(
+                "ulimit -v 4000000; exec '{}' gen-scene large --min-triangles 100000000000 --out '{}'",
+                env!("CARGO_BIN_EXE_fovea"),
+                out.display()
+            ),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--min-triangles 100000000000 must be in 1..=4000000")
+            && stderr.contains("FOVEA_MAX_TRIANGLES"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
