@@ -13,9 +13,10 @@ use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Eval
 use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -241,7 +242,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                             camera_path::CameraMotion::Still
                         },
                         seed: args.seed,
-                        max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+                        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
                         exposure: 1.0,
                         profile: args.profile.clone(),
                         debug_views: false,
@@ -335,7 +336,7 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
         let reference = renderer.render_reference(
             &pose,
             args.reference_spp,
-            fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+            fovea_renderer::frame::REALTIME_MAX_DEPTH,
             |_| {},
         )?;
         let name = format!(

@@ -2,7 +2,8 @@
 
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::frame::RenderSettings;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
