@@ -97,7 +97,7 @@ pub fn camera_path(data: &[u8]) {
     let Ok(keys) = fovea_tools::camera_keys::CameraKeys::load(&path) else {
         return;
     };
-    let start = fovea_renderer::pipeline::CameraPose {
+    let start = fovea_renderer::frame::CameraPose {
         world_from_view: glam::Mat4::IDENTITY,
         fov_tan: glam::Vec4::new(-1.0, 1.0, -1.0, 1.0),
     };
@@ -146,8 +146,11 @@ pub fn hdr(data: &[u8]) {
     }
 }
 
+/// A fuzz target: arbitrary bytes in, a panic on a finding.
+pub type Target = fn(&[u8]);
+
 /// Every target by name (the corpus folders' names).
-pub const TARGETS: [(&str, fn(&[u8])); 9] = [
+pub const TARGETS: [(&str, Target); 9] = [
     ("gltf", gltf),
     ("trace", trace),
     ("headset", headset),

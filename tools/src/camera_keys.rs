@@ -28,6 +28,26 @@ const MAX_COORDINATE: f32 = 1e7;
 /// f32 resolves no finer) for the pair to give a view direction.
 pub const MIN_VIEW_DISTANCE: f32 = 1e-5;
 
+/// The file cut before each line that opens an array-of-tables header (`[[key]]`), each piece
+/// with its first line's number (from 1). Only such headers may follow the first one in a valid
+/// file (every value is a number or an array of numbers), so each piece parses as the file would.
+fn key_tables(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut lines = text.split_inclusive('\n').peekable();
+    let (mut offset, mut line) = (0, 1);
+    std::iter::from_fn(move || {
+        let (start, start_line) = (offset, line);
+        while let Some(next) = lines.peek() {
+            if offset > start && next.trim_start().starts_with("[[") {
+                break;
+            }
+            offset += next.len();
+            line += 1;
+            lines.next();
+        }
+        (offset > start).then(|| (start_line, &text[start..offset]))
+    })
+}
+
 /// `look - position` gives a direction at f32 precision.
 fn has_view(position: Vec3, look: Vec3) -> bool {
     let scale = position
@@ -39,9 +59,17 @@ fn has_view(position: Vec3, look: Vec3) -> bool {
     d.is_finite() && d >= MIN_VIEW_DISTANCE * scale
 }
 
+/// The most bytes of one `[[key]]` table, and of the text before the first (a key takes about
+/// 100). Each table is parsed on its own, so the TOML parser's memory (up to 75 × what it parses)
+/// is bounded by this rather than by the file: a 64 MiB file of tiny values parsed whole took 5 GB.
+pub const MAX_KEY_TABLE_BYTES: usize = 64 << 10;
+/// The largest camera path file (400 000 keys written by a tool take about 45 MB).
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct KeysFile {
+    #[serde(default)]
     key: Vec<KeyEntry>,
 }
 
@@ -70,13 +98,47 @@ pub struct CameraKeys {
 
 impl CameraKeys {
     pub fn load(path: &Path) -> Result<CameraKeys> {
-        let limit = fovea_hal::file::MAX_PROFILE_BYTES * 64;
-        let text = fovea_hal::file::read_text(path, limit, "a camera path")
+        let text = fovea_hal::file::read_text(path, MAX_FILE_BYTES, "a camera path")
             .with_context(|| format!("reading camera path {}", path.display()))?;
-        let file: KeysFile = toml::from_str(&text)
-            .with_context(|| format!("{}: invalid camera path", path.display()))?;
-        let keys = file
-            .key
+        let mut entries = Vec::new();
+        let mut tables = key_tables(&text).peekable();
+        while let Some((line, table)) = tables.next() {
+            if table.len() > MAX_KEY_TABLE_BYTES {
+                bail!(
+                    "{}: invalid camera path at line {line}: {} bytes before the next [[key]], at most {MAX_KEY_TABLE_BYTES} (a key takes about 100)",
+                    path.display(),
+                    table.len()
+                );
+            }
+            let file: KeysFile = toml::from_str(table).map_err(|e| {
+                let offset = e.span().map_or(0, |s| s.start.min(table.len()));
+                let at = line
+                    + table.as_bytes()[..offset]
+                        .iter()
+                        .filter(|&&b| b == b'\n')
+                        .count();
+                anyhow::anyhow!(
+                    "{}: invalid camera path at line {at}: {}",
+                    path.display(),
+                    e.message().trim_end()
+                )
+            })?;
+            if line == 1
+                && tables.peek().is_some()
+                && !file.key.is_empty()
+                && !table.trim_start().starts_with("[[")
+            {
+                bail!(
+                    "{}: invalid camera path: `key` is given as an array before [[key]] tables (use one form)",
+                    path.display()
+                );
+            }
+            entries.extend(file.key);
+            if entries.len() > MAX_KEYS {
+                bail!("{}: more than {MAX_KEYS} keys", path.display());
+            }
+        }
+        let keys = entries
             .iter()
             .map(|k| Key {
                 time: k.time,
@@ -366,6 +428,58 @@ mod tests {
         ];
         assert!(
             format!("{:#}", CameraKeys::new(mixed).unwrap_err()).contains("every key or on none")
+        );
+    }
+
+    /// Each `[[key]]` table is parsed alone: errors still give the line in the file, the inline
+    /// form still loads, a table past the size limit is refused before it is parsed.
+    #[test]
+    fn tables_are_parsed_one_at_a_time_with_file_lines() {
+        let dir = std::env::temp_dir().join(format!("fovea-camera-tables-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |name: &str, text: &str| {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            path
+        };
+        let table =
+            |t: u32| format!("[[key]]\ntime = {t}\nposition = [0, 1, 2]\nlook = [0, 0, 0]\n");
+        let text = format!(
+            "# a path\n{}{}[[key]]\ntime = 2\nposition = [0, 1]\n",
+            table(0),
+            table(1)
+        );
+        let err = format!(
+            "{:#}",
+            CameraKeys::load(&write("lines.toml", &text)).unwrap_err()
+        );
+        assert!(
+            err.contains("lines.toml: invalid camera path at line 12"),
+            "{err}"
+        );
+        let inline = "key = [{ time = 0, position = [0, 1, 2], look = [0, 0, 0] }]\n";
+        let path = CameraKeys::load(&write("inline.toml", inline)).unwrap();
+        assert_eq!(path.keys().len(), 1);
+        let both = format!("{inline}{}", table(1));
+        let err = format!(
+            "{:#}",
+            CameraKeys::load(&write("both.toml", &both)).unwrap_err()
+        );
+        assert!(err.contains("one form"), "{err}");
+        let huge = format!(
+            "{}{}# {}\n",
+            table(0),
+            table(1),
+            "x".repeat(MAX_KEY_TABLE_BYTES)
+        );
+        let err = format!(
+            "{:#}",
+            CameraKeys::load(&write("huge.toml", &huge)).unwrap_err()
+        );
+        assert!(
+            err.contains("huge.toml: invalid camera path at line 5")
+                && err.contains("at most 65536"),
+            "{err}"
         );
     }
 

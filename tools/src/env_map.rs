@@ -114,7 +114,9 @@ mod tests {
         ] {
             let err = format!("{:#}", load(&hdr(name, rgbe), 0.0, intensity).unwrap_err());
             assert!(
-                err.contains(name) && err.contains("texel (1, 1)") && err.contains("--env-intensity"),
+                err.contains(name)
+                    && err.contains("texel (1, 1)")
+                    && err.contains("--env-intensity"),
                 "{name}: {err}"
             );
         }

@@ -375,7 +375,14 @@ fn a_view_screenshot_does_not_replace_a_file_without_force() {
     let shot = dir.join("shot.png");
     std::fs::write(&shot, "MY PICTURE").unwrap();
     let output = Command::new(env!("CARGO_BIN_EXE_fovea"))
-        .args(["view", "--scene", &cornell(), "--frames", "1", "--screenshot"])
+        .args([
+            "view",
+            "--scene",
+            &cornell(),
+            "--frames",
+            "1",
+            "--screenshot",
+        ])
         .arg(&shot)
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
@@ -415,4 +422,38 @@ fn gen_scene_triangles_are_bounded_by_the_loader_budget() {
         "{stderr}"
     );
     assert!(!out.exists());
+}
+
+/// A camera path file was parsed whole: the TOML parser took up to 75 × its size (a 64 MiB file
+/// of tiny values, 5 GB) before the key count was checked. Under a 1 GB address-space limit a
+/// 16 MiB file of that kind is refused with the file and line named, not aborted.
+#[test]
+fn a_camera_path_file_is_parsed_within_bounded_memory() {
+    let dir = temp_dir("camera-path");
+    let path = dir.join("tiny_values.toml");
+    let mut text = String::from("[[key]]\ntime = 0\nposition = [0, 1, 2]\nlook = [0, 0, 0]\n");
+    text += "[[key]]\ntime = 1\nposition = [0, 1, 2]\nlook = [0, 0, 0]\nfov = [";
+    text += &"0,".repeat(8 << 20);
+    text += "0]\n";
+    std::fs::write(&path, text).unwrap();
+    let output = Command::new("sh")
+        .args([
+            "-c",
+            &format!(
+                "ulimit -v 1000000; exec '{}' render --scene '{}' --camera-path '{}' --frames 1 --out '{}'",
+                env!("CARGO_BIN_EXE_fovea"),
+                cornell(),
+                path.display(),
+                dir.join("out").display()
+            ),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("tiny_values.toml: invalid camera path at line 5")
+            && stderr.contains("at most 65536"),
+        "{stderr}"
+    );
 }

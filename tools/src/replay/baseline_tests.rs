@@ -227,7 +227,8 @@ fn frame_counts_are_bounded_and_consistent() {
 fn manifest_fields_are_checked() {
     let root = temp_dir("fields");
     let (id, dir) = write_baseline(&root, 0);
-    let cases: [(&str, fn(&mut serde_json::Value), &str); 6] = [
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit, &str); 6] = [
         (
             "trace",
             |v| v["trace_sha256"] = "0".repeat(64).into(),
