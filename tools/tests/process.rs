@@ -449,6 +449,7 @@ fn a_camera_path_file_is_parsed_within_bounded_memory() {
         ])
         .output()
         .unwrap();
+    let _ = std::fs::remove_dir_all(&dir); // 16 MiB
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert!(

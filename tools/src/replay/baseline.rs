@@ -614,7 +614,7 @@ impl Staging {
             ),
             Ok(_) => {
                 exchange(&self.dir, &self.target)?;
-                // The staging name now holds the old baseline.
+                // After the exchange the staging name holds the old baseline.
                 self.committed = true;
                 sync_dir(parent)?;
                 std::fs::remove_dir_all(&self.dir).with_context(|| {
