@@ -2,7 +2,8 @@
 //! Radiance `.hdr` through `image`) into a checked [`EnvironmentMap`]. Every error names the file
 //! and the reason: missing or not a regular file, an extension other than .exr/.hdr, a file that
 //! does not decode, a size of zero or above `MAX_ENVIRONMENT_SIZE` (checked from the header,
-//! before the texels are decoded), a non-finite or negative texel.
+//! before the texels are decoded), a non-finite or negative texel, a texel whose radiance ×
+//! the intensity exceeds `MAX_ENVIRONMENT_RADIANCE` (the frame would be black).
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::environment::{check_size, EnvironmentMap, MAX_ENVIRONMENT_SIZE};

@@ -190,6 +190,22 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
     }
+    let max_spp = super::reference::MAX_REFERENCE_SPP;
+    if args.reference_spp > max_spp {
+        bail!(
+            "--reference-spp {} must be at most {max_spp} (as fovea reference --spp)",
+            args.reference_spp
+        );
+    }
+    // Every frame is read back within the image budget: a larger run would render for nothing.
+    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
+    if args.width as u64 * args.height as u64 > max_pixels {
+        bail!(
+            "--width {} --height {}: at most {max_pixels} pixels (the frames are read back for the figures)",
+            args.width,
+            args.height
+        );
+    }
     super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
