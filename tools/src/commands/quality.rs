@@ -16,6 +16,7 @@ use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
@@ -259,7 +260,11 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         },
                         seed: args.seed,
                         max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
-                        exposure: 1.0,
+                        // Every method is judged at one fixed exposure and curve, its
+                        // reference's (`tonemap_preview`).
+                        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+                        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+                        overview: false,
                         profile: args.profile.clone(),
                         debug_views: false,
                         denoiser,
@@ -408,7 +413,7 @@ fn measure(
             size,
         )?
         .2;
-        let reference_displayed = tonemap_preview(reference, 1.0);
+        let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,
             &displayed,

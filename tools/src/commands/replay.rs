@@ -247,7 +247,6 @@ fn replay_trace(args: &ReplayArgs, store: &Store, trace: &str) -> Result<TraceRe
         Some(l) => l.reference.clone(),
         None => reference_for(args, &render, width, height)?,
     };
-    let reference_ldr = tonemap_preview(&reference, render.exposure);
     let ppd = pixels_per_degree(args, width)?;
     let passes: BTreeMap<String, f64> =
         serde_json::from_value(report["passes"].clone()).unwrap_or_default();
@@ -260,6 +259,10 @@ fn replay_trace(args: &ReplayArgs, store: &Store, trace: &str) -> Result<TraceRe
             MAX_PIXELS,
             Some((width, height)),
         )?;
+        // The reference displayed as the frame was: its exposure (automatic exposure moves it
+        // frame by frame) and its curve.
+        let exposure = report["exposure"][k as usize].as_f64().unwrap_or(1.0) as f32;
+        let reference_ldr = tonemap_preview(&reference, exposure, render.tone);
         let reference_flip = flip_map(&reference_ldr, &ldr, width, height, ppd);
         let g = &report["gaze"][k as usize];
         let gaze = Vec2::new(
