@@ -255,7 +255,12 @@ fn a_rerun_that_fails_midway_leaves_the_earlier_run_whole() {
     let before = snapshot();
     assert_eq!(
         before.iter().map(|f| f.0.as_str()).collect::<Vec<_>>(),
-        ["frame_0000.png", "frame_0001.png", "report.json"]
+        [
+            "frame_0000.png",
+            "frame_0001.png",
+            "overview.png",
+            "report.json"
+        ]
     );
     let full = Command::new("sh")
         .args([
