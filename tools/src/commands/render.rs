@@ -359,7 +359,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 struct FrameWriter<'a> {
     args: &'a RenderArgs<'a>,
     /// Where the frames go (the run's staging folder).
-    dir: &'a Path,
+    dir: &'a std::path::Path,
     eyes: Eyes,
     width: u32,
     height: u32,
