@@ -357,9 +357,13 @@ enum Command {
     View {
         #[command(flatten)]
         opts: Box<RenderOpts>,
-        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N.
+        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N. An
+        /// existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
         #[arg(long, default_value = "fifo")]
         present_mode: String,
@@ -379,9 +383,13 @@ enum Command {
         /// `fovea render --headset <same> --gaze TRACE.csv`.
         #[arg(long)]
         record: Option<PathBuf>,
-        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs --frames.
+        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs
+        /// --frames. An existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// The runtime space the scene camera stands in: local (the default: where the head was
         /// when the session started) or stage (the play area's floor is the scene's y = 0).
         #[arg(long, default_value = "local")]
@@ -770,6 +778,7 @@ fn run() -> Result<()> {
         Command::View {
             opts,
             screenshot,
+            force,
             present_mode,
             debug_view,
             device,
@@ -792,6 +801,7 @@ fn run() -> Result<()> {
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
+                force,
                 present_mode: &present_mode,
                 mouse_gaze: opts.gaze.is_none(),
                 debug_view: fovea_tools::viewer::debug::DebugView::parse(&debug_view)?,
@@ -802,6 +812,7 @@ fn run() -> Result<()> {
             opts,
             record,
             screenshot,
+            force,
             reference_space,
             device,
         } => {
@@ -832,6 +843,7 @@ fn run() -> Result<()> {
                 gaze: opts.gaze.as_deref(),
                 record: record.as_deref(),
                 screenshot: screenshot.as_deref(),
+                force,
                 reference_space: commands::xr::ReferenceSpace::parse(&reference_space)?,
             })
         }
