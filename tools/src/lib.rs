@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod output;
 pub mod plot;
 pub mod projection;
+pub mod reference_sum;
 pub mod render_profile;
 pub mod replay;
 pub mod scenegen;
