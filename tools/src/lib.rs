@@ -21,5 +21,6 @@ pub mod replay;
 pub mod scenegen;
 pub mod scenes;
 pub mod sky_model;
+pub mod sweep;
 pub mod viewer;
 pub mod xr;
