@@ -2,12 +2,11 @@
 //! ring of slots (same images as waiting, no drain in the steady state, deferred release), and
 //! how the two eyes' noise relates. Synchronisation validation is on in the ring tests.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, StereoNoise, ViewInput};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, RenderSettings, Renderer, StereoNoise, ViewInput,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Context, ContextOptions, EngineCounters};
 use fovea_tests::{assert_clean, assert_pictures_equal, gpu, Picture};

@@ -29,6 +29,21 @@ pub const MAX_BVH_STACK: u32 = 64;
 /// Must match TOP_STACK_SIZE in shaders/common/bvh.glsl (the instance level's stack).
 pub const MAX_TOP_STACK: u32 = 16;
 
+/// The scene's bindings by their GLSL names (`GpuScene::binds`); a kernel binds those it reads.
+#[derive(Clone, Copy)]
+pub struct SceneBinds<'a> {
+    pub bvh_nodes: Bind<'a>,
+    pub bvh_triangles: Bind<'a>,
+    pub vertices: Bind<'a>,
+    pub triangles: Bind<'a>,
+    pub materials: Bind<'a>,
+    pub textures: Bind<'a>,
+    pub texels: Bind<'a>,
+    pub lights: Bind<'a>,
+    pub environment: Bind<'a>,
+    pub instances: Bind<'a>,
+}
+
 pub struct GpuScene {
     pub bvh_nodes: Buffer,
     pub bvh_triangles: Buffer,
@@ -187,19 +202,19 @@ impl GpuScene {
     }
 
     /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only).
-    pub fn binds(&self) -> [Bind<'_>; 10] {
-        [
-            read_texels("bvh_nodes", &self.bvh_nodes),
-            read_texels("bvh_triangles", &self.bvh_triangles),
-            read_buffer("vertices", &self.vertices),
-            read_buffer("triangles", &self.triangles),
-            read_buffer("materials", &self.materials),
-            read_buffer("textures", &self.textures),
-            read_buffer("texels", &self.texels),
-            read_buffer("lights", &self.lights),
-            read_buffer("environment", &self.environment.buffer),
-            read_buffer("instances", &self.instances),
-        ]
+    pub fn binds(&self) -> SceneBinds<'_> {
+        SceneBinds {
+            bvh_nodes: read_texels("bvh_nodes", &self.bvh_nodes),
+            bvh_triangles: read_texels("bvh_triangles", &self.bvh_triangles),
+            vertices: read_buffer("vertices", &self.vertices),
+            triangles: read_buffer("triangles", &self.triangles),
+            materials: read_buffer("materials", &self.materials),
+            textures: read_buffer("textures", &self.textures),
+            texels: read_buffer("texels", &self.texels),
+            lights: read_buffer("lights", &self.lights),
+            environment: read_buffer("environment", &self.environment.buffer),
+            instances: read_buffer("instances", &self.instances),
+        }
     }
 
     /// Centre and radius of the scene's bounding sphere.

@@ -12,7 +12,8 @@
 //! the additions of a single process.
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::{CameraPose, Renderer};
+use fovea_renderer::frame::CameraPose;
+use fovea_renderer::pipeline::Renderer;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::ops::Range;
 use std::path::Path;

@@ -1,69 +1,68 @@
 //! Traces an arbitrary list of rays: BVH correctness tests and ray-throughput benchmarks.
 
-use super::push_bytes;
+use super::{Kernel, Pass};
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use crate::layouts::RaycastPush;
-use crate::vk::{Buffer, ComputePipeline, Context};
+use crate::vk::{Buffer, Context};
 use glam::UVec4;
 use std::sync::Arc;
 
-pub struct RaycastPass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Raycast;
+
+impl Kernel for Raycast {
+    const SHADER: &'static str = "passes/raycast";
+    type Push = RaycastPush;
 }
 
-impl RaycastPass {
-    pub fn new(ctx: &Arc<Context>) -> Result<RaycastPass> {
-        Ok(RaycastPass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                "passes/raycast",
-                std::mem::size_of::<RaycastPush>() as u32,
-            )?,
-        })
-    }
+pub type RaycastPass = Pass<Raycast>;
 
-    /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel
-    /// reads are far cheaper than std430 reads on lavapipe); `hits` receives `count` HitGpu. `any_hit` stops at the first
-    /// hit found (shadow rays).
-    #[allow(clippy::too_many_arguments)]
+/// A list of rays and where their hits go.
+pub struct RayBatch<'a> {
+    /// `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel reads are far
+    /// cheaper than std430 reads on lavapipe).
+    pub rays: &'a Buffer,
+    /// Receives `count` HitGpu.
+    pub hits: &'a Buffer,
+    pub count: u32,
+}
+
+impl Pass<Raycast> {
+    /// Traces `batch`; `any_hit` stops at the first hit found (shadow rays). The pass is named
+    /// `raycast_any` or `raycast_closest` in the timings.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
-        pass_name: &'static str,
         scene: &GpuScene,
         frame: &Buffer,
-        rays: &Buffer,
-        hits: &Buffer,
-        count: u32,
+        batch: &RayBatch,
         any_hit: bool,
     ) -> Result<()> {
         let s = scene.binds();
         let binds = [
-            s[0],
-            s[1],
-            s[2],
-            s[3],
-            s[4],
-            s[5],
-            s[6],
-            s[7],
-            s[9],
+            s.bvh_nodes,
+            s.bvh_triangles,
+            s.vertices,
+            s.triangles,
+            s.materials,
+            s.textures,
+            s.texels,
+            s.lights,
+            s.instances,
             read_buffer("frame", frame),
-            read_texels("rays", rays),
-            write_buffer("hits", hits),
+            read_texels("rays", batch.rays),
+            write_buffer("hits", batch.hits),
         ];
         let push = RaycastPush {
-            config: UVec4::new(count, any_hit as u32, 0, 0),
+            config: UVec4::new(batch.count, any_hit as u32, 0, 0),
         };
-        rec.dispatch(
-            pass_name,
-            &self.pipeline,
-            &binds,
-            push_bytes(&push),
-            [count, 1, 1],
-        )
+        let name = if any_hit {
+            "raycast_any"
+        } else {
+            "raycast_closest"
+        };
+        self.dispatch(rec, name, &binds, &push, [batch.count, 1, 1])
     }
 }
 
@@ -83,7 +82,7 @@ impl RayCaster {
         let uniform = ash::vk::BufferUsageFlags::UNIFORM_BUFFER;
         Ok(RayCaster {
             ctx: ctx.clone(),
-            pass: RaycastPass::new(ctx)?,
+            pass: Pass::single(ctx)?,
             frame: Buffer::with_data(
                 ctx,
                 "frame",
@@ -133,21 +132,13 @@ impl RayCaster {
             ..Default::default()
         }])?;
         self.recorder.begin()?;
-        let name = if any_hit {
-            "raycast_any"
-        } else {
-            "raycast_closest"
+        let batch = RayBatch {
+            rays: ray_buf,
+            hits: hit_buf,
+            count: rays.len() as u32,
         };
-        self.pass.record(
-            &mut self.recorder,
-            name,
-            scene,
-            &self.frame,
-            ray_buf,
-            hit_buf,
-            rays.len() as u32,
-            any_hit,
-        )?;
+        self.pass
+            .record(&mut self.recorder, scene, &self.frame, &batch, any_hit)?;
         let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
         let mut hits = vec![crate::layouts::HitGpu::default(); rays.len()];
         hit_buf.download(&mut hits)?;

@@ -132,7 +132,8 @@ impl ComputePipeline {
         push_size: u32,
     ) -> Result<Arc<ComputePipeline>> {
         let mut cache = ctx.pipelines.lock().expect("pipeline cache lock");
-        if let Some(p) = cache.get(shader).and_then(|w| w.upgrade()) {
+        let cached = cache.get(shader).and_then(|w| w.upgrade());
+        if let Some(p) = cached.and_then(|p| p.downcast::<ComputePipeline>().ok()) {
             if p.push_size != push_size {
                 return Err(Error::Shader {
                     shader: shader.into(),
@@ -146,7 +147,8 @@ impl ComputePipeline {
         }
         let pipeline = Arc::new(ComputePipeline::new(ctx, shader, push_size)?);
         cache.retain(|_, w| w.strong_count() > 0);
-        cache.insert(shader.to_string(), Arc::downgrade(&pipeline));
+        let entry: Arc<dyn std::any::Any + Send + Sync> = pipeline.clone();
+        cache.insert(shader.to_string(), Arc::downgrade(&entry));
         Ok(pipeline)
     }
 

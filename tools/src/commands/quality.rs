@@ -15,9 +15,10 @@ use crate::output::{
 };
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::{Deserialize, Serialize};
@@ -344,7 +345,7 @@ pub fn run_combination(
             camera_path::CameraMotion::Still
         },
         seed: args.seed,
-        max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
         exposure: 1.0,
         profile: args.profile.clone(),
         debug_views: false,
@@ -427,7 +428,7 @@ pub fn reference_file_name(camera: &str, frame: u32) -> String {
 pub struct ReferenceRenderer {
     pub ctx: std::sync::Arc<fovea_renderer::vk::Context>,
     pub renderer: Renderer,
-    pub poses: Vec<(u32, fovea_renderer::pipeline::CameraPose)>,
+    pub poses: Vec<(u32, fovea_renderer::frame::CameraPose)>,
 }
 
 pub fn reference_renderer(
@@ -491,7 +492,7 @@ fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Vec
             &mut r.renderer,
             pose,
             args.reference_spp,
-            fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+            fovea_renderer::frame::REALTIME_MAX_DEPTH,
             &mut |_| Ok(()),
         )?;
         write_exr(

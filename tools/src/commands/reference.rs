@@ -2,7 +2,8 @@
 
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Context as _, Result};
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::frame::{CameraPose, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::Context;
 use glam::UVec2;

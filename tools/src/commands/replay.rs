@@ -13,7 +13,8 @@ use crate::output::{
 use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
 use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::frame::RenderSettings;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;

@@ -10,9 +10,9 @@ use crate::projection::EyeRig;
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::{Eye, EyeView, HmdDescription};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
+use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
 use glam::{UVec2, Vec3};
@@ -327,12 +327,7 @@ pub fn filters(
     taa: &str,
     profile: &RenderProfile,
 ) -> Result<(DenoiserSettings, TaaMode)> {
-    let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
-        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
-        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
-        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
-        other => other,
-    };
+    let denoiser_settings = profile.denoisers.get(denoiser).context("--denoiser")?;
     let taa_mode = TaaMode::parse(taa)
         .context("--taa")?
         .with_settings(profile.taa);

@@ -17,11 +17,12 @@ use fovea_hal::openxr::{
     xr, GazeActions, OpenXrGaze, OpenXrRuntime, RuntimeFigures, SessionEnd, SessionOwner,
 };
 use fovea_hal::{Eye, GazeOrigin, HmdDescription};
+use fovea_renderer::frame::{
+    CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;

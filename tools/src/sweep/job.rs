@@ -216,7 +216,7 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                     &mut r.renderer,
                     &pose,
                     q.reference_spp,
-                    fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+                    fovea_renderer::frame::REALTIME_MAX_DEPTH,
                     batches[0]..batches[1],
                     &mut |_| stop_requested(),
                 )?;
