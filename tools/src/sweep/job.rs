@@ -2,11 +2,12 @@
 //! renamed to `result/` when whole. Under the job's lock: a finished job is left as it is, a
 //! killed attempt's folder is removed, and a failed attempt leaves only `failed.json`.
 
-use super::status::{done, State};
-use super::{
-    host_name, Failure, Job, JobRecord, Parse, Part, Study, Sweep, ATTEMPT_PREFIX, FAILURE, LOCK,
-    RECORD,
+use super::files::{
+    commit, host_name, Failure, Job, JobRecord, Parse, Part, Study, ATTEMPT_PREFIX, FAILURE,
+    JOBS_FILE, LOCK, RECORD,
 };
+use super::open::Sweep;
+use super::status::{done, State};
 use crate::commands::quality::{self, Combination, Outcome};
 use crate::output::write_json;
 use crate::reference_sum::{self, SampleSum};
@@ -39,7 +40,7 @@ pub fn run(dir: &Path, index: Option<u32>, offset: u32, parse: Parse) -> Result<
     let Some(job) = sweep.jobs.get(index as usize) else {
         bail!(
             "{} plans jobs 0..{}; there is no job {index}",
-            sweep.dir.join(super::JOBS_FILE).display(),
+            sweep.dir.join(JOBS_FILE).display(),
             sweep.jobs.len()
         );
     };
@@ -76,7 +77,7 @@ pub fn run(dir: &Path, index: Option<u32>, offset: u32, parse: Parse) -> Result<
             &JobRecord {
                 index,
                 name: job.name.clone(),
-                commit: super::commit().to_string(),
+                commit: commit().to_string(),
                 device,
                 host: host_name(),
                 seconds: started.elapsed().as_secs_f64(),

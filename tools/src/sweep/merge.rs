@@ -3,9 +3,10 @@
 //! reference EXRs and `run_*` folders; `fovea reference`'s EXR (and preview). Each study's folder
 //! is built beside its place and renamed into it whole.
 
+use super::files::{Parse, Part, Study};
 use super::job::{reference_of, OUTCOME_FILE};
+use super::open::Sweep;
 use super::status::{done, state, State};
-use super::{Parse, Study, Sweep};
 use crate::commands::quality::{self, Combination, Outcome};
 use crate::output::write_exr;
 use anyhow::{bail, Context, Result};
@@ -120,7 +121,7 @@ fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path
     }
     let mut outcomes = Vec::new();
     for job in sweep.jobs.iter().filter(|j| j.study == study) {
-        let super::Part::Run {
+        let Part::Run {
             camera,
             method,
             denoiser,

@@ -1,6 +1,6 @@
 //! `fovea sweep plan`: the studies of a command and its axes, and their jobs.
 
-use super::{
+use super::files::{
     commit, Axes, DeviceRequirement, Job, Parse, Part, Study, StudyEntry, SweepFile, FORMAT,
     JOBS_FILE, SWEEP_FILE,
 };

@@ -1,7 +1,8 @@
 //! `fovea sweep status` (each job done, running, failed or missing, with the reason) and
 //! `fovea sweep list` (job indices for a shell loop, GNU parallel or Slurm arrays).
 
-use super::{Failure, Job, JobRecord, Parse, Sweep, ATTEMPT_PREFIX, FAILURE, LOCK, RECORD};
+use super::files::{commit, Failure, Job, JobRecord, Parse, ATTEMPT_PREFIX, FAILURE, LOCK, RECORD};
+use super::open::Sweep;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -169,7 +170,7 @@ pub fn status(dir: &Path, json: bool, parse: Parse) -> Result<()> {
     let report = StatusReport {
         dir: sweep.dir.display().to_string(),
         plan_commit: &sweep.file.commit,
-        fovea_commit: super::commit(),
+        fovea_commit: commit(),
         done: count("done"),
         running: count("running"),
         failed: count("failed"),

@@ -1,6 +1,7 @@
+use super::files::{Axes, Job, Part, JOBS_FILE};
+use super::open::check_jobs_file;
 use super::plan::{flag_value, set_flag, studies};
 use super::status::array_chunks;
-use super::*;
 
 fn words(s: &str) -> Vec<String> {
     s.split_whitespace().map(str::to_string).collect()
@@ -142,7 +143,7 @@ fn an_edited_jobs_file_is_named_by_line_and_field() {
     std::fs::write(&path, "{\"index\":0}\nnot json\n").unwrap();
     let e = format!("{:#}", check_jobs_file(&path, &jobs).unwrap_err());
     assert!(
-        e.contains("line 1 (job 0): field `stage` is missing"),
+        e.contains("line 1 (job 0): field `after` is missing"),
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&dir);
