@@ -538,35 +538,46 @@ const SLURM_QUALITY: &[&str] = &[
     "4",
 ];
 
-/// Whether a Slurm cluster answers and has a node taking jobs (the one of scripts/slurm/setup
-/// through SLURM_CONF, or the machine's own).
-fn slurm_up() -> Result<(), String> {
-    let out = Command::new("sinfo")
-        .args(["-h", "-o", "%T"])
+/// Where Slurm is installed but not the cluster: scripts/slurm/setup's exit status.
+const SLURM_MISSING: i32 = 3;
+
+/// The one-node cluster of scripts/slurm/setup, started if it is not running: its SLURM_CONF,
+/// or why there is none (Slurm or root missing).
+fn slurm_cluster() -> Result<String, String> {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scripts/slurm/setup");
+    let out = Command::new(&script)
+        .arg("--print-env")
         .output()
-        .map_err(|e| format!("sinfo: {e}"))?;
-    if !out.status.success() {
-        return Err(format!(
-            "sinfo: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
+        .map_err(|e| format!("{}: {e}", script.display()))?;
+    let stderr = String::from_utf8_lossy(&out.stderr).trim().to_string();
+    if out.status.code() == Some(SLURM_MISSING) {
+        return Err(stderr);
     }
-    let states = String::from_utf8_lossy(&out.stdout).into_owned();
-    let taking = ["idle", "mixed", "allocated", "completing"];
-    if states
+    assert!(
+        out.status.success(),
+        "{} failed ({}): {stderr}",
+        script.display(),
+        out.status
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let conf = stdout
         .lines()
-        .any(|s| taking.iter().any(|t| s.starts_with(t)))
-    {
-        Ok(())
-    } else {
-        Err(format!("no node takes jobs (states: {})", states.trim()))
-    }
+        .find_map(|l| l.strip_prefix("export SLURM_CONF="))
+        .unwrap_or_else(|| panic!("{} printed no SLURM_CONF: {stdout}", script.display()));
+    Ok(conf.trim_matches('\'').to_string())
+}
+
+/// A Slurm client command against the test's cluster.
+fn slurm(tool: &str, conf: &str) -> Command {
+    let mut command = Command::new(tool);
+    command.env("SLURM_CONF", conf);
+    command
 }
 
 /// Runs scripts/sweep-slurm; returns the job array ids per stage it printed.
-fn sweep_slurm(sweep: &Path, extra: &[&str]) -> Vec<(String, String)> {
+fn sweep_slurm(conf: &str, sweep: &Path, extra: &[&str]) -> Vec<(String, String)> {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scripts/sweep-slurm");
-    let out = Command::new(script)
+    let out = slurm(script.to_str().unwrap(), conf)
         .arg(sweep)
         .args(extra)
         .env("FOVEA", env!("CARGO_BIN_EXE_fovea"))
@@ -590,10 +601,10 @@ fn sweep_slurm(sweep: &Path, extra: &[&str]) -> Vec<(String, String)> {
 }
 
 /// Waits until Slurm lists none of `jobs` as pending or running.
-fn wait_for_slurm(jobs: &[String], limit: Duration) {
+fn wait_for_slurm(conf: &str, jobs: &[String], limit: Duration) {
     let started = Instant::now();
     loop {
-        let out = Command::new("squeue")
+        let out = slurm("squeue", conf)
             .args(["-h", "-o", "%i %T", "-j", &jobs.join(",")])
             .output()
             .unwrap();
@@ -611,13 +622,17 @@ fn wait_for_slurm(jobs: &[String], limit: Duration) {
 
 #[test]
 fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_output() {
-    if let Err(why) = slurm_up() {
-        if std::env::var("FOVEA_REQUIRE_SLURM").as_deref() == Ok("1") {
-            panic!("FOVEA_REQUIRE_SLURM=1 but no Slurm cluster answers: {why} (scripts/slurm/setup starts one)");
+    let conf = match slurm_cluster() {
+        Ok(conf) => conf,
+        Err(why) => {
+            assert!(
+                std::env::var("FOVEA_REQUIRE_SLURM").as_deref() != Ok("1"),
+                "FOVEA_REQUIRE_SLURM=1 but scripts/slurm/setup starts no cluster: {why}"
+            );
+            eprintln!("skipped: no Slurm cluster ({why})");
+            return;
         }
-        eprintln!("skipped: no Slurm cluster answers ({why}); scripts/slurm/setup starts one");
-        return;
-    }
+    };
     let dir = temp_dir("slurm");
     let sweep = dir.join("sweep");
     let sweep_arg = sweep.to_str().unwrap().to_string();
@@ -636,7 +651,7 @@ fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_
     assert_eq!(jobs.len(), 2 * 2 + 2 * 4);
 
     // Submitted whole; the run stage cancelled once one of its jobs is mid-run.
-    let arrays = sweep_slurm(&sweep, &[]);
+    let arrays = sweep_slurm(&conf, &sweep, &[]);
     let run_arrays: Vec<String> = arrays
         .iter()
         .filter(|(stage, _)| stage == "run")
@@ -671,10 +686,10 @@ fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_
         );
         std::thread::sleep(Duration::from_millis(20));
     };
-    let cancel = Command::new("scancel").args(&run_arrays).status().unwrap();
+    let cancel = slurm("scancel", &conf).args(&run_arrays).status().unwrap();
     assert!(cancel.success());
     let all: Vec<String> = arrays.iter().map(|(_, id)| id.clone()).collect();
-    wait_for_slurm(&all, Duration::from_secs(120));
+    wait_for_slurm(&conf, &all, Duration::from_secs(120));
     // The merge depended on the cancelled stage: it never ran.
     std::thread::sleep(Duration::from_secs(1));
     assert!(!sweep.join("merged").exists());
@@ -705,7 +720,7 @@ fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_
     }
 
     // Submitted again: only what is missing runs, then the merge.
-    let again = sweep_slurm(&sweep, &["--wait"]);
+    let again = sweep_slurm(&conf, &sweep, &["--wait"]);
     assert!(
         again.iter().all(|(stage, _)| stage == "run"),
         "the references were done: {again:?}"
