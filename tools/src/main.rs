@@ -654,7 +654,7 @@ enum Command {
     },
     /// Split `fovea quality` or `fovea reference` into independent jobs for a batch scheduler
     /// (Slurm job arrays: scripts/sweep-slurm) or a shell loop, and merge their results into the
-    /// files the one-process command writes (docs/guide/sweep.md).
+    /// files the one-process command writes (docs/guide/sweeps.md).
     Sweep {
         #[command(subcommand)]
         command: SweepCommand,
@@ -696,7 +696,9 @@ enum SweepCommand {
     /// SLURM_ARRAY_TASK_ID; plus --offset): its result appears whole in its folder or not at all;
     /// a finished job is left as it is; a failure is recorded and exits non-zero.
     Run {
+        /// The sweep folder (`fovea sweep plan --out`).
         dir: PathBuf,
+        /// The job: its line in jobs.jsonl, counted from 0.
         #[arg(long)]
         index: Option<u32>,
         /// Added to the index (Slurm arrays whose task ids start at 0).
@@ -705,6 +707,7 @@ enum SweepCommand {
     },
     /// Every job's state: done, running, failed or missing, with the reason.
     Status {
+        /// The sweep folder.
         dir: PathBuf,
         /// As JSON.
         #[arg(long)]
@@ -712,6 +715,7 @@ enum SweepCommand {
     },
     /// Job indices, one per line, for a shell loop, GNU parallel or Slurm.
     List {
+        /// The sweep folder.
         dir: PathBuf,
         /// Only the jobs of this stage (reference, run).
         #[arg(long)]
@@ -728,7 +732,10 @@ enum SweepCommand {
     },
     /// Gather every job's result into DIR/merged/<study>/: the files the one-process command
     /// writes (refused while a job is not done or the jobs ran on different devices).
-    Merge { dir: PathBuf },
+    Merge {
+        /// The sweep folder.
+        dir: PathBuf,
+    },
 }
 
 /// `fovea replay`'s length for a new baseline without `--frames`.

@@ -490,7 +490,7 @@ fn bad_plans_are_refused_naming_the_file_and_field() {
         "{status}"
     );
 
-    // A plan whose studies no longer match its command, and one missing a field.
+    // A plan whose studies do not follow from its command, and one missing a field.
     value["commit"] = serde_json::from_str::<serde_json::Value>(&text).unwrap()["commit"].clone();
     value["studies"][0]["args"][1] = "--width=65".into();
     std::fs::write(&plan_path, serde_json::to_string_pretty(&value).unwrap()).unwrap();
