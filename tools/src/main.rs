@@ -374,6 +374,38 @@ struct QualityFlags {
     latency: LatencyFlags,
 }
 
+/// `fovea replay`'s flags (also the command a replay sweep splits).
+#[derive(clap::Args)]
+struct ReplayFlags {
+    /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
+    traces: Vec<String>,
+    /// Baseline folder (one subfolder per trace).
+    #[arg(long)]
+    baseline: PathBuf,
+    /// Write the baselines from this run instead of comparing (overwrites them).
+    #[arg(long)]
+    update_baseline: bool,
+    /// Samples per pixel of the converged reference made with a new baseline.
+    #[arg(long, default_value_t = 256)]
+    reference_spp: u32,
+    /// Rings of distance from the gaze for every per-ring figure.
+    #[arg(long, default_value_t = 4)]
+    rings: usize,
+    /// Largest mean FLIP per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_flip)]
+    change_flip: f64,
+    /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_rmse)]
+    change_rmse: f64,
+    /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
+    #[arg(long, default_value_t = Tolerances::default().quality_rel)]
+    quality_rel: f64,
+    #[arg(long, default_value_t = Tolerances::default().quality_abs)]
+    quality_abs: f64,
+    #[command(flatten)]
+    opts: Box<RenderOpts>,
+}
+
 /// `fovea reference`'s flags (also the command a reference sweep splits).
 #[derive(clap::Args)]
 struct ReferenceFlags {
@@ -467,33 +499,8 @@ enum Command {
     /// (change: FLIP/RMSE per ring; quality against the converged reference; the gaze used;
     /// cost, reported). Exit 0 within tolerance, 1 on a regression, 2 on bad input.
     Replay {
-        /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
-        traces: Vec<String>,
-        /// Baseline folder (one subfolder per trace).
-        #[arg(long)]
-        baseline: PathBuf,
-        /// Write the baselines from this run instead of comparing (overwrites them).
-        #[arg(long)]
-        update_baseline: bool,
-        /// Samples per pixel of the converged reference made with a new baseline.
-        #[arg(long, default_value_t = 256)]
-        reference_spp: u32,
-        /// Rings of distance from the gaze for every per-ring figure.
-        #[arg(long, default_value_t = 4)]
-        rings: usize,
-        /// Largest mean FLIP per ring against the baseline's frame.
-        #[arg(long, default_value_t = Tolerances::default().change_flip)]
-        change_flip: f64,
-        /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
-        #[arg(long, default_value_t = Tolerances::default().change_rmse)]
-        change_rmse: f64,
-        /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
-        #[arg(long, default_value_t = Tolerances::default().quality_rel)]
-        quality_rel: f64,
-        #[arg(long, default_value_t = Tolerances::default().quality_abs)]
-        quality_abs: f64,
         #[command(flatten)]
-        opts: Box<RenderOpts>,
+        flags: ReplayFlags,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -652,9 +659,10 @@ enum Command {
         #[arg(long)]
         ppd: Option<f32>,
     },
-    /// Split `fovea quality` or `fovea reference` into independent jobs for a batch scheduler
-    /// (Slurm job arrays: scripts/sweep-slurm) or a shell loop, and merge their results into the
-    /// files the one-process command writes (docs/guide/sweeps.md).
+    /// Split `fovea quality`, `fovea reference` or `fovea replay` into independent jobs for a batch
+    /// scheduler
+    /// (Slurm job arrays: scripts/sweep-slurm) or a shell loop, and merge their results into
+    /// the files the one-process command writes (docs/guide/sweeps.md).
     Sweep {
         #[command(subcommand)]
         command: SweepCommand,
@@ -663,17 +671,20 @@ enum Command {
 
 #[derive(Subcommand)]
 enum SweepCommand {
-    /// Write DIR/sweep.json and DIR/jobs.jsonl: the jobs of a `fovea quality …` or
-    /// `fovea reference …` command, given after the sweep's own flags (references split into
-    /// sample batches whose merge is exact, then one job per combination).
+    /// Write DIR/sweep.json and DIR/jobs.jsonl: the jobs of a `fovea quality …`,
+    /// `fovea reference …` or `fovea replay …` command, given after the sweep's own flags
+    /// (references split into sample batches whose merge is exact, then one job per combination
+    /// or trace).
     Plan {
         /// The sweep folder (new or empty).
         #[arg(long)]
         out: PathBuf,
-        /// Scenes, one study (one merged output) each; default the command's --scene.
+        /// Scenes, one study (one merged output) each; default the command's --scene (quality and
+        /// reference sweeps).
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<String>,
-        /// Headset profiles, one study each; default the command's --headset.
+        /// Headset profiles, one study each; default the command's --headset (quality and
+        /// reference sweeps).
         #[arg(long, value_delimiter = ',')]
         headsets: Vec<String>,
         /// Gaze sources of a quality sweep, one study each; default the command's --gaze.
@@ -682,8 +693,8 @@ enum SweepCommand {
         /// Reference batches (16 samples each) per reference job: a power of two.
         #[arg(long, default_value_t = 4)]
         batches_per_job: u32,
-        /// The one-process command: `quality …` or `reference …` with that command's flags
-        /// (without --out).
+        /// The one-process command: `quality …`, `reference …` or `replay …` (comparing with
+        /// existing baselines) with that command's flags (without --out).
         #[arg(
             required = true,
             trailing_var_arg = true,
@@ -919,54 +930,8 @@ fn run() -> Result<()> {
                 reference_space: commands::xr::ReferenceSpace::parse(&reference_space)?,
             })
         }
-        Command::Replay {
-            traces,
-            baseline,
-            update_baseline,
-            reference_spp,
-            rings,
-            change_flip,
-            change_rmse,
-            quality_rel,
-            quality_abs,
-            opts,
-            device,
-        } => {
-            let profile = opts.profile()?;
-            let camera = opts.look.camera()?;
-            let mut render = render_args(
-                &opts,
-                &camera,
-                &device,
-                &profile,
-                RenderDefaults {
-                    frames: DEFAULT_REPLAY_FRAMES,
-                    gaze: "center",
-                    out: "out/replay",
-                    scale: DEFAULT_SCALE,
-                },
-            )?;
-            // Small by default: replays run in the test suite.
-            render.width = Some(opts.width.unwrap_or(64));
-            render.height = Some(opts.height.unwrap_or(72));
-            let tolerances = Tolerances {
-                change_flip,
-                change_rmse,
-                quality_rel,
-                quality_abs,
-                ..Tolerances::default()
-            };
-            commands::replay::run(&commands::replay::ReplayArgs {
-                traces: &traces,
-                baseline: &baseline,
-                frames: opts.frames,
-                out: render.out,
-                render,
-                update: update_baseline,
-                reference_spp,
-                rings,
-                tolerances,
-            })
+        Command::Replay { flags, device } => {
+            with_replay_args(flags, &device, &mut commands::replay::run)
         }
         Command::Reference { flags, device } => {
             with_reference_args(flags, &device, &mut commands::reference::run)
@@ -1165,6 +1130,61 @@ fn with_quality_args(
     })
 }
 
+/// `fovea replay`'s flags as its arguments, handed to `run`.
+fn with_replay_args(
+    flags: ReplayFlags,
+    device: &DeviceArgs,
+    run: &mut dyn FnMut(&commands::replay::ReplayArgs) -> Result<()>,
+) -> Result<()> {
+    let ReplayFlags {
+        traces,
+        baseline,
+        update_baseline,
+        reference_spp,
+        rings,
+        change_flip,
+        change_rmse,
+        quality_rel,
+        quality_abs,
+        opts,
+    } = flags;
+    let profile = opts.profile()?;
+    let camera = opts.look.camera()?;
+    let mut render = render_args(
+        &opts,
+        &camera,
+        device,
+        &profile,
+        RenderDefaults {
+            frames: DEFAULT_REPLAY_FRAMES,
+            gaze: "center",
+            out: "out/replay",
+            scale: DEFAULT_SCALE,
+        },
+    )?;
+    // Small by default: replays run in the test suite.
+    render.width = Some(opts.width.unwrap_or(64));
+    render.height = Some(opts.height.unwrap_or(72));
+    let tolerances = Tolerances {
+        change_flip,
+        change_rmse,
+        quality_rel,
+        quality_abs,
+        ..Tolerances::default()
+    };
+    run(&commands::replay::ReplayArgs {
+        traces: &traces,
+        baseline: &baseline,
+        frames: opts.frames,
+        out: render.out,
+        render,
+        update: update_baseline,
+        reference_spp,
+        rings,
+        tolerances,
+    })
+}
+
 /// `fovea reference`'s flags as its arguments, handed to `run`.
 fn with_reference_args(
     flags: ReferenceFlags,
@@ -1237,8 +1257,12 @@ fn parse_study(
         Some(Command::Reference { flags, device }) => {
             with_reference_args(flags, &device, &mut |r| f(Study::Reference(r)))
         }
+        Some(Command::Replay { flags, device }) => {
+            with_replay_args(flags, &device, &mut |r| f(Study::Replay(r)))
+        }
         _ => bail!(
-            "fovea sweep splits `fovea quality …` or `fovea reference …`, not `fovea {}`",
+            "fovea sweep splits `fovea quality …`, `fovea reference …` or `fovea replay …`, not \
+             `fovea {}`",
             argv.join(" ")
         ),
     }

@@ -410,6 +410,99 @@ fn a_reference_split_into_sample_batches_merges_into_the_same_bytes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// fovea in the repository root (where the committed replay traces and baselines are named from).
+fn fovea_in_repo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fovea"))
+        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A JSON file without the fields measured from GPU times (`cost_ratio`).
+fn without_costs(path: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    for trace in v["traces"].as_array_mut().unwrap() {
+        trace["cost_ratio"] = serde_json::Value::Null;
+    }
+    v
+}
+
+#[test]
+fn a_replay_sweep_merges_into_the_one_process_report_and_exit_status() {
+    let dir = temp_dir("replay");
+    let sweep = dir.join("sweep");
+    let sweep_arg = sweep.to_str().unwrap().to_string();
+    // Two committed baselines and a planted regression (as tools/tests/replay.rs): failing frames,
+    // their baseline and FLIP pictures, exit status 1.
+    let replay = [
+        "replay",
+        "sim:1",
+        "config/gaze/example_trace.csv",
+        "--baseline",
+        "tests/replay/baseline",
+        "--max-depth",
+        "2",
+        "--validation",
+    ];
+    let mut plan = vec!["sweep", "plan", "--out", &sweep_arg];
+    plan.extend(replay);
+    let planned = fovea_in_repo(&plan);
+    assert!(planned.status.success(), "{planned:?}");
+    assert_eq!(read_jobs(&sweep).len(), 2, "one job per trace");
+    // The jobs run from any folder: the plan records where its paths resolve from.
+    for index in ["1", "0"] {
+        fovea_ok(&["sweep", "run", &sweep_arg, "--index", index]);
+    }
+    let merged = fovea(&["sweep", "merge", &sweep_arg]);
+    assert_eq!(merged.status.code(), Some(1), "{merged:?}");
+    let stderr = String::from_utf8_lossy(&merged.stderr);
+    assert!(stderr.contains("outside the tolerances"), "{stderr}");
+
+    let one = dir.join("one");
+    let one_arg = one.to_str().unwrap().to_string();
+    let mut one_process = replay.to_vec();
+    one_process.extend(["--out", &one_arg]);
+    let ran = fovea_in_repo(&one_process);
+    assert_eq!(ran.status.code(), Some(1), "{ran:?}");
+
+    let merged = sweep.join("merged/cornell-box");
+    assert_eq!(
+        without_costs(&merged.join("replay.json")),
+        without_costs(&one.join("replay.json"))
+    );
+    let no_costs = |dir: &Path| -> String {
+        std::fs::read_to_string(dir.join("replay.md"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with("Cost now / baseline"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let report = no_costs(&merged);
+    assert!(report.contains("REGRESSION"), "{report}");
+    assert_eq!(report, no_costs(&one));
+    let mut compared = 0;
+    for run in ["run_sim-1", "run_example_trace"] {
+        for entry in std::fs::read_dir(one.join(run)).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if !name.starts_with("frame_") {
+                continue;
+            }
+            assert!(
+                std::fs::read(&path).unwrap()
+                    == std::fs::read(merged.join(run).join(&name)).unwrap(),
+                "{run}/{name} differs"
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared > 16, "only {compared} files compared");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn bad_plans_are_refused_naming_the_file_and_field() {
     let dir = temp_dir("bad");
@@ -452,7 +545,23 @@ fn bad_plans_are_refused_naming_the_file_and_field() {
         "--frames",
         "2",
     ]);
-    assert!(not_quality.contains("is neither"), "{not_quality}");
+    assert!(not_quality.contains("is none of them"), "{not_quality}");
+    let update = fovea_err(&[
+        "sweep",
+        "plan",
+        "--out",
+        dir.join("other").to_str().unwrap(),
+        "replay",
+        "sim:1",
+        "--baseline",
+        "tests/replay/baseline",
+        "--update-baseline",
+    ]);
+    assert!(
+        update.contains("--update-baseline: a sweep compares"),
+        "{update}"
+    );
+    assert!(!dir.join("other").exists());
 
     // An edited jobs file: the line and the field.
     let jobs_path = sweep.join("jobs.jsonl");

@@ -3,6 +3,7 @@
 
 use crate::commands::quality::QualityArgs;
 use crate::commands::reference::ReferenceArgs;
+use crate::commands::replay::ReplayArgs;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -11,6 +12,7 @@ use std::path::PathBuf;
 pub enum Study<'a> {
     Quality(&'a QualityArgs<'a>),
     Reference(&'a ReferenceArgs<'a>),
+    Replay(&'a ReplayArgs<'a>),
 }
 
 /// Parses `fovea ARGS…` and hands the command to the callback; errors for any other command.
@@ -96,8 +98,8 @@ pub struct Job {
     pub name: String,
     /// Index into `sweep.json` `studies`.
     pub study: u32,
-    /// The one-process `fovea` command restricted to this job's camera (and combination): run
-    /// alone it computes the same piece and more.
+    /// The one-process `fovea` command whose piece the job computes (a quality job's restricted
+    /// to its camera and combination): run alone it computes the same piece and more.
     pub args: Vec<String>,
     pub part: Part,
     /// The job's folder, relative to the sweep folder.
@@ -123,6 +125,8 @@ pub enum Part {
         denoiser: String,
         taa: String,
     },
+    /// One trace of a replay study: rendered and checked against its baseline.
+    Trace { trace: String },
 }
 
 /// What a finished job recorded (`result/job.json`).

@@ -297,6 +297,15 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                     Some(render_device(&run_dir)?)
                 }
             }
+            (Study::Replay(r), Part::Trace { trace }) => {
+                crate::commands::replay::check(r)?;
+                let result = crate::commands::replay::replay_trace(r, trace, attempt)
+                    .with_context(|| format!("trace {trace}"))?;
+                write_json(&attempt.join(OUTCOME_FILE), &result)?;
+                Some(render_device(
+                    &attempt.join(crate::commands::replay::run_dir_name(trace)),
+                )?)
+            }
             (_, part) => bail!(
                 "job {}: its part {part:?} does not fit its command `fovea {}`",
                 job.index,

@@ -1,13 +1,15 @@
 //! `fovea sweep merge`: every job's result gathered into the files the one-process command
 //! writes, per study under `DIR/merged/<study>/`: `fovea quality`'s quality.json, quality.md,
-//! reference EXRs and `run_*` folders; `fovea reference`'s EXR (and preview). Each study's folder
-//! is built beside its place and renamed into it whole.
+//! reference EXRs and `run_*` folders; `fovea reference`'s EXR (and preview); `fovea replay`'s
+//! replay.json, replay.md and `run_*` folders (exit status 1 on a regression, as `fovea replay`).
+//! Each study's folder is built beside its place and renamed into it whole.
 
 use super::files::{Parse, Part, Study};
 use super::job::{reference_of, OUTCOME_FILE};
 use super::open::Sweep;
 use super::status::{done, state, State};
 use crate::commands::quality::{self, Combination, Outcome};
+use crate::commands::replay::{self, Regression, ReplayArgs, TraceResult};
 use crate::output::write_exr;
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeMap;
@@ -37,6 +39,9 @@ pub fn merge(dir: &Path, parse: Parse) -> Result<()> {
         );
     }
     check_one_device(&sweep)?;
+    // Replays whose frames left the tolerances: the merge is written, then exits as `fovea
+    // replay` would (status 1).
+    let mut regressions: Vec<Regression> = Vec::new();
     for (i, study) in sweep.file.studies.iter().enumerate() {
         let target = sweep.dir.join(&study.merged);
         let parent = target.parent().context("a merged folder has a parent")?;
@@ -50,6 +55,15 @@ pub fn merge(dir: &Path, parse: Parse) -> Result<()> {
         std::fs::create_dir(&temp.0).with_context(|| format!("creating {}", temp.0.display()))?;
         parse(&study.args, &mut |s| match s {
             Study::Quality(q) => merge_quality(&sweep, i as u32, q, &temp.0),
+            Study::Replay(r) => {
+                if let Some(regression) = merge_replay(&sweep, i as u32, r, &temp.0)? {
+                    regressions.push(Regression {
+                        report: target.join("replay.md"),
+                        ..regression
+                    });
+                }
+                Ok(())
+            }
             Study::Reference(r) => {
                 let image = reference_of(&sweep, i as u32, None, None)?.mean()?;
                 let name = r
@@ -65,7 +79,15 @@ pub fn merge(dir: &Path, parse: Parse) -> Result<()> {
         replace(&temp.0, &target)?;
         println!("merged {}", target.display());
     }
-    Ok(())
+    match regressions.len() {
+        0 => Ok(()),
+        1 => Err(regressions.remove(0).into()),
+        _ => Err(Regression {
+            failed_frames: regressions.iter().map(|r| r.failed_frames).sum(),
+            report: sweep.dir.join("merged"),
+        }
+        .into()),
+    }
 }
 
 /// A folder being built, removed unless it was moved into place.
@@ -149,6 +171,31 @@ fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path
         outcomes.push(outcome);
     }
     quality::write_report(q, &prepared, outcomes, out)
+}
+
+/// A replay study: each trace's result and frames, and the report (with the regression, if any).
+fn merge_replay(
+    sweep: &Sweep,
+    study: u32,
+    r: &ReplayArgs,
+    out: &Path,
+) -> Result<Option<Regression>> {
+    let mut results = Vec::new();
+    for job in sweep.jobs.iter().filter(|j| j.study == study) {
+        let Part::Trace { trace } = &job.part else {
+            continue;
+        };
+        let result = sweep.result_dir(job);
+        let path = result.join(OUTCOME_FILE);
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let trace_result: TraceResult = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a replay result", path.display()))?;
+        let name = replay::run_dir_name(trace);
+        link_tree(&result.join(&name), &out.join(&name))?;
+        results.push(trace_result);
+    }
+    replay::write_report(r, results, out)
 }
 
 /// `dst` as a copy of `src` made of hard links (copies across file systems).

@@ -1,6 +1,6 @@
-//! `fovea sweep`: a `fovea quality` or `fovea reference` run split into independent jobs that a
-//! batch scheduler (Slurm job arrays, `scripts/sweep-slurm`) or a shell loop runs, and merged into
-//! the files the one-process command writes.
+//! `fovea sweep`: a `fovea quality`, `fovea reference` or `fovea replay` run split into
+//! independent jobs that a batch scheduler (Slurm job arrays, `scripts/sweep-slurm`) or a shell
+//! loop runs, and merged into the files the one-process command writes.
 //!
 //! A sweep folder holds:
 //! - `sweep.json`: the command split, the axes, the commit of the fovea that planned it, the

@@ -12,7 +12,7 @@ use std::path::Path;
 
 pub struct PlanArgs<'a> {
     pub out: &'a Path,
-    /// The one-process command (after `fovea`): `quality …` or `reference …`.
+    /// The one-process command (after `fovea`): `quality …`, `reference …` or `replay …`.
     pub command: &'a [String],
     pub axes: Axes,
     pub batches_per_job: u32,
@@ -72,9 +72,10 @@ fn slug(value: &str) -> String {
 /// One study per scene × headset × gaze of the axes (an empty axis: the command's own value).
 pub(super) fn studies(command: &[String], axes: &Axes) -> Result<Vec<StudyEntry>> {
     let kind = command.first().map(String::as_str).unwrap_or("");
-    if kind != "quality" && kind != "reference" {
+    if !["quality", "reference", "replay"].contains(&kind) {
         bail!(
-            "fovea sweep splits `fovea quality …` or `fovea reference …`; `{}` is neither",
+            "fovea sweep splits `fovea quality …`, `fovea reference …` or `fovea replay …`; `{}` \
+             is none of them",
             command.join(" ")
         );
     }
@@ -92,6 +93,12 @@ pub(super) fn studies(command: &[String], axes: &Axes) -> Result<Vec<StudyEntry>
     for (axis, flag, values) in axis_flags {
         if values.is_empty() {
             continue;
+        }
+        if kind == "replay" {
+            bail!(
+                "{axis}: a replay sweep has no axes (its traces are its jobs, each against its \
+                 baseline)"
+            );
         }
         if flag_value(command, flag).is_some() {
             bail!("{flag} in the command and {axis}: give one of them");
@@ -168,6 +175,9 @@ enum Shape {
     Reference {
         spp: u32,
     },
+    Replay {
+        traces: Vec<String>,
+    },
 }
 
 fn shape(args: &[String], parse: Parse) -> Result<Shape> {
@@ -178,6 +188,18 @@ fn shape(args: &[String], parse: Parse) -> Result<Shape> {
             Study::Reference(r) => {
                 crate::commands::reference::check(r)?;
                 Shape::Reference { spp: r.spp }
+            }
+            Study::Replay(r) => {
+                crate::commands::replay::check(r)?;
+                if r.update {
+                    bail!(
+                        "--update-baseline: a sweep compares with baselines; write them with one \
+                         `fovea replay --update-baseline` process"
+                    );
+                }
+                Shape::Replay {
+                    traces: r.traces.to_vec(),
+                }
             }
         });
         Ok(())
@@ -198,7 +220,8 @@ fn quality_shape(q: &QualityArgs) -> Result<Shape> {
 }
 
 /// The stages and jobs of the studies: every reference part first (stage `reference`), then
-/// every combination (stage `run`) after the parts of its study's camera.
+/// every quality combination after the parts of its study's camera and every replay trace (stage
+/// `run`).
 pub(super) fn jobs(
     studies: &[StudyEntry],
     batches_per_job: u32,
@@ -272,9 +295,20 @@ pub(super) fn jobs(
                     push("reference", name, i, study.args.clone(), part, vec![]);
                 }
             }
+            Shape::Replay { .. } => {}
         }
     }
     for (i, (study, shape)) in studies.iter().zip(&shapes).enumerate() {
+        if let Shape::Replay { traces } = shape {
+            for trace in traces {
+                let name = format!("{}: trace {trace}", study.name);
+                let part = Part::Trace {
+                    trace: trace.clone(),
+                };
+                push("run", name, i, study.args.clone(), part, vec![]);
+            }
+            continue;
+        }
         let Shape::Quality {
             cameras,
             methods,

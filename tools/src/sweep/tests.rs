@@ -61,7 +61,9 @@ fn axes_make_one_study_each_with_the_merged_output_as_out() {
 fn bad_commands_and_axes_are_refused_with_the_flag() {
     let err =
         |command: &str, axes: Axes| format!("{:#}", studies(&words(command), &axes).unwrap_err());
-    assert!(err("render --frames 2", Axes::default()).contains("`render --frames 2` is neither"));
+    assert!(
+        err("render --frames 2", Axes::default()).contains("`render --frames 2` is none of them")
+    );
     assert!(err("quality --out x", Axes::default()).contains("leave --out out"));
     let scenes = Axes {
         scenes: words("cornell-box"),
@@ -73,6 +75,11 @@ fn bad_commands_and_axes_are_refused_with_the_flag() {
         ..Axes::default()
     };
     assert!(err("reference --spp 4", gazes).contains("a reference has no gaze"));
+    let replay_scenes = Axes {
+        scenes: words("cornell-box"),
+        ..Axes::default()
+    };
+    assert!(err("replay sim:1 --baseline b", replay_scenes).contains("a replay sweep has no axes"));
     let twins = Axes {
         scenes: words("a/x.gltf b/x.gltf"),
         ..Axes::default()
