@@ -9,6 +9,7 @@ pub mod headsets;
 pub mod info;
 pub mod method_table;
 pub mod methods;
+pub mod overview;
 pub mod quality;
 pub mod reference;
 pub mod render;

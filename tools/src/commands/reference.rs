@@ -3,6 +3,7 @@
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Context as _, Result};
 use fovea_renderer::frame::{CameraPose, RenderSettings};
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::Context;
@@ -119,7 +120,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
 pub fn write(args: &ReferenceArgs, out: &Path, image: &[[f32; 4]]) -> Result<()> {
     write_exr(out, args.width, args.height, image)?;
     if args.preview {
-        let displayed = tonemap_preview(image, 1.0);
+        let displayed = tonemap_preview(image, 1.0, ToneCurve::Aces);
         write_png(
             &out.with_extension("png"),
             args.width,
@@ -132,7 +133,7 @@ pub fn write(args: &ReferenceArgs, out: &Path, image: &[[f32; 4]]) -> Result<()>
 
 /// What a converged image should not have: isolated pixels far brighter than their neighbours.
 pub fn fireflies(args: &ReferenceArgs, image: &[[f32; 4]]) {
-    let displayed = tonemap_preview(image, 1.0);
+    let displayed = tonemap_preview(image, 1.0, ToneCurve::Aces);
     let (w, h) = (args.width as usize, args.height as usize);
     let [ff30, ff60, ff100] = [30.0, 60.0, 100.0]
         .map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
