@@ -21,15 +21,6 @@ const KNOWN_TOOLS_CYCLES: &[&[&str]] = &[
         "fovea_tools::commands::bench",
         "fovea_tools::commands::bench_vp",
     ],
-    &[
-        "fovea_tools::commands::render",
-        "fovea_tools::commands::setup",
-    ],
-    &[
-        "fovea_tools::commands::xr",
-        "fovea_tools::commands::xr_report",
-    ],
-    &["fovea_tools::look", "fovea_tools::sky_model"],
 ];
 
 /// One module: its place in the tree, the names its `use` items bring in and the paths it uses.

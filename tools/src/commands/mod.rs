@@ -13,6 +13,7 @@ pub mod overview;
 pub mod quality;
 pub mod reference;
 pub mod render;
+pub mod render_args;
 pub mod replay;
 pub mod setup;
 pub mod view;

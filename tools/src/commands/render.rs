@@ -2,7 +2,9 @@
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
 use super::methods::{ReportSection, VpVariant};
-use super::setup::{Eyes, Setup};
+use super::render_args::Eyes;
+pub use super::render_args::RenderArgs;
+use super::setup::Setup;
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::render_profile::RenderProfile;
 use anyhow::Result;
@@ -13,48 +15,6 @@ use fovea_renderer::pipeline::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
-
-#[derive(Clone)]
-pub struct RenderArgs<'a> {
-    pub scene: &'a str,
-    pub method: &'a str,
-    /// Render size; `None` = the headset's per-eye recommended size × `scale`.
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub scale: f32,
-    pub headset: &'a str,
-    pub gaze: &'a str,
-    pub frames: u32,
-    pub out: &'a Path,
-    pub exr: bool,
-    /// Still, the default orbit, or keyframes (`--camera-path [FILE]`).
-    pub camera_path: crate::camera_path::CameraMotion,
-    pub seed: u32,
-    pub max_depth: u32,
-    /// `--exposure`: automatic (the default) or fixed.
-    pub exposure: fovea_renderer::passes::exposure::Exposure,
-    /// Write `overview.png` (the last frame, the same frame at full cost, the sample density).
-    pub overview: bool,
-    /// `--tone`: the display transform.
-    pub tone: fovea_renderer::passes::tonemap::ToneCurve,
-    /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
-    pub profile: RenderProfile,
-    /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
-    pub debug_views: bool,
-    /// `auto` (`setup::AUTO`), `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
-    pub denoiser: &'a str,
-    /// `auto`, `off`, `vp` or `screen` (`TaaMode::NAMES`).
-    pub taa: &'a str,
-    pub device: Option<&'a str>,
-    pub validation: bool,
-    /// `--eyes`: left (the default, plain frame names), right, or both (one submit per frame).
-    pub eyes: Eyes,
-    /// Frames kept on the GPU at once (a frame's images are written while later ones render).
-    pub frames_in_flight: usize,
-    /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
-    pub camera: &'a crate::look::CameraOptions,
-}
 
 #[derive(Serialize)]
 struct Report {

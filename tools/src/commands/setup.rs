@@ -3,7 +3,8 @@
 //! frame. Both commands build frame `k` with `Setup::frame_input`, so the viewer's frames equal
 //! the offline render's (same seeds, cameras and gaze).
 
-use super::render::RenderArgs;
+pub use super::render_args::Eyes;
+use super::render_args::RenderArgs;
 use crate::camera_path;
 use crate::gaze::{FrameGaze, GazeDriver};
 use crate::projection::EyeRig;
@@ -21,43 +22,6 @@ use glam::{UVec2, Vec3};
 
 pub use super::methods::{method, names as method_names};
 use super::methods::{ScreenNeeds, SpaceInputs};
-
-/// Which eyes a run renders (`--eyes`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Eyes {
-    Left,
-    Right,
-    Both,
-}
-
-impl Eyes {
-    pub const NAMES: &'static [&'static str] = &["left", "right", "both"];
-
-    pub fn parse(name: &str) -> Result<Eyes> {
-        Ok(match name {
-            "left" => Eyes::Left,
-            "right" => Eyes::Right,
-            "both" => Eyes::Both,
-            _ => bail!("--eyes {name}: expected one of {}", Eyes::NAMES.join(", ")),
-        })
-    }
-
-    pub fn list(self) -> &'static [Eye] {
-        match self {
-            Eyes::Left => &[Eye::Left],
-            Eyes::Right => &[Eye::Right],
-            Eyes::Both => &[Eye::Left, Eye::Right],
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Eyes::Left => "left",
-            Eyes::Right => "right",
-            Eyes::Both => "both",
-        }
-    }
-}
 
 pub struct Setup {
     pub hmd: HmdDescription,

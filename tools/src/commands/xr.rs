@@ -547,6 +547,10 @@ impl<'a> XrRun<'a> {
         }
         self.save_screenshot()?;
         super::check_validation(&self.ctx)?;
+        let (denoiser, taa) = (
+            self.renderer.settings.denoiser.name(),
+            self.renderer.settings.taa.name(),
+        );
         let XrRun {
             args,
             log,
@@ -559,7 +563,10 @@ impl<'a> XrRun<'a> {
         let logged = log.commit()?;
         let recorded = gaze.finish()?;
         let report = super::xr_report::build(&super::xr_report::Inputs {
-            args,
+            render: &args.render,
+            reference_space: args.reference_space.name(),
+            denoiser,
+            taa,
             rt,
             base,
             hmd: &facts.hmd,
