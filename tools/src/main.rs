@@ -472,7 +472,7 @@ enum Command {
         device: DeviceArgs,
     },
     /// Real-time rendering in a window: one eye or both side by side, gaze from the mouse (or
-    /// --gaze), keys m / d / t cycle method, denoiser and TAA, f freezes the gaze, q or Esc quits.
+    /// --gaze), keys m / n / t cycle method, denoiser and TAA, f freezes the gaze, q or Esc quits.
     View {
         #[command(flatten)]
         opts: Box<RenderOpts>,
