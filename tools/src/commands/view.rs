@@ -48,7 +48,7 @@ pub struct ViewArgs<'a> {
     pub debug_view: DebugView,
 }
 
-/// Key d cycles through every registered denoiser (and none).
+/// Key n cycles through every registered denoiser (and none).
 const DENOISERS: &[&str] = DenoiserSettings::NAMES;
 const TAAS: &[&str] = &["off", "vp", "screen"];
 
