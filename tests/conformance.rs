@@ -638,3 +638,68 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// ReSTIR DI (`--resampling di`) on every space whose grid runs the temporal filters (its reuse
+/// addresses the grid as they do: φ wraps, clipped texels hold nothing, the previous gaze's grid
+/// for the temporal step): no validation message, every pixel finite and non-negative, the mean
+/// over frames like next-event estimation's, and BMFR after it; every other space refuses it by
+/// name, and A-SVGF (whose re-shading cannot replay reservoirs) refuses it on every space.
+#[test]
+fn resampling_on_every_space_that_supports_it() {
+    use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let start = CameraPose::from_scene_camera(&scene.cameras[0], SIZE.x, SIZE.y);
+    let gaze = SIZE.as_vec2() * 0.5;
+    let with_di = |settings: RenderSettings| RenderSettings {
+        resampling: ResamplingSettings::default().with_mode(ResamplingMode::Di),
+        ..settings
+    };
+    let plain = settings(DenoiserSettings::None, TaaMode::Off);
+    let refusal = |make: &MakeSpace, settings: RenderSettings| {
+        Renderer::new(&ctx, &scene, make(), settings)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    for (space_name, make) in spaces(SIZE) {
+        if !make().capabilities().temporal_filters {
+            let err = refusal(&make, with_di(plain));
+            assert!(
+                err.contains(space_name) && err.contains("resampling"),
+                "{space_name} + resampling: {err}"
+            );
+            continue;
+        }
+        let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
+        let err = refusal(&make, with_di(asvgf));
+        assert!(
+            err.contains("asvgf") && err.contains("resampling"),
+            "{space_name} + asvgf + resampling: {err}"
+        );
+        let check = |what: &str| {
+            let what = what.to_string();
+            move |f: u32, hdr: &[[f32; 4]]| {
+                assert_finite_non_negative(&format!("{space_name} + {what}, frame {f}"), hdr)
+            }
+        };
+        let frames = 24;
+        let mut r = Renderer::new(&ctx, &scene, make(), plain).unwrap();
+        let off = fovea_tests::mean_over_frames(&mut r, start, Some(gaze), frames, check("nee"));
+        let mut r = Renderer::new(&ctx, &scene, make(), with_di(plain)).unwrap();
+        let di = fovea_tests::mean_over_frames(&mut r, start, Some(gaze), frames, check("di"));
+        let bmfr = settings(DenoiserSettings::parse("bmfr").unwrap(), TaaMode::Off);
+        let mut r = Renderer::new(&ctx, &scene, make(), with_di(bmfr)).unwrap();
+        fovea_tests::mean_over_frames(&mut r, start, Some(gaze), 4, check("di + bmfr"));
+        println!("{space_name}: mean of {frames} frames, resampling di {di:?} vs off {off:?}");
+        for c in 0..3 {
+            assert!(
+                (di[c] / off[c] - 1.0).abs() < 0.05,
+                "{space_name}: channel {c}, resampling di {} vs off {}",
+                di[c],
+                off[c]
+            );
+        }
+        assert_clean(&ctx);
+    }
+}

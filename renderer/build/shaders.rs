@@ -6,8 +6,9 @@
 //! stands for one such line per sampling space of `shaders/sampling/spaces.txt` (`NAME: DEFINES`),
 //! named `SPACE SUFFIX` with the space's and the line's defines, so a new space is one line there,
 //! not one in every kernel. `//! variants per trace space[ SUFFIX: DEFINES]` does the same over the
-//! trace kernel's sampling variants of `shaders/sampling/trace_spaces.txt`, and `//! variants per
-//! gradient trace space SUFFIX: DEFINES` over those of its lines tagged `gradients`.
+//! trace kernel's sampling variants of `shaders/sampling/trace_spaces.txt`, `//! variants per
+//! gradient trace space SUFFIX: DEFINES` over those of its lines tagged `gradients`, and
+//! `//! variants per resampling trace space SUFFIX: DEFINES` over those tagged `resampling`.
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -22,6 +23,8 @@ struct SpaceLists {
     /// `trace_spaces.txt`: the tracer's sampling variants, and which can trace gradient samples.
     trace: Vec<(String, Defines)>,
     gradient_trace: Vec<(String, Defines)>,
+    /// The trace variants of the spaces the resampling passes run in (ReSTIR DI).
+    resampling_trace: Vec<(String, Defines)>,
 }
 
 fn read_list(root: &Path, file: &str) -> Result<Vec<(String, Vec<String>, Defines)>, String> {
@@ -53,17 +56,20 @@ impl SpaceLists {
             list.into_iter().map(|(n, _, d)| (n, d)).collect::<Vec<_>>()
         };
         let trace = read_list(root, "sampling/trace_spaces.txt")?;
-        let gradient_trace = untagged(
-            trace
-                .iter()
-                .filter(|(_, tags, _)| tags.iter().any(|t| t == "gradients"))
-                .cloned()
-                .collect(),
-        );
+        let tagged = |tag: &str| {
+            untagged(
+                trace
+                    .iter()
+                    .filter(|(_, tags, _)| tags.iter().any(|t| t == tag))
+                    .cloned()
+                    .collect(),
+            )
+        };
         Ok(SpaceLists {
             grid: untagged(read_list(root, "sampling/spaces.txt")?),
+            gradient_trace: tagged("gradients"),
+            resampling_trace: tagged("resampling"),
             trace: untagged(trace),
-            gradient_trace,
         })
     }
 }
@@ -219,6 +225,10 @@ fn parse_variants(source: &str, spaces: &SpaceLists) -> Vec<(String, Defines)> {
         (
             "//! variants per gradient trace space",
             &spaces.gradient_trace,
+        ),
+        (
+            "//! variants per resampling trace space",
+            &spaces.resampling_trace,
         ),
     ];
     for (directive, list) in directives {

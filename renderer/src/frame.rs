@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::graph::{ExternalImage, SubmitSync};
 use crate::passes::denoise::DenoiserSettings;
 use crate::passes::exposure::Exposure;
+use crate::passes::resampling::ResamplingSettings;
 use crate::passes::taa::TaaMode;
 use crate::passes::tonemap::ToneCurve;
 use crate::scene::Camera;
@@ -65,6 +66,9 @@ pub struct RenderSettings {
     /// Whether samples far off the screen are traced (only the paper's Visual-Polar layout, the
     /// log-polar and composite buffers and random acuity place any there).
     pub offscreen_samples: OffscreenSamples,
+    /// Reuse of light samples between the sampling grid's texels and frames (ReSTIR DI) before
+    /// the denoiser; off by default. Fixed for the renderer's life (it owns reservoirs).
+    pub resampling: ResamplingSettings,
 }
 
 /// `RenderSettings::environment_sampling`.
@@ -93,6 +97,7 @@ impl Default for RenderSettings {
             texture_lod: TextureLod::default(),
             path_regularisation: DEFAULT_PATH_REGULARISATION,
             offscreen_samples: OffscreenSamples::default(),
+            resampling: ResamplingSettings::default(),
         }
     }
 }

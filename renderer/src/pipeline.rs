@@ -1,6 +1,6 @@
-//! Composes a frame: sampling space → trace → denoiser (optional, in the sampling grid) → screen
-//! image (Visual-Polar: φ-mips, remap, foveated blur) for every view → one exposure metered over
-//! all views → tonemap → read-back.
+//! Composes a frame: sampling space → trace → resampling (optional) → denoiser (optional, in the
+//! sampling grid) → screen image (Visual-Polar: φ-mips, remap, foveated blur) for every view → one
+//! exposure metered over all views → tonemap → read-back.
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
@@ -703,8 +703,8 @@ fn pixels_per_degree(camera: &CameraPose, width: u32) -> f32 {
     width as f32 / span.to_degrees().max(1e-3)
 }
 
-/// Records one view's frame up to its screen radiance: trace → denoiser → TAA → the way back to
-/// the screen (a pending foveated blur left to `record_display`).
+/// Records one view's frame up to its screen radiance: trace → resampling → denoiser → TAA → the
+/// way back to the screen (a pending foveated blur left to `record_display`).
 fn record_view<'a>(
     rec: &mut FrameRecorder,
     view: &'a mut View,
@@ -738,8 +738,16 @@ fn record_view<'a>(
         d.record_before_trace(rec, &frame)?;
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
-    let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
+    let trace = view
+        .trace_gradients
+        .as_ref()
+        .or(view.trace_resampled.as_ref())
+        .unwrap_or(&view.trace);
     trace.record(rec, &frame, scene, &s.ray_counters, 0, gradients)?;
+    // The primary hits' direct light, from reservoirs reused over frames and grid neighbours.
+    if let Some(resampling) = &mut view.resampling {
+        resampling.record(rec, &frame, scene, &s.ray_counters)?;
+    }
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
     let traced = match &view.sample_mean {

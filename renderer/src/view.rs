@@ -8,6 +8,7 @@ use crate::frame::{CameraPose, FrameStats, RenderSettings};
 use crate::layouts::{FrameData, SamplingParams};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
 use crate::passes::grid::GBuffer;
+use crate::passes::resampling::{Resampling, ResamplingMode};
 use crate::passes::taa::{Taa, TaaMode};
 use crate::passes::trace::{TracePass, RAY_COUNTERS};
 use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
@@ -107,6 +108,10 @@ pub struct View {
     /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
     /// (references keep `trace`).
     pub(crate) trace_gradients: Option<TracePass>,
+    /// The tracer's resampled variant and the resampling passes after it, which real-time frames
+    /// use with `--resampling di` (references keep `trace`).
+    pub(crate) trace_resampled: Option<TracePass>,
+    pub(crate) resampling: Option<Resampling>,
     /// The passes of the space's way back to the screen.
     pub(crate) back: Box<dyn WayBackPasses>,
     /// Each texel's mean over the frame's samples, for spaces that trace several per texel.
@@ -168,6 +173,36 @@ impl View {
                 &format!("{}_gradients", space.trace_variant()),
             )?),
         };
+        let resampled = settings.resampling.mode == ResamplingMode::Di;
+        if resampled && gradients {
+            // A-SVGF re-shades last frame's paths to measure how the light changed; the
+            // resampled paths' direct light comes from reservoirs the re-shading cannot replay.
+            return Err(Error::Invalid(format!(
+                "resampling '{}' with denoiser '{}': A-SVGF's gradient samples re-shade paths \
+                 whose direct light the reservoirs give; use svgf or bmfr",
+                settings.resampling.mode.name(),
+                settings.denoiser.name()
+            )));
+        }
+        let resampling = match resampled {
+            true => Some(Resampling::new(ctx, space.as_ref(), settings.resampling)?),
+            false => None,
+        };
+        let trace_resampled = match resampled {
+            true => Some(TracePass::new(
+                ctx,
+                &format!("{}_resampled", space.trace_variant()),
+            )?),
+            false => None,
+        };
+        let mut gbuffer = if gradients {
+            GBuffer::with_visibility(ctx, grid)?
+        } else {
+            GBuffer::new(ctx, grid)?
+        };
+        if resampled {
+            gbuffer.add_primary_hit(ctx)?;
+        }
         let taa = match grid_taa {
             Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
             None => None,
@@ -178,11 +213,9 @@ impl View {
         Ok(View {
             trace: TracePass::new(ctx, space.trace_variant())?,
             trace_gradients,
-            gbuffer: if gradients {
-                GBuffer::with_visibility(ctx, grid)?
-            } else {
-                GBuffer::new(ctx, grid)?
-            },
+            trace_resampled,
+            resampling,
+            gbuffer,
             ldr: Image::new(ctx, "ldr", screen.x, screen.y, vk::Format::R8G8B8A8_UNORM)?,
             grid_ldr: Image::new(ctx, "grid_ldr", grid.x, grid.y, vk::Format::R8G8B8A8_UNORM)?,
             accum: None,
@@ -222,6 +255,7 @@ impl View {
         // 26: the idle tiles' clear is one of them.
         26 + extra_samples
             + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
+            + self.resampling.as_ref().map_or(0, |_| Resampling::PASSES)
             + self.back.extra_passes()
     }
 
@@ -237,6 +271,11 @@ impl View {
 
     pub fn taa(&self) -> Option<&Taa> {
         self.taa.as_ref()
+    }
+
+    /// The resampling passes' state, when `--resampling` is on.
+    pub fn resampling(&self) -> Option<&Resampling> {
+        self.resampling.as_ref()
     }
 
     /// The read-back buffers a frame in `slot` needs, made on first use.

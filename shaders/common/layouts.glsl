@@ -395,6 +395,45 @@ struct AsvgfGradientPush {
     uvec4 config;               // x tap spacing in strata (2^iteration), yzw unused
 };
 
+// ---- Resampling (ReSTIR DI, Bitterli et al. 2020; docs/design/resampling.md): one reservoir
+// of light samples per sampling-grid texel, reused over time and over grid neighbours.
+
+// Salts of the resampling passes' own random streams, rng_seed(texel, frame, seed, salt) (the
+// paths' streams use sample indices): candidate generation, and the reuse decisions.
+const uint RESAMPLING_SALT_CANDIDATES = 0x72697363u;
+const uint RESAMPLING_SALT_REUSE = 0x72657573u;
+// Most grid neighbours the spatial pass combines per sample (it keeps their taps for the
+// normalisation).
+const uint RESAMPLING_MAX_NEIGHBOURS = 16u;
+
+// One texel's reservoir: the chosen light sample, its weights and the surface it belongs to.
+// The sample is a point of the light table that re-evaluates exactly anywhere (no Jacobian):
+// an emissive triangle's point by barycentrics, the environment's direction (octahedral),
+// a punctual or directional light by its entry alone.
+struct ReservoirGpu {
+    uvec4 light_point;          // x light entry + 1 (0: empty), y, z the point (float bits: barycentrics u, v, or the
+                                //   environment direction's octahedral x, y), w unused
+    vec4 weights;               // x W (unbiased contribution weight), y M (candidates it stands for), z p̂ of the sample at
+                                //   its own surface, w unused
+    uvec4 surface;              // the owner's surface (denoise/svgf.glsl svgf_pack_surface; key 0: no sample)
+    vec4 position;              // xyz the owner's shading point (world space; W is for its visibility), w unused
+};
+
+// Push constants of the first resampling pass (initial candidates, visibility, temporal reuse),
+// 128 bytes like SvgfTemporalPush.
+struct ResampleTemporalPush {
+    SamplingParams space;       // this frame's space
+    SamplingFrame prev;         // the previous frame's (its grid = space.grid)
+    vec4 params;                // x light candidates per texel, y M cap of the previous reservoir (× this frame's
+                                //   candidates), z 1 = no usable history, w unused
+};
+
+// Push constants of the second resampling pass (spatial reuse and the final shading).
+struct ResampleSpatialPush {
+    SamplingParams space;       // this frame's space
+    vec4 params;                // x neighbours, y radius (grid texels), zw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 const uint TONEMAP_NEUTRAL = 2u;

@@ -49,6 +49,10 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
     Hit hit;
     float min_pdf = 1e30;   // smallest bounce density so far (regularise)
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
+#if defined(RESAMPLED_DI)
+        // The primary hit's direct light is the resampling passes' (shaders/passes/resample_*).
+        if (depth_i > 1u)
+#endif
         color += throughput * direct_light(s, v, rng);
         // The environment's second strategy: at the last vertex a BRDF ray still looks for it
         // (its MIS share of the direct light); a surface it hits adds nothing there.

@@ -6,9 +6,13 @@
 // of last frame's samples chose (asvgf_forward.comp) re-shades that frame's surface with that
 // frame's random state, and every texel writes the visibility (barycentrics, random state) the
 // next projection reads. Plain rendering keeps the variants without them and pays nothing.
+// The *_resampled variants (RESAMPLED_DI) leave the primary hit's next-event estimation to the
+// resampling passes (ReSTIR DI, docs/design/resampling.md) and write the primary hit's
+// barycentrics and ray-cone width, from which those passes re-fetch the surface.
 // Its variants are the sampling spaces of shaders/sampling/trace_spaces.txt.
 //! variants per trace space
 //! variants per gradient trace space _gradients: TRACE_GRADIENTS
+//! variants per resampling trace space _resampled: RESAMPLED_DI
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -45,6 +49,9 @@ layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_co
 layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
 layout(std430, set = 0, binding = 22) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
 layout(set = 0, binding = 23, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
+#endif
+#if defined(RESAMPLED_DI)
+layout(set = 0, binding = 21, rgba32f) uniform writeonly image2D out_primary_hit;  // barycentrics u, v, ray-cone width, 0
 #endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
@@ -129,6 +136,9 @@ void main() {
 #if defined(TRACE_GRADIENTS)
         imageStore(out_visibility, texel, uvec4(0u));
 #endif
+#if defined(RESAMPLED_DI)
+        imageStore(out_primary_hit, texel, vec4(0.0));
+#endif
         return;
     }
     if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, frame.data.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
@@ -160,6 +170,7 @@ void main() {
     vec4 position = vec4(0.0);
     uvec2 ids = uvec2(0u);
     vec2 prev_screen = vec2(-1.0);
+    vec4 primary_hit = vec4(0.0);   // RESAMPLED_DI: barycentrics, ray-cone width
     bool found = bvh_trace(org, dir, 0.0, 1e30, false, hit);
 #if defined(TRACE_GRADIENTS)
     gradient = gradient && found && hit.triangle == gs.surface.y - 1u;
@@ -198,7 +209,11 @@ void main() {
         ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
         project_view((prev_view_from_world * vec4(s.position, 1.0)).xyz, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
         color = shade_path(s, dir, max_depth, cone, rng);
+        primary_hit = vec4(hit.u, hit.v, cone.x, 0.0);
     }
+#if defined(RESAMPLED_DI)
+    imageStore(out_primary_hit, texel, primary_hit);
+#endif
     atomicAdd(ray_counters.data[0], 1u);
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);
     if (continuation_rays > 0u) atomicAdd(ray_counters.data[2], continuation_rays);

@@ -78,6 +78,12 @@ struct SceneFlags {
     /// log-polar and composite buffers and random acuity place samples there).
     #[arg(long)]
     offscreen_samples: Option<String>,
+    /// Light-sample reuse before the denoiser: off (the default: next-event estimation at every
+    /// hit) or di (ReSTIR DI at the primary hit: light candidates resampled per sample, reused
+    /// from the previous frame and from grid neighbours; spaces with temporal filters only, not
+    /// with --denoiser asvgf); parameters from the profile's [resampling].
+    #[arg(long)]
+    resampling: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
     /// vertices' glossy lobes are widened so sunlight focused through them stops making
     /// fireflies; biased, 0 = off (the unbiased estimator).
@@ -323,6 +329,7 @@ impl RenderOpts {
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
+            resampling: self.look.resampling.clone(),
             gaze_timing: self.latency.timing()?,
         })
     }
@@ -1130,6 +1137,7 @@ fn with_quality_args(
         texture_lod: look.texture_lod.clone(),
         path_regularisation: look.path_regularisation,
         offscreen_samples: look.offscreen_samples.clone(),
+        resampling: look.resampling.clone(),
         gaze_timing: latency.timing()?,
         ..Default::default()
     })?;

@@ -12,6 +12,7 @@ use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
 use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
+use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
 use fovea_renderer::passes::taa::TaaSettings;
 use fovea_renderer::sampling::{
     CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent,
@@ -47,6 +48,8 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `[resampling]` and `--resampling`: ReSTIR DI's mode and parameters (off by default).
+    pub resampling: ResamplingSettings,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -64,6 +67,7 @@ struct ProfileFile {
     textures: Option<TexturesSection>,
     path: Option<PathSection>,
     trace: Option<TraceSection>,
+    resampling: Option<ResamplingSettings>,
     /// The denoiser sections present.
     denoisers: Vec<DenoiserSettings>,
 }
@@ -79,6 +83,7 @@ const FIXED_SECTIONS: &[&str] = &[
     "textures",
     "path",
     "trace",
+    "resampling",
 ];
 
 impl<'de> Deserialize<'de> for ProfileFile {
@@ -112,6 +117,7 @@ impl<'de> Visitor<'de> for ProfileVisitor {
                 "textures" => file.textures = Some(map.next_value()?),
                 "path" => file.path = Some(map.next_value()?),
                 "trace" => file.trace = Some(map.next_value()?),
+                "resampling" => file.resampling = Some(map.next_value()?),
                 section if DenoiserSettings::NAMES[1..].contains(&section) => {
                     if let Some(d) = map.next_value_seed(DenoiserSection(section))? {
                         file.denoisers.push(d);
@@ -243,6 +249,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--resampling`.
+    pub resampling: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -469,6 +477,10 @@ impl RenderProfile {
             profile.offscreen_samples = OffscreenSamples::parse(&mode)
                 .with_context(|| format!("{}.offscreen", at("trace")))?;
         }
+        if let Some(resampling) = file.resampling {
+            resampling.validate().with_context(|| at("resampling"))?;
+            profile.resampling = resampling;
+        }
         if let Some(strength) = file.path.and_then(|p| p.regularisation) {
             profile.path_regularisation = Some(check_path_regularisation(
                 Some(strength),
@@ -529,6 +541,10 @@ impl RenderProfile {
         if let Some(mode) = &o.offscreen_samples {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
+        }
+        if let Some(mode) = &o.resampling {
+            let mode = ResamplingMode::parse(mode).context("--resampling")?;
+            self.resampling = self.resampling.with_mode(mode);
         }
         if o.gaze_timing.enabled() {
             self.gaze_timing = o.gaze_timing;
@@ -1251,5 +1267,59 @@ gradient_sigma_normal = 64
             RenderProfile::default().override_with(&bad).unwrap_err()
         )
         .contains("--env-intensity"));
+    }
+
+    /// `[resampling]`: the mode and parameters onto the engine's defaults, checked by name;
+    /// `--resampling` sets the mode and keeps the section's parameters.
+    #[test]
+    fn resampling_section_and_flag() {
+        let p = load_str(
+            "resampling.toml",
+            "[resampling]\nmode = \"di\"\ncandidates = 16\nradius = 4.0\n",
+        )
+        .unwrap();
+        assert_eq!(p.resampling.mode, ResamplingMode::Di);
+        assert_eq!(
+            (
+                p.resampling.candidates,
+                p.resampling.radius,
+                p.resampling.neighbours
+            ),
+            (16, 4.0, ResamplingSettings::default().neighbours)
+        );
+        let off = ProfileOverrides {
+            resampling: Some("off".into()),
+            ..Default::default()
+        };
+        let p = p.override_with(&off).unwrap();
+        assert_eq!(
+            (p.resampling.mode, p.resampling.candidates),
+            (ResamplingMode::Off, 16)
+        );
+        let err = format!(
+            "{:#}",
+            load_str("resampling_bad.toml", "[resampling]\ncandidates = 0\n").unwrap_err()
+        );
+        assert!(
+            err.contains("[resampling]") && err.contains("candidates"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str("resampling_mode.toml", "[resampling]\nmode = \"gi\"\n").unwrap_err()
+        );
+        assert!(err.contains("gi") && err.contains("di"), "{err}");
+        let bad = ProfileOverrides {
+            resampling: Some("on".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(
+            err.contains("--resampling") && err.contains("off, di"),
+            "{err}"
+        );
     }
 }

@@ -32,6 +32,10 @@ pub struct GBuffer {
     /// re-shading exactly this sample's path next frame needs besides `ids` — and w 1 where the
     /// sample was itself a gradient sample (not projected again).
     pub visibility: Option<Image>,
+    /// Only for resampling (`GBuffer::add_primary_hit`; written by the `*_resampled` kernel
+    /// variants): the primary hit's barycentrics (x, y) and ray-cone width (z), from which the
+    /// resampling passes re-fetch the surface the tracer shaded.
+    pub primary_hit: Option<Image>,
 }
 
 impl GBuffer {
@@ -47,6 +51,7 @@ impl GBuffer {
             ids: image("gbuffer.ids", vk::Format::R32G32_UINT)?,
             motion: image("gbuffer.motion", vk::Format::R32G32_SFLOAT)?,
             visibility: None,
+            primary_hit: None,
         })
     }
 
@@ -61,6 +66,18 @@ impl GBuffer {
             write_image("out_ids", &self.ids),
             write_image("out_motion", &self.motion),
         ]
+    }
+
+    /// Adds the primary-hit image the resampling passes read.
+    pub fn add_primary_hit(&mut self, ctx: &Arc<Context>) -> Result<()> {
+        self.primary_hit = Some(Image::new(
+            ctx,
+            "gbuffer.primary_hit",
+            self.size.x,
+            self.size.y,
+            vk::Format::R32G32B32A32_SFLOAT,
+        )?);
+        Ok(())
     }
 
     /// A G-buffer with the visibility image the A-SVGF gradient samples are projected from.

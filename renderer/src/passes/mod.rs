@@ -7,6 +7,7 @@ pub mod denoise;
 pub mod exposure;
 pub mod grid;
 pub mod raycast;
+pub mod resampling;
 pub mod taa;
 pub mod tonemap;
 pub mod trace;

@@ -1,5 +1,6 @@
 //! The path-tracing pass: one sample per sampling-grid texel, writing the per-sample G-buffer.
-//! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf).
+//! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf), its
+//! `*_resampled` variants leave the primary hit's direct light to the resampling passes.
 
 use super::grid::{GradientTargets, GridFrame};
 use super::trace_clear::TraceClearPass;
@@ -71,7 +72,16 @@ impl TracePass {
             ]),
             _ => None,
         };
-        let extra = gradient_binds.unwrap_or([s.bvh_nodes; 3]);
+        // The `*_resampled` variants write the primary hit (the G-buffer has its image only then).
+        let primary_hit = out
+            .primary_hit
+            .as_ref()
+            .map(|h| write_image("out_primary_hit", h));
+        let (extra, extra_count) = match (gradient_binds, primary_hit) {
+            (Some(g), _) => (g, 3),
+            (None, Some(h)) => ([h, s.bvh_nodes, s.bvh_nodes], 1),
+            (None, None) => ([s.bvh_nodes; 3], 0),
+        };
         let g = out.write_binds();
         let binds = [
             s.bvh_nodes,
@@ -100,11 +110,7 @@ impl TracePass {
             extra[1],
             extra[2],
         ];
-        let binds = &binds[..if gradient_binds.is_some() {
-            binds.len()
-        } else {
-            binds.len() - 3
-        }];
+        let binds = &binds[..binds.len() - 3 + extra_count];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush {
             config: UVec4::new(sample_index, 0, 0, 0),

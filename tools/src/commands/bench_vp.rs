@@ -10,6 +10,7 @@ use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
+use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams,
@@ -70,6 +71,9 @@ pub struct VpFrameReport {
     pub to_screen_share: f64,
     /// Each denoiser (`DENOISERS`) at the same sizes and gaze.
     pub denoisers: Vec<DenoiserCost>,
+    /// ReSTIR DI (`--resampling di`, its default parameters) at the same sizes and gaze, no
+    /// denoiser.
+    pub resampling: ResamplingCost,
     /// Every other method of `--method` (the comparators, VP's variants, fixed foveation)
     /// in the same interleaved run as the VP and Cartesian frames above, no denoiser, each with
     /// its paper's defaults (`comparator_spaces`; `linear-falloff`'s samples: the expected count).
@@ -127,6 +131,31 @@ pub struct DenoiserCost {
     pub cartesian_history_bytes: u64,
     pub vp_history_bytes: u64,
 }
+
+/// ReSTIR DI's cost in VP and Cartesian space: frames with it and without it in one interleaved
+/// run.
+#[derive(Serialize)]
+pub struct ResamplingCost {
+    /// The trace (its `*_resampled` variant: no next-event estimation at the primary hit) and
+    /// the two resampling passes, median ms per frame.
+    pub cartesian_passes_ms: BTreeMap<String, f64>,
+    pub vp_passes_ms: BTreeMap<String, f64>,
+    /// The two resampling passes.
+    pub cartesian_ms: f64,
+    pub vp_ms: f64,
+    /// Their share of the whole frame with resampling.
+    pub cartesian_share: f64,
+    pub vp_share: f64,
+    /// Whole frame with resampling / without it, each space.
+    pub cartesian_frame_ratio: f64,
+    pub vp_frame_ratio: f64,
+    /// GPU bytes of reservoirs per view.
+    pub cartesian_history_bytes: u64,
+    pub vp_history_bytes: u64,
+}
+
+/// The resampling passes' names (`passes/resampling`).
+const RESAMPLING_PASSES: [&str; 2] = ["resample_temporal", "resample_spatial"];
 
 /// A comparator method's whole frames against the Cartesian ones of the same run.
 #[derive(Serialize)]
@@ -306,7 +335,10 @@ pub fn measure(
         }
         let history: Vec<u64> = renderers
             .iter()
-            .map(|(r, _)| r.denoiser().map_or(0, |d| d.history_bytes()))
+            .map(|(r, _)| {
+                r.denoiser().map_or(0, |d| d.history_bytes())
+                    + r.view(0).resampling().map_or(0, |s| s.history_bytes())
+            })
             .collect();
         let mut timed: Vec<(&mut Renderer, Option<Vec2>)> =
             renderers.iter_mut().map(|(r, g)| (r, *g)).collect();
@@ -419,6 +451,7 @@ pub fn measure(
             vp_history_bytes,
         });
     }
+    let resampling = resampling_cost(screen, &vp, &measure)?;
     let vp_frame_ms = frame_ms(&vp_passes_ms);
     let to_screen = |passes: &BTreeMap<String, f64>| -> f64 {
         TO_SCREEN_PASSES.iter().filter_map(|p| passes.get(*p)).sum()
@@ -462,6 +495,7 @@ pub fn measure(
         cartesian_frame_ms,
         vp_frame_ms,
         denoisers: costs,
+        resampling,
         comparators,
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
@@ -529,7 +563,69 @@ pub fn measure(
             mib(d.cartesian_history_bytes)
         );
     }
+    let r = &report.resampling;
+    println!(
+        "  resampling di: {:.1} ms VP vs {:.1} ms Cartesian ({:.1} % vs {:.1} % of the frame); whole frame with it / without {:.3} VP, {:.3} Cartesian; reservoirs {:.1} vs {:.1} MiB",
+        r.vp_ms,
+        r.cartesian_ms,
+        100.0 * r.vp_share,
+        100.0 * r.cartesian_share,
+        r.vp_frame_ratio,
+        r.cartesian_frame_ratio,
+        mib(r.vp_history_bytes),
+        mib(r.cartesian_history_bytes)
+    );
     Ok(report)
+}
+
+/// Medians and history bytes of each renderer of one interleaved run: a Cartesian renderer with
+/// the settings given, then one per foveated space (with its own settings, if any).
+type MeasureFn<'a> = dyn Fn(
+        RenderSettings,
+        Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)>,
+    ) -> Result<Vec<(FrameMedians, u64)>>
+    + 'a;
+
+/// ReSTIR DI against plain frames, Cartesian and VP, in one interleaved run.
+fn resampling_cost(screen: UVec2, vp: &VisualPolar, measure: &MeasureFn) -> Result<ResamplingCost> {
+    let resampled = RenderSettings {
+        resampling: ResamplingSettings::default().with_mode(ResamplingMode::Di),
+        ..Default::default()
+    };
+    let plain = RenderSettings::default();
+    let [(cart, cartesian_history_bytes), (vp_di, vp_history_bytes), (vp_plain, _), (cart_plain, _)]: [_; 4] =
+        measure(
+            resampled,
+            vec![
+                (Box::new(*vp), None),
+                (Box::new(*vp), Some(plain)),
+                (Box::new(Cartesian::new(screen)), Some(plain)),
+            ],
+        )?
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("one median map per renderer"))?;
+    let own = |m: &BTreeMap<String, f64>| -> f64 {
+        RESAMPLING_PASSES.iter().filter_map(|p| m.get(*p)).sum()
+    };
+    let listed = |m: &BTreeMap<String, f64>| -> BTreeMap<String, f64> {
+        m.iter()
+            .filter(|(k, _)| *k == "trace" || RESAMPLING_PASSES.contains(&k.as_str()))
+            .map(|(k, v)| (k.clone(), *v))
+            .collect()
+    };
+    let (cart_frame, vp_frame) = (frame_ms(&cart.passes), frame_ms(&vp_di.passes));
+    Ok(ResamplingCost {
+        cartesian_ms: own(&cart.passes),
+        vp_ms: own(&vp_di.passes),
+        cartesian_share: own(&cart.passes) / cart_frame,
+        vp_share: own(&vp_di.passes) / vp_frame,
+        cartesian_frame_ratio: cart_frame / frame_ms(&cart_plain.passes),
+        vp_frame_ratio: vp_frame / frame_ms(&vp_plain.passes),
+        cartesian_passes_ms: listed(&cart.passes),
+        vp_passes_ms: listed(&vp_di.passes),
+        cartesian_history_bytes,
+        vp_history_bytes,
+    })
 }
 
 /// Of a renderer's pass medians: the denoiser's passes (named `prefix*` for one of `prefixes`)

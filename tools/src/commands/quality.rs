@@ -15,6 +15,7 @@ use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::resampling::ResamplingMode;
 use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
@@ -123,6 +124,8 @@ struct Report<'a> {
     eval_frames: u32,
     reference_spp: u32,
     blur_sigma_at_30: f32,
+    /// `off` or `di`: every run's `--resampling`.
+    resampling: &'static str,
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
     /// With the latency model: its latency and predictor (the runs' report.json `gaze_latency`).
@@ -172,8 +175,32 @@ fn filters_refusal(
         UVec2::new(args.width, args.height),
     )?;
     let caps = space.capabilities();
-    Ok((!caps.temporal_filters)
-        .then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
+    let resampling = match resampled(args) {
+        true => " and no resampling",
+        false => "",
+    };
+    Ok((!caps.temporal_filters).then(|| {
+        format!(
+            "{method} supports no denoiser or TAA{resampling} {}",
+            caps.filters_note
+        )
+    }))
+}
+
+/// Whether every run resamples light (`--resampling` / the profile's `[resampling]`): the
+/// resampling passes need a grid with temporal filters, as the denoisers do.
+fn resampled(args: &QualityArgs) -> bool {
+    args.profile.resampling.mode != ResamplingMode::Off
+}
+
+/// Why a combination cannot run after resampling, if it cannot (A-SVGF's re-shading).
+fn resampling_refusal(args: &QualityArgs, combination: &Combination) -> Option<RefusedRun> {
+    (resampled(args) && combination.denoiser == "asvgf").then(|| {
+        combination.refused(format!(
+            "asvgf cannot run after resampling {}: its gradient samples re-shade paths whose direct light the reservoirs give",
+            args.profile.resampling.mode.name()
+        ))
+    })
 }
 
 /// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser and a TAA mode.
@@ -279,8 +306,9 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     for camera in args.cameras {
         let references = references(args, camera, &prepared.evaluated)?;
         for method in args.methods {
-            let filtered =
-                args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
+            let filtered = resampled(args)
+                || args.denoisers.iter().any(|d| d != "none")
+                || args.taa.iter().any(|t| t != "off");
             // Asked once per method (some spaces take a full-screen sum to build).
             let refusal = if filtered {
                 filters_refusal(args, &prepared.hmd, method)?
@@ -296,11 +324,14 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         taa,
                     };
                     let dir = args.out.join(combination.run_dir_name());
-                    outcomes.push(match (&refusal, combination.filtered()) {
-                        (Some(reason), true) => {
-                            Outcome::Refused(combination.refused(reason.clone()))
-                        }
-                        _ => Outcome::Run(run_combination(
+                    let needs_filters = resampled(args) || combination.filtered();
+                    let refused = match (&refusal, needs_filters) {
+                        (Some(reason), true) => Some(combination.refused(reason.clone())),
+                        _ => resampling_refusal(args, &combination),
+                    };
+                    outcomes.push(match refused {
+                        Some(refused) => Outcome::Refused(refused),
+                        None => Outcome::Run(run_combination(
                             args,
                             &prepared,
                             &combination,
@@ -321,7 +352,10 @@ pub fn refusal(
     prepared: &Prepared,
     combination: &Combination,
 ) -> Result<Option<RefusedRun>> {
-    if !combination.filtered() {
+    if let Some(refused) = resampling_refusal(args, combination) {
+        return Ok(Some(refused));
+    }
+    if !(combination.filtered() || resampled(args)) {
         return Ok(None);
     }
     Ok(filters_refusal(args, &prepared.hmd, combination.method)?
@@ -414,6 +448,7 @@ pub fn write_report(
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
+        resampling: args.profile.resampling.mode.name(),
         flip_ppd: prepared.ppd,
         latency: model.map(|m| m.describe()),
         gaze_predict: model.map(|_| args.profile.gaze_timing.mode().name().to_string()),
@@ -713,8 +748,9 @@ fn markdown(r: &Report) -> String {
         s,
         "Quality over a gaze sequence: {} at {}×{}, gaze {}, {} frames, metrics averaged over the last {}, \
          against {}-spp Cartesian references; rings of the paper's normalised eccentricity around each frame's gaze; \
-         blur σ at 30° {}.\n",
-        r.scene, r.width, r.height, r.gaze_source, r.frames, r.eval_frames, r.reference_spp, r.blur_sigma_at_30
+         blur σ at 30° {}; resampling {}.\n",
+        r.scene, r.width, r.height, r.gaze_source, r.frames, r.eval_frames, r.reference_spp, r.blur_sigma_at_30,
+        r.resampling
     );
     for camera in CAMERAS {
         let runs: Vec<&RunQuality> = r.runs.iter().filter(|q| q.camera == *camera).collect();

@@ -30,6 +30,8 @@ struct Report {
     path_regularisation: f32,
     /// `cull` (samples far off the screen not traced) or `trace`.
     offscreen_samples: &'static str,
+    /// `off` or `di` (ReSTIR DI at the primary hit, `--resampling`).
+    resampling: &'static str,
     scene: String,
     headset: String,
     /// `headset` (each eye through the profile's frustum, the camera the head) or
@@ -270,6 +272,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         texture_lod: args.profile.texture_lod.name(),
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples.name(),
+        resampling: args.profile.resampling.mode.name(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         projection: args.camera.projection.name(),
@@ -330,12 +333,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return Err(interrupted.into());
     }
     println!(
-        "rendered {} frame(s) of {}×{} ({} eye(s), {}, denoiser {}, taa {}, grid {}×{}, {} samples per eye) on {}: {:.1} ms GPU per frame, {} rays per eye and frame → {}",
+        "rendered {} frame(s) of {}×{} ({} eye(s), {}, resampling {}, denoiser {}, taa {}, grid {}×{}, {} samples per eye) on {}: {:.1} ms GPU per frame, {} rays per eye and frame → {}",
         frames,
         width,
         height,
         eyes.name(),
         report.method,
+        report.resampling,
         report.denoiser,
         report.taa,
         grid.x,

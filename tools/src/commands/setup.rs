@@ -359,6 +359,7 @@ pub fn render_settings(
         texture_lod: args.profile.texture_lod,
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples,
+        resampling: args.profile.resampling,
         ..Default::default()
     }
 }

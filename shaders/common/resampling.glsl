@@ -1,0 +1,227 @@
+// ReSTIR DI (Bitterli et al. 2020) at the primary hit: light samples as points of the light
+// table, the target function p̂, weighted reservoirs and their streaming update, and the primary
+// surface the resampling passes re-fetch from the G-buffer (docs/design/resampling.md).
+// Needs scene.glsl, random.glsl, brdf.glsl, lights.glsl and path.glsl first.
+#ifndef FOVEA_RESAMPLING_GLSL
+#define FOVEA_RESAMPLING_GLSL
+
+// A light sample that evaluates exactly at any shading point: the light table entry and, for an
+// emissive triangle, the barycentrics of the point; for the environment, its direction
+// (octahedral); nothing more for punctual and directional lights.
+struct LightPoint {
+    uint light;   // light table entry
+    vec2 data;
+};
+
+vec2 octahedral_encode(vec3 d) {
+    d /= abs(d.x) + abs(d.y) + abs(d.z);
+    vec2 o = d.xy;
+    if (d.z < 0.0) o = (1.0 - abs(d.yx)) * vec2(d.x >= 0.0 ? 1.0 : -1.0, d.y >= 0.0 ? 1.0 : -1.0);
+    return o;
+}
+
+vec3 octahedral_decode(vec2 o) {
+    vec3 n = vec3(o, 1.0 - abs(o.x) - abs(o.y));
+    float t = max(-n.z, 0.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
+
+// A candidate as next-event estimation draws it (lights.glsl: the entry by power through the
+// alias table, a triangle's point uniform by area, the environment by luminance); false when the
+// draw gives no sample (the environment not sampled, a pole). Draws 1 + 2 numbers (1 + 4 for the
+// environment) from `rng`.
+bool draw_light_point(inout uint rng, out LightPoint lp) {
+    lp.light = 0u;
+    lp.data = vec2(0.0);
+    if (frame.data.counts.x == 0u) return false;
+    float select_pdf;
+    lp.light = pick_light(rng, select_pdf);
+    if (select_pdf <= 0.0) return false;
+    uint kind = lights.data[lp.light].kind_index.x;
+    if (kind == LIGHT_KIND_TRIANGLE) {
+        vec2 u = rng_next2(rng);
+        float su = sqrt(u.x);
+        lp.data = vec2(su * (1.0 - u.y), su * u.y);
+        return true;
+    }
+    if (kind == LIGHT_KIND_ENVIRONMENT) {
+        if (frame.data.environment.w == 0.0) return false;
+        vec4 u = vec4(rng_next2(rng), rng_next2(rng));
+        vec3 dir, radiance;
+        float pdf;
+        if (!env_sample(frame.data.environment, frame.data.environment_map, u, dir, radiance, pdf)) return false;
+        lp.data = octahedral_encode(dir);
+        return true;
+    }
+    return true;
+}
+
+// The light point seen from `p`, unshadowed. `radiance`: what reaches p per unit of the light's
+// own measure (a triangle: emitted radiance × cos at the light / distance², per area; the
+// environment: radiance per solid angle; a punctual or directional light: its intensity with
+// attenuation); `source_pdf`: the density draw_light_point gives it in that measure (selection ×
+// point); `ls`: direction, distance and the MIS density (environment) as sample_light's.
+bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 radiance, out float source_pdf) {
+    ls.direction = vec3(0.0, 1.0, 0.0);
+    ls.distance = 0.0;
+    ls.radiance_over_pdf = vec3(0.0);
+    ls.mis_pdf = 0.0;
+    radiance = vec3(0.0);
+    source_pdf = 0.0;
+    LightGpu l = lights.data[lp.light];
+    float select_pdf = l.sampling.y;
+    if (select_pdf <= 0.0) return false;
+    uint kind = l.kind_index.x;
+    if (kind == LIGHT_KIND_TRIANGLE) {
+        PlacedTriangle placed = placed_triangle(l.kind_index.y);
+        vec3 a = placed.a.position_u.xyz, b = placed.b.position_u.xyz, c = placed.c.position_u.xyz;
+        Hit h;
+        h.t = 0.0;
+        h.u = lp.data.x;
+        h.v = lp.data.y;
+        h.triangle = l.kind_index.y;
+        vec3 q = (1.0 - h.u - h.v) * a + h.u * b + h.v * c;
+        vec3 to = q - p;
+        float d2 = dot(to, to);
+        vec3 cr = cross(b - a, c - a);
+        float area = 0.5 * length(cr);
+        if (d2 <= 0.0 || area <= 0.0) return false;
+        ls.distance = sqrt(d2);
+        ls.direction = to / ls.distance;
+        float cos_light = abs(dot(cr / (2.0 * area), ls.direction));
+        Surface e = fetch_surface(h, ls.direction, 0.0);
+        radiance = e.emission * cos_light / d2;
+        source_pdf = select_pdf / area;
+    } else if (kind == LIGHT_KIND_ENVIRONMENT) {
+        if (frame.data.environment.w == 0.0) return false;
+        ls.direction = octahedral_decode(lp.data);
+        ls.distance = 1e30;
+        radiance = env_radiance(frame.data.environment, frame.data.environment_map, ls.direction);
+        source_pdf = select_pdf * env_pdf(frame.data.environment, frame.data.environment_map, ls.direction);
+        ls.mis_pdf = source_pdf;
+    } else if (kind == LIGHT_KIND_DIRECTIONAL) {
+        ls.direction = -l.direction.xyz;
+        ls.distance = 1e30;
+        radiance = l.intensity.rgb;
+        source_pdf = select_pdf;
+    } else {
+        vec3 to = l.position.xyz - p;
+        float d2 = dot(to, to);
+        if (d2 <= 0.0) return false;
+        ls.distance = sqrt(d2);
+        ls.direction = to / ls.distance;
+        float atten = range_window(ls.distance, l.position.w) / d2;
+        if (kind == LIGHT_KIND_SPOT) {
+            float cd = dot(l.direction.xyz, -ls.direction);
+            float t = clamp((cd - l.direction.w) / max(l.intensity.w - l.direction.w, 1e-4), 0.0, 1.0);
+            atten *= t * t;
+        }
+        radiance = l.intensity.rgb * atten;
+        source_pdf = select_pdf;
+    }
+    if (source_pdf <= 0.0 || all(equal(radiance, vec3(0.0)))) return false;
+    ls.radiance_over_pdf = radiance / source_pdf;
+    return true;
+}
+
+float resampling_luminance(vec3 c) {
+    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+}
+
+// The light point's unshadowed contribution at surface `s` seen from `v`, in the light's
+// measure: f·cos · radiance, weighted for the environment by next-event estimation's MIS share
+// against the BRDF-sampled ray that the path still traces (path.glsl), so that the two strategies
+// still sum to one. Zero where the light does not reach the surface's upper side.
+vec3 light_point_contribution(Surface s, vec3 v, LightPoint lp, out LightSample ls, out float source_pdf) {
+    vec3 radiance;
+    if (!evaluate_light_point(s.position, lp, ls, radiance, source_pdf)) return vec3(0.0);
+    vec3 f = brdf_eval_cos(s, v, ls.direction);
+    float w = ls.mis_pdf > 0.0 ? mis_power(ls.mis_pdf, brdf_pdf(s, v, ls.direction)) : 1.0;
+    vec3 c = f * radiance * w;
+    return (any(isnan(c)) || any(isinf(c))) ? vec3(0.0) : c;
+}
+
+// A weighted reservoir (Chao's streaming resampling): the chosen sample, the sum of the weights
+// seen, the candidates it stands for, and p̂ of the chosen sample at this texel's surface.
+struct Reservoir {
+    LightPoint y;
+    bool full;
+    float weight_sum;
+    float m;
+    float target;
+};
+
+Reservoir reservoir_empty() {
+    Reservoir r;
+    r.y.light = 0u;
+    r.y.data = vec2(0.0);
+    r.full = false;
+    r.weight_sum = 0.0;
+    r.m = 0.0;
+    r.target = 0.0;
+    return r;
+}
+
+// Streams one candidate of weight `w` (and p̂ here `target`) into `r`; `u` uniform in [0, 1).
+// Returns whether it became the chosen sample.
+bool reservoir_update(inout Reservoir r, LightPoint y, float w, float target, float u) {
+    if (!(w > 0.0)) return false;
+    r.weight_sum += w;
+    if (u * r.weight_sum >= w) return false;
+    r.y = y;
+    r.target = target;
+    r.full = true;
+    return true;
+}
+
+ReservoirGpu reservoir_pack(Reservoir r, float contribution_weight, uvec4 surface, vec3 position) {
+    ReservoirGpu g;
+    g.light_point = uvec4(r.full ? r.y.light + 1u : 0u, floatBitsToUint(r.y.data), 0u);
+    g.weights = vec4(contribution_weight, r.m, r.target, 0.0);
+    g.surface = surface;
+    g.position = vec4(position, 0.0);
+    return g;
+}
+
+ReservoirGpu reservoir_none() {
+    ReservoirGpu g;
+    g.light_point = uvec4(0u);
+    g.weights = vec4(0.0);
+    g.surface = uvec4(0u);
+    g.position = vec4(0.0);
+    return g;
+}
+
+// Whether the light point reaches surface `s` moved to `position` (another sample of the same
+// surface: the previous frame's point of a reprojected reservoir) with a non-zero target, and is
+// not occluded there: could a reservoir owned by that point have chosen it?
+bool light_point_reaches(Surface s, vec3 v, vec3 position, LightPoint y) {
+    s.position = position;
+    LightSample ls;
+    float source_pdf;
+    vec3 c = light_point_contribution(s, v, y, ls, source_pdf);
+    return any(greaterThan(c, vec3(0.0))) && visible(s.position, s.geometric_normal, ls);
+}
+
+LightPoint reservoir_light_point(ReservoirGpu g) {
+    LightPoint lp;
+    lp.light = max(g.light_point.x, 1u) - 1u;
+    lp.data = uintBitsToFloat(g.light_point.yz);
+    return lp;
+}
+
+// The primary hit's surface at texel `t`, re-fetched as the tracer shaded it: its triangle from
+// the G-buffer ids, barycentrics and ray-cone width from the tracer's primary-hit image, the
+// direction from the camera-relative position.
+Surface primary_surface(uint triangle, vec4 primary_hit, vec3 position, out vec3 dir) {
+    dir = normalize(position);
+    Hit h;
+    h.t = length(position);
+    h.u = primary_hit.x;
+    h.v = primary_hit.y;
+    h.triangle = triangle;
+    return fetch_surface(h, dir, primary_hit.z);
+}
+
+#endif
