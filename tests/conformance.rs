@@ -694,7 +694,7 @@ fn resampling_on_every_space_that_supports_it() {
         println!("{space_name}: mean of {frames} frames, resampling di {di:?} vs off {off:?}");
         for c in 0..3 {
             assert!(
-                (di[c] / off[c] - 1.0).abs() < 0.05,
+                (di[c] / off[c] - 1.0).abs() < 0.02,
                 "{space_name}: channel {c}, resampling di {} vs off {}",
                 di[c],
                 off[c]
