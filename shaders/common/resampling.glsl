@@ -57,6 +57,24 @@ bool draw_light_point(inout uint rng, out LightPoint lp) {
     return true;
 }
 
+// The radiance an emissive triangle sends along `dir` (from the shading point toward the light)
+// from its point at barycentrics `bary`: exactly what next-event estimation reads there
+// (fetch_surface's emission, texture level 0), without the rest of the surface.
+vec3 emitter_radiance(PlacedTriangle placed, vec2 bary, vec3 dir) {
+    vec3 a = placed.a.position_u.xyz, b = placed.b.position_u.xyz, c = placed.c.position_u.xyz;
+    MaterialGpu m = materials.data[placed.tri.vertices.w & 0xffffu];
+    vec3 e = m.emissive.rgb;
+    if (m.textures.w != NO_TEXTURE) {
+        vec3 w = vec3(1.0 - bary.x - bary.y, bary);
+        vec2 uv = w.x * vec2(placed.a.position_u.w, placed.a.normal_v.w) + w.y * vec2(placed.b.position_u.w, placed.b.normal_v.w) + w.z * vec2(placed.c.position_u.w, placed.c.normal_v.w);
+        e *= sample_texture(m.textures.w, uv, true).rgb;
+    }
+    vec3 ng = cross(b - a, c - a);
+    if (placed.mirrored) ng = -ng;
+    bool front = dot(ng, dir) < 0.0;
+    return (front || (m.textures2.z & MATERIAL_DOUBLE_SIDED) != 0u) ? e : vec3(0.0);
+}
+
 // The light point seen from `p`, unshadowed. `radiance`: what reaches p per unit of the light's
 // own measure (a triangle: emitted radiance × cos at the light / distance², per area; the
 // environment: radiance per solid angle; a punctual or directional light: its intensity with
@@ -76,12 +94,7 @@ bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 ra
     if (kind == LIGHT_KIND_TRIANGLE) {
         PlacedTriangle placed = placed_triangle(l.kind_index.y);
         vec3 a = placed.a.position_u.xyz, b = placed.b.position_u.xyz, c = placed.c.position_u.xyz;
-        Hit h;
-        h.t = 0.0;
-        h.u = lp.data.x;
-        h.v = lp.data.y;
-        h.triangle = l.kind_index.y;
-        vec3 q = (1.0 - h.u - h.v) * a + h.u * b + h.v * c;
+        vec3 q = (1.0 - lp.data.x - lp.data.y) * a + lp.data.x * b + lp.data.y * c;
         vec3 to = q - p;
         float d2 = dot(to, to);
         vec3 cr = cross(b - a, c - a);
@@ -90,8 +103,7 @@ bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 ra
         ls.distance = sqrt(d2);
         ls.direction = to / ls.distance;
         float cos_light = abs(dot(cr / (2.0 * area), ls.direction));
-        Surface e = fetch_surface(h, ls.direction, 0.0);
-        radiance = e.emission * cos_light / d2;
+        radiance = emitter_radiance(placed, lp.data, ls.direction) * cos_light / d2;
         source_pdf = select_pdf / area;
     } else if (kind == LIGHT_KIND_ENVIRONMENT) {
         if (frame.data.environment.w == 0.0) return false;
@@ -193,15 +205,16 @@ ReservoirGpu reservoir_none() {
     return g;
 }
 
-// Whether the light point reaches surface `s` moved to `position` (another sample of the same
-// surface: the previous frame's point of a reprojected reservoir) with a non-zero target, and is
-// not occluded there: could a reservoir owned by that point have chosen it?
-bool light_point_reaches(Surface s, vec3 v, vec3 position, LightPoint y) {
-    s.position = position;
+// Could a reservoir owned by the point `p` (shading normal `n`, seen from `v`) have chosen light
+// point `y`: does `y` send light there from the upper side (a non-zero target: the BRDF's
+// hemisphere and the light's own support) and is it not occluded? For the 1/Z normalisation; the
+// point's BRDF itself is not needed, the geometric normal is taken to be `n`.
+bool light_point_reaches(vec3 p, vec3 n, vec3 v, LightPoint y) {
     LightSample ls;
+    vec3 radiance;
     float source_pdf;
-    vec3 c = light_point_contribution(s, v, y, ls, source_pdf);
-    return any(greaterThan(c, vec3(0.0))) && visible(s.position, s.geometric_normal, ls);
+    if (!evaluate_light_point(p, y, ls, radiance, source_pdf)) return false;
+    return dot(n, ls.direction) > 0.0 && dot(n, v) > 0.0 && visible(p, n, ls);
 }
 
 LightPoint reservoir_light_point(ReservoirGpu g) {

@@ -114,15 +114,11 @@ void main() {
                 z += tap_m[k];
                 continue;
             }
+            // The neighbour's own point and normal as the first pass stored and the G-buffer has.
             ivec2 tap = taps[k];
-            uvec2 tap_id = imageLoad(ids, tap).xy;
-            vec4 tap_pos = imageLoad(position, tap);
-            vec3 tap_dir;
-            Surface st = primary_surface(tap_id.x - 1u, imageLoad(primary_hit, tap), tap_pos.xyz, tap_dir);
-            LightSample tap_ls;
-            float tap_pdf;
-            vec3 c = light_point_contribution(st, -tap_dir, combined.y, tap_ls, tap_pdf);
-            if (any(greaterThan(c, vec3(0.0))) && visible(st.position, st.geometric_normal, tap_ls)) z += tap_m[k];
+            ReservoirGpu q = fresh.data[uint(tap.y) * uint(g.size.x) + uint(tap.x)];
+            vec3 tap_v = -normalize(imageLoad(position, tap).xyz);
+            if (light_point_reaches(q.position.xyz, imageLoad(normal_depth, tap).xyz, tap_v, combined.y)) z += tap_m[k];
         }
     }
     float w = lit && z > 0.0 && combined.target > 0.0 ? combined.weight_sum / (z * combined.target) : 0.0;

@@ -104,7 +104,7 @@ void main() {
     float w = 0.0;
     if (combined.full && combined.target > 0.0 && visible(s.position, s.geometric_normal, chosen)) {
         float z = r.m;
-        if (m_prev > 0.0 && light_point_reaches(s, v, prev_position, combined.y)) z += m_prev;
+        if (m_prev > 0.0 && light_point_reaches(prev_position, s.normal, v, combined.y)) z += m_prev;
         w = combined.weight_sum / (z * combined.target);
     }
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);

@@ -6,10 +6,12 @@
 //! to the G-buffer's colour and radiance before any denoiser runs. Per view: the reservoirs are
 //! history, like a denoiser's.
 
+mod reservoirs;
 mod settings;
 mod spatial;
 mod temporal;
 
+pub use reservoirs::Reservoirs;
 pub use settings::{
     ResamplingMode, ResamplingSettings, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_TEMPORAL_CAP,
     RADIUS_RANGE,
@@ -26,14 +28,6 @@ use crate::vk::{Buffer, Context};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
-
-/// One reservoir per grid texel, twice: `history` holds last frame's final reservoirs until the
-/// first pass has read them (the second pass then writes this frame's there), `fresh` the first
-/// pass's output that the second reads.
-pub struct Reservoirs {
-    pub history: Buffer,
-    pub fresh: Buffer,
-}
 
 /// A view's resampling: its two passes, its reservoirs and how many frames they hold.
 pub struct Resampling {

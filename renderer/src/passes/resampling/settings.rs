@@ -60,7 +60,7 @@ impl Default for ResamplingSettings {
             mode: ResamplingMode::Off,
             candidates: 8,
             temporal_cap: 20.0,
-            neighbours: 4,
+            neighbours: 3,
             radius: 8.0,
         }
     }

@@ -2,8 +2,8 @@
 //! combined, one shadow ray to the chosen light point, its contribution added to the G-buffer's
 //! colour and demodulated radiance.
 
+use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
-use super::Reservoirs;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{

@@ -1,8 +1,8 @@
 //! ReSTIR DI's first pass (`shaders/passes/resample_temporal.comp`): initial candidates, the
 //! chosen one's visibility, and the previous frame's reservoir reprojected into this frame's.
 
+use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
-use super::Reservoirs;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_image, read_texels, write_buffer, FrameRecorder};
