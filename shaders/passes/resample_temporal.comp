@@ -30,6 +30,10 @@ layout(std430, set = 0, binding = 16) writeonly buffer Fresh { ReservoirGpu data
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
 
+// How far (in pixels at the sample's depth) last frame's shading point may lie from this one for
+// its reservoir to be reused.
+const float RESAMPLING_TEMPORAL_PIXELS = 2.0;
+
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     Grid g = grid_make(push.p.space);
@@ -78,8 +82,13 @@ void main() {
         ivec2 pt = grid_nearest(prev, p);
         if (grid_holds_sample(prev, pt)) {
             ReservoirGpu q = history.data[uint(pt.y) * uint(g.size.x) + uint(pt.x)];
-            // An empty reservoir of the same surface still counts its candidates (M).
-            if (svgf_same_surface(here, svgf_unpack_surface(q.surface))) {
+            // An empty reservoir of the same surface still counts its candidates (M). Only from
+            // a shading point within a few pixels of this one: in the Visual-Polar periphery a
+            // texel spans many pixels and its jittered sample crosses it from frame to frame, and
+            // a reservoir drawn for a point that far away is a poor proposal here.
+            float pixel = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z * here.depth;
+            bool near = distance(q.position.xyz, s.position) <= RESAMPLING_TEMPORAL_PIXELS * pixel;
+            if (near && svgf_same_surface(here, svgf_unpack_surface(q.surface))) {
                 float m_q = min(q.weights.y, push.p.params.y * r.m);
                 float u = rng_next(rng);
                 if (q.light_point.x != 0u && q.weights.x > 0.0) {
