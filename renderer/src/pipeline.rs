@@ -329,13 +329,14 @@ impl Renderer {
         };
         // Every view's screen radiance first, then one exposure metered over all of them (both
         // eyes share it), then every view's display image.
-        let mut screens = Vec::with_capacity(inputs.len());
+        // A fixed array, not a Vec: the render loop makes no host allocation (tests/host_alloc.rs).
+        let mut screens: [Option<_>; MAX_VIEWS] = std::array::from_fn(|_| None);
         for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
             rec.set_view(v as u32);
-            screens.push(record_view(rec, view, slot, &shared, view_input)?);
+            screens[v] = Some(record_view(rec, view, slot, &shared, view_input)?);
         }
         if let Exposure::Auto(auto) = &self.settings.exposure {
-            for (v, screen) in screens.iter().enumerate() {
+            for (v, screen) in screens.iter().flatten().enumerate() {
                 rec.set_view(v as u32);
                 let metered = screen.screen.metered();
                 self.exposure.record_meter(
@@ -350,7 +351,7 @@ impl Renderer {
         rec.set_view(0);
         self.exposure
             .record_adapt(rec, &self.settings.exposure, input.frame_seconds, slot)?;
-        for (v, screen) in screens.into_iter().enumerate() {
+        for (v, screen) in screens.into_iter().flatten().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
             record_display(rec, screen, &shared, external)?;

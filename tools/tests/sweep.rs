@@ -352,11 +352,20 @@ fn attempt_has_frame(job_dir: &Path, pid: u32) -> bool {
         let name = e.file_name().to_string_lossy().into_owned();
         name.starts_with(".attempt-")
             && name.ends_with(&format!("-{pid}"))
-            && std::fs::read_dir(e.path()).is_ok_and(|runs| {
-                runs.filter_map(|r| r.ok())
-                    .any(|r| r.path().join("frame_0000.png").exists())
-            })
+            && holds_frame(&e.path(), 2)
     })
+}
+
+/// Whether `dir` or a folder up to `depth` levels below it holds a rendered frame: a run folder
+/// in an attempt, and the staging folder inside it where `fovea render` writes until it ends.
+fn holds_frame(dir: &Path, depth: u32) -> bool {
+    dir.join("frame_0000.png").exists()
+        || (depth > 0
+            && std::fs::read_dir(dir).is_ok_and(|entries| {
+                entries
+                    .filter_map(|e| e.ok())
+                    .any(|e| e.path().is_dir() && holds_frame(&e.path(), depth - 1))
+            }))
 }
 
 #[test]
@@ -484,7 +493,14 @@ fn a_replay_sweep_merges_into_the_one_process_report_and_exit_status() {
     assert!(report.contains("REGRESSION"), "{report}");
     assert_eq!(report, no_costs(&one));
     let mut compared = 0;
-    for run in ["run_sim-1", "run_example_trace"] {
+    // Run folders are named by the baseline folder: `run_<stem>-<SHA-256 prefix>`.
+    let runs: Vec<String> = std::fs::read_dir(&one)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("run_sim-1-") || n.starts_with("run_example_trace-"))
+        .collect();
+    assert_eq!(runs.len(), 2, "{runs:?}");
+    for run in &runs {
         for entry in std::fs::read_dir(one.join(run)).unwrap() {
             let path = entry.unwrap().path();
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -778,10 +794,7 @@ fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_
             std::fs::read_dir(d).is_ok_and(|entries| {
                 entries.filter_map(|e| e.ok()).any(|e| {
                     e.file_name().to_string_lossy().starts_with(".attempt-")
-                        && std::fs::read_dir(e.path()).is_ok_and(|runs| {
-                            runs.filter_map(|r| r.ok())
-                                .any(|r| r.path().join("frame_0000.png").exists())
-                        })
+                        && holds_frame(&e.path(), 2)
                 })
             })
         });
