@@ -17,23 +17,26 @@
 //! one ([`slab_test`]) on a box that contains the child's.
 //!
 //! **Children.** A node's interior children are consecutive nodes from `child_base` in slot order;
-//! its leaves' triangles are consecutive entries from `triangle_base` (≤ 24 per node). Slots are
-//! ordered by octant: slot s holds the child lying most in the direction a ray of octant s enters
-//! first from, and the traversal visits the hit interior children in the order `slot ^ octant`
-//! (nearest first, approximately) without sorting. Meta byte: 0 empty; interior `0b001_11sss`
-//! (24 + slot); leaf `unary(count) << 5 | offset`.
+//! its leaves' triangles are consecutive entries from `triangle_base` (≤ 24 per node). Meta byte:
+//! 0 empty; interior `0b001_11sss` (24 + slot); leaf `unary(count) << 5 | offset`. Slots are
+//! ordered by octant (Ylitie et al. §3.2): slot s holds the child lying farthest against the
+//! direction of a ray of octant s, so that visiting slots in the order `octant ^ k` is nearest
+//! first when entry distances tie (rays starting inside several boxes).
 //!
-//! **Traversal** ([`Bvh8::intersect_into`], the CPU twin of `bvh8_walk` in
-//! shaders/common/bvh.glsl): a node group (child base, hit bits of its unvisited interior
-//! children, interior mask) and a triangle group (triangle base, hit bits of its leaf triangles);
-//! opening a node yields both, the triangles are tested at once, the rest of the node group waits
-//! on a stack of at most [`Bvh8::max_stack`] entries.
+//! **Traversal** ([`Bvh8::walk`], the CPU twin of `bvh8_walk` in shaders/common/bvh.glsl): fully
+//! ordered. Opening a node slab-tests its eight children, sorts the reached ones by entry distance
+//! (a 19-comparator network, [`SORT8`]), visits the nearest and pushes the others with their entry
+//! distance; a leaf slot is an entry like a node (its ≤ 3 triangles are tested when it is popped),
+//! and a popped entry farther than the closest hit so far is skipped. Measured against the
+//! paper's unsorted octant-ordered node groups, this reads about a third fewer bytes per ray on
+//! Sponza and the Breakfast Room (docs/performance.md), for a stack of (entry, distance) pairs of
+//! at most [`Bvh8::max_stack`] entries instead of one group per level.
 //!
 //! **Triangles** ([`Bvh8::triangle_words`]): 48 bytes per leaf entry, (v0, bits(original index)),
 //! (v1, bits(flags)), (v2, 0); flag [`TRIANGLE_ALPHA_TESTED`] marks the triangles whose material
 //! is alpha-masked or blended, so opaque ones never reach the alpha test.
 
-use super::traverse::{safe_inverse_dir, slab_test};
+use super::traverse::{safe_inverse_dir, SLAB_SLACK};
 use super::{Bvh, TraceState};
 use crate::intersect::{Hit, Ray, WatertightRay};
 use crate::Aabb;
@@ -321,10 +324,10 @@ impl Collapse {
             };
             self.cost[i][0] = best;
             self.choice[i][0] = how;
-            for j in 2..=WIDTH {
-                if dist[j].0 < best {
-                    best = dist[j].0;
-                    how = Choice::Split(dist[j].1, dist[j].2);
+            for (j, &(cost, a, b)) in dist.iter().enumerate().skip(2) {
+                if cost < best {
+                    best = cost;
+                    how = Choice::Split(a, b);
                 }
                 self.cost[i][j - 1] = best;
                 self.choice[i][j - 1] = how;
@@ -523,11 +526,6 @@ impl Bvh8 {
         depth.into_iter().max().unwrap_or(0)
     }
 
-    /// Most entries the traversal stack can hold: one node group per level below the root.
-    pub fn max_stack(&self) -> u32 {
-        self.depth().saturating_sub(1)
-    }
-
     /// 5 uvec4 per node, see the module doc.
     pub fn node_words(&self) -> Vec<[u32; 4]> {
         let bytes4 = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
@@ -630,7 +628,7 @@ impl Bvh8 {
     }
 
     /// The traversal with `leaf_entry(tri_order value, state)` called for each leaf entry whose
-    /// slot the ray enters (a triangle, or an instance in a top level); an entry's `Some` ends
+    /// slot the ray reaches (a triangle, or an instance in a top level); an entry's `Some` ends
     /// the walk with it (any hit).
     pub fn walk(
         &self,
@@ -640,50 +638,117 @@ impl Bvh8 {
         mut leaf_entry: impl FnMut(u32, &mut TraceState) -> Option<Hit>,
     ) -> Option<Hit> {
         let inv_dir = safe_inverse_dir(ray.dir);
-        let octant_inv = 7 - octant(ray.dir);
-        let mut stack: Vec<(u32, u32)> = Vec::with_capacity(32);
-        // The root as a group of one interior child at rank 0.
-        let mut group = (0u32, 0x8000_0000u32);
+        let octant = octant(ray.dir) as usize;
+        let mut stack: Vec<(u32, f32)> = Vec::with_capacity(STACK_SIZE);
+        let mut next = Some(0u32);
         loop {
-            let bit = 31 - group.1.leading_zeros();
-            group.1 &= !(1 << bit);
-            if group.1 > 0x00ff_ffff {
-                stack.push(group);
+            let limit = state.best.map_or(t_max, |h| h.t) * SLAB_SLACK;
+            let entry = match next.take() {
+                Some(e) => e,
+                // Entries whose box the ray enters beyond the closest hit so far are skipped.
+                None => loop {
+                    let (e, enter) = stack.pop()?;
+                    if enter <= limit {
+                        break e;
+                    }
+                },
+            };
+            if entry & LEAF_ENTRY != 0 {
+                let first = (entry & !LEAF_ENTRY) >> 2;
+                for e in first..first + (entry & 3) {
+                    let item = self.tri_order[e as usize];
+                    if let Some(hit) = leaf_entry(item, state) {
+                        return Some(hit);
+                    }
+                }
+                continue;
             }
-            let slot = (bit - 24) ^ octant_inv;
-            let rank = (group.1 & 0xff & ((1 << slot) - 1)).count_ones();
-            let n = &self.nodes[(group.0 + rank) as usize];
+            let n = &self.nodes[entry as usize];
             state.counts.nodes += 1;
             state.counts.bytes += NODE_BYTES;
-            let limit = state.best.map_or(t_max, |h| h.t);
-            let mut hits = 0u32;
-            for s in 0..WIDTH {
-                let meta = u32::from(n.meta[s]);
-                let b = n.child_bounds(s);
-                if meta == 0 || slab_test(b.min, b.max, ray.origin, inv_dir, limit).is_none() {
-                    continue;
-                }
-                let interior = (meta & (meta << 1)) & 0x10 != 0;
-                let index = if interior {
-                    (meta ^ octant_inv) & 0x1f
+            // The children in octant order (slot octant ^ k at k), keyed by entry distance
+            // (+∞: missed or empty), then sorted nearest first by the GLSL's network.
+            let mut keyed: [(f32, u32); WIDTH] = std::array::from_fn(|k| {
+                let slot = octant ^ k;
+                let meta = u32::from(n.meta[slot]);
+                let b = n.child_bounds(slot);
+                let enter = slab_enter(b.min, b.max, ray.origin, inv_dir, limit);
+                let entry = if n.is_interior(slot) {
+                    n.child_base + (u32::from(n.imask) & ((1 << slot) - 1)).count_ones()
                 } else {
-                    meta & 0x1f
+                    LEAF_ENTRY | (n.triangle_base + (meta & 0x1f)) << 2 | (meta >> 5).count_ones()
                 };
-                hits |= (meta >> 5) << index;
-            }
-            group = (n.child_base, (hits & 0xff00_0000) | u32::from(n.imask));
-            let mut entries = hits & 0x00ff_ffff;
-            while entries != 0 {
-                let bit = 31 - entries.leading_zeros();
-                entries &= !(1 << bit);
-                let entry = self.tri_order[(n.triangle_base + bit) as usize];
-                if let Some(hit) = leaf_entry(entry, state) {
-                    return Some(hit);
+                (enter.filter(|_| meta != 0).unwrap_or(f32::INFINITY), entry)
+            });
+            for (a, b) in SORT8 {
+                if keyed[b].0 < keyed[a].0 {
+                    keyed.swap(a, b);
                 }
             }
-            while group.1 <= 0x00ff_ffff {
-                group = stack.pop()?;
+            let reached = keyed.iter().filter(|k| k.0 != f32::INFINITY).count();
+            if reached > 0 {
+                next = Some(keyed[0].1);
+                stack.extend(keyed[1..reached].iter().rev().map(|&(t, e)| (e, t)));
             }
         }
     }
+
+    /// Most entries the traversal stack can hold: at a node with k reached children the nearest
+    /// is visited and k − 1 pushed, so the worst path sums k − 1 over its nodes.
+    pub fn max_stack(&self) -> u32 {
+        let mut most = 0;
+        let mut stack = vec![(0u32, 0u32)];
+        while let Some((node, below)) = stack.pop() {
+            let n = &self.nodes[node as usize];
+            let children = n.meta.iter().filter(|&&m| m != 0).count() as u32;
+            let held = below + children.saturating_sub(1);
+            most = most.max(held);
+            for rank in 0..n.imask.count_ones() {
+                stack.push((n.child_base + rank, held));
+            }
+        }
+        most
+    }
 }
+
+/// The entry distance of the slab test (`slab_test`) against an already slackened `limit`, as
+/// the GLSL computes it for eight children at once.
+fn slab_enter(min: Vec3, max: Vec3, origin: Vec3, inv_dir: Vec3, limit: f32) -> Option<f32> {
+    let t0 = (min - origin) * inv_dir;
+    let t1 = (max - origin) * inv_dir;
+    let near = t0.min(t1);
+    let far = t0.max(t1);
+    let enter = near.x.max(near.y).max(near.z).max(0.0);
+    let leave = far.x.min(far.y).min(far.z) * SLAB_SLACK;
+    (enter <= leave && enter <= limit).then_some(enter)
+}
+
+/// Stack and child entries: bit 31 marks a leaf slot, `(first entry << 2) | count`; otherwise a
+/// node index.
+pub const LEAF_ENTRY: u32 = 0x8000_0000;
+/// The GLSL's stack size (BVH8_STACK_SIZE): uploads refuse trees whose [`Bvh8::max_stack`]
+/// exceeds it. The real scenes need up to 91 (the Breakfast Room's SBVH, depth 13); 128 entries
+/// of 8 bytes leave room for deeper trees at no cost to the rays that push fewer.
+pub const STACK_SIZE: usize = 128;
+/// Batcher's odd–even merge sort of 8 keys (19 compare-exchanges), as in the GLSL.
+pub const SORT8: [(usize, usize); 19] = [
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (1, 2),
+    (5, 6),
+    (0, 4),
+    (3, 7),
+    (1, 5),
+    (2, 6),
+    (1, 4),
+    (3, 6),
+    (2, 4),
+    (3, 5),
+    (3, 4),
+];

@@ -8,8 +8,8 @@
 //! culling boxes across the levels, and `(t, placed id)` ties resolve as in the flat scene.
 //! [`SceneBvh::intersect`] is the CPU reference of `bvh_trace` in shaders/common/bvh.glsl.
 
-use super::traverse::{safe_inverse_dir, slab_test};
 use super::compressed::Bvh8;
+use super::traverse::{safe_inverse_dir, slab_test};
 use super::wide::{Bvh4, WIDTH};
 use super::{Bvh, BvhBuilder, TraceState};
 use crate::intersect::{Hit, Ray};
@@ -313,12 +313,32 @@ pub struct InstancingStats {
     /// GPU bytes a flattened upload would add (vertices 48 B, triangles 16 B and one 48 B leaf
     /// reference each, for every copy beyond the first of each instanced mesh; its extra BVH
     /// nodes not counted) less what instancing costs (per instance 112 B of data and a 16 B leaf
-    /// entry, the top level's nodes at 128 B).
+    /// entry, the top level's nodes: 128 B each in the 4-wide layout, 80 B in the compressed one).
     pub bytes_saved: i64,
 }
 
 impl InstancingStats {
+    /// For the 4-wide levels (top-level nodes at 128 B).
     pub fn of(scene: &Scene, bvh: &SceneBvh) -> InstancingStats {
+        let top = if scene.instancing.instances.is_empty() {
+            0
+        } else {
+            bvh.top.nodes.len() * 128
+        };
+        InstancingStats::with_top_bytes(scene, top)
+    }
+
+    /// For the compressed levels (top-level nodes at 80 B).
+    pub fn of_compressed(scene: &Scene, bvh: &SceneBvh8) -> InstancingStats {
+        let top = if scene.instancing.instances.is_empty() {
+            0
+        } else {
+            bvh.top.nodes.len() * super::compressed::NODE_BYTES as usize
+        };
+        InstancingStats::with_top_bytes(scene, top)
+    }
+
+    fn with_top_bytes(scene: &Scene, top_bytes: usize) -> InstancingStats {
         let inst = &scene.instancing;
         let mut copies_bytes = 0i64;
         for i in &inst.instances {
@@ -328,12 +348,7 @@ impl InstancingStats {
         for mesh in &inst.meshes {
             copies_bytes -= (mesh.vertices.len() * 48 + mesh.triangles.len() * (16 + 48)) as i64;
         }
-        let top_nodes = if inst.instances.is_empty() {
-            0
-        } else {
-            bvh.top.nodes.len()
-        };
-        let overhead = (inst.instances.len() * (112 + 16) + top_nodes * 128) as i64;
+        let overhead = (inst.instances.len() * (112 + 16) + top_bytes) as i64;
         InstancingStats {
             instances: inst.instances.len(),
             instanced_meshes: inst.meshes.len(),

@@ -213,7 +213,7 @@ fn assert_same_hit(
 /// child base, leaf slots of ≤ 3 consecutive entries within the node's ≤ 24, the slot meta and
 /// interior mask agreeing, and (binned trees, whose leaves hold whole triangles) every leaf
 /// triangle inside the decoded box of its slot and of every ancestor's slot. The stack bound is
-/// the depth below the root.
+/// at least the depth below the root.
 fn check_compressed(bvh: &Bvh, tris: &[[Vec3; 3]], eight: &compressed::Bvh8, builder: BvhBuilder) {
     use compressed::{LEAF_MAX as SLOT_MAX, WIDTH as W8};
     let sorted = |v: &[u32]| {
@@ -278,7 +278,7 @@ fn check_compressed(bvh: &Bvh, tris: &[[Vec3; 3]], eight: &compressed::Bvh8, bui
         "every node reached exactly once"
     );
     assert_eq!(entries_seen, eight.tri_order.len());
-    assert_eq!(eight.max_stack() + 1, eight.depth());
+    assert!(eight.max_stack() >= eight.depth().saturating_sub(1));
 }
 
 #[test]
@@ -291,7 +291,11 @@ fn quantised_boxes_decode_exactly_and_contain_the_child() {
         let tris: Vec<[Vec3; 3]> = (0..6)
             .map(|_| {
                 let c = offset + rng.vec3(-scale, scale);
-                [c, c + rng.vec3(0.0, scale * 0.1), c - rng.vec3(0.0, scale * 0.1)]
+                [
+                    c,
+                    c + rng.vec3(0.0, scale * 0.1),
+                    c - rng.vec3(0.0, scale * 0.1),
+                ]
             })
             .collect();
         let bvh = Bvh::build_with(&tris, BvhBuilder::BINNED);
@@ -301,7 +305,10 @@ fn quantised_boxes_decode_exactly_and_contain_the_child() {
                 let b = n.child_bounds(slot);
                 for axis in 0..3 {
                     let scale = 2f64.powi(i32::from(n.exponent[axis]) - 127);
-                    for (q, plane) in [(n.lo[axis][slot], b.min[axis]), (n.hi[axis][slot], b.max[axis])] {
+                    for (q, plane) in [
+                        (n.lo[axis][slot], b.min[axis]),
+                        (n.hi[axis][slot], b.max[axis]),
+                    ] {
                         let exact = f64::from(n.origin[axis]) + f64::from(q) * scale;
                         assert_eq!(f64::from(plane), exact, "box {i}: plane not exact");
                     }
@@ -323,8 +330,16 @@ fn compressed_tree_of_nothing_and_of_one_triangle() {
     assert!(empty.intersect(&[], &ray, f32::INFINITY, false).is_none());
     let one = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
     let eight = compressed::Bvh8::from_binary(&Bvh::build(&one), &one);
-    assert_eq!((eight.nodes.len(), eight.tri_order.as_slice()), (1, &[0u32][..]));
-    assert_eq!(eight.intersect(&one, &ray, f32::INFINITY, false).map(|h| h.triangle), Some(0));
+    assert_eq!(
+        (eight.nodes.len(), eight.tri_order.as_slice()),
+        (1, &[0u32][..])
+    );
+    assert_eq!(
+        eight
+            .intersect(&one, &ray, f32::INFINITY, false)
+            .map(|h| h.triangle),
+        Some(0)
+    );
     assert_eq!(eight.depth(), 1);
 }
 
@@ -334,7 +349,10 @@ fn compressed_tree_of_nothing_and_of_one_triangle() {
 fn compressed_tree_reads_fewer_bytes_than_the_four_wide_one() {
     let tris = sphere(Vec3::ZERO, 1.0, 64, 128);
     let bvh = Bvh::build(&tris);
-    let (four, eight) = (wide::Bvh4::from_binary(&bvh), compressed::Bvh8::from_binary(&bvh, &tris));
+    let (four, eight) = (
+        wide::Bvh4::from_binary(&bvh),
+        compressed::Bvh8::from_binary(&bvh, &tris),
+    );
     let mut rng = TestRng::new(12);
     let (mut s4, mut s8) = (TraceState::default(), TraceState::default());
     for _ in 0..2000 {
@@ -349,8 +367,18 @@ fn compressed_tree_reads_fewer_bytes_than_the_four_wide_one() {
         eight.intersect_into(&tris, &ray, f32::INFINITY, false, 0, &mut s8);
         assert_eq!(s4.best.map(|h| h.t), s8.best.map(|h| h.t));
     }
-    assert!(s8.counts.nodes < s4.counts.nodes, "{:?} vs {:?}", s8.counts, s4.counts);
-    assert!(s8.counts.bytes < s4.counts.bytes, "{:?} vs {:?}", s8.counts, s4.counts);
+    assert!(
+        s8.counts.nodes < s4.counts.nodes,
+        "{:?} vs {:?}",
+        s8.counts,
+        s4.counts
+    );
+    assert!(
+        s8.counts.bytes < s4.counts.bytes,
+        "{:?} vs {:?}",
+        s8.counts,
+        s4.counts
+    );
 }
 
 /// Random rays that mostly point at the mesh, plus a few random ones.
@@ -789,5 +817,22 @@ fn builder_names_parse() {
         "binned/x",
     ] {
         assert!(BvhBuilder::parse(bad).is_err(), "{bad}");
+    }
+}
+
+/// The traversal's sorting network sorts every input (0–1 principle: all 256 binary inputs).
+#[test]
+fn sort8_network_sorts() {
+    for bits in 0u32..256 {
+        let mut keys: [u32; 8] = std::array::from_fn(|i| (bits >> i) & 1);
+        for (a, b) in compressed::SORT8 {
+            if keys[b] < keys[a] {
+                keys.swap(a, b);
+            }
+        }
+        assert!(
+            keys.windows(2).all(|w| w[0] <= w[1]),
+            "{bits:#010b} → {keys:?}"
+        );
     }
 }

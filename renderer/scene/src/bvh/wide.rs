@@ -178,13 +178,15 @@ impl Bvh4 {
             });
             for c in (0..WIDTH).filter(|&c| near[c].is_some() && n.child_count[c] > 0) {
                 let start = n.child_ref[c] as usize;
-                let leaf = &self.tri_order[start..start + n.child_count[c] as usize];
-                state.counts.triangles += leaf.len() as u64;
-                state.counts.bytes += leaf.len() as u64 * TRIANGLE_BYTES;
-                if let Some(hit) =
-                    test_leaf(tris, leaf, &wray, t_max, any_hit, id_base, &mut state.best)
-                {
-                    return Some(hit);
+                // One at a time, so an any-hit walk counts only the triangles it tested.
+                for tri in self.tri_order[start..start + n.child_count[c] as usize].chunks(1) {
+                    state.counts.triangles += 1;
+                    state.counts.bytes += TRIANGLE_BYTES;
+                    if let Some(hit) =
+                        test_leaf(tris, tri, &wray, t_max, any_hit, id_base, &mut state.best)
+                    {
+                        return Some(hit);
+                    }
                 }
             }
             // Interior children nearest first, ordered by the GLSL's comparator network (so equal
