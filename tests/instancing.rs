@@ -9,7 +9,8 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
 use fovea_renderer::sampling::Cartesian;
-use fovea_scene::bvh::instanced::SceneBvh;
+use fovea_renderer::traversal::Traversal;
+use fovea_scene::bvh::instanced::{SceneBvh, SceneBvh8};
 use fovea_scene::bvh::BvhBuilder;
 use fovea_scene::intersect::Ray;
 use fovea_scene::Scene;
@@ -278,8 +279,10 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
         (157, 157, 6 * 157)
     );
     let ctx = gpu();
-    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
     let cpu = SceneBvh::build(&scene, BvhBuilder::DEFAULT);
+    let positions = scene.flat_positions();
+    let world = fovea_scene::bvh::Bvh::build(&positions);
+    let cpu8 = SceneBvh8::with_world(&scene, positions.clone(), &world, BvhBuilder::DEFAULT);
     let flat = fovea_scene::bvh::wide::Bvh4::from_binary(&fovea_scene::bvh::Bvh::build(
         &by_hand.triangle_positions(),
     ));
@@ -307,11 +310,21 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
         })
         .collect();
     let mut caster = RayCaster::new(&ctx).unwrap();
-    for any_hit in [false, true] {
+    for (traversal, any_hit) in Traversal::ALL
+        .into_iter()
+        .flat_map(|t| [(t, false), (t, true)])
+    {
+        let gpu_scene = GpuScene::upload_for(&ctx, &scene, &positions, &world, traversal).unwrap();
         let (hits, _) = caster.trace(&gpu_scene, &gpu_rays, any_hit).unwrap();
         let (mut instanced, mut differ) = (0, 0);
         for (ray, hit) in rays.iter().zip(&hits) {
             let want = cpu.intersect(ray, 1e30, any_hit);
+            // The compressed levels (the GPU traversal's twin) find the same hits.
+            let want8 = cpu8.intersect(ray, 1e30, any_hit, &mut Default::default());
+            assert_eq!(want8.is_some(), want.is_some(), "{ray:?}");
+            if !any_hit {
+                assert_eq!(want8, want, "{ray:?}");
+            }
             assert_eq!(
                 hit.t_u_v.x >= 0.0,
                 want.is_some(),
@@ -337,13 +350,16 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
             );
             instanced += usize::from(w.triangle >= 2);
         }
-        println!("any_hit {any_hit}: {instanced} instanced hits, {differ} differ in the last bits");
+        println!(
+            "{} traversal, any_hit {any_hit}: {instanced} instanced hits, {differ} differ in the last bits",
+            traversal.name()
+        );
         assert!(
             any_hit || instanced > 1500,
             "the rays must exercise the instances: {instanced}"
         );
     }
-    drop((gpu_scene, caster));
+    drop(caster);
     assert_clean(&ctx);
 }
 

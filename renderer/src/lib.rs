@@ -5,7 +5,8 @@
 //! `sampling` (where samples go) → `passes` (trace; mip_phi, remap, blur; tonemap; accumulate) →
 //! `to_screen` (VP grid → screen) → `view` (one eye's state) → `pipeline` (the engine: views,
 //! one submit per frame) → `frames` (frames in flight).
-//! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
+//! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath; `traversal` picks the BVH
+//! traversal the kernels that trace are compiled for.
 
 pub mod environment;
 pub mod error;
@@ -20,6 +21,7 @@ pub mod sampling;
 pub mod shaders;
 pub mod texture_pack;
 pub mod to_screen;
+pub mod traversal;
 pub mod view;
 pub mod vk;
 

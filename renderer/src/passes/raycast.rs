@@ -1,44 +1,89 @@
-//! Traces an arbitrary list of rays: BVH correctness tests and ray-throughput benchmarks.
+//! Traces an arbitrary list of rays: BVH correctness tests and ray-throughput benchmarks, and
+//! (the `counters` variant) what each ray's traversal read.
 
 use super::push_bytes;
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use crate::layouts::RaycastPush;
+use crate::traversal::Traversal;
 use crate::vk::{Buffer, ComputePipeline, Context};
 use glam::UVec4;
 use std::sync::Arc;
 
+/// What one ray's traversal read (the `counters` variant; `shaders/common/bvh.glsl`'s
+/// BVH_COUNTERS): nodes opened, leaf triangles tested, alpha tests and bytes of node + triangle
+/// (+ instance) data.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct RayCounts {
+    pub nodes: u32,
+    pub triangles: u32,
+    pub alpha_tests: u32,
+    pub bytes: u32,
+}
+
+/// The buffers of one raycast dispatch.
+pub struct RaycastIo<'a> {
+    /// `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel reads are far
+    /// cheaper than std430 reads on lavapipe).
+    pub rays: &'a Buffer,
+    /// Receives `count` HitGpu.
+    pub hits: &'a Buffer,
+    /// Receives `count` [`RayCounts`] (the counting kernel), or `None` (the plain one).
+    pub counts: Option<&'a Buffer>,
+    pub count: u32,
+}
+
 pub struct RaycastPass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+    ctx: Arc<Context>,
+    /// The kernels used so far, by traversal and counting (held while command buffers use them).
+    pipelines: Vec<(Traversal, bool, Arc<ComputePipeline>)>,
 }
 
 impl RaycastPass {
     pub fn new(ctx: &Arc<Context>) -> Result<RaycastPass> {
         Ok(RaycastPass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                "passes/raycast",
-                std::mem::size_of::<RaycastPush>() as u32,
-            )?,
+            ctx: ctx.clone(),
+            pipelines: Vec::new(),
         })
     }
 
-    /// `rays` holds `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel
-    /// reads are far cheaper than std430 reads on lavapipe); `hits` receives `count` HitGpu. `any_hit` stops at the first
-    /// hit found (shadow rays).
-    #[allow(clippy::too_many_arguments)]
+    fn pipeline(&mut self, traversal: Traversal, counted: bool) -> Result<Arc<ComputePipeline>> {
+        if let Some((_, _, p)) = self
+            .pipelines
+            .iter()
+            .find(|(t, c, _)| *t == traversal && *c == counted)
+        {
+            return Ok(p.clone());
+        }
+        let kernel = if counted {
+            "passes/raycast.counters"
+        } else {
+            "passes/raycast.hits"
+        };
+        let pipeline = ComputePipeline::shared_for(
+            &self.ctx,
+            kernel,
+            std::mem::size_of::<RaycastPush>() as u32,
+            traversal,
+        )?;
+        self.pipelines.push((traversal, counted, pipeline.clone()));
+        Ok(pipeline)
+    }
+
+    /// Traces `io.rays` against `scene` with the kernel of the scene's traversal; `any_hit` stops
+    /// at the first hit found (shadow rays).
     pub fn record(
-        &self,
+        &mut self,
         rec: &mut FrameRecorder,
         pass_name: &'static str,
         scene: &GpuScene,
         frame: &Buffer,
-        rays: &Buffer,
-        hits: &Buffer,
-        count: u32,
+        io: &RaycastIo,
         any_hit: bool,
     ) -> Result<()> {
+        let pipeline = self.pipeline(scene.traversal, io.counts.is_some())?;
         let s = scene.binds();
         let binds = [
             s[0],
@@ -51,18 +96,21 @@ impl RaycastPass {
             s[7],
             s[9],
             read_buffer("frame", frame),
-            read_texels("rays", rays),
-            write_buffer("hits", hits),
+            read_texels("rays", io.rays),
+            write_buffer("hits", io.hits),
+            write_buffer("counts", io.counts.unwrap_or(io.hits)),
         ];
+        // The plain kernel declares no `counts`: its bind is skipped by name.
+        let binds = &binds[..if io.counts.is_some() { 13 } else { 12 }];
         let push = RaycastPush {
-            config: UVec4::new(count, any_hit as u32, 0, 0),
+            config: UVec4::new(io.count, any_hit as u32, 0, 0),
         };
         rec.dispatch(
             pass_name,
-            &self.pipeline,
-            &binds,
+            &pipeline,
+            binds,
             push_bytes(&push),
-            [count, 1, 1],
+            [io.count, 1, 1],
         )
     }
 }
@@ -75,6 +123,7 @@ pub struct RayCaster {
     frame: Buffer,
     rays: Option<Buffer>,
     hits: Option<Buffer>,
+    counts: Option<Buffer>,
     recorder: crate::graph::FrameRecorder,
 }
 
@@ -92,24 +141,51 @@ impl RayCaster {
             )?,
             rays: None,
             hits: None,
+            counts: None,
             recorder: crate::graph::FrameRecorder::new(ctx, 4)?,
         })
     }
 
-    /// Traces `rays` (closest hit, or any hit for shadow rays); returns the hits and GPU ms.
-    /// Rays and hits live in device-local memory, copied in and out outside the timed pass: on a
-    /// discrete GPU the pass would otherwise time the bus, not the traversal.
+    /// Traces `rays` (closest hit, or any hit for shadow rays) with the traversal `scene` was
+    /// uploaded for; returns the hits and GPU ms. Rays and hits live in device-local memory,
+    /// copied in and out outside the timed pass: on a discrete GPU the pass would otherwise time
+    /// the bus, not the traversal. Alpha-masked scenes are traced with their alpha tests, as the
+    /// renderer traces them.
     pub fn trace(
         &mut self,
         scene: &GpuScene,
         rays: &[crate::layouts::RayGpu],
         any_hit: bool,
     ) -> Result<(Vec<crate::layouts::HitGpu>, f64)> {
+        self.run(scene, rays, any_hit, false)
+            .map(|(hits, _, ms)| (hits, ms))
+    }
+
+    /// [`RayCaster::trace`] with the counting kernel: the hits and what each ray's traversal
+    /// read (not timed: counting costs time).
+    pub fn trace_counted(
+        &mut self,
+        scene: &GpuScene,
+        rays: &[crate::layouts::RayGpu],
+        any_hit: bool,
+    ) -> Result<(Vec<crate::layouts::HitGpu>, Vec<RayCounts>)> {
+        self.run(scene, rays, any_hit, true)
+            .map(|(hits, counts, _)| (hits, counts))
+    }
+
+    fn run(
+        &mut self,
+        scene: &GpuScene,
+        rays: &[crate::layouts::RayGpu],
+        any_hit: bool,
+        counted: bool,
+    ) -> Result<(Vec<crate::layouts::HitGpu>, Vec<RayCounts>, f64)> {
         use gpu_allocator::MemoryLocation;
         let usage =
             ash::vk::BufferUsageFlags::STORAGE_BUFFER | ash::vk::BufferUsageFlags::TRANSFER_SRC;
         let ray_bytes = (std::mem::size_of_val(rays) as u64).max(16);
         let hit_bytes = (rays.len() * std::mem::size_of::<crate::layouts::HitGpu>()) as u64;
+        let count_bytes = (rays.len() * std::mem::size_of::<RayCounts>()) as u64;
         if self.rays.as_ref().is_none_or(|b| b.size < ray_bytes) {
             self.rays = Some(Buffer::device_texels(
                 &self.ctx,
@@ -126,31 +202,51 @@ impl RayCaster {
         } else {
             self.rays.as_ref().unwrap().upload(rays)?;
         }
+        if counted && self.counts.as_ref().is_none_or(|b| b.size < count_bytes) {
+            self.counts = Some(Buffer::new(
+                &self.ctx,
+                "ray_counts",
+                count_bytes.max(16),
+                usage,
+                MemoryLocation::GpuOnly,
+            )?);
+        }
         let (ray_buf, hit_buf) = (self.rays.as_ref().unwrap(), self.hits.as_ref().unwrap());
-        // The instance level's slots are the scene's; everything else in the frame stays default.
+        // The instance level's slots are the scene's, and so is the alpha-test flag; everything
+        // else in the frame stays default.
+        let flags = if scene.alpha_masked {
+            crate::layouts::FRAME_FLAG_ALPHA_MASK
+        } else {
+            0
+        };
         self.frame.write(&[crate::layouts::FrameData {
             instancing: scene.instancing_slots,
+            frame: UVec4::new(0, 0, 0, flags),
             ..Default::default()
         }])?;
         self.recorder.begin()?;
-        let name = if any_hit {
-            "raycast_any"
-        } else {
-            "raycast_closest"
+        let name = match (any_hit, counted) {
+            (false, false) => "raycast_closest",
+            (true, false) => "raycast_any",
+            (false, true) => "raycast_closest_counted",
+            (true, true) => "raycast_any_counted",
         };
-        self.pass.record(
-            &mut self.recorder,
-            name,
-            scene,
-            &self.frame,
-            ray_buf,
-            hit_buf,
-            rays.len() as u32,
-            any_hit,
-        )?;
+        let io = RaycastIo {
+            rays: ray_buf,
+            hits: hit_buf,
+            counts: if counted { self.counts.as_ref() } else { None },
+            count: rays.len() as u32,
+        };
+        self.pass
+            .record(&mut self.recorder, name, scene, &self.frame, &io, any_hit)?;
         let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
         let mut hits = vec![crate::layouts::HitGpu::default(); rays.len()];
         hit_buf.download(&mut hits)?;
-        Ok((hits, ms))
+        let mut counts = Vec::new();
+        if counted {
+            counts = vec![RayCounts::default(); rays.len()];
+            self.counts.as_ref().unwrap().download(&mut counts)?;
+        }
+        Ok((hits, counts, ms))
     }
 }
