@@ -477,6 +477,7 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         camera_path: None,
         out: &out,
         dump_rays: false,
+        traversals: &[],
         device: None,
         validation: true,
     };
@@ -874,6 +875,7 @@ fn bench_vp_frames_follow_a_camera_path() {
         camera_path: Some(&keys),
         out: &out,
         dump_rays: true,
+        traversals: &[],
         device: None,
         validation: true,
     };

@@ -29,6 +29,33 @@ struct DeviceArgs {
     /// Turn on Vulkan validation (always on in debug builds); any message fails the run.
     #[arg(long, global = true)]
     validation: bool,
+    /// BVH traversal of the kernels that trace: auto (gpu on a discrete, integrated or virtual
+    /// GPU, cpu-driver on a CPU driver such as lavapipe), cpu-driver (4-wide nodes in texel
+    /// buffers, stack in shared memory) or gpu (compressed 8-wide nodes in storage buffers,
+    /// children in order of distance, stack in private memory). `fovea bench` takes a comma list:
+    /// ray figures and traversal counters for each, frames with the first.
+    #[arg(long, global = true, default_value = "auto")]
+    traversal: String,
+}
+
+impl DeviceArgs {
+    /// `--traversal` of a command that renders: one traversal, the process's for every device it
+    /// opens.
+    fn choose_traversal(&self) -> Result<()> {
+        let [choice] = parse_traversals(&self.traversal)?[..] else {
+            bail!("--traversal: one of auto, cpu-driver, gpu (a list only for fovea bench)");
+        };
+        commands::choose_traversal(choice);
+        Ok(())
+    }
+}
+
+/// `--traversal` as a comma list.
+fn parse_traversals(spec: &str) -> Result<Vec<fovea_renderer::traversal::TraversalChoice>> {
+    spec.split(',')
+        .map(|s| s.trim().parse().map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()
+        .context("--traversal")
 }
 
 /// The camera and the default environment (every command that renders the scene camera).
@@ -662,6 +689,7 @@ fn run() -> Result<()> {
         device: DeviceArgs {
             device: None,
             validation: false,
+            traversal: "auto".into(),
         },
     });
     if matches!(command, Command::Render { .. } | Command::Xr { .. }) {
@@ -670,6 +698,7 @@ fn run() -> Result<()> {
     }
     match command {
         Command::Render { opts, device } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             commands::render::run(&render_args(
@@ -692,6 +721,7 @@ fn run() -> Result<()> {
             debug_view,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             // Without --frames the run has no length: the camera path's period is a long one.
@@ -723,6 +753,7 @@ fn run() -> Result<()> {
             reference_space,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
@@ -766,6 +797,7 @@ fn run() -> Result<()> {
             opts,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             let mut render = render_args(
@@ -816,33 +848,36 @@ fn run() -> Result<()> {
             force,
             preview,
             device,
-        } => commands::reference::run(&commands::reference::ReferenceArgs {
-            camera: &look.camera()?,
-            headset: &headset,
-            eye: match commands::setup::Eyes::parse(&eye)? {
-                commands::setup::Eyes::Left => fovea_hal::Eye::Left,
-                commands::setup::Eyes::Right => fovea_hal::Eye::Right,
-                commands::setup::Eyes::Both => {
-                    anyhow::bail!("--eye both: a reference is one eye (left or right)")
-                }
-            },
-            environment: look.environment()?,
-            path_regularisation: fovea_tools::render_profile::check_path_regularisation(
-                look.path_regularisation,
-                "--path-regularisation",
-            )?,
-            scene: &scene,
-            width,
-            height,
-            spp,
-            max_depth,
-            seed,
-            out: &out,
-            force,
-            preview,
-            device: device.device.as_deref(),
-            validation: device.validation,
-        }),
+        } => {
+            device.choose_traversal()?;
+            commands::reference::run(&commands::reference::ReferenceArgs {
+                camera: &look.camera()?,
+                headset: &headset,
+                eye: match commands::setup::Eyes::parse(&eye)? {
+                    commands::setup::Eyes::Left => fovea_hal::Eye::Left,
+                    commands::setup::Eyes::Right => fovea_hal::Eye::Right,
+                    commands::setup::Eyes::Both => {
+                        anyhow::bail!("--eye both: a reference is one eye (left or right)")
+                    }
+                },
+                environment: look.environment()?,
+                path_regularisation: fovea_tools::render_profile::check_path_regularisation(
+                    look.path_regularisation,
+                    "--path-regularisation",
+                )?,
+                scene: &scene,
+                width,
+                height,
+                spp,
+                max_depth,
+                seed,
+                out: &out,
+                force,
+                preview,
+                device: device.device.as_deref(),
+                validation: device.validation,
+            })
+        }
         Command::Bench {
             scenes,
             bvh,
@@ -885,6 +920,8 @@ fn run() -> Result<()> {
                 .transpose()
                 .context("--loop-size")?;
             let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
+            let traversals = parse_traversals(&device.traversal)?;
+            commands::choose_traversal(traversals[0]);
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
                 builders: &builders,
@@ -898,12 +935,16 @@ fn run() -> Result<()> {
                 camera_path: camera_path.as_ref(),
                 out: &out,
                 dump_rays,
+                traversals: &traversals,
                 device: device.device.as_deref(),
                 validation: device.validation,
             })
         }
         Command::Headsets => commands::headsets::run(),
-        Command::Info { device } => commands::info::run(device.device.as_deref()),
+        Command::Info { device } => {
+            device.choose_traversal()?;
+            commands::info::run(device.device.as_deref())
+        }
         Command::GenScene {
             kind,
             out,
@@ -932,6 +973,7 @@ fn run() -> Result<()> {
             look,
             device,
         } => {
+            device.choose_traversal()?;
             let base = match &profile {
                 Some(path) => RenderProfile::load(path)?,
                 None => RenderProfile::default(),
