@@ -3,7 +3,8 @@
 //! too); made fully opaque through the mask, it renders bit for bit as the opaque block. `BLEND`
 //! (stochastic transparency) does the same at alpha 0 and 1 and lies between them at 0.5.
 
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::frame::{CameraPose, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::scene::Scene;
 use fovea_tests::{

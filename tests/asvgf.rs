@@ -5,15 +5,16 @@
 //! output with fireflies or an empty view; run-time emission scaling keeps the light table
 //! consistent; a space without temporal filters refuses it, the screen-clipped VP layout runs it.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::layouts::{AsvgfGradientSample, ASVGF_NO_LUMINANCE};
-use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
+use fovea_renderer::passes::denoise::asvgf::{Asvgf, AsvgfSettings};
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::BlurSettings;
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::{
     assert_clean, assert_pictures, gpu, light_material, mean_rgb, owned_scene, read_image, rmse,
     save_preview, Picture,
@@ -67,7 +68,7 @@ fn mean_luminance(pixels: &[[f32; 4]]) -> f64 {
 
 /// Gradient samples the tracer re-shaded last frame: (last luminance, this frame's).
 fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
-    let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+    let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
         panic!("A-SVGF expected")
     };
     let samples: Vec<AsvgfGradientSample> = a.read_samples().unwrap();
@@ -93,7 +94,7 @@ fn gradient_samples_reshade_last_frames_path() {
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     for name in SPACES {
         let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(asvgf())).unwrap();
-        let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+        let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
             panic!()
         };
         let strata = a.strata();
@@ -149,7 +150,7 @@ fn gradient_samples_reshade_last_frames_path() {
                 lit.len() - sign
             );
             // The reconstruction averages δ and max f alike: λ = |δ̂| / max f̂ is the ratio's.
-            let Some(Denoiser::Asvgf(a)) = r.denoiser() else {
+            let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
                 panic!()
             };
             let gradient: Vec<[f32; 4]> = read_image(&ctx, a.gradient());
@@ -495,7 +496,7 @@ fn emission_scale_switches_a_light_consistently() {
 #[test]
 fn the_renderer_refuses_filters_a_space_cannot_run() {
     use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
-    use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
+    use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
     use fovea_renderer::sampling::{FalloffShape, LinearFalloff, FALLOFF_BUDGET_OF_VP};
     let ctx = gpu();
     let scene = owned_scene("cornell-box");

@@ -4,22 +4,23 @@
 //! history across a disocclusion (synthetic G-buffers, moving camera); the `--denoiser bmfr` flag
 //! end to end. The φ seam is the conformance suite's (tests/conformance.rs), for every filter.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::BMFR_BLOCK;
 use fovea_renderer::passes::denoise::bmfr::{Bmfr, BmfrSettings, BLOCK_OFFSETS};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::{GBuffer, GridFrame};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::vk::{Buffer, Context};
+use fovea_renderer::vk::Context;
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials,
     rmse_where, surface_interiors, texel_screens, upload_gbuffer, Texel,
 };
 use fovea_tests::{
-    assert_clean, assert_pictures, gpu, grid_table, inject_fireflies, owned_scene, read_image,
-    save_preview, unit_hash, Picture,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, Picture, SpaceBuffers,
 };
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use std::sync::Arc;
@@ -63,26 +64,10 @@ fn frame(camera: CameraPose, frame_index: u32) -> FrameInput {
 }
 
 /// Runs one BMFR frame; returns its output (re-modulated).
-fn denoise(
-    ctx: &Arc<Context>,
-    bmfr: &mut Bmfr,
-    g: &GBuffer,
-    frame: &DenoiseFrame,
-    origin: Vec3,
-    materials: &Buffer,
-) -> Vec<[f32; 4]> {
+fn denoise(ctx: &Arc<Context>, bmfr: &mut Bmfr, frame: &GridFrame) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 8).unwrap();
     rec.begin().unwrap();
-    bmfr.record(
-        &mut rec,
-        g,
-        frame,
-        &DenoiseScene {
-            camera_origin: origin,
-            materials,
-        },
-    )
-    .unwrap();
+    bmfr.record(&mut rec, frame).unwrap();
     rec.submit_and_wait().unwrap();
     read_image(ctx, &bmfr.output)
 }
@@ -226,20 +211,12 @@ fn fit_matches_a_cpu_least_squares_solve() {
         )
         .unwrap();
         assert_eq!(bmfr.next_block_offset().to_array(), offset);
-        let table = grid_table(&ctx, space.as_ref(), None);
-        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
+        let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
+        let materials = plain_materials(&ctx);
         denoise(
             &ctx,
             &mut bmfr,
-            &g,
-            &DenoiseFrame {
-                current: space.params(),
-                previous: None,
-                sampling_table: &table,
-                tiles: tiles.list(),
-            },
-            Vec3::ZERO,
-            &plain_materials(&ctx),
+            &buffers.grid_frame(&g, (space.params(), None), &materials),
         );
         let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
 
@@ -360,20 +337,12 @@ fn rank_deficient_blocks_fit_the_remaining_features() {
         },
     )
     .unwrap();
-    let table = grid_table(&ctx, &space, None);
-    let tiles = fovea_tests::grid_tiles(&ctx, &space);
+    let buffers = SpaceBuffers::new(&ctx, &space, 0, 1);
+    let materials = plain_materials(&ctx);
     let out = denoise(
         &ctx,
         &mut bmfr,
-        &g,
-        &DenoiseFrame {
-            current: space.params(),
-            previous: None,
-            sampling_table: &table,
-            tiles: tiles.list(),
-        },
-        Vec3::ZERO,
-        &plain_materials(&ctx),
+        &buffers.grid_frame(&g, (space.params(), None), &materials),
     );
     assert_finite_non_negative("rank-deficient fit", &out);
     let fitted: Vec<[f32; 4]> = read_image(&ctx, &bmfr.fitted);
@@ -588,20 +557,15 @@ fn bmfr_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             r.render_frame(&frame(camera, f)).unwrap();
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let table = grid_table(&ctx, r.space(), None);
-            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let buffers = SpaceBuffers::new(&ctx, r.space(), f, 1);
+            let materials = &r.scene.materials;
             let out = denoise(
                 &ctx,
                 &mut bmfr,
-                &r.view(0).gbuffer,
-                &DenoiseFrame {
-                    current,
-                    previous,
-                    sampling_table: &table,
-                    tiles: tiles.list(),
+                &GridFrame {
+                    camera_origin: origin,
+                    ..buffers.grid_frame(&r.view(0).gbuffer, (current, previous), materials)
                 },
-                origin,
-                &r.scene.materials,
             );
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
@@ -653,8 +617,7 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
         )
         .unwrap();
         let params = space.params();
-        let table = grid_table(&ctx, space.as_ref(), None);
-        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
+        let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
         let materials = plain_materials(&ctx);
         let mut out = Vec::new();
         for f in 0..9u32 {
@@ -694,15 +657,10 @@ fn bmfr_drops_history_where_a_moving_camera_uncovers_the_background() {
             out = denoise(
                 &ctx,
                 &mut bmfr,
-                &g,
-                &DenoiseFrame {
-                    current: params,
-                    previous,
-                    sampling_table: &table,
-                    tiles: tiles.list(),
+                &GridFrame {
+                    camera_origin: Vec3::new(camera_x, 0.0, 0.0),
+                    ..buffers.grid_frame(&g, (params, previous), &materials)
                 },
-                Vec3::new(camera_x, 0.0, 0.0),
-                &materials,
             );
         }
         let lengths: Vec<[f32; 4]> = read_image(&ctx, bmfr.noisy());
@@ -809,22 +767,13 @@ fn bmfr_over_the_live_tiles_equals_bmfr_over_the_whole_grid() {
             .unwrap()
         };
         let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
-        denoise(
-            &ctx,
-            a,
-            &r.view(0).gbuffer,
-            over_tiles,
-            origin,
-            &r.scene.materials,
-        );
-        denoise(
-            &ctx,
-            b,
-            &r.view(0).gbuffer,
-            over_grid,
-            origin,
-            &r.scene.materials,
-        );
+        for (bmfr, frame) in [(&mut *a, over_tiles), (&mut *b, over_grid)] {
+            let frame = GridFrame {
+                camera_origin: origin,
+                ..*frame
+            };
+            denoise(&ctx, bmfr, &frame);
+        }
         let cur = (f % 2) as usize;
         let (ha, hb) = (&a.history, &b.history);
         assert_bit_equal(

@@ -4,18 +4,17 @@
 //! keeps the traced pixels, it converges to the image one sample per pixel gives, it refuses the
 //! filters it cannot run, and `fovea render --method NAME` reports it end to end.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, OffscreenSamples, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::passes::fill::FillPass;
-use fovea_renderer::passes::splat::{SplatInputs, SplatPass};
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     FalloffShape, LinearFalloff, RandomAcuity, SamplingSpace, VisualPolar, VisualPolarParams,
     FALLOFF_BUDGET_OF_VP,
 };
 use fovea_renderer::vk::Image;
+use fovea_renderer::way_back::fill::FillPass;
+use fovea_renderer::way_back::splat::{SplatInputs, SplatPass};
 use fovea_tests::{assert_clean, gpu, owned_scene, probe};
 use glam::{UVec2, Vec2};
 
@@ -364,7 +363,7 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
 /// --composite-mode M` reports it end to end.
 #[test]
 fn composite_runs_the_filters_and_the_cli_reports_it() {
-    use fovea_renderer::passes::denoise::taa::TaaMode;
+    use fovea_renderer::passes::taa::TaaMode;
     use fovea_renderer::sampling::{CompositeMode, RadialLaw};
     let ctx = gpu();
     let scene = owned_scene("cornell-box");

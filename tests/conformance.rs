@@ -8,19 +8,20 @@
 //! does not refuses every filter by name. Adding a space means adding it to `spaces()`, not
 //! copying these tests.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::denoise::taa::Taa;
-use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::{Denoiser, DenoiserSettings};
+use fovea_renderer::passes::grid::{GBuffer, GridFrame};
+use fovea_renderer::passes::taa::Taa;
+use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     BlockShape, Cartesian, CompositeMode, Eccentricity, FalloffShape, FixedFoveation,
     LinearFalloff, LogPolarParams, PixelBlocks, RadialLaw, RandomAcuity, SamplingSpace,
     UniformBudget, VisualPolar, VisualPolarParams, VpLayout, VrsTiles, FALLOFF_BUDGET_OF_VP,
 };
-use fovea_renderer::to_screen::BlurSettings;
-use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::vk::{Context, Image};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
     assert_finite_non_negative, plain_materials, rmse_where, seam_texels, seam_truth, upload,
     upload_gbuffer, SeamErrors,
@@ -29,7 +30,7 @@ use fovea_tests::{
     assert_clean, failure_message, gpu, light_material, owned_scene, read_image, Picture,
     SpaceBuffers,
 };
-use glam::{Mat4, UVec2, Vec3};
+use glam::{Mat4, UVec2};
 use std::sync::Arc;
 
 const SIZE: UVec2 = UVec2::new(96, 108);
@@ -391,7 +392,7 @@ fn every_filter_on_every_space_that_supports_it() {
 /// One grid filter run on its own over a synthetic G-buffer (the seam test's), as the renderer
 /// records it: a denoiser (A-SVGF's forward projection first) or TAA in the grid.
 enum GridFilter {
-    Denoiser(Box<Denoiser>),
+    Denoiser(Box<dyn Denoiser>),
     Taa(Box<Taa>),
 }
 
@@ -403,8 +404,8 @@ impl GridFilter {
         space: &dyn SamplingSpace,
     ) -> GridFilter {
         let (grid, variant) = (space.grid_size(), space.shader_variant());
-        match (Denoiser::new(ctx, denoiser, grid, variant).unwrap(), taa) {
-            (Some(d), _) => GridFilter::Denoiser(Box::new(d)),
+        match (denoiser.build(ctx, grid, variant).unwrap(), taa) {
+            (Some(d), _) => GridFilter::Denoiser(d),
             (None, TaaMode::SamplingGrid(s)) => {
                 GridFilter::Taa(Box::new(Taa::new(ctx, grid, variant, s).unwrap()))
             }
@@ -412,34 +413,19 @@ impl GridFilter {
         }
     }
 
-    fn run(
-        &mut self,
-        ctx: &Arc<Context>,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        buffers: &SpaceBuffers,
-        materials: &Buffer,
-    ) -> Vec<[f32; 4]> {
+    fn run(&mut self, ctx: &Arc<Context>, frame: &GridFrame) -> Vec<[f32; 4]> {
         let mut rec = FrameRecorder::new(ctx, 32).unwrap();
         rec.begin().unwrap();
         let out: &Image = match self {
             GridFilter::Denoiser(d) => {
-                d.record_before_trace(&mut rec, g, frame, &buffers.frame)
-                    .unwrap();
-                d.record(
-                    &mut rec,
-                    g,
-                    frame,
-                    &DenoiseScene {
-                        camera_origin: Vec3::ZERO,
-                        materials,
-                    },
-                )
-                .unwrap()
+                d.record_before_trace(&mut rec, frame).unwrap();
+                d.record(&mut rec, frame).unwrap()
             }
-            GridFilter::Taa(t) => t
-                .record(&mut rec, g, &g.color, frame, glam::Vec2::splat(0.5))
-                .unwrap(),
+            GridFilter::Taa(t) => {
+                let color = &frame.gbuffer.color;
+                t.record(&mut rec, color, frame, glam::Vec2::splat(0.5))
+                    .unwrap()
+            }
         };
         rec.submit_and_wait().unwrap();
         read_image(ctx, out)
@@ -486,17 +472,10 @@ fn every_grid_filter_filters_the_phi_seam_like_any_other_angle() {
             let mut out = Vec::new();
             for frame in 0..8u32 {
                 upload_gbuffer(&ctx, &g, &seam_texels(&vp, frame));
+                let previous = (frame > 0).then_some(params);
                 out = f.run(
                     &ctx,
-                    &g,
-                    &DenoiseFrame {
-                        current: params,
-                        previous: (frame > 0).then_some(params),
-                        sampling_table: &buffers.table,
-                        tiles: buffers.tiles.list(),
-                    },
-                    &buffers,
-                    &materials,
+                    &buffers.grid_frame(&g, (params, previous), &materials),
                 );
             }
             assert_finite_non_negative(&format!("{space_name} + {filter} at the seam"), &out);
@@ -631,13 +610,15 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
                     &vp,
                     previous_arcs.then_some(&prev as &dyn SamplingSpace),
                 );
-                let frame_in = DenoiseFrame {
-                    current: vp.sampling_params(),
-                    previous: (frame > 0).then(|| prev.sampling_params()),
+                let sequence = (
+                    vp.sampling_params(),
+                    (frame > 0).then(|| prev.sampling_params()),
+                );
+                let frame_in = GridFrame {
                     sampling_table: &table,
-                    tiles: buffers.tiles.list(),
+                    ..buffers.grid_frame(&g, sequence, &materials)
                 };
-                let out = f.run(&ctx, &g, &frame_in, &buffers, &materials);
+                let out = f.run(&ctx, &frame_in);
                 if frame == FRAMES - 1 {
                     assert_finite_non_negative(&format!("{layout:?} + {filter}"), &out);
                     errors[run] = error(&vp, &|i| out[i][1]);

@@ -6,22 +6,24 @@
 //! TAA in the sampling grid (Karis 2014): noise and edge aliasing reduced against the reference,
 //! fireflies, disocclusion resets, the tracer's Halton jitter, the `--taa` flag.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::passes::denoise::svgf::{Svgf, SvgfSettings};
-use fovea_renderer::passes::denoise::taa::{Taa, TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::GBuffer;
+use fovea_renderer::passes::grid::GridFrame;
+use fovea_renderer::passes::taa::{Taa, TaaMode, TaaSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Context, Image};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_tests::denoise::{
-    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, rmse_where,
-    surface_interiors, texel_screens, upload,
+    assert_bit_equal, assert_finite_non_negative, denoise_over_culled_tiles, plain_materials,
+    rmse_where, surface_interiors, texel_screens, upload,
 };
 use fovea_tests::{
-    assert_clean, assert_pictures, gpu, grid_table, inject_fireflies, owned_scene, read_image,
-    save_preview, unit_hash, write_image, Picture,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image, Picture, SpaceBuffers,
 };
 use glam::{Mat4, UVec2, Vec2};
 use std::sync::Arc;
@@ -299,12 +301,11 @@ fn occluder_scene(
 fn denoise(
     ctx: &Arc<Context>,
     svgf: &mut Svgf,
-    g: &GBuffer,
-    frame: &DenoiseFrame,
+    frame: &GridFrame,
 ) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
     let mut rec = FrameRecorder::new(ctx, 16).unwrap();
     rec.begin().unwrap();
-    svgf.record(&mut rec, g, frame).unwrap();
+    svgf.record(&mut rec, frame).unwrap();
     rec.submit_and_wait().unwrap();
     (
         read_image(ctx, &svgf.output),
@@ -335,18 +336,11 @@ fn svgf_output_is_finite_and_non_negative_with_fireflies_and_an_empty_view() {
             r.render_frame(&frame(camera, f)).unwrap();
             inject_fireflies(&ctx, &r.view(0).gbuffer.radiance, f);
             let current = r.space().params();
-            let table = grid_table(&ctx, r.space(), None);
-            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let buffers = SpaceBuffers::new(&ctx, r.space(), f, 1);
             let (out, moments) = denoise(
                 &ctx,
                 &mut svgf,
-                &r.view(0).gbuffer,
-                &DenoiseFrame {
-                    current,
-                    previous,
-                    sampling_table: &table,
-                    tiles: tiles.list(),
-                },
+                &buffers.grid_frame(&r.view(0).gbuffer, (current, previous), &r.scene.materials),
             );
             previous = Some(current);
             assert_finite_non_negative(&format!("{name} frame {f} output"), &out);
@@ -400,8 +394,8 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
         )
         .unwrap();
         let params = space.params();
-        let table = grid_table(&ctx, space.as_ref(), None);
-        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
+        let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
+        let materials = plain_materials(&ctx);
         let mut last = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
@@ -410,13 +404,7 @@ fn svgf_drops_history_where_a_moving_occluder_uncovers_the_background() {
             last = denoise(
                 &ctx,
                 &mut svgf,
-                &g,
-                &DenoiseFrame {
-                    current: params,
-                    previous,
-                    sampling_table: &table,
-                    tiles: tiles.list(),
-                },
+                &buffers.grid_frame(&g, (params, previous), &materials),
             );
         }
         let (out, moments) = last;
@@ -485,8 +473,8 @@ fn svgf_over_the_live_tiles_equals_svgf_over_the_whole_grid() {
             .unwrap()
         };
         let [a, b] = pair.get_or_insert_with(|| [new(), new()]);
-        denoise(&ctx, a, &r.view(0).gbuffer, over_tiles);
-        denoise(&ctx, b, &r.view(0).gbuffer, over_grid);
+        denoise(&ctx, a, over_tiles);
+        denoise(&ctx, b, over_grid);
         let cur = (f % 2) as usize;
         assert_bit_equal(
             &ctx,
@@ -547,14 +535,13 @@ fn with_taa(denoiser: DenoiserSettings) -> RenderSettings {
 fn resolve(
     ctx: &Arc<Context>,
     taa: &mut Taa,
-    g: &GBuffer,
     color: &Image,
-    frame: &DenoiseFrame,
+    frame: &GridFrame,
     jitter: Vec2,
 ) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 4).unwrap();
     rec.begin().unwrap();
-    let out = taa.record(&mut rec, g, color, frame, jitter).unwrap();
+    let out = taa.record(&mut rec, color, frame, jitter).unwrap();
     rec.submit_and_wait().unwrap();
     read_image(ctx, out)
 }
@@ -687,19 +674,12 @@ fn taa_output_is_finite_and_non_negative_with_fireflies() {
             inject_fireflies(&ctx, &r.view(0).gbuffer.color, f);
             let current = r.space().params();
             let jitter = TaaSettings::default().jitter(f);
-            let table = grid_table(&ctx, r.space(), None);
-            let tiles = fovea_tests::grid_tiles(&ctx, r.space());
+            let buffers = SpaceBuffers::new(&ctx, r.space(), f, 1);
             let out = resolve(
                 &ctx,
                 &mut taa,
-                &r.view(0).gbuffer,
                 &r.view(0).gbuffer.color,
-                &DenoiseFrame {
-                    current,
-                    previous,
-                    sampling_table: &table,
-                    tiles: tiles.list(),
-                },
+                &buffers.grid_frame(&r.view(0).gbuffer, (current, previous), &r.scene.materials),
                 jitter,
             );
             previous = Some(current);
@@ -733,25 +713,20 @@ fn taa_drops_history_where_a_moving_occluder_uncovers_the_background() {
         )
         .unwrap();
         let params = space.params();
-        let table = grid_table(&ctx, space.as_ref(), None);
-        let tiles = fovea_tests::grid_tiles(&ctx, space.as_ref());
+        let buffers = SpaceBuffers::new(&ctx, space.as_ref(), 0, 1);
+        let materials = plain_materials(&ctx);
         let (mut out, mut current) = (Vec::new(), Vec::new());
         for f in 0..9u32 {
             let samples = occluder_scene(&screens, f, background, occluder);
             upload_gbuffer(&ctx, &g, &samples);
             current = samples;
             // Samples at texel centres: the jitter is the centre.
+            let previous = (f > 0).then_some(params);
             out = resolve(
                 &ctx,
                 &mut taa,
-                &g,
                 &g.color,
-                &DenoiseFrame {
-                    current: params,
-                    previous: (f > 0).then_some(params),
-                    sampling_table: &table,
-                    tiles: tiles.list(),
-                },
+                &buffers.grid_frame(&g, (params, previous), &materials),
                 Vec2::splat(0.5),
             );
         }

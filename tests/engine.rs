@@ -2,9 +2,10 @@
 //! resource lifetimes and binding errors.
 
 use ash::vk;
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::graph::{read_image, FrameRecorder};
 use fovea_renderer::layouts::STRUCT_LAYOUTS;
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::{Buffer, ComputePipeline, Image};
 use fovea_renderer::Error;

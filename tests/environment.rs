@@ -2,8 +2,9 @@
 //! (furnace, the baked sky and a loaded map), the
 //! default sun's irradiance, and real glTF scenes without lights or cameras rendering lit.
 
+use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::passes::tonemap::ToneCurve;
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, EnvironmentMap, Scene, Sky, Triangle, Vertex};
 use fovea_tests::scenes::{add_quad, lambert};

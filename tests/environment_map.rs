@@ -3,10 +3,11 @@
 //! variance, both on the analytic irradiance), and the loader's errors, each naming the file.
 
 use fovea_renderer::environment::gpu_texels;
+use fovea_renderer::frame::{CameraPose, EnvironmentSampling, RenderSettings};
 use fovea_renderer::graph::{read_buffer, write_buffer, FrameRecorder};
 use fovea_renderer::layouts::EnvProbePush;
 use fovea_renderer::passes::tonemap::ToneCurve;
-use fovea_renderer::pipeline::{CameraPose, EnvironmentSampling, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::{Buffer, ComputePipeline};
 use fovea_scene::environment::{direction_to_uv, pdf_solid_angle, texel_index, uv_to_direction};

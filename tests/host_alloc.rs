@@ -4,9 +4,10 @@
 //! A counting global allocator (this test binary only) counts the allocations made by this
 //! thread while a frame is recorded, submitted and read back.
 
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
 };

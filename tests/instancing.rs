@@ -4,10 +4,11 @@
 //! with the mesh duplicated by hand (every node its own mesh, so the loader flattens all) —
 //! lit, emissive and alpha-masked. Uploaded triangle bytes grow with unique meshes only.
 
+use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::raycast::RayCaster;
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::traversal::Traversal;
 use fovea_scene::bvh::instanced::{SceneBvh, SceneBvh8};

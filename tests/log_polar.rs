@@ -3,9 +3,8 @@
 //! clip), `fovea render --method log-polar` reports it end to end, and bad profile values name
 //! their key. Every filter on it: tests/conformance.rs.
 
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
-};
+use fovea_renderer::frame::{CameraPose, FrameInput, OffscreenSamples, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     LogPolarExtent, LogPolarParams, RadialLaw, SamplingSpace, VisualPolar, VisualPolarParams,
 };

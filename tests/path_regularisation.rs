@@ -4,8 +4,9 @@
 //! fireflies without it and none with it, at little cost in brightness; primary vertices and
 //! direct light are untouched.
 
+use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::passes::tonemap::ToneCurve;
-use fovea_renderer::pipeline::{CameraPose, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, Material, PunctualLight, Scene};
 use fovea_tests::scenes::{add_quad, lambert};

@@ -2,8 +2,9 @@
 //! (next-event estimation through the alias table, area and punctual lights), depth semantics,
 //! 1/√spp convergence and determinism.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::passes::tonemap::ToneCurve;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, Material, PunctualLight, Scene};
 use fovea_tests::scenes::{add_quad, furnace, lambert};

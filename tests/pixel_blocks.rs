@@ -3,10 +3,11 @@
 //! that many samples, the block fill reproduces a linear image exactly away from the borders,
 //! the frames converge to what one sample per pixel gives, and the filters are refused.
 
-use fovea_renderer::passes::block_fill::BlockFillPass;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{BlockShape, PixelBlocks, SamplingSpace, VisualPolarParams};
 use fovea_renderer::vk::Image;
+use fovea_renderer::way_back::block_fill::BlockFillPass;
 use fovea_tests::{assert_clean, gpu, owned_scene, probe, SpaceBuffers};
 use glam::{IVec2, UVec2, Vec2};
 

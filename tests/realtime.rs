@@ -2,12 +2,11 @@
 //! ring of slots (same images as waiting, no drain in the steady state, deferred release), and
 //! how the two eyes' noise relates. Synchronisation validation is on in the ring tests.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, StereoNoise, ViewInput};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, RenderSettings, Renderer, StereoNoise, ViewInput,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Context, ContextOptions, EngineCounters};
 use fovea_tests::{assert_clean, assert_pictures_equal, gpu, Picture};
@@ -273,7 +272,11 @@ fn stereo_noise_independent_vs_shared() {
         )
         .unwrap();
         let hdr = r.render_reference(&eye(&head, dx), 64, 3, |_| {}).unwrap();
-        fovea_tools::output::tonemap_preview(&hdr, 1.0)
+        fovea_tools::output::tonemap_preview(
+            &hdr,
+            1.0,
+            fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        )
     };
     let parallax = byte_rmse(&reference(-HALF_IPD), &reference(HALF_IPD));
     println!("inter-eye RMSE (8-bit) at 63 mm: independent {independent:.2}, shared {shared:.2}, converged {parallax:.2}; same position: independent {independent_same_position:.2}, shared 0");

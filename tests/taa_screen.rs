@@ -3,19 +3,20 @@
 //! the disocclusion reset. The remap's placement of jittered samples is tested in vp_remap.rs.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
 use fovea_renderer::layouts::FrameData;
-use fovea_renderer::passes::denoise::taa::{TaaMode, TaaSettings};
-use fovea_renderer::passes::denoise::taa_screen::{ScreenTaa, ScreenTaaFrame};
-use fovea_renderer::passes::trace::GBuffer;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::grid::{GBuffer, GridFrame};
+use fovea_renderer::passes::taa::ScreenTaa;
+use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, VisualPolar, VisualPolarParams};
-use fovea_renderer::to_screen::BlurSettings;
 use fovea_renderer::vk::{Buffer, Context, Image};
-use fovea_tests::denoise::{assert_finite_non_negative, rmse_where};
+use fovea_renderer::way_back::blur::BlurSettings;
+use fovea_tests::denoise::{assert_finite_non_negative, plain_materials, rmse_where};
 use fovea_tests::{
-    assert_clean, assert_pictures, gpu, grid_table, inject_fireflies, owned_scene, read_image,
-    save_preview, unit_hash, write_image, Picture,
+    assert_clean, assert_pictures, gpu, inject_fireflies, owned_scene, read_image, save_preview,
+    unit_hash, write_image, Picture, SpaceBuffers,
 };
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
@@ -140,7 +141,7 @@ fn resolve(
     ctx: &Arc<Context>,
     taa: &mut ScreenTaa,
     color: &Image,
-    frame: &ScreenTaaFrame,
+    frame: &GridFrame,
 ) -> Vec<[f32; 4]> {
     let mut rec = FrameRecorder::new(ctx, 2).unwrap();
     rec.begin().unwrap();
@@ -175,14 +176,11 @@ fn screen_taa_output_is_finite_and_non_negative_with_fireflies() {
         write_image(&ctx, &color, &hdr);
         inject_fireflies(&ctx, &color, f);
         let space = r.space().params();
-        let columns = grid_table(&ctx, r.space(), None);
-        let input = ScreenTaaFrame {
+        let buffers = SpaceBuffers::new(&ctx, r.space(), f, 1);
+        let sequence = (space, (f > 0).then_some(space));
+        let input = GridFrame {
             frame_data: &frame_data,
-            gbuffer: &r.view(0).gbuffer,
-            space: &space,
-            columns: &columns,
-            has_previous: f > 0,
-            jitter: Vec2::splat(0.5),
+            ..buffers.grid_frame(&r.view(0).gbuffer, sequence, &r.scene.materials)
         };
         let out = resolve(&ctx, &mut taa, &color, &input);
         assert_finite_non_negative(&format!("frame {f}"), &out);
@@ -224,7 +222,8 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
         vp.vp_to_screen(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).x > SCREEN.x as f32 * 0.5
     };
     let space = vp.sampling_params();
-    let columns = grid_table(&ctx, &vp, None);
+    let buffers = SpaceBuffers::new(&ctx, &vp, 0, 1);
+    let materials = plain_materials(&ctx);
     let mut out = Vec::new();
     let mut current: Vec<[f32; 4]> = Vec::new();
     let mut previous = Vec::new();
@@ -252,13 +251,9 @@ fn screen_taa_drops_history_where_the_background_is_uncovered() {
             })
             .collect();
         write_image(&ctx, &color, &current);
-        let input = ScreenTaaFrame {
+        let input = GridFrame {
             frame_data: &frame_data,
-            gbuffer: &gbuffer,
-            space: &space,
-            columns: &columns,
-            has_previous: f > 0,
-            jitter: Vec2::splat(0.5),
+            ..buffers.grid_frame(&gbuffer, (space, (f > 0).then_some(space)), &materials)
         };
         out = resolve(&ctx, &mut taa, &color, &input);
     }

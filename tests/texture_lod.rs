@@ -3,8 +3,9 @@
 //! both modes converge to; with ray cones a 1-spp frame varies far less from frame to frame
 //! (no aliasing to average away), and in Visual-Polar space the periphery gains most.
 
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, TextureLod};
 use fovea_renderer::passes::tonemap::ToneCurve;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer, TextureLod};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_scene::{Camera, Scene, Texture};
 use fovea_tests::scenes::{add_quad, lambert};

@@ -2,7 +2,8 @@
 //! upscaled. It traces the budget it claims, converges to the same image as one sample per pixel,
 //! refuses the filters its grid cannot run, and `fovea render --method uniform-budget` reports it.
 
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, UniformBudget, VisualPolar, VisualPolarParams,
 };

@@ -7,18 +7,19 @@
 //! Then the whole VP frame through `Renderer`.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::blur::{BlurPass, BlurShape};
-use fovea_renderer::passes::denoise::taa::TaaMode;
-use fovea_renderer::passes::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
-use fovea_renderer::passes::remap::RemapPass;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, InverseCdf, SamplingSpace, VisualPolar,
     VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
 use fovea_renderer::vk::{Buffer, Context, Image};
+use fovea_renderer::way_back::blur::{BlurPass, BlurShape};
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
+use fovea_renderer::way_back::mip_phi::{level_offset, rows_at_level, MipPhiPass, PhiMips};
+use fovea_renderer::way_back::remap::RemapPass;
 use fovea_tests::{
     assert_clean, assert_pictures, assert_pictures_equal, gpu, read_image, save_preview, unit_hash,
     write_image, Picture,
@@ -420,7 +421,7 @@ fn blur(ctx: &Arc<Context>, shape: &BlurShape, src: &[[f32; 4]]) -> Vec<[f32; 4]
         shape,
         &a,
         &b,
-        fovea_renderer::passes::blur::BlurTarget::Radiance(&c),
+        fovea_renderer::way_back::blur::BlurTarget::Radiance(&c),
     )
     .unwrap();
     rec.submit_and_wait().unwrap();

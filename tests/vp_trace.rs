@@ -15,9 +15,8 @@
 //! - jitter-independently: between the texels whose whole cell is off-screen and the texels
 //!   with any part off-screen (each cell probed on a 9×9 lattice).
 
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, FrameStats, OffscreenSamples, RenderSettings, Renderer,
-};
+use fovea_renderer::frame::{CameraPose, FrameInput, FrameStats, OffscreenSamples, RenderSettings};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::random::{pcg_hash, rng_seed};
 use fovea_renderer::sampling::{
     Cartesian, Eccentricity, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,

@@ -43,6 +43,10 @@ pub enum HalError {
     #[error("invalid --gaze value `{input}`: {reason}")]
     GazeSpec { input: String, reason: String },
 
+    /// A command-line value out of range (`--latency-ms`, `--tracker-hz`, `--gaze-predict`).
+    #[error("{flag}: {reason}")]
+    Flag { flag: &'static str, reason: String },
+
     #[error("simulator script: step {index}: {reason}")]
     Script { index: usize, reason: String },
 

@@ -59,6 +59,25 @@ pub fn read_text(path: &Path, limit: u64, what: &str) -> Result<String, HalError
     })
 }
 
+/// The first line of `path` (at most `limit` bytes of it), with the same refusals as
+/// [`read_text`]: to tell file formats apart without reading a whole file.
+pub fn read_first_line(path: &Path, limit: u64) -> Result<String, HalError> {
+    let file = open_nonblocking(path).map_err(|e| HalError::io(path, e))?;
+    let meta = file.metadata().map_err(|e| HalError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(refuse(
+            path,
+            format!("it is {}, not a regular file", file_kind(&meta.file_type())),
+        ));
+    }
+    let mut bytes = Vec::new();
+    file.take(limit)
+        .read_to_end(&mut bytes)
+        .map_err(|e| HalError::io(path, e))?;
+    let text = String::from_utf8_lossy(&bytes);
+    Ok(strip_bom(text.lines().next().unwrap_or("")).to_string())
+}
+
 #[cfg(unix)]
 fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
     use std::os::unix::fs::OpenOptionsExt;

@@ -132,6 +132,15 @@ impl InvalidGazePolicy {
         }
     }
 
+    /// Hold `direction` instead of the last valid one (keeping that one's time, so the hold
+    /// ends when it would have): a gaze predictor that knows the last samples before a blink
+    /// were the lid closing, not the eye moving, says what to hold.
+    pub fn retarget_hold(&mut self, direction: Vec3) {
+        if let Some((_, held)) = &mut self.last_valid {
+            *held = direction.normalize_or(*held);
+        }
+    }
+
     pub fn reset(&mut self) {
         self.last_valid = None;
     }

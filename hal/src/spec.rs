@@ -1,13 +1,15 @@
-//! `--gaze center | X,Y | sim[:seed] | gazebase:<file> | <trace path>` for the CLI.
+//! `--gaze center | X,Y | sim[:seed] | gazebase:<file> | degrees:<file> | <trace path>` for the
+//! CLI.
 
 use crate::error::HalError;
 use crate::hmd::HmdDescription;
 use crate::sample::Eye;
 use crate::sim::{SimConfig, SimulatedFove};
 use crate::source::{FixedGaze, GazeSource};
-use crate::trace::Playback;
+use crate::trace::import::{self, DEGREES_COLUMNS};
+use crate::trace::{Playback, Trace};
 use glam::{Vec2, Vec3};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -25,6 +27,9 @@ pub enum GazeSpec {
     Trace(PathBuf),
     /// A GazeBase-style dataset CSV (`n` ms, `x`/`y` degrees, optional `val`), imported on open.
     GazeBase(PathBuf),
+    /// A recording in degrees from the screen centre (`t_s,x_deg,y_deg,valid`), placed on the
+    /// left eye's view (`trace::import::import_degrees`), imported on open.
+    Degrees(PathBuf),
 }
 
 impl FromStr for GazeSpec {
@@ -38,7 +43,7 @@ impl FromStr for GazeSpec {
         let t = s.trim();
         if t.is_empty() {
             return Err(err(
-                "empty; expected center, X,Y, sim[:seed] or a trace file path",
+                "empty; expected center, X,Y, sim[:seed], gazebase:FILE, degrees:FILE or a trace file path",
             ));
         }
         if t.eq_ignore_ascii_case("center") || t.eq_ignore_ascii_case("centre") {
@@ -60,6 +65,12 @@ impl FromStr for GazeSpec {
                 return Err(err("a file must follow `gazebase:`"));
             }
             return Ok(GazeSpec::GazeBase(PathBuf::from(path)));
+        }
+        if let Some(path) = t.strip_prefix("degrees:") {
+            if path.is_empty() {
+                return Err(err("a file must follow `degrees:`"));
+            }
+            return Ok(GazeSpec::Degrees(PathBuf::from(path)));
         }
         // Something that starts like a number, or two things that parse as numbers (`NaN,5`,
         // `inf,0`), with a comma, is meant as pixel coordinates, never as a trace file name.
@@ -85,7 +96,33 @@ impl FromStr for GazeSpec {
     }
 }
 
+/// Whether `path` starts with the header of a degrees recording (`t_s,x_deg,y_deg,valid`): such
+/// a file given as a plain path is imported as `degrees:` would.
+fn is_degrees_file(path: &Path) -> Result<bool, HalError> {
+    let header = crate::file::read_first_line(path, 256)?;
+    Ok(header.split(',').map(str::trim).eq(DEGREES_COLUMNS))
+}
+
 impl GazeSpec {
+    /// The recorded samples a file spec names (a fovea trace, or a degrees / GazeBase recording
+    /// imported for `hmd`'s left eye); other specs have no recording.
+    pub fn recording(&self, hmd: &HmdDescription) -> Result<Trace, HalError> {
+        match self {
+            GazeSpec::Trace(path) if is_degrees_file(path)? => {
+                import::import_degrees(path, &hmd.eye(Eye::Left).fov)
+            }
+            GazeSpec::Trace(path) => Trace::load(path),
+            GazeSpec::GazeBase(path) => {
+                import::import_gazebase(path, &import::DegreesImport::default())
+            }
+            GazeSpec::Degrees(path) => import::import_degrees(path, &hmd.eye(Eye::Left).fov),
+            other => Err(HalError::GazeSpec {
+                input: format!("{other:?}"),
+                reason: "not a recording: name a trace file, degrees:FILE or gazebase:FILE".into(),
+            }),
+        }
+    }
+
     /// Build the gaze source this spec names for a headset.
     pub fn open(&self, hmd: HmdDescription) -> Result<Box<dyn GazeSource>, HalError> {
         Ok(match self {
@@ -111,14 +148,15 @@ impl GazeSpec {
             GazeSpec::Simulated { seed } => {
                 Box::new(SimulatedFove::new(hmd, SimConfig::seeded(*seed))?)
             }
-            GazeSpec::Trace(path) => Box::new(Playback::open(path, hmd)?),
-            GazeSpec::GazeBase(path) => {
-                let trace = crate::trace::import::import_gazebase(
-                    path,
-                    &crate::trace::import::DegreesImport::default(),
-                )?;
-                // Dataset times start anywhere: frame 0 shows the first sample.
-                Box::new(Playback::new(trace, hmd).aligned_to_first_frame())
+            GazeSpec::Trace(_) | GazeSpec::GazeBase(_) | GazeSpec::Degrees(_) => {
+                let trace = self.recording(&hmd)?;
+                let playback = Playback::new(trace, hmd);
+                Box::new(match self {
+                    // fovea traces keep their clock (a recording of a session replays on it).
+                    GazeSpec::Trace(path) if !is_degrees_file(path)? => playback,
+                    // Dataset times start anywhere: frame 0 shows the first sample.
+                    _ => playback.aligned_to_first_frame(),
+                })
             }
         })
     }

@@ -38,6 +38,21 @@ pub const MAX_BVH8_STACK: u32 = compressed::STACK_SIZE as u32;
 /// Must match BVH8_TOP_STACK_SIZE in shaders/common/bvh.glsl (its instance level's stack).
 pub const MAX_TOP_STACK_GPU: u32 = 32;
 
+/// The scene's bindings by their GLSL names (`GpuScene::binds`); a kernel binds those it reads.
+#[derive(Clone, Copy)]
+pub struct SceneBinds<'a> {
+    pub bvh_nodes: Bind<'a>,
+    pub bvh_triangles: Bind<'a>,
+    pub vertices: Bind<'a>,
+    pub triangles: Bind<'a>,
+    pub materials: Bind<'a>,
+    pub textures: Bind<'a>,
+    pub texels: Bind<'a>,
+    pub lights: Bind<'a>,
+    pub environment: Bind<'a>,
+    pub instances: Bind<'a>,
+}
+
 pub struct GpuScene {
     /// The traversal whose tree layout the BVH buffers hold (kernels of the other cannot bind it).
     pub traversal: Traversal,
@@ -238,8 +253,8 @@ impl GpuScene {
 
     /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only);
     /// the BVH's by the names of this upload's traversal, so a kernel of the other one refuses it.
-    pub fn binds(&self) -> [Bind<'_>; 10] {
-        let (nodes, triangles) = match self.traversal {
+    pub fn binds(&self) -> SceneBinds<'_> {
+        let (bvh_nodes, bvh_triangles) = match self.traversal {
             Traversal::CpuDriver => (
                 read_texels("bvh_nodes", &self.bvh_nodes),
                 read_texels("bvh_triangles", &self.bvh_triangles),
@@ -249,18 +264,18 @@ impl GpuScene {
                 read_buffer("bvh8_triangles", &self.bvh_triangles),
             ),
         };
-        [
-            nodes,
-            triangles,
-            read_buffer("vertices", &self.vertices),
-            read_buffer("triangles", &self.triangles),
-            read_buffer("materials", &self.materials),
-            read_buffer("textures", &self.textures),
-            read_buffer("texels", &self.texels),
-            read_buffer("lights", &self.lights),
-            read_buffer("environment", &self.environment.buffer),
-            read_buffer("instances", &self.instances),
-        ]
+        SceneBinds {
+            bvh_nodes,
+            bvh_triangles,
+            vertices: read_buffer("vertices", &self.vertices),
+            triangles: read_buffer("triangles", &self.triangles),
+            materials: read_buffer("materials", &self.materials),
+            textures: read_buffer("textures", &self.textures),
+            texels: read_buffer("texels", &self.texels),
+            lights: read_buffer("lights", &self.lights),
+            environment: read_buffer("environment", &self.environment.buffer),
+            instances: read_buffer("instances", &self.instances),
+        }
     }
 
     /// Centre and radius of the scene's bounding sphere.

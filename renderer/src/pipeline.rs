@@ -1,8 +1,13 @@
 //! Composes a frame: sampling space → trace → denoiser (optional, in the sampling grid) → screen
-//! image (Visual-Polar: φ-mips, remap, foveated blur) → tonemap → read-back.
+//! image (Visual-Polar: φ-mips, remap, foveated blur) for every view → one exposure metered over
+//! all views → tonemap → read-back.
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
+use crate::frame::{
+    CameraPose, EnvironmentSampling, FrameInput, FrameStats, FrameTarget, OffscreenSamples,
+    RenderSettings, StereoNoise, TextureLod, ViewInput, MAX_VIEWS,
+};
 use crate::frames::FrameRing;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
@@ -11,281 +16,33 @@ use crate::layouts::{
     FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD,
 };
 use crate::passes::accumulate::AccumulatePass;
-use crate::passes::denoise::taa::{Taa, TaaMode};
-use crate::passes::denoise::taa_screen::ScreenTaaFrame;
-use crate::passes::denoise::{DenoiseFrame, DenoiseScene, Denoiser, DenoiserSettings};
-use crate::passes::splat::SplatInputs;
-use crate::passes::tonemap::{LdrTarget, ToneCurve, ToneTarget, TonemapPass};
-use crate::passes::trace::TileList;
+use crate::passes::denoise::Denoiser;
+use crate::passes::exposure::{Exposure, ExposurePass};
+use crate::passes::grid::{GridFrame, TileList};
+use crate::passes::taa::Taa;
+use crate::passes::tonemap::{LdrTarget, ToneTarget, TonemapPass};
 use crate::sampling::SamplingSpace;
-use crate::scene::{Camera, Scene};
-use crate::to_screen::{BlurSettings, ScreenOut};
-use crate::view::{BackPasses, View};
+use crate::scene::Scene;
+use crate::view::View;
 use crate::vk::{Buffer, Context, Image};
+use crate::way_back::{ScreenOut, WayBackFrame};
 use ash::vk;
-use glam::{Mat4, UVec2, UVec4, Vec2, Vec4};
+use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
 
-/// The real-time path: primary ray, one indirect bounce, next-event estimation at both hits.
-pub const REALTIME_MAX_DEPTH: u32 = 3;
 /// Passes one reference submission may hold (trace + accumulate per sample).
 const REFERENCE_SAMPLES_PER_SUBMIT: u32 = 8;
 
-/// A pinhole camera: rigid pose and the tangents of its four half-angles (left/down negative).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraPose {
-    pub world_from_view: Mat4,
-    pub fov_tan: Vec4,
-}
-
-impl CameraPose {
-    /// A glTF camera fitted to an output size: `yfov` is kept and the horizontal extent follows
-    /// the output's aspect ratio, so pixels stay square.
-    pub fn from_scene_camera(camera: &Camera, width: u32, height: u32) -> CameraPose {
-        let ty = (camera.yfov * 0.5).tan();
-        let tx = ty * width as f32 / height as f32;
-        CameraPose {
-            world_from_view: camera.world_from_view,
-            fov_tan: Vec4::new(-tx, tx, -ty, ty),
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct RenderSettings {
-    pub max_depth: u32,
-    pub seed: u32,
-    pub exposure: f32,
-    pub tone_curve: ToneCurve,
-    /// Foveated blur after the remap (Visual-Polar only).
-    pub blur: BlurSettings,
-    /// Denoiser between the tracer and the screen (fixed for the renderer's life: it owns state).
-    pub denoiser: DenoiserSettings,
-    /// TAA after the denoiser (fixed for the renderer's life, like the denoiser); when on, the
-    /// tracer jitters by its Halton sequence instead of the RNG.
-    pub taa: TaaMode,
-    /// How the views' (eyes') random sequences relate.
-    pub stereo_noise: StereoNoise,
-    /// Texture filtering of frames (references always read level 0: point samples converge to
-    /// the box-filtered pixel).
-    pub texture_lod: TextureLod,
-    /// How the environment map is found: next-event estimation with MIS (the default), or by
-    /// BRDF-sampled rays alone (the comparison the importance-sampling tests measure against).
-    pub environment_sampling: EnvironmentSampling,
-    /// Path regularisation strength (shaders/common/path.glsl, `regularise`): after a scattering
-    /// bounce of low pdf, later vertices are roughened so that light a near-specular lobe would
-    /// focus (sunlight through a diffuse-then-glossy path: fireflies) is spread out. Biased, like
-    /// every such filter; 0 turns it off (the unbiased estimator), 1 is the default.
-    pub path_regularisation: f32,
-    /// Whether samples far off the screen are traced (only the paper's Visual-Polar layout, the
-    /// log-polar and composite buffers and random acuity place any there).
-    pub offscreen_samples: OffscreenSamples,
-}
-
-/// `RenderSettings::environment_sampling`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum EnvironmentSampling {
-    /// Light selection picks the environment like any light, and BRDF rays that escape to it
-    /// are weighed against that sample (power heuristic).
-    #[default]
-    ImportanceMis,
-    /// Only escaping BRDF rays count it (a selected environment sample contributes nothing).
-    BrdfOnly,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            max_depth: REALTIME_MAX_DEPTH,
-            seed: 1,
-            exposure: 1.0,
-            tone_curve: ToneCurve::Aces,
-            blur: BlurSettings::default(),
-            denoiser: DenoiserSettings::None,
-            taa: TaaMode::Off,
-            stereo_noise: StereoNoise::default(),
-            environment_sampling: EnvironmentSampling::default(),
-            texture_lod: TextureLod::default(),
-            path_regularisation: DEFAULT_PATH_REGULARISATION,
-            offscreen_samples: OffscreenSamples::default(),
-        }
-    }
-}
-
-/// `RenderSettings::path_regularisation` unless the user sets it.
-pub const DEFAULT_PATH_REGULARISATION: f32 = 1.0;
-
-/// What the tracer does with a sample whose screen position lies off the screen
-/// (`RenderSettings::offscreen_samples`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum OffscreenSamples {
-    /// Samples farther off the screen than the way back and the filters read (three footprints
-    /// and three pixels, trace.comp) hold no sample, like clipped texels: the picture is the
-    /// same, the paper layout's off-screen work is not done (`FrameStats::samples_culled`).
-    #[default]
-    Cull,
-    /// Every sample is traced, as in the paper (Koskela et al. 2019).
-    Trace,
-}
-
-impl OffscreenSamples {
-    pub const NAMES: &'static str = "cull, trace";
-
-    pub fn parse(name: &str) -> Result<OffscreenSamples> {
-        match name {
-            "cull" => Ok(OffscreenSamples::Cull),
-            "trace" => Ok(OffscreenSamples::Trace),
-            other => Err(Error::Invalid(format!(
-                "off-screen samples '{other}' is not one of {}",
-                Self::NAMES
-            ))),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            OffscreenSamples::Cull => "cull",
-            OffscreenSamples::Trace => "trace",
-        }
-    }
-}
-
-/// How texture lookups choose a mip level (`RenderSettings::texture_lod`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum TextureLod {
-    /// Ray cones (Akenine-Möller et al. 2019): each sample's footprint on the screen sets the
-    /// primary spread, so sparse periphery samples read coarser mips instead of aliasing.
-    #[default]
-    RayCones,
-    /// Every lookup reads level 0 (bilinear point sampling).
-    Off,
-}
-
-impl TextureLod {
-    pub const NAMES: &'static str = "cones, off";
-
-    pub fn parse(name: &str) -> Result<TextureLod> {
-        match name {
-            "cones" => Ok(TextureLod::RayCones),
-            "off" => Ok(TextureLod::Off),
-            other => Err(Error::Invalid(format!(
-                "texture LOD '{other}' is not one of {}",
-                Self::NAMES
-            ))),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            TextureLod::RayCones => "cones",
-            TextureLod::Off => "off",
-        }
-    }
-}
-
-/// How the two eyes' 1-spp noise relates (`RenderSettings::stereo_noise`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum StereoNoise {
-    /// Each view gets its own random sequence (the view index salts the seed).
-    #[default]
-    Independent,
-    /// Every view uses the same seed: texel (x, y) of both eyes draws the same random numbers.
-    Shared,
-}
-
-/// The most views one frame renders (two eyes).
-pub const MAX_VIEWS: usize = 2;
-
-/// One view's input: its camera (pose and asymmetric FOV tangents) and gaze.
-#[derive(Clone, Copy, Debug)]
-pub struct ViewInput {
-    pub camera: CameraPose,
-    /// Gaze point in the view's screen pixels; `None` keeps the space's current gaze.
-    pub gaze: Option<Vec2>,
-}
-
-/// One frame of every view (fixed capacity: building it allocates nothing).
-#[derive(Clone, Copy, Debug)]
-pub struct FrameInput {
-    views: [ViewInput; MAX_VIEWS],
-    view_count: usize,
-    pub frame_index: u32,
-    /// Also copy the linear screen image back (EXR output).
-    pub read_hdr: bool,
-    /// Also tonemap the sampling-grid image and copy it back (`read_grid_ldr`; debug views).
-    pub read_grid: bool,
-}
-
-impl FrameInput {
-    /// A frame of one view.
-    pub fn mono(camera: CameraPose, frame_index: u32, gaze: Option<Vec2>) -> FrameInput {
-        FrameInput::views(&[ViewInput { camera, gaze }], frame_index).expect("one view fits")
-    }
-
-    /// A frame of `views.len()` ≤ MAX_VIEWS views, in the renderer's view order.
-    pub fn views(views: &[ViewInput], frame_index: u32) -> Result<FrameInput> {
-        if views.is_empty() || views.len() > MAX_VIEWS {
-            return Err(Error::Invalid(format!(
-                "a frame has 1 to {MAX_VIEWS} views, not {}",
-                views.len()
-            )));
-        }
-        let mut all = [views[0]; MAX_VIEWS];
-        all[..views.len()].copy_from_slice(views);
-        Ok(FrameInput {
-            views: all,
-            view_count: views.len(),
-            frame_index,
-            read_hdr: false,
-            read_grid: false,
-        })
-    }
-
-    pub fn with_hdr(mut self, read_hdr: bool) -> FrameInput {
-        self.read_hdr = read_hdr;
-        self
-    }
-
-    pub fn with_grid(mut self, read_grid: bool) -> FrameInput {
-        self.read_grid = read_grid;
-        self
-    }
-
-    pub fn view_inputs(&self) -> &[ViewInput] {
-        &self.views[..self.view_count]
-    }
-}
-
-/// An image the engine does not own that the frame's final pass writes (a swapchain image), with
-/// the semaphores the submission waits on and signals.
+/// What one view's frame uniforms (`FrameData`) are made from besides the scene and settings.
 #[derive(Clone, Copy)]
-pub struct FrameTarget<'a> {
-    pub image: &'a ExternalImage,
-    /// Top-left pixel of each view in the image (stereo side by side).
-    pub offsets: [UVec2; MAX_VIEWS],
-    pub sync: SubmitSync<'a>,
-    /// Copy the finished image here before it is released (screenshots).
-    pub copy_to: Option<&'a Buffer>,
-}
-
-/// Exact counts for one frame (from the GPU's own counters).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct FrameStats {
-    pub samples_traced: u64,
-    pub primary_rays: u64,
-    pub shadow_rays: u64,
-    pub continuation_rays: u64,
-    /// Traced samples whose screen position lies off the screen (Visual-Polar covers the r_max
-    /// circle; always 0 for Cartesian).
-    pub samples_offscreen: u64,
-    /// Samples not traced because they lay far off the screen (`OffscreenSamples::Cull`).
-    pub samples_culled: u64,
-}
-
-impl FrameStats {
-    pub fn rays_traced(&self) -> u64 {
-        self.primary_rays + self.shadow_rays + self.continuation_rays
-    }
+struct FrameUniforms {
+    camera: CameraPose,
+    index: u32,
+    max_depth: u32,
+    /// `FRAME_FLAG_*`.
+    flags: u32,
+    /// The TAA jitter inside the texel (zero without TAA).
+    jitter: Vec2,
 }
 
 /// The real-time engine: one scene upload and one set of pipelines shared by every view, each
@@ -299,6 +56,7 @@ pub struct Renderer {
     ring: FrameRing,
     accumulate: AccumulatePass,
     tonemap: TonemapPass,
+    exposure: ExposurePass,
     /// The newest frame whose results were collected (`render_frame`, `wait_frame`).
     last_waited: Option<u64>,
 }
@@ -350,8 +108,9 @@ impl Renderer {
         let views = build_views(ctx, spaces, &settings, frames_in_flight)?;
         let ring = FrameRing::new(ctx, frames_in_flight, max_passes(&views))?;
         Ok(Renderer {
-            accumulate: AccumulatePass::new(ctx)?,
+            accumulate: AccumulatePass::single(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
+            exposure: ExposurePass::new(ctx, frames_in_flight)?,
             ctx: ctx.clone(),
             scene,
             settings,
@@ -429,7 +188,7 @@ impl Renderer {
     }
 
     /// The first view's denoiser and its state, when `settings.denoiser` names one.
-    pub fn denoiser(&self) -> Option<&Denoiser> {
+    pub fn denoiser(&self) -> Option<&dyn Denoiser> {
         self.views[0].denoiser()
     }
 
@@ -456,20 +215,18 @@ impl Renderer {
         self.views[0].taa_history_bytes()
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn write_frame_data(
-        &self,
-        view: usize,
-        slot: usize,
-        camera: &CameraPose,
-        frame_index: u32,
-        max_depth: u32,
-        flags: u32,
-        jitter: Vec2,
-    ) -> Result<()> {
+    /// Writes `frame`'s uniforms into view `view`'s buffer of `slot`.
+    fn write_frame_data(&self, view: usize, slot: usize, frame: &FrameUniforms) -> Result<()> {
+        let FrameUniforms {
+            camera,
+            index: frame_index,
+            max_depth,
+            flags,
+            jitter,
+        } = *frame;
         let v = &self.views[view];
         let screen = v.space.screen_size().as_vec2();
-        let prev = v.prev_camera.unwrap_or(*camera);
+        let prev = v.prev_camera.unwrap_or(camera);
         let seed = match self.settings.stereo_noise {
             StereoNoise::Independent => {
                 self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9)
@@ -562,20 +319,41 @@ impl Renderer {
         if let Some(t) = target {
             rec.acquire_external(t.image);
         }
-        for (v, view_input) in inputs.iter().enumerate() {
+        let shared = FrameShared {
+            scene: &self.scene,
+            tonemap: &self.tonemap,
+            accumulate: &self.accumulate,
+            exposure: &self.exposure,
+            settings: &self.settings,
+            input,
+        };
+        // Every view's screen radiance first, then one exposure metered over all of them (both
+        // eyes share it), then every view's display image.
+        let mut screens = Vec::with_capacity(inputs.len());
+        for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
+            rec.set_view(v as u32);
+            screens.push(record_view(rec, view, slot, &shared, view_input)?);
+        }
+        if let Exposure::Auto(auto) = &self.settings.exposure {
+            for (v, screen) in screens.iter().enumerate() {
+                rec.set_view(v as u32);
+                let metered = screen.screen.metered();
+                self.exposure.record_meter(
+                    rec,
+                    auto,
+                    metered,
+                    screen.gaze,
+                    screen.pixels_per_degree,
+                )?;
+            }
+        }
+        rec.set_view(0);
+        self.exposure
+            .record_adapt(rec, &self.settings.exposure, input.frame_seconds, slot)?;
+        for (v, screen) in screens.into_iter().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
-            record_view(
-                rec,
-                &mut self.views[v],
-                slot,
-                &self.scene,
-                (&self.tonemap, &self.accumulate),
-                &self.settings,
-                view_input,
-                input,
-                external,
-            )?;
+            record_display(rec, screen, &shared, external)?;
         }
         let sync = match target {
             Some(t) => {
@@ -626,15 +404,14 @@ impl Renderer {
         } else {
             0
         };
-        self.write_frame_data(
-            v,
-            slot,
-            &view_input.camera,
-            input.frame_index,
-            self.settings.max_depth,
+        let uniforms = FrameUniforms {
+            camera: view_input.camera,
+            index: input.frame_index,
+            max_depth: self.settings.max_depth,
             flags,
-            jitter.unwrap_or(Vec2::ZERO),
-        )?;
+            jitter: jitter.unwrap_or(Vec2::ZERO),
+        };
+        self.write_frame_data(v, slot, &uniforms)?;
         let view = &mut self.views[v];
         view.ensure_readbacks(&self.ctx, slot, input.read_hdr, input.read_grid)?;
         let s = &view.slots[slot];
@@ -672,6 +449,11 @@ impl Renderer {
             .last_waited
             .ok_or_else(|| Error::Invalid("no frame has completed yet".into()))?;
         self.readable_slot(frame)
+    }
+
+    /// The exposure multiplier a completed frame was displayed with (every view shares it).
+    pub fn frame_exposure(&self, frame: u64) -> Result<f32> {
+        self.exposure.read_slot(self.readable_slot(frame)?)
     }
 
     /// Exact counts of one view of a completed frame (from the GPU's own counters).
@@ -776,15 +558,14 @@ impl Renderer {
             } else {
                 0
             };
-            self.write_frame_data(
-                0,
-                slot,
-                camera,
-                0,
+            let uniforms = FrameUniforms {
+                camera: *camera,
+                index: 0,
                 max_depth,
-                FRAME_FLAG_REFERENCE | alpha,
-                Vec2::ZERO,
-            )?;
+                flags: FRAME_FLAG_REFERENCE | alpha,
+                jitter: Vec2::ZERO,
+            };
+            self.write_frame_data(0, slot, &uniforms)?;
             self.views[0].slots[slot]
                 .sampling
                 .write(&[self.views[0].space.params()])?;
@@ -792,20 +573,20 @@ impl Renderer {
             let (_, rec) = self.ring.begin_next()?;
             let view = &self.views[0];
             let (s, accum) = (&view.slots[slot], view.accum.as_ref().expect("made above"));
-            let tiles = TileList::new(&s.trace_tiles, &view.tiles);
+            let frame = GridFrame {
+                gbuffer: &view.gbuffer,
+                frame_data: &s.frame_data,
+                sampling: &s.sampling,
+                current: view.space.params(),
+                previous: None,
+                sampling_table: &s.sampling_table,
+                tiles: TileList::new(&s.trace_tiles, &view.tiles),
+                camera_origin: camera.world_from_view.w_axis.truncate(),
+                materials: &self.scene.materials,
+            };
             for i in done..done + batch {
-                view.trace.record(
-                    rec,
-                    &self.scene,
-                    &s.frame_data,
-                    &s.sampling,
-                    &s.sampling_table,
-                    &s.ray_counters,
-                    &view.gbuffer,
-                    &tiles,
-                    i,
-                    None,
-                )?;
+                view.trace
+                    .record(rec, &frame, &self.scene, &s.ray_counters, i, None)?;
                 self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {
@@ -850,7 +631,8 @@ fn build_views(
 
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
 fn max_passes(views: &[View]) -> u32 {
-    let frame: u32 = views.iter().map(View::max_passes).sum();
+    // Each view's passes and its exposure meter, and the frame's one exposure adaptation.
+    let frame: u32 = views.iter().map(|v| v.max_passes() + 1).sum::<u32>() + 1;
     // A reference batch: trace and accumulate per sample, the idle tiles' clear, the copy.
     frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 2) + 2
 }
@@ -869,67 +651,87 @@ fn read_optional<T: bytemuck::Pod>(
     b.read_into(out)
 }
 
-/// Records one view's frame: trace → denoiser → TAA → the way back to the screen → tonemap into
-/// the view's own LDR image (read back into the slot) or into `external` at its offset.
-#[allow(clippy::too_many_arguments)]
-fn record_view(
+/// What every view of one frame records with: the scene, the shared passes and settings, and
+/// the frame's input.
+struct FrameShared<'a> {
+    scene: &'a GpuScene,
+    tonemap: &'a TonemapPass,
+    accumulate: &'a AccumulatePass,
+    exposure: &'a ExposurePass,
+    settings: &'a RenderSettings,
+    input: &'a FrameInput,
+}
+
+/// One view's frame up to its screen radiance, and where its display image and read-backs go.
+struct ViewScreen<'a> {
+    screen: ScreenOut<'a>,
+    /// The sampling grid's radiance (the grid debug view tone-maps it).
+    grid_hdr: &'a Image,
+    view: ViewTargets<'a>,
+    /// The gaze (pixels) and the pixels per degree at the view's centre, for the exposure meter.
+    gaze: Vec2,
+    pixels_per_degree: f32,
+}
+
+/// A view's own display images and this slot's read-back buffers.
+struct ViewTargets<'a> {
+    ldr: &'a Image,
+    grid_ldr: &'a Image,
+    ldr_readback: &'a Buffer,
+    hdr_readback: Option<&'a Buffer>,
+    grid_readback: Option<&'a Buffer>,
+}
+
+/// Pixels per degree at the centre of a view `width` pixels wide through `camera`'s frustum.
+fn pixels_per_degree(camera: &CameraPose, width: u32) -> f32 {
+    let span = camera.fov_tan.y.atan() - camera.fov_tan.x.atan();
+    width as f32 / span.to_degrees().max(1e-3)
+}
+
+/// Records one view's frame up to its screen radiance: trace → denoiser → TAA → the way back to
+/// the screen (a pending foveated blur left to `record_display`).
+fn record_view<'a>(
     rec: &mut FrameRecorder,
-    view: &mut View,
+    view: &'a mut View,
     slot: usize,
-    scene: &GpuScene,
-    (tonemap, accumulate): (&TonemapPass, &AccumulatePass),
-    settings: &RenderSettings,
+    shared: &FrameShared<'a>,
     view_input: &ViewInput,
-    input: &FrameInput,
-    external: Option<(&ExternalImage, UVec2)>,
-) -> Result<()> {
-    let space = view.space.params();
+) -> Result<ViewScreen<'a>> {
+    let FrameShared {
+        scene,
+        accumulate,
+        settings,
+        input,
+        ..
+    } = *shared;
     let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
     let s = &view.slots[slot];
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
-    let tiles = TileList::new(&s.trace_tiles, &view.tiles);
-    let denoise_frame = DenoiseFrame {
-        current: space,
+    let frame = GridFrame {
+        gbuffer: &view.gbuffer,
+        frame_data: &s.frame_data,
+        sampling: &s.sampling,
+        current: view.space.params(),
         previous: view.prev_sampling,
         sampling_table: &s.sampling_table,
-        tiles,
+        tiles: TileList::new(&s.trace_tiles, &view.tiles),
+        camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
+        materials: &scene.materials,
     };
     if let Some(d) = &mut view.denoiser {
-        d.record_before_trace(rec, &view.gbuffer, &denoise_frame, &s.frame_data)?;
+        d.record_before_trace(rec, &frame)?;
     }
     let gradients = view.denoiser.as_ref().and_then(|d| d.gradient_targets());
     let trace = view.trace_gradients.as_ref().unwrap_or(&view.trace);
-    trace.record(
-        rec,
-        scene,
-        &s.frame_data,
-        &s.sampling,
-        &s.sampling_table,
-        &s.ray_counters,
-        &view.gbuffer,
-        &tiles,
-        0,
-        gradients,
-    )?;
+    trace.record(rec, &frame, scene, &s.ray_counters, 0, gradients)?;
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
     let traced = match &view.sample_mean {
         Some(mean) => {
             accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
             for k in 1..view.space.samples_per_texel() {
-                trace.record(
-                    rec,
-                    scene,
-                    &s.frame_data,
-                    &s.sampling,
-                    &s.sampling_table,
-                    &s.ray_counters,
-                    &view.gbuffer,
-                    &tiles,
-                    k,
-                    None,
-                )?;
+                trace.record(rec, &frame, scene, &s.ray_counters, k, None)?;
                 accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
             }
             mean
@@ -937,88 +739,87 @@ fn record_view(
         None => &view.gbuffer.color,
     };
     let denoised = match &mut view.denoiser {
-        Some(d) => {
-            let scene = DenoiseScene {
-                camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
-                materials: &scene.materials,
-            };
-            d.record(rec, &view.gbuffer, &denoise_frame, &scene)?
-        }
+        Some(d) => d.record(rec, &frame)?,
         None => traced,
     };
     let grid_hdr = match (&mut view.taa, jitter) {
-        (Some(taa), Some(jitter)) => {
-            taa.record(rec, &view.gbuffer, denoised, &denoise_frame, jitter)?
-        }
+        (Some(taa), Some(jitter)) => taa.record(rec, denoised, &frame, jitter)?,
         _ => denoised,
     };
-    let screen_taa = jitter.map(|jitter| ScreenTaaFrame {
-        frame_data: &s.frame_data,
-        gbuffer: &view.gbuffer,
-        space: &denoise_frame.current,
-        columns: &s.sampling_table,
-        has_previous: denoise_frame.previous.is_some(),
-        jitter,
-    });
+    let screen = view.back.record(
+        rec,
+        &WayBackFrame {
+            space: view.space.as_ref(),
+            grid: frame,
+            radiance: grid_hdr,
+            blur: &settings.blur,
+            jitter,
+        },
+    )?;
+    Ok(ViewScreen {
+        screen,
+        grid_hdr,
+        view: ViewTargets {
+            ldr: &view.ldr,
+            grid_ldr: &view.grid_ldr,
+            ldr_readback: &s.ldr_readback,
+            hdr_readback: s.hdr_readback.as_ref(),
+            grid_readback: s.grid_readback.as_ref(),
+        },
+        gaze: view.space.gaze(),
+        pixels_per_degree: pixels_per_degree(&view_input.camera, view.space.screen_size().x),
+    })
+}
+
+/// Records one view's display image with the frame's exposure: the tonemap (or the pending
+/// blur's last axis) into the view's own LDR image (read back into the slot) or into `external`
+/// at its offset.
+fn record_display(
+    rec: &mut FrameRecorder,
+    screen: ViewScreen,
+    shared: &FrameShared,
+    external: Option<(&ExternalImage, UVec2)>,
+) -> Result<()> {
+    let ViewScreen {
+        screen,
+        grid_hdr,
+        view,
+        ..
+    } = screen;
     let display = ToneTarget {
         ldr: match external {
             Some((image, offset)) => LdrTarget::External { image, offset },
-            None => LdrTarget::Own(&view.ldr),
+            None => LdrTarget::Own(view.ldr),
         },
-        exposure: settings.exposure,
-        curve: settings.tone_curve,
+        exposure: shared.exposure.state(),
+        curve: shared.settings.tone_curve,
     };
-    // Unless the frame's radiance is read back, the remap's blur writes the display image itself
-    // (one full-screen pass fewer).
-    let fused = (!input.read_hdr).then_some(display);
-    let screen = match (&mut view.back, view.space.visual_polar()) {
-        (BackPasses::Remap(to_screen), Some(vp)) => to_screen.record(
-            rec,
-            vp,
-            &s.sampling_table,
-            grid_hdr,
-            &settings.blur,
-            screen_taa.as_ref(),
-            fused,
-        )?,
-        (BackPasses::Upscale(upscale, screen), _) => {
-            upscale.record(rec, grid_hdr, screen)?;
-            ScreenOut::Radiance(screen)
-        }
-        (BackPasses::Fill(fill), _) => {
-            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), grid_hdr, &settings.blur)?)
-        }
-        (BackPasses::BlockFill(fill, screen), _) => {
-            fill.record(rec, &s.sampling, grid_hdr, screen)?;
-            ScreenOut::Radiance(screen)
-        }
-        (BackPasses::Splat(splat, fill), _) => {
-            let inputs = SplatInputs {
-                frame_data: &s.frame_data,
-                sampling: &s.sampling,
-                sampling_table: &s.sampling_table,
-            };
-            let sparse = splat.record(rec, &inputs, grid_hdr)?;
-            ScreenOut::Radiance(fill.record(rec, view.space.as_ref(), sparse, &settings.blur)?)
-        }
-        _ => ScreenOut::Radiance(grid_hdr),
-    };
-    if let ScreenOut::Radiance(screen_hdr) = screen {
-        tonemap.record(rec, "tonemap", screen_hdr, &display)?;
-        if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {
-            rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+    match (screen, shared.input.read_hdr) {
+        // Unless the frame's radiance is read back, the blur writes the display image itself
+        // (one full-screen pass fewer).
+        (ScreenOut::Unblurred(pending), false) => pending.display(rec, display)?,
+        (screen, read_hdr) => {
+            let screen_hdr = screen.into_radiance(rec)?;
+            shared
+                .tonemap
+                .record(rec, "tonemap", screen_hdr, &display)?;
+            if let (true, Some(b)) = (read_hdr, view.hdr_readback) {
+                rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+            }
         }
     }
     if external.is_none() {
-        rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
+        rec.copy_image_to_buffer("readback", view.ldr, view.ldr_readback)?;
     }
-    if let (true, Some(b)) = (input.read_grid, &s.grid_readback) {
+    if let (true, Some(b)) = (shared.input.read_grid, view.grid_readback) {
         let grid_target = ToneTarget {
-            ldr: LdrTarget::Own(&view.grid_ldr),
+            ldr: LdrTarget::Own(view.grid_ldr),
             ..display
         };
-        tonemap.record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
-        rec.copy_image_to_buffer("readback_grid", &view.grid_ldr, b)?;
+        shared
+            .tonemap
+            .record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
+        rec.copy_image_to_buffer("readback_grid", view.grid_ldr, b)?;
     }
     Ok(())
 }

@@ -4,19 +4,15 @@
 //! reads (uniforms, counters, read-backs). The scene and the pipelines are shared by all views.
 
 use crate::error::{Error, Result};
-use crate::fill_to_screen::FillToScreen;
+use crate::frame::{CameraPose, FrameStats, RenderSettings};
 use crate::layouts::{FrameData, SamplingParams};
-use crate::passes::block_fill::BlockFillPass;
-use crate::passes::blur_grid::GridBlurPass;
-use crate::passes::denoise::taa::{Taa, TaaMode};
 use crate::passes::denoise::{Denoiser, DenoiserSettings};
-use crate::passes::splat::SplatPass;
-use crate::passes::trace::{GBuffer, TracePass, RAY_COUNTERS};
-use crate::passes::upscale::UpscalePass;
-use crate::pipeline::{CameraPose, FrameStats, RenderSettings};
+use crate::passes::grid::GBuffer;
+use crate::passes::taa::{Taa, TaaMode};
+use crate::passes::trace::{TracePass, RAY_COUNTERS};
 use crate::sampling::{tile_count, SamplingSpace, TraceTiles, WayBack};
-use crate::to_screen::{BlurSpace, ToScreen};
 use crate::vk::{Buffer, Context, Image};
+use crate::way_back::{self, WayBackPasses};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
@@ -94,18 +90,6 @@ impl ViewSlot {
     }
 }
 
-/// Where this view's foveated blur runs: the grid only where the space's grid can take it
-/// (`GridBlurPass::supports`, fixed for a view), the screen otherwise, so the grid blur's images
-/// are made only for a view that uses them.
-fn blur_space(asked: BlurSpace, space: &dyn SamplingSpace) -> BlurSpace {
-    match asked {
-        BlurSpace::Grid if !space.visual_polar().is_some_and(GridBlurPass::supports) => {
-            BlurSpace::Screen
-        }
-        other => other,
-    }
-}
-
 pub(crate) fn readback(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Buffer> {
     Buffer::new(
         ctx,
@@ -116,21 +100,6 @@ pub(crate) fn readback(ctx: &Arc<Context>, name: &str, bytes: u64) -> Result<Buf
     )
 }
 
-/// The passes of one `WayBack` (sampling::WayBack), owned by the view.
-// One per view, made once and never moved on a hot path: the variants' sizes do not matter.
-#[allow(clippy::large_enum_variant)]
-pub(crate) enum BackPasses {
-    Direct,
-    Remap(ToScreen),
-    /// The upscale and its screen-sized output.
-    Upscale(UpscalePass, Image),
-    Fill(FillToScreen),
-    /// The splat to a sparse screen image, then the fill's way back.
-    Splat(SplatPass, FillToScreen),
-    /// The block fill and its screen-sized output.
-    BlockFill(BlockFillPass, Image),
-}
-
 pub struct View {
     pub space: Box<dyn SamplingSpace>,
     pub gbuffer: GBuffer,
@@ -139,14 +108,14 @@ pub struct View {
     /// (references keep `trace`).
     pub(crate) trace_gradients: Option<TracePass>,
     /// The passes of the space's way back to the screen.
-    pub(crate) back: BackPasses,
+    pub(crate) back: Box<dyn WayBackPasses>,
     /// Each texel's mean over the frame's samples, for spaces that trace several per texel.
     pub(crate) sample_mean: Option<Image>,
     pub(crate) ldr: Image,
     pub(crate) grid_ldr: Image,
     /// Reference accumulation target, made by the first `render_reference`.
     pub(crate) accum: Option<Image>,
-    pub(crate) denoiser: Option<Denoiser>,
+    pub(crate) denoiser: Option<Box<dyn Denoiser>>,
     pub(crate) taa: Option<Taa>,
     pub(crate) prev_camera: Option<CameraPose>,
     /// The previous real-time frame's space (its gaze), for the denoiser's reprojection.
@@ -189,42 +158,8 @@ impl View {
             (TaaMode::Screen(s), true) => (None, Some(s)),
             (mode, _) => (mode.settings().copied(), None),
         };
-        let back = match caps.way_back {
-            WayBack::Direct => BackPasses::Direct,
-            WayBack::Remap => BackPasses::Remap(ToScreen::new(
-                ctx,
-                grid,
-                screen,
-                screen_taa,
-                blur_space(settings.blur.space, space.as_ref()),
-            )?),
-            WayBack::Upscale => BackPasses::Upscale(
-                UpscalePass::new(ctx)?,
-                Image::new(
-                    ctx,
-                    "upscaled",
-                    screen.x,
-                    screen.y,
-                    vk::Format::R32G32B32A32_SFLOAT,
-                )?,
-            ),
-            WayBack::Fill => BackPasses::Fill(FillToScreen::new(ctx, screen)?),
-            WayBack::Splat => BackPasses::Splat(
-                SplatPass::new(ctx, space.trace_variant(), screen)?,
-                FillToScreen::new(ctx, screen)?,
-            ),
-            WayBack::BlockFill => BackPasses::BlockFill(
-                BlockFillPass::new(ctx, space.shader_variant())?,
-                Image::new(
-                    ctx,
-                    "block_filled",
-                    screen.x,
-                    screen.y,
-                    vk::Format::R32G32B32A32_SFLOAT,
-                )?,
-            ),
-        };
-        let denoiser = Denoiser::new(ctx, &settings.denoiser, grid, space.shader_variant())?;
+        let back = way_back::build(ctx, space.as_ref(), screen_taa, settings.blur.space)?;
+        let denoiser = settings.denoiser.build(ctx, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
         let trace_gradients = match gradients {
             false => None,
@@ -287,25 +222,17 @@ impl View {
         // 26: the idle tiles' clear is one of them.
         26 + extra_samples
             + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
-            + match &self.back {
-                BackPasses::Fill(f) => f.passes(),
-                BackPasses::Splat(s, f) => s.passes() + f.passes(),
-                _ => 0,
-            }
+            + self.back.extra_passes()
     }
 
     /// GPU bytes of TAA history carried between frames (either mode; 0 when off).
     pub fn taa_history_bytes(&self) -> u64 {
         let grid = self.taa.as_ref().map_or(0, |t| t.history_bytes());
-        let screen = match &self.back {
-            BackPasses::Remap(s) => s.taa.as_ref().map_or(0, |t| t.history_bytes()),
-            _ => 0,
-        };
-        grid + screen
+        grid + self.back.taa_history_bytes()
     }
 
-    pub fn denoiser(&self) -> Option<&Denoiser> {
-        self.denoiser.as_ref()
+    pub fn denoiser(&self) -> Option<&dyn Denoiser> {
+        self.denoiser.as_deref()
     }
 
     pub fn taa(&self) -> Option<&Taa> {

@@ -2,10 +2,12 @@
 //! G-buffer data, masks and metrics.
 
 use ash::vk;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::graph::FrameRecorder;
-use fovea_renderer::passes::denoise::{DenoiseFrame, DenoiserSettings};
-use fovea_renderer::passes::trace::{GBuffer, OwnedTileList};
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::grid::GridFrame;
+use fovea_renderer::passes::grid::{GBuffer, OwnedTileList};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::{Buffer, Context, Image};
 use glam::{UVec2, Vec2};
@@ -306,7 +308,7 @@ impl SeamErrors {
 pub fn denoise_over_culled_tiles(
     ctx: &Arc<Context>,
     frames: u32,
-    mut each: impl FnMut(u32, &Renderer, &DenoiseFrame, &DenoiseFrame),
+    mut each: impl FnMut(u32, &Renderer, &GridFrame, &GridFrame),
 ) {
     let scene = crate::owned_scene("cornell-box");
     let size = UVec2::new(128, 144);
@@ -324,23 +326,21 @@ pub fn denoise_over_culled_tiles(
         r.render_frame(&FrameInput::mono(camera, f, Some(gaze)))
             .unwrap();
         let current = r.space().params();
-        let table = crate::grid_table(ctx, r.space(), None);
+        let buffers = crate::SpaceBuffers::new(ctx, r.space(), f, 1);
         let culled = OwnedTileList::new(ctx, r.space(), true).unwrap();
-        let whole = crate::grid_tiles(ctx, r.space());
+        let whole = &buffers.tiles;
         assert!(
             culled.tiles.idle.len() > whole.tiles.idle.len(),
             "frame {f}: no tile culled, nothing tested"
         );
         idle_seen.push(culled.tiles.idle.clone());
-        let over_culled = DenoiseFrame {
-            current,
-            previous,
-            sampling_table: &table,
-            tiles: culled.list(),
+        let over_every_tile = GridFrame {
+            camera_origin: camera.world_from_view.w_axis.truncate(),
+            ..buffers.grid_frame(&r.view(0).gbuffer, (current, previous), &r.scene.materials)
         };
-        let over_every_tile = DenoiseFrame {
-            tiles: whole.list(),
-            ..over_culled
+        let over_culled = GridFrame {
+            tiles: culled.list(),
+            ..over_every_tile
         };
         each(f, &r, &over_culled, &over_every_tile);
         previous = Some(current);

@@ -46,14 +46,14 @@ pub fn owned_scene(name: &str) -> fovea_scene::Scene {
 /// centred, 39.3° vertical field of view, fitted to `size`. The scene's own camera stands closer
 /// (a viewer's place for a headset's wide view); tests whose thresholds were measured on this
 /// framing, with the box inside a black surround, keep it.
-pub fn cornell_box_far_camera(size: glam::UVec2) -> fovea_renderer::pipeline::CameraPose {
+pub fn cornell_box_far_camera(size: glam::UVec2) -> fovea_renderer::frame::CameraPose {
     let camera = fovea_scene::Camera::look_at(
         glam::Vec3::new(0.0, 0.5, 0.5 + 800.0 / 555.0),
         glam::Vec3::new(0.0, 0.5, 0.0),
         39.3f32.to_radians(),
         "far",
     );
-    fovea_renderer::pipeline::CameraPose::from_scene_camera(&camera, size.x, size.y)
+    fovea_renderer::frame::CameraPose::from_scene_camera(&camera, size.x, size.y)
 }
 
 /// A file of the reference data under `../shared/data`: missing, it fails the test with its path
@@ -179,7 +179,8 @@ pub fn small_render_args<'a>(
         camera_path: fovea_tools::camera_path::CameraMotion::Orbit,
         seed: 1,
         max_depth: 3,
-        exposure: 1.0,
+        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
         profile: Default::default(),
         debug_views: false,
         denoiser: "none",
@@ -196,7 +197,7 @@ pub fn small_render_args<'a>(
 /// the gaze at `gaze`; each frame's HDR screen goes to `check` first.
 pub fn mean_over_frames(
     renderer: &mut fovea_renderer::pipeline::Renderer,
-    camera: fovea_renderer::pipeline::CameraPose,
+    camera: fovea_renderer::frame::CameraPose,
     gaze: Option<glam::Vec2>,
     frames: u32,
     mut check: impl FnMut(u32, &[[f32; 4]]),
@@ -205,9 +206,7 @@ pub fn mean_over_frames(
     let mut hdr = Vec::new();
     for f in 0..frames {
         renderer
-            .render_frame(
-                &fovea_renderer::pipeline::FrameInput::mono(camera, f, gaze).with_hdr(true),
-            )
+            .render_frame(&fovea_renderer::frame::FrameInput::mono(camera, f, gaze).with_hdr(true))
             .unwrap();
         renderer.read_hdr(&mut hdr).unwrap();
         check(f, &hdr);
@@ -250,7 +249,7 @@ pub struct SpaceBuffers {
     pub sampling: Buffer,
     pub table: Buffer,
     /// Every tile holding a sample (`grid_tiles`).
-    pub tiles: fovea_renderer::passes::trace::OwnedTileList,
+    pub tiles: fovea_renderer::passes::grid::OwnedTileList,
 }
 
 impl SpaceBuffers {
@@ -274,6 +273,33 @@ impl SpaceBuffers {
     }
 }
 
+impl SpaceBuffers {
+    /// These buffers' grid frame over `gbuffer`: `current` this frame's space (as `sampling`
+    /// holds it), `previous` the previous frame's (`None`: no history), the camera at the
+    /// origin, the scene's `materials`.
+    pub fn grid_frame<'a>(
+        &'a self,
+        gbuffer: &'a fovea_renderer::passes::grid::GBuffer,
+        (current, previous): (
+            fovea_renderer::layouts::SamplingParams,
+            Option<fovea_renderer::layouts::SamplingParams>,
+        ),
+        materials: &'a Buffer,
+    ) -> fovea_renderer::passes::grid::GridFrame<'a> {
+        fovea_renderer::passes::grid::GridFrame {
+            gbuffer,
+            frame_data: &self.frame,
+            sampling: &self.sampling,
+            current,
+            previous,
+            sampling_table: &self.table,
+            tiles: self.tiles.list(),
+            camera_origin: glam::Vec3::ZERO,
+            materials,
+        }
+    }
+}
+
 /// A view's sampling table as the renderer keeps it: `current`'s, then `previous`'s (`current`'s
 /// again without one) — what the trace and `DenoiseFrame::sampling_table` read.
 pub fn grid_table(
@@ -291,8 +317,8 @@ pub fn grid_table(
 pub fn grid_tiles(
     ctx: &Arc<Context>,
     space: &dyn fovea_renderer::sampling::SamplingSpace,
-) -> fovea_renderer::passes::trace::OwnedTileList {
-    fovea_renderer::passes::trace::OwnedTileList::new(ctx, space, false).unwrap()
+) -> fovea_renderer::passes::grid::OwnedTileList {
+    fovea_renderer::passes::grid::OwnedTileList::new(ctx, space, false).unwrap()
 }
 
 /// One texel as the GPU's space sees it (passes/space_probe): its sample's screen position at
@@ -376,7 +402,7 @@ pub fn assert_refuses_svgf(
 ) {
     use fovea_renderer::passes::denoise::{svgf::SvgfSettings, DenoiserSettings};
     let name = space.name();
-    let svgf = fovea_renderer::pipeline::RenderSettings {
+    let svgf = fovea_renderer::frame::RenderSettings {
         denoiser: DenoiserSettings::Svgf(SvgfSettings::default()),
         ..Default::default()
     };
@@ -393,12 +419,13 @@ pub fn assert_mean_like_cartesian(
     ctx: &Arc<Context>,
     scene: &fovea_scene::Scene,
     renderer: &mut fovea_renderer::pipeline::Renderer,
-    camera: fovea_renderer::pipeline::CameraPose,
+    camera: fovea_renderer::frame::CameraPose,
     gaze: glam::Vec2,
     frames: u32,
     mut check: impl FnMut(u32, &[[f32; 4]]),
 ) {
-    use fovea_renderer::pipeline::{RenderSettings, Renderer};
+    use fovea_renderer::frame::RenderSettings;
+    use fovea_renderer::pipeline::Renderer;
     let name = renderer.space().name();
     let screen = renderer.space().screen_size();
     let a = mean_over_frames(renderer, camera, Some(gaze), frames, &mut check);

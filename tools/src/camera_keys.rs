@@ -13,7 +13,7 @@
 //! ```
 
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::CameraPose;
+use fovea_renderer::frame::CameraPose;
 use fovea_scene::Camera;
 use glam::{Vec3, Vec4};
 use serde::Deserialize;

@@ -5,7 +5,7 @@
 
 use crate::camera_keys::CameraKeys;
 use anyhow::{Context, Result};
-use fovea_renderer::pipeline::CameraPose;
+use fovea_renderer::frame::CameraPose;
 use glam::{Mat4, Vec3};
 use std::path::Path;
 use std::sync::Arc;

@@ -171,10 +171,40 @@ impl SceneFlags {
     }
 }
 
+/// The latency model (hal): with any of these flags each frame is foveated with the gaze a
+/// headset would have and judged also where the eye is when it is shown.
+#[derive(clap::Args)]
+struct LatencyFlags {
+    /// Gaze-to-photon latency in ms: a frame displayed at T sees the tracker samples taken up to
+    /// T − this (default: the headset profile's tracker + render + display latency). Any of
+    /// --latency-ms, --tracker-hz, --gaze-predict turns this latency model on.
+    #[arg(long, allow_hyphen_values = true)]
+    latency_ms: Option<f64>,
+    /// Tracker rate of the latency model in Hz (default: the headset profile's).
+    #[arg(long, allow_hyphen_values = true)]
+    tracker_hz: Option<f64>,
+    /// Gaze prediction at the display time: off (the newest sample) | hold | linear | saccade
+    /// (default saccade, chosen by `fovea gaze-eval`; see docs/guide/gaze-latency.md).
+    #[arg(long)]
+    gaze_predict: Option<String>,
+}
+
+impl LatencyFlags {
+    fn timing(&self) -> Result<fovea_tools::gaze::GazeTiming> {
+        fovea_tools::gaze::GazeTiming::from_flags(
+            self.latency_ms,
+            self.tracker_hz,
+            self.gaze_predict.as_deref(),
+        )
+    }
+}
+
 #[derive(clap::Args)]
 struct RenderOpts {
     #[command(flatten)]
     look: SceneFlags,
+    #[command(flatten)]
+    latency: LatencyFlags,
     /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
@@ -184,8 +214,9 @@ struct RenderOpts {
     /// Headset profile: a name from `fovea headsets` or a TOML path.
     #[arg(long, default_value = "fove0")]
     headset: String,
-    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file
-    /// (render: default sim:1; view: default the mouse).
+    /// Gaze: center | X,Y (render pixels) | sim[:seed] (simulated FOVE 0 eye) | a trace file |
+    /// degrees:FILE (t_s,x_deg,y_deg,valid) | gazebase:FILE (render: default sim:1; view: default
+    /// the mouse).
     #[arg(long)]
     gaze: Option<String>,
     /// Render width (default: the headset's per-eye width × --scale).
@@ -225,9 +256,15 @@ struct RenderOpts {
     /// Path vertices: 1 = emission seen directly, 2 = + direct light, 3 = + one indirect bounce.
     #[arg(long, default_value_t = 3)]
     max_depth: u32,
-    /// Linear exposure multiplier before tonemapping.
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Exposure: auto (metered from each frame's radiance with more weight around the gaze,
+    /// adapted over time like an eye, one exposure for both eyes), auto+EV / auto-EV (metered,
+    /// then compensated by EV stops), or EV (fixed, in stops: 0 displays radiance as it is).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    exposure: String,
+    /// Display transform: neutral (Khronos PBR Neutral: base colours as authored, highlights
+    /// compressed), aces (fitted ACES filmic) or clamp.
+    #[arg(long, default_value = "neutral")]
+    tone: String,
     /// Render profile TOML (Visual-Polar parameters, blur); see config/render/default.toml.
     #[arg(long)]
     profile: Option<PathBuf>,
@@ -311,6 +348,7 @@ impl RenderOpts {
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
+            gaze_timing: self.latency.timing()?,
         })
     }
 }
@@ -556,7 +594,35 @@ enum Command {
         #[command(flatten)]
         look: SceneFlags,
         #[command(flatten)]
+        latency: LatencyFlags,
+        #[command(flatten)]
         device: DeviceArgs,
+    },
+    /// Gaze error at display time without rendering: recordings through the latency model and
+    /// each predictor, every frame against where the eye is when it is shown (median, p95, p99,
+    /// share above 2.5° and 5°, per-saccade landing error) → DIR/gaze_eval.json + a table.
+    GazeEval {
+        /// Recordings: degrees CSVs (t_s,x_deg,y_deg,valid), fovea gaze traces, degrees:FILE or
+        /// gazebase:FILE.
+        #[arg(required = true)]
+        traces: Vec<String>,
+        /// Headset profile (its left eye's view, tracker and latency).
+        #[arg(long, default_value = "fove0")]
+        headset: String,
+        /// Sample-to-photon latency in ms (default: the profile's tracker + render + display).
+        #[arg(long, allow_hyphen_values = true)]
+        latency_ms: Option<f64>,
+        /// Tracker rate in Hz (default: the profile's).
+        #[arg(long, allow_hyphen_values = true)]
+        tracker_hz: Option<f64>,
+        /// Display rate in Hz (default: the profile's refresh).
+        #[arg(long, allow_hyphen_values = true)]
+        display_hz: Option<f64>,
+        /// Predictors, comma-separated: off, hold, linear, saccade (default: all).
+        #[arg(long, value_delimiter = ',')]
+        gaze_predict: Vec<String>,
+        #[arg(long, default_value = "out/gaze-eval")]
+        out: PathBuf,
     },
     /// Write the method table into a Markdown file (between its method-table markers) from a
     /// `fovea quality` folder and a `fovea bench` report, with a picture row and the papers' claims.
@@ -651,7 +717,8 @@ fn render_args<'a>(
         )?,
         seed: opts.seed,
         max_depth: opts.max_depth,
-        exposure: opts.exposure,
+        exposure: commands::setup::parse_exposure(&opts.exposure)?,
+        tone: commands::setup::parse_tone(&opts.tone)?,
         profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
@@ -971,6 +1038,7 @@ fn run() -> Result<()> {
             blur_space,
             out,
             look,
+            latency,
             device,
         } => {
             device.choose_traversal()?;
@@ -985,6 +1053,7 @@ fn run() -> Result<()> {
                 texture_lod: look.texture_lod.clone(),
                 path_regularisation: look.path_regularisation,
                 offscreen_samples: look.offscreen_samples.clone(),
+                gaze_timing: latency.timing()?,
                 ..Default::default()
             })?;
             let all: Vec<String> = DenoiserSettings::NAMES
@@ -1017,6 +1086,23 @@ fn run() -> Result<()> {
                 validation: device.validation,
             })
         }
+        Command::GazeEval {
+            traces,
+            headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            gaze_predict,
+            out,
+        } => commands::gaze_eval::run(&commands::gaze_eval::GazeEvalArgs {
+            traces: &traces,
+            headset: &headset,
+            latency_ms,
+            tracker_hz,
+            display_hz,
+            predict: &gaze_predict,
+            out: &out,
+        }),
         Command::MethodTable {
             quality,
             bench,

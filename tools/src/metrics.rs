@@ -242,6 +242,19 @@ impl Rings {
             .map(|(s, n)| (n > 0).then(|| s / n as f64))
             .collect()
     }
+
+    /// Mean of a per-pixel map over the innermost `inner` rings together (the fovea's pixels),
+    /// skipping NaN entries.
+    pub fn inner_mean(&self, map: &[f64], inner: usize) -> Option<f64> {
+        let (mut s, mut n) = (0.0, 0usize);
+        for (&i, &v) in self.index.iter().zip(map) {
+            if (i as usize) < inner && !v.is_nan() {
+                s += v;
+                n += 1;
+            }
+        }
+        (n > 0).then(|| s / n as f64)
+    }
 }
 
 /// Fireflies of an 8-bit RGBA image (as `tonemap_preview` writes it): pixels whose luma (Rec. 709

@@ -12,7 +12,7 @@
 
 use anyhow::{bail, Result};
 use fovea_hal::{Eye, HmdDescription};
-use fovea_renderer::pipeline::CameraPose;
+use fovea_renderer::frame::CameraPose;
 use fovea_renderer::scene::Camera;
 use glam::{Mat4, Vec4};
 

@@ -1,6 +1,8 @@
-//! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur and
-//! the SVGF, A-SVGF and BMFR parameters (used with `--denoiser svgf` / `asvgf` / `bmfr`; A-SVGF's
-//! SVGF stages take `[svgf]`) and the TAA parameters (used with `--taa vp` or `--taa screen`).
+//! Render profiles (`config/render/*.toml`): the Visual-Polar parameters, the foveated blur, each
+//! registered denoiser's parameters (one section each, named as `--denoiser` names it: `[svgf]`,
+//! `[asvgf]`, `[bmfr]`; the registry is `fovea_renderer::passes::denoise`) and the TAA parameters
+//! (used with `--taa vp` or `--taa screen`); those sections read straight into the engine's
+//! settings, every key defaulting to the engine's value.
 //! Parsing is strict: unknown keys and out-of-range values are errors naming the file and key.
 //! Command-line flags override single values (`RenderProfile::override_with`).
 //! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
@@ -8,17 +10,16 @@
 
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::passes::denoise::asvgf::AsvgfSettings;
-use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
-use fovea_renderer::passes::denoise::svgf::SvgfSettings;
-use fovea_renderer::passes::denoise::taa::TaaSettings;
-use fovea_renderer::pipeline::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
+use fovea_renderer::passes::taa::TaaSettings;
 use fovea_renderer::sampling::{
     CompositeMode, CompositeParams, Eccentricity, FovTangents, InverseCdf, LogPolarExtent,
     LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
-use serde::Deserialize;
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
+use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer};
 use std::path::Path;
 
 #[derive(Clone, Debug, PartialEq, Default)]
@@ -35,10 +36,8 @@ pub struct RenderProfile {
     /// until `visual_polar_for` adds the headset's FOV.
     pub eccentricity: EccentricityMode,
     pub blur: BlurSettings,
-    pub svgf: SvgfSettings,
-    pub bmfr: BmfrSettings,
-    /// Its `svgf` is always the `[svgf]` section's.
-    pub asvgf: AsvgfSettings,
+    /// Every registered denoiser's parameters (`--denoiser` picks one: `denoisers.get`).
+    pub denoisers: DenoiserProfile,
     pub taa: TaaSettings,
     /// `[environment]`: the default sun and sky (`crate::look`), flags applied on top.
     pub environment: EnvironmentOptions,
@@ -48,23 +47,105 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+/// A render profile as written: the fixed sections, and the registered denoisers' sections
+/// (`DenoiserSettings::deserialize_section`), each read onto its defaults.
+#[derive(Default)]
 struct ProfileFile {
     visual_polar: Option<VpSection>,
     log_polar: Option<LogPolarSection>,
     composite: Option<CompositeSection>,
     blur: Option<BlurSection>,
-    svgf: Option<SvgfSection>,
-    bmfr: Option<BmfrSection>,
-    asvgf: Option<AsvgfSection>,
-    taa: Option<TaaSection>,
+    taa: Option<TaaSettings>,
     environment: Option<EnvironmentSection>,
     textures: Option<TexturesSection>,
     path: Option<PathSection>,
     trace: Option<TraceSection>,
+    /// The denoiser sections present.
+    denoisers: Vec<DenoiserSettings>,
+}
+
+/// The sections besides the denoisers'.
+const FIXED_SECTIONS: &[&str] = &[
+    "visual_polar",
+    "log_polar",
+    "composite",
+    "blur",
+    "taa",
+    "environment",
+    "textures",
+    "path",
+    "trace",
+];
+
+impl<'de> Deserialize<'de> for ProfileFile {
+    fn deserialize<D: Deserializer<'de>>(de: D) -> std::result::Result<Self, D::Error> {
+        de.deserialize_map(ProfileVisitor)
+    }
+}
+
+struct ProfileVisitor;
+
+impl<'de> Visitor<'de> for ProfileVisitor {
+    type Value = ProfileFile;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("render profile sections")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<ProfileFile, A::Error> {
+        let mut file = ProfileFile::default();
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "visual_polar" => file.visual_polar = Some(map.next_value()?),
+                "log_polar" => file.log_polar = Some(map.next_value()?),
+                "composite" => file.composite = Some(map.next_value()?),
+                "blur" => file.blur = Some(map.next_value()?),
+                "taa" => file.taa = Some(map.next_value()?),
+                "environment" => file.environment = Some(map.next_value()?),
+                "textures" => file.textures = Some(map.next_value()?),
+                "path" => file.path = Some(map.next_value()?),
+                "trace" => file.trace = Some(map.next_value()?),
+                section if DenoiserSettings::NAMES[1..].contains(&section) => {
+                    if let Some(d) = map.next_value_seed(DenoiserSection(section))? {
+                        file.denoisers.push(d);
+                    }
+                }
+                other => {
+                    let expected: Vec<&str> = FIXED_SECTIONS
+                        .iter()
+                        .chain(&DenoiserSettings::NAMES[1..])
+                        .copied()
+                        .collect();
+                    return Err(de::Error::custom(format!(
+                        "unknown section `{other}`, expected one of {}",
+                        expected.join(", ")
+                    )));
+                }
+            }
+        }
+        Ok(file)
+    }
+}
+
+/// A registered denoiser's section, read into its parameters.
+struct DenoiserSection<'a>(&'a str);
+
+impl<'de> DeserializeSeed<'de> for DenoiserSection<'_> {
+    type Value = Option<DenoiserSettings>;
+
+    fn deserialize<D: Deserializer<'de>>(
+        self,
+        de: D,
+    ) -> std::result::Result<Self::Value, D::Error> {
+        DenoiserSettings::deserialize_section(self.0, de)
+    }
 }
 
 #[derive(Deserialize, Default)]
@@ -100,42 +181,6 @@ struct EnvironmentSection {
     sky: Option<String>,
     /// "auto", "on" or "off" (`--default-light`).
     default_light: Option<String>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct AsvgfSection {
-    gradient_iterations: Option<u32>,
-    gradient_sigma_depth: Option<f32>,
-    gradient_sigma_normal: Option<f32>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct TaaSection {
-    current_weight: Option<f32>,
-    jitter_points: Option<u32>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct BmfrSection {
-    alpha_noisy: Option<f32>,
-    alpha_filtered: Option<f32>,
-    noise: Option<f32>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct SvgfSection {
-    alpha_color: Option<f32>,
-    alpha_moments: Option<f32>,
-    max_history: Option<u32>,
-    variance_history: Option<u32>,
-    atrous_iterations: Option<u32>,
-    sigma_luminance: Option<f32>,
-    sigma_depth: Option<f32>,
-    sigma_normal: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -198,6 +243,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
+    pub gaze_timing: crate::gaze::GazeTiming,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -373,38 +420,16 @@ impl RenderProfile {
             }
         }
         check_blur(&profile.blur).with_context(|| format!("{}.sigma_at_30", at("blur")))?;
-        if let Some(f) = file.svgf {
-            let s = &mut profile.svgf;
-            s.alpha_color = f.alpha_color.unwrap_or(s.alpha_color);
-            s.alpha_moments = f.alpha_moments.unwrap_or(s.alpha_moments);
-            s.max_history = f.max_history.unwrap_or(s.max_history);
-            s.variance_history = f.variance_history.unwrap_or(s.variance_history);
-            s.atrous_iterations = f.atrous_iterations.unwrap_or(s.atrous_iterations);
-            s.sigma_luminance = f.sigma_luminance.unwrap_or(s.sigma_luminance);
-            s.sigma_depth = f.sigma_depth.unwrap_or(s.sigma_depth);
-            s.sigma_normal = f.sigma_normal.unwrap_or(s.sigma_normal);
-            s.validate().with_context(|| at("svgf"))?;
+        for denoiser in file.denoisers {
+            profile.denoisers.set(denoiser);
         }
-        if let Some(f) = file.bmfr {
-            let s = &mut profile.bmfr;
-            s.alpha_noisy = f.alpha_noisy.unwrap_or(s.alpha_noisy);
-            s.alpha_filtered = f.alpha_filtered.unwrap_or(s.alpha_filtered);
-            s.noise = f.noise.unwrap_or(s.noise);
-            s.validate().with_context(|| at("bmfr"))?;
+        profile.denoisers.complete();
+        for denoiser in profile.denoisers.iter() {
+            denoiser.validate().with_context(|| at(denoiser.name()))?;
         }
-        profile.asvgf.svgf = profile.svgf;
-        if let Some(f) = file.asvgf {
-            let s = &mut profile.asvgf;
-            s.gradient_iterations = f.gradient_iterations.unwrap_or(s.gradient_iterations);
-            s.gradient_sigma_depth = f.gradient_sigma_depth.unwrap_or(s.gradient_sigma_depth);
-            s.gradient_sigma_normal = f.gradient_sigma_normal.unwrap_or(s.gradient_sigma_normal);
-            s.validate().with_context(|| at("asvgf"))?;
-        }
-        if let Some(f) = file.taa {
-            let s = &mut profile.taa;
-            s.current_weight = f.current_weight.unwrap_or(s.current_weight);
-            s.jitter_points = f.jitter_points.unwrap_or(s.jitter_points);
-            s.validate().with_context(|| at("taa"))?;
+        if let Some(taa) = file.taa {
+            taa.validate().with_context(|| at("taa"))?;
+            profile.taa = taa;
         }
         if let Some(f) = file.environment {
             let env = f
@@ -506,6 +531,9 @@ impl RenderProfile {
         if let Some(mode) = &o.offscreen_samples {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
+        }
+        if o.gaze_timing.enabled() {
+            self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
     }
@@ -609,6 +637,7 @@ fn check_blur(b: &BlurSettings) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fovea_renderer::passes::denoise::bmfr::BmfrSettings;
 
     fn load_str(name: &str, text: &str) -> Result<RenderProfile> {
         let dir = std::env::temp_dir().join(format!("fovea-profile-{}", std::process::id()));
@@ -660,9 +689,7 @@ mod tests {
         assert_eq!(p.visual_polar.layout, VpLayout::Paper);
         assert_eq!(p.eccentricity, EccentricityMode::Normalized);
         assert_eq!(p.blur.sigma_at_30, 6.8);
-        assert_eq!(p.svgf, SvgfSettings::default());
-        assert_eq!(p.bmfr, BmfrSettings::default());
-        assert_eq!(p.asvgf, AsvgfSettings::default());
+        assert_eq!(p.denoisers, DenoiserProfile::default());
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
@@ -724,12 +751,12 @@ mod tests {
         );
         let p = load_str("bmfr_ok.toml", "[bmfr]\nalpha_noisy = 0.25\nnoise = 0\n").unwrap();
         assert_eq!(
-            p.bmfr,
-            BmfrSettings {
+            p.denoisers.get("bmfr").unwrap(),
+            DenoiserSettings::Bmfr(BmfrSettings {
                 alpha_noisy: 0.25,
                 noise: 0.0,
                 ..Default::default()
-            }
+            })
         );
         let p = load_str(
             "asvgf_ok.toml",
@@ -741,10 +768,13 @@ gradient_sigma_normal = 64
 ",
         )
         .unwrap();
-        assert_eq!(p.asvgf.gradient_iterations, 2);
-        assert_eq!(p.asvgf.gradient_sigma_normal, 64.0);
+        let DenoiserSettings::Asvgf(asvgf) = p.denoisers.get("asvgf").unwrap() else {
+            panic!("asvgf is registered");
+        };
+        assert_eq!(asvgf.gradient_iterations, 2);
+        assert_eq!(asvgf.gradient_sigma_normal, 64.0);
         assert_eq!(
-            p.asvgf.svgf.alpha_color, 0.1,
+            asvgf.svgf.alpha_color, 0.1,
             "A-SVGF's SVGF stages take the [svgf] section"
         );
     }

@@ -14,37 +14,52 @@ struct Xvfb {
 }
 
 impl Xvfb {
+    /// A server on a display number nobody else holds: the number whose lock file names this
+    /// server's own process (parallel tests and test runs may pick the same free number at once;
+    /// the loser's server exits and it tries the next one).
     fn start() -> Xvfb {
-        // A display number no other server (or parallel test run) holds.
-        let number = (90..190)
-            .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
-            .expect("a free X display number");
-        let child = Command::new("Xvfb")
-            .args([
-                &format!(":{number}"),
-                "-screen",
-                "0",
-                "800x600x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("Xvfb (scripts/setup installs it: apt-get install xvfb)");
-        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
-        let start = Instant::now();
-        while !socket.exists() {
-            assert!(
-                start.elapsed() < Duration::from_secs(20),
-                "Xvfb :{number} did not start"
-            );
-            std::thread::sleep(Duration::from_millis(50));
+        for number in 90..190 {
+            if Path::new(&format!("/tmp/.X{number}-lock")).exists() {
+                continue;
+            }
+            let mut child = Command::new("Xvfb")
+                .args([
+                    &format!(":{number}"),
+                    "-screen",
+                    "0",
+                    "800x600x24",
+                    "-nolisten",
+                    "tcp",
+                ])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect("Xvfb (scripts/setup installs it: apt-get install xvfb)");
+            let socket = PathBuf::from(format!("/tmp/.X11-unix/X{number}"));
+            let pid = child.id();
+            let ours = || {
+                std::fs::read_to_string(format!("/tmp/.X{number}-lock"))
+                    .is_ok_and(|text| text.trim().parse::<u32>() == Ok(pid))
+            };
+            let start = Instant::now();
+            loop {
+                if matches!(child.try_wait(), Ok(Some(_))) {
+                    break; // another server holds this number
+                }
+                if socket.exists() && ours() {
+                    return Xvfb {
+                        child,
+                        display: format!(":{number}"),
+                    };
+                }
+                assert!(
+                    start.elapsed() < Duration::from_secs(20),
+                    "Xvfb :{number} did not start"
+                );
+                std::thread::sleep(Duration::from_millis(50));
+            }
         }
-        Xvfb {
-            child,
-            display: format!(":{number}"),
-        }
+        panic!("no free X display number in 90..190")
     }
 }
 

@@ -7,6 +7,7 @@ mod builtin;
 mod projection;
 
 pub use builtin::{builtin_names, BUILTIN_DIR};
+pub use projection::angle_between_deg;
 
 use crate::error::HalError;
 use crate::sample::Eye;
@@ -64,6 +65,18 @@ pub struct TrackerSpec {
     pub precision_deg: f32,
 }
 
+/// What follows the tracker on the way from a gaze sample to the photons that show a frame
+/// foveated with it (`[latency]` of a profile; `crate::latency::LatencyModel` adds the tracker's
+/// own delay).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PipelineLatency {
+    /// The application reads the gaze → the frame is finished (CPU, GPU, compositor).
+    pub render_ms: f32,
+    /// The finished frame → its photons (scan-out to mid-panel, panel response).
+    pub display_ms: f32,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Capabilities {
@@ -88,6 +101,8 @@ pub struct HmdDescription {
     pub eyes: [EyeView; 2],
     pub refresh_hz: f32,
     pub tracker: TrackerSpec,
+    /// `[latency]`: render and display latency; `None` in a profile without the section.
+    pub latency: Option<PipelineLatency>,
     pub capabilities: Capabilities,
 }
 
@@ -102,6 +117,8 @@ struct HmdToml {
     left_eye: EyeToml,
     right_eye: EyeToml,
     tracker: TrackerToml,
+    #[serde(default)]
+    latency: Option<PipelineLatency>,
     #[serde(default)]
     capabilities: Capabilities,
     /// Free text: sources of the numbers. Kept out of the description.
@@ -195,6 +212,10 @@ fn validate(raw: HmdToml, file: &Path) -> Result<HmdDescription, HalError> {
     non_negative(file, "tracker.latency_ms", t.latency_ms, 1000.0)?;
     non_negative(file, "tracker.accuracy_deg", t.accuracy_deg, 45.0)?;
     non_negative(file, "tracker.precision_deg", t.precision_deg, 45.0)?;
+    if let Some(l) = &raw.latency {
+        non_negative(file, "latency.render_ms", l.render_ms, 1000.0)?;
+        non_negative(file, "latency.display_ms", l.display_ms, 1000.0)?;
+    }
     Ok(HmdDescription {
         id: raw.id,
         display_name: raw.display_name,
@@ -206,6 +227,7 @@ fn validate(raw: HmdToml, file: &Path) -> Result<HmdDescription, HalError> {
             accuracy_deg: t.accuracy_deg,
             precision_deg: t.precision_deg,
         },
+        latency: raw.latency,
         capabilities: raw.capabilities,
     })
 }

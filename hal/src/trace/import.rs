@@ -6,6 +6,10 @@
 //! - Normalised screen coordinates (EHTask style): time in ms plus x, y in 0..1 of the recording
 //!   device's image; needs that device's FOV to become directions.
 //!
+//! - Degrees from the view centre (`t_s,x_deg,y_deg,valid`, the format of fovea's shared real
+//!   recordings): seconds, degrees (+x right, +y up), `valid` 0/1; placed on a headset eye's view
+//!   ([`import_degrees`]).
+//!
 //! Degrees become directions per axis through the tangent plane: dir ∝ (tan x, tan y, −1).
 
 use super::{Trace, TraceHeader};
@@ -269,6 +273,107 @@ pub fn import_normalized_text(
         deg(f.angle_up),
     ]);
     finish(file, samples, &csv, opts.rate_hz, opts.device.clone(), fov)
+}
+
+/// The one header of a degrees recording, in this order.
+pub const DEGREES_COLUMNS: [&str; 4] = ["t_s", "x_deg", "y_deg", "valid"];
+
+/// Largest gaze angle a degrees recording may hold: a rectilinear view never reaches 90°, and a
+/// desktop or headset recording stays far inside it.
+pub const MAX_DEGREES: f64 = 80.0;
+
+/// `t_s,x_deg,y_deg,valid` (seconds from the first sample; degrees from the screen centre, +x
+/// right, +y up; `valid` 0 where the tracker had no gaze, those rows may hold `nan`) placed on the
+/// eye view `fov`: the recording's screen centre goes to the view's centre and its angles through
+/// the view's tangent plane, tx = (tan l + tan r)/2 + tan x (likewise y), so a recording made on
+/// a flat screen keeps its geometry. Invalid rows become no-gaze samples (the invalid-gaze policy
+/// decides what a frame shows), and the rate is the median interval.
+pub fn import_degrees(path: &Path, fov: &Fov) -> Result<Trace, HalError> {
+    let text = crate::file::read_text(path, crate::file::MAX_TRACE_BYTES, "a degrees recording")?;
+    import_degrees_text(&text, path, fov)
+}
+
+pub fn import_degrees_text(text: &str, file: &Path, fov: &Fov) -> Result<Trace, HalError> {
+    let csv = Csv::parse(text, file)?;
+    if csv.names != DEGREES_COLUMNS {
+        return Err(HalError::trace(
+            file,
+            1,
+            format!(
+                "header `{}`: expected exactly `{}`",
+                csv.names.join(","),
+                DEGREES_COLUMNS.join(",")
+            ),
+        ));
+    }
+    if csv.rows.len() < 2 {
+        return Err(HalError::trace(
+            file,
+            csv.rows[0].0,
+            "one data row: a recording needs at least two samples",
+        ));
+    }
+    let centre = (
+        (fov.angle_left.tan() as f64 + fov.angle_right.tan() as f64) / 2.0,
+        (fov.angle_down.tan() as f64 + fov.angle_up.tan() as f64) / 2.0,
+    );
+    let mut samples = Vec::with_capacity(csv.rows.len());
+    for (line, fields) in &csv.rows {
+        let line = *line;
+        let seconds = csv.number(line, fields, 0)?;
+        if !seconds.is_finite() || seconds.abs() > 9.0e9 {
+            let reason = format!("t_s {seconds} is not a usable time in seconds");
+            return Err(HalError::trace(file, line, reason));
+        }
+        let time = (seconds * 1e9).round() as i64;
+        let valid = match fields[3] {
+            "1" => true,
+            "0" => false,
+            other => {
+                return Err(HalError::trace(
+                    file,
+                    line,
+                    format!("valid `{other}` must be 0 or 1"),
+                ))
+            }
+        };
+        let seq = samples.len() as u64;
+        if !valid {
+            // The angles of an invalid row are not read: trackers write nan, 0 or stale values.
+            samples.push(GazeSample {
+                time_kind: SampleTimeKind::Measured,
+                ..GazeSample::no_gaze(time, seq)
+            });
+            continue;
+        }
+        let angle = |col: usize| -> Result<f64, HalError> {
+            let v = csv.number(line, fields, col)?;
+            if v.is_nan() || v.abs() > MAX_DEGREES {
+                let name = &csv.names[col];
+                let reason = format!(
+                    "{name} {v} on a valid row: expected an angle within ±{MAX_DEGREES}° (rows \
+                     without gaze have valid 0)"
+                );
+                return Err(HalError::trace(file, line, reason));
+            }
+            Ok(v)
+        };
+        let (x, y) = (angle(1)?, angle(2)?);
+        let direction = tangent_direction(
+            centre.0 + x.to_radians().tan(),
+            centre.1 + y.to_radians().tan(),
+        );
+        samples.push(GazeSample::looking(time, seq, direction));
+    }
+    let mut trace = finish(file, samples, &csv, None, "degrees".into(), None)?;
+    trace.header.notes.push(format!(
+        "degrees from the view centre of an eye with FOV {:.1},{:.1},{:.1},{:.1}",
+        fov.angle_left.to_degrees(),
+        fov.angle_right.to_degrees(),
+        fov.angle_down.to_degrees(),
+        fov.angle_up.to_degrees()
+    ));
+    Ok(trace)
 }
 
 fn finish(

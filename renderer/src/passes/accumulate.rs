@@ -1,28 +1,22 @@
 //! Running mean of traced colour over many samples (reference renders).
 
-use super::push_bytes;
+use super::{Kernel, Pass};
 use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
 use crate::layouts::AccumulatePush;
-use crate::vk::{ComputePipeline, Context, Image};
+use crate::vk::Image;
 use glam::UVec4;
-use std::sync::Arc;
 
-pub struct AccumulatePass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Accumulate;
+
+impl Kernel for Accumulate {
+    const SHADER: &'static str = "passes/accumulate";
+    type Push = AccumulatePush;
 }
 
-impl AccumulatePass {
-    pub fn new(ctx: &Arc<Context>) -> Result<AccumulatePass> {
-        Ok(AccumulatePass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                "passes/accumulate",
-                std::mem::size_of::<AccumulatePush>() as u32,
-            )?,
-        })
-    }
+pub type AccumulatePass = Pass<Accumulate>;
 
+impl Pass<Accumulate> {
     /// Blends `sample` into `accum`, which already holds the mean of `samples_so_far` samples.
     pub fn record(
         &self,
@@ -31,7 +25,7 @@ impl AccumulatePass {
         accum: &Image,
         samples_so_far: u32,
     ) -> Result<()> {
-        self.dispatch(rec, sample, accum, samples_so_far, false)
+        self.blend(rec, sample, accum, samples_so_far, false)
     }
 
     /// As `record`, but texels whose sample was not traced (alpha 0) keep their mean: the mean
@@ -44,10 +38,10 @@ impl AccumulatePass {
         accum: &Image,
         samples_so_far: u32,
     ) -> Result<()> {
-        self.dispatch(rec, sample, accum, samples_so_far, true)
+        self.blend(rec, sample, accum, samples_so_far, true)
     }
 
-    fn dispatch(
+    fn blend(
         &self,
         rec: &mut FrameRecorder,
         sample: &Image,
@@ -62,12 +56,7 @@ impl AccumulatePass {
         let push = AccumulatePush {
             config: UVec4::new(samples_so_far, traced_only as u32, 0, 0),
         };
-        rec.dispatch(
-            "accumulate",
-            &self.pipeline,
-            &binds,
-            push_bytes(&push),
-            [accum.width, accum.height, 1],
-        )
+        let size = [accum.width, accum.height, 1];
+        self.dispatch(rec, "accumulate", &binds, &push, size)
     }
 }

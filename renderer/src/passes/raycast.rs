@@ -1,15 +1,22 @@
 //! Traces an arbitrary list of rays: BVH correctness tests and ray-throughput benchmarks, and
 //! (the `counters` variant) what each ray's traversal read.
 
-use super::push_bytes;
+use super::{Kernel, Pass};
 use crate::error::Result;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, FrameRecorder};
 use crate::layouts::RaycastPush;
 use crate::traversal::Traversal;
-use crate::vk::{Buffer, ComputePipeline, Context};
+use crate::vk::{Buffer, Context};
 use glam::UVec4;
 use std::sync::Arc;
+
+pub struct Raycast;
+
+impl Kernel for Raycast {
+    const SHADER: &'static str = "passes/raycast";
+    type Push = RaycastPush;
+}
 
 /// What one ray's traversal read (the `counters` variant; `shaders/common/bvh.glsl`'s
 /// BVH_COUNTERS): nodes opened, leaf triangles tested, alpha tests and bytes of node + triangle
@@ -23,8 +30,8 @@ pub struct RayCounts {
     pub bytes: u32,
 }
 
-/// The buffers of one raycast dispatch.
-pub struct RaycastIo<'a> {
+/// A list of rays and where their hits go.
+pub struct RayBatch<'a> {
     /// `count` RayGpu behind an RGBA32F texel view (`Buffer::device_texels`: texel reads are far
     /// cheaper than std430 reads on lavapipe).
     pub rays: &'a Buffer,
@@ -35,83 +42,78 @@ pub struct RaycastIo<'a> {
     pub count: u32,
 }
 
+/// The raycast kernels: `hits` and `counters`, each for the traversal of the scene it traces
+/// (built on first use).
 pub struct RaycastPass {
     ctx: Arc<Context>,
-    /// The kernels used so far, by traversal and counting (held while command buffers use them).
-    pipelines: Vec<(Traversal, bool, Arc<ComputePipeline>)>,
+    passes: Vec<(Traversal, bool, Pass<Raycast>)>,
 }
 
 impl RaycastPass {
-    pub fn new(ctx: &Arc<Context>) -> Result<RaycastPass> {
-        Ok(RaycastPass {
+    pub fn new(ctx: &Arc<Context>) -> RaycastPass {
+        RaycastPass {
             ctx: ctx.clone(),
-            pipelines: Vec::new(),
-        })
-    }
-
-    fn pipeline(&mut self, traversal: Traversal, counted: bool) -> Result<Arc<ComputePipeline>> {
-        if let Some((_, _, p)) = self
-            .pipelines
-            .iter()
-            .find(|(t, c, _)| *t == traversal && *c == counted)
-        {
-            return Ok(p.clone());
+            passes: Vec::new(),
         }
-        let kernel = if counted {
-            "passes/raycast.counters"
-        } else {
-            "passes/raycast.hits"
-        };
-        let pipeline = ComputePipeline::shared_for(
-            &self.ctx,
-            kernel,
-            std::mem::size_of::<RaycastPush>() as u32,
-            traversal,
-        )?;
-        self.pipelines.push((traversal, counted, pipeline.clone()));
-        Ok(pipeline)
     }
 
-    /// Traces `io.rays` against `scene` with the kernel of the scene's traversal; `any_hit` stops
-    /// at the first hit found (shadow rays).
+    fn pass(&mut self, traversal: Traversal, counted: bool) -> Result<&Pass<Raycast>> {
+        let at = match self
+            .passes
+            .iter()
+            .position(|(t, c, _)| *t == traversal && *c == counted)
+        {
+            Some(at) => at,
+            None => {
+                let variant = if counted { "counters" } else { "hits" };
+                let pass = Pass::for_traversal(&self.ctx, variant, traversal)?;
+                self.passes.push((traversal, counted, pass));
+                self.passes.len() - 1
+            }
+        };
+        Ok(&self.passes[at].2)
+    }
+
+    /// Traces `batch` with the kernel of `scene`'s traversal; `any_hit` stops at the first hit
+    /// found (shadow rays). The pass is named `raycast_any` or `raycast_closest` in the timings
+    /// (`_counted` with counts).
     pub fn record(
         &mut self,
         rec: &mut FrameRecorder,
-        pass_name: &'static str,
         scene: &GpuScene,
         frame: &Buffer,
-        io: &RaycastIo,
+        batch: &RayBatch,
         any_hit: bool,
     ) -> Result<()> {
-        let pipeline = self.pipeline(scene.traversal, io.counts.is_some())?;
         let s = scene.binds();
         let binds = [
-            s[0],
-            s[1],
-            s[2],
-            s[3],
-            s[4],
-            s[5],
-            s[6],
-            s[7],
-            s[9],
+            s.bvh_nodes,
+            s.bvh_triangles,
+            s.vertices,
+            s.triangles,
+            s.materials,
+            s.textures,
+            s.texels,
+            s.lights,
+            s.instances,
             read_buffer("frame", frame),
-            read_texels("rays", io.rays),
-            write_buffer("hits", io.hits),
-            write_buffer("counts", io.counts.unwrap_or(io.hits)),
+            read_texels("rays", batch.rays),
+            write_buffer("hits", batch.hits),
+            write_buffer("counts", batch.counts.unwrap_or(batch.hits)),
         ];
-        // The plain kernel declares no `counts`: its bind is skipped by name.
-        let binds = &binds[..if io.counts.is_some() { 13 } else { 12 }];
+        // The plain kernel declares no `counts`: its bind is left off.
+        let binds = &binds[..if batch.counts.is_some() { 13 } else { 12 }];
         let push = RaycastPush {
-            config: UVec4::new(io.count, any_hit as u32, 0, 0),
+            config: UVec4::new(batch.count, any_hit as u32, 0, 0),
         };
-        rec.dispatch(
-            pass_name,
-            &pipeline,
-            binds,
-            push_bytes(&push),
-            [io.count, 1, 1],
-        )
+        let name = match (any_hit, batch.counts.is_some()) {
+            (false, false) => "raycast_closest",
+            (true, false) => "raycast_any",
+            (false, true) => "raycast_closest_counted",
+            (true, true) => "raycast_any_counted",
+        };
+        self.pass(scene.traversal, batch.counts.is_some())?
+            .dispatch(rec, name, binds, &push, [batch.count, 1, 1])
     }
 }
 
@@ -132,7 +134,7 @@ impl RayCaster {
         let uniform = ash::vk::BufferUsageFlags::UNIFORM_BUFFER;
         Ok(RayCaster {
             ctx: ctx.clone(),
-            pass: RaycastPass::new(ctx)?,
+            pass: RaycastPass::new(ctx),
             frame: Buffer::with_data(
                 ctx,
                 "frame",
@@ -225,20 +227,14 @@ impl RayCaster {
             ..Default::default()
         }])?;
         self.recorder.begin()?;
-        let name = match (any_hit, counted) {
-            (false, false) => "raycast_closest",
-            (true, false) => "raycast_any",
-            (false, true) => "raycast_closest_counted",
-            (true, true) => "raycast_any_counted",
-        };
-        let io = RaycastIo {
+        let batch = RayBatch {
             rays: ray_buf,
             hits: hit_buf,
             counts: if counted { self.counts.as_ref() } else { None },
             count: rays.len() as u32,
         };
         self.pass
-            .record(&mut self.recorder, name, scene, &self.frame, &io, any_hit)?;
+            .record(&mut self.recorder, scene, &self.frame, &batch, any_hit)?;
         let ms = self.recorder.submit_and_wait()?.iter().map(|t| t.ms).sum();
         let mut hits = vec![crate::layouts::HitGpu::default(); rays.len()];
         hit_buf.download(&mut hits)?;

@@ -6,7 +6,7 @@ use super::push_bytes;
 use crate::error::Result;
 use crate::graph::{read_buffer, write_buffer, write_image, FrameRecorder};
 use crate::layouts::TraceClearPush;
-use crate::passes::trace::{GBuffer, TileList};
+use crate::passes::grid::{GBuffer, TileList};
 use crate::vk::{Buffer, ComputePipeline, Context};
 use glam::UVec4;
 use std::sync::Arc;

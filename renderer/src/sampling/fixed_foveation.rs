@@ -104,6 +104,9 @@ impl SamplingSpace for FixedFoveation {
     fn visual_polar(&self) -> Option<&VisualPolar> {
         Some(&self.vp)
     }
+    fn blur_axis(&self) -> Option<&VisualPolar> {
+        Some(&self.vp)
+    }
     fn capabilities(&self) -> SpaceCapabilities {
         self.vp.capabilities()
     }

@@ -19,6 +19,7 @@ mod visual_polar;
 mod visual_polar_clipped;
 mod visual_polar_headset;
 mod visual_polar_screen_axis;
+mod visual_polar_space;
 mod vrs_tiles;
 
 pub use cartesian::Cartesian;
@@ -53,7 +54,7 @@ fn within(p: Vec2, size: UVec2) -> bool {
 pub enum WayBack {
     /// The grid is the screen.
     Direct,
-    /// A polar grid: φ-mips, the remap and the foveated blur.
+    /// A polar grid: φ-mips, the remap and the foveated blur (`blur_axis`).
     Remap,
     /// A regular grid coarser than the screen: bilinear upscaling.
     Upscale,
@@ -118,13 +119,13 @@ pub trait SamplingSpace {
     /// Re-centres the space on a new gaze point (screen pixels); the grid size never changes, so
     /// per-sample images stay valid. Spaces that ignore the gaze only record it.
     fn set_gaze(&mut self, gaze: Vec2) -> Result<()>;
-    /// The Visual-Polar space, when this is one: its grid is not the screen, so the renderer maps
-    /// it back (φ-mips, remap) and applies the foveated blur.
+    /// The Visual-Polar space, when this grid is one (the grid blur and the filters address it
+    /// through its parameters).
     fn visual_polar(&self) -> Option<&VisualPolar> {
         None
     }
-    /// The eccentricity axis that shapes the foveated blur after a sparse way back (the polar
-    /// spaces' own blur comes with the remap).
+    /// The eccentricity axis that shapes the foveated blur of the way back (the polar spaces:
+    /// their own; the sparse spaces: the density they follow); `None`: no foveated blur.
     fn blur_axis(&self) -> Option<&VisualPolar> {
         None
     }

@@ -34,9 +34,9 @@
 use super::acuity::*;
 use super::composite::CompositeParams;
 use super::log_polar::{LogPolarLaw, LogPolarParams};
+use super::visual_polar_clipped::{on_screen_arcs, ColumnArcs};
 use super::visual_polar_headset::{FovTangents, HeadsetAxis};
-use super::visual_polar_screen_axis::ScreenAxis;
-use super::SamplingSpace;
+use super::visual_polar_screen_axis::{ScreenAxis, AXIS_KNOT_TEXELS};
 use crate::error::{Error, Result};
 use crate::layouts::SamplingParams;
 use glam::{IVec2, UVec2, UVec4, Vec2, Vec4};
@@ -695,107 +695,73 @@ pub fn params_need_general_kernel(p: &SamplingParams) -> bool {
     (p.shape1.y as u32) & (FLAG_CLIPPED | FLAG_HEADSET | FLAG_EXACT | FLAG_LOG_POLAR) != 0
 }
 
-/// The tracer's view of the space: one sample per kept texel; the GPU twin is
-/// `shaders/sampling/visual_polar.glsl` (kernel variant `visual_polar`). With the paper's layout
-/// samples may land off the screen (the r_max circle covers the corners); they are traced, as in
-/// the paper. The screen-clipped layout keeps them on it.
-impl SamplingSpace for VisualPolar {
-    fn name(&self) -> &'static str {
-        match (self.params.radial, self.log_polar) {
-            (RadialLaw::Composite(_), _) => "composite",
-            (_, Some(_)) => "log-polar",
-            _ if self.headset.is_some() => "vp-headset",
-            _ if self.params.layout == VpLayout::ScreenClipped => "vp-screen-clipped",
-            _ if self.params.layout == VpLayout::ScreenAware => "vp-screen-aware",
-            _ => "vp",
+impl VisualPolar {
+    /// Column `col`'s arcs in the active layout: the full circle in the paper's; in the
+    /// screen-clipped one the on-screen part of the circle at the column's centre radius.
+    pub fn column_arcs(&self, col: u32) -> ColumnArcs {
+        match self.params().layout {
+            VpLayout::Paper => ColumnArcs::FULL,
+            VpLayout::ScreenClipped | VpLayout::ScreenAware => {
+                let u_c = (col as f32 + 0.5) / self.grid_size().x as f32;
+                on_screen_arcs(self.gaze(), self.r_of_u(u_c), self.screen())
+            }
         }
     }
-    /// The denoisers' and TAA's grid addressing: the paper's, or the screen-clipped layout's
-    /// (its per-column arcs, `shaders/sampling/visual_polar_clipped_grid.glsl`).
-    fn shader_variant(&self) -> &'static str {
-        match self.params.layout {
-            VpLayout::Paper => "visual_polar",
-            VpLayout::ScreenClipped | VpLayout::ScreenAware => "visual_polar_clipped",
+
+    /// The per-column table the GPU reads: two RGBA32F texels per column (`ColumnArcs::texels`),
+    /// then the screen-aware axis' knots (`AXIS_KNOT_TEXELS` texels, zero in the other layouts);
+    /// GLSL looks them up through `vp_column_arcs` and `vp_axis_knot`. Recomputed whenever the
+    /// gaze moves.
+    pub fn column_table(&self) -> Vec<[f32; 4]> {
+        let mut table = Vec::new();
+        self.write_column_table(&mut table);
+        table
+    }
+
+    /// `column_table` into a caller-owned vector (cleared first; the render loop reuses it).
+    pub fn write_column_table(&self, out: &mut Vec<[f32; 4]>) {
+        out.clear();
+        out.extend((0..self.grid_size().x).flat_map(|c| self.column_arcs(c).texels()));
+        match self.screen_axis() {
+            Some(axis) => out.extend(axis.texels()),
+            None => out.extend([[0.0; 4]; AXIS_KNOT_TEXELS]),
         }
     }
-    /// `visual_polar_polynomial`: specialised for the paper's layout, normalised axis and quartic
-    /// inverse CDF (the default), `visual_polar` the same with the exact inverse; `log_polar`: the
-    /// paper's layout with the radial law read at run time; otherwise the general kernel
-    /// (`visual_polar_clipped`: either layout, either axis).
-    fn trace_variant(&self) -> &'static str {
-        match (self.params.layout, self.headset.is_some()) {
-            _ if self.log_polar.is_some() => "log_polar",
-            (VpLayout::Paper, false) if !self.exact => "visual_polar_polynomial",
-            (VpLayout::Paper, false) => "visual_polar",
-            _ => "visual_polar_clipped",
+
+    /// Grid → screen in the screen-clipped layout (GLSL `vp_clipped_vp_to_screen`): row y of a
+    /// column with n rows sits at arc position y/n·A.
+    pub fn clipped_vp_to_screen(&self, g: Vec2) -> Vec2 {
+        let col = self.column_of(g.x);
+        let n = self.rows_in_column(col) as f32;
+        let arcs = self.column_arcs(col);
+        let phi = arcs.phi_of_arc(g.y / n * arcs.total());
+        let r = self.r_of_u(g.x / self.grid_size().x as f32);
+        self.gaze() + r * Vec2::new(phi.cos(), phi.sin())
+    }
+
+    /// Screen → grid in the screen-clipped layout (GLSL `vp_clipped_screen_to_vp`); y ∈ [0, n).
+    /// Angles just outside the column's arcs clamp to the nearest arc end.
+    pub fn clipped_screen_to_vp(&self, s: Vec2) -> Vec2 {
+        let d = s - self.gaze();
+        let r = d.length();
+        let mut phi = d.y.atan2(d.x);
+        if phi < 0.0 {
+            phi += TAU;
         }
-    }
-    fn grid_size(&self) -> UVec2 {
-        self.grid
-    }
-    fn screen_size(&self) -> UVec2 {
-        self.screen
-    }
-    fn sample_count(&self) -> u64 {
-        VisualPolar::sample_count(self)
-    }
-    fn params(&self) -> SamplingParams {
-        self.sampling_params()
-    }
-    /// The per-column arcs (`column_table`): full circles in the paper's layout.
-    fn write_sampling_table(&self, out: &mut Vec<[f32; 4]>) {
-        self.write_column_table(out);
-    }
-    /// `None` outside the grid and in clipped texels (the texel is `floor(grid)`).
-    fn grid_to_screen(&self, grid: Vec2) -> Option<Vec2> {
-        if !grid.is_finite() {
-            return None;
-        }
-        let t = grid.floor();
-        // Range-check in f32 before converting, so huge values cannot wrap into the grid.
-        if t.x < 0.0 || t.y < 0.0 || t.x >= self.grid.x as f32 || t.y >= self.grid.y as f32 {
-            return None;
-        }
-        self.is_valid_texel(t.as_ivec2())
-            .then(|| self.vp_to_screen(grid))
-    }
-    /// `None` where no texel samples the position: beyond r_max (only possible on screen with
-    /// `RadiusMode::Fixed`). Off-screen positions inside r_max do have samples. r = r_max itself
-    /// (the farthest corner) maps to u = 1 up to rounding and is kept inside the last column.
-    fn screen_to_grid(&self, screen: Vec2) -> Option<Vec2> {
-        if !screen.is_finite() {
-            return None;
-        }
-        let g = self.screen_to_vp(screen);
-        let w = self.grid.x as f32;
-        if !(g.x >= 0.0 && g.x <= w * (1.0 + 1e-5) && g.y >= 0.0 && g.y < self.grid.y as f32) {
-            return None;
-        }
-        let last = f32::from_bits(w.to_bits() - 1); // largest f32 below w (w ≥ 1)
-        Some(Vec2::new(g.x.min(last), g.y))
-    }
-    fn gaze(&self) -> Vec2 {
-        self.gaze
-    }
-    fn set_gaze(&mut self, gaze: Vec2) -> Result<()> {
-        *self = VisualPolar::new(self.screen, gaze, self.params)?;
-        Ok(())
-    }
-    fn visual_polar(&self) -> Option<&VisualPolar> {
-        Some(self)
-    }
-    /// The fovea's clipped tiles and, in the paper's layout, tiles far off the screen are idle.
-    fn trace_tiles(&self, cull: bool, tiles: &mut super::TraceTiles) {
-        super::trace_tiles::visual_polar_tiles(self, cull, tiles);
-    }
-    /// Every layout runs the filters: the screen-clipped one addresses its grid through the
-    /// per-column arcs of this frame and the previous one (`DenoiseFrame::sampling_table`).
-    fn capabilities(&self) -> super::SpaceCapabilities {
-        super::SpaceCapabilities {
-            way_back: super::WayBack::Remap,
-            temporal_filters: true,
-            filters_note: "",
-        }
+        let x = self.u_of_r(r) * self.grid_size().x as f32;
+        let col = self.column_of(x);
+        let n = self.rows_in_column(col) as f32;
+        let arcs = self.column_arcs(col);
+        let y = arcs.arc_row(arcs.arc_of_phi(phi).0, n);
+        // y = n is φ = 2π on a full circle (row 0) or a clipped arc's far end (its last row).
+        let y = if y < n {
+            y
+        } else if arcs.wraps() {
+            0.0
+        } else {
+            f32::from_bits(n.to_bits() - 1)
+        };
+        Vec2::new(x, y)
     }
 }
 

@@ -10,8 +10,6 @@
 //! (a − end[i−1]). A circle entirely on the screen (or entirely off it) is one full interval
 //! starting at φ = 0, which is exactly the paper's layout, φ wrapping.
 
-use super::visual_polar::{VisualPolar, VpLayout};
-use super::visual_polar_screen_axis::AXIS_KNOT_TEXELS;
 use glam::{UVec2, Vec2};
 use std::f32::consts::TAU;
 
@@ -233,79 +231,10 @@ pub fn on_screen_arcs(gaze: Vec2, r: f32, screen: UVec2) -> ColumnArcs {
     arcs
 }
 
-impl VisualPolar {
-    /// Column `col`'s arcs in the active layout: the full circle in the paper's; in the
-    /// screen-clipped one the on-screen part of the circle at the column's centre radius.
-    pub fn column_arcs(&self, col: u32) -> ColumnArcs {
-        match self.params().layout {
-            VpLayout::Paper => ColumnArcs::FULL,
-            VpLayout::ScreenClipped | VpLayout::ScreenAware => {
-                let u_c = (col as f32 + 0.5) / self.grid_size().x as f32;
-                on_screen_arcs(self.gaze(), self.r_of_u(u_c), self.screen())
-            }
-        }
-    }
-
-    /// The per-column table the GPU reads: two RGBA32F texels per column (`ColumnArcs::texels`),
-    /// then the screen-aware axis' knots (`AXIS_KNOT_TEXELS` texels, zero in the other layouts);
-    /// GLSL looks them up through `vp_column_arcs` and `vp_axis_knot`. Recomputed whenever the
-    /// gaze moves.
-    pub fn column_table(&self) -> Vec<[f32; 4]> {
-        let mut table = Vec::new();
-        self.write_column_table(&mut table);
-        table
-    }
-
-    /// `column_table` into a caller-owned vector (cleared first; the render loop reuses it).
-    pub fn write_column_table(&self, out: &mut Vec<[f32; 4]>) {
-        out.clear();
-        out.extend((0..self.grid_size().x).flat_map(|c| self.column_arcs(c).texels()));
-        match self.screen_axis() {
-            Some(axis) => out.extend(axis.texels()),
-            None => out.extend([[0.0; 4]; AXIS_KNOT_TEXELS]),
-        }
-    }
-
-    /// Grid → screen in the screen-clipped layout (GLSL `vp_clipped_vp_to_screen`): row y of a
-    /// column with n rows sits at arc position y/n·A.
-    pub fn clipped_vp_to_screen(&self, g: Vec2) -> Vec2 {
-        let col = self.column_of(g.x);
-        let n = self.rows_in_column(col) as f32;
-        let arcs = self.column_arcs(col);
-        let phi = arcs.phi_of_arc(g.y / n * arcs.total());
-        let r = self.r_of_u(g.x / self.grid_size().x as f32);
-        self.gaze() + r * Vec2::new(phi.cos(), phi.sin())
-    }
-
-    /// Screen → grid in the screen-clipped layout (GLSL `vp_clipped_screen_to_vp`); y ∈ [0, n).
-    /// Angles just outside the column's arcs clamp to the nearest arc end.
-    pub fn clipped_screen_to_vp(&self, s: Vec2) -> Vec2 {
-        let d = s - self.gaze();
-        let r = d.length();
-        let mut phi = d.y.atan2(d.x);
-        if phi < 0.0 {
-            phi += TAU;
-        }
-        let x = self.u_of_r(r) * self.grid_size().x as f32;
-        let col = self.column_of(x);
-        let n = self.rows_in_column(col) as f32;
-        let arcs = self.column_arcs(col);
-        let y = arcs.arc_row(arcs.arc_of_phi(phi).0, n);
-        // y = n is φ = 2π on a full circle (row 0) or a clipped arc's far end (its last row).
-        let y = if y < n {
-            y
-        } else if arcs.wraps() {
-            0.0
-        } else {
-            f32::from_bits(n.to_bits() - 1)
-        };
-        Vec2::new(x, y)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::{VisualPolar, VpLayout};
     use glam::DVec2;
 
     const SCREEN: UVec2 = UVec2::new(1280, 1440);

@@ -7,7 +7,10 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{c_char, CStr, CString};
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
+
+/// One entry of `Context::pipelines`.
+pub(crate) type PipelineEntry = Weak<dyn std::any::Any + Send + Sync>;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
@@ -154,10 +157,10 @@ pub struct Context {
     /// Storage images may be written without a format qualifier (the external-target tonemap:
     /// swapchain formats differ from the engine's own RGBA8).
     pub storage_write_without_format: bool,
-    /// Compute pipelines by shader name, shared by every view and pass that uses the kernel.
-    /// Weak: a pipeline lives as long as a pass holds it (no cycle through the context).
-    pub(crate) pipelines:
-        Mutex<std::collections::HashMap<String, std::sync::Weak<super::ComputePipeline>>>,
+    /// Compute pipelines by shader name (`ComputePipeline::shared`), shared by every view and
+    /// pass that uses the kernel. Weak: a pipeline lives as long as a pass holds it (no cycle
+    /// through the context). Held as `Any`: the context is made before any pipeline module.
+    pub(crate) pipelines: Mutex<std::collections::HashMap<String, PipelineEntry>>,
     /// Serialises queue submissions (vkQueueSubmit needs external synchronisation).
     pub(crate) queue_lock: Mutex<()>,
     pub(crate) pool: Mutex<vk::CommandPool>,
@@ -408,56 +411,6 @@ impl Context {
                 last_pass: "set-up".into(),
             },
             other => Error::Vulkan(other),
-        })
-    }
-
-    /// Copies `bytes` from the start of `src` to the start of `dst` now and waits: a full
-    /// barrier on each side (set-up work; what ran before and what runs after see the data).
-    pub fn copy_now(&self, src: &super::Buffer, dst: &super::Buffer, bytes: u64) -> Result<()> {
-        if bytes > src.size || bytes > dst.size {
-            return Err(Error::Invalid(format!(
-                "copy of {bytes} bytes from '{}' ({} bytes) to '{}' ({} bytes)",
-                src.name, src.size, dst.name, dst.size
-            )));
-        }
-        self.one_shot(|device, cmd| unsafe {
-            let all = vk::PipelineStageFlags::ALL_COMMANDS;
-            let barrier = vk::MemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-                .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
-            device.cmd_pipeline_barrier(
-                cmd,
-                all,
-                all,
-                vk::DependencyFlags::empty(),
-                &[barrier],
-                &[],
-                &[],
-            );
-            device.cmd_copy_buffer(
-                cmd,
-                src.raw,
-                dst.raw,
-                &[vk::BufferCopy {
-                    src_offset: 0,
-                    dst_offset: 0,
-                    size: bytes,
-                }],
-            );
-            let after = barrier.dst_access_mask(
-                vk::AccessFlags::MEMORY_READ
-                    | vk::AccessFlags::MEMORY_WRITE
-                    | vk::AccessFlags::HOST_READ,
-            );
-            device.cmd_pipeline_barrier(
-                cmd,
-                all,
-                all | vk::PipelineStageFlags::HOST,
-                vk::DependencyFlags::empty(),
-                &[after],
-                &[],
-                &[],
-            );
         })
     }
 

@@ -145,7 +145,8 @@ impl ComputePipeline {
         let resolved = traversal.shader_name(shader);
         let shader: &str = &resolved;
         let mut cache = ctx.pipelines.lock().expect("pipeline cache lock");
-        if let Some(p) = cache.get(shader).and_then(|w| w.upgrade()) {
+        let cached = cache.get(shader).and_then(|w| w.upgrade());
+        if let Some(p) = cached.and_then(|p| p.downcast::<ComputePipeline>().ok()) {
             if p.push_size != push_size {
                 return Err(Error::Shader {
                     shader: shader.into(),
@@ -159,7 +160,8 @@ impl ComputePipeline {
         }
         let pipeline = Arc::new(ComputePipeline::new(ctx, shader, push_size)?);
         cache.retain(|_, w| w.strong_count() > 0);
-        cache.insert(shader.to_string(), Arc::downgrade(&pipeline));
+        let entry: Arc<dyn std::any::Any + Send + Sync> = pipeline.clone();
+        cache.insert(shader.to_string(), Arc::downgrade(&entry));
         Ok(pipeline)
     }
 

@@ -184,7 +184,7 @@ impl Buffer {
             MemoryLocation::CpuToGpu,
         )?;
         staging.write(data)?;
-        self.ctx.copy_now(&staging, self, bytes)
+        copy_now(&self.ctx, &staging, self, bytes)
     }
 
     /// Reads the first `out.len()` elements of this device-local buffer back through a staging
@@ -201,7 +201,7 @@ impl Buffer {
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
-        self.ctx.copy_now(self, &staging, bytes)?;
+        copy_now(&self.ctx, self, &staging, bytes)?;
         staging.read_into(out)
     }
 
@@ -420,4 +420,54 @@ pub fn format_bytes(format: vk::Format) -> u64 {
         vk::Format::B8G8R8A8_UNORM => 4,
         other => panic!("format {other:?} not used by this engine"),
     }
+}
+
+/// Copies `bytes` from the start of `src` to the start of `dst` now and waits: a full
+/// barrier on each side (set-up work; what ran before and what runs after see the data).
+fn copy_now(ctx: &Context, src: &Buffer, dst: &Buffer, bytes: u64) -> Result<()> {
+    if bytes > src.size || bytes > dst.size {
+        return Err(Error::Invalid(format!(
+            "copy of {bytes} bytes from '{}' ({} bytes) to '{}' ({} bytes)",
+            src.name, src.size, dst.name, dst.size
+        )));
+    }
+    ctx.one_shot(|device, cmd| unsafe {
+        let all = vk::PipelineStageFlags::ALL_COMMANDS;
+        let barrier = vk::MemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+        device.cmd_pipeline_barrier(
+            cmd,
+            all,
+            all,
+            vk::DependencyFlags::empty(),
+            &[barrier],
+            &[],
+            &[],
+        );
+        device.cmd_copy_buffer(
+            cmd,
+            src.raw,
+            dst.raw,
+            &[vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: bytes,
+            }],
+        );
+        let after = barrier.dst_access_mask(
+            vk::AccessFlags::MEMORY_READ
+                | vk::AccessFlags::MEMORY_WRITE
+                | vk::AccessFlags::HOST_READ,
+        );
+        device.cmd_pipeline_barrier(
+            cmd,
+            all,
+            all | vk::PipelineStageFlags::HOST,
+            vk::DependencyFlags::empty(),
+            &[after],
+            &[],
+            &[],
+        );
+    })
 }

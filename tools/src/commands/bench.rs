@@ -5,10 +5,11 @@
 //! two mono renders, host CPU time) in `bench_loop.rs`.
 
 use anyhow::{bail, Result};
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::{HitGpu, RayGpu};
 use fovea_renderer::passes::raycast::RayCaster;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::scene::bvh::compressed::Bvh8;
 use fovea_renderer::scene::bvh::instanced::InstancingStats;

@@ -5,17 +5,16 @@
 
 use crate::camera_keys::CameraKeys;
 use anyhow::Result;
+use fovea_renderer::frame::{CameraPose, FrameInput, OffscreenSamples, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::raycast::RayCaster;
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, OffscreenSamples, RenderSettings, Renderer,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams,
 };
-use fovea_renderer::to_screen::{BlurSettings, BlurSpace};
+use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;

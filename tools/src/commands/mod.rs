@@ -4,6 +4,7 @@ mod bench_loop;
 pub mod bench_vp;
 pub mod debug_views;
 pub mod eval;
+pub mod gaze_eval;
 pub mod gen_scene;
 pub mod headsets;
 pub mod info;

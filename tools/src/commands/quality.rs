@@ -15,9 +15,11 @@ use crate::output::{
 };
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::passes::tonemap::ToneCurve;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -72,7 +74,23 @@ struct RunQuality {
     /// Mean temporal flicker over consecutive evaluated frames (`metrics::flicker_map`); null
     /// with a single evaluated frame.
     frame_flicker: Option<f64>,
+    /// With the latency model (`--latency-ms`, `--tracker-hz`, `--gaze-predict`), the same frames
+    /// judged where the eye is when they are shown: its gaze per evaluated frame (null without
+    /// gaze or off the image; such frames are left out), the rings around it, and the mean FLIP
+    /// of the innermost two rings around it (`foveal_flip_true_gaze`) and around the rendered
+    /// gaze (`foveal_flip`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_true: Option<Vec<Option<[f32; 2]>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rings_true_gaze: Option<Vec<RingMean>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    foveal_flip: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    foveal_flip_true_gaze: Option<f64>,
 }
+
+/// Rings of the fovea in `foveal_flip*`: the innermost two.
+const FOVEAL_RINGS: usize = 2;
 
 /// A combination the method cannot run (a denoiser or TAA on a space without temporal filters):
 /// listed in the table with the reason instead of silently left out.
@@ -109,6 +127,11 @@ struct Report<'a> {
     blur_sigma_at_30: f32,
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
+    /// With the latency model: its latency and predictor (the runs' report.json `gaze_latency`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    latency: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_predict: Option<String>,
     runs: &'a [RunQuality],
     refused: &'a [RefusedRun],
 }
@@ -176,6 +199,8 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     let ppd = flip_ppd(args)?;
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
+    // Checked before anything renders.
+    let model = args.profile.gaze_timing.model(&hmd)?;
     let (mut runs, mut refused) = (Vec::new(), Vec::new());
     for camera in args.cameras {
         let moving = camera == "moving";
@@ -220,8 +245,11 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                             camera_path::CameraMotion::Still
                         },
                         seed: args.seed,
-                        max_depth: fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
-                        exposure: 1.0,
+                        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
+                        // Every method is judged at one fixed exposure and curve, its
+                        // reference's (`tonemap_preview`).
+                        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+                        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
                         profile: args.profile.clone(),
                         debug_views: false,
                         denoiser,
@@ -258,6 +286,10 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         reference_spp: args.reference_spp,
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
         flip_ppd: ppd,
+        latency: model.as_ref().map(|m| m.describe()),
+        gaze_predict: model
+            .as_ref()
+            .map(|_| args.profile.gaze_timing.mode().name().to_string()),
         runs: &runs,
         refused: &refused,
     };
@@ -310,7 +342,7 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
         let reference = renderer.render_reference(
             &pose,
             args.reference_spp,
-            fovea_renderer::pipeline::REALTIME_MAX_DEPTH,
+            fovea_renderer::frame::REALTIME_MAX_DEPTH,
             |_| {},
         )?;
         let name = format!(
@@ -345,6 +377,10 @@ fn measure(
     // Per consecutive pair: flicker per ring and whole frame.
     let mut flickers: Vec<(Vec<Option<f64>>, Option<f64>)> = Vec::new();
     let mut previous: Option<(u32, Vec<u8>, Vec<u8>)> = None;
+    // With the latency model: the frames judged around the true gaze.
+    let latency = report.get("gaze_true").is_some();
+    let (mut evals_true, mut gazes_true, mut foveal, mut foveal_true) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (&f, reference) in evaluated.iter().zip(references) {
         let gaze = &report["gaze"][f as usize];
         let gaze = Vec2::new(
@@ -358,7 +394,7 @@ fn measure(
         let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?
             .to_rgba8()
             .into_raw();
-        let reference_displayed = tonemap_preview(reference, 1.0);
+        let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,
             &displayed,
@@ -367,6 +403,24 @@ fn measure(
             ppd,
         );
         add_flip(&mut eval, &flip);
+        if latency {
+            let g = &report["gaze_true"][f as usize];
+            let true_gaze = g[0]
+                .as_f64()
+                .zip(g[1].as_f64())
+                .map(|(x, y)| Vec2::new(x as f32, y as f32));
+            gazes_true.push(true_gaze.map(|g| g.to_array()));
+            let inner = |g: Vec2| {
+                Rings::new(args.width, args.height, g, args.rings).inner_mean(&flip, FOVEAL_RINGS)
+            };
+            if let Some(tg) = true_gaze {
+                let mut e = evaluate(reference, &test, args.width, args.height, tg, args.rings);
+                add_flip(&mut e, &flip);
+                evals_true.push(e);
+                foveal_true.extend(inner(tg));
+                foveal.extend(inner(gaze));
+            }
+        }
         if let Some((_, test_prev, reference_prev)) = previous.as_ref().filter(|p| p.0 + 1 == f) {
             let map = flicker_map(test_prev, &displayed, reference_prev, &reference_displayed);
             flickers.push((
@@ -385,6 +439,25 @@ fn measure(
             .sum::<Option<f64>>()
             .map(|s| s / v.len() as f64)
     };
+    let mean_of = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let rings_true_gaze = (latency && !evals_true.is_empty()).then(|| {
+        (0..args.rings)
+            .map(|i| RingMean {
+                ecc_inner: evals_true[0].rings[i].ecc_inner,
+                ecc_outer: evals_true[0].rings[i].ecc_outer,
+                rmse: mean(
+                    evals_true
+                        .iter()
+                        .map(|e| e.rings[i].metrics.rmse.map(|r| r * r))
+                        .collect(),
+                )
+                .map(f64::sqrt),
+                ssim: mean(evals_true.iter().map(|e| e.rings[i].metrics.ssim).collect()),
+                flip: mean(evals_true.iter().map(|e| e.rings[i].metrics.flip).collect()),
+                flicker: None,
+            })
+            .collect()
+    });
     let rings = (0..args.rings)
         .map(|i| RingMean {
             ecc_inner: evals[0].rings[i].ecc_inner,
@@ -434,6 +507,10 @@ fn measure(
         frame_flicker: (!flickers.is_empty())
             .then(|| mean(flickers.iter().map(|f| f.1).collect()))
             .flatten(),
+        gaze_true: latency.then_some(gazes_true),
+        rings_true_gaze,
+        foveal_flip: mean_of(&foveal),
+        foveal_flip_true_gaze: mean_of(&foveal_true),
     })
 }
 
@@ -524,6 +601,36 @@ fn markdown(r: &Report) -> String {
                     " {} |",
                     q.frame_flicker
                         .map_or("–".to_string(), |f| format!("{f:.4}"))
+                );
+            }
+            s.push('\n');
+        }
+        if let Some(first_true) = first.rings_true_gaze.as_ref() {
+            let _ = write!(
+                s,
+                "FLIP around the true gaze at display time ({}, predictor {})\n\n| method + denoiser, TAA |",
+                r.latency.as_deref().unwrap_or(""),
+                r.gaze_predict.as_deref().unwrap_or("")
+            );
+            for ring in first_true {
+                let _ = write!(s, " {:.0}–{:.0}° |", ring.ecc_inner, ring.ecc_outer);
+            }
+            let _ = writeln!(
+                s,
+                " foveal (2 rings), true gaze | foveal, rendered gaze |\n|---|{}---|---|",
+                "---|".repeat(first_true.len())
+            );
+            let cell = |v: Option<f64>| v.map_or("–".to_string(), |f| format!("{f:.4}"));
+            for q in &runs {
+                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                for ring in q.rings_true_gaze.iter().flatten() {
+                    let _ = write!(s, " {} |", cell(ring.flip));
+                }
+                let _ = writeln!(
+                    s,
+                    " {} | {} |",
+                    cell(q.foveal_flip_true_gaze),
+                    cell(q.foveal_flip)
                 );
             }
             s.push('\n');

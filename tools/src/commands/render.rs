@@ -7,8 +7,9 @@ use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::render_profile::RenderProfile;
 use anyhow::Result;
 use fovea_hal::GazeOrigin;
+use fovea_renderer::frame::FrameStats;
 use fovea_renderer::gpu_scene::GpuScene;
-use fovea_renderer::pipeline::{FrameStats, Renderer};
+use fovea_renderer::pipeline::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -31,7 +32,10 @@ pub struct RenderArgs<'a> {
     pub camera_path: crate::camera_path::CameraMotion,
     pub seed: u32,
     pub max_depth: u32,
-    pub exposure: f32,
+    /// `--exposure`: automatic (the default) or fixed.
+    pub exposure: fovea_renderer::passes::exposure::Exposure,
+    /// `--tone`: the display transform.
+    pub tone: fovea_renderer::passes::tonemap::ToneCurve,
     /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
     pub profile: RenderProfile,
     /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
@@ -85,6 +89,13 @@ struct Report {
     /// Of `gaze_centre`: frames whose gaze lay behind or outside a rendered eye's view (the
     /// source gave one, the frame foveated at the image centre).
     gaze_outside_view: u32,
+    /// With the latency model (`--latency-ms`, `--tracker-hz`, `--gaze-predict`): per frame
+    /// where the eye is at its display time (left eye's render pixels, null without gaze or off
+    /// the image), and the latency accounting.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_true: Option<Vec<Option<[f32; 2]>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_latency: Option<crate::gaze::LatencyLog>,
     device: String,
     width: u32,
     height: u32,
@@ -104,6 +115,12 @@ struct Report {
     rays: RayReport,
     max_depth: u32,
     seed: u32,
+    /// `auto` (metered and adapted), `auto+EV`/`auto-EV`, or the fixed exposure in stops.
+    exposure_mode: String,
+    /// The display transform (`--tone`).
+    tone: &'static str,
+    /// Per frame: the exposure multiplier its pixels were displayed with (both eyes share it).
+    exposure: Vec<f32>,
     /// Whether the camera moved (`camera_motion` says how).
     camera_path: bool,
     /// `still`, `orbit` or `keys` (a `--camera-path` file).
@@ -188,6 +205,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         totals: FrameStats::default(),
         ldr: Vec::new(),
         hdr: Vec::new(),
+        exposures: Vec::with_capacity(frames as usize),
     };
 
     let bar = ProgressBar::new(frames as u64);
@@ -199,6 +217,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut outside_view = 0u32;
+    let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
@@ -213,6 +232,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             GazeOrigin::Centre => 2,
         }] += 1;
         outside_view += u32::from(frame_gaze.reason.is_some());
+        if let Some(log) = &mut latency_log {
+            log.push(&frame_gaze);
+        }
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
@@ -274,6 +296,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         gaze_held: origins[1],
         gaze_centre: origins[2],
         gaze_outside_view: outside_view,
+        gaze_true: latency_log.as_ref().map(|l| l.true_pixels.clone()),
+        gaze_latency: latency_log,
         device: ctx.info.name.clone(),
         width,
         height,
@@ -288,6 +312,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         rays,
         max_depth: args.max_depth,
         seed: args.seed,
+        exposure_mode: exposure_name(&args.exposure),
+        tone: args.tone.name(),
+        exposure: out.exposures,
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
         visual_polar: match method.report {
@@ -347,10 +374,12 @@ struct FrameWriter<'a> {
     totals: FrameStats,
     ldr: Vec<u8>,
     hdr: Vec<[f32; 4]>,
+    exposures: Vec<f32>,
 }
 
 impl FrameWriter<'_> {
     fn write(&mut self, renderer: &Renderer, frame: u64) -> Result<()> {
+        self.exposures.push(renderer.frame_exposure(frame)?);
         for t in renderer.frame_timings(frame)? {
             *self.pass_sums.entry(t.name.to_string()).or_default() += t.ms;
         }
@@ -388,6 +417,16 @@ impl FrameWriter<'_> {
             debug.frame(frame as u32, renderer)?;
         }
         Ok(())
+    }
+}
+
+/// `--exposure` as the report names it: `auto`, `auto+EV`, or the fixed exposure in stops.
+pub fn exposure_name(exposure: &fovea_renderer::passes::exposure::Exposure) -> String {
+    use fovea_renderer::passes::exposure::Exposure;
+    match exposure {
+        Exposure::Auto(a) if a.compensation_ev == 0.0 => "auto".into(),
+        Exposure::Auto(a) => format!("auto{:+}", a.compensation_ev),
+        Exposure::Manual(m) => format!("{}", m.log2()),
     }
 }
 

@@ -6,13 +6,15 @@
 
 use super::render::RenderArgs;
 use crate::flip::{flip_image, flip_map};
+use crate::metrics::Rings;
 use crate::output::{
     prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_png, write_text,
 };
 use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
 use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::pipeline::{RenderSettings, Renderer};
+use fovea_renderer::frame::RenderSettings;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::Serialize;
@@ -80,7 +82,16 @@ struct TraceResult {
     failed_frames: Vec<u32>,
     /// Pass → GPU ms now / in the baseline (report only).
     cost_ratio: BTreeMap<String, f64>,
+    /// With the latency model: mean FLIP against the reference of the innermost two rings
+    /// around the rendered gaze and around the true gaze at display time (report only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    foveal_flip: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    foveal_flip_true_gaze: Option<f64>,
 }
+
+/// Rings of the fovea in `foveal_flip*`: the innermost two.
+const FOVEAL_RINGS: usize = 2;
 
 #[derive(Serialize)]
 struct ReplayReport<'a> {
@@ -191,16 +202,20 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         Some(_) => read_exr(&Baseline::reference_exr(&base_dir))?.2,
         None => reference_for(args, &render, width, height)?,
     };
-    let reference_ldr = tonemap_preview(&reference, render.exposure);
     let ppd = pixels_per_degree(args, width)?;
     let passes: BTreeMap<String, f64> =
         serde_json::from_value(report["passes"].clone()).unwrap_or_default();
     let mut records = Vec::new();
     let mut checks = Vec::new();
+    let (mut foveal, mut foveal_true) = (Vec::new(), Vec::new());
     for k in 0..frames {
         let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?
             .to_rgba8()
             .into_raw();
+        // The reference displayed as the frame was: its exposure (automatic exposure moves it
+        // frame by frame) and its curve.
+        let exposure = report["exposure"][k as usize].as_f64().unwrap_or(1.0) as f32;
+        let reference_ldr = tonemap_preview(&reference, exposure, render.tone);
         let reference_flip = flip_map(&reference_ldr, &ldr, width, height, ppd);
         let g = &report["gaze"][k as usize];
         let gaze = Vec2::new(
@@ -259,7 +274,17 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
                     origin: &origin,
                 };
                 let flip = flip_map(&base_ldr, &ldr, width, height, ppd);
-                let check = check_frame(&images, &b.frames[k as usize], &flip, &args.tolerances);
+                let mut check =
+                    check_frame(&images, &b.frames[k as usize], &flip, &args.tolerances);
+                let g = &report["gaze_true"][k as usize];
+                if let (Some(x), Some(y)) = (g[0].as_f64(), g[1].as_f64()) {
+                    let true_gaze = Vec2::new(x as f32, y as f32);
+                    let rings = |g: Vec2| Rings::new(width, height, g, args.rings);
+                    check.gaze_true = Some(true_gaze.to_array());
+                    check.quality_flip_true_gaze = Some(rings(true_gaze).mean(&reference_flip));
+                    foveal_true.extend(rings(true_gaze).inner_mean(&reference_flip, FOVEAL_RINGS));
+                    foveal.extend(rings(gaze).inner_mean(&reference_flip, FOVEAL_RINGS));
+                }
                 if check.failed() {
                     write_png(
                         &run_dir.join(format!("frame_{k:04}_baseline.png")),
@@ -298,7 +323,10 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         write_json(&base_dir.join("baseline.json"), &new)?;
     }
     let b = baseline.as_ref();
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     Ok(TraceResult {
+        foveal_flip: mean(&foveal),
+        foveal_flip_true_gaze: mean(&foveal_true),
         trace: trace.into(),
         baseline: base_dir.display().to_string(),
         baseline_commit: b.map(|b| b.commit.clone()).unwrap_or_default(),
@@ -347,6 +375,7 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
         rings: args.rings,
         camera: format!("{:?}", r.camera),
         environment: r.profile.environment.describe(),
+        gaze_timing: crate::gaze::describe_timing(&r.profile.gaze_timing),
     }
 }
 
@@ -476,6 +505,11 @@ fn markdown(r: &ReplayReport) -> String {
                 );
             }
             s += &format!("\nImages of failing frames: `run_{}/frame_NNNN.png` (now), `_baseline.png`, `_flip.png` (FLIP map).\n\n", trace_name(&t.trace));
+        }
+        if let (Some(rendered), Some(seen)) = (t.foveal_flip, t.foveal_flip_true_gaze) {
+            s += &format!(
+                "Latency model: mean FLIP of the innermost two rings {rendered:.4} around the rendered gaze, {seen:.4} around the true gaze at display time.\n\n"
+            );
         }
         if !t.cost_ratio.is_empty() {
             let costs: Vec<String> = t

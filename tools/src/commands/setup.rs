@@ -10,9 +10,11 @@ use crate::projection::EyeRig;
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::{Eye, EyeView, HmdDescription};
-use fovea_renderer::passes::denoise::taa::TaaMode;
+use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::passes::denoise::DenoiserSettings;
-use fovea_renderer::pipeline::{CameraPose, FrameInput, RenderSettings, ViewInput};
+use fovea_renderer::passes::exposure::{AutoExposure, Exposure};
+use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
 use glam::{UVec2, Vec3};
@@ -92,7 +94,8 @@ impl Setup {
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
         let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
-        let gaze = GazeDriver::open(args.gaze, &hmd, width, height)?;
+        let timing = &args.profile.gaze_timing;
+        let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
         let rig = EyeRig {
             projection: args.camera.projection,
             hmd: hmd.clone(),
@@ -179,7 +182,10 @@ impl Setup {
                 gaze: Some(gaze.pixels[eye.index()]),
             };
         }
-        Ok((FrameInput::views(&views[..eyes.len()], frame)?, gaze))
+        let mut input = FrameInput::views(&views[..eyes.len()], frame)?;
+        // Frames follow each other at the headset's refresh (the camera path's clock too).
+        input.frame_seconds = 1.0 / self.hmd.refresh_hz;
+        Ok((input, gaze))
     }
 }
 
@@ -187,9 +193,9 @@ impl Setup {
 /// closed room never escapes, so each vertex costs another trace of the whole frame: a huge value
 /// never finishes a frame (and trips a GPU watchdog). 64 is 20× the real-time default of 3.
 pub const MAX_DEPTH_LIMIT: u32 = 64;
-/// `--exposure` range: 10⁻⁴ to 10⁴ (±13 stops). Outside it (and at 0, negative or non-finite)
-/// the tonemapped frame is all black or blown out.
-pub const EXPOSURE_RANGE: (f32, f32) = (1e-4, 1e4);
+/// `--exposure` range in stops: ±13 (multipliers 10⁻⁴ to 10⁴). Beyond it the tonemapped frame is
+/// all black or blown out.
+pub const EXPOSURE_STOPS: f32 = 13.0;
 /// The smallest Visual-Polar screen and grid per axis: one grid column would put every sample on
 /// one ring around the gaze (all of the screen at one eccentricity), one row every sample on one
 /// ray from it, either a flat, meaningless frame; a screen one pixel across has no periphery on
@@ -200,15 +206,62 @@ pub const MIN_VP_GRID: u32 = 2;
 pub const MAX_VP_RADIUS_DIAGONALS: f32 = 10.0;
 
 /// `--max-depth` and `--exposure` (`fovea render`, `view` and `xr`).
-pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
+pub fn check_settings(max_depth: u32, exposure: &Exposure) -> Result<()> {
     if !(1..=MAX_DEPTH_LIMIT).contains(&max_depth) {
         bail!("--max-depth {max_depth} must be in 1..={MAX_DEPTH_LIMIT} (path vertices: 1 = emission seen directly)");
     }
-    let (lo, hi) = EXPOSURE_RANGE;
-    if !(exposure.is_finite() && (lo..=hi).contains(&exposure)) {
-        bail!("--exposure {exposure:?} must be a finite multiplier in [{lo:e}, {hi:e}] (outside it the frame is all black or blown out)");
+    let within = |stops: f32| stops.is_finite() && stops.abs() <= EXPOSURE_STOPS;
+    match exposure {
+        Exposure::Manual(m) if !(*m > 0.0 && within(m.log2())) => {
+            bail!("--exposure: a multiplier of {m:?} is outside ±{EXPOSURE_STOPS} stops (the frame would be all black or blown out)")
+        }
+        Exposure::Auto(a) if !within(a.compensation_ev) => bail!(
+            "--exposure auto{:+}: the compensation must be within ±{EXPOSURE_STOPS} stops",
+            a.compensation_ev
+        ),
+        Exposure::Auto(a) => a.validate().context("--exposure")?,
+        Exposure::Manual(_) => {}
     }
     Ok(())
+}
+
+/// `--exposure`: `auto` (metered from every frame, adapted over time), `auto+EV` / `auto-EV`
+/// (metered, then EV stops brighter or darker), or a fixed exposure of EV stops (0: radiance
+/// displayed as it is; each stop doubles it).
+pub fn parse_exposure(text: &str) -> Result<Exposure> {
+    let stops = |s: &str| -> Result<f32> {
+        let ev: f32 = s.trim().parse().map_err(|_| {
+            anyhow::anyhow!(
+                "--exposure {text:?}: expected auto, auto+EV, auto-EV or EV (stops, a number)"
+            )
+        })?;
+        if !(ev.is_finite() && ev.abs() <= EXPOSURE_STOPS) {
+            bail!(
+                "--exposure {text:?}: EV must be a finite number of stops within ±{EXPOSURE_STOPS}"
+            );
+        }
+        Ok(ev)
+    };
+    let exposure = match text.trim().strip_prefix("auto") {
+        Some("") => Exposure::auto(),
+        Some(rest) if rest.starts_with(['+', '-']) => Exposure::Auto(AutoExposure {
+            compensation_ev: stops(rest)?,
+            ..AutoExposure::default()
+        }),
+        Some(_) => bail!("--exposure {text:?}: expected auto, auto+EV, auto-EV or EV (stops)"),
+        None => Exposure::stops(stops(text)?),
+    };
+    Ok(exposure)
+}
+
+/// `--tone`: the display transform's name (`ToneCurve::NAMES`).
+pub fn parse_tone(text: &str) -> Result<ToneCurve> {
+    ToneCurve::from_name(text).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--tone {text:?}: expected one of {}",
+            ToneCurve::NAMES.join(", ")
+        )
+    })
 }
 
 /// What the Visual-Polar mapping needs of the screen `method` renders: a screen and a grid of at
@@ -289,7 +342,7 @@ pub fn check_common(args: &RenderArgs) -> Result<()> {
         bail!("--scale {} must be in (0, 4]", args.scale);
     }
     method(args.method)?;
-    check_settings(args.max_depth, args.exposure)
+    check_settings(args.max_depth, &args.exposure)
 }
 
 /// A headset eye's recommended size × `--scale`, at least one pixel per axis.
@@ -308,6 +361,7 @@ pub fn render_settings(
         max_depth: args.max_depth,
         seed: args.seed,
         exposure: args.exposure,
+        tone_curve: args.tone,
         blur: args.profile.blur,
         denoiser,
         taa,
@@ -326,12 +380,7 @@ pub fn filters(
     taa: &str,
     profile: &RenderProfile,
 ) -> Result<(DenoiserSettings, TaaMode)> {
-    let denoiser_settings = match DenoiserSettings::parse(denoiser).context("--denoiser")? {
-        DenoiserSettings::Svgf(_) => DenoiserSettings::Svgf(profile.svgf),
-        DenoiserSettings::Asvgf(_) => DenoiserSettings::Asvgf(profile.asvgf),
-        DenoiserSettings::Bmfr(_) => DenoiserSettings::Bmfr(profile.bmfr),
-        other => other,
-    };
+    let denoiser_settings = profile.denoisers.get(denoiser).context("--denoiser")?;
     let taa_mode = TaaMode::parse(taa)
         .context("--taa")?
         .with_settings(profile.taa);

@@ -12,12 +12,13 @@ use crate::viewer::debug::{compose, DebugView};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
+use fovea_renderer::frame::{
+    CameraPose, FrameInput, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::CameraPose;
-use fovea_renderer::pipeline::{
-    FrameInput, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
-};
+use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{Mat4, Quat, UVec2, Vec2, Vec3};
 use gpu_allocator::MemoryLocation;
@@ -45,7 +46,8 @@ pub struct ViewArgs<'a> {
     pub debug_view: DebugView,
 }
 
-const DENOISERS: &[&str] = &["none", "svgf", "asvgf", "bmfr"];
+/// Key d cycles through every registered denoiser (and none).
+const DENOISERS: &[&str] = DenoiserSettings::NAMES;
 const TAAS: &[&str] = &["off", "vp", "screen"];
 
 pub fn run(args: &ViewArgs) -> Result<()> {
@@ -407,7 +409,7 @@ impl Viewer<'_> {
         if self.args.frames.is_none() && eye != self.setup.screen() && eye.x > 0 {
             self.setup.width = eye.x;
             self.setup.height = eye.y;
-            self.setup.start_pose = fovea_renderer::pipeline::CameraPose {
+            self.setup.start_pose = fovea_renderer::frame::CameraPose {
                 fov_tan: scaled_fov(self.setup.start_pose.fov_tan, eye),
                 ..self.setup.start_pose
             };

@@ -17,11 +17,12 @@ use fovea_hal::openxr::{
     xr, GazeActions, OpenXrGaze, OpenXrRuntime, RuntimeFigures, SessionEnd, SessionOwner,
 };
 use fovea_hal::{Eye, GazeOrigin, HmdDescription};
+use fovea_renderer::frame::{
+    CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, ViewInput, MAX_VIEWS,
+};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
-use fovea_renderer::pipeline::{
-    CameraPose, FrameInput, FrameStats, FrameTarget, RenderSettings, Renderer, ViewInput, MAX_VIEWS,
-};
+use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
@@ -239,16 +240,23 @@ impl<'a> XrRun<'a> {
             (hmd, figures, None)
         };
         let eye_size = scaled_eye_size(hmd.eye(Eye::Left), r.scale);
+        let timing = &r.profile.gaze_timing;
         let (driver, timebase, gaze_source) = match source {
-            Some(gaze) => (
-                GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1),
-                Timebase::Runtime,
-                "openxr".to_string(),
-            ),
+            Some(gaze) => {
+                if timing.latency_ms.is_some() || timing.tracker_hz.is_some() {
+                    bail!("--latency-ms and --tracker-hz model the latency of recorded or simulated gaze; the runtime's eye tracker has its own (--gaze-predict applies)");
+                }
+                let driver = GazeDriver::from_source(Box::new(gaze), &hmd, eye_size.0, eye_size.1);
+                let driver = match timing.predict {
+                    Some(mode) => driver.with_live_prediction(mode),
+                    None => driver,
+                };
+                (driver, Timebase::Runtime, "openxr".to_string())
+            }
             None => {
                 let spec = args.gaze.unwrap_or("center");
                 (
-                    GazeDriver::open(spec, &hmd, eye_size.0, eye_size.1)?,
+                    GazeDriver::open_timed(spec, &hmd, eye_size.0, eye_size.1, timing)?,
                     Timebase::FromFirstFrame,
                     spec.to_string(),
                 )
@@ -352,6 +360,7 @@ impl<'a> XrRun<'a> {
                 }
             };
             row.frame = self.tally.frames;
+            row.predicted_display_period_ns = state.predicted_display_period.as_nanos();
             row.cpu_ms = host.elapsed().as_secs_f64() * 1e3;
             self.tally.frames += 1;
             if engine_frame.is_some() {
@@ -424,6 +433,7 @@ impl<'a> XrRun<'a> {
         let row = FrameRow {
             frame: 0,
             predicted_display_time_ns: t,
+            predicted_display_period_ns: 0,
             should_render: true,
             rendered: true,
             views: vec![
@@ -624,6 +634,7 @@ fn gaze_row(g: &XrFrameGaze) -> GazeRow {
         age_ns: g.age_ns,
         pixels: [g.pixels[0].to_array(), g.pixels[1].to_array()],
         reason: g.reason,
+        latency: g.latency,
     }
 }
 

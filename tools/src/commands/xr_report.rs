@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use ash::vk;
 use fovea_hal::openxr::{OpenXrRuntime, RuntimeFigures, SessionEnd};
 use fovea_hal::HmdDescription;
-use fovea_renderer::pipeline::FrameStats;
+use fovea_renderer::frame::FrameStats;
 use serde::Serialize;
 use std::collections::BTreeMap;
 

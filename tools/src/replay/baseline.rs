@@ -31,6 +31,10 @@ pub struct Params {
     pub camera: String,
     #[serde(default)]
     pub environment: String,
+    /// The latency model's flags (`--latency-ms`, `--tracker-hz`, `--gaze-predict`); empty
+    /// without one (and in older baselines).
+    #[serde(default)]
+    pub gaze_timing: String,
 }
 
 #[derive(Serialize, Deserialize, Clone, Debug)]

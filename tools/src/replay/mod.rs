@@ -64,6 +64,12 @@ pub struct FrameCheck {
     pub origin: String,
     pub origin_baseline: String,
     pub gaze_differs: bool,
+    /// With the latency model: where the eye is at the frame's display time (left eye's render
+    /// pixels) and the frame's FLIP against the reference per ring around it (report only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gaze_true: Option<[f32; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality_flip_true_gaze: Option<Vec<Option<f64>>>,
 }
 
 impl FrameCheck {
@@ -164,5 +170,7 @@ pub fn check_frame(
         origin_baseline: base.origin.clone(),
         gaze_differs: (images.gaze - gaze_baseline).length() as f64 > tol.gaze_px
             || images.origin != base.origin,
+        gaze_true: None,
+        quality_flip_true_gaze: None,
     }
 }

@@ -67,12 +67,43 @@ pub struct GazeRow {
     pub pixels: [[f32; 2]; 2],
     /// Why the centre is used although a gaze was available.
     pub reason: Option<&'static str>,
+    /// Latency accounting of the gaze.
+    pub latency: LatencyRow,
+}
+
+/// Which sample a frame's gaze rests on, what the predictor made of it, and the parts of the
+/// sample-to-photon latency that the runtime and the headset profile give.
+#[derive(Serialize, Clone, Copy, Debug, PartialEq)]
+pub struct LatencyRow {
+    /// `--gaze-predict`: off | hold | linear | saccade.
+    pub gaze_predict: &'static str,
+    /// What the predictor took the eye to be doing (fixation, pursuit, saccade, blink, newest);
+    /// null without a predictor.
+    pub motion: Option<&'static str>,
+    /// The predicted gaze (VIEW space, before the invalid-gaze policy and the projection); null
+    /// without a predictor or while it has none (a blink).
+    pub predicted: Option<[f32; 3]>,
+    /// Display time − the time of the newest sample behind the gaze (ms): how far ahead the
+    /// prediction reaches; null when the sample time is unknown.
+    pub horizon_ms: Option<f64>,
+    /// From the runtime: predicted display time − the sample's time as it returned it (ms; null
+    /// when it cannot say).
+    pub runtime_sample_age_ms: Option<f64>,
+    /// From the headset profile: the tracker's delay, render and display latency (ms; the last
+    /// two null for a profile without [latency]).
+    pub profile_tracker_ms: f32,
+    pub profile_render_ms: Option<f32>,
+    pub profile_display_ms: Option<f32>,
+    /// The latency model's total (ms) when recorded or simulated gaze runs through it.
+    pub model_total_ms: Option<f64>,
 }
 
 #[derive(Serialize, Clone, Debug)]
 pub struct FrameRow {
     pub frame: u64,
     pub predicted_display_time_ns: i64,
+    /// xrWaitFrame's predicted display period (the runtime's frame interval).
+    pub predicted_display_period_ns: i64,
     pub should_render: bool,
     /// Both eyes rendered and submitted in a projection layer (false: ended without layers —
     /// shouldRender false, views not located, or the session stopping).
@@ -92,6 +123,7 @@ impl FrameRow {
         FrameRow {
             frame: 0,
             predicted_display_time_ns,
+            predicted_display_period_ns: 0,
             should_render,
             rendered: false,
             views: Vec::new(),

@@ -4,6 +4,7 @@
 //! eye with that frame's located views; optionally recorded (`--record`) so `fovea render --gaze
 //! TRACE.csv` replays the session.
 
+use super::frame_log::LatencyRow;
 use crate::gaze::{project_gaze, GazeDriver};
 use anyhow::{Context, Result};
 use fovea_hal::openxr::xr;
@@ -37,10 +38,13 @@ pub struct XrFrameGaze {
     pub pixels: [Vec2; 2],
     /// Why the centre is used although a gaze was available (behind or outside an eye's view).
     pub reason: Option<&'static str>,
+    pub latency: LatencyRow,
 }
 
 pub struct XrGaze {
     driver: GazeDriver,
+    /// The `--headset` TOML: the latency figures the runtime does not give.
+    profile: HmdDescription,
     /// The `--headset` TOML's refresh period: the recording's frame timebase.
     record_period_ns: f64,
     timebase: Timebase,
@@ -67,6 +71,7 @@ impl XrGaze {
         };
         Ok(XrGaze {
             driver,
+            profile: base.clone(),
             record_period_ns: 1e9 / base.refresh_hz as f64,
             timebase,
             first_display_time: None,
@@ -89,6 +94,12 @@ impl XrGaze {
             Timebase::FromFirstFrame => display_time - first,
         };
         let (sample, resolved) = self.driver.resolve_at(t)?;
+        let latency = self.latency_row(t, &sample);
+        // A live predictor's sample carries the runtime's time only when the runtime gave one.
+        let unknown = match (self.driver.latency_model(), self.driver.last_delayed()) {
+            (None, Some(frame)) => frame.truth.time_kind == SampleTimeKind::Unknown,
+            _ => sample.time_kind == SampleTimeKind::Unknown,
+        };
         let mut gaze = XrFrameGaze {
             direction: resolved.direction,
             origin: resolved.source,
@@ -96,9 +107,10 @@ impl XrGaze {
             age_ns: resolved.age_ns,
             pixels: [Vec2::new(size.0 as f32, size.1 as f32) * 0.5; 2],
             reason: None,
+            latency,
         };
         gaze.sample_time_ns = match resolved.source {
-            GazeOrigin::Live if sample.time_kind == SampleTimeKind::Unknown => None,
+            GazeOrigin::Live if unknown => None,
             GazeOrigin::Live | GazeOrigin::Held => Some(t - resolved.age_ns),
             GazeOrigin::Centre => None,
         };
@@ -122,6 +134,38 @@ impl XrGaze {
         }
         self.record(render_index, &gaze)?;
         Ok(gaze)
+    }
+
+    /// The frame's latency accounting; `t` in the source's timebase, `sample` what the driver
+    /// gave the invalid-gaze policy.
+    fn latency_row(&self, t: XrTime, sample: &GazeSample) -> LatencyRow {
+        let hmd = &self.profile;
+        let ms = |ns: i64| ns as f64 * 1e-6;
+        let frame = self.driver.last_delayed();
+        // The runtime's own sample: the live predictor's input, or what the driver gave.
+        let runtime = match (self.timebase, self.driver.latency_model(), frame) {
+            (Timebase::Runtime, None, Some(f)) => Some(f.truth),
+            (Timebase::Runtime, _, None) => Some(*sample),
+            _ => None,
+        };
+        let known = |s: &GazeSample| s.time != 0 && s.time_kind != SampleTimeKind::Unknown;
+        LatencyRow {
+            gaze_predict: self.driver.predict_mode().name(),
+            motion: frame.map(|f| f.prediction.motion.name()),
+            predicted: frame.and_then(|f| f.prediction.direction.map(|d| d.to_array())),
+            horizon_ms: match frame {
+                Some(f) if f.prediction.sample_time != 0 => Some(ms(f.prediction.horizon_ns)),
+                Some(_) => None,
+                None => known(sample).then(|| ms(t - sample.time)),
+            },
+            runtime_sample_age_ms: runtime
+                .filter(|s| s.valid && known(s))
+                .map(|s| ms(t - s.time)),
+            profile_tracker_ms: hmd.tracker.latency_ms,
+            profile_render_ms: hmd.latency.map(|l| l.render_ms),
+            profile_display_ms: hmd.latency.map(|l| l.display_ms),
+            model_total_ms: self.driver.latency_model().map(|m| m.total_ms()),
+        }
     }
 
     fn record(&mut self, render_index: u32, gaze: &XrFrameGaze) -> Result<()> {

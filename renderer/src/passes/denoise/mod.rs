@@ -1,180 +1,239 @@
-//! Denoisers (design: shared/design/denoisers.md). They run in the sampling grid between the
-//! tracer and the way to the screen — texel = sample, in Cartesian and Visual-Polar space alike —
-//! and return re-modulated radiance of the grid's size. Each is a sibling module here (SVGF; TAA,
-//! which runs after the denoiser; BMFR; A-SVGF fits beside them), one pass = one module + one
-//! shader (a variant per sampling space, `shaders/passes/denoise/`) + one push-constant struct
-//! in `layouts.glsl`; the grid addressing they share is `shaders/denoise/grid.glsl`.
+//! Denoisers (design: shared/design/denoisers.md). They run in the sampling grid between the tracer and
+//! the way back to the screen — texel = sample, in Cartesian and Visual-Polar space alike — and
+//! return re-modulated radiance of the grid's size. A denoiser is one module here (SVGF, A-SVGF,
+//! BMFR; TAA, which runs after them, is `passes::taa`) whose parameters implement
+//! `DenoiserParams` and whose per-eye state implements `Denoiser`, its shaders (one pass = one
+//! `Pass` + one shader, a variant per sampling space, `shaders/passes/denoise/`, + one
+//! push-constant struct in `layouts.glsl`; the grid addressing they share is
+//! `shaders/denoise/grid.glsl`), and one entry in `registry!` below: the `--denoiser` names, the
+//! viewer's key cycle and the render profile's sections all come from it.
 
 pub mod asvgf;
 pub mod bmfr;
+mod denoiser;
 pub mod modulate;
 pub mod svgf;
-pub mod taa;
-pub mod taa_screen;
+
+pub use denoiser::{Denoiser, DenoiserParams, OtherParams};
 
 use crate::error::{Error, Result};
-use crate::graph::FrameRecorder;
-use crate::layouts::SamplingParams;
-use crate::passes::trace::{GBuffer, GradientTargets, TileList};
-use crate::vk::{Buffer, Context, Image};
-use asvgf::{Asvgf, AsvgfSettings};
-use bmfr::{Bmfr, BmfrSettings};
-use glam::{UVec2, Vec3};
+use crate::vk::Context;
+use denoiser::ErasedParams;
+use glam::UVec2;
+use std::any::Any;
 use std::sync::Arc;
-use svgf::{Svgf, SvgfSettings};
 
-/// Which denoiser runs after the tracer (`fovea render --denoiser`).
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub enum DenoiserSettings {
-    /// The tracer's 1-sample colour goes to the screen as is.
-    #[default]
-    None,
-    Svgf(SvgfSettings),
-    Asvgf(AsvgfSettings),
-    Bmfr(BmfrSettings),
+/// Defines `DenoiserSettings` (a variant per registered denoiser, holding its parameters) and
+/// what is listed over the registry: the names, the defaults, the profile sections.
+macro_rules! registry {
+    ($($variant:ident($params:ty)),+ $(,)?) => {
+        /// Which denoiser runs after the tracer (`fovea render --denoiser`), with its parameters.
+        #[derive(Clone, Copy, Debug, PartialEq, Default)]
+        pub enum DenoiserSettings {
+            /// The tracer's colour goes to the screen as is.
+            #[default]
+            None,
+            $($variant($params),)+
+        }
+
+        $(impl From<$params> for DenoiserSettings {
+            fn from(params: $params) -> Self {
+                DenoiserSettings::$variant(params)
+            }
+        })+
+
+        impl DenoiserSettings {
+            /// The names `parse` accepts: `none`, then the registry's, in its order.
+            pub const NAMES: &'static [&'static str] =
+                &["none", $(<$params as DenoiserParams>::NAME),+];
+
+            fn params(&self) -> Option<&dyn ErasedParams> {
+                match self {
+                    DenoiserSettings::None => None,
+                    $(DenoiserSettings::$variant(p) => Some(p),)+
+                }
+            }
+
+            fn params_mut(&mut self) -> Option<&mut dyn ErasedParams> {
+                match self {
+                    DenoiserSettings::None => None,
+                    $(DenoiserSettings::$variant(p) => Some(p),)+
+                }
+            }
+
+            /// The registered denoiser whose render-profile section is `section`, its parameters
+            /// read from `de` onto its defaults; `None` when no denoiser has that section.
+            pub fn deserialize_section<'de, D: serde::Deserializer<'de>>(
+                section: &str,
+                de: D,
+            ) -> std::result::Result<Option<DenoiserSettings>, D::Error> {
+                $(if section == <$params as DenoiserParams>::NAME {
+                    let params = <$params as serde::Deserialize>::deserialize(de)?;
+                    return Ok(Some(params.into()));
+                })+
+                Ok(None)
+            }
+        }
+
+        impl Default for DenoiserProfile {
+            fn default() -> Self {
+                DenoiserProfile {
+                    settings: vec![$(<$params>::default().into()),+],
+                }
+            }
+        }
+    };
+}
+
+// The registry: one `DenoiserSettings` variant per denoiser and its parameters type, in the
+// order `--denoiser`, the viewer's cycle and the profile list them.
+registry! {
+    Svgf(svgf::SvgfSettings),
+    Asvgf(asvgf::AsvgfSettings),
+    Bmfr(bmfr::BmfrSettings),
 }
 
 impl DenoiserSettings {
-    /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["none", "svgf", "asvgf", "bmfr"];
-
     /// A denoiser by name, with its defaults.
     pub fn parse(name: &str) -> Result<DenoiserSettings> {
-        match name {
-            "none" => Ok(DenoiserSettings::None),
-            "svgf" => Ok(DenoiserSettings::Svgf(SvgfSettings::default())),
-            "asvgf" => Ok(DenoiserSettings::Asvgf(AsvgfSettings::default())),
-            "bmfr" => Ok(DenoiserSettings::Bmfr(BmfrSettings::default())),
-            other => Err(Error::Invalid(format!(
-                "denoiser '{other}': expected one of {}",
-                Self::NAMES.join(", ")
-            ))),
-        }
+        DenoiserProfile::default().get(name)
     }
 
     pub fn name(&self) -> &'static str {
-        match self {
-            DenoiserSettings::None => "none",
-            DenoiserSettings::Svgf(_) => "svgf",
-            DenoiserSettings::Asvgf(_) => "asvgf",
-            DenoiserSettings::Bmfr(_) => "bmfr",
-        }
+        self.params().map_or("none", |p| p.name())
     }
 
     /// Whether the tracer must re-shade gradient samples (its `*_gradients` variant) and keep
     /// the visibility they are projected from.
     pub fn needs_gradients(&self) -> bool {
-        matches!(self, DenoiserSettings::Asvgf(_))
+        self.params().is_some_and(|p| p.needs_gradients())
     }
-}
 
-/// The sampling space of this frame and of the previous one (its gaze differs; `None` when there
-/// is no usable previous frame, which drops all history).
-#[derive(Clone, Copy)]
-pub struct DenoiseFrame<'a> {
-    pub current: SamplingParams,
-    pub previous: Option<SamplingParams>,
-    /// The view's sampling table: this frame's (`SamplingSpace::sampling_table`) followed by the
-    /// previous frame's of the same length (the screen-clipped layout's kernels read both
-    /// frames' arcs from it).
-    pub sampling_table: &'a Buffer,
-    /// The trace's tiles this frame: filters that work per texel run over the live ones (the
-    /// idle ones hold no traced sample) and write what later frames read of the idle ones.
-    pub tiles: TileList<'a>,
-}
+    pub fn validate(&self) -> Result<()> {
+        self.params().map_or(Ok(()), |p| p.validate())
+    }
 
-/// What a denoiser may need from the scene besides the G-buffer.
-#[derive(Clone, Copy)]
-pub struct DenoiseScene<'a> {
-    /// This frame's camera position in world space (the G-buffer's positions are relative to it;
-    /// BMFR accumulates positions across frames).
-    pub camera_origin: Vec3,
-    /// The scene's materials (`MaterialGpu`; BMFR keeps emitters out of its fits).
-    pub materials: &'a Buffer,
-}
-
-/// A denoiser with its per-eye state.
-pub enum Denoiser {
-    Svgf(Box<Svgf>),
-    Asvgf(Box<Asvgf>),
-    Bmfr(Box<Bmfr>),
-}
-
-impl Denoiser {
+    /// The denoiser with its per-eye state for a grid of `grid` texels (`None` for none);
     /// `variant` is the sampling space's kernel variant (`SamplingSpace::shader_variant`).
-    pub fn new(
+    pub fn build(
+        &self,
         ctx: &Arc<Context>,
-        settings: &DenoiserSettings,
         grid: UVec2,
         variant: &str,
-    ) -> Result<Option<Denoiser>> {
-        Ok(match settings {
-            DenoiserSettings::None => None,
-            DenoiserSettings::Svgf(s) => {
-                Some(Denoiser::Svgf(Box::new(Svgf::new(ctx, grid, variant, *s)?)))
+    ) -> Result<Option<Box<dyn Denoiser>>> {
+        self.params()
+            .map(|p| p.build(ctx, grid, variant))
+            .transpose()
+    }
+}
+
+/// Every registered denoiser's parameters, in the registry's order: its defaults, then what a
+/// render profile's sections give (`set`, `complete`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenoiserProfile {
+    settings: Vec<DenoiserSettings>,
+}
+
+impl DenoiserProfile {
+    /// Replaces one denoiser's parameters (a profile section, `deserialize_section`).
+    pub fn set(&mut self, settings: DenoiserSettings) {
+        if let Some(slot) = self
+            .settings
+            .iter_mut()
+            .find(|s| s.name() == settings.name())
+        {
+            *slot = settings;
+        }
+    }
+
+    /// Completes each denoiser's parameters from the others' (`DenoiserParams::complete`), once
+    /// every section is set.
+    pub fn complete(&mut self) {
+        let others = self.clone();
+        for settings in &mut self.settings {
+            if let Some(p) = settings.params_mut() {
+                p.complete(&others);
             }
-            DenoiserSettings::Asvgf(s) => Some(Denoiser::Asvgf(Box::new(Asvgf::new(
-                ctx, grid, variant, *s,
-            )?))),
-            DenoiserSettings::Bmfr(s) => {
-                Some(Denoiser::Bmfr(Box::new(Bmfr::new(ctx, grid, variant, *s)?)))
-            }
-        })
-    }
-
-    /// GPU bytes of the history carried between frames.
-    pub fn history_bytes(&self) -> u64 {
-        match self {
-            Denoiser::Svgf(s) => s.history.bytes(),
-            Denoiser::Asvgf(a) => a.history_bytes(),
-            Denoiser::Bmfr(b) => b.history.bytes(),
         }
     }
 
-    /// Dispatches one frame records at most.
-    pub fn max_passes(&self) -> u32 {
-        match self {
-            Denoiser::Svgf(s) => s.max_passes(),
-            Denoiser::Asvgf(a) => a.max_passes(),
-            Denoiser::Bmfr(b) => b.max_passes(),
-        }
+    /// Each denoiser's parameters, in the registry's order.
+    pub fn iter(&self) -> impl Iterator<Item = &DenoiserSettings> {
+        self.settings.iter()
     }
 
-    /// Records what must run before the tracer, while `gbuffer` still holds last frame (A-SVGF's
-    /// forward projection). `frame_data`: the frame's uniform buffer (both cameras).
-    pub fn record_before_trace(
-        &mut self,
-        rec: &mut FrameRecorder,
-        gbuffer: &GBuffer,
-        frame: &DenoiseFrame,
-        frame_data: &Buffer,
-    ) -> Result<()> {
-        match self {
-            Denoiser::Svgf(_) | Denoiser::Bmfr(_) => Ok(()),
-            Denoiser::Asvgf(a) => a.record_before_trace(rec, gbuffer, frame, frame_data),
+    /// Denoiser `name` (`none` or a registered one) with these parameters.
+    pub fn get(&self, name: &str) -> Result<DenoiserSettings> {
+        if name == "none" {
+            return Ok(DenoiserSettings::None);
         }
+        self.settings
+            .iter()
+            .find(|s| s.name() == name)
+            .copied()
+            .ok_or_else(|| {
+                Error::Invalid(format!(
+                    "denoiser '{name}': expected one of {}",
+                    DenoiserSettings::NAMES.join(", ")
+                ))
+            })
+    }
+}
+
+impl OtherParams for DenoiserProfile {
+    fn params(&self, name: &str) -> Option<&dyn Any> {
+        self.settings
+            .iter()
+            .find(|s| s.name() == name)
+            .and_then(|s| s.params())
+            .map(|p| p.as_any())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::de::value::{Error as ValueError, MapDeserializer};
+
+    #[test]
+    fn every_registered_name_parses_to_itself_and_unknown_names_list_them() {
+        assert_eq!(DenoiserSettings::NAMES, ["none", "svgf", "asvgf", "bmfr"]);
+        for &name in DenoiserSettings::NAMES {
+            assert_eq!(DenoiserSettings::parse(name).unwrap().name(), name);
+        }
+        let err = DenoiserSettings::parse("nlm").unwrap_err().to_string();
+        assert!(
+            err.contains("nlm") && err.contains("none, svgf, asvgf, bmfr"),
+            "{err}"
+        );
+        let gradients: Vec<_> = DenoiserSettings::NAMES
+            .iter()
+            .filter(|n| DenoiserSettings::parse(n).unwrap().needs_gradients())
+            .collect();
+        assert_eq!(gradients, [&"asvgf"]);
     }
 
-    /// What the tracer's gradient variant re-shades and writes (A-SVGF only).
-    pub fn gradient_targets(&self) -> Option<GradientTargets<'_>> {
-        match self {
-            Denoiser::Svgf(_) | Denoiser::Bmfr(_) => None,
-            Denoiser::Asvgf(a) => Some(a.gradient_targets()),
-        }
-    }
-
-    /// Records the denoiser over this frame's G-buffer; returns the denoised radiance (grid-sized).
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        gbuffer: &GBuffer,
-        frame: &DenoiseFrame,
-        scene: &DenoiseScene,
-    ) -> Result<&Image> {
-        match self {
-            Denoiser::Svgf(s) => s.record(rec, gbuffer, frame),
-            Denoiser::Asvgf(a) => a.record(rec, gbuffer, frame),
-            Denoiser::Bmfr(b) => b.record(rec, gbuffer, frame, scene),
-        }
+    /// A section sets its keys on the defaults, and A-SVGF's SVGF stages take `[svgf]`'s.
+    #[test]
+    fn profile_sections_read_onto_the_defaults_and_complete_each_other() {
+        let section = |name: &str, keys: Vec<(&'static str, f32)>| {
+            let de = MapDeserializer::<_, ValueError>::new(keys.into_iter());
+            DenoiserSettings::deserialize_section(name, de).unwrap()
+        };
+        let svgf = section("svgf", vec![("alpha_color", 0.5)]).unwrap();
+        let DenoiserSettings::Svgf(s) = svgf else {
+            panic!("{svgf:?}")
+        };
+        assert_eq!(s.alpha_color, 0.5);
+        assert_eq!(s.max_history, svgf::SvgfSettings::default().max_history);
+        assert_eq!(section("nlm", vec![]), None);
+        let mut profile = DenoiserProfile::default();
+        profile.set(svgf);
+        profile.complete();
+        let DenoiserSettings::Asvgf(a) = profile.get("asvgf").unwrap() else {
+            panic!("asvgf is registered")
+        };
+        assert_eq!(a.svgf, s);
+        assert_eq!(profile.get("none").unwrap(), DenoiserSettings::None);
     }
 }

@@ -1,22 +1,19 @@
 //! Re-modulation by albedo, the last step of every denoiser that filters demodulated radiance
-//! (SVGF, and A-SVGF/BMFR alike): filtered × albedo → radiance for the remap / tonemap.
+//! (SVGF, and A-SVGF/BMFR alike): filtered × albedo → radiance for the way back.
 
 use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
-use crate::vk::{ComputePipeline, Context, Image};
-use std::sync::Arc;
+use crate::passes::{Kernel, Pass};
+use crate::vk::Image;
 
-pub struct ModulatePass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Modulate;
+
+impl Kernel for Modulate {
+    const SHADER: &'static str = "passes/denoise/modulate";
+    type Push = ();
 }
 
-impl ModulatePass {
-    pub fn new(ctx: &Arc<Context>) -> Result<ModulatePass> {
-        Ok(ModulatePass {
-            pipeline: ComputePipeline::shared(ctx, "passes/denoise/modulate", 0)?,
-        })
-    }
-
+impl Pass<Modulate> {
     /// `pass` names the dispatch in the timing report (e.g. "svgf_modulate").
     pub fn record(
         &self,
@@ -31,12 +28,6 @@ impl ModulatePass {
             read_image("albedo", albedo),
             write_image("dst", dst),
         ];
-        rec.dispatch(
-            pass,
-            &self.pipeline,
-            &binds,
-            &[],
-            [dst.width, dst.height, 1],
-        )
+        self.dispatch(rec, pass, &binds, &(), [dst.width, dst.height, 1])
     }
 }

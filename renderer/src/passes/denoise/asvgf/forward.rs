@@ -6,68 +6,49 @@ use crate::error::{Error, Result};
 use crate::graph::{
     read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
 };
-use crate::layouts::{AsvgfForwardPush, SamplingParams};
-use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::layouts::AsvgfForwardPush;
+use crate::passes::grid::{GradientTargets, GridFrame};
+use crate::passes::{Kernel, Pass};
 use glam::UVec4;
-use std::sync::Arc;
 
-pub struct ForwardPass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Forward;
+
+impl Kernel for Forward {
+    const SHADER: &'static str = "passes/denoise/asvgf_forward";
+    type Push = AsvgfForwardPush;
 }
 
-impl ForwardPass {
-    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<ForwardPass> {
-        let shader = format!("passes/denoise/asvgf_forward.{variant}");
-        Ok(ForwardPass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                &shader,
-                std::mem::size_of::<AsvgfForwardPush>() as u32,
-            )?,
-        })
-    }
-
-    /// Reads last frame's samples from `g` (before the tracer overwrites it) and the cameras from
-    /// `frame_data`; fills `samples` (cleared before) and clears `gradient` (strata-sized).
-    /// `project: false` (no usable last frame) only clears.
-    #[allow(clippy::too_many_arguments)]
+impl Pass<Forward> {
+    /// Reads last frame's samples from the G-buffer (before the tracer overwrites it) and the
+    /// cameras from the frame data; fills `targets.samples` (cleared before) and clears
+    /// `targets.gradient` (strata-sized). `project: false` (no usable last frame) only clears.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame_data: &Buffer,
-        samples: &Buffer,
-        gradient: &Image,
-        space: &SamplingParams,
-        table: &Buffer,
+        frame: &GridFrame,
+        targets: &GradientTargets,
         project: bool,
     ) -> Result<()> {
+        let g = frame.gbuffer;
         let visibility = g
             .visibility
             .as_ref()
             .ok_or_else(|| Error::Invalid("A-SVGF needs a G-buffer with visibility".into()))?;
         let binds = [
-            read_buffer("frame", frame_data),
+            read_buffer("frame", frame.frame_data),
             read_image("radiance", &g.radiance),
             read_image("ids", &g.ids),
             read_image("position", &g.position),
             read_image("visibility", visibility),
-            write_buffer("gradient_samples", samples),
-            write_image("gradient", gradient),
-            read_texels("grid_columns", table),
+            write_buffer("gradient_samples", targets.samples),
+            write_image("gradient", targets.gradient),
+            read_texels("grid_columns", frame.sampling_table),
         ];
         let push = AsvgfForwardPush {
-            space: *space,
+            space: frame.current,
             config: UVec4::new(project as u32, 0, 0, 0),
         };
-        rec.dispatch(
-            "asvgf_forward",
-            &self.pipeline,
-            &binds,
-            push_bytes(&push),
-            [gradient.width, gradient.height, 1],
-        )
+        let size = [targets.gradient.width, targets.gradient.height, 1];
+        self.dispatch(rec, "asvgf_forward", &binds, &push, size)
     }
 }

@@ -12,72 +12,31 @@
 
 mod forward;
 mod gradient;
+mod settings;
 
-use super::svgf::{Svgf, SvgfSettings};
-use super::DenoiseFrame;
-use crate::error::{Error, Result};
+pub use settings::{AsvgfSettings, MAX_GRADIENT_ITERATIONS};
+
+use super::svgf::Svgf;
+use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::layouts::{AsvgfGradientSample, ASVGF_STRATUM};
-use crate::passes::trace::{GBuffer, GradientTargets};
+use crate::passes::denoise::svgf::SvgfSettings;
+use crate::passes::denoise::{Denoiser, DenoiserParams, OtherParams};
+use crate::passes::grid::{GradientTargets, GridFrame};
+use crate::passes::Pass;
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
-use forward::ForwardPass;
+use forward::Forward;
 use glam::UVec2;
 use gpu_allocator::MemoryLocation;
-use gradient::GradientPass;
+use gradient::Gradient;
 use std::sync::Arc;
-
-/// Gradient parameters; SVGF's own (`svgf`) apply to the filter after the adaptive α.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AsvgfSettings {
-    pub svgf: SvgfSettings,
-    /// À-trous iterations of the gradient reconstruction (5×5 taps, spacing 2^i strata).
-    pub gradient_iterations: u32,
-    /// Depth edge-stop σ_z of the reconstruction (as SVGF's).
-    pub gradient_sigma_depth: f32,
-    /// Normal edge-stop exponent σ_n of the reconstruction.
-    pub gradient_sigma_normal: f32,
-}
-
-impl Default for AsvgfSettings {
-    fn default() -> Self {
-        AsvgfSettings {
-            svgf: SvgfSettings::default(),
-            gradient_iterations: 4,
-            gradient_sigma_depth: 1.0,
-            gradient_sigma_normal: 128.0,
-        }
-    }
-}
-
-/// Most reconstruction iterations accepted: 2^7 strata apart spans any grid.
-pub const MAX_GRADIENT_ITERATIONS: u32 = 8;
-
-impl AsvgfSettings {
-    pub fn validate(&self) -> Result<()> {
-        self.svgf.validate()?;
-        let bad = |what: String| Err(Error::Invalid(format!("asvgf: {what}")));
-        if !(1..=MAX_GRADIENT_ITERATIONS).contains(&self.gradient_iterations) {
-            return bad(format!(
-                "gradient_iterations must be in 1..={MAX_GRADIENT_ITERATIONS}, got {}",
-                self.gradient_iterations
-            ));
-        }
-        let sigmas = [self.gradient_sigma_depth, self.gradient_sigma_normal];
-        if !sigmas.iter().all(|s| s.is_finite() && *s > 0.0) {
-            return bad(format!(
-                "gradient σ_z, σ_n must be finite and > 0, got {sigmas:?}"
-            ));
-        }
-        Ok(())
-    }
-}
 
 pub struct Asvgf {
     pub settings: AsvgfSettings,
     pub svgf: Svgf,
-    forward: ForwardPass,
-    gradient: GradientPass,
+    forward: Pass<Forward>,
+    gradient: Pass<Gradient>,
     /// One `AsvgfGradientSample` per stratum, cleared every frame (host-visible for inspection).
     pub samples: Buffer,
     /// Per stratum: δ, max f, 1 where the tracer re-shaded a sample (zeros elsewhere).
@@ -114,8 +73,8 @@ impl Asvgf {
         Ok(Asvgf {
             settings,
             svgf: Svgf::adaptive(ctx, grid, variant, settings.svgf)?,
-            forward: ForwardPass::new(ctx, variant)?,
-            gradient: GradientPass::new(ctx, variant)?,
+            forward: Pass::new(ctx, variant)?,
+            gradient: Pass::new(ctx, variant)?,
             samples: Buffer::new(
                 ctx,
                 "asvgf.gradient_samples",
@@ -141,26 +100,16 @@ impl Asvgf {
     }
 
     /// Before the tracer: clears the gradient samples and projects last frame's into them (none on
-    /// the first frame or without a previous frame). `frame_data` holds both cameras.
+    /// the first frame or without a previous frame).
     pub fn record_before_trace(
         &mut self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        frame_data: &Buffer,
+        frame: &GridFrame,
     ) -> Result<()> {
         rec.fill_buffer("asvgf_clear", &self.samples, 0)?;
         let project = self.frames > 0 && frame.previous.is_some();
-        self.forward.record(
-            rec,
-            g,
-            frame_data,
-            &self.samples,
-            &self.raw,
-            &frame.current,
-            frame.sampling_table,
-            project,
-        )
+        self.forward
+            .record(rec, frame, &self.gradient_targets(), project)
     }
 
     /// The tracer's gradient-variant inputs and outputs.
@@ -172,31 +121,17 @@ impl Asvgf {
     }
 
     /// After the tracer: reconstructs the gradients, then SVGF with the adaptive α.
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-    ) -> Result<&Image> {
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
         let s = self.settings;
         let mut src = &self.raw;
         for i in 0..s.gradient_iterations {
             let dst = &self.ping[(i % 2) as usize];
-            self.gradient.record(
-                rec,
-                g,
-                src,
-                dst,
-                1 << i,
-                &frame.current,
-                frame.sampling_table,
-                &s,
-            )?;
+            self.gradient.record(rec, frame, (src, dst), 1 << i, &s)?;
             src = dst;
         }
         let gradient = &self.ping[((s.gradient_iterations - 1) % 2) as usize];
         self.frames += 1;
-        self.svgf.record_adaptive(rec, g, frame, gradient)
+        self.svgf.record_adaptive(rec, frame, gradient)
     }
 
     /// The gradient samples of the last recorded frame.
@@ -215,5 +150,52 @@ impl Asvgf {
     /// Size of the strata grid.
     pub fn strata(&self) -> UVec2 {
         UVec2::new(self.raw.width, self.raw.height)
+    }
+}
+
+impl DenoiserParams for AsvgfSettings {
+    const NAME: &'static str = "asvgf";
+    const NEEDS_GRADIENTS: bool = true;
+
+    fn validate(&self) -> Result<()> {
+        AsvgfSettings::validate(self)
+    }
+
+    fn build(&self, ctx: &Arc<Context>, grid: UVec2, variant: &str) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Asvgf::new(ctx, grid, variant, *self)?))
+    }
+
+    /// The SVGF stages take SVGF's parameters (a render profile's `[svgf]`).
+    fn complete(&mut self, others: &dyn OtherParams) {
+        let svgf = others.params(SvgfSettings::NAME);
+        if let Some(svgf) = svgf.and_then(|p| p.downcast_ref::<SvgfSettings>()) {
+            self.svgf = *svgf;
+        }
+    }
+}
+
+impl Denoiser for Asvgf {
+    fn history_bytes(&self) -> u64 {
+        Asvgf::history_bytes(self)
+    }
+
+    fn max_passes(&self) -> u32 {
+        Asvgf::max_passes(self)
+    }
+
+    fn record_before_trace(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<()> {
+        Asvgf::record_before_trace(self, rec, frame)
+    }
+
+    fn gradient_targets(&self) -> Option<GradientTargets<'_>> {
+        Some(Asvgf::gradient_targets(self))
+    }
+
+    fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        Asvgf::record(self, rec, frame)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

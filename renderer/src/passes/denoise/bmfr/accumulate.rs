@@ -1,17 +1,18 @@
 //! BMFR accumulation before the fit: noisy demodulated radiance, normal and camera-relative
 //! position blended with their reprojected history (α = max(α_floor, 1/history)).
 
-use super::{BmfrHistory, Reprojection};
+use super::history::{BmfrHistory, Reprojection};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{BmfrTemporalPush, SamplingParams};
-use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
-use crate::vk::{Buffer, ComputePipeline, Context};
-use std::sync::Arc;
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
 
-pub struct AccumulatePass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Accumulate;
+
+impl Kernel for Accumulate {
+    const SHADER: &'static str = "passes/denoise/bmfr_accumulate";
+    type Push = BmfrTemporalPush;
 }
 
 /// The push block both temporal passes share: this frame's space, the previous frame's
@@ -34,57 +35,42 @@ pub(super) fn temporal_push(
     }
 }
 
-impl AccumulatePass {
-    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulatePass> {
-        let shader = format!("passes/denoise/bmfr_accumulate.{variant}");
-        Ok(AccumulatePass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                &shader,
-                std::mem::size_of::<BmfrTemporalPush>() as u32,
-            )?,
-        })
-    }
-
-    /// Reads history half `prev`, writes half `cur` (noisy, normal, position) in the live tiles.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+impl Pass<Accumulate> {
+    /// Reads the history's other half, writes this frame's (noisy, normal, position) in the
+    /// live tiles.
+    pub(super) fn record(
         &self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        materials: &Buffer,
+        frame: &GridFrame,
         h: &BmfrHistory,
-        prev: usize,
-        cur: usize,
-        current: &SamplingParams,
-        table: &Buffer,
-        tiles: &TileList,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
+        let g = frame.gbuffer;
+        let (cur, prev) = (h.current(), 1 - h.current());
         let binds = [
             read_image("radiance", &g.radiance),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
             read_image("motion", &g.motion),
             read_image("ids", &g.ids),
-            read_buffer("materials", materials),
+            read_buffer("materials", frame.materials),
             read_image("prev_noisy", &h.noisy[prev]),
             read_image("prev_normal", &h.normal[prev]),
             read_image("prev_position", &h.position[prev]),
             write_image("noisy", &h.noisy[cur]),
             write_image("normal", &h.normal[cur]),
             write_image("features_position", &h.position[cur]),
-            read_texels("grid_columns", table),
-            read_buffer("tiles", tiles.buffer),
+            read_texels("grid_columns", frame.sampling_table),
+            read_buffer("tiles", frame.tiles.buffer),
         ];
-        let push = temporal_push(current, r, alpha_floor);
-        rec.dispatch(
+        let push = temporal_push(&frame.current, r, alpha_floor);
+        self.dispatch(
+            rec,
             "bmfr_accumulate",
-            &self.pipeline,
             &binds,
-            push_bytes(&push),
-            tiles.live_threads(),
+            &push,
+            frame.tiles.live_threads(),
         )
     }
 }

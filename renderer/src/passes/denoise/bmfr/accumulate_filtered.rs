@@ -2,50 +2,35 @@
 //! reprojection as before the fit (α = max(α_floor, 1/history)), then re-modulated by albedo.
 
 use super::accumulate::temporal_push;
-use super::{BmfrHistory, Reprojection};
+use super::history::{FrameTargets, Reprojection};
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
-use crate::layouts::{BmfrTemporalPush, SamplingParams};
-use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
-use std::sync::Arc;
+use crate::layouts::BmfrTemporalPush;
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
 
-pub struct AccumulateFilteredPass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct AccumulateFiltered;
+
+impl Kernel for AccumulateFiltered {
+    const SHADER: &'static str = "passes/denoise/bmfr_accumulate_filtered";
+    type Push = BmfrTemporalPush;
 }
 
-impl AccumulateFilteredPass {
-    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<AccumulateFilteredPass> {
-        let shader = format!("passes/denoise/bmfr_accumulate_filtered.{variant}");
-        Ok(AccumulateFilteredPass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                &shader,
-                std::mem::size_of::<BmfrTemporalPush>() as u32,
-            )?,
-        })
-    }
-
-    /// `fitted` + history half `prev` → history half `cur` and `dst` (re-modulated), live tiles.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+impl Pass<AccumulateFiltered> {
+    /// `t.fitted` + the history's other half → this frame's half and `t.output` (re-modulated),
+    /// live tiles.
+    pub(super) fn record(
         &self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        h: &BmfrHistory,
-        prev: usize,
-        cur: usize,
-        fitted: &Image,
-        dst: &Image,
-        current: &SamplingParams,
-        table: &Buffer,
-        tiles: &TileList,
+        frame: &GridFrame,
+        t: &FrameTargets,
         r: &Reprojection,
         alpha_floor: f32,
     ) -> Result<()> {
+        let (g, h) = (frame.gbuffer, t.history);
+        let (cur, prev) = (h.current(), 1 - h.current());
         let binds = [
-            read_image("fitted", fitted),
+            read_image("fitted", t.fitted),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
             read_image("motion", &g.motion),
@@ -55,18 +40,18 @@ impl AccumulateFilteredPass {
             read_image("prev_filtered", &h.filtered[prev]),
             read_image("albedo", &g.albedo),
             write_image("filtered", &h.filtered[cur]),
-            write_image("dst", dst),
+            write_image("dst", t.output),
             read_image("features_position", &h.position[cur]),
-            read_texels("grid_columns", table),
-            read_buffer("tiles", tiles.buffer),
+            read_texels("grid_columns", frame.sampling_table),
+            read_buffer("tiles", frame.tiles.buffer),
         ];
-        let push = temporal_push(current, r, alpha_floor);
-        rec.dispatch(
+        let push = temporal_push(&frame.current, r, alpha_floor);
+        self.dispatch(
+            rec,
             "bmfr_accumulate_filtered",
-            &self.pipeline,
             &binds,
-            push_bytes(&push),
-            tiles.live_threads(),
+            &push,
+            frame.tiles.live_threads(),
         )
     }
 }

@@ -18,151 +18,39 @@
 mod accumulate;
 mod accumulate_filtered;
 mod fit;
+mod history;
 mod idle;
+mod settings;
 mod weighted_sum;
 
-use super::{DenoiseFrame, DenoiseScene};
-use crate::error::{Error, Result};
+pub use fit::{block_count, BLOCK_OFFSETS};
+pub use history::BmfrHistory;
+pub use settings::BmfrSettings;
+
+use crate::error::Result;
 use crate::graph::FrameRecorder;
-use crate::layouts::{SamplingParams, BMFR_BLOCK, BMFR_WEIGHT_TEXELS};
-use crate::passes::trace::GBuffer;
+use crate::layouts::BMFR_WEIGHT_TEXELS;
+use crate::passes::denoise::{Denoiser, DenoiserParams};
+use crate::passes::grid::GridFrame;
+use crate::passes::Pass;
 use crate::vk::{Context, Image};
-use accumulate::AccumulatePass;
-use accumulate_filtered::AccumulateFilteredPass;
+use accumulate::Accumulate;
+use accumulate_filtered::AccumulateFiltered;
 use ash::vk;
-use fit::FitPass;
-use glam::{IVec2, UVec2, Vec3};
-use idle::{IdlePass, IdleTargets};
+use fit::{Blocks, Fit};
+use glam::{IVec2, UVec2};
+use history::{FrameTargets, Reprojection};
+use idle::Idle;
 use std::sync::Arc;
-use weighted_sum::WeightedSumPass;
-
-/// Filter parameters; `Default` is the paper's.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BmfrSettings {
-    /// Smallest blend weight of the new noisy sample and features before the fit
-    /// (α = max(this, 1/history)).
-    pub alpha_noisy: f32,
-    /// The same for the fitted colour after the fit.
-    pub alpha_filtered: f32,
-    /// Amplitude of the uniform noise added to the features (not the constant) in the fit.
-    pub noise: f32,
-}
-
-impl Default for BmfrSettings {
-    fn default() -> Self {
-        BmfrSettings {
-            alpha_noisy: 0.2,
-            alpha_filtered: 0.1,
-            noise: 1e-2,
-        }
-    }
-}
-
-impl BmfrSettings {
-    pub fn validate(&self) -> Result<()> {
-        let bad = |what: String| Err(Error::Invalid(format!("bmfr: {what}")));
-        // α = 1 would mean no accumulation at all; the passes use it to drop the history.
-        let open_unit = |a: f32| a > 0.0 && a < 1.0;
-        if !open_unit(self.alpha_noisy) || !open_unit(self.alpha_filtered) {
-            return bad(format!(
-                "alpha_noisy and alpha_filtered must be in (0, 1), got {} and {}",
-                self.alpha_noisy, self.alpha_filtered
-            ));
-        }
-        if !(self.noise.is_finite() && (0.0..=0.1).contains(&self.noise)) {
-            return bad(format!("noise must be in [0, 0.1], got {}", self.noise));
-        }
-        Ok(())
-    }
-}
-
-/// Block-grid offsets in texels, one per frame (frame % 16): every even value of [−16, 14] once
-/// per axis, in an order that spreads consecutive offsets (x bit-reversed, y stepping by 5).
-pub const BLOCK_OFFSETS: [[i32; 2]; 16] = block_offsets();
-
-const fn block_offsets() -> [[i32; 2]; 16] {
-    let mut table = [[0; 2]; 16];
-    let mut i = 0;
-    while i < 16 {
-        let reversed = ((i & 1) << 3 | (i & 2) << 1 | (i & 4) >> 1 | (i & 8) >> 3) as i32;
-        table[i] = [2 * reversed - 16, 2 * ((5 * i as i32 + 3) % 16) - 16];
-        i += 1;
-    }
-    table
-}
-
-/// Blocks per axis of a grid: one more than the grid needs, so that every offset covers it.
-pub fn block_count(grid: UVec2) -> UVec2 {
-    grid.map(|v| v.div_ceil(BMFR_BLOCK) + 1)
-}
-
-/// Per-eye temporal state: everything BMFR carries from one frame to the next, allocated once,
-/// in halves that ping-pong by frame parity (a frame reads the other half at reprojected
-/// positions while writing its own).
-pub struct BmfrHistory {
-    /// Accumulated noisy demodulated radiance (rgb) and history length (w).
-    pub noisy: [Image; 2],
-    /// Accumulated normal.
-    pub normal: [Image; 2],
-    /// Accumulated camera-relative position (xyz; w the texel's world footprint, negative for an
-    /// emitter, 0 = a miss).
-    pub position: [Image; 2],
-    /// Accumulated fitted colour (demodulated).
-    pub filtered: [Image; 2],
-    /// Frames recorded so far; the parity picks this frame's half and `% 16` the block offset.
-    frames: u64,
-    /// The camera origin of the last recorded frame (positions are relative to it).
-    origin: Vec3,
-}
-
-impl BmfrHistory {
-    fn new(ctx: &Arc<Context>, grid: UVec2) -> Result<BmfrHistory> {
-        let pair = |name: &str, format| -> Result<[Image; 2]> {
-            Ok([
-                Image::new(ctx, &format!("{name}0"), grid.x, grid.y, format)?,
-                Image::new(ctx, &format!("{name}1"), grid.x, grid.y, format)?,
-            ])
-        };
-        let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
-        Ok(BmfrHistory {
-            noisy: pair("bmfr.noisy", rgba32)?,
-            normal: pair("bmfr.normal", vk::Format::R16G16B16A16_SFLOAT)?,
-            position: pair("bmfr.position", rgba32)?,
-            filtered: pair("bmfr.filtered", rgba32)?,
-            frames: 0,
-            origin: Vec3::ZERO,
-        })
-    }
-
-    fn current(&self) -> usize {
-        (self.frames % 2) as usize
-    }
-
-    /// GPU bytes of the state carried between frames (the per-eye memory cost of the filter).
-    pub fn bytes(&self) -> u64 {
-        [&self.noisy, &self.normal, &self.position, &self.filtered]
-            .iter()
-            .flat_map(|pair| pair.iter())
-            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
-            .sum()
-    }
-}
-
-/// What the temporal passes need to know about the previous frame.
-pub(crate) struct Reprojection<'a> {
-    /// The previous frame's space; `None` drops all history.
-    pub previous: Option<&'a SamplingParams>,
-    /// Previous camera origin − this one (positions are camera-relative).
-    pub camera_shift: Vec3,
-}
+use weighted_sum::WeightedSum;
 
 pub struct Bmfr {
     pub settings: BmfrSettings,
-    accumulate: AccumulatePass,
-    fit: FitPass,
-    weighted_sum: WeightedSumPass,
-    accumulate_filtered: AccumulateFilteredPass,
-    idle: IdlePass,
+    accumulate: Pass<Accumulate>,
+    fit: Pass<Fit>,
+    weighted_sum: Pass<WeightedSum>,
+    accumulate_filtered: Pass<AccumulateFiltered>,
+    idle: Pass<Idle>,
     pub history: BmfrHistory,
     /// Per block: BMFR_WEIGHT_TEXELS texels (10 × rgb weights, position offset, position scale).
     pub weights: Image,
@@ -185,11 +73,11 @@ impl Bmfr {
         let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
         Ok(Bmfr {
             settings,
-            accumulate: AccumulatePass::new(ctx, variant)?,
-            fit: FitPass::new(ctx, variant)?,
-            weighted_sum: WeightedSumPass::new(ctx, variant)?,
-            accumulate_filtered: AccumulateFilteredPass::new(ctx, variant)?,
-            idle: IdlePass::new(ctx, variant)?,
+            accumulate: Pass::new(ctx, variant)?,
+            fit: Pass::new(ctx, variant)?,
+            weighted_sum: Pass::new(ctx, variant)?,
+            accumulate_filtered: Pass::new(ctx, variant)?,
+            idle: Pass::new(ctx, variant)?,
             history: BmfrHistory::new(ctx, grid)?,
             weights: Image::new(
                 ctx,
@@ -221,87 +109,68 @@ impl Bmfr {
     /// returns `output`. The per-texel passes run over `frame.tiles`' live tiles; the idle pass
     /// writes the idle ones before the fit reads whole blocks. History is dropped on the first frame and whenever `frame.previous` is
     /// `None`.
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        frame: &DenoiseFrame,
-        scene: &DenoiseScene,
-    ) -> Result<&Image> {
-        let camera_origin = scene.camera_origin;
+    pub fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        let camera_origin = frame.camera_origin;
         let s = self.settings;
-        let offset = self.next_block_offset();
-        let h = &self.history;
-        let (cur, prev) = (h.current(), 1 - h.current());
-        let previous = if h.frames == 0 {
-            None
-        } else {
-            frame.previous.as_ref()
+        let blocks = Blocks {
+            offset: self.next_block_offset(),
+            seed: self.history.frames as u32,
+            noise: s.noise,
         };
+        let h = &self.history;
         let reprojection = Reprojection {
-            previous,
+            previous: if h.frames == 0 {
+                None
+            } else {
+                frame.previous.as_ref()
+            },
             camera_shift: h.origin - camera_origin,
         };
-        let (table, tiles) = (frame.sampling_table, &frame.tiles);
-        self.accumulate.record(
-            rec,
-            g,
-            scene.materials,
-            h,
-            prev,
-            cur,
-            &frame.current,
-            table,
-            tiles,
-            &reprojection,
-            s.alpha_noisy,
-        )?;
-        let idle = IdleTargets {
+        let targets = FrameTargets {
             history: h,
-            cur,
             fitted: &self.fitted,
             output: &self.output,
         };
-        self.idle.record(rec, &idle, &frame.current, table, tiles)?;
-        let seed = h.frames as u32;
-        self.fit.record(
-            rec,
-            h,
-            cur,
-            &self.weights,
-            &frame.current,
-            table,
-            offset,
-            seed,
-            s.noise,
-        )?;
-        self.weighted_sum.record(
-            rec,
-            h,
-            cur,
-            &self.weights,
-            &self.fitted,
-            &frame.current,
-            table,
-            tiles,
-            offset,
-        )?;
-        self.accumulate_filtered.record(
-            rec,
-            g,
-            h,
-            prev,
-            cur,
-            &self.fitted,
-            &self.output,
-            &frame.current,
-            table,
-            tiles,
-            &reprojection,
-            s.alpha_filtered,
-        )?;
+        self.accumulate
+            .record(rec, frame, h, &reprojection, s.alpha_noisy)?;
+        self.idle.record(rec, frame, &targets)?;
+        self.fit.record(rec, frame, h, &self.weights, &blocks)?;
+        self.weighted_sum
+            .record(rec, frame, h, (&self.weights, &self.fitted), &blocks)?;
+        self.accumulate_filtered
+            .record(rec, frame, &targets, &reprojection, s.alpha_filtered)?;
         self.history.frames += 1;
         self.history.origin = camera_origin;
         Ok(&self.output)
+    }
+}
+
+impl DenoiserParams for BmfrSettings {
+    const NAME: &'static str = "bmfr";
+
+    fn validate(&self) -> Result<()> {
+        BmfrSettings::validate(self)
+    }
+
+    fn build(&self, ctx: &Arc<Context>, grid: UVec2, variant: &str) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Bmfr::new(ctx, grid, variant, *self)?))
+    }
+}
+
+impl Denoiser for Bmfr {
+    fn history_bytes(&self) -> u64 {
+        self.history.bytes()
+    }
+
+    fn max_passes(&self) -> u32 {
+        Bmfr::max_passes(self)
+    }
+
+    fn record(&mut self, rec: &mut FrameRecorder, frame: &GridFrame) -> Result<&Image> {
+        Bmfr::record(self, rec, frame)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

@@ -1,57 +1,46 @@
 //! SVGF variance: temporal where the history is long enough, else a 7×7 edge-stopped spatial
 //! estimate from the moments.
 
-use super::SvgfSettings;
+use super::history::SvgfHistory;
+use super::settings::SvgfSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
-use crate::layouts::{SamplingParams, SvgfVariancePush};
-use crate::passes::push_bytes;
-use crate::passes::trace::{GBuffer, TileList};
-use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use crate::layouts::SvgfVariancePush;
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
+use crate::vk::Image;
 use glam::Vec4;
-use std::sync::Arc;
 
-pub struct VariancePass {
-    pipeline: std::sync::Arc<ComputePipeline>,
+pub struct Variance;
+
+impl Kernel for Variance {
+    const SHADER: &'static str = "passes/denoise/svgf_variance";
+    type Push = SvgfVariancePush;
 }
 
-impl VariancePass {
-    pub fn new(ctx: &Arc<Context>, variant: &str) -> Result<VariancePass> {
-        let shader = format!("passes/denoise/svgf_variance.{variant}");
-        Ok(VariancePass {
-            pipeline: ComputePipeline::shared(
-                ctx,
-                &shader,
-                std::mem::size_of::<SvgfVariancePush>() as u32,
-            )?,
-        })
-    }
-
-    /// `accum` (colour, temporal variance) and `moments` → `dst` (colour, variance), live tiles.
-    #[allow(clippy::too_many_arguments)]
+impl Pass<Variance> {
+    /// `accum` (colour, temporal variance) and this frame's moments → `dst` (colour, variance),
+    /// live tiles.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
-        g: &GBuffer,
-        accum: &Image,
-        moments: &Image,
-        dst: &Image,
-        space: &SamplingParams,
-        table: &Buffer,
-        tiles: &TileList,
+        frame: &GridFrame,
+        h: &SvgfHistory,
+        (accum, dst): (&Image, &Image),
         s: &SvgfSettings,
     ) -> Result<()> {
+        let g = frame.gbuffer;
         let binds = [
             read_image("accum", accum),
-            read_image("moments", moments),
+            read_image("moments", &h.moments[h.current()]),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
             write_image("dst", dst),
-            read_texels("grid_columns", table),
-            read_buffer("tiles", tiles.buffer),
+            read_texels("grid_columns", frame.sampling_table),
+            read_buffer("tiles", frame.tiles.buffer),
         ];
         let push = SvgfVariancePush {
-            space: *space,
+            space: frame.current,
             params: Vec4::new(
                 s.sigma_luminance,
                 s.sigma_depth,
@@ -59,12 +48,12 @@ impl VariancePass {
                 s.variance_history as f32,
             ),
         };
-        rec.dispatch(
+        self.dispatch(
+            rec,
             "svgf_variance",
-            &self.pipeline,
             &binds,
-            push_bytes(&push),
-            tiles.live_threads(),
+            &push,
+            frame.tiles.live_threads(),
         )
     }
 }

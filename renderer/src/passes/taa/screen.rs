@@ -6,13 +6,13 @@
 //! the local texel footprint (see `taa_screen.comp`). Runs between the remap and the foveated blur;
 //! the history is screen-sized and unblurred.
 
-use super::taa::TaaSettings;
+use super::TaaSettings;
 use crate::error::Result;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
-use crate::layouts::{SamplingParams, TaaScreenPush};
-use crate::passes::trace::GBuffer;
+use crate::layouts::TaaScreenPush;
+use crate::passes::grid::GridFrame;
 use crate::passes::{push_bytes, VpLayoutPipelines};
-use crate::vk::{Buffer, Context, Image};
+use crate::vk::{Context, Image};
 use ash::vk;
 use glam::{UVec2, Vec4};
 use std::sync::Arc;
@@ -24,22 +24,6 @@ pub struct ScreenTaa {
     pipelines: VpLayoutPipelines,
     history: [Image; 2],
     frames: u64,
-}
-
-/// What one frame's resolve reads besides the remapped image.
-pub struct ScreenTaaFrame<'a> {
-    /// The renderer's `FrameData` uniform buffer (this and the previous camera).
-    pub frame_data: &'a Buffer,
-    /// The VP G-buffer the remapped image came from (depths for the reprojection).
-    pub gbuffer: &'a GBuffer,
-    /// This frame's space (its gaze).
-    pub space: &'a SamplingParams,
-    /// Its sampling table (`VisualPolar::column_table`: the screen-clipped layout's arcs).
-    pub columns: &'a Buffer,
-    /// False when no previous frame may be used (all history dropped).
-    pub has_previous: bool,
-    /// Where the tracer put this frame's samples inside their VP texel (`TaaSettings::jitter`).
-    pub jitter: glam::Vec2,
 }
 
 impl ScreenTaa {
@@ -58,7 +42,7 @@ impl ScreenTaa {
             settings,
             pipelines: VpLayoutPipelines::new(
                 ctx,
-                "passes/denoise/taa_screen",
+                "passes/taa_screen",
                 std::mem::size_of::<TaaScreenPush>() as u32,
             )?,
             history: [image("taa_screen.history0")?, image("taa_screen.history1")?],
@@ -75,15 +59,16 @@ impl ScreenTaa {
     }
 
     /// Resolves the remapped `color` (screen-sized) against the history; returns the resolved
-    /// image (next frame's history).
+    /// image (next frame's history). `frame`: the Visual-Polar grid the remapped image came from
+    /// (its G-buffer's depths reproject; the cameras are in its frame data).
     pub fn record(
         &mut self,
         rec: &mut FrameRecorder,
         color: &Image,
-        frame: &ScreenTaaFrame,
+        frame: &GridFrame,
     ) -> Result<&Image> {
         let cur = (self.frames % 2) as usize;
-        let reset = self.frames == 0 || !frame.has_previous;
+        let reset = self.frames == 0 || frame.previous.is_none();
         let binds = [
             read_buffer("frame", frame.frame_data),
             read_image("color", color),
@@ -91,10 +76,10 @@ impl ScreenTaa {
             read_image("position", &frame.gbuffer.position),
             read_image("prev_history", &self.history[1 - cur]),
             write_image("history", &self.history[cur]),
-            read_texels("vp_columns", frame.columns),
+            read_texels("vp_columns", frame.sampling_table),
         ];
         let push = TaaScreenPush {
-            space: *frame.space,
+            space: frame.current,
             params: Vec4::new(
                 self.settings.current_weight,
                 if reset { 1.0 } else { 0.0 },
@@ -105,7 +90,7 @@ impl ScreenTaa {
         let out = &self.history[cur];
         rec.dispatch(
             "taa_screen",
-            self.pipelines.for_space(frame.space),
+            self.pipelines.for_space(&frame.current),
             &binds,
             push_bytes(&push),
             [out.width, out.height, 1],

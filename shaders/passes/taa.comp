@@ -7,10 +7,10 @@
 // afresh: the bilinear taps are the reprojected history, the previous 3×3 surfaces decide
 // whether it may be used. Writes the new history, which is also the pass's output, and this frame's surface.
 //! variants per space
-#include "../../common/layouts.glsl"
-#include "../../denoise/grid.glsl"
-#include "../../denoise/svgf.glsl"
-#include "../../denoise/taa.glsl"
+#include "../common/layouts.glsl"
+#include "../denoise/grid.glsl"
+#include "../denoise/svgf.glsl"
+#include "../denoise/taa.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { TaaPush p; } push;

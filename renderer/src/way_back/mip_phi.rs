@@ -4,10 +4,10 @@
 //! (`PhiMips::image`), laid out by `shaders/sampling/phi_mips.glsl`, which `rows_at_level` and
 //! `level_offset` mirror.
 
-use super::{push_bytes, VpLayoutPipelines};
 use crate::error::Result;
 use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::{MipPhiPush, SamplingParams, PHI_MIP_LEVELS};
+use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::vk::{Buffer, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};

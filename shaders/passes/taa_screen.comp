@@ -17,11 +17,11 @@
 // layout gets a kernel without the screen-clipped mapping; `clipped` is the general kernel.
 //! variant paper:
 //! variant clipped: VP_LAYOUT_CLIPPED
-#include "../../common/layouts.glsl"
-#include "../../common/camera.glsl"
-#include "../../sampling/visual_polar_clipped.glsl"
-#include "../../denoise/svgf.glsl"
-#include "../../denoise/taa.glsl"
+#include "../common/layouts.glsl"
+#include "../common/camera.glsl"
+#include "../sampling/visual_polar_clipped.glsl"
+#include "../denoise/svgf.glsl"
+#include "../denoise/taa.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { TaaScreenPush p; } push;

@@ -2,10 +2,13 @@
 //! pixels holding a sample: pulled down a pyramid of half-size levels to 1×1, then pushed back up
 //! with every level's own samples over the filled level below.
 
-use super::push_bytes;
+use super::blur::{BlurSettings, FoveatedBlur};
+use super::frame::{ScreenOut, WayBackFrame, WayBackPasses};
 use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
 use crate::layouts::FillPush;
+use crate::passes::push_bytes;
+use crate::sampling::VisualPolar;
 use crate::vk::{ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
@@ -107,6 +110,56 @@ impl FillPass {
             push_bytes(&push),
             [dst.width, dst.height, 1],
         )
+    }
+}
+
+/// The way back of the screen's own pixels, not all traced (`WayBack::Fill`: linear falloff):
+/// push-pull hole filling, then the foveated blur shaped by the space's eccentricity axis — the
+/// blur Koskela et al. 2019 added to every comparator.
+pub struct FillWayBack {
+    fill: FillPass,
+    blur: FoveatedBlur,
+}
+
+impl FillWayBack {
+    pub fn new(ctx: &Arc<Context>, screen: UVec2) -> Result<FillWayBack> {
+        Ok(FillWayBack {
+            fill: FillPass::new(ctx, screen)?,
+            blur: FoveatedBlur::new(ctx, screen)?,
+        })
+    }
+
+    /// Fills `sparse` (the traced colour on the screen, alpha 1 where traced) and blurs it
+    /// around `axis`; returns the image to show.
+    pub fn fill_and_blur<'a>(
+        &'a self,
+        rec: &mut FrameRecorder,
+        sparse: &'a Image,
+        axis: Option<&VisualPolar>,
+        blur: &BlurSettings,
+    ) -> Result<&'a Image> {
+        let filled = self.fill.record(rec, sparse)?;
+        match axis {
+            Some(axis) => self.blur.record(rec, blur, axis, filled),
+            None => Ok(filled),
+        }
+    }
+}
+
+impl WayBackPasses for FillWayBack {
+    fn record<'a>(
+        &'a mut self,
+        rec: &mut FrameRecorder,
+        frame: &WayBackFrame<'a>,
+    ) -> Result<ScreenOut<'a>> {
+        let screen =
+            self.fill_and_blur(rec, frame.radiance, frame.space.blur_axis(), frame.blur)?;
+        Ok(ScreenOut::Radiance(screen))
+    }
+
+    /// The pyramid's pulls and pushes and the blur's two axes.
+    fn extra_passes(&self) -> u32 {
+        self.fill.passes() + 2
     }
 }
 

@@ -4,13 +4,14 @@
 //! The paper's layout only (`supports`): a row is one angle in every full column.
 
 use super::blur::BlurShape;
-use super::{push_bytes, VpLayoutPipelines};
 use crate::error::Result;
 use crate::graph::{read_image, write_image, FrameRecorder};
 use crate::layouts::{GridBlurPush, SamplingParams};
+use crate::passes::{push_bytes, VpLayoutPipelines};
 use crate::sampling::{VisualPolar, VpLayout};
 use crate::vk::{Context, Image};
-use glam::Vec4;
+use ash::vk;
+use glam::{UVec2, Vec4};
 use std::sync::Arc;
 
 pub struct GridBlurPass {
@@ -69,5 +70,37 @@ impl GridBlurPass {
             push_bytes(&push),
             size,
         )
+    }
+}
+
+/// The grid blur's pass and its two grid-sized images.
+pub struct GridBlur {
+    pass: GridBlurPass,
+    scratch: Image,
+    blurred: Image,
+}
+
+impl GridBlur {
+    pub fn new(ctx: &Arc<Context>, grid: UVec2) -> Result<GridBlur> {
+        let image =
+            |name: &str| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
+        Ok(GridBlur {
+            pass: GridBlurPass::new(ctx)?,
+            scratch: image("grid.blur_scratch")?,
+            blurred: image("grid.blurred")?,
+        })
+    }
+
+    /// Blurs `src` (the grid of `vp`) into the returned image.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        vp: &SamplingParams,
+        shape: &BlurShape,
+        src: &Image,
+    ) -> Result<&Image> {
+        self.pass
+            .record(rec, vp, shape, src, &self.scratch, &self.blurred)?;
+        Ok(&self.blurred)
     }
 }

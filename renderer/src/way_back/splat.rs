@@ -2,12 +2,14 @@
 //! acuity) → a sparse screen image, each pixel the mean of the samples that fell in it, alpha 1
 //! where one did. The push-pull fill and the foveated blur take it from there.
 
-use super::push_bytes;
+use super::fill::FillWayBack;
+use super::frame::{ScreenOut, WayBackFrame, WayBackPasses};
 use crate::error::Result;
 use crate::graph::{
     read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
 };
 use crate::layouts::SplatPush;
+use crate::passes::push_bytes;
 use crate::vk::{Buffer, ComputePipeline, Context, Image};
 use ash::vk;
 use glam::{UVec2, UVec4};
@@ -91,5 +93,46 @@ impl SplatPass {
             [self.sparse.width, self.sparse.height, 1],
         )?;
         Ok(&self.sparse)
+    }
+}
+
+/// The way back of samples anywhere on the screen (`WayBack::Splat`: random acuity, the packed
+/// variable-rate tiles): each splatted to its pixel, then as `FillWayBack`.
+pub struct SplatWayBack {
+    splat: SplatPass,
+    fill: FillWayBack,
+}
+
+impl SplatWayBack {
+    /// `variant`: the space's trace kernel variant (the splat recomputes each sample's position
+    /// with the trace's own mapping).
+    pub fn new(ctx: &Arc<Context>, variant: &str, screen: UVec2) -> Result<SplatWayBack> {
+        Ok(SplatWayBack {
+            splat: SplatPass::new(ctx, variant, screen)?,
+            fill: FillWayBack::new(ctx, screen)?,
+        })
+    }
+}
+
+impl WayBackPasses for SplatWayBack {
+    fn record<'a>(
+        &'a mut self,
+        rec: &mut FrameRecorder,
+        frame: &WayBackFrame<'a>,
+    ) -> Result<ScreenOut<'a>> {
+        let inputs = SplatInputs {
+            frame_data: frame.grid.frame_data,
+            sampling: frame.grid.sampling,
+            sampling_table: frame.grid.sampling_table,
+        };
+        let sparse = self.splat.record(rec, &inputs, frame.radiance)?;
+        let screen = self
+            .fill
+            .fill_and_blur(rec, sparse, frame.space.blur_axis(), frame.blur)?;
+        Ok(ScreenOut::Radiance(screen))
+    }
+
+    fn extra_passes(&self) -> u32 {
+        self.splat.passes() + self.fill.extra_passes()
     }
 }

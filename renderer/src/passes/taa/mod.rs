@@ -1,22 +1,21 @@
-//! TAA (Karis 2014; denoisers.md) in the sampling grid, as the paper does: the tracer
-//! jitters each frame by a Halton(2, 3) offset inside the grid texel (Visual-Polar: inside the VP
-//! texel), and one pass reprojects the history through the previous frame's grid, clips it toward
-//! this frame's 3×3 YCoCg neighbourhood and blends it with luma weights. It runs after the
-//! denoiser (or on the raw colour) and before the way to the screen.
+//! Temporal anti-aliasing (Karis 2014; denoisers.md): the tracer jitters each frame by a
+//! Halton(2, 3) offset inside its texel and a resolve blends the frame into a reprojected
+//! history. It runs in the sampling grid after the denoiser (`grid`, the paper's place) or, for
+//! the Visual-Polar way back, on the remapped screen image before the foveated blur (`screen`).
+//! It is no denoiser: it filters over time what the tracer jittered, whatever ran before it.
 
-use super::DenoiseFrame;
+mod grid;
+mod screen;
+
+pub use grid::Taa;
+pub use screen::ScreenTaa;
+
 use crate::error::{Error, Result};
-use crate::graph::{read_image, read_texels, write_image, FrameRecorder};
-use crate::layouts::TaaPush;
-use crate::passes::push_bytes;
-use crate::passes::trace::GBuffer;
-use crate::vk::{ComputePipeline, Context, Image};
-use ash::vk;
-use glam::{UVec2, Vec2, Vec4};
-use std::sync::Arc;
+use glam::Vec2;
 
-/// Filter parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Filter parameters (`Default`, and a render profile's `[taa]` keys' defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TaaSettings {
     /// Blend weight of the current frame (the history keeps 1 − this), before luma weighting.
     pub current_weight: f32,
@@ -126,102 +125,6 @@ impl TaaMode {
             TaaMode::SamplingGrid(_) => TaaMode::SamplingGrid(settings),
             TaaMode::Screen(_) => TaaMode::Screen(settings),
         }
-    }
-}
-
-/// Per-eye TAA: the pass and its ping-pong history, allocated once.
-pub struct Taa {
-    pub settings: TaaSettings,
-    pipeline: std::sync::Arc<ComputePipeline>,
-    /// Resolved colour by frame parity; this frame's half is also the pass's output.
-    history: [Image; 2],
-    /// The packed surface each history texel belongs to (disocclusion test).
-    surface: [Image; 2],
-    frames: u64,
-}
-
-impl Taa {
-    /// `variant`: the sampling space's kernel variant (`cartesian`, `visual_polar`).
-    pub fn new(
-        ctx: &Arc<Context>,
-        grid: UVec2,
-        variant: &str,
-        settings: TaaSettings,
-    ) -> Result<Taa> {
-        settings.validate()?;
-        let image = |name: &str, format| Image::new(ctx, name, grid.x, grid.y, format);
-        let (rgba, surface) = (
-            vk::Format::R32G32B32A32_SFLOAT,
-            vk::Format::R32G32B32A32_UINT,
-        );
-        let shader = format!("passes/denoise/taa.{variant}");
-        Ok(Taa {
-            settings,
-            pipeline: ComputePipeline::shared(ctx, &shader, std::mem::size_of::<TaaPush>() as u32)?,
-            history: [image("taa.history0", rgba)?, image("taa.history1", rgba)?],
-            surface: [
-                image("taa.surface0", surface)?,
-                image("taa.surface1", surface)?,
-            ],
-            frames: 0,
-        })
-    }
-
-    /// GPU bytes carried between frames.
-    pub fn history_bytes(&self) -> u64 {
-        self.history
-            .iter()
-            .chain(&self.surface)
-            .map(|i| i.width as u64 * i.height as u64 * i.texel_bytes())
-            .sum()
-    }
-
-    /// Resolves `color` (grid-sized radiance) against the history; `jitter` is the offset the
-    /// tracer used this frame (`TaaSettings::jitter`). History is dropped on the first frame and
-    /// whenever `frame.previous` is `None`. Returns the resolved image (next frame's history).
-    pub fn record(
-        &mut self,
-        rec: &mut FrameRecorder,
-        g: &GBuffer,
-        color: &Image,
-        frame: &DenoiseFrame,
-        jitter: Vec2,
-    ) -> Result<&Image> {
-        let cur = (self.frames % 2) as usize;
-        let previous = if self.frames == 0 {
-            None
-        } else {
-            frame.previous
-        };
-        let binds = [
-            read_image("color", color),
-            read_image("normal_depth", &g.normal_depth),
-            read_image("position", &g.position),
-            read_image("ids", &g.ids),
-            read_image("motion", &g.motion),
-            read_image("prev_history", &self.history[1 - cur]),
-            read_image("prev_surface", &self.surface[1 - cur]),
-            write_image("history", &self.history[cur]),
-            write_image("surface", &self.surface[cur]),
-            read_texels("grid_columns", frame.sampling_table),
-        ];
-        let (current, p) = (&frame.current, previous.as_ref().unwrap_or(&frame.current));
-        let reset = if previous.is_none() { 1.0 } else { 0.0 };
-        let push = TaaPush {
-            space: *current,
-            prev: p.frame(),
-            params: Vec4::new(self.settings.current_weight, reset, jitter.x, jitter.y),
-        };
-        let out = &self.history[cur];
-        rec.dispatch(
-            "taa",
-            &self.pipeline,
-            &binds,
-            push_bytes(&push),
-            [out.width, out.height, 1],
-        )?;
-        self.frames += 1;
-        Ok(&self.history[cur])
     }
 }
 
