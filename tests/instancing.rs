@@ -2,7 +2,8 @@
 //! nodes (translations, a rotation, a non-uniform scale, mirroring scales) is uploaded once; the
 //! GPU's two-level traversal finds the CPU reference's hits; and it renders as the same scene
 //! with the mesh duplicated by hand (every node its own mesh, so the loader flattens all) —
-//! lit, emissive and alpha-masked. Uploaded triangle bytes grow with unique meshes only.
+//! lit, emissive and alpha-masked. Uploaded triangle bytes grow with unique meshes only. The
+//! renderer's trace kernel draws the same pictures with either BVH traversal.
 
 use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -10,7 +11,8 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
-use fovea_renderer::traversal::Traversal;
+use fovea_renderer::traversal::{Traversal, TraversalChoice};
+use fovea_renderer::vk::{Context, ContextOptions};
 use fovea_scene::bvh::instanced::{SceneBvh, SceneBvh8};
 use fovea_scene::bvh::BvhBuilder;
 use fovea_scene::intersect::Ray;
@@ -18,6 +20,7 @@ use fovea_scene::Scene;
 use fovea_tests::{artifacts_dir, assert_clean, assert_pictures, gpu, rmse, Picture};
 use glam::{Quat, UVec2, Vec3};
 use serde_json::{json, Value};
+use std::sync::Arc;
 
 const SIZE: UVec2 = UVec2::new(64, 72);
 
@@ -200,7 +203,11 @@ fn pair(look: Look) -> (Scene, Scene) {
 }
 
 fn reference(scene: &Scene, spp: u32, seed: u32) -> Vec<[f32; 4]> {
-    let ctx = gpu();
+    reference_with(scene, spp, seed, gpu())
+}
+
+/// [`reference`] on `ctx`, whose traversal the trace kernel runs.
+fn reference_with(scene: &Scene, spp: u32, seed: u32, ctx: Arc<Context>) -> Vec<[f32; 4]> {
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SIZE.x, SIZE.y);
     let settings = RenderSettings {
         seed,
@@ -448,4 +455,59 @@ fn uploaded_triangle_bytes_grow_with_unique_meshes_not_placements() {
         few.4
     );
     assert_clean(&ctx);
+}
+
+/// The trace kernel compiled for each traversal (the context's, `--traversal`) draws the same
+/// pictures of the instanced scenes (two-level walk) and their flattened copies (one level), lit
+/// and alpha-masked: both traversals find the same hits, so every pixel agrees to float rounding
+/// in nine of ten and the whole far closer than two seeds do.
+#[test]
+fn both_traversals_render_the_same_pictures() {
+    let with = |traversal| {
+        let ctx = Context::new(&ContextOptions {
+            validation: true,
+            traversal: TraversalChoice::Forced(traversal),
+            ..Default::default()
+        })
+        .expect("Vulkan device with validation layers");
+        assert_eq!(ctx.traversal, traversal);
+        ctx
+    };
+    for look in [Look::Lit, Look::Masked] {
+        let (instanced, by_hand) = pair(look);
+        for (name, scene) in [("instanced", &instanced), ("flattened", &by_hand)] {
+            let a = reference_with(scene, 8, 1, with(Traversal::CpuDriver));
+            let b = reference_with(scene, 8, 1, with(Traversal::Gpu));
+            let noise = rmse(&a, &reference(scene, 8, 2));
+            let apart = rmse(&a, &b);
+            let close = a
+                .iter()
+                .zip(&b)
+                .filter(|(p, q)| (0..3).all(|c| (p[c] - q[c]).abs() <= 1e-3 * q[c].abs().max(1.0)))
+                .count();
+            println!(
+                "look {} {name}: rmse cpu-driver vs gpu traversal {apart:.3e}, seed noise {noise:.3e}, {close}/{} pixels equal to 1e-3",
+                look as u8,
+                a.len()
+            );
+            let pictures = (
+                Picture::hdr(SIZE.x, SIZE.y, &a),
+                Picture::hdr(SIZE.x, SIZE.y, &b),
+            );
+            let label = format!(
+                "look {} {name}, cpu-driver against gpu traversal",
+                look as u8
+            );
+            assert_pictures(
+                apart < noise / 20.0 && close * 10 >= a.len() * 9,
+                &label,
+                &pictures.0,
+                &pictures.1,
+                format_args!(
+                    "{apart} apart, two seeds {noise}; {close} of {} pixels agree",
+                    a.len()
+                ),
+            );
+        }
+    }
 }
