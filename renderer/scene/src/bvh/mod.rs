@@ -198,8 +198,9 @@ pub struct BvhBuilder {
     /// `None`: object splits only (binned SAH), every triangle in exactly one leaf. `Some(b)`:
     /// object and spatial splits (SBVH), at most `b` × triangles extra leaf references.
     pub spatial_budget: Option<f32>,
-    /// Ranges of at most this many triangles always become leaves (larger ones up to 8 when no
-    /// split is cheaper by SAH).
+    /// Ranges of at most this many triangles become leaves (larger ones up to 8 when no split is
+    /// cheaper by SAH; the SBVH splits small ranges too where an object split costs less than
+    /// three quarters of the leaf).
     pub leaf_target: usize,
     /// Cost of one node visit relative to one triangle test, in the SAH.
     pub node_cost: f32,
