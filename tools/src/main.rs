@@ -205,7 +205,8 @@ struct RenderOpts {
     look: SceneFlags,
     #[command(flatten)]
     latency: LatencyFlags,
-    /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
+    /// Scene name (cornell-box, stress, large; sponza, breakfast-room, flight-helmet from the
+    /// shared scene folder, $FOVEA_SCENES or ../shared/data/scenes) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
     /// Sampling method: vp (Visual-Polar, Koskela et al. 2019) or cartesian (uniform, 1 spp).
@@ -479,7 +480,7 @@ enum Command {
     /// Benchmark: BVH build, rays per second, per-pass GPU milliseconds, the real-time loop (one
     /// run, one device).
     Bench {
-        /// Scenes of the BVH, ray and frame figures ("" skips them).
+        /// Scenes of the BVH, ray and frame figures, names or paths as --scene ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
         scenes: Vec<String>,
         /// BVH builders to compare: binned, sbvh, sbvh:BUDGET (extra references per triangle).
@@ -507,10 +508,22 @@ enum Command {
         /// frames in flight, stereo vs two mono renders ("" skips them).
         #[arg(long, default_value = "320x360")]
         loop_size: String,
-        /// Timed frames of each real-time loop run (after 2 warm-up frames; at least 2). Each run
-        /// is made twice (order A B C C B A).
+        /// Timed frames of each run of the real-time loop and of the headset loop (after 2 warm-up
+        /// frames; at least 2). Each run is made twice (order A B C C B A).
         #[arg(long, default_value_t = 5)]
         loop_frames: u32,
+        /// Scenes of the headset loop: both eyes at each --loop-headsets size, the head on the
+        /// default orbit and the simulated gaze, VP + SVGF, VP + A-SVGF and Cartesian + SVGF (2
+        /// frames in flight, --loop-frames timed frames each, order A B C C B A): frames/s,
+        /// per-pass GPU ms and VP / Cartesian per size ("" skips it; names as --scenes, e.g.
+        /// sponza, breakfast-room from the shared scene folder).
+        #[arg(long, default_value = "")]
+        loop_scenes: String,
+        /// Headsets of the headset loop, each at its recommended per-eye size (names from `fovea
+        /// headsets` or profile paths), or per-eye sizes WxH (through the FOVE 0's frusta). The
+        /// frames run the first --traversal.
+        #[arg(long, default_value = fovea_tools::commands::bench_headsets::DEFAULT_HEADSETS)]
+        loop_headsets: String,
         /// A keyframe file (as `fovea render --camera-path FILE`) the VP vs Cartesian frames
         /// follow, frame i at i / 70 Hz (default: the scene camera, still).
         #[arg(long)]
@@ -955,6 +968,8 @@ fn run() -> Result<()> {
             frames,
             loop_size,
             loop_frames,
+            loop_scenes,
+            loop_headsets,
             camera_path,
             out,
             dump_rays,
@@ -987,6 +1002,17 @@ fn run() -> Result<()> {
                 .transpose()
                 .context("--loop-size")?;
             let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
+            let loop_scenes: Vec<String> = loop_scenes
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(String::from)
+                .collect();
+            let loop_headsets = if loop_scenes.is_empty() {
+                Vec::new()
+            } else {
+                commands::bench_headsets::LoopHeadset::parse_list(&loop_headsets)?
+            };
             let traversals = parse_traversals(&device.traversal)?;
             commands::choose_traversal(traversals[0]);
             commands::bench::run(&commands::bench::BenchArgs {
@@ -999,6 +1025,8 @@ fn run() -> Result<()> {
                 frames,
                 loop_size,
                 loop_frames,
+                loop_scenes: &loop_scenes,
+                loop_headsets: &loop_headsets,
                 camera_path: camera_path.as_ref(),
                 out: &out,
                 dump_rays,

@@ -46,6 +46,10 @@ pub struct BenchArgs<'a> {
     pub loop_size: Option<(u32, u32)>,
     /// Timed frames of each loop run (after `bench_loop::WARMUP_FRAMES` warm-up frames).
     pub loop_frames: u32,
+    /// Scenes and per-eye sizes of the headset loop (`--loop-scenes`, `--loop-headsets`; no
+    /// scenes: skip it).
+    pub loop_scenes: &'a [String],
+    pub loop_headsets: &'a [super::bench_headsets::LoopHeadset],
     /// Keyframes the VP vs Cartesian frames follow and the ray rates are measured along
     /// (`--camera-path FILE`; none: the still camera).
     pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
@@ -104,8 +108,8 @@ struct RayReport {
     width: u32,
     height: u32,
     primary_mrays_per_s: f64,
-    /// `null` when the scene has no light to aim shadow rays at (Sponza, the Breakfast Room: the
-    /// default sun is the renderer's, not the scene's).
+    /// `null` when the scene has no point-like light to aim shadow rays at (only an environment;
+    /// a scene without lights gets the default sun, as `fovea render` gives it).
     shadow_mrays_per_s: Option<f64>,
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
@@ -131,10 +135,12 @@ struct BenchReport {
     /// The real-time loop section (`null` when skipped).
     #[serde(rename = "loop")]
     real_time_loop: Option<super::bench_loop::LoopReport>,
+    /// The headset loop: one entry per scene and size (empty when skipped).
+    headset_loop: Vec<super::bench_headsets::HeadsetLoopReport>,
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    if args.loop_size.is_some() {
+    if args.loop_size.is_some() || !args.loop_scenes.is_empty() {
         super::bench_loop::check_frames(args.loop_frames)?;
     }
     let _out_dir = crate::output::prepare_output_dir(args.out)?;
@@ -145,9 +151,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         rays: Vec::new(),
         visual_polar: Vec::new(),
         real_time_loop: None,
+        headset_loop: Vec::new(),
     };
     for name in args.scenes {
-        let scene = crate::scenes::load(name)?;
+        let mut scene = crate::scenes::load(name)?;
+        // Lit as `fovea render` lights it: a scene without lights of its own (Sponza, the
+        // Breakfast Room) gets the default sun and sky, so its shadow rays aim at the sun.
+        if let Some(notice) =
+            crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())
+        {
+            println!("{notice}");
+        }
         let scene = if args.flatten {
             scene.flattened()
         } else {
@@ -351,6 +365,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if let Some(size) = args.loop_size {
         report.real_time_loop = Some(super::bench_loop::measure(&ctx, size, args.loop_frames)?);
+    }
+    if !args.loop_scenes.is_empty() {
+        report.headset_loop = super::bench_headsets::measure(
+            &ctx,
+            args.loop_scenes,
+            args.loop_headsets,
+            args.loop_frames,
+        )?;
     }
     super::check_validation(&ctx)?;
     let path = args.out.join("report.json");

@@ -1,5 +1,6 @@
 pub mod bench;
 mod bench_counters;
+pub mod bench_headsets;
 mod bench_loop;
 pub mod bench_vp;
 pub mod debug_views;
