@@ -181,6 +181,7 @@ pub fn small_render_args<'a>(
         max_depth: 3,
         exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
         tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        overview: false,
         profile: Default::default(),
         debug_views: false,
         denoiser: "none",

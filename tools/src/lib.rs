@@ -5,6 +5,7 @@ pub mod camera_keys;
 pub mod camera_path;
 pub mod commands;
 pub mod cpu_time;
+pub mod decode;
 pub mod density;
 pub mod env_map;
 pub mod flip;

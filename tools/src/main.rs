@@ -313,15 +313,17 @@ struct RenderOpts {
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
-    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017) | asvgf (Schied et al. 2018:
-    /// SVGF with temporal gradients) | bmfr (Koskela et al. 2019); parameters from the profile's
-    /// [svgf] / [asvgf] / [bmfr] sections (VP needs the paper's layout).
-    #[arg(long, default_value = "none")]
+    /// Denoiser in the sampling grid: auto (bmfr where the method's grid runs denoisers, none
+    /// where it cannot: the method table's best for Visual-Polar, docs/quality.md) | none | svgf
+    /// (Schied et al. 2017) | asvgf (Schied et al. 2018: SVGF with temporal gradients) | bmfr
+    /// (Koskela et al. 2019); parameters from the profile's [svgf] / [asvgf] / [bmfr] sections.
+    #[arg(long, default_value = "auto")]
     denoiser: String,
-    /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for
-    /// Cartesian) | screen (after the remap to the screen, neighbourhood sized by the local VP
-    /// texel footprint; for Cartesian the same as vp).
-    #[arg(long, default_value = "off")]
+    /// TAA (Karis 2014) after the denoiser: auto (vp where the method's grid runs it, off where it
+    /// cannot) | off | vp (in the sampling grid; the screen for Cartesian) | screen (after the
+    /// remap to the screen, neighbourhood sized by the local VP texel footprint; for Cartesian the
+    /// same as vp).
+    #[arg(long, default_value = "auto")]
     taa: String,
 }
 
@@ -370,6 +372,11 @@ enum Command {
         // Boxed: the render options dwarf every other command's.
         #[command(flatten)]
         opts: Box<RenderOpts>,
+        /// Skip overview.png (the last frame beside the same frame at full cost, every pixel
+        /// traced, and the sample density with the gaze; the full-cost frame renders the last
+        /// 8 frames again without foveation).
+        #[arg(long)]
+        no_overview: bool,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -378,9 +385,13 @@ enum Command {
     View {
         #[command(flatten)]
         opts: Box<RenderOpts>,
-        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N.
+        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N. An
+        /// existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
         #[arg(long, default_value = "fifo")]
         present_mode: String,
@@ -400,9 +411,13 @@ enum Command {
         /// `fovea render --headset <same> --gaze TRACE.csv`.
         #[arg(long)]
         record: Option<PathBuf>,
-        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs --frames.
+        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs
+        /// --frames. An existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// The runtime space the scene camera stands in: local (the default: where the head was
         /// when the session started) or stage (the play area's floor is the scene's y = 0).
         #[arg(long, default_value = "local")]
@@ -732,6 +747,7 @@ fn render_args<'a>(
         max_depth: opts.max_depth,
         exposure: commands::setup::parse_exposure(&opts.exposure)?,
         tone: commands::setup::parse_tone(&opts.tone)?,
+        overview: false,
         profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
@@ -766,6 +782,7 @@ fn run() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
         opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
+        no_overview: false,
         device: DeviceArgs {
             device: None,
             validation: false,
@@ -777,11 +794,15 @@ fn run() -> Result<()> {
         fovea_tools::interrupt::install()?;
     }
     match command {
-        Command::Render { opts, device } => {
+        Command::Render {
+            opts,
+            no_overview,
+            device,
+        } => {
             device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
-            commands::render::run(&render_args(
+            let mut args = render_args(
                 &opts,
                 &camera,
                 &device,
@@ -792,11 +813,14 @@ fn run() -> Result<()> {
                     out: "out/render",
                     scale: DEFAULT_SCALE,
                 },
-            )?)
+            )?;
+            args.overview = !no_overview;
+            commands::render::run(&args)
         }
         Command::View {
             opts,
             screenshot,
+            force,
             present_mode,
             debug_view,
             device,
@@ -820,6 +844,7 @@ fn run() -> Result<()> {
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
+                force,
                 present_mode: &present_mode,
                 mouse_gaze: opts.gaze.is_none(),
                 debug_view: fovea_tools::viewer::debug::DebugView::parse(&debug_view)?,
@@ -830,6 +855,7 @@ fn run() -> Result<()> {
             opts,
             record,
             screenshot,
+            force,
             reference_space,
             device,
         } => {
@@ -861,6 +887,7 @@ fn run() -> Result<()> {
                 gaze: opts.gaze.as_deref(),
                 record: record.as_deref(),
                 screenshot: screenshot.as_deref(),
+                force,
                 reference_space: commands::xr::ReferenceSpace::parse(&reference_space)?,
             })
         }

@@ -10,9 +10,7 @@ use super::render::{self, RenderArgs};
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
-use crate::output::{
-    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text,
-};
+use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::RenderSettings;
@@ -193,6 +191,22 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
     }
+    let max_spp = super::reference::MAX_REFERENCE_SPP;
+    if args.reference_spp > max_spp {
+        bail!(
+            "--reference-spp {} must be at most {max_spp} (as fovea reference --spp)",
+            args.reference_spp
+        );
+    }
+    // Every frame is read back within the image budget: a larger run would render for nothing.
+    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
+    if args.width as u64 * args.height as u64 > max_pixels {
+        bail!(
+            "--width {} --height {}: at most {max_pixels} pixels (the frames are read back for the figures)",
+            args.width,
+            args.height
+        );
+    }
     super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
     let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
@@ -250,6 +264,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         // reference's (`tonemap_preview`).
                         exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
                         tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+                        overview: false,
                         profile: args.profile.clone(),
                         debug_views: false,
                         denoiser,
@@ -388,12 +403,16 @@ fn measure(
             gaze[1].as_f64().unwrap_or(0.0) as f32,
         );
         let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
-        let (_, _, test) = read_exr(&path)?;
+        let size = Some((args.width, args.height));
+        let (_, _, test) = crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?
-            .to_rgba8()
-            .into_raw();
+        let displayed = crate::decode::read_rgba8(
+            &dir.join(format!("frame_{f:04}.png")),
+            crate::decode::MAX_IMAGE_PIXELS,
+            size,
+        )?
+        .2;
         let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,

@@ -32,9 +32,27 @@ pub struct ReferenceArgs<'a> {
     pub path_regularisation: f32,
 }
 
+/// The most samples per pixel `fovea reference --spp` takes (about 2²⁰: a 64-spp frame of noise
+/// is already below FLIP's visibility at 16 Ki; a million is a converged bound, not a goal).
+pub const MAX_REFERENCE_SPP: u32 = 1 << 20;
+
 pub fn run(args: &ReferenceArgs) -> Result<()> {
     if args.width == 0 || args.height == 0 || args.spp == 0 || args.max_depth == 0 {
         bail!("--width, --height, --spp and --max-depth must be at least 1");
+    }
+    let max_side = super::setup::MAX_RENDER_SIDE;
+    if args.width > max_side || args.height > max_side {
+        bail!(
+            "--width {} --height {}: each must be at most {max_side} pixels",
+            args.width,
+            args.height
+        );
+    }
+    if args.spp > MAX_REFERENCE_SPP {
+        bail!(
+            "--spp {} must be at most {MAX_REFERENCE_SPP} (a reference converges long before)",
+            args.spp
+        );
     }
     if args.max_depth > super::setup::MAX_DEPTH_LIMIT {
         bail!(

@@ -2,7 +2,9 @@
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
 use super::methods::{ReportSection, VpVariant};
-use super::setup::{Eyes, Setup};
+use super::render_args::Eyes;
+pub use super::render_args::RenderArgs;
+use super::setup::Setup;
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::render_profile::RenderProfile;
 use anyhow::Result;
@@ -13,46 +15,6 @@ use fovea_renderer::pipeline::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
-
-#[derive(Clone)]
-pub struct RenderArgs<'a> {
-    pub scene: &'a str,
-    pub method: &'a str,
-    /// Render size; `None` = the headset's per-eye recommended size × `scale`.
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub scale: f32,
-    pub headset: &'a str,
-    pub gaze: &'a str,
-    pub frames: u32,
-    pub out: &'a Path,
-    pub exr: bool,
-    /// Still, the default orbit, or keyframes (`--camera-path [FILE]`).
-    pub camera_path: crate::camera_path::CameraMotion,
-    pub seed: u32,
-    pub max_depth: u32,
-    /// `--exposure`: automatic (the default) or fixed.
-    pub exposure: fovea_renderer::passes::exposure::Exposure,
-    /// `--tone`: the display transform.
-    pub tone: fovea_renderer::passes::tonemap::ToneCurve,
-    /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
-    pub profile: RenderProfile,
-    /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
-    pub debug_views: bool,
-    /// `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
-    pub denoiser: &'a str,
-    /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
-    pub taa: &'a str,
-    pub device: Option<&'a str>,
-    pub validation: bool,
-    /// `--eyes`: left (the default, plain frame names), right, or both (one submit per frame).
-    pub eyes: Eyes,
-    /// Frames kept on the GPU at once (a frame's images are written while later ones render).
-    pub frames_in_flight: usize,
-    /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
-    pub camera: &'a crate::look::CameraOptions,
-}
 
 #[derive(Serialize)]
 struct Report {
@@ -180,6 +142,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut setup = Setup::new(args, frames)?;
     let (width, height, eyes) = (setup.width, setup.height, setup.eyes);
     let out_dir = prepare_output_dir(args.out)?;
+    // Every file of the run goes here first and into `args.out` only once all are written.
+    let staged = out_dir.stage()?;
     let ctx = super::open_device(args.device, args.validation)?;
     let spaces = setup.spaces(args.method, &args.profile)?;
     let grid = spaces[0].grid_size();
@@ -189,18 +153,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let in_flight = if args.debug_views {
         1
     } else {
-        args.frames_in_flight.max(1)
+        super::setup::frames_in_flight(args.frames_in_flight, frames)
     };
     let scene = GpuScene::upload(&ctx, &setup.scene)?;
     let mut renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, in_flight)?;
     let mut out = FrameWriter {
         args,
+        dir: staged.path(),
         eyes,
         width,
         height,
         debug: args
             .debug_views
-            .then(|| super::debug_views::DebugViews::new(args.out, screen, grid)),
+            .then(|| super::debug_views::DebugViews::new(staged.path(), screen, grid)),
         pass_sums: BTreeMap::new(),
         totals: FrameStats::default(),
         ldr: Vec::new(),
@@ -219,6 +184,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut outside_view = 0u32;
     let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
+    let mut recent = super::overview::RecentFrames::default();
+    crate::interrupt::running(); // a signal from here on stops after the frames in flight
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
             break; // finish the frames in flight below; report what was rendered
@@ -236,6 +203,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             log.push(&frame_gaze);
         }
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
+        recent.push(input);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
             out.write(&renderer, done)?;
@@ -261,6 +229,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
     }
+    let overview = match args.overview && interrupted.is_none() {
+        true => {
+            let staged_overview = super::overview::Overview {
+                ctx: &ctx,
+                setup: &setup,
+                renderer: &renderer,
+                last_frame: frames as u64 - 1,
+                recent: &recent,
+            }
+            .write(staged.path())?;
+            // Where it lies once the run is moved into place.
+            Some(
+                args.out
+                    .join(staged_overview.file_name().unwrap_or_default()),
+            )
+        }
+        false => None,
+    };
     super::check_validation(&ctx)?;
 
     let views = eyes.list().len() as u64;
@@ -338,8 +324,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         wall_seconds: started.elapsed().as_secs_f64(),
         interrupted: interrupted.is_some(),
     };
-    write_json(&args.out.join("report.json"), &report)?;
-    out_dir.remove_stale()?;
+    write_json(&staged.path().join(crate::output::REPORT_FILE), &report)?;
+    staged.commit(&out_dir)?;
     if let Some(interrupted) = interrupted {
         return Err(interrupted.into());
     }
@@ -360,12 +346,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         report.rays_traced,
         args.out.display()
     );
+    if let Some(path) = overview {
+        println!(
+            "overview: {} (left: the last frame; middle: the same frame at full cost, every pixel traced; right: samples per pixel, the gaze marked)",
+            path.display()
+        );
+    }
     Ok(())
 }
 
 /// Writes each completed frame's images and adds its counts and timings up.
 struct FrameWriter<'a> {
     args: &'a RenderArgs<'a>,
+    /// Where the frames go (the run's staging folder).
+    dir: &'a std::path::Path,
     eyes: Eyes,
     width: u32,
     height: u32,
@@ -398,7 +392,7 @@ impl FrameWriter<'_> {
             };
             renderer.read_view_ldr(frame, view, &mut self.ldr)?;
             write_png(
-                &self.args.out.join(format!("frame_{frame:04}{suffix}.png")),
+                &self.dir.join(format!("frame_{frame:04}{suffix}.png")),
                 self.width,
                 self.height,
                 &self.ldr,
@@ -406,7 +400,7 @@ impl FrameWriter<'_> {
             if self.args.exr {
                 renderer.read_view_hdr(frame, view, &mut self.hdr)?;
                 write_exr(
-                    &self.args.out.join(format!("frame_{frame:04}{suffix}.exr")),
+                    &self.dir.join(format!("frame_{frame:04}{suffix}.exr")),
                     self.width,
                     self.height,
                     &self.hdr,

@@ -3,7 +3,8 @@
 //! frame. Both commands build frame `k` with `Setup::frame_input`, so the viewer's frames equal
 //! the offline render's (same seeds, cameras and gaze).
 
-use super::render::RenderArgs;
+pub use super::render_args::Eyes;
+use super::render_args::RenderArgs;
 use crate::camera_path;
 use crate::gaze::{FrameGaze, GazeDriver};
 use crate::projection::EyeRig;
@@ -21,43 +22,6 @@ use glam::{UVec2, Vec3};
 
 pub use super::methods::{method, names as method_names};
 use super::methods::{ScreenNeeds, SpaceInputs};
-
-/// Which eyes a run renders (`--eyes`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Eyes {
-    Left,
-    Right,
-    Both,
-}
-
-impl Eyes {
-    pub const NAMES: &'static [&'static str] = &["left", "right", "both"];
-
-    pub fn parse(name: &str) -> Result<Eyes> {
-        Ok(match name {
-            "left" => Eyes::Left,
-            "right" => Eyes::Right,
-            "both" => Eyes::Both,
-            _ => bail!("--eyes {name}: expected one of {}", Eyes::NAMES.join(", ")),
-        })
-    }
-
-    pub fn list(self) -> &'static [Eye] {
-        match self {
-            Eyes::Left => &[Eye::Left],
-            Eyes::Right => &[Eye::Right],
-            Eyes::Both => &[Eye::Left, Eye::Right],
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Eyes::Left => "left",
-            Eyes::Right => "right",
-            Eyes::Both => "both",
-        }
-    }
-}
 
 pub struct Setup {
     pub hmd: HmdDescription,
@@ -93,7 +57,8 @@ impl Setup {
         }
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
-        let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
+        let (denoiser, taa) =
+            filters_for_method(args.denoiser, args.taa, args.method, &args.profile, &hmd)?;
         let timing = &args.profile.gaze_timing;
         let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
         let rig = EyeRig {
@@ -341,8 +306,34 @@ pub fn check_common(args: &RenderArgs) -> Result<()> {
     if !(args.scale > 0.0 && args.scale <= 4.0) {
         bail!("--scale {} must be in (0, 4]", args.scale);
     }
+    if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&args.frames_in_flight) {
+        bail!(
+            "--frames-in-flight {} must be in 1..={MAX_FRAMES_IN_FLIGHT} (each frame in flight holds its own images and read-back buffers)",
+            args.frames_in_flight
+        );
+    }
+    for (flag, side) in [("--width", args.width), ("--height", args.height)] {
+        if let Some(side) = side.filter(|&s| s > MAX_RENDER_SIDE) {
+            bail!("{flag} {side} must be at most {MAX_RENDER_SIDE} pixels (the largest image side Vulkan devices promise)");
+        }
+    }
     method(args.method)?;
     check_settings(args.max_depth, &args.exposure)
+}
+
+/// Most frames kept on the GPU at once (`--frames-in-flight`); a run of fewer frames keeps that
+/// many. Past three the CPU only waits longer for the first image.
+pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
+/// The largest `--width` / `--height` (also `fovea reference`): the `maxImageDimension2D` every
+/// desktop Vulkan device offers.
+pub const MAX_RENDER_SIDE: u32 = 16384;
+
+/// Frames in flight for a run of `frames` frames: `--frames-in-flight` (checked by
+/// [`check_common`]), never more than the frames rendered.
+pub fn frames_in_flight(requested: usize, frames: u32) -> usize {
+    requested
+        .clamp(1, MAX_FRAMES_IN_FLIGHT)
+        .min(frames.max(1) as usize)
 }
 
 /// A headset eye's recommended size × `--scale`, at least one pixel per axis.
@@ -385,6 +376,39 @@ pub fn filters(
         .context("--taa")?
         .with_settings(profile.taa);
     Ok((denoiser_settings, taa_mode))
+}
+
+/// `--denoiser auto` / `--taa auto` (the defaults): what the method table shows best for
+/// Visual-Polar (docs/quality.md: BMFR with TAA in the sampling grid), where the method's grid
+/// runs temporal filters; none and off where it cannot.
+pub const AUTO: &str = "auto";
+pub const AUTO_DENOISER: &str = "bmfr";
+pub const AUTO_TAA: &str = "vp";
+
+/// `filters` with `auto` resolved for `method` (see `AUTO`).
+pub fn filters_for_method(
+    denoiser: &str,
+    taa: &str,
+    method_name: &str,
+    profile: &RenderProfile,
+    hmd: &HmdDescription,
+) -> Result<(DenoiserSettings, TaaMode)> {
+    let runs_filters = || -> Result<bool> {
+        // The capabilities do not depend on the size: a small probe screen.
+        let probe = space_for(method_name, profile, hmd, Eye::Left, UVec2::new(64, 72))?;
+        Ok(probe.capabilities().temporal_filters)
+    };
+    let auto = (denoiser == AUTO || taa == AUTO) && runs_filters()?;
+    let pick = |given: &'static str, off: &'static str| if auto { given } else { off };
+    let denoiser = match denoiser {
+        AUTO => pick(AUTO_DENOISER, "none"),
+        name => name,
+    };
+    let taa = match taa {
+        AUTO => pick(AUTO_TAA, "off"),
+        name => name,
+    };
+    filters(denoiser, taa, profile)
 }
 
 /// The sampling space of `method_name` for one eye of `hmd` (its FOV drives the headset ρ axis).

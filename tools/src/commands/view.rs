@@ -39,6 +39,8 @@ pub struct ViewArgs<'a> {
     /// `None`: run until the window closes.
     pub frames: Option<u32>,
     pub screenshot: Option<&'a Path>,
+    /// `--force`: the screenshot may replace an existing file.
+    pub force: bool,
     pub present_mode: &'a str,
     /// Gaze from the mouse (no `--gaze` given).
     pub mouse_gaze: bool,
@@ -64,6 +66,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if args.screenshot.is_some() && args.frames.is_none() {
         bail!("--screenshot needs --frames N (the screenshot is of frame N − 1)");
     }
+    if let Some(path) = args.screenshot {
+        // Before the window opens: an existing file is not replaced without --force.
+        crate::output::check_new_file(path, args.force)
+            .with_context(|| format!("--screenshot {}", path.display()))?;
+    }
     let setup = Setup::new(&args.render, args.frames.unwrap_or(u32::MAX))?;
     let event_loop = EventLoop::new()
         .context("opening the display (X11 or Wayland; is DISPLAY or WAYLAND_DISPLAY set?)")?;
@@ -83,7 +90,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         scene,
         spaces,
         setup.settings,
-        args.render.frames_in_flight.max(1),
+        super::setup::frames_in_flight(
+            args.render.frames_in_flight,
+            args.frames.unwrap_or(u32::MAX),
+        ),
     )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Viewer {
@@ -450,7 +460,13 @@ impl Viewer<'_> {
                 )
             })
             .collect::<Result<Vec<_>>>()?;
-        let (denoiser, taa) = super::setup::filters(&self.denoiser, &self.taa, profile)?;
+        let (denoiser, taa) = super::setup::filters_for_method(
+            &self.denoiser,
+            &self.taa,
+            &self.method,
+            profile,
+            &self.setup.hmd,
+        )?;
         let settings = RenderSettings {
             denoiser,
             taa,

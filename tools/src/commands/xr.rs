@@ -5,7 +5,7 @@
 //! `DIR/frames.jsonl` (one row per frame) and `DIR/report.json`.
 
 use super::render::RenderArgs;
-use super::setup::{check_common, filters, render_settings, scaled_eye_size, space_for};
+use super::setup::{check_common, filters_for_method, render_settings, scaled_eye_size, space_for};
 use crate::gaze::GazeDriver;
 use crate::output::{prepare_output_dir, write_json};
 use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
@@ -41,6 +41,8 @@ pub struct XrArgs<'a> {
     pub gaze: Option<&'a str>,
     pub record: Option<&'a Path>,
     pub screenshot: Option<&'a Path>,
+    /// `--force`: the screenshot may replace an existing file.
+    pub force: bool,
     /// The runtime space the scene camera is placed in (`--reference-space`).
     pub reference_space: ReferenceSpace,
 }
@@ -152,13 +154,17 @@ pub fn run(args: &XrArgs) -> Result<()> {
     if args.screenshot.is_some() && args.frames.is_none() {
         bail!("--screenshot needs --frames N (the screenshot is of the last rendered frame)");
     }
+    if let Some(path) = args.screenshot {
+        crate::output::check_new_file(path, args.force)
+            .with_context(|| format!("--screenshot {}", path.display()))?;
+    }
     if args.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
     check_common(r)?;
-    let (denoiser, taa) = filters(r.denoiser, r.taa, &r.profile)?;
     let base =
         HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
+    let (denoiser, taa) = filters_for_method(r.denoiser, r.taa, r.method, &r.profile, &base)?;
     // The runtime's views are known only later; the profile's frustums frame the scene.
     let (yfov, aspect) = crate::projection::inscribed_view(&base);
     let framing = crate::look::Framing {
@@ -291,7 +297,7 @@ impl<'a> XrRun<'a> {
             GpuScene::upload(&ctx, scene)?,
             spaces,
             settings,
-            r.frames_in_flight.max(1),
+            super::setup::frames_in_flight(r.frames_in_flight, args.frames.unwrap_or(u32::MAX)),
         )?;
         let screenshot = match args.screenshot {
             Some(_) => Some(Buffer::new(
@@ -333,6 +339,7 @@ impl<'a> XrRun<'a> {
     /// Runs frames until the session ends; returns why it ended.
     fn frame_loop(&mut self) -> Result<SessionEnd> {
         let exit = self.owner.exit_handle();
+        crate::interrupt::running(); // a signal from here on ends the session cleanly
         loop {
             let done = self.args.frames.is_some_and(|n| self.tally.rendered >= n);
             if done || crate::interrupt::requested().is_some() {
@@ -547,6 +554,10 @@ impl<'a> XrRun<'a> {
         }
         self.save_screenshot()?;
         super::check_validation(&self.ctx)?;
+        let (denoiser, taa) = (
+            self.renderer.settings.denoiser.name(),
+            self.renderer.settings.taa.name(),
+        );
         let XrRun {
             args,
             log,
@@ -559,7 +570,10 @@ impl<'a> XrRun<'a> {
         let logged = log.commit()?;
         let recorded = gaze.finish()?;
         let report = super::xr_report::build(&super::xr_report::Inputs {
-            args,
+            render: &args.render,
+            reference_space: args.reference_space.name(),
+            denoiser,
+            taa,
             rt,
             base,
             hmd: &facts.hmd,
