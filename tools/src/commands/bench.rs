@@ -109,7 +109,7 @@ struct RayReport {
     height: u32,
     primary_mrays_per_s: f64,
     /// `null` when the scene has no point-like light to aim shadow rays at (only an environment;
-    /// a scene without lights gets the default sun, as `fovea render` gives it).
+    /// a scene its own lights do not light gets the default sun, as `fovea render` gives it).
     shadow_mrays_per_s: Option<f64>,
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
@@ -155,7 +155,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     };
     for name in args.scenes {
         let mut scene = crate::scenes::load(name)?;
-        // Lit as `fovea render` lights it: a scene without lights of its own (Sponza, the
+        // Lit as `fovea render` lights it: a scene its own emitters do not light (Sponza, the
         // Breakfast Room) gets the default sun and sky, so its shadow rays aim at the sun.
         if let Some(notice) =
             crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())

@@ -140,8 +140,8 @@ pub struct LoopScene {
 }
 
 impl LoopScene {
-    /// Loads `name` lit as `fovea render` lights it (the default sun and sky where the scene has
-    /// no lights of its own) and builds its tree.
+    /// Loads `name` lit as `fovea render` lights it (the default sun and sky where the scene's
+    /// own emitters do not light it) and builds its tree.
     pub fn load(name: &str) -> Result<LoopScene> {
         let mut scene = crate::scenes::load(name)?;
         if let Some(notice) =
