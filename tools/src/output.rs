@@ -194,10 +194,19 @@ pub fn write_exr(path: &Path, width: u32, height: u32, texels: &[[f32; 4]]) -> R
         let t = texels[y * w + x];
         (t[0], t[1], t[2], 1.0f32)
     });
+    // Tiles in increasing order: the parallel compressor otherwise writes them as they finish,
+    // and the same pixels would give different bytes from run to run (`fovea sweep merge`
+    // promises one process's files byte for byte).
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
     write_atomic(path, |out| {
-        Ok(Image::from_channels((w, height as usize), channels)
-            .write()
-            .to_buffered(out)?)
+        Ok(
+            Image::from_encoded_channels((w, height as usize), encoding, channels)
+                .write()
+                .to_buffered(out)?,
+        )
     })
 }
 

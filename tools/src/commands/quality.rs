@@ -20,7 +20,7 @@ use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -51,8 +51,8 @@ pub struct QualityArgs<'a> {
 pub const CAMERAS: &[&str] = &["still", "moving"];
 
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
-#[derive(Serialize)]
-struct RunQuality {
+#[derive(Serialize, Deserialize)]
+pub struct RunQuality {
     camera: String,
     method: String,
     denoiser: String,
@@ -92,8 +92,8 @@ const FOVEAL_RINGS: usize = 2;
 
 /// A combination the method cannot run (a denoiser or TAA on a space without temporal filters):
 /// listed in the table with the reason instead of silently left out.
-#[derive(Serialize)]
-struct RefusedRun {
+#[derive(Serialize, Deserialize)]
+pub struct RefusedRun {
     camera: String,
     method: String,
     denoiser: String,
@@ -101,7 +101,7 @@ struct RefusedRun {
     reason: String,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct RingMean {
     /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
     ecc_inner: f64,
@@ -176,7 +176,58 @@ fn filters_refusal(
         .then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
 }
 
-pub fn run(args: &QualityArgs) -> Result<()> {
+/// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser and a TAA mode.
+pub struct Combination<'a> {
+    pub camera: &'a str,
+    pub method: &'a str,
+    pub denoiser: &'a str,
+    pub taa: &'a str,
+}
+
+impl Combination<'_> {
+    /// The `fovea render` folder of this combination inside the output folder.
+    pub fn run_dir_name(&self) -> String {
+        format!(
+            "run_{}_{}_{}_taa-{}",
+            self.camera, self.method, self.denoiser, self.taa
+        )
+    }
+
+    /// Whether the combination runs a temporal filter (which some methods refuse).
+    fn filtered(&self) -> bool {
+        self.denoiser != "none" || self.taa != "off"
+    }
+
+    fn refused(&self, reason: String) -> RefusedRun {
+        RefusedRun {
+            camera: self.camera.to_string(),
+            method: self.method.to_string(),
+            denoiser: self.denoiser.to_string(),
+            taa: self.taa.to_string(),
+            reason,
+        }
+    }
+}
+
+/// What one combination gives: its metrics, or why the method cannot run it.
+#[derive(Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    Run(RunQuality),
+    Refused(RefusedRun),
+}
+
+/// The settings every combination shares, checked once.
+pub struct Prepared {
+    /// The frames whose metrics are averaged.
+    pub evaluated: Vec<u32>,
+    ppd: f32,
+    hmd: fovea_hal::HmdDescription,
+    model: Option<fovea_hal::latency::LatencyModel>,
+}
+
+/// Checks the flags (before anything renders) and resolves what every combination shares.
+pub fn prepare(args: &QualityArgs) -> Result<Prepared> {
     check_names("--methods", args.methods, &super::methods::names())?;
     check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
     check_names("--taa", args.taa, TaaMode::NAMES)?;
@@ -208,88 +259,151 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         );
     }
     super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
-    let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let ppd = flip_ppd(args)?;
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    // Checked before anything renders.
     let model = args.profile.gaze_timing.model(&hmd)?;
-    let (mut runs, mut refused) = (Vec::new(), Vec::new());
+    Ok(Prepared {
+        evaluated,
+        ppd,
+        hmd,
+        model,
+    })
+}
+
+pub fn run(args: &QualityArgs) -> Result<()> {
+    let prepared = prepare(args)?;
+    let _out_dir = prepare_output_dir(args.out)?;
+    let mut outcomes = Vec::new();
     for camera in args.cameras {
-        let moving = camera == "moving";
-        let references = references(args, moving, &evaluated)?;
+        let references = references(args, camera, &prepared.evaluated)?;
         for method in args.methods {
             let filtered =
                 args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
+            // Asked once per method (some spaces take a full-screen sum to build).
             let refusal = if filtered {
-                filters_refusal(args, &hmd, method)?
+                filters_refusal(args, &prepared.hmd, method)?
             } else {
                 None
             };
             for denoiser in args.denoisers {
                 for taa in args.taa {
-                    if let (Some(reason), false) = (&refusal, denoiser == "none" && taa == "off") {
-                        refused.push(RefusedRun {
-                            camera: camera.clone(),
-                            method: method.clone(),
-                            denoiser: denoiser.clone(),
-                            taa: taa.clone(),
-                            reason: reason.clone(),
-                        });
-                        continue;
-                    }
-                    let dir = args
-                        .out
-                        .join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
-                    let render_args = RenderArgs {
-                        scene: args.scene,
+                    let combination = Combination {
+                        camera,
                         method,
-                        width: Some(args.width),
-                        height: Some(args.height),
-                        scale: 1.0,
-                        headset: args.headset,
-                        gaze: args.gaze,
-                        frames: args.frames,
-                        out: &dir,
-                        exr: true,
-                        camera_path: if moving {
-                            camera_path::CameraMotion::Orbit
-                        } else {
-                            camera_path::CameraMotion::Still
-                        },
-                        seed: args.seed,
-                        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
-                        // Every method is judged at one fixed exposure and curve, its
-                        // reference's (`tonemap_preview`).
-                        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
-                        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
-                        overview: false,
-                        profile: args.profile.clone(),
-                        debug_views: false,
                         denoiser,
                         taa,
-                        device: args.device,
-                        validation: args.validation,
-                        eyes: super::setup::Eyes::Left,
-                        frames_in_flight: 2,
-                        camera: args.camera,
                     };
-                    render::run(&render_args).with_context(|| {
-                        format!("{camera} camera, {method} + {denoiser}, taa {taa}")
-                    })?;
-                    let mut q = measure(args, &dir, &evaluated, &references, ppd)?;
-                    (q.camera, q.method, q.denoiser, q.taa) = (
-                        camera.clone(),
-                        method.clone(),
-                        denoiser.clone(),
-                        taa.clone(),
-                    );
-                    runs.push(q);
+                    let dir = args.out.join(combination.run_dir_name());
+                    outcomes.push(match (&refusal, combination.filtered()) {
+                        (Some(reason), true) => {
+                            Outcome::Refused(combination.refused(reason.clone()))
+                        }
+                        _ => Outcome::Run(run_combination(
+                            args,
+                            &prepared,
+                            &combination,
+                            &references,
+                            &dir,
+                        )?),
+                    });
                 }
             }
         }
     }
+    write_report(args, &prepared, outcomes, args.out)
+}
+
+/// Why the method of `combination` cannot run it, if it cannot.
+pub fn refusal(
+    args: &QualityArgs,
+    prepared: &Prepared,
+    combination: &Combination,
+) -> Result<Option<RefusedRun>> {
+    if !combination.filtered() {
+        return Ok(None);
+    }
+    Ok(filters_refusal(args, &prepared.hmd, combination.method)?
+        .map(|reason| combination.refused(reason)))
+}
+
+/// Renders one combination into `dir` (a `fovea render` folder) and measures its evaluated frames
+/// against `references` (one per evaluated frame).
+pub fn run_combination(
+    args: &QualityArgs,
+    prepared: &Prepared,
+    combination: &Combination,
+    references: &[Vec<[f32; 4]>],
+    dir: &Path,
+) -> Result<RunQuality> {
+    let Combination {
+        camera,
+        method,
+        denoiser,
+        taa,
+    } = *combination;
+    let render_args = RenderArgs {
+        scene: args.scene,
+        method,
+        width: Some(args.width),
+        height: Some(args.height),
+        scale: 1.0,
+        headset: args.headset,
+        gaze: args.gaze,
+        frames: args.frames,
+        out: dir,
+        exr: true,
+        camera_path: if camera == "moving" {
+            camera_path::CameraMotion::Orbit
+        } else {
+            camera_path::CameraMotion::Still
+        },
+        seed: args.seed,
+        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
+        // Every method is judged at one fixed exposure and curve, its reference's
+        // (`tonemap_preview`).
+        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        overview: false,
+        profile: args.profile.clone(),
+        debug_views: false,
+        denoiser,
+        taa,
+        device: args.device,
+        validation: args.validation,
+        eyes: super::setup::Eyes::Left,
+        frames_in_flight: 2,
+        camera: args.camera,
+    };
+    render::run(&render_args)
+        .with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
+    let mut q = measure(args, dir, &prepared.evaluated, references, prepared.ppd)?;
+    (q.camera, q.method, q.denoiser, q.taa) = (
+        camera.to_string(),
+        method.to_string(),
+        denoiser.to_string(),
+        taa.to_string(),
+    );
+    Ok(q)
+}
+
+/// Writes `out/quality.json` and `out/quality.md` from the outcomes in the order of the grid
+/// (cameras, methods, denoisers, TAA modes), and prints the table.
+pub fn write_report(
+    args: &QualityArgs,
+    prepared: &Prepared,
+    outcomes: Vec<Outcome>,
+    out: &Path,
+) -> Result<()> {
+    let (mut runs, mut refused) = (Vec::new(), Vec::new());
+    for outcome in outcomes {
+        match outcome {
+            Outcome::Run(q) => runs.push(q),
+            Outcome::Refused(r) => refused.push(r),
+        }
+    }
+    let model = prepared.model.as_ref();
     let report = Report {
         scene: args.scene,
         width: args.width,
@@ -300,24 +414,48 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
-        flip_ppd: ppd,
-        latency: model.as_ref().map(|m| m.describe()),
-        gaze_predict: model
-            .as_ref()
-            .map(|_| args.profile.gaze_timing.mode().name().to_string()),
+        flip_ppd: prepared.ppd,
+        latency: model.map(|m| m.describe()),
+        gaze_predict: model.map(|_| args.profile.gaze_timing.mode().name().to_string()),
         runs: &runs,
         refused: &refused,
     };
-    write_json(&args.out.join("quality.json"), &report)?;
+    write_json(&out.join("quality.json"), &report)?;
     let table = markdown(&report);
-    write_text(&args.out.join("quality.md"), &table)?;
+    write_text(&out.join("quality.md"), &table)?;
     print!("{table}");
     Ok(())
 }
 
-/// Converged references of the evaluated frames' camera poses (one for a still camera), written
-/// to `DIR/reference_<camera>_NNNN.exr`.
-fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+/// The camera poses that get a converged reference: frame 0 for a still camera, every evaluated
+/// frame for a moving one.
+pub fn reference_frames(camera: &str, evaluated: &[u32]) -> Vec<u32> {
+    if camera == "moving" {
+        evaluated.to_vec()
+    } else {
+        vec![0]
+    }
+}
+
+/// The name of the reference of `camera` at `frame` in the output folder.
+pub fn reference_file_name(camera: &str, frame: u32) -> String {
+    format!("reference_{camera}_{frame:04}.exr")
+}
+
+/// A Cartesian renderer set up for the references of `camera`, and the eye pose of each frame of
+/// [`reference_frames`].
+pub struct ReferenceRenderer {
+    pub ctx: std::sync::Arc<fovea_renderer::vk::Context>,
+    pub renderer: Renderer,
+    pub poses: Vec<(u32, fovea_renderer::frame::CameraPose)>,
+}
+
+pub fn reference_renderer(
+    args: &QualityArgs,
+    camera: &str,
+    evaluated: &[u32],
+) -> Result<ReferenceRenderer> {
+    let moving = camera == "moving";
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
     // The frames are the left eye's (`fovea render --eyes left`): the same eye through the same
@@ -330,13 +468,13 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
         height: args.height,
         metres_per_unit: args.camera.world_scale,
     };
-    let (scene, camera) = crate::look::load(
+    let (scene, scene_camera) = crate::look::load(
         args.scene,
         args.camera,
         &args.profile.environment,
         rig.framing(),
     )?;
-    let start = rig.head(&camera);
+    let start = rig.head(&scene_camera);
     let centre = scene.bounds().center();
     let ctx = super::open_device(args.device, args.validation)?;
     let size = UVec2::new(args.width, args.height);
@@ -344,35 +482,62 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
         seed: args.seed.wrapping_add(0x5eed),
         ..Default::default()
     };
-    let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
-    let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
+    let renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
+    let poses = reference_frames(camera, evaluated)
+        .into_iter()
+        .map(|f| {
+            let head = if moving {
+                camera_path::orbit(&start, centre, f, args.frames)
+            } else {
+                start
+            };
+            (f, rig.eye(&head, fovea_hal::Eye::Left))
+        })
+        .collect();
+    Ok(ReferenceRenderer {
+        ctx,
+        renderer,
+        poses,
+    })
+}
+
+/// Converged references of the evaluated frames' camera poses (one for a still camera, the same
+/// for every evaluated frame), written to `DIR/reference_<camera>_NNNN.exr`.
+fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+    let mut r = reference_renderer(args, camera, evaluated)?;
     let mut out = Vec::new();
-    for &f in &poses {
-        let head = if moving {
-            camera_path::orbit(&start, centre, f, args.frames)
-        } else {
-            start
-        };
-        let pose = rig.eye(&head, fovea_hal::Eye::Left);
-        let reference = renderer.render_reference(
-            &pose,
+    for (f, pose) in &r.poses {
+        let reference = crate::reference_sum::render(
+            &mut r.renderer,
+            pose,
             args.reference_spp,
             fovea_renderer::frame::REALTIME_MAX_DEPTH,
-            |_| {},
+            &mut |_| Ok(()),
         )?;
-        let name = format!(
-            "reference_{}_{f:04}.exr",
-            if moving { "moving" } else { "still" }
-        );
-        write_exr(&args.out.join(name), args.width, args.height, &reference)?;
+        write_exr(
+            &args.out.join(reference_file_name(camera, *f)),
+            args.width,
+            args.height,
+            &reference,
+        )?;
         out.push(reference);
     }
-    super::check_validation(&ctx)?;
-    Ok(if moving {
-        out
+    super::check_validation(&r.ctx)?;
+    Ok(per_evaluated_frame(camera, out, evaluated))
+}
+
+/// The references of [`reference_frames`] as one per evaluated frame (the still camera's one
+/// repeated).
+pub fn per_evaluated_frame(
+    camera: &str,
+    mut references: Vec<Vec<[f32; 4]>>,
+    evaluated: &[u32],
+) -> Vec<Vec<[f32; 4]>> {
+    if camera == "moving" {
+        references
     } else {
-        vec![out.remove(0); evaluated.len()]
-    })
+        vec![references.remove(0); evaluated.len()]
+    }
 }
 
 /// The run's evaluated frames against their references, ring metrics averaged over frames.

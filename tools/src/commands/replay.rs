@@ -18,7 +18,7 @@ use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -71,8 +71,9 @@ impl std::fmt::Display for BadInput {
 
 impl std::error::Error for BadInput {}
 
-#[derive(Serialize)]
-struct TraceResult {
+/// One trace's checks (a part of `replay.json`; a sweep job's result).
+#[derive(Serialize, Deserialize)]
+pub struct TraceResult {
     trace: String,
     baseline: String,
     /// The folder of this run's frames under `--out` (`run_<baseline folder name>`).
@@ -113,7 +114,8 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     })
 }
 
-fn run_checked(args: &ReplayArgs) -> Result<()> {
+/// Checks the flags before anything renders.
+pub fn check(args: &ReplayArgs) -> Result<()> {
     if args.traces.is_empty() {
         bail!(
             "fovea replay needs at least one trace (a trace file or a gaze source such as sim:1)"
@@ -135,6 +137,11 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
     if args.render.camera_path.moves() || args.render.debug_views {
         bail!("fovea replay renders a still camera without debug views (--camera-path/--debug-views do not apply)");
     }
+    Ok(())
+}
+
+fn run_checked(args: &ReplayArgs) -> Result<()> {
+    check(args)?;
     // Baselines first: a folder another run updates is refused before anything renders.
     let store = if args.update {
         Store::open_update(args.baseline)?
@@ -144,7 +151,8 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
     let _out_dir = prepare_output_dir(args.out)?;
     let mut results = Vec::new();
     for trace in args.traces {
-        let result = replay_trace(args, &store, trace).with_context(|| format!("trace {trace}"))?;
+        let result = replay_trace(args, &store, trace, args.out)
+            .with_context(|| format!("trace {trace}"))?;
         results.push(result);
     }
     if args.update {
@@ -155,27 +163,49 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
         );
         return Ok(());
     }
+    match write_report(args, results, args.out)? {
+        Some(regression) => Err(regression.into()),
+        None => Ok(()),
+    }
+}
+
+/// Writes `out/replay.json` and `out/replay.md` from the traces' results (in the order of the
+/// traces) and prints the table; the regression, if a frame left the tolerances (naming the
+/// `replay.md` of the command's own `--out`).
+pub fn write_report(
+    args: &ReplayArgs,
+    results: Vec<TraceResult>,
+    out: &Path,
+) -> Result<Option<Regression>> {
     let failed: usize = results.iter().map(|r| r.failed_frames.len()).sum();
     let report = ReplayReport {
         tolerances: &args.tolerances,
         passed: failed == 0,
         traces: results,
     };
-    write_json(&args.out.join("replay.json"), &report)?;
+    write_json(&out.join("replay.json"), &report)?;
     let table = markdown(&report);
-    write_text(&args.out.join("replay.md"), &table)?;
+    write_text(&out.join("replay.md"), &table)?;
     print!("{table}");
-    if failed > 0 {
-        return Err(Regression {
-            failed_frames: failed,
-            report: args.out.join("replay.md"),
-        }
-        .into());
-    }
-    Ok(())
+    Ok((failed > 0).then(|| Regression {
+        failed_frames: failed,
+        report: args.out.join("replay.md"),
+    }))
 }
 
-fn replay_trace(args: &ReplayArgs, store: &Store, trace: &str) -> Result<TraceResult> {
+/// The folder of `trace`'s frames inside the output folder (`run_` and its baseline folder's name).
+pub fn run_dir_name(trace: &str) -> Result<String> {
+    Ok(format!("run_{}", TraceId::of(trace)?.key))
+}
+
+/// Renders `trace` into `out`/[`run_dir_name`] and checks it against its baseline in `store` (or
+/// stages the baseline with `--update-baseline`).
+pub fn replay_trace(
+    args: &ReplayArgs,
+    store: &Store,
+    trace: &str,
+    out: &Path,
+) -> Result<TraceResult> {
     // The trace first: a file that is not one is named as such, not as a missing baseline.
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
     crate::gaze::GazeDriver::open(
@@ -215,7 +245,7 @@ fn replay_trace(args: &ReplayArgs, store: &Store, trace: &str) -> Result<TraceRe
         true => Some(store.begin(&id)?),
         false => None,
     };
-    let run_dir = args.out.join(format!("run_{}", id.key));
+    let run_dir = out.join(format!("run_{}", id.key));
     let render = RenderArgs {
         gaze: trace,
         out: &run_dir,

@@ -48,7 +48,7 @@ pub struct ViewArgs<'a> {
     pub debug_view: DebugView,
 }
 
-/// Key d cycles through every registered denoiser (and none).
+/// Key n cycles through every registered denoiser (and none).
 const DENOISERS: &[&str] = DenoiserSettings::NAMES;
 const TAAS: &[&str] = &["off", "vp", "screen"];
 
@@ -488,7 +488,8 @@ impl Viewer<'_> {
                 return Ok(());
             }
             Key::Character("m") => self.method = next(&method_names(), &self.method),
-            Key::Character("d") => self.denoiser = next(DENOISERS, &self.denoiser),
+            // `n` for the noise filter: `d` moves the free camera right.
+            Key::Character("n") => self.denoiser = next(DENOISERS, &self.denoiser),
             Key::Character("t") => self.taa = next(TAAS, &self.taa),
             Key::Character("f") => {
                 self.frozen = !self.frozen;
