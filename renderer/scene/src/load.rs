@@ -68,11 +68,31 @@ pub(crate) fn load(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError
     })
 }
 
+/// A binary glTF's header length must cover the 12-byte header itself: the gltf crate subtracts
+/// the header's size from it unchecked (an overflow panic where overflow checks are on).
+fn check_glb_header(bytes: &[u8], file: &Path) -> Result<(), SceneError> {
+    const HEADER: usize = 12;
+    if bytes.len() < HEADER || &bytes[..4] != b"glTF" {
+        return Ok(());
+    }
+    let length = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+    if (length as usize) < HEADER {
+        return Err(SceneError::Malformed {
+            file: file.to_path_buf(),
+            detail: format!(
+                "GLB header: length {length} is shorter than the {HEADER}-byte header itself"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The whole load without the panic backstop (the fuzz test calls this, so a panic fails it).
 pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
     let file = path.to_path_buf();
     let mut budget = ByteBudget::new(limits.max_bytes);
     let bytes = read_scene_file(path, &mut budget)?;
+    check_glb_header(&bytes, &file)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| SceneError::Malformed {
             file: file.clone(),

@@ -835,3 +835,19 @@ fn texture_transforms_are_read_per_slot_and_checked() {
         ],
     );
 }
+
+#[test]
+fn a_glb_header_shorter_than_itself_is_malformed_not_a_panic() {
+    let dir = temp_dir("glb-short-header");
+    let json = br#"{"asset":{"version":"2.0"}}"#;
+    let mut glb = b"glTF".to_vec();
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&0u32.to_le_bytes()); // total length below the 12-byte header
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(json);
+    let path = dir.join("short.glb");
+    std::fs::write(&path, &glb).unwrap();
+    let msg = error_text(load(&path));
+    assert_mentions(&msg, &["short.glb", "GLB header", "length 0"]);
+}
