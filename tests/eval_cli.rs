@@ -451,6 +451,9 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         camera_path: None,
         out: &bench_out,
         dump_rays: false,
+        loop_scenes: &[],
+        loop_headsets: &[],
+        traversals: &[],
         device: None,
         validation: true,
     })

@@ -9,6 +9,7 @@
 // Its variants are the sampling spaces of shaders/sampling/trace_spaces.txt.
 //! variants per trace space
 //! variants per gradient trace space _gradients: TRACE_GRADIENTS
+//! traversals
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
