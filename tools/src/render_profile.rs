@@ -10,7 +10,10 @@
 
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::frame::{
+    OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION, DEFAULT_SURFACE_CELL,
+    SURFACE_CELL_RANGE,
+};
 use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
 use fovea_renderer::passes::taa::TaaSettings;
 use fovea_renderer::sampling::{
@@ -47,6 +50,11 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `[trace] stereo_noise`: how the two eyes' random numbers relate (`--stereo-noise`).
+    pub stereo_noise: StereoNoise,
+    /// `[trace] surface_cell`: the surface noise's cell edge in sample footprints
+    /// (`RenderSettings::surface_cell`); `None`: the engine's default.
+    pub surface_cell: Option<f32>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -152,6 +160,8 @@ impl<'de> DeserializeSeed<'de> for DenoiserSection<'_> {
 #[serde(deny_unknown_fields)]
 struct TraceSection {
     offscreen: Option<String>,
+    stereo_noise: Option<String>,
+    surface_cell: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -243,6 +253,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--stereo-noise`.
+    pub stereo_noise: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -467,9 +479,24 @@ impl RenderProfile {
             profile.texture_lod =
                 TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
-        if let Some(mode) = file.trace.and_then(|t| t.offscreen) {
+        let trace = file.trace.unwrap_or_default();
+        if let Some(mode) = trace.offscreen {
             profile.offscreen_samples = OffscreenSamples::parse(&mode)
                 .with_context(|| format!("{}.offscreen", at("trace")))?;
+        }
+        if let Some(mode) = trace.stereo_noise {
+            profile.stereo_noise = StereoNoise::parse(&mode)
+                .with_context(|| format!("{}.stereo_noise", at("trace")))?;
+        }
+        if let Some(cell) = trace.surface_cell {
+            let (lo, hi) = SURFACE_CELL_RANGE;
+            if !(lo..=hi).contains(&cell) {
+                bail!(
+                    "{}.surface_cell = {cell}: must be in [{lo}, {hi}] sample footprints",
+                    at("trace")
+                );
+            }
+            profile.surface_cell = Some(cell);
         }
         if let Some(strength) = file.path.and_then(|p| p.regularisation) {
             profile.path_regularisation = Some(check_path_regularisation(
@@ -532,10 +559,18 @@ impl RenderProfile {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
         }
+        if let Some(mode) = &o.stereo_noise {
+            self.stereo_noise = StereoNoise::parse(mode).context("--stereo-noise")?;
+        }
         if o.gaze_timing.enabled() {
             self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
+    }
+
+    /// The surface noise's cell the engine runs with (footprints).
+    pub fn surface_cell(&self) -> f32 {
+        self.surface_cell.unwrap_or(DEFAULT_SURFACE_CELL)
     }
 
     /// The strength the engine runs with.

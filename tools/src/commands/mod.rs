@@ -10,6 +10,7 @@ pub mod info;
 pub mod method_table;
 pub mod methods;
 pub mod quality;
+mod quality_stereo;
 pub mod reference;
 pub mod render;
 pub mod replay;

@@ -4,9 +4,12 @@
 //! `DIR/run_*`; its last `--eval-frames` frames are compared with converged Cartesian references of
 //! the same camera poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own
 //! gaze, and the ring metrics are averaged over those frames → `DIR/quality.json` +
-//! `DIR/quality.md`.
+//! `DIR/quality.md`. With `--eyes both` every run renders both eyes, each eye is judged against
+//! its own reference, and the binocular consistency measure (`quality_stereo`) compares the eyes.
 
+use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
+use super::setup::Eyes;
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
@@ -15,7 +18,7 @@ use crate::output::{
 };
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::RenderSettings;
+use fovea_renderer::frame::{RenderSettings, StereoNoise};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::pipeline::Renderer;
@@ -43,6 +46,11 @@ pub struct QualityArgs<'a> {
     pub rings: usize,
     pub seed: u32,
     pub profile: RenderProfile,
+    /// `left` or `both` (stereo runs, the binocular consistency measure added).
+    pub eyes: Eyes,
+    /// How the eyes' random numbers relate, one run each; empty: the profile's, and the run
+    /// folders keep their names without it.
+    pub stereo_noises: &'a [StereoNoise],
     pub camera: &'a crate::look::CameraOptions,
     pub out: &'a Path,
     pub device: Option<&'a str>,
@@ -53,11 +61,13 @@ pub const CAMERAS: &[&str] = &["still", "moving"];
 
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
 #[derive(Serialize)]
-struct RunQuality {
+pub(super) struct RunQuality {
     camera: String,
     method: String,
     denoiser: String,
     taa: String,
+    /// How the eyes' random numbers related (`--stereo-noise`).
+    stereo_noise: String,
     frame_gpu_ms: f64,
     /// Samples and rays per frame (the run's mean, its report.json).
     samples_traced: u64,
@@ -65,14 +75,15 @@ struct RunQuality {
     /// Frames whose metrics are averaged, and their gaze points (render pixels).
     frames: Vec<u32>,
     gaze: Vec<[f32; 2]>,
-    rings: Vec<RingMean>,
-    frame_rmse: f64,
-    frame_ssim: f64,
+    /// The left eye's (the only one of a one-eye run).
+    pub(super) rings: Vec<RingMean>,
+    pub(super) frame_rmse: f64,
+    pub(super) frame_ssim: f64,
     /// Mean FLIP of the displayed frame against the tonemapped reference.
-    frame_flip: f64,
+    pub(super) frame_flip: f64,
     /// Mean temporal flicker over consecutive evaluated frames (`metrics::flicker_map`); null
     /// with a single evaluated frame.
-    frame_flicker: Option<f64>,
+    pub(super) frame_flicker: Option<f64>,
     /// With the latency model (`--latency-ms`, `--tracker-hz`, `--gaze-predict`), the same frames
     /// judged where the eye is when they are shown: its gaze per evaluated frame (null without
     /// gaze or off the image; such frames are left out), the rings around it, and the mean FLIP
@@ -86,6 +97,10 @@ struct RunQuality {
     foveal_flip: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     foveal_flip_true_gaze: Option<f64>,
+    /// A stereo run (`--eyes both`): the right eye's own quality and the binocular consistency
+    /// measure (`quality_stereo`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    binocular: Option<BinocularQuality>,
 }
 
 /// Rings of the fovea in `foveal_flip*`: the innermost two.
@@ -103,14 +118,14 @@ struct RefusedRun {
 }
 
 #[derive(Serialize)]
-struct RingMean {
+pub(super) struct RingMean {
     /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
-    ecc_inner: f64,
-    ecc_outer: f64,
-    rmse: Option<f64>,
-    ssim: Option<f64>,
-    flip: Option<f64>,
-    flicker: Option<f64>,
+    pub(super) ecc_inner: f64,
+    pub(super) ecc_outer: f64,
+    pub(super) rmse: Option<f64>,
+    pub(super) ssim: Option<f64>,
+    pub(super) flip: Option<f64>,
+    pub(super) flicker: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -120,6 +135,8 @@ struct Report<'a> {
     height: u32,
     headset: &'a str,
     gaze_source: &'a str,
+    /// `left` or `both`.
+    eyes: &'static str,
     frames: u32,
     eval_frames: u32,
     reference_spp: u32,
@@ -182,6 +199,9 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
     check_names("--taa", args.taa, TaaMode::NAMES)?;
     check_names("--cameras", args.cameras, CAMERAS)?;
+    if args.eyes == Eyes::Right {
+        bail!("--eyes right: fovea quality judges the left eye or both (left, both)");
+    }
     if args.eval_frames == 0 || args.eval_frames > args.frames {
         bail!(
             "--eval-frames {} must be in 1..={} (--frames)",
@@ -200,6 +220,11 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         .with_context(|| format!("--headset {}", args.headset))?;
     // Checked before anything renders.
     let model = args.profile.gaze_timing.model(&hmd)?;
+    // `None`: the profile's, the run folders named as without the flag.
+    let noises: Vec<Option<StereoNoise>> = match args.stereo_noises {
+        [] => vec![None],
+        given => given.iter().copied().map(Some).collect(),
+    };
     let (mut runs, mut refused) = (Vec::new(), Vec::new());
     for camera in args.cameras {
         let moving = camera == "moving";
@@ -224,49 +249,22 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         });
                         continue;
                     }
-                    let dir = args
-                        .out
-                        .join(format!("run_{camera}_{method}_{denoiser}_taa-{taa}"));
-                    let render_args = RenderArgs {
-                        scene: args.scene,
-                        method,
-                        width: Some(args.width),
-                        height: Some(args.height),
-                        scale: 1.0,
-                        headset: args.headset,
-                        gaze: args.gaze,
-                        frames: args.frames,
-                        out: &dir,
-                        exr: true,
-                        camera_path: if moving {
-                            camera_path::CameraMotion::Orbit
-                        } else {
-                            camera_path::CameraMotion::Still
-                        },
-                        seed: args.seed,
-                        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
-                        exposure: 1.0,
-                        profile: args.profile.clone(),
-                        debug_views: false,
-                        denoiser,
-                        taa,
-                        device: args.device,
-                        validation: args.validation,
-                        eyes: super::setup::Eyes::Left,
-                        frames_in_flight: 2,
-                        camera: args.camera,
-                    };
-                    render::run(&render_args).with_context(|| {
-                        format!("{camera} camera, {method} + {denoiser}, taa {taa}")
-                    })?;
-                    let mut q = measure(args, &dir, &evaluated, &references, ppd)?;
-                    (q.camera, q.method, q.denoiser, q.taa) = (
-                        camera.clone(),
-                        method.clone(),
-                        denoiser.clone(),
-                        taa.clone(),
-                    );
-                    runs.push(q);
+                    for &noise in &noises {
+                        let run = Run {
+                            camera,
+                            method,
+                            denoiser,
+                            taa,
+                            noise,
+                        };
+                        runs.push(render_and_measure(
+                            args,
+                            &run,
+                            &references,
+                            &evaluated,
+                            ppd,
+                        )?);
+                    }
                 }
             }
         }
@@ -277,6 +275,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
         height: args.height,
         headset: args.headset,
         gaze_source: args.gaze,
+        eyes: args.eyes.name(),
         frames: args.frames,
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
@@ -296,17 +295,117 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     Ok(())
 }
 
+/// One combination `fovea quality` renders.
+struct Run<'a> {
+    camera: &'a str,
+    method: &'a str,
+    denoiser: &'a str,
+    taa: &'a str,
+    noise: Option<StereoNoise>,
+}
+
+/// Renders one combination into its folder (`fovea render`) and judges it.
+fn render_and_measure(
+    args: &QualityArgs,
+    run: &Run,
+    references: &References,
+    evaluated: &[u32],
+    ppd: f32,
+) -> Result<RunQuality> {
+    let Run {
+        camera,
+        method,
+        denoiser,
+        taa,
+        noise,
+    } = *run;
+    let moving = camera == "moving";
+    let mut profile = args.profile.clone();
+    let noise_suffix = match noise {
+        Some(n) => {
+            profile.stereo_noise = n;
+            format!("_noise-{}", n.name())
+        }
+        None => String::new(),
+    };
+    let dir = args.out.join(format!(
+        "run_{camera}_{method}_{denoiser}_taa-{taa}{noise_suffix}"
+    ));
+    let render_args = RenderArgs {
+        scene: args.scene,
+        method,
+        width: Some(args.width),
+        height: Some(args.height),
+        scale: 1.0,
+        headset: args.headset,
+        gaze: args.gaze,
+        frames: args.frames,
+        out: &dir,
+        exr: true,
+        camera_path: if moving {
+            camera_path::CameraMotion::Orbit
+        } else {
+            camera_path::CameraMotion::Still
+        },
+        seed: args.seed,
+        max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
+        exposure: 1.0,
+        profile: profile.clone(),
+        debug_views: false,
+        denoiser,
+        taa,
+        device: args.device,
+        validation: args.validation,
+        eyes: args.eyes,
+        frames_in_flight: 2,
+        camera: args.camera,
+    };
+    let what = format!(
+        "{camera} camera, {method} + {denoiser}, taa {taa}, stereo noise {}",
+        profile.stereo_noise.name()
+    );
+    render::run(&render_args).with_context(|| what.clone())?;
+    let stereo = references.stereo.as_ref();
+    let left = match stereo {
+        Some(_) => EyeFiles::LEFT,
+        None => EyeFiles::MONO,
+    };
+    let mut q = measure(args, &dir, evaluated, &references.left, ppd, &left)?;
+    if let Some(stereo) = stereo {
+        let right = measure(args, &dir, evaluated, &stereo.right, ppd, &EyeFiles::RIGHT)?;
+        let measured = quality_stereo::measure(args, &dir, evaluated, &references.left, stereo)
+            .with_context(|| what.clone())?;
+        q.binocular = Some(measured.with_right_eye(right));
+    }
+    (q.camera, q.method, q.denoiser, q.taa, q.stereo_noise) = (
+        camera.to_string(),
+        method.to_string(),
+        denoiser.to_string(),
+        taa.to_string(),
+        profile.stereo_noise.name().to_string(),
+    );
+    Ok(q)
+}
+
+/// The converged references of one camera: the left eye's per evaluated frame, and in a stereo
+/// run the right eye's with both eyes' depth.
+struct References {
+    left: Vec<Vec<[f32; 4]>>,
+    stereo: Option<StereoReferences>,
+}
+
 /// Converged references of the evaluated frames' camera poses (one for a still camera), written
-/// to `DIR/reference_<camera>_NNNN.exr`.
-fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+/// to `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`), and
+/// in a stereo run each eye's depth through its pixel centres (`binocular::EyeGeometry`).
+fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<References> {
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    // The frames are the left eye's (`fovea render --eyes left`): the same eye through the same
-    // projection.
+    let stereo = args.eyes == Eyes::Both;
+    // The eyes `fovea render --eyes left|both` renders, through the same projection.
     let rig = crate::projection::EyeRig {
         projection: args.camera.projection,
         hmd,
-        stereo: false,
+        stereo,
         width: args.width,
         height: args.height,
         metres_per_unit: args.camera.world_scale,
@@ -327,32 +426,55 @@ fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<Vec
     };
     let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
     let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
-    let mut out = Vec::new();
+    let camera_name = if moving { "moving" } else { "still" };
+    let eyes = if stereo { Eyes::Both } else { Eyes::Left };
+    let mut out: [Vec<Vec<[f32; 4]>>; 2] = Default::default();
+    let mut heads = Vec::new();
     for &f in &poses {
         let head = if moving {
             camera_path::orbit(&start, centre, f, args.frames)
         } else {
             start
         };
-        let pose = rig.eye(&head, fovea_hal::Eye::Left);
-        let reference = renderer.render_reference(
-            &pose,
-            args.reference_spp,
-            fovea_renderer::frame::REALTIME_MAX_DEPTH,
-            |_| {},
-        )?;
-        let name = format!(
-            "reference_{}_{f:04}.exr",
-            if moving { "moving" } else { "still" }
-        );
-        write_exr(&args.out.join(name), args.width, args.height, &reference)?;
-        out.push(reference);
+        heads.push(head);
+        for (slot, &eye) in eyes.list().iter().enumerate() {
+            let pose = rig.eye(&head, eye);
+            let reference = renderer.render_reference(
+                &pose,
+                args.reference_spp,
+                fovea_renderer::frame::REALTIME_MAX_DEPTH,
+                |_| {},
+            )?;
+            let name = match stereo {
+                true => format!(
+                    "reference_{camera_name}_{}_{f:04}.exr",
+                    super::setup::eye_name(eye)
+                ),
+                false => format!("reference_{camera_name}_{f:04}.exr"),
+            };
+            write_exr(&args.out.join(name), args.width, args.height, &reference)?;
+            out[slot].push(reference);
+        }
     }
     super::check_validation(&ctx)?;
-    Ok(if moving {
-        out
-    } else {
-        vec![out.remove(0); evaluated.len()]
+    // A still camera's one pose stands for every evaluated frame.
+    let per_frame = |mut v: Vec<Vec<[f32; 4]>>| match moving {
+        true => v,
+        false => vec![v.remove(0); evaluated.len()],
+    };
+    let [left, right] = out;
+    let stereo = match stereo {
+        true => Some(StereoReferences::new(
+            &scene,
+            &rig,
+            &heads,
+            per_frame(right),
+        )),
+        false => None,
+    };
+    Ok(References {
+        left: per_frame(left),
+        stereo,
     })
 }
 
@@ -363,6 +485,7 @@ fn measure(
     evaluated: &[u32],
     references: &[Vec<[f32; 4]>],
     ppd: f32,
+    eye: &EyeFiles,
 ) -> Result<RunQuality> {
     let report_path = dir.join("report.json");
     let report: serde_json::Value =
@@ -374,20 +497,20 @@ fn measure(
     let mut flickers: Vec<(Vec<Option<f64>>, Option<f64>)> = Vec::new();
     let mut previous: Option<(u32, Vec<u8>, Vec<u8>)> = None;
     // With the latency model: the frames judged around the true gaze.
-    let latency = report.get("gaze_true").is_some();
+    let latency = eye.latency && report.get("gaze_true").is_some();
     let (mut evals_true, mut gazes_true, mut foveal, mut foveal_true) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (&f, reference) in evaluated.iter().zip(references) {
-        let gaze = &report["gaze"][f as usize];
+        let gaze = &report[eye.gaze_key][f as usize];
         let gaze = Vec2::new(
             gaze[0].as_f64().unwrap_or(0.0) as f32,
             gaze[1].as_f64().unwrap_or(0.0) as f32,
         );
-        let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
+        let path: PathBuf = dir.join(format!("frame_{f:04}{}.exr", eye.suffix));
         let (_, _, test) = read_exr(&path)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = image::open(dir.join(format!("frame_{f:04}.png")))?
+        let displayed = image::open(dir.join(format!("frame_{f:04}{}.png", eye.suffix)))?
             .to_rgba8()
             .into_raw();
         let reference_displayed = tonemap_preview(reference, 1.0);
@@ -478,6 +601,7 @@ fn measure(
         method: String::new(),
         denoiser: String::new(),
         taa: String::new(),
+        stereo_noise: String::new(),
         frame_gpu_ms: report["frame_gpu_ms"].as_f64().unwrap_or(0.0),
         samples_traced: report["samples_traced"].as_u64().unwrap_or(0),
         rays_traced: report["rays_traced"].as_u64().unwrap_or(0),
@@ -507,6 +631,7 @@ fn measure(
         rings_true_gaze,
         foveal_flip: mean_of(&foveal),
         foveal_flip_true_gaze: mean_of(&foveal_true),
+        binocular: None,
     })
 }
 
@@ -515,6 +640,19 @@ fn flip_ppd(args: &QualityArgs) -> Result<f32> {
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
     Ok(crate::flip::headset_ppd(&hmd, args.width))
+}
+
+/// A run's row label: method + denoiser, TAA, and the stereo noise where runs differ in it or
+/// render both eyes.
+fn label(r: &Report, q: &RunQuality) -> String {
+    let noises_differ = r.runs.iter().any(|o| o.stereo_noise != q.stereo_noise);
+    match noises_differ || r.eyes == "both" {
+        true => format!(
+            "{} + {}, {}, {}",
+            q.method, q.denoiser, q.taa, q.stereo_noise
+        ),
+        false => format!("{} + {}, {}", q.method, q.denoiser, q.taa),
+    }
 }
 
 /// Per camera: one row per combination, RMSE / SSIM per ring and whole frame; then, per filter,
@@ -550,7 +688,7 @@ fn markdown(r: &Report) -> String {
         let _ = writeln!(s, " frame | GPU ms |");
         let _ = writeln!(s, "|---|{}---|---|", "---|".repeat(first.rings.len()));
         for q in &runs {
-            let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+            let _ = write!(s, "| {} |", label(r, q));
             for ring in &q.rings {
                 match (ring.rmse, ring.ssim, ring.flip) {
                     (Some(e), Some(m), Some(f)) => {
@@ -584,7 +722,7 @@ fn markdown(r: &Report) -> String {
             }
             let _ = writeln!(s, " frame |\n|---|{}---|", "---|".repeat(first.rings.len()));
             for q in &runs {
-                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                let _ = write!(s, "| {} |", label(r, q));
                 for ring in &q.rings {
                     let _ = write!(
                         s,
@@ -618,7 +756,7 @@ fn markdown(r: &Report) -> String {
             );
             let cell = |v: Option<f64>| v.map_or("–".to_string(), |f| format!("{f:.4}"));
             for q in &runs {
-                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                let _ = write!(s, "| {} |", label(r, q));
                 for ring in q.rings_true_gaze.iter().flatten() {
                     let _ = write!(s, " {} |", cell(ring.flip));
                 }
@@ -631,10 +769,25 @@ fn markdown(r: &Report) -> String {
             }
             s.push('\n');
         }
+        let stereo: Vec<quality_stereo::StereoRow> = runs
+            .iter()
+            .filter_map(|q| {
+                Some(quality_stereo::StereoRow {
+                    label: label(r, q),
+                    binocular: q.binocular.as_ref()?,
+                    left_flip: q.frame_flip,
+                    left_flicker: q.frame_flicker,
+                })
+            })
+            .collect();
+        s.push_str(&quality_stereo::markdown(&stereo));
         for vp in runs.iter().filter(|q| q.method == "vp") {
-            let cartesian = runs
-                .iter()
-                .find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
+            let cartesian = runs.iter().find(|q| {
+                q.method == "cartesian"
+                    && q.denoiser == vp.denoiser
+                    && q.taa == vp.taa
+                    && q.stereo_noise == vp.stereo_noise
+            });
             if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
                 if let Some(c_rmse) = c.rings[0].rmse {
                     let verdict = if v_rmse < c_rmse {
