@@ -182,9 +182,12 @@ impl TextureLod {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum StereoNoise {
     /// Each view gets its own random sequence (the view index salts the seed).
-    #[default]
     Independent,
     /// Every view uses the same seed: texel (x, y) of both eyes draws the same random numbers.
+    /// The default: after SVGF it gave the smallest binocular difference at an unchanged
+    /// single-eye FLIP (docs/quality.md, "Binocular consistency"). In Visual-Polar space texel
+    /// (ρ, φ) of both eyes looks at nearly one point near the fixation, where both gazes meet.
+    #[default]
     Screen,
     /// The jitter as `Screen`; every number after the primary hit from the hit's world position
     /// quantised at the sample's footprint (`surface_rng_seed`, shaders/common/random.glsl):

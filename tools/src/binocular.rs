@@ -239,6 +239,24 @@ fn signed(to_rgba: &[u8], from_rgba: &[u8], warp: &Warp, f: impl Fn(DVec3) -> f6
         .collect()
 }
 
+/// The difference of [`difference_map`] at which the heat map saturates (displayed sRGB, 0…1).
+pub const HEAT_MAP_MAX: f64 = 0.1;
+
+/// The binocular difference as a picture of the measured eye (RGBA8): 0…`HEAT_MAP_MAX` along the
+/// viridis ramp of the density views, black where the surface is not visible in both eyes.
+pub fn heat_map(to_rgba: &[u8], from_rgba: &[u8], warp: &Warp) -> Vec<u8> {
+    difference_map(to_rgba, from_rgba, warp)
+        .into_iter()
+        .flat_map(|d| {
+            let [r, g, b] = match d.is_nan() {
+                true => [0, 0, 0],
+                false => crate::density::ramp((d / HEAT_MAP_MAX) as f32),
+            };
+            [r, g, b, 255]
+        })
+        .collect()
+}
+
 /// Temporal flicker of the eyes' difference from one frame to the next: per pixel,
 /// |Δ(signed difference of the run) − Δ(signed difference of the converged pair)| — how much the
 /// disagreement between the eyes changes beyond what the converged images' does. NaN where any

@@ -80,8 +80,8 @@ struct SceneFlags {
     #[arg(long)]
     offscreen_samples: Option<String>,
     /// How the two eyes' random numbers relate in a stereo run (docs/design/random-numbers.md):
-    /// independent (each eye its own sequence), screen (texel (x, y) of both eyes draws the same
-    /// numbers) or surface (the path after the primary hit drawn from the hit's world position at
+    /// screen (the default: texel (x, y) of both eyes draws the same numbers), independent (each
+    /// eye its own sequence) or surface (the path after the primary hit drawn from the hit's world position at
     /// the sample's footprint: the noise lies on the surfaces). `fovea quality` takes a
     /// comma-separated list and renders each.
     #[arg(long)]
@@ -360,7 +360,9 @@ enum Command {
         #[arg(long, default_value = "fifo")]
         present_mode: String,
         /// The debug view shown first: off, grid (the sampling grid as traced), density (samples
-        /// per pixel) or rings (eccentricity rings at 5, 10, 20, 30, 40°); key v cycles them.
+        /// per pixel), rings (eccentricity rings at 5, 10, 20, 30, 40°) or stereo-diff (with
+        /// --eyes both: each eye's binocular difference as a heat map, the other eye warped into
+        /// it through the scene's depth); key v cycles them.
         #[arg(long, default_value = "off")]
         debug_view: String,
         #[command(flatten)]

@@ -1210,4 +1210,57 @@ gradient_sigma_normal = 64
         )
         .contains("--env-intensity"));
     }
+
+    /// `[trace] stereo_noise` and `surface_cell` (and `--stereo-noise`) reach the profile; bad
+    /// values are refused naming the file and key (or the flag) and the accepted ones.
+    #[test]
+    fn stereo_noise_and_surface_cell_from_file_and_flag() {
+        let p = load_str(
+            "stereo.toml",
+            "[trace]\nstereo_noise = \"surface\"\nsurface_cell = 2\n",
+        )
+        .unwrap();
+        assert_eq!(p.stereo_noise, StereoNoise::Surface);
+        assert_eq!(p.surface_cell(), 2.0);
+        assert_eq!(RenderProfile::default().stereo_noise, StereoNoise::Screen);
+        assert_eq!(
+            RenderProfile::default().surface_cell(),
+            DEFAULT_SURFACE_CELL
+        );
+        let o = ProfileOverrides {
+            stereo_noise: Some("independent".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().stereo_noise,
+            StereoNoise::Independent
+        );
+        let err = format!(
+            "{:#}",
+            load_str("stereo_bad.toml", "[trace]\nstereo_noise = \"eyes\"\n").unwrap_err()
+        );
+        assert!(
+            err.contains("stereo_bad.toml")
+                && err.contains("[trace].stereo_noise")
+                && err.contains("independent, screen, surface"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str("cell_bad.toml", "[trace]\nsurface_cell = 100\n").unwrap_err()
+        );
+        assert!(
+            err.contains("cell_bad.toml") && err.contains("surface_cell = 100"),
+            "{err}"
+        );
+        let bad = ProfileOverrides {
+            stereo_noise: Some("eyes".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(err.contains("--stereo-noise"), "{err}");
+    }
 }

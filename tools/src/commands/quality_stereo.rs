@@ -3,14 +3,15 @@
 //! both eyes see; occlusions and off-screen points masked) and the eyes' displayed difference is
 //! averaged per eccentricity ring around the left eye's gaze, beside the same measure on the
 //! converged reference pair. The flicker of the difference (its change from frame to frame beyond
-//! the reference pair's) joins each eye's own flicker.
+//! the reference pair's) joins each eye's own flicker. Each evaluated frame's difference is also
+//! written as a heat map, `binocular_NNNN.png` in the run's folder (`binocular::heat_map`).
 
 use super::quality::{QualityArgs, RingMean, RunQuality};
 use crate::binocular::{
-    difference_flicker_map, difference_map, signed_difference_map, EyeGeometry, Warp,
+    difference_flicker_map, difference_map, heat_map, signed_difference_map, EyeGeometry, Warp,
 };
 use crate::metrics::{mean, Rings};
-use crate::output::tonemap_preview;
+use crate::output::{tonemap_preview, write_png};
 use crate::projection::EyeRig;
 use anyhow::{Context, Result};
 use fovea_hal::Eye;
@@ -201,6 +202,12 @@ pub(super) fn measure(
         let reference_left = tonemap_preview(&left_references[i], 1.0);
         let reference_right = tonemap_preview(&stereo.right[i], 1.0);
         let warp = stereo.warp(i);
+        write_png(
+            &dir.join(format!("binocular_{f:04}.png")),
+            args.width,
+            args.height,
+            &heat_map(&left, &right, warp),
+        )?;
         let signed = signed_difference_map(&left, &right, warp);
         let reference_signed = signed_difference_map(&reference_left, &reference_right, warp);
         let flicker =
