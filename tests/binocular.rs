@@ -107,7 +107,7 @@ fn reference_pair(ctx: &Arc<Context>, scene: &Scene, head: &CameraPose) -> (Vec<
     .unwrap();
     let mut one = |dx| {
         let hdr = r.render_reference(&eye(head, dx), 1024, 3, |_| {}).unwrap();
-        tonemap_preview(&hdr, 1.0)
+        tonemap_preview(&hdr, 1.0, fovea_renderer::passes::tonemap::ToneCurve::Aces)
     };
     (one(-HALF_IPD), one(HALF_IPD))
 }

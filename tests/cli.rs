@@ -1,8 +1,10 @@
 //! The `fovea` command-line contract through its library: report.json keys and exact counts,
 //! bad input named clearly, and user files never overwritten.
 
+use fovea_renderer::passes::exposure::{AutoExposure, Exposure};
 use fovea_tools::commands::reference::{run as reference, ReferenceArgs};
 use fovea_tools::commands::render::{run as render, RenderArgs};
+use fovea_tools::commands::setup::parse_exposure;
 use std::path::{Path, PathBuf};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -609,8 +611,39 @@ fn meaningless_values_are_refused_with_the_flag_named() {
     };
     for exposure in [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e-30, 1e30] {
         let mut args = render_args("cornell-box", &out);
-        args.exposure = exposure;
-        refused(&args, &["--exposure", "[1e-4, 1e4]"]);
+        args.exposure = Exposure::Manual(exposure);
+        refused(&args, &["--exposure", "±13 stops"]);
+    }
+    let mut args = render_args("cornell-box", &out);
+    args.exposure = Exposure::Auto(AutoExposure {
+        compensation_ev: 20.0,
+        ..AutoExposure::default()
+    });
+    refused(&args, &["--exposure auto+20", "±13 stops"]);
+    // The flag's text: auto, auto±EV, or EV stops; anything else names the forms.
+    assert_eq!(parse_exposure("auto").unwrap(), Exposure::auto());
+    assert_eq!(
+        parse_exposure("auto-1.5").unwrap(),
+        Exposure::Auto(AutoExposure {
+            compensation_ev: -1.5,
+            ..AutoExposure::default()
+        })
+    );
+    assert_eq!(parse_exposure("2").unwrap(), Exposure::Manual(4.0));
+    assert_eq!(parse_exposure("-1").unwrap(), Exposure::Manual(0.5));
+    for bad in [
+        "",
+        "automatic",
+        "auto1",
+        "auto+",
+        "NaN",
+        "inf",
+        "14",
+        "auto-14",
+        "1e30",
+    ] {
+        let err = format!("{:#}", parse_exposure(bad).unwrap_err());
+        assert!(err.contains("--exposure"), "{bad:?}: {err}");
     }
     for max_depth in [0, 65, u32::MAX] {
         let mut args = render_args("cornell-box", &out);
@@ -654,7 +687,7 @@ fn meaningless_values_are_refused_with_the_flag_named() {
     (args.method, args.width, args.height, args.frames, args.exr) =
         ("vp", Some(3), Some(3), 1, false);
     args.profile.visual_polar.radius_mode = fovea_renderer::sampling::RadiusMode::Fixed(42.0);
-    (args.max_depth, args.exposure) = (64, 1e4);
+    (args.max_depth, args.exposure) = (64, Exposure::stops(13.0));
     render(&args).unwrap();
     let mut args = render_args("cornell-box", &out);
     (
@@ -664,7 +697,7 @@ fn meaningless_values_are_refused_with_the_flag_named() {
         args.exr,
         args.max_depth,
         args.exposure,
-    ) = (Some(1), Some(1), 1, false, 1, 1e-4);
+    ) = (Some(1), Some(1), 1, false, 1, Exposure::stops(-13.0));
     render(&args).unwrap();
 
     for max_depth in [0, 65] {

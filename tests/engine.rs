@@ -132,7 +132,7 @@ fn pipeline_creation_checks_the_params_struct_size_and_shader_name() {
         .err()
         .expect("size mismatch")
         .to_string();
-    assert!(err.contains("32") && err.contains("4"), "{err}");
+    assert!(err.contains("16") && err.contains("4"), "{err}");
     let err = ComputePipeline::new(&ctx, "passes/no_such_pass", 0)
         .err()
         .expect("unknown shader")

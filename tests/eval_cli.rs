@@ -710,7 +710,11 @@ fn flip_whole_frame_and_per_ring_for_exr_and_png() {
             &path,
             W,
             H,
-            &fovea_tools::output::tonemap_preview(texels, 1.0),
+            &fovea_tools::output::tonemap_preview(
+                texels,
+                1.0,
+                fovea_renderer::passes::tonemap::ToneCurve::Aces,
+            ),
         )
         .unwrap();
         path

@@ -272,7 +272,11 @@ fn stereo_noise_independent_vs_shared() {
         )
         .unwrap();
         let hdr = r.render_reference(&eye(&head, dx), 64, 3, |_| {}).unwrap();
-        fovea_tools::output::tonemap_preview(&hdr, 1.0)
+        fovea_tools::output::tonemap_preview(
+            &hdr,
+            1.0,
+            fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        )
     };
     let parallax = byte_rmse(&reference(-HALF_IPD), &reference(HALF_IPD));
     println!("inter-eye RMSE (8-bit) at 63 mm: independent {independent:.2}, shared {shared:.2}, converged {parallax:.2}; same position: independent {independent_same_position:.2}, shared 0");

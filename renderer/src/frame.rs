@@ -5,6 +5,7 @@
 use crate::error::{Error, Result};
 use crate::graph::{ExternalImage, SubmitSync};
 use crate::passes::denoise::DenoiserSettings;
+use crate::passes::exposure::Exposure;
 use crate::passes::taa::TaaMode;
 use crate::passes::tonemap::ToneCurve;
 use crate::scene::Camera;
@@ -39,7 +40,7 @@ impl CameraPose {
 pub struct RenderSettings {
     pub max_depth: u32,
     pub seed: u32,
-    pub exposure: f32,
+    pub exposure: Exposure,
     pub tone_curve: ToneCurve,
     /// Foveated blur after the remap (Visual-Polar only).
     pub blur: BlurSettings,
@@ -86,7 +87,7 @@ impl Default for RenderSettings {
         RenderSettings {
             max_depth: REALTIME_MAX_DEPTH,
             seed: 1,
-            exposure: 1.0,
+            exposure: Exposure::default(),
             tone_curve: ToneCurve::Aces,
             blur: BlurSettings::default(),
             denoiser: DenoiserSettings::None,
@@ -231,12 +232,18 @@ pub struct ViewInput {
     pub gaze: Option<Vec2>,
 }
 
+/// `FrameInput::frame_seconds` by default: one refresh of a 90 Hz headset.
+pub const DEFAULT_FRAME_SECONDS: f32 = 1.0 / 90.0;
+
 /// One frame of every view (fixed capacity: building it allocates nothing).
 #[derive(Clone, Copy, Debug)]
 pub struct FrameInput {
     views: [ViewInput; MAX_VIEWS],
     view_count: usize,
     pub frame_index: u32,
+    /// Seconds from the previous frame to this one on the display (automatic exposure adapts
+    /// over it); `DEFAULT_FRAME_SECONDS` unless the caller knows better.
+    pub frame_seconds: f32,
     /// Also copy the linear screen image back (EXR output).
     pub read_hdr: bool,
     /// Also tonemap the sampling-grid image and copy it back (`read_grid_ldr`; debug views).
@@ -263,6 +270,7 @@ impl FrameInput {
             views: all,
             view_count: views.len(),
             frame_index,
+            frame_seconds: DEFAULT_FRAME_SECONDS,
             read_hdr: false,
             read_grid: false,
         })

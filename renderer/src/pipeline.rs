@@ -1,5 +1,6 @@
 //! Composes a frame: sampling space → trace → denoiser (optional, in the sampling grid) → screen
-//! image (Visual-Polar: φ-mips, remap, foveated blur) → tonemap → read-back.
+//! image (Visual-Polar: φ-mips, remap, foveated blur) for every view → one exposure metered over
+//! all views → tonemap → read-back.
 //! Also renders converged references by accumulating many samples.
 
 use crate::error::{Error, Result};
@@ -16,6 +17,7 @@ use crate::layouts::{
 };
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::Denoiser;
+use crate::passes::exposure::{Exposure, ExposurePass};
 use crate::passes::grid::{GridFrame, TileList};
 use crate::passes::taa::Taa;
 use crate::passes::tonemap::{LdrTarget, ToneTarget, TonemapPass};
@@ -54,6 +56,7 @@ pub struct Renderer {
     ring: FrameRing,
     accumulate: AccumulatePass,
     tonemap: TonemapPass,
+    exposure: ExposurePass,
     /// The newest frame whose results were collected (`render_frame`, `wait_frame`).
     last_waited: Option<u64>,
 }
@@ -114,6 +117,7 @@ impl Renderer {
         Ok(Renderer {
             accumulate: AccumulatePass::single(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
+            exposure: ExposurePass::new(ctx, frames_in_flight)?,
             ctx: ctx.clone(),
             scene,
             settings,
@@ -327,17 +331,41 @@ impl Renderer {
         if let Some(t) = target {
             rec.acquire_external(t.image);
         }
-        for (v, view_input) in inputs.iter().enumerate() {
+        let shared = FrameShared {
+            scene: &self.scene,
+            tonemap: &self.tonemap,
+            accumulate: &self.accumulate,
+            exposure: &self.exposure,
+            settings: &self.settings,
+            input,
+        };
+        // Every view's screen radiance first, then one exposure metered over all of them (both
+        // eyes share it), then every view's display image.
+        let mut screens = Vec::with_capacity(inputs.len());
+        for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
+            rec.set_view(v as u32);
+            screens.push(record_view(rec, view, slot, &shared, view_input)?);
+        }
+        if let Exposure::Auto(auto) = &self.settings.exposure {
+            for (v, screen) in screens.iter().enumerate() {
+                rec.set_view(v as u32);
+                let metered = screen.screen.metered();
+                self.exposure.record_meter(
+                    rec,
+                    auto,
+                    metered,
+                    screen.gaze,
+                    screen.pixels_per_degree,
+                )?;
+            }
+        }
+        rec.set_view(0);
+        self.exposure
+            .record_adapt(rec, &self.settings.exposure, input.frame_seconds, slot)?;
+        for (v, screen) in screens.into_iter().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
-            let shared = FrameShared {
-                scene: &self.scene,
-                tonemap: &self.tonemap,
-                accumulate: &self.accumulate,
-                settings: &self.settings,
-                input,
-            };
-            record_view(rec, &mut self.views[v], slot, &shared, view_input, external)?;
+            record_display(rec, screen, &shared, external)?;
         }
         let sync = match target {
             Some(t) => {
@@ -437,6 +465,11 @@ impl Renderer {
             .last_waited
             .ok_or_else(|| Error::Invalid("no frame has completed yet".into()))?;
         self.readable_slot(frame)
+    }
+
+    /// The exposure multiplier a completed frame was displayed with (every view shares it).
+    pub fn frame_exposure(&self, frame: u64) -> Result<f32> {
+        self.exposure.read_slot(self.readable_slot(frame)?)
     }
 
     /// Exact counts of one view of a completed frame (from the GPU's own counters).
@@ -614,7 +647,8 @@ fn build_views(
 
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
 fn max_passes(views: &[View]) -> u32 {
-    let frame: u32 = views.iter().map(View::max_passes).sum();
+    // Each view's passes and its exposure meter, and the frame's one exposure adaptation.
+    let frame: u32 = views.iter().map(|v| v.max_passes() + 1).sum::<u32>() + 1;
     // A reference batch: trace and accumulate per sample, the idle tiles' clear, the copy.
     frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 2) + 2
 }
@@ -639,26 +673,52 @@ struct FrameShared<'a> {
     scene: &'a GpuScene,
     tonemap: &'a TonemapPass,
     accumulate: &'a AccumulatePass,
+    exposure: &'a ExposurePass,
     settings: &'a RenderSettings,
     input: &'a FrameInput,
 }
 
-/// Records one view's frame: trace → denoiser → TAA → the way back to the screen → tonemap into
-/// the view's own LDR image (read back into the slot) or into `external` at its offset.
-fn record_view(
+/// One view's frame up to its screen radiance, and where its display image and read-backs go.
+struct ViewScreen<'a> {
+    screen: ScreenOut<'a>,
+    /// The sampling grid's radiance (the grid debug view tone-maps it).
+    grid_hdr: &'a Image,
+    view: ViewTargets<'a>,
+    /// The gaze (pixels) and the pixels per degree at the view's centre, for the exposure meter.
+    gaze: Vec2,
+    pixels_per_degree: f32,
+}
+
+/// A view's own display images and this slot's read-back buffers.
+struct ViewTargets<'a> {
+    ldr: &'a Image,
+    grid_ldr: &'a Image,
+    ldr_readback: &'a Buffer,
+    hdr_readback: Option<&'a Buffer>,
+    grid_readback: Option<&'a Buffer>,
+}
+
+/// Pixels per degree at the centre of a view `width` pixels wide through `camera`'s frustum.
+fn pixels_per_degree(camera: &CameraPose, width: u32) -> f32 {
+    let span = camera.fov_tan.y.atan() - camera.fov_tan.x.atan();
+    width as f32 / span.to_degrees().max(1e-3)
+}
+
+/// Records one view's frame up to its screen radiance: trace → denoiser → TAA → the way back to
+/// the screen (a pending foveated blur left to `record_display`).
+fn record_view<'a>(
     rec: &mut FrameRecorder,
-    view: &mut View,
+    view: &'a mut View,
     slot: usize,
-    shared: &FrameShared,
+    shared: &FrameShared<'a>,
     view_input: &ViewInput,
-    external: Option<(&ExternalImage, UVec2)>,
-) -> Result<()> {
+) -> Result<ViewScreen<'a>> {
     let FrameShared {
         scene,
-        tonemap,
         accumulate,
         settings,
         input,
+        ..
     } = *shared;
     let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
     let s = &view.slots[slot];
@@ -702,17 +762,6 @@ fn record_view(
         (Some(taa), Some(jitter)) => taa.record(rec, denoised, &frame, jitter)?,
         _ => denoised,
     };
-    let display = ToneTarget {
-        ldr: match external {
-            Some((image, offset)) => LdrTarget::External { image, offset },
-            None => LdrTarget::Own(&view.ldr),
-        },
-        exposure: settings.exposure,
-        curve: settings.tone_curve,
-    };
-    // Unless the frame's radiance is read back, the remap's blur writes the display image itself
-    // (one full-screen pass fewer).
-    let fused = (!input.read_hdr).then_some(display);
     let screen = view.back.record(
         rec,
         &WayBackFrame {
@@ -721,25 +770,72 @@ fn record_view(
             radiance: grid_hdr,
             blur: &settings.blur,
             jitter,
-            display: fused,
         },
     )?;
-    if let ScreenOut::Radiance(screen_hdr) = screen {
-        tonemap.record(rec, "tonemap", screen_hdr, &display)?;
-        if let (true, Some(b)) = (input.read_hdr, &s.hdr_readback) {
-            rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+    Ok(ViewScreen {
+        screen,
+        grid_hdr,
+        view: ViewTargets {
+            ldr: &view.ldr,
+            grid_ldr: &view.grid_ldr,
+            ldr_readback: &s.ldr_readback,
+            hdr_readback: s.hdr_readback.as_ref(),
+            grid_readback: s.grid_readback.as_ref(),
+        },
+        gaze: view.space.gaze(),
+        pixels_per_degree: pixels_per_degree(&view_input.camera, view.space.screen_size().x),
+    })
+}
+
+/// Records one view's display image with the frame's exposure: the tonemap (or the pending
+/// blur's last axis) into the view's own LDR image (read back into the slot) or into `external`
+/// at its offset.
+fn record_display(
+    rec: &mut FrameRecorder,
+    screen: ViewScreen,
+    shared: &FrameShared,
+    external: Option<(&ExternalImage, UVec2)>,
+) -> Result<()> {
+    let ViewScreen {
+        screen,
+        grid_hdr,
+        view,
+        ..
+    } = screen;
+    let display = ToneTarget {
+        ldr: match external {
+            Some((image, offset)) => LdrTarget::External { image, offset },
+            None => LdrTarget::Own(view.ldr),
+        },
+        exposure: shared.exposure.state(),
+        curve: shared.settings.tone_curve,
+    };
+    match (screen, shared.input.read_hdr) {
+        // Unless the frame's radiance is read back, the blur writes the display image itself
+        // (one full-screen pass fewer).
+        (ScreenOut::Unblurred(pending), false) => pending.display(rec, display)?,
+        (screen, read_hdr) => {
+            let screen_hdr = screen.into_radiance(rec)?;
+            shared
+                .tonemap
+                .record(rec, "tonemap", screen_hdr, &display)?;
+            if let (true, Some(b)) = (read_hdr, view.hdr_readback) {
+                rec.copy_image_to_buffer("readback_hdr", screen_hdr, b)?;
+            }
         }
     }
     if external.is_none() {
-        rec.copy_image_to_buffer("readback", &view.ldr, &s.ldr_readback)?;
+        rec.copy_image_to_buffer("readback", view.ldr, view.ldr_readback)?;
     }
-    if let (true, Some(b)) = (input.read_grid, &s.grid_readback) {
+    if let (true, Some(b)) = (shared.input.read_grid, view.grid_readback) {
         let grid_target = ToneTarget {
-            ldr: LdrTarget::Own(&view.grid_ldr),
+            ldr: LdrTarget::Own(view.grid_ldr),
             ..display
         };
-        tonemap.record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
-        rec.copy_image_to_buffer("readback_grid", &view.grid_ldr, b)?;
+        shared
+            .tonemap
+            .record(rec, "tonemap_grid", grid_hdr, &grid_target)?;
+        rec.copy_image_to_buffer("readback_grid", view.grid_ldr, b)?;
     }
     Ok(())
 }

@@ -194,10 +194,41 @@ struct SplatPush {
     uvec4 config;               // x 0: scatter the grid's samples into the sums, 1: resolve the sums into the sparse screen image; yzw unused
 };
 
-// Push constants of the tonemap pass.
+// Push constants of the tonemap pass. The exposure comes from the frame's ExposureState.
 struct TonemapPush {
-    vec4 params;                // x exposure multiplier, yzw unused
-    uvec4 config;               // x operator (0 clamp, 1 ACES fitted), yz target offset (px), w unused
+    uvec4 config;               // x operator (TONEMAP_*), yz target offset (px), w unused
+};
+
+// Automatic exposure (passes/exposure_meter.comp, passes/exposure_adapt.comp): one histogram of
+// log2 luminance over every view's screen radiance, each pixel weighted toward the gaze, and one
+// exposure adapted over time from it, which every view's tone mapping reads.
+const uint EXPOSURE_BINS = 512u;
+const float EXPOSURE_LOG2_MIN = -16.0;
+const float EXPOSURE_LOG2_MAX = 16.0;
+// A pixel's histogram weight in fixed point: this at the periphery, (1 + boost) times it at the
+// gaze.
+const float EXPOSURE_WEIGHT_SCALE = 16.0;
+
+// The exposure the tone mapping applies, and the adaptation's state (one per renderer; each
+// frame's copy is read back into its slot).
+struct ExposureState {
+    vec4 values;                // x exposure multiplier applied this frame, y its log2, z this frame's metered target (log2),
+                                //   w frames metered so far (0: none, the first metered frame takes its target at once)
+};
+
+// Push constants of the exposure meter (one dispatch per view).
+struct ExposureMeterPush {
+    vec4 gaze;                  // xy gaze (pixels), z 1 / (metering radius in pixels), w extra weight at the gaze (0: flat)
+    uvec4 config;               // x block size (pixels per axis; each block's mean over 4×4 taps is one histogram entry), yzw unused
+};
+
+// Push constants of the exposure adaptation (one invocation per frame, after every view's meter).
+struct ExposureAdaptPush {
+    vec4 params;                // x 1 automatic, 0 manual; y the manual multiplier; z compensation (EV, automatic);
+                                //   w seconds since the last frame
+    vec4 adapt;                 // x time constant toward a brighter scene (s), y toward a darker one (s), z, w the share of
+                                //   the histogram's weight left out below and above (the mean is over the rest)
+    vec4 limits;                // x lowest, y highest log2 exposure, z log2 of the key (the displayed mean luminance), w unused
 };
 
 // Push constants of the raycast pass (BVH tests and ray-throughput benchmarks).
@@ -245,7 +276,7 @@ struct RemapPush {
 struct BlurPush {
     vec4 shape;                 // xy gaze (pixels), z fovea radius (pixels), w σ per pixel beyond it
     uvec4 config;               // x axis (0 horizontal, 1 vertical), y max kernel radius, zw unused
-    TonemapPush tone;           // the `ldr` variants (last axis writing the display image): exposure, operator, target offset
+    TonemapPush tone;           // the `ldr` variants (last axis writing the display image): operator, target offset
 };
 
 // Push constants of the foveated blur in the Visual-Polar grid (one pass per axis; the axis is
@@ -372,5 +403,6 @@ struct AsvgfGradientPush {
 
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
+const uint TONEMAP_NEUTRAL = 2u;
 
 #endif

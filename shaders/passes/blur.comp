@@ -26,11 +26,14 @@ layout(set = 0, binding = 1, rgba8) uniform writeonly image2D dst;
 #else
 layout(set = 0, binding = 1, rgba32f) uniform writeonly image2D dst;
 #endif
+#if defined(BLUR_TONEMAP)
+layout(std430, set = 0, binding = 2) readonly buffer Exposure { ExposureState s; } exposure;
+#endif
 
 void store(ivec2 t, vec4 radiance) {
 #if defined(BLUR_TONEMAP)
     ivec2 target = t + ivec2(push.p.tone.config.yz);
-    if (all(lessThan(target, imageSize(dst)))) imageStore(dst, target, tone_map(radiance.rgb, push.p.tone));
+    if (all(lessThan(target, imageSize(dst)))) imageStore(dst, target, tone_map(radiance.rgb, exposure.s.values.x, push.p.tone));
 #else
     imageStore(dst, t, radiance);
 #endif

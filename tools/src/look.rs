@@ -21,6 +21,7 @@
 //!   lights never get the sun.
 
 pub use crate::projection::{Framing, Projection};
+pub use crate::sky_model::{default_sky, sun_direction};
 use crate::sky_model::{preetham_map, SkyModel};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::{Camera, PunctualLight, Scene, Sky};
@@ -274,23 +275,6 @@ fn parse_floats(text: &str) -> Result<Vec<f32>> {
                 .with_context(|| format!("'{}' is not a number", v.trim()))
         })
         .collect()
-}
-
-/// The unit vector toward the sun at `azimuth` (from +Z toward +X) and `elevation` (degrees).
-pub fn sun_direction(azimuth_deg: f32, elevation_deg: f32) -> Vec3 {
-    let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
-    Vec3::new(az.sin() * el.cos(), el.sin(), az.cos() * el.cos())
-}
-
-/// The default sky, radiance × `intensity`: a pale horizon (1, 0.97, 0.92), a blue zenith
-/// (0.35, 0.55, 1.0) and a dim grey ground (0.3) below the horizon, so that light from below
-/// (an open floor's bounce) stays weaker than from above.
-pub fn default_sky(intensity: f32) -> Sky {
-    Sky {
-        zenith: Vec3::new(0.35, 0.55, 1.0) * intensity,
-        horizon: Vec3::new(1.0, 0.97, 0.92) * intensity,
-        ground: Vec3::splat(0.3) * intensity,
-    }
 }
 
 /// Adds the default sun and sky where the rule of this module says so; returns the one-line

@@ -237,9 +237,15 @@ struct RenderOpts {
     /// Path vertices: 1 = emission seen directly, 2 = + direct light, 3 = + one indirect bounce.
     #[arg(long, default_value_t = 3)]
     max_depth: u32,
-    /// Linear exposure multiplier before tonemapping.
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Exposure: auto (metered from each frame's radiance with more weight around the gaze,
+    /// adapted over time like an eye, one exposure for both eyes), auto+EV / auto-EV (metered,
+    /// then compensated by EV stops), or EV (fixed, in stops: 0 displays radiance as it is).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    exposure: String,
+    /// Display transform: neutral (Khronos PBR Neutral: base colours as authored, highlights
+    /// compressed), aces (fitted ACES filmic) or clamp.
+    #[arg(long, default_value = "neutral")]
+    tone: String,
     /// Render profile TOML (Visual-Polar parameters, blur); see config/render/default.toml.
     #[arg(long)]
     profile: Option<PathBuf>,
@@ -287,15 +293,17 @@ struct RenderOpts {
     /// Also write per-frame grid images and density heat maps, and a density-vs-eccentricity plot.
     #[arg(long)]
     debug_views: bool,
-    /// Denoiser in the sampling grid: none | svgf (Schied et al. 2017) | asvgf (Schied et al. 2018:
-    /// SVGF with temporal gradients) | bmfr (Koskela et al. 2019); parameters from the profile's
-    /// [svgf] / [asvgf] / [bmfr] sections (VP needs the paper's layout).
-    #[arg(long, default_value = "none")]
+    /// Denoiser in the sampling grid: auto (bmfr where the method's grid runs denoisers, none
+    /// where it cannot: the method table's best for Visual-Polar, docs/quality.md) | none | svgf
+    /// (Schied et al. 2017) | asvgf (Schied et al. 2018: SVGF with temporal gradients) | bmfr
+    /// (Koskela et al. 2019); parameters from the profile's [svgf] / [asvgf] / [bmfr] sections.
+    #[arg(long, default_value = "auto")]
     denoiser: String,
-    /// TAA (Karis 2014) after the denoiser: off | vp (in the sampling grid; the screen for
-    /// Cartesian) | screen (after the remap to the screen, neighbourhood sized by the local VP
-    /// texel footprint; for Cartesian the same as vp).
-    #[arg(long, default_value = "off")]
+    /// TAA (Karis 2014) after the denoiser: auto (vp where the method's grid runs it, off where it
+    /// cannot) | off | vp (in the sampling grid; the screen for Cartesian) | screen (after the
+    /// remap to the screen, neighbourhood sized by the local VP texel footprint; for Cartesian the
+    /// same as vp).
+    #[arg(long, default_value = "auto")]
     taa: String,
 }
 
@@ -345,6 +353,11 @@ enum Command {
         // Boxed: the render options dwarf every other command's.
         #[command(flatten)]
         opts: Box<RenderOpts>,
+        /// Skip overview.png (the last frame beside the same frame at full cost, every pixel
+        /// traced, and the sample density with the gaze; the full-cost frame renders the last
+        /// 8 frames again without foveation).
+        #[arg(long)]
+        no_overview: bool,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -700,7 +713,9 @@ fn render_args<'a>(
         )?,
         seed: opts.seed,
         max_depth: opts.max_depth,
-        exposure: opts.exposure,
+        exposure: commands::setup::parse_exposure(&opts.exposure)?,
+        tone: commands::setup::parse_tone(&opts.tone)?,
+        overview: false,
         profile: profile.clone(),
         debug_views: opts.debug_views,
         denoiser: &opts.denoiser,
@@ -735,6 +750,7 @@ fn run() -> Result<()> {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(|| Command::Render {
         opts: Box::new(DefaultRender::parse_from(["fovea"]).opts),
+        no_overview: false,
         device: DeviceArgs {
             device: None,
             validation: false,
@@ -745,10 +761,14 @@ fn run() -> Result<()> {
         fovea_tools::interrupt::install()?;
     }
     match command {
-        Command::Render { opts, device } => {
+        Command::Render {
+            opts,
+            no_overview,
+            device,
+        } => {
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
-            commands::render::run(&render_args(
+            let mut args = render_args(
                 &opts,
                 &camera,
                 &device,
@@ -759,7 +779,9 @@ fn run() -> Result<()> {
                     out: "out/render",
                     scale: DEFAULT_SCALE,
                 },
-            )?)
+            )?;
+            args.overview = !no_overview;
+            commands::render::run(&args)
         }
         Command::View {
             opts,

@@ -9,6 +9,7 @@
 //! cannot interleave their frames.
 
 use anyhow::{anyhow, bail, Context, Result};
+use fovea_renderer::passes::tonemap::ToneCurve;
 use std::ffi::OsString;
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
@@ -248,6 +249,7 @@ fn is_fovea_file(name: &str) -> bool {
             | "frames.jsonl"
             | "replay.json"
             | "replay.md"
+            | "overview.png"
     ) || (name.starts_with("reference_") && name.ends_with(".exr"))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_")
@@ -419,9 +421,9 @@ pub fn check_regular_input(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Linear radiance → sRGB RGBA8 with the same fitted ACES curve as the tonemap pass (previews).
-pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32) -> Vec<u8> {
-    let curve = |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+/// Linear radiance → sRGB RGBA8 through `curve` at `exposure`, as the tonemap pass displays it
+/// (`shaders/common/tone.glsl`; previews and references).
+pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32, curve: ToneCurve) -> Vec<u8> {
     let srgb = |c: f32| {
         if c <= 0.0031308 {
             c * 12.92
@@ -432,10 +434,36 @@ pub fn tonemap_preview(texels: &[[f32; 4]], exposure: f32) -> Vec<u8> {
     texels
         .iter()
         .flat_map(|t| {
-            let px = |c: f32| (srgb(curve((c * exposure).max(0.0))) * 255.0 + 0.5) as u8;
-            [px(t[0]), px(t[1]), px(t[2]), 255]
+            let c = tone_curve(curve, [t[0], t[1], t[2]].map(|c| (c * exposure).max(0.0)));
+            let px = |c: f32| (srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
+            [px(c[0]), px(c[1]), px(c[2]), 255]
         })
         .collect()
+}
+
+/// The display transforms of `shaders/common/tone.glsl` on the host.
+pub fn tone_curve(curve: ToneCurve, c: [f32; 3]) -> [f32; 3] {
+    match curve {
+        ToneCurve::Clamp => c,
+        ToneCurve::Aces => {
+            c.map(|x| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0))
+        }
+        ToneCurve::Neutral => {
+            const START: f32 = 0.8 - 0.04;
+            const DESATURATION: f32 = 0.15;
+            let x = c[0].min(c[1]).min(c[2]);
+            let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+            let c = c.map(|v| v - offset);
+            let peak = c[0].max(c[1]).max(c[2]);
+            if peak < START {
+                return c;
+            }
+            let d = 1.0 - START;
+            let new_peak = 1.0 - d * d / (peak + d - START);
+            let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+            c.map(|v| v * new_peak / peak * (1.0 - g) + new_peak * g)
+        }
+    }
 }
 
 #[cfg(test)]

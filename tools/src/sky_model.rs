@@ -6,6 +6,7 @@
 //! disc itself is not in the map).
 
 use fovea_renderer::scene::environment::{uv_to_direction, EnvironmentMap};
+use fovea_renderer::scene::Sky;
 use glam::{Vec2, Vec3};
 
 /// A clear sky (Preetham's range is 2–10; 2–3 is clear, 6 hazy).
@@ -148,9 +149,7 @@ pub fn preetham_map(sun: Vec3, intensity: f32) -> EnvironmentMap {
         .collect();
     let mut map = EnvironmentMap::new(width, height, texels)
         .expect("a finite, non-negative bake of a valid size");
-    let target = upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(
-        intensity,
-    )));
+    let target = upward_irradiance(&EnvironmentMap::from_sky(&default_sky(intensity)));
     let scale = if intensity > 0.0 {
         target / upward_irradiance(&map)
     } else {
@@ -174,7 +173,7 @@ pub fn preetham_map(sun: Vec3, intensity: f32) -> EnvironmentMap {
 /// The gradient sky is [`Sky`]; this names the models `--sky` takes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SkyModel {
-    /// The horizon-to-zenith gradient (`crate::look::default_sky`).
+    /// The horizon-to-zenith gradient (`default_sky`).
     #[default]
     Gradient,
     /// Preetham et al. 1999 around the default sun.
@@ -200,10 +199,26 @@ impl SkyModel {
     }
 }
 
+/// The unit vector toward the sun at `azimuth` (from +Z toward +X) and `elevation` (degrees).
+pub fn sun_direction(azimuth_deg: f32, elevation_deg: f32) -> Vec3 {
+    let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+    Vec3::new(az.sin() * el.cos(), el.sin(), az.cos() * el.cos())
+}
+
+/// The default sky, radiance × `intensity`: a pale horizon (1, 0.97, 0.92), a blue zenith
+/// (0.35, 0.55, 1.0) and a dim grey ground (0.3) below the horizon, so that light from below
+/// (an open floor's bounce) stays weaker than from above.
+pub fn default_sky(intensity: f32) -> Sky {
+    Sky {
+        zenith: Vec3::new(0.35, 0.55, 1.0) * intensity,
+        horizon: Vec3::new(1.0, 0.97, 0.92) * intensity,
+        ground: Vec3::splat(0.3) * intensity,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::look::sun_direction;
 
     #[test]
     fn zenith_is_bluish_and_brightens_with_the_sun_and_the_sky_peaks_around_it() {
@@ -243,8 +258,7 @@ mod tests {
     fn baked_map_has_the_gradient_skys_irradiance_and_a_grey_ground() {
         for (azimuth, elevation) in [(30.0, 60.0), (200.0, 15.0)] {
             let map = preetham_map(sun_direction(azimuth, elevation), 0.5);
-            let target =
-                upward_irradiance(&EnvironmentMap::from_sky(&crate::look::default_sky(0.5)));
+            let target = upward_irradiance(&EnvironmentMap::from_sky(&default_sky(0.5)));
             assert!((upward_irradiance(&map) - target).abs() < 1e-3 * target);
             let below = map.radiance(-Vec3::Y);
             assert!(

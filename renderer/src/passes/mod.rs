@@ -4,6 +4,7 @@
 
 pub mod accumulate;
 pub mod denoise;
+pub mod exposure;
 pub mod grid;
 pub mod raycast;
 pub mod taa;

@@ -1,21 +1,51 @@
 //! Exposure, tone curve and sRGB encoding into an 8-bit image: the engine's own RGBA8 image, or
-//! an external one (a swapchain image) at an offset.
+//! an external one (a swapchain image) at an offset. The exposure is the frame's, on the GPU
+//! (`passes::exposure`).
 
 use super::push_bytes;
 use crate::error::Result;
-use crate::graph::{read_image, write_external, write_image, Bind, ExternalImage, FrameRecorder};
-use crate::layouts::{TonemapPush, TONEMAP_ACES, TONEMAP_CLAMP};
-use crate::vk::{ComputePipeline, Context, Image};
-use glam::{UVec2, UVec4, Vec4};
+use crate::graph::{
+    read_buffer, read_image, write_external, write_image, Bind, ExternalImage, FrameRecorder,
+};
+use crate::layouts::{TonemapPush, TONEMAP_ACES, TONEMAP_CLAMP, TONEMAP_NEUTRAL};
+use crate::vk::{Buffer, ComputePipeline, Context, Image};
+use glam::{UVec2, UVec4};
 use std::sync::Arc;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// The display transform. The engine's `RenderSettings` default to ACES at a fixed exposure
+/// (exact, reproducible pictures); the `fovea` commands default to Neutral with automatic
+/// exposure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ToneCurve {
     /// Plain clamp to [0, 1]: exact for images whose radiance stays below 1 (tests).
     Clamp,
-    /// The fitted ACES filmic curve.
-    #[default]
+    /// The fitted ACES filmic curve (Narkowicz): soft highlights, darker and more saturated
+    /// mid-tones than authored.
     Aces,
+    /// Khronos PBR Neutral: base colours under neutral light display as authored; only
+    /// highlights are compressed (toward white, gradually desaturated).
+    Neutral,
+}
+
+impl ToneCurve {
+    pub const NAMES: [&'static str; 3] = ["neutral", "aces", "clamp"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneCurve::Clamp => "clamp",
+            ToneCurve::Aces => "aces",
+            ToneCurve::Neutral => "neutral",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<ToneCurve> {
+        match name {
+            "clamp" => Some(ToneCurve::Clamp),
+            "aces" => Some(ToneCurve::Aces),
+            "neutral" => Some(ToneCurve::Neutral),
+            _ => None,
+        }
+    }
 }
 
 /// Where the tonemapped pixels go.
@@ -34,7 +64,8 @@ pub enum LdrTarget<'a> {
 #[derive(Clone, Copy)]
 pub struct ToneTarget<'a> {
     pub ldr: LdrTarget<'a>,
-    pub exposure: f32,
+    /// The frame's `ExposureState`.
+    pub exposure: &'a Buffer,
     pub curve: ToneCurve,
 }
 
@@ -44,23 +75,24 @@ impl ToneTarget<'_> {
         let op = match self.curve {
             ToneCurve::Clamp => TONEMAP_CLAMP,
             ToneCurve::Aces => TONEMAP_ACES,
+            ToneCurve::Neutral => TONEMAP_NEUTRAL,
         };
         let offset = match self.ldr {
             LdrTarget::Own(_) => UVec2::ZERO,
             LdrTarget::External { offset, .. } => offset,
         };
         TonemapPush {
-            params: Vec4::new(self.exposure, 0.0, 0.0, 0.0),
             config: UVec4::new(op, offset.x, offset.y, 0),
         }
     }
 
-    /// The target's binding, named `name`.
-    pub fn bind(&self, name: &'static str) -> Bind<'_> {
-        match self.ldr {
+    /// The target's bindings: the display image, named `name`, and the exposure.
+    pub fn binds(&self, name: &'static str) -> [Bind<'_>; 2] {
+        let ldr = match self.ldr {
             LdrTarget::Own(image) => write_image(name, image),
             LdrTarget::External { image, .. } => write_external(name, image),
-        }
+        };
+        [ldr, read_buffer("exposure", self.exposure)]
     }
 }
 
@@ -107,7 +139,8 @@ impl TonemapPass {
             LdrTarget::Own(_) => &self.own,
             LdrTarget::External { .. } => self.external.as_ref().ok_or_else(no_external_targets)?,
         };
-        let binds = [read_image("hdr", hdr), target.bind("ldr")];
+        let [ldr, exposure] = target.binds("ldr");
+        let binds = [read_image("hdr", hdr), ldr, exposure];
         rec.dispatch(
             pass,
             pipeline,

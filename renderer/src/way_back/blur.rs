@@ -180,7 +180,8 @@ impl BlurPass {
                         self.ldr_external.as_ref().ok_or_else(no_external_targets)?
                     }
                 };
-                let binds = [read_image("src", scratch), target.bind("dst")];
+                let [dst, exposure] = target.binds("dst");
+                let binds = [read_image("src", scratch), dst, exposure];
                 rec.dispatch(
                     "blur_v_tonemap",
                     pipeline,
@@ -240,21 +241,54 @@ impl FoveatedBlur {
         Ok(&self.blurred)
     }
 
-    /// Blurs `src` around `axis`'s gaze, the last axis writing the display image `target` itself
-    /// (σ must be above 0: the caller tone-maps `src` otherwise).
-    pub fn record_display(
-        &self,
-        rec: &mut FrameRecorder,
+    /// The blur of `src` around `axis`'s gaze, to record later: its last axis may write the
+    /// display image itself (`PendingBlur::display`). `None` at σ 0 (nothing to blur).
+    pub fn pending<'a>(
+        &'a self,
         settings: &BlurSettings,
         axis: &VisualPolar,
-        src: &Image,
-        target: ToneTarget,
-    ) -> Result<()> {
-        self.pass.record(
-            rec,
-            &settings.shape(axis),
+        src: &'a Image,
+    ) -> Option<PendingBlur<'a>> {
+        (settings.sigma_at_30 > 0.0).then(|| PendingBlur {
+            blur: self,
+            shape: settings.shape(axis),
             src,
-            &self.scratch,
+        })
+    }
+}
+
+/// A foveated blur not yet recorded: the last step of a way back, left to the frame so that the
+/// exposure can be metered on `src` (a blur barely moves a mean of log luminance) before the
+/// blur's last axis writes the display image with it.
+pub struct PendingBlur<'a> {
+    blur: &'a FoveatedBlur,
+    shape: BlurShape,
+    /// The unblurred screen radiance.
+    pub src: &'a Image,
+}
+
+impl<'a> PendingBlur<'a> {
+    /// Records the blur into the screen's radiance image.
+    pub fn radiance(self, rec: &mut FrameRecorder) -> Result<&'a Image> {
+        let b = self.blur;
+        b.pass.record(
+            rec,
+            &self.shape,
+            self.src,
+            &b.scratch,
+            BlurTarget::Radiance(&b.blurred),
+        )?;
+        Ok(&b.blurred)
+    }
+
+    /// Records the blur, its last axis writing `target` (the tone mapping fused in).
+    pub fn display(self, rec: &mut FrameRecorder, target: ToneTarget) -> Result<()> {
+        let b = self.blur;
+        b.pass.record(
+            rec,
+            &self.shape,
+            self.src,
+            &b.scratch,
             BlurTarget::Display(target),
         )
     }

@@ -1,10 +1,9 @@
 //! What every way back reads of a frame and what it leaves, and the interface its passes share.
 
-use super::blur::BlurSettings;
+use super::blur::{BlurSettings, PendingBlur};
 use crate::error::Result;
 use crate::graph::FrameRecorder;
 use crate::passes::grid::GridFrame;
-use crate::passes::tonemap::ToneTarget;
 use crate::sampling::SamplingSpace;
 use crate::vk::Image;
 use glam::Vec2;
@@ -22,16 +21,32 @@ pub struct WayBackFrame<'a> {
     /// Where the tracer put this frame's samples inside their texel (`TaaSettings::jitter`), on
     /// frames jittered for TAA.
     pub jitter: Option<Vec2>,
-    /// The display image, when nothing reads the screen's radiance: a way back whose last pass
-    /// can tone-map (the foveated blur) writes it there itself.
-    pub display: Option<ToneTarget<'a>>,
 }
 
-/// What a way back leaves: radiance on the screen to tone-map, or the display image already
-/// written (the blur's last axis wrote it).
+/// What a way back leaves: radiance on the screen, or radiance whose foveated blur is still to
+/// record (its last axis can write the display image itself, one full-screen pass fewer than a
+/// separate tone mapping).
 pub enum ScreenOut<'a> {
     Radiance(&'a Image),
-    Shown,
+    Unblurred(PendingBlur<'a>),
+}
+
+impl<'a> ScreenOut<'a> {
+    /// The screen radiance the exposure meter reads.
+    pub fn metered(&self) -> &'a Image {
+        match self {
+            ScreenOut::Radiance(image) => image,
+            ScreenOut::Unblurred(pending) => pending.src,
+        }
+    }
+
+    /// The final screen radiance, recording a pending blur.
+    pub fn into_radiance(self, rec: &mut FrameRecorder) -> Result<&'a Image> {
+        match self {
+            ScreenOut::Radiance(image) => Ok(image),
+            ScreenOut::Unblurred(pending) => pending.radiance(rec),
+        }
+    }
 }
 
 /// The passes of one way back with their screen-sized images, made once for a view.

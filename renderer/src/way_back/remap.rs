@@ -113,8 +113,8 @@ impl RemapWayBack {
 
 impl WayBackPasses for RemapWayBack {
     /// Mips, remap, the screen-space TAA (when this was made with one and the frame is jittered)
-    /// and the blur around the space's blur axis (none without one, or at σ 0); the blur's last
-    /// axis writes `frame.display` when given.
+    /// and the blur around the space's blur axis (none without one, or at σ 0), left pending
+    /// for the frame to record (`ScreenOut::Unblurred`).
     fn record<'a>(
         &'a mut self,
         rec: &mut FrameRecorder,
@@ -145,18 +145,14 @@ impl WayBackPasses for RemapWayBack {
             (Some(resolver), Some(_)) => resolver.record(rec, &self.remapped, &frame.grid)?,
             _ => &self.remapped,
         };
-        match (axis, frame.display) {
-            (Some(_), _) if self.grid_blur.is_some() => Ok(ScreenOut::Radiance(resolved)),
-            (Some(axis), Some(target)) => {
-                self.blur
-                    .record_display(rec, blur, axis, resolved, target)?;
-                Ok(ScreenOut::Shown)
-            }
-            (Some(axis), None) => Ok(ScreenOut::Radiance(
-                self.blur.record(rec, blur, axis, resolved)?,
-            )),
-            (None, _) => Ok(ScreenOut::Radiance(resolved)),
-        }
+        Ok(match axis {
+            Some(_) if self.grid_blur.is_some() => ScreenOut::Radiance(resolved),
+            Some(axis) => match self.blur.pending(blur, axis, resolved) {
+                Some(pending) => ScreenOut::Unblurred(pending),
+                None => ScreenOut::Radiance(resolved),
+            },
+            None => ScreenOut::Radiance(resolved),
+        })
     }
 
     fn taa_history_bytes(&self) -> u64 {

@@ -10,6 +10,7 @@ use crate::metrics::{
 use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_json};
 use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
+use fovea_renderer::passes::tonemap::ToneCurve;
 use glam::Vec2;
 use serde::Serialize;
 use std::path::Path;
@@ -191,7 +192,7 @@ fn read_input(path: &Path) -> Result<Input> {
         });
     }
     let (width, height, values) = read_checked(path)?;
-    let displayed = tonemap_preview(&values, 1.0);
+    let displayed = tonemap_preview(&values, 1.0, ToneCurve::Aces);
     Ok(Input {
         width,
         height,

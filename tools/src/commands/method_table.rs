@@ -8,6 +8,7 @@
 use crate::flip::{flip_image, flip_map};
 use crate::output::{read_exr, tonemap_preview, write_png, write_text};
 use anyhow::{bail, Context, Result};
+use fovea_renderer::passes::tonemap::ToneCurve;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -303,7 +304,7 @@ fn write_table(
 fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, String)>> {
     let reference_path = args.quality.join("reference_still_0000.exr");
     let (w, h, reference) = read_exr(&reference_path)?;
-    let reference = tonemap_preview(&reference, 1.0);
+    let reference = tonemap_preview(&reference, 1.0, ToneCurve::Aces);
     std::fs::create_dir_all(args.pictures)
         .with_context(|| format!("creating {}", args.pictures.display()))?;
     write_png(&args.pictures.join("reference.png"), w, h, &reference)?;

@@ -21,6 +21,7 @@ use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::{RenderSettings, StereoNoise};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
@@ -349,7 +350,11 @@ fn render_and_measure(
         },
         seed: args.seed,
         max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
-        exposure: 1.0,
+        // Every method is judged at one fixed exposure and curve, its reference's
+        // (`tonemap_preview`).
+        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+        tone: ToneCurve::Aces,
+        overview: false,
         profile: profile.clone(),
         debug_views: false,
         denoiser,
@@ -513,7 +518,7 @@ fn measure(
         let displayed = image::open(dir.join(format!("frame_{f:04}{}.png", eye.suffix)))?
             .to_rgba8()
             .into_raw();
-        let reference_displayed = tonemap_preview(reference, 1.0);
+        let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,
             &displayed,

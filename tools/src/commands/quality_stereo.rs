@@ -16,6 +16,7 @@ use crate::projection::EyeRig;
 use anyhow::{Context, Result};
 use fovea_hal::Eye;
 use fovea_renderer::frame::CameraPose;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::scene::bvh::instanced::SceneBvh;
 use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_renderer::scene::Scene;
@@ -199,8 +200,8 @@ pub(super) fn measure(
         }
         let left = read_png(&dir.join(format!("frame_{f:04}_left.png")))?;
         let right = read_png(&dir.join(format!("frame_{f:04}_right.png")))?;
-        let reference_left = tonemap_preview(&left_references[i], 1.0);
-        let reference_right = tonemap_preview(&stereo.right[i], 1.0);
+        let reference_left = tonemap_preview(&left_references[i], 1.0, ToneCurve::Aces);
+        let reference_right = tonemap_preview(&stereo.right[i], 1.0, ToneCurve::Aces);
         let warp = stereo.warp(i);
         write_png(
             &dir.join(format!("binocular_{f:04}.png")),

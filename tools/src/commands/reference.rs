@@ -3,6 +3,7 @@
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::RenderSettings;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::UVec2;
@@ -78,7 +79,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
     write_exr(args.out, args.width, args.height, &image)?;
-    let displayed = tonemap_preview(&image, 1.0);
+    let displayed = tonemap_preview(&image, 1.0, ToneCurve::Aces);
     if args.preview {
         write_png(&preview, args.width, args.height, &displayed)?;
     }

@@ -2,7 +2,9 @@
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
 use super::methods::{ReportSection, VpVariant};
-use super::setup::{Eyes, Setup};
+use super::render_args::Eyes;
+pub use super::render_args::RenderArgs;
+use super::setup::Setup;
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::render_profile::RenderProfile;
 use anyhow::Result;
@@ -13,43 +15,6 @@ use fovea_renderer::pipeline::Renderer;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
-
-#[derive(Clone)]
-pub struct RenderArgs<'a> {
-    pub scene: &'a str,
-    pub method: &'a str,
-    /// Render size; `None` = the headset's per-eye recommended size × `scale`.
-    pub width: Option<u32>,
-    pub height: Option<u32>,
-    pub scale: f32,
-    pub headset: &'a str,
-    pub gaze: &'a str,
-    pub frames: u32,
-    pub out: &'a Path,
-    pub exr: bool,
-    /// Still, the default orbit, or keyframes (`--camera-path [FILE]`).
-    pub camera_path: crate::camera_path::CameraMotion,
-    pub seed: u32,
-    pub max_depth: u32,
-    pub exposure: f32,
-    /// Visual-Polar parameters, blur and SVGF parameters (profile file + flags, already merged).
-    pub profile: RenderProfile,
-    /// Per frame: the sampling-grid image and a sample-density heat map; once: density plot.
-    pub debug_views: bool,
-    /// `none`, `svgf`, `asvgf` or `bmfr` (`DenoiserSettings::NAMES`).
-    pub denoiser: &'a str,
-    /// `off`, `vp` or `screen` (`TaaMode::NAMES`).
-    pub taa: &'a str,
-    pub device: Option<&'a str>,
-    pub validation: bool,
-    /// `--eyes`: left (the default, plain frame names), right, or both (one submit per frame).
-    pub eyes: Eyes,
-    /// Frames kept on the GPU at once (a frame's images are written while later ones render).
-    pub frames_in_flight: usize,
-    /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
-    pub camera: &'a crate::look::CameraOptions,
-}
 
 #[derive(Serialize)]
 struct Report {
@@ -120,6 +85,12 @@ struct Report {
     rays: RayReport,
     max_depth: u32,
     seed: u32,
+    /// `auto` (metered and adapted), `auto+EV`/`auto-EV`, or the fixed exposure in stops.
+    exposure_mode: String,
+    /// The display transform (`--tone`).
+    tone: &'static str,
+    /// Per frame: the exposure multiplier its pixels were displayed with (both eyes share it).
+    exposure: Vec<f32>,
     /// Whether the camera moved (`camera_motion` says how).
     camera_path: bool,
     /// `still`, `orbit` or `keys` (a `--camera-path` file).
@@ -204,6 +175,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         totals: FrameStats::default(),
         ldr: Vec::new(),
         hdr: Vec::new(),
+        exposures: Vec::with_capacity(frames as usize),
     };
 
     let bar = ProgressBar::new(frames as u64);
@@ -218,6 +190,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut outside_view = 0u32;
     let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
+    let mut recent = super::overview::RecentFrames::default();
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
             break; // finish the frames in flight below; report what was rendered
@@ -236,6 +209,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             log.push(&frame_gaze);
         }
         let input = input.with_hdr(args.exr).with_grid(args.debug_views);
+        recent.push(input);
         // The slot this frame takes held frame − in_flight: write that one out first.
         if let Some(done) = renderer.retire_next()? {
             out.write(&renderer, done)?;
@@ -261,6 +235,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(debug) = &out.debug {
         debug.finish(&renderer)?;
     }
+    let overview = match args.overview && interrupted.is_none() {
+        true => Some(
+            super::overview::Overview {
+                ctx: &ctx,
+                setup: &setup,
+                renderer: &renderer,
+                last_frame: frames as u64 - 1,
+                recent: &recent,
+            }
+            .write(args.out)?,
+        ),
+        false => None,
+    };
     super::check_validation(&ctx)?;
 
     let views = eyes.list().len() as u64;
@@ -316,6 +303,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         rays,
         max_depth: args.max_depth,
         seed: args.seed,
+        exposure_mode: exposure_name(&args.exposure),
+        tone: args.tone.name(),
+        exposure: out.exposures,
         camera_path: args.camera_path.moves(),
         camera_motion: args.camera_path.name(),
         visual_polar: match method.report {
@@ -361,6 +351,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         report.rays_traced,
         args.out.display()
     );
+    if let Some(path) = overview {
+        println!(
+            "overview: {} (left: the last frame; middle: the same frame at full cost, every pixel traced; right: samples per pixel, the gaze marked)",
+            path.display()
+        );
+    }
     Ok(())
 }
 
@@ -375,10 +371,12 @@ struct FrameWriter<'a> {
     totals: FrameStats,
     ldr: Vec<u8>,
     hdr: Vec<[f32; 4]>,
+    exposures: Vec<f32>,
 }
 
 impl FrameWriter<'_> {
     fn write(&mut self, renderer: &Renderer, frame: u64) -> Result<()> {
+        self.exposures.push(renderer.frame_exposure(frame)?);
         for t in renderer.frame_timings(frame)? {
             *self.pass_sums.entry(t.name.to_string()).or_default() += t.ms;
         }
@@ -416,6 +414,16 @@ impl FrameWriter<'_> {
             debug.frame(frame as u32, renderer)?;
         }
         Ok(())
+    }
+}
+
+/// `--exposure` as the report names it: `auto`, `auto+EV`, or the fixed exposure in stops.
+pub fn exposure_name(exposure: &fovea_renderer::passes::exposure::Exposure) -> String {
+    use fovea_renderer::passes::exposure::Exposure;
+    match exposure {
+        Exposure::Auto(a) if a.compensation_ev == 0.0 => "auto".into(),
+        Exposure::Auto(a) => format!("auto{:+}", a.compensation_ev),
+        Exposure::Manual(m) => format!("{}", m.log2()),
     }
 }
 

@@ -202,7 +202,6 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         Some(_) => read_exr(&Baseline::reference_exr(&base_dir))?.2,
         None => reference_for(args, &render, width, height)?,
     };
-    let reference_ldr = tonemap_preview(&reference, render.exposure);
     let ppd = pixels_per_degree(args, width)?;
     let passes: BTreeMap<String, f64> =
         serde_json::from_value(report["passes"].clone()).unwrap_or_default();
@@ -213,6 +212,10 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?
             .to_rgba8()
             .into_raw();
+        // The reference displayed as the frame was: its exposure (automatic exposure moves it
+        // frame by frame) and its curve.
+        let exposure = report["exposure"][k as usize].as_f64().unwrap_or(1.0) as f32;
+        let reference_ldr = tonemap_preview(&reference, exposure, render.tone);
         let reference_flip = flip_map(&reference_ldr, &ldr, width, height, ppd);
         let g = &report["gaze"][k as usize];
         let gaze = Vec2::new(

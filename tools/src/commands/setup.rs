@@ -3,7 +3,8 @@
 //! frame. Both commands build frame `k` with `Setup::frame_input`, so the viewer's frames equal
 //! the offline render's (same seeds, cameras and gaze).
 
-use super::render::RenderArgs;
+pub use super::render_args::Eyes;
+use super::render_args::RenderArgs;
 use crate::camera_path;
 use crate::gaze::{FrameGaze, GazeDriver};
 use crate::projection::EyeRig;
@@ -12,50 +13,15 @@ use anyhow::{bail, Context, Result};
 use fovea_hal::{Eye, EyeView, HmdDescription};
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::exposure::{AutoExposure, Exposure};
 use fovea_renderer::passes::taa::TaaMode;
+use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
 use glam::{UVec2, Vec3};
 
 pub use super::methods::{method, names as method_names};
 use super::methods::{ScreenNeeds, SpaceInputs};
-
-/// Which eyes a run renders (`--eyes`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Eyes {
-    Left,
-    Right,
-    Both,
-}
-
-impl Eyes {
-    pub const NAMES: &'static [&'static str] = &["left", "right", "both"];
-
-    pub fn parse(name: &str) -> Result<Eyes> {
-        Ok(match name {
-            "left" => Eyes::Left,
-            "right" => Eyes::Right,
-            "both" => Eyes::Both,
-            _ => bail!("--eyes {name}: expected one of {}", Eyes::NAMES.join(", ")),
-        })
-    }
-
-    pub fn list(self) -> &'static [Eye] {
-        match self {
-            Eyes::Left => &[Eye::Left],
-            Eyes::Right => &[Eye::Right],
-            Eyes::Both => &[Eye::Left, Eye::Right],
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Eyes::Left => "left",
-            Eyes::Right => "right",
-            Eyes::Both => "both",
-        }
-    }
-}
 
 pub struct Setup {
     pub hmd: HmdDescription,
@@ -91,7 +57,8 @@ impl Setup {
         }
         // Before the device is opened; `space_for` checks again for the viewer's method switch.
         check_space(args.method, &args.profile, UVec2::new(width, height))?;
-        let (denoiser, taa) = filters(args.denoiser, args.taa, &args.profile)?;
+        let (denoiser, taa) =
+            filters_for_method(args.denoiser, args.taa, args.method, &args.profile, &hmd)?;
         let timing = &args.profile.gaze_timing;
         let gaze = GazeDriver::open_timed(args.gaze, &hmd, width, height, timing)?;
         let rig = EyeRig {
@@ -180,7 +147,10 @@ impl Setup {
                 gaze: Some(gaze.pixels[eye.index()]),
             };
         }
-        Ok((FrameInput::views(&views[..eyes.len()], frame)?, gaze))
+        let mut input = FrameInput::views(&views[..eyes.len()], frame)?;
+        // Frames follow each other at the headset's refresh (the camera path's clock too).
+        input.frame_seconds = 1.0 / self.hmd.refresh_hz;
+        Ok((input, gaze))
     }
 }
 
@@ -188,9 +158,9 @@ impl Setup {
 /// closed room never escapes, so each vertex costs another trace of the whole frame: a huge value
 /// never finishes a frame (and trips a GPU watchdog). 64 is 20× the real-time default of 3.
 pub const MAX_DEPTH_LIMIT: u32 = 64;
-/// `--exposure` range: 10⁻⁴ to 10⁴ (±13 stops). Outside it (and at 0, negative or non-finite)
-/// the tonemapped frame is all black or blown out.
-pub const EXPOSURE_RANGE: (f32, f32) = (1e-4, 1e4);
+/// `--exposure` range in stops: ±13 (multipliers 10⁻⁴ to 10⁴). Beyond it the tonemapped frame is
+/// all black or blown out.
+pub const EXPOSURE_STOPS: f32 = 13.0;
 /// The smallest Visual-Polar screen and grid per axis: one grid column would put every sample on
 /// one ring around the gaze (all of the screen at one eccentricity), one row every sample on one
 /// ray from it, either a flat, meaningless frame; a screen one pixel across has no periphery on
@@ -201,15 +171,62 @@ pub const MIN_VP_GRID: u32 = 2;
 pub const MAX_VP_RADIUS_DIAGONALS: f32 = 10.0;
 
 /// `--max-depth` and `--exposure` (`fovea render`, `view` and `xr`).
-pub fn check_settings(max_depth: u32, exposure: f32) -> Result<()> {
+pub fn check_settings(max_depth: u32, exposure: &Exposure) -> Result<()> {
     if !(1..=MAX_DEPTH_LIMIT).contains(&max_depth) {
         bail!("--max-depth {max_depth} must be in 1..={MAX_DEPTH_LIMIT} (path vertices: 1 = emission seen directly)");
     }
-    let (lo, hi) = EXPOSURE_RANGE;
-    if !(exposure.is_finite() && (lo..=hi).contains(&exposure)) {
-        bail!("--exposure {exposure:?} must be a finite multiplier in [{lo:e}, {hi:e}] (outside it the frame is all black or blown out)");
+    let within = |stops: f32| stops.is_finite() && stops.abs() <= EXPOSURE_STOPS;
+    match exposure {
+        Exposure::Manual(m) if !(*m > 0.0 && within(m.log2())) => {
+            bail!("--exposure: a multiplier of {m:?} is outside ±{EXPOSURE_STOPS} stops (the frame would be all black or blown out)")
+        }
+        Exposure::Auto(a) if !within(a.compensation_ev) => bail!(
+            "--exposure auto{:+}: the compensation must be within ±{EXPOSURE_STOPS} stops",
+            a.compensation_ev
+        ),
+        Exposure::Auto(a) => a.validate().context("--exposure")?,
+        Exposure::Manual(_) => {}
     }
     Ok(())
+}
+
+/// `--exposure`: `auto` (metered from every frame, adapted over time), `auto+EV` / `auto-EV`
+/// (metered, then EV stops brighter or darker), or a fixed exposure of EV stops (0: radiance
+/// displayed as it is; each stop doubles it).
+pub fn parse_exposure(text: &str) -> Result<Exposure> {
+    let stops = |s: &str| -> Result<f32> {
+        let ev: f32 = s.trim().parse().map_err(|_| {
+            anyhow::anyhow!(
+                "--exposure {text:?}: expected auto, auto+EV, auto-EV or EV (stops, a number)"
+            )
+        })?;
+        if !(ev.is_finite() && ev.abs() <= EXPOSURE_STOPS) {
+            bail!(
+                "--exposure {text:?}: EV must be a finite number of stops within ±{EXPOSURE_STOPS}"
+            );
+        }
+        Ok(ev)
+    };
+    let exposure = match text.trim().strip_prefix("auto") {
+        Some("") => Exposure::auto(),
+        Some(rest) if rest.starts_with(['+', '-']) => Exposure::Auto(AutoExposure {
+            compensation_ev: stops(rest)?,
+            ..AutoExposure::default()
+        }),
+        Some(_) => bail!("--exposure {text:?}: expected auto, auto+EV, auto-EV or EV (stops)"),
+        None => Exposure::stops(stops(text)?),
+    };
+    Ok(exposure)
+}
+
+/// `--tone`: the display transform's name (`ToneCurve::NAMES`).
+pub fn parse_tone(text: &str) -> Result<ToneCurve> {
+    ToneCurve::from_name(text).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--tone {text:?}: expected one of {}",
+            ToneCurve::NAMES.join(", ")
+        )
+    })
 }
 
 /// What the Visual-Polar mapping needs of the screen `method` renders: a screen and a grid of at
@@ -290,7 +307,7 @@ pub fn check_common(args: &RenderArgs) -> Result<()> {
         bail!("--scale {} must be in (0, 4]", args.scale);
     }
     method(args.method)?;
-    check_settings(args.max_depth, args.exposure)
+    check_settings(args.max_depth, &args.exposure)
 }
 
 /// A headset eye's recommended size × `--scale`, at least one pixel per axis.
@@ -309,6 +326,7 @@ pub fn render_settings(
         max_depth: args.max_depth,
         seed: args.seed,
         exposure: args.exposure,
+        tone_curve: args.tone,
         blur: args.profile.blur,
         denoiser,
         taa,
@@ -334,6 +352,39 @@ pub fn filters(
         .context("--taa")?
         .with_settings(profile.taa);
     Ok((denoiser_settings, taa_mode))
+}
+
+/// `--denoiser auto` / `--taa auto` (the defaults): what the method table shows best for
+/// Visual-Polar (docs/quality.md: BMFR with TAA in the sampling grid), where the method's grid
+/// runs temporal filters; none and off where it cannot.
+pub const AUTO: &str = "auto";
+pub const AUTO_DENOISER: &str = "bmfr";
+pub const AUTO_TAA: &str = "vp";
+
+/// `filters` with `auto` resolved for `method` (see `AUTO`).
+pub fn filters_for_method(
+    denoiser: &str,
+    taa: &str,
+    method_name: &str,
+    profile: &RenderProfile,
+    hmd: &HmdDescription,
+) -> Result<(DenoiserSettings, TaaMode)> {
+    let runs_filters = || -> Result<bool> {
+        // The capabilities do not depend on the size: a small probe screen.
+        let probe = space_for(method_name, profile, hmd, Eye::Left, UVec2::new(64, 72))?;
+        Ok(probe.capabilities().temporal_filters)
+    };
+    let auto = (denoiser == AUTO || taa == AUTO) && runs_filters()?;
+    let pick = |given: &'static str, off: &'static str| if auto { given } else { off };
+    let denoiser = match denoiser {
+        AUTO => pick(AUTO_DENOISER, "none"),
+        name => name,
+    };
+    let taa = match taa {
+        AUTO => pick(AUTO_TAA, "off"),
+        name => name,
+    };
+    filters(denoiser, taa, profile)
 }
 
 /// The sampling space of `method_name` for one eye of `hmd` (its FOV drives the headset ρ axis).

@@ -458,7 +458,13 @@ impl Viewer<'_> {
                 )
             })
             .collect::<Result<Vec<_>>>()?;
-        let (denoiser, taa) = super::setup::filters(&self.denoiser, &self.taa, profile)?;
+        let (denoiser, taa) = super::setup::filters_for_method(
+            &self.denoiser,
+            &self.taa,
+            &self.method,
+            profile,
+            &self.setup.hmd,
+        )?;
         let settings = RenderSettings {
             denoiser,
             taa,

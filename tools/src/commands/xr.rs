@@ -5,7 +5,7 @@
 //! `DIR/frames.jsonl` (one row per frame) and `DIR/report.json`.
 
 use super::render::RenderArgs;
-use super::setup::{check_common, filters, render_settings, scaled_eye_size, space_for};
+use super::setup::{check_common, filters_for_method, render_settings, scaled_eye_size, space_for};
 use crate::gaze::GazeDriver;
 use crate::output::{prepare_output_dir, write_json};
 use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
@@ -156,9 +156,9 @@ pub fn run(args: &XrArgs) -> Result<()> {
         bail!("--frames must be at least 1");
     }
     check_common(r)?;
-    let (denoiser, taa) = filters(r.denoiser, r.taa, &r.profile)?;
     let base =
         HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
+    let (denoiser, taa) = filters_for_method(r.denoiser, r.taa, r.method, &r.profile, &base)?;
     // The runtime's views are known only later; the profile's frustums frame the scene.
     let (yfov, aspect) = crate::projection::inscribed_view(&base);
     let framing = crate::look::Framing {
@@ -547,6 +547,10 @@ impl<'a> XrRun<'a> {
         }
         self.save_screenshot()?;
         super::check_validation(&self.ctx)?;
+        let (denoiser, taa) = (
+            self.renderer.settings.denoiser.name(),
+            self.renderer.settings.taa.name(),
+        );
         let XrRun {
             args,
             log,
@@ -559,7 +563,10 @@ impl<'a> XrRun<'a> {
         let logged = log.commit()?;
         let recorded = gaze.finish()?;
         let report = super::xr_report::build(&super::xr_report::Inputs {
-            args,
+            render: &args.render,
+            reference_space: args.reference_space.name(),
+            denoiser,
+            taa,
             rt,
             base,
             hmd: &facts.hmd,

@@ -2,7 +2,7 @@
 //! runtime, the system's properties, which headset figure came from the runtime and which from
 //! the `--headset` TOML, and the gaze's age at display.
 
-use super::xr::XrArgs;
+use super::render_args::RenderArgs;
 use anyhow::{Context, Result};
 use ash::vk;
 use fovea_hal::openxr::{OpenXrRuntime, RuntimeFigures, SessionEnd};
@@ -27,7 +27,12 @@ pub struct Tally<'a> {
 }
 
 pub struct Inputs<'a> {
-    pub args: &'a XrArgs<'a>,
+    pub render: &'a RenderArgs<'a>,
+    /// `--reference-space`, as the report names it.
+    pub reference_space: &'static str,
+    /// The denoiser and TAA that ran (`auto` resolved).
+    pub denoiser: &'a str,
+    pub taa: &'a str,
     pub rt: &'a OpenXrRuntime,
     pub base: &'a HmdDescription,
     pub hmd: &'a HmdDescription,
@@ -151,7 +156,7 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
             .system_properties(i.rt.system)
             .context("xrGetSystemProperties")?;
     let t = i.tally;
-    let r = &i.args.render;
+    let r = i.render;
     let source = |from_runtime: bool| {
         if from_runtime {
             "runtime"
@@ -197,15 +202,15 @@ pub fn build(i: &Inputs) -> Result<XrReport> {
         },
         refresh_hz: i.hmd.refresh_hz,
         method: r.method.to_string(),
-        denoiser: r.denoiser.to_string(),
-        taa: r.taa.to_string(),
+        denoiser: i.denoiser.to_string(),
+        taa: i.taa.to_string(),
         scene: r.scene.to_string(),
         eyes: "both",
         device: i.device.to_string(),
         swapchain_format: format!("{:?}", i.swapchain_format),
         width: i.eye_size.0,
         height: i.eye_size.1,
-        reference_space: i.args.reference_space.name(),
+        reference_space: i.reference_space,
         world_scale: r.camera.world_scale,
         frames: t.frames,
         frames_rendered: t.rendered,
