@@ -62,7 +62,7 @@ pub const CAMERAS: &[&str] = &["still", "moving"];
 
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
 #[derive(Serialize)]
-pub(super) struct RunQuality {
+struct RunQuality {
     camera: String,
     method: String,
     denoiser: String,
@@ -77,14 +77,14 @@ pub(super) struct RunQuality {
     frames: Vec<u32>,
     gaze: Vec<[f32; 2]>,
     /// The left eye's (the only one of a one-eye run).
-    pub(super) rings: Vec<RingMean>,
-    pub(super) frame_rmse: f64,
-    pub(super) frame_ssim: f64,
+    rings: Vec<RingMean>,
+    frame_rmse: f64,
+    frame_ssim: f64,
     /// Mean FLIP of the displayed frame against the tonemapped reference.
-    pub(super) frame_flip: f64,
+    frame_flip: f64,
     /// Mean temporal flicker over consecutive evaluated frames (`metrics::flicker_map`); null
     /// with a single evaluated frame.
-    pub(super) frame_flicker: Option<f64>,
+    frame_flicker: Option<f64>,
     /// With the latency model (`--latency-ms`, `--tracker-hz`, `--gaze-predict`), the same frames
     /// judged where the eye is when they are shown: its gaze per evaluated frame (null without
     /// gaze or off the image; such frames are left out), the rings around it, and the mean FLIP
@@ -98,10 +98,29 @@ pub(super) struct RunQuality {
     foveal_flip: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     foveal_flip_true_gaze: Option<f64>,
-    /// A stereo run (`--eyes both`): the right eye's own quality and the binocular consistency
-    /// measure (`quality_stereo`).
+    /// A stereo run (`--eyes both`): the binocular consistency measure (`quality_stereo`) and
+    /// the right eye's own quality.
     #[serde(skip_serializing_if = "Option::is_none")]
-    binocular: Option<BinocularQuality>,
+    binocular: Option<Binocular>,
+}
+
+/// quality.json's `binocular`: the measure, and the right eye judged as the left is (its rings
+/// around its own gaze).
+#[derive(Serialize)]
+struct Binocular {
+    #[serde(flatten)]
+    measure: BinocularQuality,
+    right_eye: EyeQuality,
+}
+
+/// One eye's quality against its own reference.
+#[derive(Serialize)]
+struct EyeQuality {
+    rings: Vec<RingMean>,
+    frame_rmse: f64,
+    frame_ssim: f64,
+    frame_flip: f64,
+    frame_flicker: Option<f64>,
 }
 
 /// Rings of the fovea in `foveal_flip*`: the innermost two.
@@ -119,14 +138,14 @@ struct RefusedRun {
 }
 
 #[derive(Serialize)]
-pub(super) struct RingMean {
+struct RingMean {
     /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
-    pub(super) ecc_inner: f64,
-    pub(super) ecc_outer: f64,
-    pub(super) rmse: Option<f64>,
-    pub(super) ssim: Option<f64>,
-    pub(super) flip: Option<f64>,
-    pub(super) flicker: Option<f64>,
+    ecc_inner: f64,
+    ecc_outer: f64,
+    rmse: Option<f64>,
+    ssim: Option<f64>,
+    flip: Option<f64>,
+    flicker: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -378,9 +397,19 @@ fn render_and_measure(
     let mut q = measure(args, &dir, evaluated, &references.left, ppd, &left)?;
     if let Some(stereo) = stereo {
         let right = measure(args, &dir, evaluated, &stereo.right, ppd, &EyeFiles::RIGHT)?;
-        let measured = quality_stereo::measure(args, &dir, evaluated, &references.left, stereo)
-            .with_context(|| what.clone())?;
-        q.binocular = Some(measured.with_right_eye(right));
+        let measure =
+            quality_stereo::measure(&dir, evaluated, &references.left, stereo, args.rings)
+                .with_context(|| what.clone())?;
+        q.binocular = Some(Binocular {
+            measure,
+            right_eye: EyeQuality {
+                rings: right.rings,
+                frame_rmse: right.frame_rmse,
+                frame_ssim: right.frame_ssim,
+                frame_flip: right.frame_flip,
+                frame_flicker: right.frame_flicker,
+            },
+        });
     }
     (q.camera, q.method, q.denoiser, q.taa, q.stereo_noise) = (
         camera.to_string(),
@@ -777,11 +806,12 @@ fn markdown(r: &Report) -> String {
         let stereo: Vec<quality_stereo::StereoRow> = runs
             .iter()
             .filter_map(|q| {
+                let b = q.binocular.as_ref()?;
                 Some(quality_stereo::StereoRow {
                     label: label(r, q),
-                    binocular: q.binocular.as_ref()?,
-                    left_flip: q.frame_flip,
-                    left_flicker: q.frame_flicker,
+                    binocular: &b.measure,
+                    flip: [q.frame_flip, b.right_eye.frame_flip],
+                    flicker: [q.frame_flicker, b.right_eye.frame_flicker],
                 })
             })
             .collect();

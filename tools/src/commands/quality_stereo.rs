@@ -6,7 +6,6 @@
 //! the reference pair's) joins each eye's own flicker. Each evaluated frame's difference is also
 //! written as a heat map, `binocular_NNNN.png` in the run's folder (`binocular::heat_map`).
 
-use super::quality::{QualityArgs, RingMean, RunQuality};
 use crate::binocular::{
     difference_flicker_map, difference_map, heat_map, signed_difference_map, EyeGeometry, Warp,
 };
@@ -58,6 +57,8 @@ impl EyeFiles {
 pub(super) struct StereoReferences {
     pub right: Vec<Vec<[f32; 4]>>,
     warps: Vec<Warp>,
+    width: u32,
+    height: u32,
 }
 
 impl StereoReferences {
@@ -77,7 +78,12 @@ impl StereoReferences {
                 Warp::new(&eye(Eye::Left), &eye(Eye::Right))
             })
             .collect();
-        StereoReferences { right, warps }
+        StereoReferences {
+            right,
+            warps,
+            width: rig.width,
+            height: rig.height,
+        }
     }
 
     fn warp(&self, frame: usize) -> &Warp {
@@ -112,38 +118,12 @@ pub(super) struct BinocularFrame {
     difference_flicker: Option<f64>,
 }
 
-/// The right eye's own quality against its reference (rings around its own gaze).
-#[derive(Serialize)]
-pub(super) struct EyeQuality {
-    rings: Vec<RingMean>,
-    frame_rmse: f64,
-    frame_ssim: f64,
-    frame_flip: f64,
-    frame_flicker: Option<f64>,
-}
-
-/// quality.json's `binocular` of a stereo run.
+/// quality.json's `binocular` of a stereo run (`quality` adds the right eye's own quality).
 #[derive(Serialize)]
 pub(super) struct BinocularQuality {
-    /// The right eye measured as the left is (the run's own `rings`, `frame_*`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    right_eye: Option<EyeQuality>,
     /// The right eye warped into the left; rings around the left eye's gaze.
     rings: Vec<BinocularRing>,
     frame: BinocularFrame,
-}
-
-impl BinocularQuality {
-    pub fn with_right_eye(mut self, right: RunQuality) -> BinocularQuality {
-        self.right_eye = Some(EyeQuality {
-            rings: right.rings,
-            frame_rmse: right.frame_rmse,
-            frame_ssim: right.frame_ssim,
-            frame_flip: right.frame_flip,
-            frame_flicker: right.frame_flicker,
-        });
-        self
-    }
 }
 
 /// Per-ring means of one frame's maps (and the whole frame's, last).
@@ -167,14 +147,15 @@ fn read_png(path: &Path) -> Result<Vec<u8>> {
         .into_raw())
 }
 
-/// The binocular measure of the run in `dir` over the evaluated frames.
+/// The binocular measure of the run in `dir` over the evaluated frames, in `rings` rings.
 pub(super) fn measure(
-    args: &QualityArgs,
     dir: &Path,
     evaluated: &[u32],
     left_references: &[Vec<[f32; 4]>],
     stereo: &StereoReferences,
+    rings: usize,
 ) -> Result<BinocularQuality> {
+    let (width, height) = (stereo.width, stereo.height);
     let report_path = dir.join("report.json");
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report_path)?)
@@ -188,15 +169,13 @@ pub(super) fn measure(
             g[0].as_f64().unwrap_or(0.0) as f32,
             g[1].as_f64().unwrap_or(0.0) as f32,
         );
-        let rings = Rings::new(args.width, args.height, gaze, args.rings);
+        let ring_set = Rings::new(width, height, gaze, rings);
         if edges.is_empty() {
-            edges = (0..args.rings).map(|r| rings.bounds(r)).collect();
-            edges.iter_mut().for_each(|e: &mut (f64, f64)| {
-                *e = (
-                    e.0 / rings.r_max * crate::metrics::ECC_MAX,
-                    e.1 / rings.r_max * crate::metrics::ECC_MAX,
-                )
-            });
+            let ecc = |r: f64| r / ring_set.r_max * crate::metrics::ECC_MAX;
+            edges = (0..rings)
+                .map(|r| ring_set.bounds(r))
+                .map(|(inner, outer)| (ecc(inner), ecc(outer)))
+                .collect();
         }
         let left = read_png(&dir.join(format!("frame_{f:04}_left.png")))?;
         let right = read_png(&dir.join(format!("frame_{f:04}_right.png")))?;
@@ -205,8 +184,8 @@ pub(super) fn measure(
         let warp = stereo.warp(i);
         write_png(
             &dir.join(format!("binocular_{f:04}.png")),
-            args.width,
-            args.height,
+            width,
+            height,
             &heat_map(&left, &right, warp),
         )?;
         let signed = signed_difference_map(&left, &right, warp);
@@ -222,20 +201,20 @@ pub(super) fn measure(
                         reference_prev,
                         &reference_signed,
                     );
-                    ring_means(&rings, &map)
+                    ring_means(&ring_set, &map)
                 });
         frames.push(FrameMeans {
-            difference: ring_means(&rings, &difference_map(&left, &right, warp)),
+            difference: ring_means(&ring_set, &difference_map(&left, &right, warp)),
             reference: ring_means(
-                &rings,
+                &ring_set,
                 &difference_map(&reference_left, &reference_right, warp),
             ),
-            visible: ring_means(&rings, &warp.coverage_map()),
+            visible: ring_means(&ring_set, &warp.coverage_map()),
             flicker,
         });
         previous = Some((f, signed, reference_signed));
     }
-    // Mean over the frames that have a value; slot `args.rings` is the whole frame.
+    // Mean over the frames that have a value; slot `rings` is the whole frame.
     let over_frames = |pick: &dyn Fn(&FrameMeans) -> Option<f64>| {
         let values: Vec<f64> = frames.iter().filter_map(pick).collect();
         (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
@@ -251,7 +230,7 @@ pub(super) fn measure(
         let visible = over_frames(&|m| m.visible[k]).unwrap_or(0.0);
         (visible, difference, reference_difference, ratio, flicker)
     };
-    let rings = (0..args.rings)
+    let ring_means = (0..rings)
         .map(|k| {
             let (visible_in_both, difference, reference_difference, ratio, difference_flicker) =
                 slot(k);
@@ -267,10 +246,9 @@ pub(super) fn measure(
         })
         .collect();
     let (visible_in_both, difference, reference_difference, ratio, difference_flicker) =
-        slot(args.rings);
+        slot(rings);
     Ok(BinocularQuality {
-        right_eye: None,
-        rings,
+        rings: ring_means,
         frame: BinocularFrame {
             visible_in_both,
             difference,
@@ -281,13 +259,12 @@ pub(super) fn measure(
     })
 }
 
-/// One row of the stereo tables: the run's label, its measure, and the left eye's FLIP and
-/// flicker.
+/// One row of the stereo tables: the run's label, its measure, and each eye's FLIP and flicker.
 pub(super) struct StereoRow<'a> {
     pub label: String,
     pub binocular: &'a BinocularQuality,
-    pub left_flip: f64,
-    pub left_flicker: Option<f64>,
+    pub flip: [f64; 2],
+    pub flicker: [Option<f64>; 2],
 }
 
 /// quality.md's stereo tables of one camera.
@@ -336,17 +313,15 @@ pub(super) fn markdown(rows: &[StereoRow]) -> String {
          flicker right | flicker of the difference |\n|---|---|---|---|---|---|"
     );
     for row in rows {
-        let b = row.binocular;
-        let right = b.right_eye.as_ref();
         let _ = writeln!(
             s,
-            "| {} | {:.4} | {} | {} | {} | {} |",
+            "| {} | {:.4} | {:.4} | {} | {} | {} |",
             row.label,
-            row.left_flip,
-            cell(right.map(|r| r.frame_flip)),
-            cell(row.left_flicker),
-            cell(right.and_then(|r| r.frame_flicker)),
-            cell(b.frame.difference_flicker)
+            row.flip[0],
+            row.flip[1],
+            cell(row.flicker[0]),
+            cell(row.flicker[1]),
+            cell(row.binocular.frame.difference_flicker)
         );
     }
     s.push('\n');
