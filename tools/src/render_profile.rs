@@ -728,6 +728,8 @@ mod tests {
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
+        assert_eq!(p.stereo_noise, StereoNoise::default());
+        assert_eq!(p.surface_cell(), DEFAULT_SURFACE_CELL);
         assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
