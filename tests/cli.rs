@@ -1040,3 +1040,31 @@ fn bench_vp_frames_follow_a_camera_path() {
     );
     assert!(size("indirect") > 0 && size("indirect") % 32 == 0);
 }
+
+/// `--frames-in-flight` had no bound and was not capped by `--frames` (10⁶ slots passed 6 GB): a
+/// run keeps at most as many frames in flight as it renders, and more than 8 is refused before
+/// anything is allocated.
+#[test]
+fn frames_in_flight_are_bounded_and_capped_by_the_frame_count() {
+    let out = temp_dir("in-flight");
+    let capped = RenderArgs {
+        frames: 2,
+        frames_in_flight: 8,
+        ..render_args("cornell-box", &out)
+    };
+    render(&capped).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["frames_in_flight"], 2);
+    for n in [0, 9, 1_000_000] {
+        let args = RenderArgs {
+            frames_in_flight: n,
+            ..render_args("cornell-box", &out)
+        };
+        let err = format!("{:#}", render(&args).unwrap_err());
+        assert!(
+            err.contains(&format!("--frames-in-flight {n} must be in 1..=8")),
+            "{err}"
+        );
+    }
+}

@@ -402,6 +402,40 @@ fn quality_of_both_eyes_adds_the_binocular_measure() {
     );
 }
 
+/// `--reference-spp` and the frame size of `fovea quality` have upper bounds, checked before
+/// anything renders or the output folder is made.
+#[test]
+fn quality_counts_are_bounded() {
+    use fovea_tools::commands::quality::{run, QualityArgs};
+    let out = temp_dir("quality-bounds");
+    let _ = std::fs::remove_dir_all(&out);
+    let names = |v: &str| vec![v.to_string()];
+    let (methods, denoisers, taa, cameras) =
+        (names("vp"), names("none"), names("off"), names("still"));
+    let base = || quality_args([&methods, &denoisers, &taa, &cameras], &out);
+    for (args, needle) in [
+        (
+            QualityArgs {
+                reference_spp: u32::MAX,
+                ..base()
+            },
+            "--reference-spp 4294967295 must be at most 1048576",
+        ),
+        (
+            QualityArgs {
+                width: 100_000,
+                height: 100_000,
+                ..base()
+            },
+            "--width 100000 --height 100000: at most 16777216 pixels",
+        ),
+    ] {
+        let err = format!("{:#}", run(&args).unwrap_err());
+        assert!(err.contains(needle), "{err}");
+    }
+    assert!(!out.exists());
+}
+
 /// `fovea quality --methods all`: every method of `fovea render` is measured, and the
 /// combinations a method cannot run (a denoiser on a space without temporal filters) are listed
 /// with the space's reason, in quality.json and in the table, instead of failing or vanishing.

@@ -51,10 +51,11 @@ impl LatencyModel {
             }
         }
         if let Some(r) = tracker_hz {
-            if !(r > 0.0 && r <= MAX_TRACKER_HZ) {
+            // Below 1 Hz the model replays years of tracker samples per second shown.
+            if !(r >= crate::hmd::MIN_RATE_HZ as f64 && r <= MAX_TRACKER_HZ) {
                 return Err(flag(
                     "--tracker-hz",
-                    format!("{r} must be a rate in Hz, > 0 and <= {MAX_TRACKER_HZ}"),
+                    format!("{r} must be a rate in Hz, >= 1 and <= {MAX_TRACKER_HZ}"),
                 ));
             }
         }

@@ -154,6 +154,19 @@ fn negative_rate_is_rejected() {
     );
 }
 
+/// A refresh of 1e-30 Hz passed the range check and `fovea render` with the simulated gaze never
+/// finished (frame k at k × 1e30 s); rates below 1 Hz are refused.
+#[test]
+fn rates_below_one_hertz_are_rejected() {
+    for (key, from, to) in [
+        ("refresh_hz", "refresh_hz = 90.0", "refresh_hz = 1e-30"),
+        ("refresh_hz", "refresh_hz = 90.0", "refresh_hz = 0.5"),
+        ("tracker.rate_hz", "rate_hz = 120.0", "rate_hz = 1e-30"),
+    ] {
+        expect_err(&GOOD.replace(from, to), &[key, "[1, "]);
+    }
+}
+
 #[test]
 fn zero_resolution_is_rejected() {
     expect_err(

@@ -535,8 +535,22 @@ impl Renderer {
         camera: &CameraPose,
         spp: u32,
         max_depth: u32,
+        progress: impl FnMut(u32),
+    ) -> Result<Vec<[f32; 4]>> {
+        self.render_reference_samples(camera, 0..spp, max_depth, progress)
+    }
+
+    /// As [`Renderer::render_reference`], the mean of the samples whose indices lie in `samples`:
+    /// a sample index draws the same paths in every call, so references of disjoint ranges are
+    /// parts of the reference of their union (split across processes and summed).
+    pub fn render_reference_samples(
+        &mut self,
+        camera: &CameraPose,
+        samples: std::ops::Range<u32>,
+        max_depth: u32,
         mut progress: impl FnMut(u32),
     ) -> Result<Vec<[f32; 4]>> {
+        let (first, spp) = (samples.start, samples.len() as u32);
         if spp == 0 || max_depth == 0 {
             return Err(Error::Invalid(
                 "reference needs spp ≥ 1 and max depth ≥ 1".into(),
@@ -601,8 +615,9 @@ impl Renderer {
                 materials: &self.scene.materials,
             };
             for i in done..done + batch {
+                // The sample index seeds the paths; `i` counts the samples in the mean so far.
                 view.trace
-                    .record(rec, &frame, &self.scene, &s.ray_counters, i, None)?;
+                    .record(rec, &frame, &self.scene, &s.ray_counters, first + i, None)?;
                 self.accumulate.record(rec, &view.gbuffer.color, accum, i)?;
             }
             if done + batch == spp {

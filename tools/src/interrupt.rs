@@ -1,7 +1,10 @@
 //! SIGINT / SIGTERM as a request to stop cleanly: the binary installs the handler for commands
 //! that check it (`fovea render` finishes the frame in flight, writes its report marked
-//! interrupted and exits 128 + the signal). A second signal while the first is pending ends the
-//! process at once, so a hung run can still be stopped.
+//! interrupted and exits 128 + the signal). Until the command calls [`running`] (its frame loop
+//! starts), a signal ends the process at once with 128 + the signal, as without a handler: start-up
+//! (loading a scene, the OpenXR loader and runtime, the device) does not look at the flag, and a
+//! call blocked there must not swallow the signal. A second signal while the first is pending
+//! ends the process at once, so a hung run can still be stopped.
 //!
 //! The library never installs the handler itself: tests and other embedders keep their own
 //! signal behaviour, and [`requested`] is then always `None`.
@@ -12,6 +15,8 @@ use std::sync::{Arc, OnceLock};
 struct State {
     pending: Arc<AtomicBool>,
     signal: Arc<AtomicUsize>,
+    /// True until [`running`]: a signal then ends the process at once.
+    starting: Arc<AtomicBool>,
 }
 
 static STATE: OnceLock<State> = OnceLock::new();
@@ -60,8 +65,14 @@ pub fn install() -> std::io::Result<()> {
     let state = State {
         pending: Arc::new(AtomicBool::new(false)),
         signal: Arc::new(AtomicUsize::new(0)),
+        starting: Arc::new(AtomicBool::new(true)),
     };
     for sig in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(
+            sig,
+            128 + sig,
+            Arc::clone(&state.starting),
+        )?;
         // Registered first, so it sees the flag as it was before this signal set it.
         signal_hook::flag::register_conditional_shutdown(
             sig,
@@ -78,6 +89,14 @@ pub fn install() -> std::io::Result<()> {
 #[cfg(not(unix))]
 pub fn install() -> std::io::Result<()> {
     Ok(())
+}
+
+/// From here on a signal asks the command to stop cleanly (it checks [`requested`]); before,
+/// a signal ends the process at once.
+pub fn running() {
+    if let Some(state) = STATE.get() {
+        state.starting.store(false, Ordering::SeqCst);
+    }
 }
 
 /// The signal that asked the run to stop, if any.

@@ -337,6 +337,130 @@ impl RenderOpts {
     }
 }
 
+/// `fovea quality`'s flags (also the command a quality sweep splits).
+#[derive(clap::Args)]
+struct QualityFlags {
+    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    scene: String,
+    #[arg(long, default_value_t = 160)]
+    width: u32,
+    #[arg(long, default_value_t = 180)]
+    height: u32,
+    #[arg(long, default_value = "fove0")]
+    headset: String,
+    /// Gaze source of every run (as for `render`); rings follow each frame's gaze.
+    #[arg(long, default_value = "sim:1")]
+    gaze: String,
+    #[arg(long, default_value_t = 16)]
+    frames: u32,
+    /// The last this many frames are evaluated and averaged.
+    #[arg(long, default_value_t = 4)]
+    eval_frames: u32,
+    /// Sampling methods (`all`: every `--method` of `fovea render`).
+    #[arg(long, value_delimiter = ',', default_value = "vp,cartesian")]
+    methods: Vec<String>,
+    /// Denoisers to compare (default: every one built in).
+    #[arg(long, value_delimiter = ',')]
+    denoisers: Vec<String>,
+    #[arg(long, value_delimiter = ',', default_value = "off")]
+    taa: Vec<String>,
+    /// still and/or moving (the scene's default camera path).
+    #[arg(long, value_delimiter = ',', default_value = "still,moving")]
+    cameras: Vec<String>,
+    /// left, or both: every run renders both eyes (the headset's eye offsets), each eye is
+    /// judged against its own reference, and the binocular consistency measure is added
+    /// (the right eye warped into the left through the converged depth).
+    #[arg(long, default_value = "left")]
+    eyes: String,
+    #[arg(long, default_value_t = 256)]
+    reference_spp: u32,
+    /// Equal-width rings from the gaze out to the farthest corner.
+    #[arg(long, default_value_t = 10)]
+    rings: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Render profile (TOML) for every run; flags below override it.
+    #[arg(long)]
+    profile: Option<PathBuf>,
+    /// Foveated blur σ at 30° (0 turns it off).
+    #[arg(long)]
+    blur_sigma: Option<f32>,
+    /// Where the foveated blur runs: screen | grid (see `fovea render --blur-space`).
+    #[arg(long)]
+    blur_space: Option<String>,
+    #[arg(long, default_value = "out/quality")]
+    out: PathBuf,
+    #[command(flatten)]
+    look: SceneFlags,
+    #[command(flatten)]
+    latency: LatencyFlags,
+}
+
+/// `fovea replay`'s flags (also the command a replay sweep splits).
+#[derive(clap::Args)]
+struct ReplayFlags {
+    /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
+    traces: Vec<String>,
+    /// Baseline folder (one subfolder per trace).
+    #[arg(long)]
+    baseline: PathBuf,
+    /// Write the baselines from this run instead of comparing (overwrites them).
+    #[arg(long)]
+    update_baseline: bool,
+    /// Samples per pixel of the converged reference made with a new baseline.
+    #[arg(long, default_value_t = 256)]
+    reference_spp: u32,
+    /// Rings of distance from the gaze for every per-ring figure.
+    #[arg(long, default_value_t = 4)]
+    rings: usize,
+    /// Largest mean FLIP per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_flip)]
+    change_flip: f64,
+    /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_rmse)]
+    change_rmse: f64,
+    /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
+    #[arg(long, default_value_t = Tolerances::default().quality_rel)]
+    quality_rel: f64,
+    #[arg(long, default_value_t = Tolerances::default().quality_abs)]
+    quality_abs: f64,
+    #[command(flatten)]
+    opts: Box<RenderOpts>,
+}
+
+/// `fovea reference`'s flags (also the command a reference sweep splits).
+#[derive(clap::Args)]
+struct ReferenceFlags {
+    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    scene: String,
+    #[arg(long, default_value_t = 256)]
+    width: u32,
+    #[arg(long, default_value_t = 256)]
+    height: u32,
+    #[arg(long, default_value_t = 1024)]
+    spp: u32,
+    #[arg(long, default_value_t = 3)]
+    max_depth: u32,
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    look: SceneFlags,
+    /// Headset profile whose eye is rendered (with --projection headset, the default).
+    #[arg(long, default_value = "fove0")]
+    headset: String,
+    /// The eye: left (as `fovea render` writes by default) or right.
+    #[arg(long, default_value = "left")]
+    eye: String,
+    /// Replace FILE if it exists.
+    #[arg(long)]
+    force: bool,
+    /// Also write a tonemapped PNG preview (FILE with .png).
+    #[arg(long)]
+    preview: bool,
+}
+
 /// `fovea` with no arguments renders with every default.
 #[derive(Parser)]
 struct DefaultRender {
@@ -362,13 +486,17 @@ enum Command {
         device: DeviceArgs,
     },
     /// Real-time rendering in a window: one eye or both side by side, gaze from the mouse (or
-    /// --gaze), keys m / d / t cycle method, denoiser and TAA, f freezes the gaze, q or Esc quits.
+    /// --gaze), keys m / n / t cycle method, denoiser and TAA, f freezes the gaze, q or Esc quits.
     View {
         #[command(flatten)]
         opts: Box<RenderOpts>,
-        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N.
+        /// Save the last presented image (both eyes side by side) as PNG; needs --frames N. An
+        /// existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
         #[arg(long, default_value = "fifo")]
         present_mode: String,
@@ -390,9 +518,13 @@ enum Command {
         /// `fovea render --headset <same> --gaze TRACE.csv`.
         #[arg(long)]
         record: Option<PathBuf>,
-        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs --frames.
+        /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs
+        /// --frames. An existing file is replaced only with --force.
         #[arg(long)]
         screenshot: Option<PathBuf>,
+        /// Let --screenshot replace an existing file.
+        #[arg(long)]
+        force: bool,
         /// The runtime space the scene camera stands in: local (the default: where the head was
         /// when the session started) or stage (the play area's floor is the scene's y = 0).
         #[arg(long, default_value = "local")]
@@ -404,66 +536,15 @@ enum Command {
     /// (change: FLIP/RMSE per ring; quality against the converged reference; the gaze used;
     /// cost, reported). Exit 0 within tolerance, 1 on a regression, 2 on bad input.
     Replay {
-        /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
-        traces: Vec<String>,
-        /// Baseline folder (one subfolder per trace).
-        #[arg(long)]
-        baseline: PathBuf,
-        /// Write the baselines from this run instead of comparing (overwrites them).
-        #[arg(long)]
-        update_baseline: bool,
-        /// Samples per pixel of the converged reference made with a new baseline.
-        #[arg(long, default_value_t = 256)]
-        reference_spp: u32,
-        /// Rings of distance from the gaze for every per-ring figure.
-        #[arg(long, default_value_t = 4)]
-        rings: usize,
-        /// Largest mean FLIP per ring against the baseline's frame.
-        #[arg(long, default_value_t = Tolerances::default().change_flip)]
-        change_flip: f64,
-        /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
-        #[arg(long, default_value_t = Tolerances::default().change_rmse)]
-        change_rmse: f64,
-        /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
-        #[arg(long, default_value_t = Tolerances::default().quality_rel)]
-        quality_rel: f64,
-        #[arg(long, default_value_t = Tolerances::default().quality_abs)]
-        quality_abs: f64,
         #[command(flatten)]
-        opts: Box<RenderOpts>,
+        flags: ReplayFlags,
         #[command(flatten)]
         device: DeviceArgs,
     },
     /// Render a converged linear-radiance reference EXR.
     Reference {
-        #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
-        scene: String,
-        #[arg(long, default_value_t = 256)]
-        width: u32,
-        #[arg(long, default_value_t = 256)]
-        height: u32,
-        #[arg(long, default_value_t = 1024)]
-        spp: u32,
-        #[arg(long, default_value_t = 3)]
-        max_depth: u32,
-        #[arg(long, default_value_t = 1)]
-        seed: u32,
-        #[arg(long)]
-        out: PathBuf,
         #[command(flatten)]
-        look: SceneFlags,
-        /// Headset profile whose eye is rendered (with --projection headset, the default).
-        #[arg(long, default_value = "fove0")]
-        headset: String,
-        /// The eye: left (as `fovea render` writes by default) or right.
-        #[arg(long, default_value = "left")]
-        eye: String,
-        /// Replace FILE if it exists.
-        #[arg(long)]
-        force: bool,
-        /// Also write a tonemapped PNG preview (FILE with .png).
-        #[arg(long)]
-        preview: bool,
+        flags: ReferenceFlags,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -537,60 +618,8 @@ enum Command {
     /// Quality over a gaze sequence for each method × denoiser × TAA, still and moving camera:
     /// per-ring RMSE/SSIM against converged references → DIR/quality.json + quality.md.
     Quality {
-        #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
-        scene: String,
-        #[arg(long, default_value_t = 160)]
-        width: u32,
-        #[arg(long, default_value_t = 180)]
-        height: u32,
-        #[arg(long, default_value = "fove0")]
-        headset: String,
-        /// Gaze source of every run (as for `render`); rings follow each frame's gaze.
-        #[arg(long, default_value = "sim:1")]
-        gaze: String,
-        #[arg(long, default_value_t = 16)]
-        frames: u32,
-        /// The last this many frames are evaluated and averaged.
-        #[arg(long, default_value_t = 4)]
-        eval_frames: u32,
-        /// Sampling methods (`all`: every `--method` of `fovea render`).
-        #[arg(long, value_delimiter = ',', default_value = "vp,cartesian")]
-        methods: Vec<String>,
-        /// Denoisers to compare (default: every one built in).
-        #[arg(long, value_delimiter = ',')]
-        denoisers: Vec<String>,
-        #[arg(long, value_delimiter = ',', default_value = "off")]
-        taa: Vec<String>,
-        /// still and/or moving (the scene's default camera path).
-        #[arg(long, value_delimiter = ',', default_value = "still,moving")]
-        cameras: Vec<String>,
-        /// left, or both: every run renders both eyes (the headset's eye offsets), each eye is
-        /// judged against its own reference, and the binocular consistency measure is added
-        /// (the right eye warped into the left through the converged depth).
-        #[arg(long, default_value = "left")]
-        eyes: String,
-        #[arg(long, default_value_t = 256)]
-        reference_spp: u32,
-        /// Equal-width rings from the gaze out to the farthest corner.
-        #[arg(long, default_value_t = 10)]
-        rings: usize,
-        #[arg(long, default_value_t = 1)]
-        seed: u32,
-        /// Render profile (TOML) for every run; flags below override it.
-        #[arg(long)]
-        profile: Option<PathBuf>,
-        /// Foveated blur σ at 30° (0 turns it off).
-        #[arg(long)]
-        blur_sigma: Option<f32>,
-        /// Where the foveated blur runs: screen | grid (see `fovea render --blur-space`).
-        #[arg(long)]
-        blur_space: Option<String>,
-        #[arg(long, default_value = "out/quality")]
-        out: PathBuf,
         #[command(flatten)]
-        look: SceneFlags,
-        #[command(flatten)]
-        latency: LatencyFlags,
+        flags: QualityFlags,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -666,6 +695,94 @@ enum Command {
         /// horizontal FOV, the FOVE 0's without --headset); eval.json `flip_ppd`.
         #[arg(long)]
         ppd: Option<f32>,
+    },
+    /// Split `fovea quality`, `fovea reference` or `fovea replay` into independent jobs for a batch
+    /// scheduler
+    /// (Slurm job arrays: scripts/sweep-slurm) or a shell loop, and merge their results into
+    /// the files the one-process command writes (docs/guide/sweeps.md).
+    Sweep {
+        #[command(subcommand)]
+        command: SweepCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum SweepCommand {
+    /// Write DIR/sweep.json and DIR/jobs.jsonl: the jobs of a `fovea quality …`,
+    /// `fovea reference …` or `fovea replay …` command, given after the sweep's own flags
+    /// (references split into sample batches whose merge is exact, then one job per combination
+    /// or trace).
+    Plan {
+        /// The sweep folder (new or empty).
+        #[arg(long)]
+        out: PathBuf,
+        /// Scenes, one study (one merged output) each; default the command's --scene (quality and
+        /// reference sweeps).
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<String>,
+        /// Headset profiles, one study each; default the command's --headset (quality and
+        /// reference sweeps).
+        #[arg(long, value_delimiter = ',')]
+        headsets: Vec<String>,
+        /// Gaze sources of a quality sweep, one study each; default the command's --gaze.
+        #[arg(long, value_delimiter = ',')]
+        gazes: Vec<String>,
+        /// Reference batches (16 samples each) per reference job: a power of two.
+        #[arg(long, default_value_t = 4)]
+        batches_per_job: u32,
+        /// The one-process command: `quality …`, `reference …` or `replay …` (comparing with
+        /// existing baselines) with that command's flags (without --out).
+        #[arg(
+            required = true,
+            trailing_var_arg = true,
+            allow_hyphen_values = true,
+            value_name = "COMMAND"
+        )]
+        command: Vec<String>,
+    },
+    /// Run job K of the sweep in DIR (K from --index, else the Slurm array task's
+    /// SLURM_ARRAY_TASK_ID; plus --offset): its result appears whole in its folder or not at all;
+    /// a finished job is left as it is; a failure is recorded and exits non-zero.
+    Run {
+        /// The sweep folder (`fovea sweep plan --out`).
+        dir: PathBuf,
+        /// The job: its line in jobs.jsonl, counted from 0.
+        #[arg(long)]
+        index: Option<u32>,
+        /// Added to the index (Slurm arrays whose task ids start at 0).
+        #[arg(long, default_value_t = 0)]
+        offset: u32,
+    },
+    /// Every job's state: done, running, failed or missing, with the reason.
+    Status {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// As JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Job indices, one per line, for a shell loop, GNU parallel or Slurm.
+    List {
+        /// The sweep folder.
+        dir: PathBuf,
+        /// Only the jobs of this stage (reference, run).
+        #[arg(long)]
+        stage: Option<String>,
+        /// Only jobs not done.
+        #[arg(long)]
+        pending: bool,
+        /// Print the stages in the order they run instead.
+        #[arg(long)]
+        stages: bool,
+        /// Print Slurm array chunks "OFFSET SPEC" whose task ids stay below this (MaxArraySize).
+        #[arg(long)]
+        arrays: Option<u32>,
+    },
+    /// Gather every job's result into DIR/merged/<study>/: the files the one-process command
+    /// writes (refused while a job is not done or the jobs ran on different devices).
+    Merge {
+        /// The sweep folder.
+        dir: PathBuf,
     },
 }
 
@@ -756,8 +873,16 @@ fn run() -> Result<()> {
             validation: false,
         },
     });
-    if matches!(command, Command::Render { .. } | Command::Xr { .. }) {
-        // Only `render` and `xr` check for it (a clean end); other commands stop at once.
+    if matches!(
+        command,
+        Command::Render { .. }
+            | Command::Xr { .. }
+            | Command::Sweep {
+                command: SweepCommand::Run { .. }
+            }
+    ) {
+        // Only `render`, `xr` and a sweep's job check for it (a clean end); other commands stop
+        // at once.
         fovea_tools::interrupt::install()?;
     }
     match command {
@@ -786,6 +911,7 @@ fn run() -> Result<()> {
         Command::View {
             opts,
             screenshot,
+            force,
             present_mode,
             debug_view,
             device,
@@ -808,6 +934,7 @@ fn run() -> Result<()> {
             commands::view::run(&commands::view::ViewArgs {
                 frames: opts.frames,
                 screenshot: screenshot.as_deref(),
+                force,
                 present_mode: &present_mode,
                 mouse_gaze: opts.gaze.is_none(),
                 debug_view: fovea_tools::viewer::debug::DebugView::parse(&debug_view)?,
@@ -818,6 +945,7 @@ fn run() -> Result<()> {
             opts,
             record,
             screenshot,
+            force,
             reference_space,
             device,
         } => {
@@ -848,99 +976,16 @@ fn run() -> Result<()> {
                 gaze: opts.gaze.as_deref(),
                 record: record.as_deref(),
                 screenshot: screenshot.as_deref(),
+                force,
                 reference_space: commands::xr::ReferenceSpace::parse(&reference_space)?,
             })
         }
-        Command::Replay {
-            traces,
-            baseline,
-            update_baseline,
-            reference_spp,
-            rings,
-            change_flip,
-            change_rmse,
-            quality_rel,
-            quality_abs,
-            opts,
-            device,
-        } => {
-            let profile = opts.profile()?;
-            let camera = opts.look.camera()?;
-            let mut render = render_args(
-                &opts,
-                &camera,
-                &device,
-                &profile,
-                RenderDefaults {
-                    frames: DEFAULT_REPLAY_FRAMES,
-                    gaze: "center",
-                    out: "out/replay",
-                    scale: DEFAULT_SCALE,
-                },
-            )?;
-            // Small by default: replays run in the test suite.
-            render.width = Some(opts.width.unwrap_or(64));
-            render.height = Some(opts.height.unwrap_or(72));
-            let tolerances = Tolerances {
-                change_flip,
-                change_rmse,
-                quality_rel,
-                quality_abs,
-                ..Tolerances::default()
-            };
-            commands::replay::run(&commands::replay::ReplayArgs {
-                traces: &traces,
-                baseline: &baseline,
-                frames: opts.frames,
-                out: render.out,
-                render,
-                update: update_baseline,
-                reference_spp,
-                rings,
-                tolerances,
-            })
+        Command::Replay { flags, device } => {
+            with_replay_args(flags, &device, &mut commands::replay::run)
         }
-        Command::Reference {
-            scene,
-            width,
-            height,
-            spp,
-            max_depth,
-            seed,
-            out,
-            look,
-            headset,
-            eye,
-            force,
-            preview,
-            device,
-        } => commands::reference::run(&commands::reference::ReferenceArgs {
-            camera: &look.camera()?,
-            headset: &headset,
-            eye: match commands::setup::Eyes::parse(&eye)? {
-                commands::setup::Eyes::Left => fovea_hal::Eye::Left,
-                commands::setup::Eyes::Right => fovea_hal::Eye::Right,
-                commands::setup::Eyes::Both => {
-                    anyhow::bail!("--eye both: a reference is one eye (left or right)")
-                }
-            },
-            environment: look.environment()?,
-            path_regularisation: fovea_tools::render_profile::check_path_regularisation(
-                look.path_regularisation,
-                "--path-regularisation",
-            )?,
-            scene: &scene,
-            width,
-            height,
-            spp,
-            max_depth,
-            seed,
-            out: &out,
-            force,
-            preview,
-            device: device.device.as_deref(),
-            validation: device.validation,
-        }),
+        Command::Reference { flags, device } => {
+            with_reference_args(flags, &device, &mut commands::reference::run)
+        }
         Command::Bench {
             scenes,
             bvh,
@@ -1008,83 +1053,10 @@ fn run() -> Result<()> {
             min_triangles,
             force,
         } => commands::gen_scene::run(&kind, &out, min_triangles, force),
-        Command::Quality {
-            scene,
-            width,
-            height,
-            headset,
-            gaze,
-            frames,
-            eval_frames,
-            methods,
-            denoisers,
-            taa,
-            cameras,
-            eyes,
-            reference_spp,
-            rings,
-            seed,
-            profile,
-            blur_sigma,
-            blur_space,
-            out,
-            look,
-            latency,
-            device,
-        } => {
-            let base = match &profile {
-                Some(path) => RenderProfile::load(path)?,
-                None => RenderProfile::default(),
-            };
-            let profile = base.override_with(&ProfileOverrides {
-                blur_sigma,
-                blur_space,
-                environment: look.environment()?,
-                texture_lod: look.texture_lod.clone(),
-                path_regularisation: look.path_regularisation,
-                offscreen_samples: look.offscreen_samples.clone(),
-                gaze_timing: latency.timing()?,
-                ..Default::default()
-            })?;
-            let all: Vec<String> = DenoiserSettings::NAMES
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-            let stereo_noises = match &look.stereo_noise {
-                Some(list) => list
-                    .split(',')
-                    .map(|n| StereoNoise::parse(n.trim()).context("--stereo-noise"))
-                    .collect::<Result<Vec<_>>>()?,
-                None => Vec::new(),
-            };
-            commands::quality::run(&commands::quality::QualityArgs {
-                scene: &scene,
-                width,
-                height,
-                headset: &headset,
-                gaze: &gaze,
-                frames,
-                eval_frames,
-                methods: &commands::quality::expand_methods(methods),
-                denoisers: if denoisers.is_empty() {
-                    &all
-                } else {
-                    &denoisers
-                },
-                taa: &taa,
-                cameras: &cameras,
-                reference_spp,
-                rings,
-                seed,
-                profile,
-                eyes: commands::setup::Eyes::parse(&eyes)?,
-                stereo_noises: &stereo_noises,
-                camera: &look.camera()?,
-                out: &out,
-                device: device.device.as_deref(),
-                validation: device.validation,
-            })
+        Command::Quality { flags, device } => {
+            with_quality_args(flags, &device, &mut commands::quality::run)
         }
+        Command::Sweep { command } => sweep(command),
         Command::GazeEval {
             traces,
             headset,
@@ -1132,6 +1104,272 @@ fn run() -> Result<()> {
             headset: headset.as_deref(),
             ppd,
         }),
+    }
+}
+
+/// `fovea quality`'s flags as its arguments, handed to `run`.
+fn with_quality_args(
+    flags: QualityFlags,
+    device: &DeviceArgs,
+    run: &mut dyn FnMut(&commands::quality::QualityArgs) -> Result<()>,
+) -> Result<()> {
+    let QualityFlags {
+        scene,
+        width,
+        height,
+        headset,
+        gaze,
+        frames,
+        eval_frames,
+        methods,
+        denoisers,
+        taa,
+        cameras,
+        eyes,
+        reference_spp,
+        rings,
+        seed,
+        profile,
+        blur_sigma,
+        blur_space,
+        out,
+        look,
+        latency,
+    } = flags;
+    let base = match &profile {
+        Some(path) => RenderProfile::load(path)?,
+        None => RenderProfile::default(),
+    };
+    let profile = base.override_with(&ProfileOverrides {
+        blur_sigma,
+        blur_space,
+        environment: look.environment()?,
+        texture_lod: look.texture_lod.clone(),
+        path_regularisation: look.path_regularisation,
+        offscreen_samples: look.offscreen_samples.clone(),
+        gaze_timing: latency.timing()?,
+        ..Default::default()
+    })?;
+    let all: Vec<String> = DenoiserSettings::NAMES
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let stereo_noises = match &look.stereo_noise {
+        Some(list) => list
+            .split(',')
+            .map(|n| StereoNoise::parse(n.trim()).context("--stereo-noise"))
+            .collect::<Result<Vec<_>>>()?,
+        None => Vec::new(),
+    };
+    run(&commands::quality::QualityArgs {
+        scene: &scene,
+        width,
+        height,
+        headset: &headset,
+        gaze: &gaze,
+        frames,
+        eval_frames,
+        methods: &commands::quality::expand_methods(methods),
+        denoisers: if denoisers.is_empty() {
+            &all
+        } else {
+            &denoisers
+        },
+        taa: &taa,
+        cameras: &cameras,
+        reference_spp,
+        rings,
+        seed,
+        profile,
+        eyes: commands::setup::Eyes::parse(&eyes)?,
+        stereo_noises: &stereo_noises,
+        camera: &look.camera()?,
+        out: &out,
+        device: device.device.as_deref(),
+        validation: device.validation,
+    })
+}
+
+/// `fovea replay`'s flags as its arguments, handed to `run`.
+fn with_replay_args(
+    flags: ReplayFlags,
+    device: &DeviceArgs,
+    run: &mut dyn FnMut(&commands::replay::ReplayArgs) -> Result<()>,
+) -> Result<()> {
+    let ReplayFlags {
+        traces,
+        baseline,
+        update_baseline,
+        reference_spp,
+        rings,
+        change_flip,
+        change_rmse,
+        quality_rel,
+        quality_abs,
+        opts,
+    } = flags;
+    let profile = opts.profile()?;
+    let camera = opts.look.camera()?;
+    let mut render = render_args(
+        &opts,
+        &camera,
+        device,
+        &profile,
+        RenderDefaults {
+            frames: DEFAULT_REPLAY_FRAMES,
+            gaze: "center",
+            out: "out/replay",
+            scale: DEFAULT_SCALE,
+        },
+    )?;
+    // Small by default: replays run in the test suite.
+    render.width = Some(opts.width.unwrap_or(64));
+    render.height = Some(opts.height.unwrap_or(72));
+    let tolerances = Tolerances {
+        change_flip,
+        change_rmse,
+        quality_rel,
+        quality_abs,
+        ..Tolerances::default()
+    };
+    run(&commands::replay::ReplayArgs {
+        traces: &traces,
+        baseline: &baseline,
+        frames: opts.frames,
+        out: render.out,
+        render,
+        update: update_baseline,
+        reference_spp,
+        rings,
+        tolerances,
+    })
+}
+
+/// `fovea reference`'s flags as its arguments, handed to `run`.
+fn with_reference_args(
+    flags: ReferenceFlags,
+    device: &DeviceArgs,
+    run: &mut dyn FnMut(&commands::reference::ReferenceArgs) -> Result<()>,
+) -> Result<()> {
+    let ReferenceFlags {
+        scene,
+        width,
+        height,
+        spp,
+        max_depth,
+        seed,
+        out,
+        look,
+        headset,
+        eye,
+        force,
+        preview,
+    } = flags;
+    run(&commands::reference::ReferenceArgs {
+        camera: &look.camera()?,
+        headset: &headset,
+        eye: match commands::setup::Eyes::parse(&eye)? {
+            commands::setup::Eyes::Left => fovea_hal::Eye::Left,
+            commands::setup::Eyes::Right => fovea_hal::Eye::Right,
+            commands::setup::Eyes::Both => {
+                anyhow::bail!("--eye both: a reference is one eye (left or right)")
+            }
+        },
+        environment: look.environment()?,
+        path_regularisation: fovea_tools::render_profile::check_path_regularisation(
+            look.path_regularisation,
+            "--path-regularisation",
+        )?,
+        scene: &scene,
+        width,
+        height,
+        spp,
+        max_depth,
+        seed,
+        out: &out,
+        force,
+        preview,
+        device: device.device.as_deref(),
+        validation: device.validation,
+    })
+}
+
+/// A sweep's command (`fovea ARGS…`) parsed as the command line parses it.
+fn parse_study(
+    argv: &[String],
+    f: &mut dyn FnMut(fovea_tools::sweep::Study<'_>) -> Result<()>,
+) -> Result<()> {
+    use fovea_tools::sweep::Study;
+    let words = std::iter::once("fovea").chain(argv.iter().map(String::as_str));
+    let cli = Cli::try_parse_from(words).map_err(|e| {
+        let message = e.to_string();
+        let first = message
+            .lines()
+            .next()
+            .unwrap_or("")
+            .trim_start_matches("error: ");
+        anyhow::anyhow!("`fovea {}`: {first}", argv.join(" "))
+    })?;
+    match cli.command {
+        Some(Command::Quality { flags, device }) => {
+            with_quality_args(flags, &device, &mut |q| f(Study::Quality(q)))
+        }
+        Some(Command::Reference { flags, device }) => {
+            with_reference_args(flags, &device, &mut |r| f(Study::Reference(r)))
+        }
+        Some(Command::Replay { flags, device }) => {
+            with_replay_args(flags, &device, &mut |r| f(Study::Replay(r)))
+        }
+        _ => bail!(
+            "fovea sweep splits `fovea quality …`, `fovea reference …` or `fovea replay …`, not \
+             `fovea {}`",
+            argv.join(" ")
+        ),
+    }
+}
+
+fn sweep(command: SweepCommand) -> Result<()> {
+    use fovea_tools::sweep;
+    match command {
+        SweepCommand::Plan {
+            out,
+            scenes,
+            headsets,
+            gazes,
+            batches_per_job,
+            command,
+        } => sweep::plan(
+            &sweep::PlanArgs {
+                out: &out,
+                command: &command,
+                axes: sweep::Axes {
+                    scenes,
+                    headsets,
+                    gazes,
+                },
+                batches_per_job,
+            },
+            &parse_study,
+        ),
+        SweepCommand::Run { dir, index, offset } => sweep::run(&dir, index, offset, &parse_study),
+        SweepCommand::Status { dir, json } => sweep::status(&dir, json, &parse_study),
+        SweepCommand::List {
+            dir,
+            stage,
+            pending,
+            stages,
+            arrays,
+        } => sweep::list(
+            &dir,
+            &sweep::ListArgs {
+                stage: stage.as_deref(),
+                pending,
+                stages,
+                arrays,
+            },
+            &parse_study,
+        ),
+        SweepCommand::Merge { dir } => sweep::merge(&dir, &parse_study),
     }
 }
 

@@ -18,6 +18,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Name of the lock file inside an output folder.
 pub const LOCK_FILE: &str = ".fovea.lock";
+/// A run's outputs are written into `.fovea-run.<pid>.<n>` inside its output folder
+/// ([`OutputDir::stage`]) and moved out when the run is complete.
+const STAGING_PREFIX: &str = ".fovea-run.";
+/// The file whose presence says an output folder holds a complete run (written last).
+pub const REPORT_FILE: &str = "report.json";
 /// Temporary files are `.<name>.<pid>.<n>.tmp` next to their target.
 const TEMP_SUFFIX: &str = ".tmp";
 
@@ -189,34 +194,27 @@ pub fn write_exr(path: &Path, width: u32, height: u32, texels: &[[f32; 4]]) -> R
         let t = texels[y * w + x];
         (t[0], t[1], t[2], 1.0f32)
     });
+    // Tiles in increasing order: the parallel compressor otherwise writes them as they finish,
+    // and the same pixels would give different bytes from run to run (`fovea sweep merge`
+    // promises one process's files byte for byte).
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
     write_atomic(path, |out| {
-        Ok(Image::from_channels((w, height as usize), channels)
-            .write()
-            .to_buffered(out)?)
+        Ok(
+            Image::from_encoded_channels((w, height as usize), encoding, channels)
+                .write()
+                .to_buffered(out)?,
+        )
     })
 }
 
-/// Reads a linear EXR's RGB channels (references for `fovea eval` and tests).
+/// Reads a linear EXR's RGB channels (references for `fovea eval` and tests): a regular file of
+/// at most [`crate::decode::MAX_IMAGE_FILE_BYTES`], declaring at most
+/// [`crate::decode::MAX_IMAGE_PIXELS`] (checked from its headers before pixels are allocated).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
-    use exr::prelude::*;
-    check_regular_input(path)?;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| {
-            let w = resolution.width();
-            (w, vec![[0f32; 4]; w * resolution.height()])
-        },
-        |(w, pixels), pos, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[pos.y() * *w + pos.x()] = [r, g, b, a]
-        },
-    )
-    .with_context(|| format!("reading {}", path.display()))?;
-    let size = image.layer_data.size;
-    Ok((
-        size.width() as u32,
-        size.height() as u32,
-        image.layer_data.channel_data.pixels.1,
-    ))
+    crate::decode::read_exr(path, crate::decode::MAX_IMAGE_PIXELS, None)
 }
 
 /// Refuses to replace an existing file unless `force` is set, and refuses any target that is not a
@@ -362,6 +360,13 @@ fn scan(dir: &Path, clean: bool) -> Result<Vec<(OsString, Version)>> {
         if name.starts_with("run_") && meta.is_dir() {
             continue;
         }
+        // A run's staging folder: under the lock, one a dead run left.
+        if name.starts_with(STAGING_PREFIX) && meta.is_dir() {
+            if clean {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+            continue;
+        }
         if is_fovea_temp(&name) && regular {
             if clean {
                 let _ = std::fs::remove_file(entry.path());
@@ -388,6 +393,22 @@ impl OutputDir {
         &self.path
     }
 
+    /// A hidden folder inside this one that a run writes all its files into; [`Staged::commit`]
+    /// moves them out (renames only: no space needed), so a run that fails for any reason (a full
+    /// disk, an error) leaves the earlier run's files exactly as they were.
+    pub fn stage(&self) -> Result<Staged> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = self
+            .path
+            .join(format!("{STAGING_PREFIX}{}.{n}", std::process::id()));
+        std::fs::create_dir(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(Staged {
+            dir,
+            committed: false,
+        })
+    }
+
     /// Removes the fovea files an earlier run left that this run did not rewrite (frames beyond
     /// this run's count, EXR or debug files it did not produce), so the folder holds exactly this
     /// run's outputs. Returns how many were removed.
@@ -404,6 +425,55 @@ impl OutputDir {
             }
         }
         Ok(removed)
+    }
+}
+
+/// A run's files while it writes them: removed with everything in them unless committed.
+#[must_use = "the staged files are removed unless committed"]
+pub struct Staged {
+    dir: PathBuf,
+    committed: bool,
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
+    }
+}
+
+impl Staged {
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Moves the staged files into `out` as one run: the earlier run's [`REPORT_FILE`] is removed
+    /// first and the new one moved in last, so the folder holds a report only beside the files of
+    /// its run (a process killed while moving leaves no report: an incomplete folder); then the
+    /// earlier run's files that this one did not rewrite are removed ([`OutputDir::remove_stale`]).
+    pub fn commit(mut self, out: &OutputDir) -> Result<usize> {
+        let report = out.path.join(REPORT_FILE);
+        match std::fs::remove_file(&report) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(e).with_context(|| format!("removing the earlier {}", report.display()))
+            }
+            _ => {}
+        }
+        let mut names: Vec<OsString> = std::fs::read_dir(&self.dir)
+            .with_context(|| format!("reading {}", self.dir.display()))?
+            .map(|e| e.map(|e| e.file_name()))
+            .collect::<std::io::Result<_>>()?;
+        names.sort_by_key(|n| n == REPORT_FILE);
+        for name in names {
+            let (from, to) = (self.dir.join(&name), out.path.join(&name));
+            check_replaceable(&to)?;
+            std::fs::rename(&from, &to)
+                .with_context(|| format!("moving {} into place", to.display()))?;
+        }
+        self.committed = true;
+        let _ = std::fs::remove_dir(&self.dir);
+        out.remove_stale()
     }
 }
 

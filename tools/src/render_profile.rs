@@ -444,9 +444,7 @@ impl RenderProfile {
             profile.taa = taa;
         }
         if let Some(f) = file.environment {
-            let env = f
-                .env
-                .map(|e| path.parent().map_or(e.clone(), |dir| dir.join(&e)));
+            let env = f.env.map(|e| confined_env_path(path, &e)).transpose()?;
             profile.environment = EnvironmentOptions {
                 sun: f.sun,
                 sun_intensity: f.sun_intensity,
@@ -667,6 +665,50 @@ fn check_blur(b: &BlurSettings) -> Result<()> {
         bail!("σ at 30° must be in [0, 64] pixels, got {}", b.sigma_at_30);
     }
     Ok(())
+}
+
+/// A profile's `[environment].env`: a relative path inside the profile's folder (no `..`, not
+/// absolute, no symbolic link leading out), so a profile from elsewhere cannot make fovea read
+/// (and show) a file outside its folder. A map anywhere else is given with `--env FILE`.
+fn confined_env_path(profile: &Path, env: &Path) -> Result<std::path::PathBuf> {
+    use std::path::Component;
+    let key = || {
+        format!(
+            "{}: [environment].env = {:?}",
+            profile.display(),
+            env.display().to_string()
+        )
+    };
+    if env.as_os_str().is_empty()
+        || env
+            .components()
+            .any(|c| !matches!(c, Component::Normal(_) | Component::CurDir))
+    {
+        bail!(
+            "{}: a profile names an environment map inside its own folder (a relative path without `..`); give a map elsewhere on the command line with --env FILE",
+            key()
+        );
+    }
+    let dir = profile.parent().unwrap_or(Path::new("."));
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let joined = dir.join(env);
+    crate::env_map::check_path(&joined).with_context(key)?;
+    let (inside, folder) = (
+        joined.canonicalize().with_context(key)?,
+        dir.canonicalize().with_context(key)?,
+    );
+    if !inside.starts_with(&folder) {
+        bail!(
+            "{}: it leads out of the profile's folder through a symbolic link (to {}); give a map elsewhere with --env FILE",
+            key(),
+            inside.display()
+        );
+    }
+    Ok(joined)
 }
 
 #[cfg(test)]
@@ -1139,6 +1181,39 @@ gradient_sigma_normal = 64
         .contains("--sun"));
     }
 
+    /// `env = "../x.exr"` or an absolute path read a map from outside the profile's folder; a
+    /// link inside the folder that leads out is refused too.
+    #[test]
+    fn a_profile_reads_maps_only_inside_its_folder() {
+        let root = std::env::temp_dir().join(format!("fovea-profile-env-{}", std::process::id()));
+        let (dir, outside) = (root.join("profiles"), root.join("elsewhere"));
+        std::fs::create_dir_all(dir.join("maps")).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        std::fs::write(outside.join("x.exr"), b"").unwrap();
+        std::fs::write(dir.join("maps/in.exr"), b"").unwrap();
+        let _ = std::fs::remove_file(dir.join("maps/out.exr"));
+        std::os::unix::fs::symlink(outside.join("x.exr"), dir.join("maps/out.exr")).unwrap();
+        let profile = dir.join("p.toml");
+        let load = |env: &str| {
+            std::fs::write(&profile, format!("[environment]\nenv = {env:?}\n")).unwrap();
+            RenderProfile::load(&profile)
+        };
+        let ok = load("maps/in.exr").unwrap();
+        assert_eq!(ok.environment.env, Some(dir.join("maps/in.exr")));
+        for (env, needle) in [
+            ("../elsewhere/x.exr", "without `..`"),
+            (outside.join("x.exr").to_str().unwrap(), "without `..`"),
+            ("maps/../maps/in.exr", "without `..`"),
+            ("maps/out.exr", "through a symbolic link"),
+        ] {
+            let err = format!("{:#}", load(env).unwrap_err());
+            assert!(
+                err.contains("p.toml") && err.contains("[environment].env") && err.contains(needle),
+                "{env}: {err}"
+            );
+        }
+    }
+
     #[test]
     fn environment_map_keys_and_flags() {
         // The map's path is relative to the profile's folder.
@@ -1185,6 +1260,8 @@ gradient_sigma_normal = 64
         // Errors name the file and the key.
         for (text, key) in [
             ("env = \"nowhere.exr\"", "[environment].env"),
+            ("env = \"../sky.hdr\"", "--env FILE"),
+            ("env = \"/etc/passwd.hdr\"", "--env FILE"),
             ("env = \"envmap.toml\"", "[environment].env"),
             ("env_intensity = -1.0", "[environment].env_intensity"),
             ("env_rotation = inf", "[environment].env_rotation"),

@@ -157,7 +157,12 @@ fn replay_reports_the_true_gaze_and_records_the_flags() {
     let latency = ["--latency-ms", "150", "--gaze-predict", "off"];
     let o = run(args(&dir.join("u"), true, &latency));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stored = json(&baseline.join("jump").join("baseline.json"));
+    // The baseline folder is named by the trace's identity (stem and SHA-256).
+    let folder = fovea_tools::replay::baseline::TraceId::of(&rec.display().to_string())
+        .unwrap()
+        .key;
+    assert!(folder.starts_with("jump-"), "{folder}");
+    let stored = json(&baseline.join(folder).join("baseline.json"));
     assert_eq!(
         stored["params"]["gaze_timing"],
         "--latency-ms 150 --gaze-predict off"

@@ -49,6 +49,21 @@ const TRACES: [&str; 3] = [
     "gazebase:tests/replay/traces/gazebase_style.csv",
 ];
 
+/// The baseline folder of a trace (named by its identity: stem and SHA-256), as `fovea replay`
+/// names it.
+fn folder_of(trace: &str) -> String {
+    let trace = match trace.split_once(':') {
+        Some((kind @ ("gazebase" | "degrees"), file)) => {
+            format!("{kind}:{}", repo().join(file).display())
+        }
+        Some(_) => trace.to_string(),
+        None => repo().join(trace).display().to_string(),
+    };
+    fovea_tools::replay::baseline::TraceId::of(&trace)
+        .unwrap()
+        .key
+}
+
 fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -65,13 +80,13 @@ fn failing_frames(out: &Path, report: &Value) -> String {
     for t in report["traces"].as_array().into_iter().flatten() {
         let baseline = PathBuf::from(t["baseline"].as_str().unwrap_or_default());
         let name = baseline.file_name().unwrap_or_default().to_string_lossy();
+        let run = t["run"].as_str().unwrap_or_default();
         for frame in t["failed_frames"].as_array().into_iter().flatten() {
             let file = format!("frame_{:04}.png", frame.as_u64().unwrap_or_default());
             let read = |p: PathBuf| image::open(&p).map(|i| i.to_rgba8());
-            let (Ok(now), Ok(before)) = (
-                read(out.join(format!("run_{name}")).join(&file)),
-                read(baseline.join(&file)),
-            ) else {
+            let (Ok(now), Ok(before)) =
+                (read(out.join(run).join(&file)), read(baseline.join(&file)))
+            else {
                 lines.push(format!("{name} {file}: no picture to compare"));
                 continue;
             };
@@ -167,10 +182,10 @@ fn a_planted_regression_fails_naming_frames_and_rings() {
         md.contains("REGRESSION") && md.contains("| 0 |") && md.contains(" > "),
         "{md}"
     );
+    let run = out.join(format!("run_{}", folder_of(TRACES[0])));
     assert!(
-        out.join("run_example_trace/frame_0000_baseline.png")
-            .is_file()
-            && out.join("run_example_trace/frame_0000_flip.png").is_file()
+        run.join("frame_0000_baseline.png").is_file() && run.join("frame_0000_flip.png").is_file(),
+        "{run:?}"
     );
 }
 
@@ -235,7 +250,11 @@ fn a_blink_replays_the_held_gaze_exactly() {
         ],
     );
     assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
-    let frames = json(&baseline.join("blink/baseline.json"))["frames"]
+    let key = fovea_tools::replay::baseline::TraceId::of(&trace_arg)
+        .unwrap()
+        .key;
+    assert!(key.starts_with("blink-"), "{key}");
+    let frames = json(&baseline.join(&key).join("baseline.json"))["frames"]
         .as_array()
         .unwrap()
         .clone();
@@ -276,7 +295,7 @@ fn bad_baselines_and_traces_are_exit_2_naming_the_file() {
         stderr(&missing)
     );
     // A corrupt baseline.json.
-    let broken = dir.join("broken/example_trace");
+    let broken = dir.join("broken").join(folder_of(TRACES[0]));
     std::fs::create_dir_all(&broken).unwrap();
     std::fs::write(broken.join("baseline.json"), "{ \"format\": 3 ").unwrap();
     let corrupt = replay(&TRACES[..1], &dir.join("broken"), &dir.join("o2"), &[]);
@@ -297,4 +316,121 @@ fn bad_baselines_and_traces_are_exit_2_naming_the_file() {
         "{}",
         stderr(&bad_trace)
     );
+}
+
+/// The committed baselines are named by their traces' identities, and each manifest names its
+/// trace's full SHA-256.
+#[test]
+fn committed_baselines_are_keyed_by_trace_identity() {
+    for trace in TRACES {
+        let key = folder_of(trace);
+        let manifest = json(&committed().join(&key).join("baseline.json"));
+        assert_eq!(manifest["format"], "fovea-replay-baseline 2", "{trace}");
+        assert!(key.ends_with(&manifest["trace_sha256"].as_str().unwrap()[..16]));
+    }
+}
+
+/// Two concurrent `--update-baseline` runs both exited 0 with their files interleaved: an update
+/// while another holds the folder is exit 2 before anything renders, and so is a replay.
+#[test]
+fn an_update_while_another_runs_is_refused() {
+    let dir = temp_dir("concurrent");
+    let root = dir.join("baseline");
+    std::fs::create_dir_all(&root).unwrap();
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(root.join(".fovea.lock"))
+        .unwrap();
+    lock.try_lock().unwrap(); // as a running update holds it
+    let second = replay(
+        &TRACES[1..2],
+        &root,
+        &dir.join("o1"),
+        &["--update-baseline"],
+    );
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("in use by another fovea run"),
+        "{}",
+        stderr(&second)
+    );
+    let reading = replay(&TRACES[1..2], &root, &dir.join("o2"), &[]);
+    assert_eq!(reading.status.code(), Some(2), "{}", stderr(&reading));
+    assert!(
+        stderr(&reading).contains("being updated"),
+        "{}",
+        stderr(&reading)
+    );
+    drop(lock);
+    assert_eq!(
+        std::fs::read_dir(&root).unwrap().count(),
+        1,
+        "nothing written"
+    );
+}
+
+/// An update that fails in its write phase (a 32 KiB file-size limit, 64 blocks, as a full disk: the frames
+/// fit, the reference EXR does not) wrote new frames beside the old baseline.json; every later
+/// replay then reported a false regression. The old baseline stays whole and still replays.
+#[test]
+fn an_update_that_fails_midway_keeps_the_old_baseline() {
+    let dir = temp_dir("midway");
+    let root = dir.join("baseline");
+    let fast = ["--method", "cartesian", "--reference-spp", "4"];
+    let made = replay(
+        &TRACES[1..2],
+        &root,
+        &dir.join("o1"),
+        &[&["--update-baseline"][..], &fast[..]].concat(),
+    );
+    assert_eq!(made.status.code(), Some(0), "{}", stderr(&made));
+    let folder = root.join(folder_of(TRACES[1]));
+    let read_all = || {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(&folder)
+            .unwrap()
+            .map(|e| e.unwrap())
+            .map(|e| {
+                (
+                    e.file_name().to_string_lossy().into_owned(),
+                    std::fs::read(e.path()).unwrap(),
+                )
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let before = read_all();
+    let script = format!(
+        "trap '' XFSZ; ulimit -f 64; exec '{}' replay sim:1 --baseline '{}' --out '{}' --update-baseline --seed 7 {}",
+        env!("CARGO_BIN_EXE_fovea"),
+        root.display(),
+        dir.join("o2").display(),
+        fast.join(" ")
+    );
+    let failed = Command::new("sh")
+        .args(["-c", &script])
+        .current_dir(repo())
+        .env("MESA_SHADER_CACHE_DISABLE", "true")
+        .output()
+        .unwrap();
+    assert_eq!(failed.status.code(), Some(2), "{}", stderr(&failed));
+    assert!(
+        stderr(&failed).contains("File too large"),
+        "{}",
+        stderr(&failed)
+    );
+    assert!(read_all() == before, "the old baseline changed");
+    let names: Vec<String> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names.len(),
+        2,
+        "the lock and the baseline, no staging folder: {names:?}"
+    );
+    let again = replay(&TRACES[1..2], &root, &dir.join("o3"), &fast);
+    assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
 }

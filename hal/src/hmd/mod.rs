@@ -204,11 +204,13 @@ fn validate(raw: HmdToml, file: &Path) -> Result<HmdDescription, HalError> {
             ),
         );
     }
-    positive(file, "refresh_hz", raw.refresh_hz, 1000.0)?;
+    // Frame k is shown at k / refresh: below 1 Hz a simulated or recorded gaze is played over
+    // years of samples (1e-30 Hz never finished) and a frame is not an image in a headset.
+    within(file, "refresh_hz", raw.refresh_hz, MIN_RATE_HZ, 1000.0)?;
     let left = validate_eye(&raw.left_eye, "left_eye", file)?;
     let right = validate_eye(&raw.right_eye, "right_eye", file)?;
     let t = &raw.tracker;
-    positive(file, "tracker.rate_hz", t.rate_hz, 10_000.0)?;
+    within(file, "tracker.rate_hz", t.rate_hz, MIN_RATE_HZ, 10_000.0)?;
     non_negative(file, "tracker.latency_ms", t.latency_ms, 1000.0)?;
     non_negative(file, "tracker.accuracy_deg", t.accuracy_deg, 45.0)?;
     non_negative(file, "tracker.precision_deg", t.precision_deg, 45.0)?;
@@ -297,12 +299,15 @@ fn validate_eye(e: &EyeToml, name: &str, file: &Path) -> Result<EyeView, HalErro
     })
 }
 
-fn positive(file: &Path, key: &str, v: f32, max: f32) -> Result<(), HalError> {
-    if !v.is_finite() || v <= 0.0 || v > max {
+/// The lowest display refresh and tracker rate a profile may give (Hz).
+pub const MIN_RATE_HZ: f32 = 1.0;
+
+fn within(file: &Path, key: &str, v: f32, min: f32, max: f32) -> Result<(), HalError> {
+    if !(v.is_finite() && (min..=max).contains(&v)) {
         return Err(HalError::invalid(
             file,
             key,
-            format!("{v} must be > 0 and <= {max}"),
+            format!("{v} must be in [{min}, {max}] Hz"),
         ));
     }
     Ok(())

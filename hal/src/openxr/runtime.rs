@@ -29,6 +29,7 @@ impl OpenXrRuntime {
     /// `XR_KHR_convert_timespec_time`, `XR_FB_display_refresh_rate`. None is required: a
     /// runtime without eye gaze gives a gaze source that reports "no eye tracker".
     pub fn create(application_name: &str) -> Result<Self, HalError> {
+        check_runtime_manifest()?;
         // SAFETY: loads the system OpenXR loader, which must follow the OpenXR specification.
         let entry = unsafe { xr::Entry::load(&()) }.map_err(|e| {
             fail(format!("cannot load the OpenXR loader (libopenxr_loader.so.1; Debian: libopenxr-loader1): {e}"))
@@ -125,6 +126,58 @@ impl OpenXrRuntime {
                 fail("the runtime lacks XR_KHR_convert_timespec_time: no way to read its clock")
             })
     }
+}
+
+/// The largest runtime manifest fovea lets the loader read (real ones are under 1 KiB).
+pub const MAX_RUNTIME_MANIFEST_BYTES: u64 = 64 << 10;
+
+/// The runtime manifest the loader is about to read (`XR_RUNTIME_JSON`, else the first
+/// `openxr/1/active_runtime.json` of the XDG config folders and /etc), checked as a regular file
+/// of at most [`MAX_RUNTIME_MANIFEST_BYTES`]: the loader reads it whole and blocks on a FIFO
+/// (`/dev/zero` took 13.7 GB). Only its metadata is read here, so nothing blocks.
+pub fn check_runtime_manifest() -> Result<(), HalError> {
+    use std::path::PathBuf;
+    let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
+    let (candidates, named): (Vec<PathBuf>, &str) = match env("XR_RUNTIME_JSON") {
+        Some(p) => (vec![PathBuf::from(p)], "XR_RUNTIME_JSON"),
+        None => {
+            let mut dirs: Vec<PathBuf> = Vec::new();
+            if let Some(c) = env("XDG_CONFIG_HOME") {
+                dirs.push(c.into());
+            } else if let Some(h) = env("HOME") {
+                dirs.push(PathBuf::from(h).join(".config"));
+            }
+            let xdg = env("XDG_CONFIG_DIRS").unwrap_or_else(|| "/etc/xdg".into());
+            dirs.extend(std::env::split_paths(&xdg));
+            dirs.push("/etc".into());
+            let files = dirs
+                .into_iter()
+                .map(|d| d.join("openxr/1/active_runtime.json"))
+                .filter(|p| std::fs::symlink_metadata(p).is_ok())
+                .take(1)
+                .collect();
+            (files, "the active OpenXR runtime")
+        }
+    };
+    for path in candidates {
+        let meta = std::fs::metadata(&path)
+            .map_err(|e| fail(format!("{named} {}: {e}", path.display())))?;
+        if !meta.is_file() {
+            return Err(fail(format!(
+                "{named} {}: it is {}, not a regular file (the OpenXR loader would block on it or read without end)",
+                path.display(),
+                crate::file::file_kind(&meta.file_type())
+            )));
+        }
+        if meta.len() > MAX_RUNTIME_MANIFEST_BYTES {
+            return Err(fail(format!(
+                "{named} {}: {} bytes, more than the {MAX_RUNTIME_MANIFEST_BYTES}-byte limit for a runtime manifest",
+                path.display(),
+                meta.len()
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn wanted_extensions(available: &xr::ExtensionSet) -> xr::ExtensionSet {

@@ -19,6 +19,11 @@ use std::f32::consts::PI;
 /// Largest accepted map (columns × rows): 2:1 equirectangular at 8K. The device may still get a
 /// halved copy (`fits`), this bound keeps a file's decoded texels within ~400 MB of host memory.
 pub const MAX_ENVIRONMENT_SIZE: (u32, u32) = (8192, 4096);
+/// Largest radiance a map may give once scaled (a texel's brightest channel × the intensity).
+/// Finite values of 1e20 and above give black frames (lavapipe: the estimator's products leave
+/// f32); 1e12 still renders (a 32×36 Cornell box under a uniform 1e12 map, every denoiser and TAA
+/// mode, 2026-12-07), and no picture needs more: the sun's luminance is 1.6e9 cd/m².
+pub const MAX_ENVIRONMENT_RADIANCE: f32 = 1e12;
 /// The baked analytic sky: it varies with elevation only, so few columns and many rows
 /// (0.35° per row keeps the horizon-to-zenith gradient free of visible bands).
 pub const SKY_BAKE_SIZE: (u32, u32) = (32, 512);
@@ -63,6 +68,29 @@ impl EnvironmentMap {
             rotation: 0.0,
             intensity: 1.0,
         })
+    }
+
+    /// The brightest texel's largest channel × the intensity must stay within
+    /// [`MAX_ENVIRONMENT_RADIANCE`]; the error names the texel, its value and the product.
+    pub fn check_radiance(&self) -> Result<(), String> {
+        let Some((i, t)) = self
+            .texels
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.max_element().total_cmp(&b.1.max_element()))
+        else {
+            return Ok(());
+        };
+        let scaled = t.max_element() as f64 * self.intensity as f64;
+        if scaled > MAX_ENVIRONMENT_RADIANCE as f64 {
+            let (x, y) = (i as u32 % self.width, i as u32 / self.width);
+            return Err(format!(
+                "texel ({x}, {y}) is {:?}; × intensity {} gives {scaled:e}, beyond the {MAX_ENVIRONMENT_RADIANCE:e} a frame can show (the frame would be black)",
+                t.to_array(),
+                self.intensity
+            ));
+        }
+        Ok(())
     }
 
     /// The analytic sky ([`Sky`]) at each texel centre, so the default sky takes the same

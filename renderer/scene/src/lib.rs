@@ -395,6 +395,13 @@ pub enum SceneError {
     Budget { file: PathBuf, detail: String },
 }
 
+/// [`Scene::load_with_limits`] without its panic backstop, for the fuzz targets (`fuzz/`): there a
+/// panic is a bug to find, not to hide. Renderers load with [`Scene::load_with_limits`].
+#[doc(hidden)]
+pub fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
+    load::load_unguarded(path, limits)
+}
+
 impl Scene {
     /// Loads a `.gltf` (with embedded or external buffers/images) or `.glb` file within the
     /// budgets of [`LoadLimits::from_env`] (the defaults unless `FOVEA_MAX_*` variables are set).

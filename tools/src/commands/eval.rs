@@ -173,12 +173,8 @@ fn read_input(path: &Path) -> Result<Input> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if png {
-        crate::output::check_regular_input(path)?;
-        let image = image::open(path)
-            .with_context(|| format!("reading {}", path.display()))?
-            .to_rgba8();
-        let (width, height) = image.dimensions();
-        let displayed = image.into_raw();
+        let (width, height, displayed) =
+            crate::decode::read_rgba8(path, crate::decode::MAX_IMAGE_PIXELS, None)?;
         let values = displayed
             .chunks_exact(4)
             .map(|p| [p[0], p[1], p[2], p[3]].map(|c| c as f32 / 255.0))

@@ -172,8 +172,8 @@ pub fn run(args: &GazeEvalArgs) -> Result<()> {
         .with_context(|| format!("--headset {}", args.headset))?;
     let model = LatencyModel::for_headset(&hmd, args.latency_ms, args.tracker_hz)?;
     let display_hz = args.display_hz.unwrap_or(hmd.refresh_hz as f64);
-    if !(display_hz > 0.0 && display_hz <= 1000.0) {
-        bail!("--display-hz {display_hz}: expected a rate in Hz, > 0 and <= 1000");
+    if !(display_hz >= fovea_hal::hmd::MIN_RATE_HZ as f64 && display_hz <= 1000.0) {
+        bail!("--display-hz {display_hz}: expected a rate in Hz, >= 1 and <= 1000");
     }
     let modes = parse_modes(args.predict)?;
     // Every recording loads before anything is written.

@@ -4,12 +4,24 @@ use crate::scenegen::{write_scene, SceneKind, DEFAULT_LARGE_TRIANGLES};
 use anyhow::{bail, Result};
 use std::path::Path;
 
+/// `--min-triangles`: at most the scene loader's triangle budget (`FOVEA_MAX_TRIANGLES`, default
+/// 4,000,000), so every scene written loads (1e11 took 18.8 GB and wrote a file fovea refused).
+pub fn check_triangles(n: usize) -> Result<usize> {
+    let budget = fovea_scene::LoadLimits::from_env()
+        .map_err(anyhow::Error::msg)?
+        .max_triangles;
+    if n == 0 || n as u64 > budget {
+        bail!("--min-triangles {n} must be in 1..={budget} (the scene loader's triangle budget; set FOVEA_MAX_TRIANGLES to raise it)");
+    }
+    Ok(n)
+}
+
 pub fn run(kind: &str, out: &Path, min_triangles: Option<usize>, force: bool) -> Result<()> {
     let kind = match kind {
         "cornell-box" => SceneKind::CornellBox,
         "stress" => SceneKind::Stress,
         "large" => SceneKind::Large {
-            min_triangles: min_triangles.unwrap_or(DEFAULT_LARGE_TRIANGLES),
+            min_triangles: check_triangles(min_triangles.unwrap_or(DEFAULT_LARGE_TRIANGLES))?,
         },
         other => bail!("unknown scene kind '{other}' (cornell-box, stress, large)"),
     };

@@ -13,19 +13,19 @@ use super::setup::Eyes;
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
-use crate::output::{
-    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_text,
-};
+use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::{RenderSettings, StereoNoise};
+use fovea_hal::Eye;
+use fovea_renderer::frame::{CameraPose, RenderSettings, StereoNoise};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::Scene;
 use glam::{UVec2, Vec2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -61,8 +61,8 @@ pub struct QualityArgs<'a> {
 pub const CAMERAS: &[&str] = &["still", "moving"];
 
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
-#[derive(Serialize)]
-struct RunQuality {
+#[derive(Serialize, Deserialize)]
+pub struct RunQuality {
     camera: String,
     method: String,
     denoiser: String,
@@ -106,7 +106,7 @@ struct RunQuality {
 
 /// quality.json's `binocular`: the measure, and the right eye judged as the left is (its rings
 /// around its own gaze).
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct Binocular {
     #[serde(flatten)]
     measure: BinocularQuality,
@@ -114,7 +114,7 @@ struct Binocular {
 }
 
 /// One eye's quality against its own reference.
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct EyeQuality {
     rings: Vec<RingMean>,
     frame_rmse: f64,
@@ -127,9 +127,10 @@ struct EyeQuality {
 const FOVEAL_RINGS: usize = 2;
 
 /// A combination the method cannot run (a denoiser or TAA on a space without temporal filters):
-/// listed in the table with the reason instead of silently left out.
-#[derive(Serialize)]
-struct RefusedRun {
+/// listed in the table with the reason instead of silently left out (once, whatever the stereo
+/// noise).
+#[derive(Serialize, Deserialize, PartialEq)]
+pub struct RefusedRun {
     camera: String,
     method: String,
     denoiser: String,
@@ -137,7 +138,7 @@ struct RefusedRun {
     reason: String,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct RingMean {
     /// The paper's normalised eccentricity r / r_max · 80 of the ring's edges.
     ecc_inner: f64,
@@ -214,7 +215,73 @@ fn filters_refusal(
         .then(|| format!("{method} supports no denoiser or TAA {}", caps.filters_note)))
 }
 
-pub fn run(args: &QualityArgs) -> Result<()> {
+/// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser, a TAA mode and,
+/// where `--stereo-noise` is given, how the eyes' random numbers relate.
+pub struct Combination<'a> {
+    pub camera: &'a str,
+    pub method: &'a str,
+    pub denoiser: &'a str,
+    pub taa: &'a str,
+    /// `None`: the profile's, and the folder named as without `--stereo-noise`.
+    pub noise: Option<StereoNoise>,
+}
+
+impl Combination<'_> {
+    /// The `fovea render` folder of this combination inside the output folder.
+    pub fn run_dir_name(&self) -> String {
+        let noise = self
+            .noise
+            .map_or(String::new(), |n| format!("_noise-{}", n.name()));
+        format!(
+            "run_{}_{}_{}_taa-{}{noise}",
+            self.camera, self.method, self.denoiser, self.taa
+        )
+    }
+
+    /// Whether the combination runs a temporal filter (which some methods refuse).
+    fn filtered(&self) -> bool {
+        self.denoiser != "none" || self.taa != "off"
+    }
+
+    fn refused(&self, reason: String) -> RefusedRun {
+        RefusedRun {
+            camera: self.camera.to_string(),
+            method: self.method.to_string(),
+            denoiser: self.denoiser.to_string(),
+            taa: self.taa.to_string(),
+            reason,
+        }
+    }
+}
+
+/// The stereo noises of the grid: `--stereo-noise`'s, or only the profile's (`None`).
+pub fn stereo_noises(args: &QualityArgs) -> Vec<Option<StereoNoise>> {
+    match args.stereo_noises {
+        [] => vec![None],
+        given => given.iter().copied().map(Some).collect(),
+    }
+}
+
+/// What one combination gives: its metrics (boxed: a stereo run's outweigh a refusal), or why
+/// the method cannot run it.
+#[derive(Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    Run(Box<RunQuality>),
+    Refused(RefusedRun),
+}
+
+/// The settings every combination shares, checked once.
+pub struct Prepared {
+    /// The frames whose metrics are averaged.
+    pub evaluated: Vec<u32>,
+    ppd: f32,
+    hmd: fovea_hal::HmdDescription,
+    model: Option<fovea_hal::latency::LatencyModel>,
+}
+
+/// Checks the flags (before anything renders) and resolves what every combination shares.
+pub fn prepare(args: &QualityArgs) -> Result<Prepared> {
     check_names("--methods", args.methods, &super::methods::names())?;
     check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
     check_names("--taa", args.taa, TaaMode::NAMES)?;
@@ -232,125 +299,117 @@ pub fn run(args: &QualityArgs) -> Result<()> {
     if args.rings == 0 || args.reference_spp == 0 || args.width == 0 || args.height == 0 {
         bail!("--rings, --reference-spp, --width and --height must be at least 1");
     }
+    let max_spp = super::reference::MAX_REFERENCE_SPP;
+    if args.reference_spp > max_spp {
+        bail!(
+            "--reference-spp {} must be at most {max_spp} (as fovea reference --spp)",
+            args.reference_spp
+        );
+    }
+    // Every frame is read back within the image budget: a larger run would render for nothing.
+    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
+    if args.width as u64 * args.height as u64 > max_pixels {
+        bail!(
+            "--width {} --height {}: at most {max_pixels} pixels (the frames are read back for the figures)",
+            args.width,
+            args.height
+        );
+    }
     super::eval::check_rings(args.rings, Some((args.width, args.height)))?;
-    let _out_dir = prepare_output_dir(args.out)?;
     let evaluated: Vec<u32> = (args.frames - args.eval_frames..args.frames).collect();
     let ppd = flip_ppd(args)?;
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    // Checked before anything renders.
     let model = args.profile.gaze_timing.model(&hmd)?;
-    // `None`: the profile's, the run folders named as without the flag.
-    let noises: Vec<Option<StereoNoise>> = match args.stereo_noises {
-        [] => vec![None],
-        given => given.iter().copied().map(Some).collect(),
-    };
-    let (mut runs, mut refused) = (Vec::new(), Vec::new());
+    Ok(Prepared {
+        evaluated,
+        ppd,
+        hmd,
+        model,
+    })
+}
+
+pub fn run(args: &QualityArgs) -> Result<()> {
+    let prepared = prepare(args)?;
+    let _out_dir = prepare_output_dir(args.out)?;
+    let noises = stereo_noises(args);
+    let mut outcomes = Vec::new();
     for camera in args.cameras {
-        let moving = camera == "moving";
-        let references = references(args, moving, &evaluated)?;
+        let references = references(args, camera, &prepared.evaluated)?;
         for method in args.methods {
             let filtered =
                 args.denoisers.iter().any(|d| d != "none") || args.taa.iter().any(|t| t != "off");
+            // Asked once per method (some spaces take a full-screen sum to build).
             let refusal = if filtered {
-                filters_refusal(args, &hmd, method)?
+                filters_refusal(args, &prepared.hmd, method)?
             } else {
                 None
             };
             for denoiser in args.denoisers {
                 for taa in args.taa {
-                    if let (Some(reason), false) = (&refusal, denoiser == "none" && taa == "off") {
-                        refused.push(RefusedRun {
-                            camera: camera.clone(),
-                            method: method.clone(),
-                            denoiser: denoiser.clone(),
-                            taa: taa.clone(),
-                            reason: reason.clone(),
-                        });
-                        continue;
-                    }
                     for &noise in &noises {
-                        let run = Run {
+                        let combination = Combination {
                             camera,
                             method,
                             denoiser,
                             taa,
                             noise,
                         };
-                        runs.push(render_and_measure(
-                            args,
-                            &run,
-                            &references,
-                            &evaluated,
-                            ppd,
-                        )?);
+                        let dir = args.out.join(combination.run_dir_name());
+                        outcomes.push(match (&refusal, combination.filtered()) {
+                            (Some(reason), true) => {
+                                Outcome::Refused(combination.refused(reason.clone()))
+                            }
+                            _ => Outcome::Run(Box::new(run_combination(
+                                args,
+                                &prepared,
+                                &combination,
+                                &references,
+                                &dir,
+                            )?)),
+                        });
                     }
                 }
             }
         }
     }
-    let report = Report {
-        scene: args.scene,
-        width: args.width,
-        height: args.height,
-        headset: args.headset,
-        gaze_source: args.gaze,
-        eyes: args.eyes.name(),
-        frames: args.frames,
-        eval_frames: args.eval_frames,
-        reference_spp: args.reference_spp,
-        blur_sigma_at_30: args.profile.blur.sigma_at_30,
-        flip_ppd: ppd,
-        latency: model.as_ref().map(|m| m.describe()),
-        gaze_predict: model
-            .as_ref()
-            .map(|_| args.profile.gaze_timing.mode().name().to_string()),
-        runs: &runs,
-        refused: &refused,
-    };
-    write_json(&args.out.join("quality.json"), &report)?;
-    let table = markdown(&report);
-    write_text(&args.out.join("quality.md"), &table)?;
-    print!("{table}");
-    Ok(())
+    write_report(args, &prepared, outcomes, args.out)
 }
 
-/// One combination `fovea quality` renders.
-struct Run<'a> {
-    camera: &'a str,
-    method: &'a str,
-    denoiser: &'a str,
-    taa: &'a str,
-    noise: Option<StereoNoise>,
-}
-
-/// Renders one combination into its folder (`fovea render`) and judges it.
-fn render_and_measure(
+/// Why the method of `combination` cannot run it, if it cannot.
+pub fn refusal(
     args: &QualityArgs,
-    run: &Run,
+    prepared: &Prepared,
+    combination: &Combination,
+) -> Result<Option<RefusedRun>> {
+    if !combination.filtered() {
+        return Ok(None);
+    }
+    Ok(filters_refusal(args, &prepared.hmd, combination.method)?
+        .map(|reason| combination.refused(reason)))
+}
+
+/// Renders one combination into `dir` (a `fovea render` folder, both eyes in a stereo run) and
+/// measures its evaluated frames against `references`: each eye against its own, and in a stereo
+/// run the eyes against each other.
+pub fn run_combination(
+    args: &QualityArgs,
+    prepared: &Prepared,
+    combination: &Combination,
     references: &References,
-    evaluated: &[u32],
-    ppd: f32,
+    dir: &Path,
 ) -> Result<RunQuality> {
-    let Run {
+    let Combination {
         camera,
         method,
         denoiser,
         taa,
         noise,
-    } = *run;
-    let moving = camera == "moving";
+    } = *combination;
     let mut profile = args.profile.clone();
-    let noise_suffix = match noise {
-        Some(n) => {
-            profile.stereo_noise = n;
-            format!("_noise-{}", n.name())
-        }
-        None => String::new(),
-    };
-    let dir = args.out.join(format!(
-        "run_{camera}_{method}_{denoiser}_taa-{taa}{noise_suffix}"
-    ));
+    if let Some(noise) = noise {
+        profile.stereo_noise = noise;
+    }
     let render_args = RenderArgs {
         scene: args.scene,
         method,
@@ -360,9 +419,9 @@ fn render_and_measure(
         headset: args.headset,
         gaze: args.gaze,
         frames: args.frames,
-        out: &dir,
+        out: dir,
         exr: true,
-        camera_path: if moving {
+        camera_path: if camera == "moving" {
             camera_path::CameraMotion::Orbit
         } else {
             camera_path::CameraMotion::Still
@@ -389,17 +448,24 @@ fn render_and_measure(
         profile.stereo_noise.name()
     );
     render::run(&render_args).with_context(|| what.clone())?;
+    let evaluated = &prepared.evaluated;
     let stereo = references.stereo.as_ref();
     let left = match stereo {
         Some(_) => EyeFiles::LEFT,
         None => EyeFiles::MONO,
     };
-    let mut q = measure(args, &dir, evaluated, &references.left, ppd, &left)?;
+    let mut q = measure(args, dir, evaluated, &references.left, prepared.ppd, &left)?;
     if let Some(stereo) = stereo {
-        let right = measure(args, &dir, evaluated, &stereo.right, ppd, &EyeFiles::RIGHT)?;
-        let measure =
-            quality_stereo::measure(&dir, evaluated, &references.left, stereo, args.rings)
-                .with_context(|| what.clone())?;
+        let right = measure(
+            args,
+            dir,
+            evaluated,
+            &stereo.right,
+            prepared.ppd,
+            &EyeFiles::RIGHT,
+        )?;
+        let measure = quality_stereo::measure(dir, evaluated, &references.left, stereo, args.rings)
+            .with_context(|| what.clone())?;
         q.binocular = Some(Binocular {
             measure,
             right_eye: EyeQuality {
@@ -421,95 +487,256 @@ fn render_and_measure(
     Ok(q)
 }
 
-/// The converged references of one camera: the left eye's per evaluated frame, and in a stereo
-/// run the right eye's with both eyes' depth.
-struct References {
-    left: Vec<Vec<[f32; 4]>>,
-    stereo: Option<StereoReferences>,
+/// Writes `out/quality.json` and `out/quality.md` from the outcomes in the order of the grid
+/// (cameras, methods, denoisers, TAA modes, stereo noises), and prints the table.
+pub fn write_report(
+    args: &QualityArgs,
+    prepared: &Prepared,
+    outcomes: Vec<Outcome>,
+    out: &Path,
+) -> Result<()> {
+    let (mut runs, mut refused) = (Vec::new(), Vec::new());
+    for outcome in outcomes {
+        match outcome {
+            Outcome::Run(q) => runs.push(*q),
+            // A refusal holds for every stereo noise: listed once.
+            Outcome::Refused(r) if !refused.contains(&r) => refused.push(r),
+            Outcome::Refused(_) => {}
+        }
+    }
+    let model = prepared.model.as_ref();
+    let report = Report {
+        scene: args.scene,
+        width: args.width,
+        height: args.height,
+        headset: args.headset,
+        gaze_source: args.gaze,
+        eyes: args.eyes.name(),
+        frames: args.frames,
+        eval_frames: args.eval_frames,
+        reference_spp: args.reference_spp,
+        blur_sigma_at_30: args.profile.blur.sigma_at_30,
+        flip_ppd: prepared.ppd,
+        latency: model.map(|m| m.describe()),
+        gaze_predict: model.map(|_| args.profile.gaze_timing.mode().name().to_string()),
+        runs: &runs,
+        refused: &refused,
+    };
+    write_json(&out.join("quality.json"), &report)?;
+    let table = markdown(&report);
+    write_text(&out.join("quality.md"), &table)?;
+    print!("{table}");
+    Ok(())
 }
 
-/// Converged references of the evaluated frames' camera poses (one for a still camera), written
-/// to `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`), and
-/// in a stereo run each eye's depth through its pixel centres (`binocular::EyeGeometry`).
-fn references(args: &QualityArgs, moving: bool, evaluated: &[u32]) -> Result<References> {
+/// The camera poses that get a converged reference: frame 0 for a still camera, every evaluated
+/// frame for a moving one.
+pub fn reference_frames(camera: &str, evaluated: &[u32]) -> Vec<u32> {
+    if camera == "moving" {
+        evaluated.to_vec()
+    } else {
+        vec![0]
+    }
+}
+
+/// The eyes that get converged references: the left, and in a stereo run the right after it.
+pub fn reference_eyes(args: &QualityArgs) -> &'static [Eye] {
+    match args.eyes {
+        Eyes::Both => Eyes::Both.list(),
+        Eyes::Left | Eyes::Right => Eyes::Left.list(),
+    }
+}
+
+/// The name of the reference of `camera` at `frame` for `eye` in the output folder; the eye is
+/// named in a stereo run (`eyes` both) only.
+pub fn reference_file_name(eyes: Eyes, camera: &str, eye: Eye, frame: u32) -> String {
+    match eyes {
+        Eyes::Both => format!(
+            "reference_{camera}_{}_{frame:04}.exr",
+            super::setup::eye_name(eye)
+        ),
+        Eyes::Left | Eyes::Right => format!("reference_{camera}_{frame:04}.exr"),
+    }
+}
+
+/// The scene and the head of the references of one camera: the eyes `fovea render --eyes
+/// left|both` renders, through the same projection, at each frame of [`reference_frames`].
+pub struct ReferenceViews {
+    scene: Scene,
+    rig: crate::projection::EyeRig,
+    /// The head pose at each reference frame.
+    heads: Vec<(u32, CameraPose)>,
+}
+
+impl ReferenceViews {
+    /// The pose of `eye` at reference frame `frame`.
+    pub fn pose(&self, frame: u32, eye: Eye) -> Option<CameraPose> {
+        self.heads
+            .iter()
+            .find(|(f, _)| *f == frame)
+            .map(|(_, head)| self.rig.eye(head, eye))
+    }
+}
+
+/// Loads the scene (no device) and places the head at each frame of [`reference_frames`].
+pub fn reference_views(
+    args: &QualityArgs,
+    camera: &str,
+    evaluated: &[u32],
+) -> Result<ReferenceViews> {
+    let moving = camera == "moving";
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    let stereo = args.eyes == Eyes::Both;
-    // The eyes `fovea render --eyes left|both` renders, through the same projection.
+    // A stereo run offsets the eyes (in either projection): the references see what the runs do.
     let rig = crate::projection::EyeRig {
         projection: args.camera.projection,
         hmd,
-        stereo,
+        stereo: args.eyes == Eyes::Both,
         width: args.width,
         height: args.height,
         metres_per_unit: args.camera.world_scale,
     };
-    let (scene, camera) = crate::look::load(
+    let (scene, scene_camera) = crate::look::load(
         args.scene,
         args.camera,
         &args.profile.environment,
         rig.framing(),
     )?;
-    let start = rig.head(&camera);
+    let start = rig.head(&scene_camera);
     let centre = scene.bounds().center();
+    let heads = reference_frames(camera, evaluated)
+        .into_iter()
+        .map(|f| {
+            let head = if moving {
+                camera_path::orbit(&start, centre, f, args.frames)
+            } else {
+                start
+            };
+            (f, head)
+        })
+        .collect();
+    Ok(ReferenceViews { scene, rig, heads })
+}
+
+/// A Cartesian renderer set up for the references of `camera`, and their views.
+pub struct ReferenceRenderer {
+    pub ctx: std::sync::Arc<fovea_renderer::vk::Context>,
+    pub renderer: Renderer,
+    pub views: ReferenceViews,
+}
+
+pub fn reference_renderer(
+    args: &QualityArgs,
+    camera: &str,
+    evaluated: &[u32],
+) -> Result<ReferenceRenderer> {
+    let views = reference_views(args, camera, evaluated)?;
     let ctx = super::open_device(args.device, args.validation)?;
     let size = UVec2::new(args.width, args.height);
     let settings = RenderSettings {
         seed: args.seed.wrapping_add(0x5eed),
         ..Default::default()
     };
-    let mut renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
-    let poses: Vec<u32> = if moving { evaluated.to_vec() } else { vec![0] };
-    let camera_name = if moving { "moving" } else { "still" };
-    let eyes = if stereo { Eyes::Both } else { Eyes::Left };
-    let mut out: [Vec<Vec<[f32; 4]>>; 2] = Default::default();
-    let mut heads = Vec::new();
-    for &f in &poses {
-        let head = if moving {
-            camera_path::orbit(&start, centre, f, args.frames)
-        } else {
-            start
+    let renderer = Renderer::new(&ctx, &views.scene, Box::new(Cartesian::new(size)), settings)?;
+    Ok(ReferenceRenderer {
+        ctx,
+        renderer,
+        views,
+    })
+}
+
+/// The converged references of one camera, one per evaluated frame: the left eye's, and in a
+/// stereo run the right eye's with the warp of the right eye into the left.
+pub struct References {
+    left: Vec<Vec<[f32; 4]>>,
+    stereo: Option<StereoReferences>,
+}
+
+impl References {
+    /// From the images of [`reference_frames`] of each eye of [`reference_eyes`], in that order
+    /// (`images[eye][frame]`); a still camera's one image stands for every evaluated frame. A
+    /// stereo run needs the references' views (the eyes' depth for the warp).
+    pub fn new(
+        args: &QualityArgs,
+        camera: &str,
+        evaluated: &[u32],
+        images: Vec<Vec<Vec<[f32; 4]>>>,
+        views: Option<&ReferenceViews>,
+    ) -> Result<References> {
+        let eyes = reference_eyes(args);
+        if images.len() != eyes.len() {
+            bail!(
+                "{} eyes' references for a run of {} eyes",
+                images.len(),
+                eyes.len()
+            );
+        }
+        let mut per_eye = images
+            .into_iter()
+            .map(|v| per_evaluated_frame(camera, v, evaluated));
+        let left = per_eye.next().context("the left eye's references")?;
+        let stereo = match (per_eye.next(), views) {
+            (None, _) => None,
+            (Some(right), Some(views)) => {
+                let heads: Vec<CameraPose> = views.heads.iter().map(|(_, h)| *h).collect();
+                Some(StereoReferences::new(
+                    &views.scene,
+                    &views.rig,
+                    &heads,
+                    right,
+                ))
+            }
+            (Some(_), None) => bail!("a stereo run's references need their views"),
         };
-        heads.push(head);
-        for (slot, &eye) in eyes.list().iter().enumerate() {
-            let pose = rig.eye(&head, eye);
-            let reference = renderer.render_reference(
+        Ok(References { left, stereo })
+    }
+}
+
+/// Converged references of the evaluated frames' camera poses (one for a still camera, the same
+/// for every evaluated frame) for each eye of [`reference_eyes`], written to
+/// `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`).
+fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<References> {
+    let mut r = reference_renderer(args, camera, evaluated)?;
+    let mut images = Vec::new();
+    for &eye in reference_eyes(args) {
+        let mut eye_images = Vec::new();
+        for f in reference_frames(camera, evaluated) {
+            let pose = r.views.pose(f, eye).context("a reference frame's pose")?;
+            let reference = crate::reference_sum::render(
+                &mut r.renderer,
                 &pose,
                 args.reference_spp,
                 fovea_renderer::frame::REALTIME_MAX_DEPTH,
-                |_| {},
+                &mut |_| Ok(()),
             )?;
-            let name = match stereo {
-                true => format!(
-                    "reference_{camera_name}_{}_{f:04}.exr",
-                    super::setup::eye_name(eye)
-                ),
-                false => format!("reference_{camera_name}_{f:04}.exr"),
-            };
-            write_exr(&args.out.join(name), args.width, args.height, &reference)?;
-            out[slot].push(reference);
+            write_exr(
+                &args
+                    .out
+                    .join(reference_file_name(args.eyes, camera, eye, f)),
+                args.width,
+                args.height,
+                &reference,
+            )?;
+            eye_images.push(reference);
         }
+        images.push(eye_images);
     }
-    super::check_validation(&ctx)?;
-    // A still camera's one pose stands for every evaluated frame.
-    let per_frame = |mut v: Vec<Vec<[f32; 4]>>| match moving {
-        true => v,
-        false => vec![v.remove(0); evaluated.len()],
-    };
-    let [left, right] = out;
-    let stereo = match stereo {
-        true => Some(StereoReferences::new(
-            &scene,
-            &rig,
-            &heads,
-            per_frame(right),
-        )),
-        false => None,
-    };
-    Ok(References {
-        left: per_frame(left),
-        stereo,
-    })
+    super::check_validation(&r.ctx)?;
+    References::new(args, camera, evaluated, images, Some(&r.views))
+}
+
+/// The references of [`reference_frames`] as one per evaluated frame (the still camera's one
+/// repeated).
+fn per_evaluated_frame(
+    camera: &str,
+    mut references: Vec<Vec<[f32; 4]>>,
+    evaluated: &[u32],
+) -> Vec<Vec<[f32; 4]>> {
+    if camera == "moving" {
+        references
+    } else {
+        vec![references.remove(0); evaluated.len()]
+    }
 }
 
 /// The run's evaluated frames against their references, ring metrics averaged over frames.
@@ -541,12 +768,16 @@ fn measure(
             gaze[1].as_f64().unwrap_or(0.0) as f32,
         );
         let path: PathBuf = dir.join(format!("frame_{f:04}{}.exr", eye.suffix));
-        let (_, _, test) = read_exr(&path)?;
+        let size = Some((args.width, args.height));
+        let (_, _, test) = crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = image::open(dir.join(format!("frame_{f:04}{}.png", eye.suffix)))?
-            .to_rgba8()
-            .into_raw();
+        let displayed = crate::decode::read_rgba8(
+            &dir.join(format!("frame_{f:04}{}.png", eye.suffix)),
+            crate::decode::MAX_IMAGE_PIXELS,
+            size,
+        )?
+        .2;
         let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,

@@ -20,7 +20,7 @@ use fovea_renderer::scene::bvh::instanced::SceneBvh;
 use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_renderer::scene::Scene;
 use glam::Vec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -92,7 +92,7 @@ impl StereoReferences {
 }
 
 /// One ring of the binocular measure, means over the evaluated frames.
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 pub(super) struct BinocularRing {
     ecc_inner: f64,
     ecc_outer: f64,
@@ -109,7 +109,7 @@ pub(super) struct BinocularRing {
 }
 
 /// The whole frame's binocular measure, means over the evaluated frames.
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 pub(super) struct BinocularFrame {
     visible_in_both: f64,
     difference: Option<f64>,
@@ -119,7 +119,7 @@ pub(super) struct BinocularFrame {
 }
 
 /// quality.json's `binocular` of a stereo run (`quality` adds the right eye's own quality).
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 pub(super) struct BinocularQuality {
     /// The right eye warped into the left; rings around the left eye's gaze.
     rings: Vec<BinocularRing>,
@@ -140,11 +140,10 @@ fn ring_means(rings: &Rings, map: &[f64]) -> Vec<Option<f64>> {
     v
 }
 
-fn read_png(path: &Path) -> Result<Vec<u8>> {
-    Ok(image::open(path)
-        .with_context(|| format!("reading {}", path.display()))?
-        .to_rgba8()
-        .into_raw())
+/// A displayed frame of the run (bounded read, its size checked from the header).
+fn read_png(path: &Path, width: u32, height: u32) -> Result<Vec<u8>> {
+    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
+    Ok(crate::decode::read_rgba8(path, max_pixels, Some((width, height)))?.2)
 }
 
 /// The binocular measure of the run in `dir` over the evaluated frames, in `rings` rings.
@@ -177,8 +176,8 @@ pub(super) fn measure(
                 .map(|(inner, outer)| (ecc(inner), ecc(outer)))
                 .collect();
         }
-        let left = read_png(&dir.join(format!("frame_{f:04}_left.png")))?;
-        let right = read_png(&dir.join(format!("frame_{f:04}_right.png")))?;
+        let left = read_png(&dir.join(format!("frame_{f:04}_left.png")), width, height)?;
+        let right = read_png(&dir.join(format!("frame_{f:04}_right.png")), width, height)?;
         let reference_left = tonemap_preview(&left_references[i], 1.0, ToneCurve::Aces);
         let reference_right = tonemap_preview(&stereo.right[i], 1.0, ToneCurve::Aces);
         let warp = stereo.warp(i);

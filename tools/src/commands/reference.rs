@@ -1,14 +1,16 @@
 //! `fovea reference`: a converged linear-radiance EXR (many samples per pixel, chosen depth).
 
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
-use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::RenderSettings;
+use anyhow::{bail, Context as _, Result};
+use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::vk::Context;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
+use std::sync::Arc;
 
 pub struct ReferenceArgs<'a> {
     pub scene: &'a str,
@@ -32,9 +34,28 @@ pub struct ReferenceArgs<'a> {
     pub path_regularisation: f32,
 }
 
-pub fn run(args: &ReferenceArgs) -> Result<()> {
+/// The most samples per pixel `fovea reference --spp` takes (about 2²⁰: a 64-spp frame of noise
+/// is already below FLIP's visibility at 16 Ki; a million is a converged bound, not a goal).
+pub const MAX_REFERENCE_SPP: u32 = 1 << 20;
+
+/// Checks the numbers of the flags.
+pub fn check(args: &ReferenceArgs) -> Result<()> {
     if args.width == 0 || args.height == 0 || args.spp == 0 || args.max_depth == 0 {
         bail!("--width, --height, --spp and --max-depth must be at least 1");
+    }
+    let max_side = super::setup::MAX_RENDER_SIDE;
+    if args.width > max_side || args.height > max_side {
+        bail!(
+            "--width {} --height {}: each must be at most {max_side} pixels",
+            args.width,
+            args.height
+        );
+    }
+    if args.spp > MAX_REFERENCE_SPP {
+        bail!(
+            "--spp {} must be at most {MAX_REFERENCE_SPP} (a reference converges long before)",
+            args.spp
+        );
     }
     if args.max_depth > super::setup::MAX_DEPTH_LIMIT {
         bail!(
@@ -43,11 +64,11 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
             super::setup::MAX_DEPTH_LIMIT
         );
     }
-    check_new_file(args.out, args.force)?;
-    let preview = args.out.with_extension("png");
-    if args.preview {
-        check_new_file(&preview, args.force)?;
-    }
+    Ok(())
+}
+
+/// The Cartesian renderer of the reference and the eye's pose.
+pub fn renderer(args: &ReferenceArgs) -> Result<(Arc<Context>, Renderer, CameraPose)> {
     let rig = crate::projection::EyeRig {
         projection: args.camera.projection,
         hmd: fovea_hal::HmdDescription::resolve(args.headset)
@@ -68,22 +89,36 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         ..Default::default()
     };
     let space = Box::new(Cartesian::new(UVec2::new(args.width, args.height)));
-    let mut renderer = Renderer::new(&ctx, &scene, space, settings)?;
+    let renderer = Renderer::new(&ctx, &scene, space, settings)?;
+    Ok((ctx, renderer, pose))
+}
+
+pub fn run(args: &ReferenceArgs) -> Result<()> {
+    check(args)?;
+    check_new_file(args.out, args.force)?;
+    if args.preview {
+        check_new_file(&args.out.with_extension("png"), args.force)?;
+    }
+    let (ctx, mut renderer, pose) = renderer(args)?;
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template(
         "{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})",
     )?);
     let started = std::time::Instant::now();
-    let image = renderer.render_reference(&pose, args.spp, args.max_depth, |done| {
-        bar.set_position(done as u64)
-    })?;
+    // Summed in the fixed batch order of `reference_sum`, so `fovea sweep` can split it exactly.
+    let image = crate::reference_sum::render(
+        &mut renderer,
+        &pose,
+        args.spp,
+        args.max_depth,
+        &mut |done| {
+            bar.set_position(done as u64);
+            Ok(())
+        },
+    )?;
     bar.finish_and_clear();
-    write_exr(args.out, args.width, args.height, &image)?;
-    let displayed = tonemap_preview(&image, 1.0, ToneCurve::Aces);
-    if args.preview {
-        write_png(&preview, args.width, args.height, &displayed)?;
-    }
     super::check_validation(&ctx)?;
+    write(args, args.out, &image)?;
     println!(
         "wrote {} ({}×{}, {} spp, max depth {}, path regularisation {}) in {:.1} s on {}",
         args.out.display(),
@@ -95,10 +130,30 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         ctx.info.name
     );
-    // What a converged image should not have: isolated pixels far brighter than their neighbours.
+    fireflies(args, &image);
+    Ok(())
+}
+
+/// Writes the reference to `out` (and its preview next to it with `--preview`).
+pub fn write(args: &ReferenceArgs, out: &Path, image: &[[f32; 4]]) -> Result<()> {
+    write_exr(out, args.width, args.height, image)?;
+    if args.preview {
+        let displayed = tonemap_preview(image, 1.0, ToneCurve::Aces);
+        write_png(
+            &out.with_extension("png"),
+            args.width,
+            args.height,
+            &displayed,
+        )?;
+    }
+    Ok(())
+}
+
+/// What a converged image should not have: isolated pixels far brighter than their neighbours.
+pub fn fireflies(args: &ReferenceArgs, image: &[[f32; 4]]) {
+    let displayed = tonemap_preview(image, 1.0, ToneCurve::Aces);
     let (w, h) = (args.width as usize, args.height as usize);
     let [ff30, ff60, ff100] = [30.0, 60.0, 100.0]
         .map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
     println!("fireflies (pixels of the tonemapped image brighter than all 8 neighbours by > 30 / 60 / 100 of 255 levels): {ff30} / {ff60} / {ff100} of {}", w * h);
-    Ok(())
 }

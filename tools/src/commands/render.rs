@@ -150,6 +150,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut setup = Setup::new(args, frames)?;
     let (width, height, eyes) = (setup.width, setup.height, setup.eyes);
     let out_dir = prepare_output_dir(args.out)?;
+    // Every file of the run goes here first and into `args.out` only once all are written.
+    let staged = out_dir.stage()?;
     let ctx = super::open_device(args.device, args.validation)?;
     let spaces = setup.spaces(args.method, &args.profile)?;
     let grid = spaces[0].grid_size();
@@ -159,18 +161,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let in_flight = if args.debug_views {
         1
     } else {
-        args.frames_in_flight.max(1)
+        super::setup::frames_in_flight(args.frames_in_flight, frames)
     };
     let scene = GpuScene::upload(&ctx, &setup.scene)?;
     let mut renderer = Renderer::with_views(&ctx, scene, spaces, setup.settings, in_flight)?;
     let mut out = FrameWriter {
         args,
+        dir: staged.path(),
         eyes,
         width,
         height,
         debug: args
             .debug_views
-            .then(|| super::debug_views::DebugViews::new(args.out, screen, grid)),
+            .then(|| super::debug_views::DebugViews::new(staged.path(), screen, grid)),
         pass_sums: BTreeMap::new(),
         totals: FrameStats::default(),
         ldr: Vec::new(),
@@ -191,6 +194,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
     let mut recent = super::overview::RecentFrames::default();
+    crate::interrupt::running(); // a signal from here on stops after the frames in flight
     for frame in 0..frames {
         if crate::interrupt::requested().is_some() {
             break; // finish the frames in flight below; report what was rendered
@@ -236,16 +240,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         debug.finish(&renderer)?;
     }
     let overview = match args.overview && interrupted.is_none() {
-        true => Some(
-            super::overview::Overview {
+        true => {
+            let staged_overview = super::overview::Overview {
                 ctx: &ctx,
                 setup: &setup,
                 renderer: &renderer,
                 last_frame: frames as u64 - 1,
                 recent: &recent,
             }
-            .write(args.out)?,
-        ),
+            .write(staged.path())?;
+            // Where it lies once the run is moved into place.
+            Some(
+                args.out
+                    .join(staged_overview.file_name().unwrap_or_default()),
+            )
+        }
         false => None,
     };
     super::check_validation(&ctx)?;
@@ -329,8 +338,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         wall_seconds: started.elapsed().as_secs_f64(),
         interrupted: interrupted.is_some(),
     };
-    write_json(&args.out.join("report.json"), &report)?;
-    out_dir.remove_stale()?;
+    write_json(&staged.path().join(crate::output::REPORT_FILE), &report)?;
+    staged.commit(&out_dir)?;
     if let Some(interrupted) = interrupted {
         return Err(interrupted.into());
     }
@@ -363,6 +372,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 /// Writes each completed frame's images and adds its counts and timings up.
 struct FrameWriter<'a> {
     args: &'a RenderArgs<'a>,
+    /// Where the frames go (the run's staging folder).
+    dir: &'a std::path::Path,
     eyes: Eyes,
     width: u32,
     height: u32,
@@ -395,7 +406,7 @@ impl FrameWriter<'_> {
             };
             renderer.read_view_ldr(frame, view, &mut self.ldr)?;
             write_png(
-                &self.args.out.join(format!("frame_{frame:04}{suffix}.png")),
+                &self.dir.join(format!("frame_{frame:04}{suffix}.png")),
                 self.width,
                 self.height,
                 &self.ldr,
@@ -403,7 +414,7 @@ impl FrameWriter<'_> {
             if self.args.exr {
                 renderer.read_view_hdr(frame, view, &mut self.hdr)?;
                 write_exr(
-                    &self.args.out.join(format!("frame_{frame:04}{suffix}.exr")),
+                    &self.dir.join(format!("frame_{frame:04}{suffix}.exr")),
                     self.width,
                     self.height,
                     &self.hdr,

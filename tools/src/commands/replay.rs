@@ -7,17 +7,18 @@
 use super::render::RenderArgs;
 use crate::flip::{flip_image, flip_map};
 use crate::metrics::Rings;
-use crate::output::{
-    prepare_output_dir, read_exr, tonemap_preview, write_exr, write_json, write_png, write_text,
+use crate::output::{prepare_output_dir, tonemap_preview, write_json, write_png, write_text};
+use crate::replay::baseline::{
+    current_commit, Baseline, FrameRecord, Params, Store, TraceId, FORMAT, MAX_FRAMES, MAX_PIXELS,
+    MAX_REFERENCE_SPP, MAX_RINGS,
 };
-use crate::replay::baseline::{current_commit, trace_name, Baseline, FrameRecord, Params, FORMAT};
 use crate::replay::{check_frame, quality_flip, FrameCheck, FrameImages, Tolerances};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::RenderSettings;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -70,10 +71,13 @@ impl std::fmt::Display for BadInput {
 
 impl std::error::Error for BadInput {}
 
-#[derive(Serialize)]
-struct TraceResult {
+/// One trace's checks (a part of `replay.json`; a sweep job's result).
+#[derive(Serialize, Deserialize)]
+pub struct TraceResult {
     trace: String,
     baseline: String,
+    /// The folder of this run's frames under `--out` (`run_<baseline folder name>`).
+    run: String,
     baseline_commit: String,
     baseline_device: String,
     /// Settings that differ from the baseline's: (name, baseline, now).
@@ -110,22 +114,45 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     })
 }
 
-fn run_checked(args: &ReplayArgs) -> Result<()> {
+/// Checks the flags before anything renders.
+pub fn check(args: &ReplayArgs) -> Result<()> {
     if args.traces.is_empty() {
         bail!(
             "fovea replay needs at least one trace (a trace file or a gaze source such as sim:1)"
         );
     }
-    if !(1..=64).contains(&args.rings) || !(1..=1 << 16).contains(&args.reference_spp) {
-        bail!("--rings must be in 1..=64 and --reference-spp in 1..=65536");
+    if !(1..=MAX_RINGS).contains(&args.rings)
+        || !(1..=MAX_REFERENCE_SPP).contains(&args.reference_spp)
+    {
+        bail!("--rings must be in 1..={MAX_RINGS} and --reference-spp in 1..={MAX_REFERENCE_SPP}");
+    }
+    if let Some(n) = args.frames.filter(|n| !(1..=MAX_FRAMES).contains(n)) {
+        bail!("--frames {n}: a baseline holds 1..={MAX_FRAMES} frames");
+    }
+    if let (Some(w), Some(h)) = (args.render.width, args.render.height) {
+        if w as u64 * h as u64 > MAX_PIXELS {
+            bail!("--width {w} --height {h}: a baseline frame holds at most {MAX_PIXELS} pixels");
+        }
     }
     if args.render.camera_path.moves() || args.render.debug_views {
         bail!("fovea replay renders a still camera without debug views (--camera-path/--debug-views do not apply)");
     }
+    Ok(())
+}
+
+fn run_checked(args: &ReplayArgs) -> Result<()> {
+    check(args)?;
+    // Baselines first: a folder another run updates is refused before anything renders.
+    let store = if args.update {
+        Store::open_update(args.baseline)?
+    } else {
+        Store::open_read(args.baseline)?
+    };
     let _out_dir = prepare_output_dir(args.out)?;
     let mut results = Vec::new();
     for trace in args.traces {
-        let result = replay_trace(args, trace).with_context(|| format!("trace {trace}"))?;
+        let result = replay_trace(args, &store, trace, args.out)
+            .with_context(|| format!("trace {trace}"))?;
         results.push(result);
     }
     if args.update {
@@ -136,28 +163,49 @@ fn run_checked(args: &ReplayArgs) -> Result<()> {
         );
         return Ok(());
     }
+    match write_report(args, results, args.out)? {
+        Some(regression) => Err(regression.into()),
+        None => Ok(()),
+    }
+}
+
+/// Writes `out/replay.json` and `out/replay.md` from the traces' results (in the order of the
+/// traces) and prints the table; the regression, if a frame left the tolerances (naming the
+/// `replay.md` of the command's own `--out`).
+pub fn write_report(
+    args: &ReplayArgs,
+    results: Vec<TraceResult>,
+    out: &Path,
+) -> Result<Option<Regression>> {
     let failed: usize = results.iter().map(|r| r.failed_frames.len()).sum();
     let report = ReplayReport {
         tolerances: &args.tolerances,
         passed: failed == 0,
         traces: results,
     };
-    write_json(&args.out.join("replay.json"), &report)?;
+    write_json(&out.join("replay.json"), &report)?;
     let table = markdown(&report);
-    write_text(&args.out.join("replay.md"), &table)?;
+    write_text(&out.join("replay.md"), &table)?;
     print!("{table}");
-    if failed > 0 {
-        return Err(Regression {
-            failed_frames: failed,
-            report: args.out.join("replay.md"),
-        }
-        .into());
-    }
-    Ok(())
+    Ok((failed > 0).then(|| Regression {
+        failed_frames: failed,
+        report: args.out.join("replay.md"),
+    }))
 }
 
-fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
-    let name = trace_name(trace);
+/// The folder of `trace`'s frames inside the output folder (`run_` and its baseline folder's name).
+pub fn run_dir_name(trace: &str) -> Result<String> {
+    Ok(format!("run_{}", TraceId::of(trace)?.key))
+}
+
+/// Renders `trace` into `out`/[`run_dir_name`] and checks it against its baseline in `store` (or
+/// stages the baseline with `--update-baseline`).
+pub fn replay_trace(
+    args: &ReplayArgs,
+    store: &Store,
+    trace: &str,
+    out: &Path,
+) -> Result<TraceResult> {
     // The trace first: a file that is not one is named as such, not as a missing baseline.
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
     crate::gaze::GazeDriver::open(
@@ -166,13 +214,15 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         args.render.width.unwrap_or(64),
         args.render.height.unwrap_or(72),
     )?;
-    let base_dir = args.baseline.join(&name);
-    let baseline = if args.update {
+    let id = TraceId::of(trace)?;
+    let base_dir = store.folder(&id);
+    let loaded = if args.update {
         None
     } else {
-        Some(Baseline::load(&base_dir)?)
+        Some(store.load(&id)?)
     };
-    let frames = match (&baseline, args.frames) {
+    let baseline = loaded.as_ref().map(|l| &l.baseline);
+    let frames = match (baseline, args.frames) {
         (Some(b), Some(n)) if n != b.params.frames => bail!(
             "--frames {n}: the baseline {} has {} frames",
             base_dir.display(),
@@ -181,7 +231,21 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         (Some(b), _) => b.params.frames,
         (None, n) => n.unwrap_or(DEFAULT_FRAMES),
     };
-    let run_dir = args.out.join(format!("run_{name}"));
+    if let (Some(b), Some(w), Some(h)) = (baseline, args.render.width, args.render.height) {
+        if (w, h) != (b.params.width, b.params.height) {
+            bail!(
+                "--width {w} --height {h}: the baseline {} is {}×{} (replay at its size)",
+                base_dir.display(),
+                b.params.width,
+                b.params.height
+            );
+        }
+    }
+    let mut staging = match args.update {
+        true => Some(store.begin(&id)?),
+        false => None,
+    };
+    let run_dir = out.join(format!("run_{}", id.key));
     let render = RenderArgs {
         gaze: trace,
         out: &run_dir,
@@ -197,9 +261,20 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
         report["width"].as_u64().unwrap_or(0) as u32,
         report["height"].as_u64().unwrap_or(0) as u32,
     );
+    if let Some(b) = baseline {
+        // FLIP compares pixel by pixel: never a reference or frame of another size.
+        if (width, height) != (b.params.width, b.params.height) {
+            bail!(
+                "the replay rendered {width}×{height}; the baseline {} is {}×{}",
+                base_dir.display(),
+                b.params.width,
+                b.params.height
+            );
+        }
+    }
     let params = params_of(args, &render, width, height);
-    let reference = match &baseline {
-        Some(_) => read_exr(&Baseline::reference_exr(&base_dir))?.2,
+    let reference = match &loaded {
+        Some(l) => l.reference.clone(),
         None => reference_for(args, &render, width, height)?,
     };
     let ppd = pixels_per_degree(args, width)?;
@@ -209,9 +284,11 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
     let mut checks = Vec::new();
     let (mut foveal, mut foveal_true) = (Vec::new(), Vec::new());
     for k in 0..frames {
-        let ldr = image::open(run_dir.join(format!("frame_{k:04}.png")))?
-            .to_rgba8()
-            .into_raw();
+        let (_, _, ldr) = crate::decode::read_rgba8(
+            &run_dir.join(format!("frame_{k:04}.png")),
+            MAX_PIXELS,
+            Some((width, height)),
+        )?;
         // The reference displayed as the frame was: its exposure (automatic exposure moves it
         // frame by frame) and its curve.
         let exposure = report["exposure"][k as usize].as_f64().unwrap_or(1.0) as f32;
@@ -226,7 +303,7 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
             .as_str()
             .unwrap_or("")
             .to_string();
-        match &baseline {
+        match baseline {
             None => {
                 let images = FrameImages {
                     width,
@@ -243,27 +320,17 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
                     origin: origin.clone(),
                     quality_flip: quality_flip(&images, args.rings),
                 });
-                write_png(
-                    &Baseline::frame_png(&base_dir_created(&base_dir)?, k),
-                    width,
-                    height,
-                    &ldr,
-                )?;
+                if let Some(staging) = &mut staging {
+                    staging.write_frame(k, width, height, &ldr)?;
+                }
             }
             Some(b) => {
-                let base_png = Baseline::frame_png(&base_dir, k);
-                let base_ldr = image::open(&base_png)
-                    .with_context(|| format!("reading {}", base_png.display()))?
-                    .to_rgba8();
-                if base_ldr.dimensions() != (width, height) {
-                    bail!(
-                        "{}: {}×{}, the replay renders {width}×{height}",
-                        base_png.display(),
-                        base_ldr.width(),
-                        base_ldr.height()
-                    );
-                }
-                let base_ldr = base_ldr.into_raw();
+                // Checked when loaded; read again, its size and SHA-256 checked again.
+                let base_ldr = loaded
+                    .as_ref()
+                    .map(|l| l.frame(k))
+                    .transpose()?
+                    .unwrap_or_default();
                 let images = FrameImages {
                     width,
                     height,
@@ -303,32 +370,29 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
             }
         }
     }
-    if baseline.is_none() {
-        write_exr(
-            &Baseline::reference_exr(&base_dir),
-            width,
-            height,
-            &reference,
-        )?;
+    if let Some(staging) = staging {
         let device = report["device"].as_str().unwrap_or("").to_string();
         let new = Baseline {
             format: FORMAT.into(),
             trace: trace.into(),
+            trace_sha256: id.sha256.clone(),
             commit: current_commit(),
             device,
             params: params.clone(),
             frames: records,
             passes: passes.clone(),
+            files: Vec::new(),
         };
-        write_json(&base_dir.join("baseline.json"), &new)?;
+        staging.commit(new, width, height, &reference)?;
     }
-    let b = baseline.as_ref();
+    let b = baseline;
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     Ok(TraceResult {
         foveal_flip: mean(&foveal),
         foveal_flip_true_gaze: mean(&foveal_true),
         trace: trace.into(),
         baseline: base_dir.display().to_string(),
+        run: format!("run_{}", id.key),
         baseline_commit: b.map(|b| b.commit.clone()).unwrap_or_default(),
         baseline_device: b.map(|b| b.device.clone()).unwrap_or_default(),
         param_changes: b
@@ -351,11 +415,6 @@ fn replay_trace(args: &ReplayArgs, trace: &str) -> Result<TraceResult> {
             })
             .unwrap_or_default(),
     })
-}
-
-fn base_dir_created(dir: &Path) -> Result<std::path::PathBuf> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    Ok(dir.to_path_buf())
 }
 
 fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Params {
@@ -504,7 +563,7 @@ fn markdown(r: &ReplayReport) -> String {
                     gaze
                 );
             }
-            s += &format!("\nImages of failing frames: `run_{}/frame_NNNN.png` (now), `_baseline.png`, `_flip.png` (FLIP map).\n\n", trace_name(&t.trace));
+            s += &format!("\nImages of failing frames: `{}/frame_NNNN.png` (now), `_baseline.png`, `_flip.png` (FLIP map).\n\n", t.run);
         }
         if let (Some(rendered), Some(seen)) = (t.foveal_flip, t.foveal_flip_true_gaze) {
             s += &format!(

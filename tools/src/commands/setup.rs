@@ -306,8 +306,34 @@ pub fn check_common(args: &RenderArgs) -> Result<()> {
     if !(args.scale > 0.0 && args.scale <= 4.0) {
         bail!("--scale {} must be in (0, 4]", args.scale);
     }
+    if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&args.frames_in_flight) {
+        bail!(
+            "--frames-in-flight {} must be in 1..={MAX_FRAMES_IN_FLIGHT} (each frame in flight holds its own images and read-back buffers)",
+            args.frames_in_flight
+        );
+    }
+    for (flag, side) in [("--width", args.width), ("--height", args.height)] {
+        if let Some(side) = side.filter(|&s| s > MAX_RENDER_SIDE) {
+            bail!("{flag} {side} must be at most {MAX_RENDER_SIDE} pixels (the largest image side Vulkan devices promise)");
+        }
+    }
     method(args.method)?;
     check_settings(args.max_depth, &args.exposure)
+}
+
+/// Most frames kept on the GPU at once (`--frames-in-flight`); a run of fewer frames keeps that
+/// many. Past three the CPU only waits longer for the first image.
+pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
+/// The largest `--width` / `--height` (also `fovea reference`): the `maxImageDimension2D` every
+/// desktop Vulkan device offers.
+pub const MAX_RENDER_SIDE: u32 = 16384;
+
+/// Frames in flight for a run of `frames` frames: `--frames-in-flight` (checked by
+/// [`check_common`]), never more than the frames rendered.
+pub fn frames_in_flight(requested: usize, frames: u32) -> usize {
+    requested
+        .clamp(1, MAX_FRAMES_IN_FLIGHT)
+        .min(frames.max(1) as usize)
 }
 
 /// A headset eye's recommended size × `--scale`, at least one pixel per axis.

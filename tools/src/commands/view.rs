@@ -41,6 +41,8 @@ pub struct ViewArgs<'a> {
     /// `None`: run until the window closes.
     pub frames: Option<u32>,
     pub screenshot: Option<&'a Path>,
+    /// `--force`: the screenshot may replace an existing file.
+    pub force: bool,
     pub present_mode: &'a str,
     /// Gaze from the mouse (no `--gaze` given).
     pub mouse_gaze: bool,
@@ -69,6 +71,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if args.debug_view == DebugView::StereoDiff && args.render.eyes != Eyes::Both {
         bail!("--debug-view stereo-diff compares the eyes: it needs --eyes both");
     }
+    if let Some(path) = args.screenshot {
+        // Before the window opens: an existing file is not replaced without --force.
+        crate::output::check_new_file(path, args.force)
+            .with_context(|| format!("--screenshot {}", path.display()))?;
+    }
     let setup = Setup::new(&args.render, args.frames.unwrap_or(u32::MAX))?;
     let event_loop = EventLoop::new()
         .context("opening the display (X11 or Wayland; is DISPLAY or WAYLAND_DISPLAY set?)")?;
@@ -88,7 +95,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         scene,
         spaces,
         setup.settings,
-        args.render.frames_in_flight.max(1),
+        super::setup::frames_in_flight(
+            args.render.frames_in_flight,
+            args.frames.unwrap_or(u32::MAX),
+        ),
     )?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Viewer {
@@ -486,7 +496,8 @@ impl Viewer<'_> {
                 return Ok(());
             }
             Key::Character("m") => self.method = next(&method_names(), &self.method),
-            Key::Character("d") => self.denoiser = next(DENOISERS, &self.denoiser),
+            // `n` for the noise filter: `d` moves the free camera right.
+            Key::Character("n") => self.denoiser = next(DENOISERS, &self.denoiser),
             Key::Character("t") => self.taa = next(TAAS, &self.taa),
             Key::Character("f") => {
                 self.frozen = !self.frozen;

@@ -41,6 +41,8 @@ pub struct XrArgs<'a> {
     pub gaze: Option<&'a str>,
     pub record: Option<&'a Path>,
     pub screenshot: Option<&'a Path>,
+    /// `--force`: the screenshot may replace an existing file.
+    pub force: bool,
     /// The runtime space the scene camera is placed in (`--reference-space`).
     pub reference_space: ReferenceSpace,
 }
@@ -151,6 +153,10 @@ pub fn run(args: &XrArgs) -> Result<()> {
     }
     if args.screenshot.is_some() && args.frames.is_none() {
         bail!("--screenshot needs --frames N (the screenshot is of the last rendered frame)");
+    }
+    if let Some(path) = args.screenshot {
+        crate::output::check_new_file(path, args.force)
+            .with_context(|| format!("--screenshot {}", path.display()))?;
     }
     if args.frames == Some(0) {
         bail!("--frames must be at least 1");
@@ -291,7 +297,7 @@ impl<'a> XrRun<'a> {
             GpuScene::upload(&ctx, scene)?,
             spaces,
             settings,
-            r.frames_in_flight.max(1),
+            super::setup::frames_in_flight(r.frames_in_flight, args.frames.unwrap_or(u32::MAX)),
         )?;
         let screenshot = match args.screenshot {
             Some(_) => Some(Buffer::new(
@@ -333,6 +339,7 @@ impl<'a> XrRun<'a> {
     /// Runs frames until the session ends; returns why it ended.
     fn frame_loop(&mut self) -> Result<SessionEnd> {
         let exit = self.owner.exit_handle();
+        crate::interrupt::running(); // a signal from here on ends the session cleanly
         loop {
             let done = self.args.frames.is_some_and(|n| self.tally.rendered >= n);
             if done || crate::interrupt::requested().is_some() {

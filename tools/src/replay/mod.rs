@@ -8,7 +8,7 @@ pub mod baseline;
 use crate::metrics::Rings;
 use baseline::FrameRecord;
 use glam::Vec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What counts as a regression (documented in docs/guide/replay.md; flags override).
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -37,7 +37,7 @@ impl Default for Tolerances {
     }
 }
 
-#[derive(Serialize, Clone, Debug)]
+#[derive(Serialize, Deserialize, Clone, Debug)]
 pub struct RingChange {
     pub ring: usize,
     pub flip: Option<f64>,
@@ -45,7 +45,7 @@ pub struct RingChange {
     pub changed: bool,
 }
 
-#[derive(Serialize, Clone, Debug)]
+#[derive(Serialize, Deserialize, Clone, Debug)]
 pub struct RingQuality {
     pub ring: usize,
     pub baseline: Option<f64>,
@@ -54,7 +54,7 @@ pub struct RingQuality {
     pub regressed: bool,
 }
 
-#[derive(Serialize, Clone, Debug)]
+#[derive(Serialize, Deserialize, Clone, Debug)]
 pub struct FrameCheck {
     pub frame: u32,
     pub change: Vec<RingChange>,
