@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
+use fovea_renderer::frame::StereoNoise;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_tools::commands;
@@ -105,6 +106,13 @@ struct SceneFlags {
     /// log-polar and composite buffers and random acuity place samples there).
     #[arg(long)]
     offscreen_samples: Option<String>,
+    /// How the two eyes' random numbers relate in a stereo run (docs/design/random-numbers.md):
+    /// screen (the default: texel (x, y) of both eyes draws the same numbers), independent (each
+    /// eye its own sequence) or surface (the path after the primary hit drawn from the hit's world position at
+    /// the sample's footprint: the noise lies on the surfaces). `fovea quality` takes a
+    /// comma-separated list and renders each.
+    #[arg(long)]
+    stereo_noise: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
     /// vertices' glossy lobes are widened so sunlight focused through them stops making
     /// fireflies; biased, 0 = off (the unbiased estimator).
@@ -351,6 +359,7 @@ impl RenderOpts {
             texture_lod: self.look.texture_lod.clone(),
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
+            stereo_noise: self.look.stereo_noise.clone(),
             gaze_timing: self.latency.timing()?,
         })
     }
@@ -386,6 +395,11 @@ struct QualityFlags {
     /// still and/or moving (the scene's default camera path).
     #[arg(long, value_delimiter = ',', default_value = "still,moving")]
     cameras: Vec<String>,
+    /// left, or both: every run renders both eyes (the headset's eye offsets), each eye is
+    /// judged against its own reference, and the binocular consistency measure is added
+    /// (the right eye warped into the left through the converged depth).
+    #[arg(long, default_value = "left")]
+    eyes: String,
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
     /// Equal-width rings from the gaze out to the farthest corner.
@@ -515,7 +529,9 @@ enum Command {
         #[arg(long, default_value = "fifo")]
         present_mode: String,
         /// The debug view shown first: off, grid (the sampling grid as traced), density (samples
-        /// per pixel) or rings (eccentricity rings at 5, 10, 20, 30, 40°); key v cycles them.
+        /// per pixel), rings (eccentricity rings at 5, 10, 20, 30, 40°) or stereo-diff (with
+        /// --eyes both: each eye's binocular difference as a heat map, the other eye warped into
+        /// it through the scene's depth); key v cycles them.
         #[arg(long, default_value = "off")]
         debug_view: String,
         #[command(flatten)]
@@ -1175,6 +1191,7 @@ fn with_quality_args(
         denoisers,
         taa,
         cameras,
+        eyes,
         reference_spp,
         rings,
         seed,
@@ -1203,6 +1220,13 @@ fn with_quality_args(
         .iter()
         .map(|s| s.to_string())
         .collect();
+    let stereo_noises = match &look.stereo_noise {
+        Some(list) => list
+            .split(',')
+            .map(|n| StereoNoise::parse(n.trim()).context("--stereo-noise"))
+            .collect::<Result<Vec<_>>>()?,
+        None => Vec::new(),
+    };
     run(&commands::quality::QualityArgs {
         scene: &scene,
         width,
@@ -1223,6 +1247,8 @@ fn with_quality_args(
         rings,
         seed,
         profile,
+        eyes: commands::setup::Eyes::parse(&eyes)?,
+        stereo_noises: &stereo_noises,
         camera: &look.camera()?,
         out: &out,
         device: device.device.as_deref(),

@@ -10,7 +10,10 @@
 
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::frame::{
+    OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION, DEFAULT_SURFACE_CELL,
+    SURFACE_CELL_RANGE,
+};
 use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
 use fovea_renderer::passes::taa::TaaSettings;
 use fovea_renderer::sampling::{
@@ -47,6 +50,11 @@ pub struct RenderProfile {
     pub path_regularisation: Option<f32>,
     /// `[trace] offscreen`: samples far off the screen culled (the default) or traced.
     pub offscreen_samples: OffscreenSamples,
+    /// `[trace] stereo_noise`: how the two eyes' random numbers relate (`--stereo-noise`).
+    pub stereo_noise: StereoNoise,
+    /// `[trace] surface_cell`: the surface noise's cell edge in sample footprints
+    /// (`RenderSettings::surface_cell`); `None`: the engine's default.
+    pub surface_cell: Option<f32>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -152,6 +160,8 @@ impl<'de> DeserializeSeed<'de> for DenoiserSection<'_> {
 #[serde(deny_unknown_fields)]
 struct TraceSection {
     offscreen: Option<String>,
+    stereo_noise: Option<String>,
+    surface_cell: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -243,6 +253,8 @@ pub struct ProfileOverrides {
     pub path_regularisation: Option<f32>,
     /// `--offscreen-samples`.
     pub offscreen_samples: Option<String>,
+    /// `--stereo-noise`.
+    pub stereo_noise: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -465,9 +477,24 @@ impl RenderProfile {
             profile.texture_lod =
                 TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
-        if let Some(mode) = file.trace.and_then(|t| t.offscreen) {
+        let trace = file.trace.unwrap_or_default();
+        if let Some(mode) = trace.offscreen {
             profile.offscreen_samples = OffscreenSamples::parse(&mode)
                 .with_context(|| format!("{}.offscreen", at("trace")))?;
+        }
+        if let Some(mode) = trace.stereo_noise {
+            profile.stereo_noise = StereoNoise::parse(&mode)
+                .with_context(|| format!("{}.stereo_noise", at("trace")))?;
+        }
+        if let Some(cell) = trace.surface_cell {
+            let (lo, hi) = SURFACE_CELL_RANGE;
+            if !(lo..=hi).contains(&cell) {
+                bail!(
+                    "{}.surface_cell = {cell}: must be in [{lo}, {hi}] sample footprints",
+                    at("trace")
+                );
+            }
+            profile.surface_cell = Some(cell);
         }
         if let Some(strength) = file.path.and_then(|p| p.regularisation) {
             profile.path_regularisation = Some(check_path_regularisation(
@@ -530,10 +557,18 @@ impl RenderProfile {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
         }
+        if let Some(mode) = &o.stereo_noise {
+            self.stereo_noise = StereoNoise::parse(mode).context("--stereo-noise")?;
+        }
         if o.gaze_timing.enabled() {
             self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
+    }
+
+    /// The surface noise's cell the engine runs with (footprints).
+    pub fn surface_cell(&self) -> f32 {
+        self.surface_cell.unwrap_or(DEFAULT_SURFACE_CELL)
     }
 
     /// The strength the engine runs with.
@@ -735,6 +770,8 @@ mod tests {
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
+        assert_eq!(p.stereo_noise, StereoNoise::default());
+        assert_eq!(p.surface_cell(), DEFAULT_SURFACE_CELL);
         assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
@@ -1251,5 +1288,58 @@ gradient_sigma_normal = 64
             RenderProfile::default().override_with(&bad).unwrap_err()
         )
         .contains("--env-intensity"));
+    }
+
+    /// `[trace] stereo_noise` and `surface_cell` (and `--stereo-noise`) reach the profile; bad
+    /// values are refused naming the file and key (or the flag) and the accepted ones.
+    #[test]
+    fn stereo_noise_and_surface_cell_from_file_and_flag() {
+        let p = load_str(
+            "stereo.toml",
+            "[trace]\nstereo_noise = \"surface\"\nsurface_cell = 2\n",
+        )
+        .unwrap();
+        assert_eq!(p.stereo_noise, StereoNoise::Surface);
+        assert_eq!(p.surface_cell(), 2.0);
+        assert_eq!(RenderProfile::default().stereo_noise, StereoNoise::Screen);
+        assert_eq!(
+            RenderProfile::default().surface_cell(),
+            DEFAULT_SURFACE_CELL
+        );
+        let o = ProfileOverrides {
+            stereo_noise: Some("independent".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().stereo_noise,
+            StereoNoise::Independent
+        );
+        let err = format!(
+            "{:#}",
+            load_str("stereo_bad.toml", "[trace]\nstereo_noise = \"eyes\"\n").unwrap_err()
+        );
+        assert!(
+            err.contains("stereo_bad.toml")
+                && err.contains("[trace].stereo_noise")
+                && err.contains("independent, screen, surface"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str("cell_bad.toml", "[trace]\nsurface_cell = 100\n").unwrap_err()
+        );
+        assert!(
+            err.contains("cell_bad.toml") && err.contains("surface_cell = 100"),
+            "{err}"
+        );
+        let bad = ProfileOverrides {
+            stereo_noise: Some("eyes".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(err.contains("--stereo-noise"), "{err}");
     }
 }

@@ -1,7 +1,8 @@
 //! `fovea sweep` without a scheduler: a small quality sweep run job by job (as a shell loop would)
-//! merges into what one `fovea quality` process writes; a reference split into sample batches
-//! merges into the same EXR bytes as `fovea reference`; failed, killed and repeated jobs leave no
-//! partial result and never reach the merge; bad plans are refused naming the file and field.
+//! merges into what one `fovea quality` process writes (a stereo one with two stereo noises too);
+//! a reference split into sample batches merges into the same EXR bytes as `fovea reference`;
+//! failed, killed and repeated jobs leave no partial result and never reach the merge; bad plans
+//! are refused naming the file and field.
 //! Then the same through a real Slurm (`scripts/sweep-slurm`, sbatch job arrays on the one-node
 //! cluster of scripts/slurm/setup): two scenes merged equal to one process's output, and a stage
 //! cancelled mid-run (scancel) rerun cleanly. Without a cluster that test says "skipped"; with
@@ -233,6 +234,95 @@ fn a_sweep_run_job_by_job_merges_into_the_one_process_quality_output() {
     one_process.extend(["--scene", "cornell-box", "--out", &one_arg]);
     fovea_ok(&one_process);
     assert_same_quality(&one, &sweep.join("merged/cornell-box"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A stereo study: both eyes, two stereo noises, moving camera (a reference per evaluated frame
+/// and eye), 40×36, 32-spp references in one job each.
+const STEREO: &[&str] = &[
+    "quality",
+    "--width",
+    "40",
+    "--height",
+    "36",
+    "--frames",
+    "3",
+    "--eval-frames",
+    "2",
+    "--methods",
+    "cartesian",
+    "--denoisers",
+    "none",
+    "--cameras",
+    "moving",
+    "--reference-spp",
+    "32",
+    "--rings",
+    "4",
+    "--eyes",
+    "both",
+    "--stereo-noise",
+    "independent,surface",
+];
+
+#[test]
+fn a_stereo_quality_sweep_merges_into_the_one_process_output() {
+    let dir = temp_dir("stereo");
+    let sweep = dir.join("sweep");
+    let sweep_arg = sweep.to_str().unwrap().to_string();
+    let mut plan = vec![
+        "sweep",
+        "plan",
+        "--out",
+        &sweep_arg,
+        "--batches-per-job",
+        "2",
+    ];
+    plan.extend(["--scenes", "cornell-box"]);
+    plan.extend(STEREO);
+    fovea_ok(&plan);
+    let jobs = read_jobs(&sweep);
+    let (references, runs): (Vec<_>, Vec<_>) = jobs.iter().partition(|j| j["stage"] == "reference");
+    assert_eq!(references.len(), 2 * 2, "2 frames × 2 eyes: {references:?}");
+    let eyes: Vec<&str> = references
+        .iter()
+        .map(|j| j["part"]["eye"].as_str().unwrap())
+        .collect();
+    assert_eq!(eyes, ["left", "right", "left", "right"]);
+    let noises: Vec<&str> = runs
+        .iter()
+        .map(|j| j["part"]["noise"].as_str().unwrap())
+        .collect();
+    assert_eq!(noises, ["independent", "surface"]);
+    for run in &runs {
+        assert_eq!(run["after"].as_array().unwrap().len(), 4, "{run}");
+    }
+    run_stage(&sweep, "reference");
+    run_stage(&sweep, "run");
+    fovea_ok(&["sweep", "merge", &sweep_arg]);
+
+    let one = dir.join("one");
+    let one_arg = one.to_str().unwrap().to_string();
+    let mut one_process: Vec<&str> = STEREO.to_vec();
+    one_process.extend(["--scene", "cornell-box", "--out", &one_arg]);
+    fovea_ok(&one_process);
+    let merged = sweep.join("merged/cornell-box");
+    assert_same_quality(&one, &merged);
+    for name in [
+        "reference_moving_right_0002.exr",
+        "run_moving_cartesian_none_taa-off_noise-surface/frame_0002_right.png",
+        "run_moving_cartesian_none_taa-off_noise-surface/binocular_0002.png",
+    ] {
+        assert!(
+            std::fs::read(one.join(name)).unwrap() == std::fs::read(merged.join(name)).unwrap(),
+            "{name} differs"
+        );
+    }
+    let report = quality_json(&merged);
+    assert_eq!(report["eyes"], "both");
+    for run in report["runs"].as_array().unwrap() {
+        assert!(run["binocular"]["frame"]["difference"].is_f64(), "{run}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

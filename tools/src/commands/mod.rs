@@ -13,6 +13,7 @@ pub mod method_table;
 pub mod methods;
 pub mod overview;
 pub mod quality;
+mod quality_stereo;
 pub mod reference;
 pub mod render;
 pub mod render_args;

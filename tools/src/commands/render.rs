@@ -30,6 +30,11 @@ struct Report {
     path_regularisation: f32,
     /// `cull` (samples far off the screen not traced) or `trace`.
     offscreen_samples: &'static str,
+    /// How the eyes' random numbers relate: `independent`, `screen` or `surface`.
+    stereo_noise: &'static str,
+    /// `surface` noise: its cells' edge in sample footprints.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    surface_cell: Option<f32>,
     scene: String,
     headset: String,
     /// `headset` (each eye through the profile's frustum, the camera the head) or
@@ -42,6 +47,9 @@ struct Report {
     /// Gaze point per frame in the left eye's render pixels (the Cartesian method traces uniformly and only
     /// records it; foveated methods centre their sampling on it).
     gaze: Vec<[f32; 2]>,
+    /// A run of both eyes: the same gaze per frame in the right eye's render pixels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_right: Option<Vec<[f32; 2]>>,
     /// Per frame: live, held or centre (`fovea replay` checks the playback frame by frame).
     gaze_origin: Vec<&'static str>,
     /// Frames whose gaze was live / held after a lost sample / the view centre.
@@ -179,6 +187,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     )?);
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
+    let mut gaze_right = Vec::with_capacity(frames as usize);
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut outside_view = 0u32;
@@ -192,6 +201,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         let (input, frame_gaze) = setup.frame_input(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
+        gaze_right.push(frame_gaze.pixels[fovea_hal::Eye::Right.index()].to_array());
         gaze_origin.push(frame_gaze.origin.name());
         origins[match frame_gaze.origin {
             GazeOrigin::Live => 0,
@@ -270,6 +280,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         texture_lod: args.profile.texture_lod.name(),
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples.name(),
+        stereo_noise: args.profile.stereo_noise.name(),
+        surface_cell: (args.profile.stereo_noise == fovea_renderer::frame::StereoNoise::Surface)
+            .then(|| args.profile.surface_cell()),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         projection: args.camera.projection.name(),
@@ -277,6 +290,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),
         gaze: gaze_points,
+        gaze_right: (eyes == Eyes::Both).then_some(gaze_right),
         gaze_origin,
         gaze_live: origins[0],
         gaze_held: origins[1],

@@ -359,6 +359,8 @@ pub fn render_settings(
         texture_lod: args.profile.texture_lod,
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples,
+        stereo_noise: args.profile.stereo_noise,
+        surface_cell: args.profile.surface_cell(),
         ..Default::default()
     }
 }
