@@ -4,6 +4,7 @@
 //! Cartesian comparison lives in `bench_vp.rs`, the real-time loop (frames in flight, stereo vs
 //! two mono renders, host CPU time) in `bench_loop.rs`.
 
+use super::bench_rays::{primary_rays, timed_trace};
 use anyhow::{bail, Result};
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -350,13 +351,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let bvh = &variants[0].2;
         for &size in args.vp_sizes {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
-            report.visual_polar.push(super::bench_vp::measure(
-                &ctx,
+            let scene = super::bench_vp::VpBenchScene {
+                ctx: &ctx,
                 name,
-                &make_scene,
-                &mut caster,
+                make_scene: &make_scene,
+                caster: &mut caster,
                 camera,
-                args.camera_path,
+                camera_path: args.camera_path,
+            };
+            report.visual_polar.push(super::bench_vp::measure(
+                scene,
                 size,
                 args.vp_gaze,
                 args.frames,
@@ -408,26 +412,6 @@ fn load_average() -> String {
         .unwrap_or_else(|| "?".into())
 }
 
-/// Runs of each ray set after the untimed warm-up; the median GPU time is reported.
-const TIMED_RUNS: usize = 5;
-
-/// Traces `rays` once untimed (warm-up), then `TIMED_RUNS` times; returns the hits and the
-/// median GPU milliseconds.
-pub(crate) fn timed_trace(
-    caster: &mut RayCaster,
-    gpu: &GpuScene,
-    rays: &[RayGpu],
-    any_hit: bool,
-) -> Result<(Vec<HitGpu>, f64)> {
-    let (hits, _) = caster.trace(gpu, rays, any_hit)?;
-    let mut ms = Vec::with_capacity(TIMED_RUNS);
-    for _ in 0..TIMED_RUNS {
-        ms.push(caster.trace(gpu, rays, any_hit)?.1);
-    }
-    ms.sort_by(f64::total_cmp);
-    Ok((hits, ms[TIMED_RUNS / 2]))
-}
-
 /// Frames of primary rays the ray-rate figures take along a camera path: its start, its end and
 /// evenly between (the rates then describe the path's views, not one of them).
 pub const PATH_RAY_POSES: usize = 4;
@@ -446,25 +430,6 @@ fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) 
             )
         })
         .collect()
-}
-
-pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
-    let origin = pose.world_from_view.w_axis.truncate();
-    let t = pose.fov_tan;
-    let mut rays = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let fx = (x as f32 + 0.5) / w as f32;
-            let fy = (y as f32 + 0.5) / h as f32;
-            let view = Vec3::new(t.x + fx * (t.y - t.x), t.w + fy * (t.z - t.w), -1.0);
-            let dir = pose.world_from_view.transform_vector3(view).normalize();
-            rays.push(RayGpu {
-                origin_tmin: origin.extend(0.0),
-                direction_tmax: dir.extend(1e30),
-            });
-        }
-    }
-    rays
 }
 
 /// `DIR/rays_SCENE-WxH.{triangles,primary,indirect}.bin`: little-endian f32, 9 per triangle

@@ -2,6 +2,7 @@ pub mod bench;
 mod bench_counters;
 pub mod bench_headsets;
 mod bench_loop;
+mod bench_rays;
 pub mod bench_vp;
 pub mod debug_views;
 pub mod eval;
