@@ -1,10 +1,15 @@
 //! GPU BVH traversal (shaders/common/bvh.glsl) equals the CPU brute-force watertight intersector
-//! on thousands of random rays over several meshes: hit/miss, distance and primitive.
+//! on thousands of random rays over several meshes: hit/miss, distance, primitive and
+//! barycentrics, for both traversals (the CPU driver's 4-wide one and the GPU's compressed 8-wide
+//! one); and the counting kernel counts what the CPU twin of each traversal reads.
 
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::layouts::RayGpu;
-use fovea_renderer::passes::raycast::RayCaster;
-use fovea_scene::bvh::{Bvh, BvhBuilder};
+use fovea_renderer::passes::raycast::{RayCaster, RayCounts};
+use fovea_renderer::traversal::Traversal;
+use fovea_scene::bvh::compressed::Bvh8;
+use fovea_scene::bvh::wide::Bvh4;
+use fovea_scene::bvh::{Bvh, BvhBuilder, TraceState};
 use fovea_scene::intersect::{brute_force, Ray};
 use fovea_scene::{Material, Scene, Triangle, Vertex};
 use fovea_tests::{assert_clean, gpu};
@@ -158,7 +163,7 @@ fn bunny() -> Option<Vec<[Vec3; 3]>> {
 }
 
 /// Both builders' trees: the binned one (one leaf per triangle) and the SBVH (triangles split
-/// across leaves, leaf boxes holding only their clipped parts).
+/// across leaves, leaf boxes holding only their clipped parts); each traversal.
 fn check_mesh(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool) {
     for builder in [
         BvhBuilder::BINNED,
@@ -167,14 +172,52 @@ fn check_mesh(name: &str, tris: &[[Vec3; 3]], rays: &[Ray], any_hit: bool) {
             ..BvhBuilder::BINNED
         },
     ] {
-        check_mesh_with(
-            &format!("{name} ({})", builder.name()),
-            tris,
-            rays,
-            any_hit,
-            builder,
-        );
+        for traversal in Traversal::ALL {
+            check_mesh_with(
+                &format!(
+                    "{name} ({}, {} traversal)",
+                    builder.name(),
+                    traversal.name()
+                ),
+                tris,
+                rays,
+                any_hit,
+                builder,
+                traversal,
+            );
+        }
     }
+}
+
+/// What the CPU twin of `traversal` reads for each ray (closest or any hit, `0 < t < 1e30`).
+fn cpu_counts(
+    traversal: Traversal,
+    bvh: &Bvh,
+    tris: &[[Vec3; 3]],
+    rays: &[Ray],
+    any_hit: bool,
+) -> Vec<RayCounts> {
+    let (four, eight) = match traversal {
+        Traversal::CpuDriver => (Some(Bvh4::from_binary(bvh)), None),
+        Traversal::Gpu => (None, Some(Bvh8::from_binary(bvh, tris))),
+    };
+    rays.iter()
+        .map(|ray| {
+            let mut state = TraceState::default();
+            if let Some(four) = &four {
+                four.intersect_into(tris, ray, 1e30, any_hit, 0, &mut state);
+            }
+            if let Some(eight) = &eight {
+                eight.intersect_into(tris, ray, 1e30, any_hit, 0, &mut state);
+            }
+            RayCounts {
+                nodes: state.counts.nodes as u32,
+                triangles: state.counts.triangles as u32,
+                alpha_tests: 0,
+                bytes: state.counts.bytes as u32,
+            }
+        })
+        .collect()
 }
 
 fn check_mesh_with(
@@ -183,12 +226,14 @@ fn check_mesh_with(
     rays: &[Ray],
     any_hit: bool,
     builder: BvhBuilder,
+    traversal: Traversal,
 ) {
     let ctx = gpu();
     let scene = scene_from_triangles(tris);
     let positions = scene.triangle_positions();
     let bvh = Bvh::build_with(&positions, builder);
-    let gpu_scene = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh).unwrap();
+    let gpu_scene = GpuScene::upload_for(&ctx, &scene, &positions, &bvh, traversal).unwrap();
+    assert_eq!(gpu_scene.traversal, traversal);
     let mut caster = RayCaster::new(&ctx).unwrap();
     let gpu_rays: Vec<RayGpu> = rays
         .iter()
@@ -198,6 +243,26 @@ fn check_mesh_with(
         })
         .collect();
     let (hits, _) = caster.trace(&gpu_scene, &gpu_rays, any_hit).unwrap();
+    // The counting kernel finds the same hits and counts what the CPU twin reads, ray by ray
+    // (the same algorithm on the same floats; a ray may differ where the device's arithmetic
+    // rounds one box test the other way).
+    let (counted_hits, counts) = caster
+        .trace_counted(&gpu_scene, &gpu_rays, any_hit)
+        .unwrap();
+    assert_eq!(counted_hits, hits, "{name}: the counting kernel's hits");
+    let expected = cpu_counts(traversal, &bvh, &positions, rays, any_hit);
+    let differ = counts.iter().zip(&expected).filter(|(a, b)| a != b).count();
+    assert!(
+        differ * 200 <= rays.len(),
+        "{name}: {differ} of {} rays count other reads than the CPU twin, e.g. {:?}",
+        rays.len(),
+        counts.iter().zip(&expected).find(|(a, b)| a != b)
+    );
+    let total = |c: &[RayCounts]| c.iter().map(|c| u64::from(c.nodes)).sum::<u64>();
+    assert!(
+        total(&counts) > rays.len() as u64,
+        "{name}: nodes were counted"
+    );
     let mut hit_count = 0;
     for (i, (ray, gpu_hit)) in rays.iter().zip(&hits).enumerate() {
         let cpu = brute_force(tris, ray, 1e30, false);
@@ -224,6 +289,15 @@ fn check_mesh_with(
                     h.t
                 );
                 let id = gpu_hit.triangle.x;
+                if id == h.triangle {
+                    let (u, v) = (gpu_hit.t_u_v.y, gpu_hit.t_u_v.z);
+                    assert!(
+                        (u - h.u).abs() <= 1e-5 && (v - h.v).abs() <= 1e-5,
+                        "{name} ray {i}: barycentrics ({u}, {v}) vs CPU ({}, {})",
+                        h.u,
+                        h.v
+                    );
+                }
                 if id != h.triangle {
                     // Equal distances may pick either triangle: the GPU's must be hit at that t too.
                     let other = brute_force(&tris[id as usize..id as usize + 1], ray, 1e30, false);

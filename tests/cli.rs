@@ -479,6 +479,9 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         camera_path: None,
         out: &out,
         dump_rays: false,
+        loop_scenes: &[],
+        loop_headsets: &[],
+        traversals: &[],
         device: None,
         validation: true,
     };
@@ -595,6 +598,116 @@ fn bench_loop_section_reports_each_runs_submits_waits_and_bytes() {
         l["in_flight_2_vs_1_fps"].as_f64().unwrap(),
         fps("stereo_in_flight_2") / fps("stereo_in_flight_1")
     ));
+}
+
+/// `fovea bench`'s headset loop alone (`--loop-scenes cornell-box --loop-headsets 64x72`, 2 timed
+/// frames per repeat): report.json's `headset_loop` holds one entry with the three methods, each a
+/// stereo renderer with 2 frames in flight running the passes of its method and denoiser, and the
+/// VP / Cartesian ratios of those runs. Times are only checked to be there.
+#[test]
+fn bench_headset_loop_reports_each_method_per_scene_and_size() {
+    use fovea_tools::commands::bench::{run as bench, BenchArgs};
+    use fovea_tools::commands::bench_headsets::LoopHeadset;
+    let out = temp_dir("bench-headset-loop");
+    let scenes = ["cornell-box".to_string()];
+    let headsets = LoopHeadset::parse_list("64x72").unwrap();
+    let args = |loop_frames| BenchArgs {
+        scenes: &[],
+        builders: &[fovea_renderer::scene::bvh::BvhBuilder::DEFAULT],
+        flatten: false,
+        sizes: &[],
+        vp_sizes: &[],
+        vp_gaze: fovea_tools::commands::bench::CENTRED_GAZE,
+        frames: 1,
+        loop_size: None,
+        loop_frames,
+        camera_path: None,
+        out: &out,
+        dump_rays: false,
+        loop_scenes: &scenes,
+        loop_headsets: &headsets,
+        traversals: &[],
+        device: None,
+        validation: true,
+    };
+    let err = bench(&args(1)).unwrap_err().to_string();
+    assert!(err.contains("--loop-frames"), "{err}");
+    bench(&args(2)).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert!(
+        report["loop"].is_null(),
+        "the real-time loop was not skipped"
+    );
+    let entries = report["headset_loop"].as_array().unwrap();
+    assert_eq!(entries.len(), 1);
+    let h = &entries[0];
+    for (key, value) in [
+        ("scene", "cornell-box"),
+        ("headset", "fove0"),
+        ("camera", "orbit"),
+        ("gaze", "sim:1"),
+    ] {
+        assert_eq!(h[key], value, "{key}");
+    }
+    assert!(["cpu-driver", "gpu"].contains(&h["traversal"].as_str().unwrap()));
+    assert_eq!(
+        (
+            h["width"].as_u64(),
+            h["height"].as_u64(),
+            h["eyes"].as_u64()
+        ),
+        (Some(64), Some(72), Some(2))
+    );
+    assert_eq!(
+        (h["frames"].as_u64(), h["repeats"].as_u64()),
+        (Some(2), Some(2))
+    );
+    let runs = h["runs"].as_array().unwrap();
+    let names: Vec<(&str, &str)> = runs
+        .iter()
+        .map(|r| {
+            (
+                r["method"].as_str().unwrap(),
+                r["denoiser"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        names,
+        [("vp", "svgf"), ("vp", "asvgf"), ("cartesian", "svgf")]
+    );
+    for (run, (method, denoiser)) in runs.iter().zip(names) {
+        let name = format!("{method} + {denoiser}");
+        assert_eq!(run["timed_frames"], 4, "{name}");
+        assert_eq!(run["renderers"], 1, "{name}");
+        assert_eq!(run["views_per_renderer"], 2, "{name}");
+        assert_eq!(run["frames_in_flight"], 2, "{name}");
+        assert_eq!(run["submits_per_frame"], 1.0, "{name}");
+        for key in ["frames_per_second", "wall_ms_per_frame", "gpu_ms_per_frame"] {
+            let v = run[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{name}.{key} missing"));
+            assert!(v.is_finite() && v > 0.0, "{name}.{key} = {v}");
+        }
+        let passes = run["passes_ms"].as_object().unwrap();
+        let has = |pass: &str| passes.contains_key(pass);
+        assert!(
+            has("trace") && has("svgf_atrous"),
+            "{name}: {:?}",
+            passes.keys()
+        );
+        assert_eq!(has("asvgf_gradient"), denoiser == "asvgf", "{name}");
+        // Only the VP frames go back to the screen through φ-mips and the remap.
+        assert_eq!(has("mip_phi") && has("remap"), method == "vp", "{name}");
+    }
+    let ratio = |key: &str, of: &str| {
+        let r = h[key].as_f64().unwrap();
+        let expected = runs[0][of].as_f64().unwrap() / runs[2][of].as_f64().unwrap();
+        assert!((r / expected - 1.0).abs() < 1e-9, "{key} {r} vs {expected}");
+    };
+    ratio("vp_vs_cartesian_frame_time", "wall_ms_per_frame");
+    ratio("vp_vs_cartesian_gpu_ms", "gpu_ms_per_frame");
 }
 
 /// Values that would render a black, flat or meaningless frame without a word are refused
@@ -907,6 +1020,9 @@ fn bench_vp_frames_follow_a_camera_path() {
         camera_path: Some(&keys),
         out: &out,
         dump_rays: true,
+        loop_scenes: &[],
+        loop_headsets: &[],
+        traversals: &[],
         device: None,
         validation: true,
     };

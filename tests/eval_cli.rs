@@ -258,6 +258,8 @@ fn quality_args<'a>(
         rings: 4,
         seed: 1,
         profile: Default::default(),
+        eyes: fovea_tools::commands::setup::Eyes::Left,
+        stereo_noises: &[],
         camera: &fovea_tools::look::NO_CAMERA_FLAGS,
         out,
         device: None,
@@ -334,6 +336,70 @@ fn quality_command_measures_every_combination() {
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let err = format!("{:#}", run(&args(&denoisers)).unwrap_err());
     assert!(err.contains("notes.txt"), "{err}");
+}
+
+/// `fovea quality --eyes both --stereo-noise independent,surface`: each run renders both eyes,
+/// judges each against its own reference and adds the binocular measure (per ring, beside the
+/// converged pair's, with the flicker of the eyes' difference) to quality.json and quality.md.
+#[test]
+fn quality_of_both_eyes_adds_the_binocular_measure() {
+    use fovea_renderer::frame::StereoNoise;
+    use fovea_tools::commands::quality::{run, QualityArgs};
+    use fovea_tools::commands::setup::Eyes;
+    let out = temp_dir("quality-stereo");
+    let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (methods, denoisers, taa, cameras) = (
+        strings(&["cartesian"]),
+        strings(&["svgf"]),
+        strings(&["off"]),
+        strings(&["still", "moving"]),
+    );
+    let noises = [StereoNoise::Independent, StereoNoise::Surface];
+    run(&QualityArgs {
+        eyes: Eyes::Both,
+        stereo_noises: &noises,
+        ..quality_args([&methods, &denoisers, &taa, &cameras], &out)
+    })
+    .unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("quality.json")).unwrap()).unwrap();
+    assert_eq!(report["eyes"], "both");
+    let runs = report["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2 * 2, "{runs:?}");
+    for r in runs {
+        let b = &r["binocular"];
+        let finite = |v: &serde_json::Value| v.as_f64().is_some_and(|x| x.is_finite() && x >= 0.0);
+        assert!(finite(&b["frame"]["difference"]), "{b}");
+        assert!(finite(&b["frame"]["reference_difference"]), "{b}");
+        assert!(finite(&b["frame"]["difference_flicker"]), "{b}");
+        let seen = b["frame"]["visible_in_both"].as_f64().unwrap();
+        assert!(seen > 0.5 && seen <= 1.0, "{b}");
+        assert_eq!(b["rings"].as_array().unwrap().len(), 4);
+        let right = &b["right_eye"];
+        assert!(
+            finite(&right["frame_flip"]) && finite(&right["frame_flicker"]),
+            "{b}"
+        );
+        assert_eq!(right["rings"].as_array().unwrap().len(), 4);
+    }
+    let noise_of = |r: &serde_json::Value| r["stereo_noise"].as_str().unwrap().to_string();
+    assert_eq!(noise_of(&runs[0]), "independent");
+    assert_eq!(noise_of(&runs[1]), "surface");
+    for name in [
+        "reference_still_left_0000.exr",
+        "reference_still_right_0000.exr",
+        "reference_moving_right_0002.exr",
+        "run_moving_cartesian_svgf_taa-off_noise-surface/frame_0002_right.png",
+    ] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
+    assert!(
+        table.contains("Binocular difference")
+            && table.contains("| cartesian + svgf, off, surface |")
+            && table.contains("flicker of the difference"),
+        "{table}"
+    );
 }
 
 /// `--reference-spp` and the frame size of `fovea quality` have upper bounds, checked before
@@ -451,6 +517,9 @@ fn quality_methods_all_lists_what_a_method_refuses() {
         camera_path: None,
         out: &bench_out,
         dump_rays: false,
+        loop_scenes: &[],
+        loop_headsets: &[],
+        traversals: &[],
         device: None,
         validation: true,
     })

@@ -2,7 +2,8 @@
 //! nodes (translations, a rotation, a non-uniform scale, mirroring scales) is uploaded once; the
 //! GPU's two-level traversal finds the CPU reference's hits; and it renders as the same scene
 //! with the mesh duplicated by hand (every node its own mesh, so the loader flattens all) —
-//! lit, emissive and alpha-masked. Uploaded triangle bytes grow with unique meshes only.
+//! lit, emissive and alpha-masked. Uploaded triangle bytes grow with unique meshes only. The
+//! renderer's trace kernel draws the same pictures with either BVH traversal.
 
 use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -10,13 +11,16 @@ use fovea_renderer::layouts::RayGpu;
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
-use fovea_scene::bvh::instanced::SceneBvh;
+use fovea_renderer::traversal::{Traversal, TraversalChoice};
+use fovea_renderer::vk::{Context, ContextOptions};
+use fovea_scene::bvh::instanced::{SceneBvh, SceneBvh8};
 use fovea_scene::bvh::BvhBuilder;
 use fovea_scene::intersect::Ray;
 use fovea_scene::Scene;
 use fovea_tests::{artifacts_dir, assert_clean, assert_pictures, gpu, rmse, Picture};
 use glam::{Quat, UVec2, Vec3};
 use serde_json::{json, Value};
+use std::sync::Arc;
 
 const SIZE: UVec2 = UVec2::new(64, 72);
 
@@ -199,7 +203,11 @@ fn pair(look: Look) -> (Scene, Scene) {
 }
 
 fn reference(scene: &Scene, spp: u32, seed: u32) -> Vec<[f32; 4]> {
-    let ctx = gpu();
+    reference_with(scene, spp, seed, gpu())
+}
+
+/// [`reference`] on `ctx`, whose traversal the trace kernel runs.
+fn reference_with(scene: &Scene, spp: u32, seed: u32, ctx: Arc<Context>) -> Vec<[f32; 4]> {
     let camera = CameraPose::from_scene_camera(scene.default_camera().unwrap(), SIZE.x, SIZE.y);
     let settings = RenderSettings {
         seed,
@@ -279,8 +287,10 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
         (157, 157, 6 * 157)
     );
     let ctx = gpu();
-    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
     let cpu = SceneBvh::build(&scene, BvhBuilder::DEFAULT);
+    let positions = scene.flat_positions();
+    let world = fovea_scene::bvh::Bvh::build(&positions);
+    let cpu8 = SceneBvh8::with_world(&scene, positions.clone(), &world, BvhBuilder::DEFAULT);
     let flat = fovea_scene::bvh::wide::Bvh4::from_binary(&fovea_scene::bvh::Bvh::build(
         &by_hand.triangle_positions(),
     ));
@@ -308,11 +318,21 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
         })
         .collect();
     let mut caster = RayCaster::new(&ctx).unwrap();
-    for any_hit in [false, true] {
+    for (traversal, any_hit) in Traversal::ALL
+        .into_iter()
+        .flat_map(|t| [(t, false), (t, true)])
+    {
+        let gpu_scene = GpuScene::upload_for(&ctx, &scene, &positions, &world, traversal).unwrap();
         let (hits, _) = caster.trace(&gpu_scene, &gpu_rays, any_hit).unwrap();
         let (mut instanced, mut differ) = (0, 0);
         for (ray, hit) in rays.iter().zip(&hits) {
             let want = cpu.intersect(ray, 1e30, any_hit);
+            // The compressed levels (the GPU traversal's twin) find the same hits.
+            let want8 = cpu8.intersect(ray, 1e30, any_hit, &mut Default::default());
+            assert_eq!(want8.is_some(), want.is_some(), "{ray:?}");
+            if !any_hit {
+                assert_eq!(want8, want, "{ray:?}");
+            }
             assert_eq!(
                 hit.t_u_v.x >= 0.0,
                 want.is_some(),
@@ -338,13 +358,16 @@ fn one_mesh_placed_five_times_is_uploaded_once_and_traced_like_the_cpu_reference
             );
             instanced += usize::from(w.triangle >= 2);
         }
-        println!("any_hit {any_hit}: {instanced} instanced hits, {differ} differ in the last bits");
+        println!(
+            "{} traversal, any_hit {any_hit}: {instanced} instanced hits, {differ} differ in the last bits",
+            traversal.name()
+        );
         assert!(
             any_hit || instanced > 1500,
             "the rays must exercise the instances: {instanced}"
         );
     }
-    drop((gpu_scene, caster));
+    drop(caster);
     assert_clean(&ctx);
 }
 
@@ -432,4 +455,59 @@ fn uploaded_triangle_bytes_grow_with_unique_meshes_not_placements() {
         few.4
     );
     assert_clean(&ctx);
+}
+
+/// The trace kernel compiled for each traversal (the context's, `--traversal`) draws the same
+/// pictures of the instanced scenes (two-level walk) and their flattened copies (one level), lit
+/// and alpha-masked: both traversals find the same hits, so every pixel agrees to float rounding
+/// in nine of ten and the whole far closer than two seeds do.
+#[test]
+fn both_traversals_render_the_same_pictures() {
+    let with = |traversal| {
+        let ctx = Context::new(&ContextOptions {
+            validation: true,
+            traversal: TraversalChoice::Forced(traversal),
+            ..Default::default()
+        })
+        .expect("Vulkan device with validation layers");
+        assert_eq!(ctx.traversal, traversal);
+        ctx
+    };
+    for look in [Look::Lit, Look::Masked] {
+        let (instanced, by_hand) = pair(look);
+        for (name, scene) in [("instanced", &instanced), ("flattened", &by_hand)] {
+            let a = reference_with(scene, 8, 1, with(Traversal::CpuDriver));
+            let b = reference_with(scene, 8, 1, with(Traversal::Gpu));
+            let noise = rmse(&a, &reference(scene, 8, 2));
+            let apart = rmse(&a, &b);
+            let close = a
+                .iter()
+                .zip(&b)
+                .filter(|(p, q)| (0..3).all(|c| (p[c] - q[c]).abs() <= 1e-3 * q[c].abs().max(1.0)))
+                .count();
+            println!(
+                "look {} {name}: rmse cpu-driver vs gpu traversal {apart:.3e}, seed noise {noise:.3e}, {close}/{} pixels equal to 1e-3",
+                look as u8,
+                a.len()
+            );
+            let pictures = (
+                Picture::hdr(SIZE.x, SIZE.y, &a),
+                Picture::hdr(SIZE.x, SIZE.y, &b),
+            );
+            let label = format!(
+                "look {} {name}, cpu-driver against gpu traversal",
+                look as u8
+            );
+            assert_pictures(
+                apart < noise / 20.0 && close * 10 >= a.len() * 9,
+                &label,
+                &pictures.0,
+                &pictures.1,
+                format_args!(
+                    "{apart} apart, two seeds {noise}; {close} of {} pixels agree",
+                    a.len()
+                ),
+            );
+        }
+    }
 }

@@ -245,7 +245,7 @@ fn stereo_noise_independent_vs_shared() {
         r.wait_frame(f).unwrap();
         (ldr(&r, f, 0), ldr(&r, f, 1))
     };
-    let (left, right) = pair(StereoNoise::Shared, 0.0, 0);
+    let (left, right) = pair(StereoNoise::Screen, 0.0, 0);
     assert_pictures_equal(
         "shared seeds at one position give one image (right eye against left)",
         &Picture::rgba8(SCREEN.x, SCREEN.y, &right),
@@ -261,7 +261,7 @@ fn stereo_noise_independent_vs_shared() {
         "independent noise differs between the eyes: RMSE {independent_same_position}"
     );
     let mean = |noise| (0..4).map(|f| pair(noise, HALF_IPD, f)).sum::<f64>() / 4.0;
-    let (independent, shared) = (mean(StereoNoise::Independent), mean(StereoNoise::Shared));
+    let (independent, shared) = (mean(StereoNoise::Independent), mean(StereoNoise::Screen));
     // The converged pair: the parallax part of the difference.
     let reference = |dx| {
         let mut r = Renderer::new(

@@ -9,9 +9,17 @@
 //! trace kernel's sampling variants of `shaders/sampling/trace_spaces.txt`, `//! variants per
 //! gradient trace space SUFFIX: DEFINES` over those of its lines tagged `gradients`, and
 //! `//! variants per resampling trace space SUFFIX: DEFINES` over those tagged `resampling`.
+//!
+//! A kernel that traces rays declares `//! traversals`: each of its variants (or the kernel
+//! itself) is compiled a second time with `BVH_TRAVERSAL_GPU`, named with [`GPU_TRAVERSAL_SUFFIX`]
+//! (the GPU-shaped BVH traversal of shaders/common/bvh.glsl; the engine picks per device).
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
+
+/// What the GPU-traversal twin of a kernel variant is named after (`passes/trace.cartesian+gpu`);
+/// `fovea_renderer::traversal` looks pipelines up by it.
+const GPU_TRAVERSAL_SUFFIX: &str = "+gpu";
 
 /// Macro definitions of one variant: (name, optional value).
 type Defines = Vec<(String, Option<String>)>;
@@ -94,18 +102,26 @@ pub fn compile_all(
             .with_extension("")
             .to_string_lossy()
             .replace('\\', "/");
-        let variants = parse_variants(&source, &spaces);
+        let mut variants: Vec<(String, Defines)> = parse_variants(&source, &spaces)
+            .into_iter()
+            .map(|(variant, defines)| (format!("{stem}.{variant}"), defines))
+            .collect();
         if variants.is_empty() {
-            jobs.push((stem, path, source, Vec::new()));
-        } else {
-            for (variant, defines) in variants {
-                jobs.push((
-                    format!("{stem}.{variant}"),
-                    path.clone(),
-                    source.clone(),
-                    defines,
-                ));
-            }
+            variants.push((stem, Vec::new()));
+        }
+        if source.lines().any(|l| l.trim() == "//! traversals") {
+            let gpu: Vec<(String, Defines)> = variants
+                .iter()
+                .map(|(name, defines)| {
+                    let mut defines = defines.clone();
+                    defines.push(("BVH_TRAVERSAL_GPU".to_string(), None));
+                    (format!("{name}{GPU_TRAVERSAL_SUFFIX}"), defines)
+                })
+                .collect();
+            variants.extend(gpu);
+        }
+        for (name, defines) in variants {
+            jobs.push((name, path.clone(), source.clone(), defines));
         }
     }
     for (name, source) in generated {

@@ -52,6 +52,10 @@ pub struct RenderSettings {
     pub taa: TaaMode,
     /// How the views' (eyes') random sequences relate.
     pub stereo_noise: StereoNoise,
+    /// `StereoNoise::Surface`: the cells' edge in sample footprints (rounded down to a power of
+    /// two in world units). Larger cells share more samples between the eyes and make coarser
+    /// noise within each.
+    pub surface_cell: f32,
     /// Texture filtering of frames (references always read level 0: point samples converge to
     /// the box-filtered pixel).
     pub texture_lod: TextureLod,
@@ -93,6 +97,7 @@ impl Default for RenderSettings {
             denoiser: DenoiserSettings::None,
             taa: TaaMode::Off,
             stereo_noise: StereoNoise::default(),
+            surface_cell: DEFAULT_SURFACE_CELL,
             environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
             path_regularisation: DEFAULT_PATH_REGULARISATION,
@@ -101,6 +106,11 @@ impl Default for RenderSettings {
         }
     }
 }
+
+/// `RenderSettings::surface_cell` unless the user sets it.
+pub const DEFAULT_SURFACE_CELL: f32 = 1.0;
+/// The range of `RenderSettings::surface_cell` (footprints).
+pub const SURFACE_CELL_RANGE: (f32, f32) = (0.25, 16.0);
 
 /// `RenderSettings::path_regularisation` unless the user sets it.
 pub const DEFAULT_PATH_REGULARISATION: f32 = 1.0;
@@ -173,14 +183,47 @@ impl TextureLod {
     }
 }
 
-/// How the two eyes' 1-spp noise relates (`RenderSettings::stereo_noise`).
+/// How the two eyes' 1-spp noise relates (`RenderSettings::stereo_noise`; the seeds' design is
+/// docs/design/random-numbers.md).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum StereoNoise {
     /// Each view gets its own random sequence (the view index salts the seed).
-    #[default]
     Independent,
     /// Every view uses the same seed: texel (x, y) of both eyes draws the same random numbers.
-    Shared,
+    /// The default: after SVGF it gave the smallest binocular difference at an unchanged
+    /// single-eye FLIP (docs/quality.md, "Binocular consistency"). In Visual-Polar space texel
+    /// (ρ, φ) of both eyes looks at nearly one point near the fixation, where both gazes meet.
+    #[default]
+    Screen,
+    /// The jitter as `Screen`; every number after the primary hit from the hit's world position
+    /// quantised at the sample's footprint (`surface_rng_seed`, shaders/common/random.glsl):
+    /// samples of both eyes that land on one surface neighbourhood draw the same path, so the
+    /// noise lies on the surfaces.
+    Surface,
+}
+
+impl StereoNoise {
+    pub const NAMES: &'static str = "independent, screen, surface";
+
+    pub fn parse(name: &str) -> Result<StereoNoise> {
+        match name {
+            "independent" => Ok(StereoNoise::Independent),
+            "screen" => Ok(StereoNoise::Screen),
+            "surface" => Ok(StereoNoise::Surface),
+            other => Err(Error::Invalid(format!(
+                "stereo noise '{other}' is not one of {}",
+                Self::NAMES
+            ))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            StereoNoise::Independent => "independent",
+            StereoNoise::Screen => "screen",
+            StereoNoise::Surface => "surface",
+        }
+    }
 }
 
 /// The most views one frame renders (two eyes).

@@ -1,5 +1,7 @@
-//! Uploads a CPU scene (`fovea_scene::Scene`) into the GPU buffers the tracing passes bind:
-//! BVH nodes and leaf triangles as texel buffers, shading data as std430 storage buffers.
+//! Uploads a CPU scene (`fovea_scene::Scene`) into the GPU buffers the tracing passes bind: the
+//! BVH in the layout of one traversal ([`Traversal`]: the 4-wide tree's nodes and leaf triangles
+//! as texel buffers, or the compressed 8-wide tree's as storage buffers), shading data as std430
+//! storage buffers.
 //! Instanced meshes (`fovea_scene::instancing`) are uploaded once: their vertices, triangles and
 //! object-space trees follow the flattened ones in the same buffers, with one `InstanceGpu` per
 //! placement and a top-level tree over the instances (`fovea_scene::bvh::instanced`).
@@ -12,12 +14,14 @@ use crate::layouts::{
     LIGHT_KIND_ENVIRONMENT, LIGHT_KIND_POINT, LIGHT_KIND_SPOT, LIGHT_KIND_TRIANGLE,
     MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_DOUBLE_SIDED, NO_TEXTURE,
 };
-use crate::scene::bvh::instanced::{InstancingStats, SceneBvh};
+use crate::scene::bvh::compressed::{self, Bvh8};
+use crate::scene::bvh::instanced::{InstanceRay, InstancingStats, SceneBvh, SceneBvh8};
 use crate::scene::bvh::wide::{Bvh4, Bvh4Node};
 use crate::scene::bvh::{Bvh, BvhBuilder};
 use crate::scene::lights::{build_light_table_scaled, LightKind};
 use crate::scene::{Aabb, PunctualLight, Scene, TextureSlot};
 use crate::texture_pack;
+use crate::traversal::Traversal;
 use crate::vk::{Buffer, Context};
 use ash::vk;
 use glam::{UVec4, Vec4};
@@ -28,6 +32,11 @@ use std::sync::Arc;
 pub const MAX_BVH_STACK: u32 = 64;
 /// Must match TOP_STACK_SIZE in shaders/common/bvh.glsl (the instance level's stack).
 pub const MAX_TOP_STACK: u32 = 16;
+/// Must match BVH8_STACK_SIZE in shaders/common/bvh.glsl (the GPU traversal's stack,
+/// `Bvh8::max_stack`).
+pub const MAX_BVH8_STACK: u32 = compressed::STACK_SIZE as u32;
+/// Must match BVH8_TOP_STACK_SIZE in shaders/common/bvh.glsl (its instance level's stack).
+pub const MAX_TOP_STACK_GPU: u32 = 32;
 
 /// The scene's bindings by their GLSL names (`GpuScene::binds`); a kernel binds those it reads.
 #[derive(Clone, Copy)]
@@ -45,6 +54,10 @@ pub struct SceneBinds<'a> {
 }
 
 pub struct GpuScene {
+    /// The traversal whose tree layout the BVH buffers hold (kernels of the other cannot bind it).
+    pub traversal: Traversal,
+    /// The nodes and leaf triangles of every tree (texel buffers for [`Traversal::CpuDriver`],
+    /// storage buffers for [`Traversal::Gpu`]).
     pub bvh_nodes: Buffer,
     pub bvh_triangles: Buffer,
     pub vertices: Buffer,
@@ -70,7 +83,7 @@ pub struct GpuScene {
     pub environment: GpuEnvironment,
     /// `FrameData.environment` and `.environment_map` for this upload and light table.
     pub environment_slots: (Vec4, UVec4),
-    /// Depth and GPU bytes of the 4-wide trees the shaders traverse (nodes + leaf triangles; with
+    /// Depth and GPU bytes of the trees the shaders traverse (nodes + leaf triangles; with
     /// instances also every BLAS, the top level and the instance data). Depth is the world tree's.
     pub bvh_depth: u32,
     pub bvh_bytes: usize,
@@ -83,6 +96,7 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
+    /// Uploads `scene` for the context's traversal.
     pub fn upload(ctx: &Arc<Context>, scene: &Scene) -> Result<GpuScene> {
         let positions = scene.flat_positions();
         let bvh = Bvh::build(&positions);
@@ -90,26 +104,51 @@ impl GpuScene {
     }
 
     /// `positions` and `bvh`: the flattened triangles ([`Scene::flat_positions`]) and the world
-    /// tree over them; instanced meshes get [`BvhBuilder::DEFAULT`] trees.
+    /// tree over them; instanced meshes get [`BvhBuilder::DEFAULT`] trees. For the context's
+    /// traversal.
     pub fn upload_with_bvh(
         ctx: &Arc<Context>,
         scene: &Scene,
         positions: &[[glam::Vec3; 3]],
         bvh: &Bvh,
     ) -> Result<GpuScene> {
-        // The GPU traverses the 4-wide trees collapsed from the binary ones (same leaves).
-        let levels = SceneBvh::with_world(
-            scene,
-            positions.to_vec(),
-            Bvh4::from_binary(bvh),
-            BvhBuilder::DEFAULT,
-        );
-        let depth = levels.world.depth();
-        check_stacks(scene, &levels)?;
+        GpuScene::upload_for(ctx, scene, positions, bvh, ctx.traversal)
+    }
+
+    /// [`GpuScene::upload_with_bvh`] in the layout of `traversal`.
+    pub fn upload_for(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        positions: &[[glam::Vec3; 3]],
+        bvh: &Bvh,
+        traversal: Traversal,
+    ) -> Result<GpuScene> {
+        // The trees collapsed from the binary ones (same leaves): 4-wide or compressed 8-wide.
+        let (trees, depth, stats) = match traversal {
+            Traversal::CpuDriver => {
+                let levels = SceneBvh::with_world(
+                    scene,
+                    positions.to_vec(),
+                    Bvh4::from_binary(bvh),
+                    BvhBuilder::DEFAULT,
+                );
+                check_stacks(scene, &levels)?;
+                (
+                    pack_trees(&levels, scene),
+                    levels.world.depth(),
+                    InstancingStats::of(scene, &levels),
+                )
+            }
+            Traversal::Gpu => {
+                let levels =
+                    SceneBvh8::with_world(scene, positions.to_vec(), bvh, BvhBuilder::DEFAULT);
+                check_stacks_gpu(scene, &levels)?;
+                let stats = InstancingStats::of_compressed(scene, &levels);
+                (pack_trees8(&levels, scene)?, levels.world.depth(), stats)
+            }
+        };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let (vertices, triangles) = geometry(scene)?;
-        let trees = pack_trees(&levels, scene);
-        let stats = InstancingStats::of(scene, &levels);
         let emission_scale = vec![1.0; scene.materials.len()];
         let packed = texture_pack::pack(scene, ctx.info.max_storage_buffer_range as usize / 4);
         let materials: Vec<MaterialGpu> = scene
@@ -124,9 +163,20 @@ impl GpuScene {
 
         let tree_bytes = (trees.nodes.len() + trees.triangles.len()) * 16
             + std::mem::size_of_val(trees.instances.as_slice());
+        let (bvh_nodes, bvh_triangles) = match traversal {
+            Traversal::CpuDriver => (
+                Buffer::device_texels(ctx, "bvh_nodes", &trees.nodes)?,
+                Buffer::device_texels(ctx, "bvh_triangles", &trees.triangles)?,
+            ),
+            Traversal::Gpu => (
+                Buffer::device_local(ctx, "bvh8_nodes", &trees.nodes, storage)?,
+                Buffer::device_local(ctx, "bvh8_triangles", &trees.triangles, storage)?,
+            ),
+        };
         Ok(GpuScene {
-            bvh_nodes: Buffer::device_texels(ctx, "bvh_nodes", &trees.nodes)?,
-            bvh_triangles: Buffer::device_texels(ctx, "bvh_triangles", &trees.triangles)?,
+            traversal,
+            bvh_nodes,
+            bvh_triangles,
             instances: Buffer::device_local(ctx, "instances", &trees.instances, storage)?,
             instancing_slots: trees.slots,
             instancing_stats: stats,
@@ -201,11 +251,22 @@ impl GpuScene {
         Ok(())
     }
 
-    /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only).
+    /// The scene bindings of `shaders/common/scene.glsl` and `environment.glsl` (all read-only);
+    /// the BVH's by the names of this upload's traversal, so a kernel of the other one refuses it.
     pub fn binds(&self) -> SceneBinds<'_> {
+        let (bvh_nodes, bvh_triangles) = match self.traversal {
+            Traversal::CpuDriver => (
+                read_texels("bvh_nodes", &self.bvh_nodes),
+                read_texels("bvh_triangles", &self.bvh_triangles),
+            ),
+            Traversal::Gpu => (
+                read_buffer("bvh8_nodes", &self.bvh_nodes),
+                read_buffer("bvh8_triangles", &self.bvh_triangles),
+            ),
+        };
         SceneBinds {
-            bvh_nodes: read_texels("bvh_nodes", &self.bvh_nodes),
-            bvh_triangles: read_texels("bvh_triangles", &self.bvh_triangles),
+            bvh_nodes,
+            bvh_triangles,
             vertices: read_buffer("vertices", &self.vertices),
             triangles: read_buffer("triangles", &self.triangles),
             materials: read_buffer("materials", &self.materials),
@@ -262,6 +323,104 @@ fn geometry(scene: &Scene) -> Result<(Vec<VertexGpu>, Vec<TriangleGpu>)> {
     Ok((vertices, triangles))
 }
 
+/// Whether placed triangle `id` of the flattened triangles, or triangle `id` of instanced mesh
+/// `mesh`, has an alpha-masked or blended material (the leaf data's TRIANGLE_ALPHA_TESTED flag).
+fn alpha_tested(scene: &Scene, mesh: Option<usize>, id: u32) -> bool {
+    let tri = match mesh {
+        None => &scene.triangles[id as usize],
+        Some(m) => &scene.instancing.meshes[m].triangles[id as usize],
+    };
+    let m = &scene.materials[tri.material as usize];
+    m.alpha_cutoff.is_some() || m.alpha_blend
+}
+
+fn check_stacks_gpu(scene: &Scene, levels: &SceneBvh8) -> Result<()> {
+    let (deepest, top) = levels.max_stack();
+    if deepest > MAX_BVH8_STACK || top > MAX_TOP_STACK_GPU {
+        return Err(Error::Invalid(format!(
+            "{}: the GPU traversal's BVH could need {deepest} stack entries (the shaders have {MAX_BVH8_STACK}) and {top} at the instance level (the shaders have {MAX_TOP_STACK_GPU}); --traversal cpu-driver traverses it",
+            scene.source.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Moves a compressed tree's children to `node_base` and its leaf entries to `entry_base`.
+fn rebased8(tree: &Bvh8, node_base: u32, entry_base: u32) -> Bvh8 {
+    let mut tree = tree.clone();
+    for n in &mut tree.nodes {
+        n.child_base += node_base;
+        n.triangle_base += entry_base;
+    }
+    tree
+}
+
+/// Every compressed tree in one node and one leaf buffer: the world tree (root 0), each instanced
+/// mesh's, then the top level (`FrameData.instancing.z` its root), whose leaf entries hold
+/// instance indices in their first word.
+fn pack_trees8(levels: &SceneBvh8, scene: &Scene) -> Result<PackedTrees> {
+    let words = |tree: &Bvh8| -> Vec<[f32; 4]> {
+        tree.node_words()
+            .into_iter()
+            .map(|w| w.map(f32::from_bits))
+            .collect()
+    };
+    let mut nodes = words(&levels.world);
+    let mut triangles = levels
+        .world
+        .triangle_words(&levels.world_tris, &|i| alpha_tested(scene, None, i));
+    let (mut roots, mut first_triangle) = (Vec::new(), scene.triangles.len() as u32);
+    let mut mesh_first = Vec::new();
+    for (m, (tree, tris)) in levels.meshes.iter().zip(&levels.mesh_tris).enumerate() {
+        let node_base = (nodes.len() / 5) as u32;
+        roots.push(node_base);
+        nodes.extend(words(&rebased8(
+            tree,
+            node_base,
+            (triangles.len() / 3) as u32,
+        )));
+        triangles.extend(tree.triangle_words(tris, &|i| alpha_tested(scene, Some(m), i)));
+        mesh_first.push(first_triangle);
+        first_triangle += tris.len() as u32;
+    }
+    let top_root = (nodes.len() / 5) as u32;
+    if !levels.instances.is_empty() {
+        nodes.extend(words(&rebased8(
+            &levels.top,
+            top_root,
+            (triangles.len() / 3) as u32,
+        )));
+        triangles.extend(
+            levels
+                .top
+                .tri_order
+                .iter()
+                .flat_map(|&k| [[f32::from_bits(k), 0.0, 0.0, 0.0]; 3]),
+        );
+    }
+    // A leaf entry addresses its first triangle in 29 bits (bvh.glsl's BVH8_LEAF encoding).
+    if triangles.len() / 3 >= 1 << 29 {
+        return Err(Error::Invalid(format!(
+            "{}: {} leaf entries, more than the GPU traversal addresses (2^29)",
+            scene.source.display(),
+            triangles.len() / 3
+        )));
+    }
+    let instances = instance_data(&levels.instances, scene, &roots, &mesh_first);
+    let slots = UVec4::new(
+        levels.instances.len() as u32,
+        scene.triangles.len() as u32,
+        top_root,
+        0,
+    );
+    Ok(PackedTrees {
+        nodes,
+        triangles,
+        instances,
+        slots,
+    })
+}
+
 fn check_stacks(scene: &Scene, levels: &SceneBvh) -> Result<()> {
     let deepest = levels
         .meshes
@@ -314,14 +473,16 @@ fn rebased(tree: &Bvh4, node_base: u32, leaf_base: u32) -> Bvh4 {
 
 fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
     let mut nodes = levels.world.node_texels();
-    let mut triangles = levels.world.triangle_texels(&levels.world_tris);
+    let mut triangles = levels
+        .world
+        .triangle_texels(&levels.world_tris, &|i| alpha_tested(scene, None, i));
     let (mut roots, mut first_triangle) = (Vec::new(), scene.triangles.len() as u32);
     let mut mesh_first = Vec::new();
-    for (tree, tris) in levels.meshes.iter().zip(&levels.mesh_tris) {
+    for (m, (tree, tris)) in levels.meshes.iter().zip(&levels.mesh_tris).enumerate() {
         let node_base = (nodes.len() / 8) as u32;
         roots.push(node_base);
         nodes.extend(rebased(tree, node_base, (triangles.len() / 3) as u32).node_texels());
-        triangles.extend(tree.triangle_texels(tris));
+        triangles.extend(tree.triangle_texels(tris, &|i| alpha_tested(scene, Some(m), i)));
         mesh_first.push(first_triangle);
         first_triangle += tris.len() as u32;
     }
@@ -337,8 +498,30 @@ fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
                 .map(|&k| [f32::from_bits(k), 0.0, 0.0, 0.0]),
         );
     }
-    let mut instances: Vec<InstanceGpu> = levels
-        .instances
+    let instances = instance_data(&levels.instances, scene, &roots, &mesh_first);
+    let slots = UVec4::new(
+        levels.instances.len() as u32,
+        scene.triangles.len() as u32,
+        top_root,
+        top_leaves,
+    );
+    PackedTrees {
+        nodes,
+        triangles,
+        instances,
+        slots,
+    }
+}
+
+/// One `InstanceGpu` per instance (a dummy when there are none: a buffer cannot be empty, and
+/// `FrameData.instancing.x` = 0 skips it), with its mesh's root node and first TriangleGpu.
+fn instance_data(
+    rays: &[InstanceRay],
+    scene: &Scene,
+    roots: &[u32],
+    mesh_first: &[u32],
+) -> Vec<InstanceGpu> {
+    let mut instances: Vec<InstanceGpu> = rays
         .iter()
         .zip(&scene.instancing.instances)
         .map(|(ray, inst)| {
@@ -360,21 +543,10 @@ fn pack_trees(levels: &SceneBvh, scene: &Scene) -> PackedTrees {
             }
         })
         .collect();
-    let slots = UVec4::new(
-        instances.len() as u32,
-        scene.triangles.len() as u32,
-        top_root,
-        top_leaves,
-    );
     if instances.is_empty() {
-        instances.push(InstanceGpu::default()); // a buffer cannot be empty; instancing.x = 0 skips it
+        instances.push(InstanceGpu::default());
     }
-    PackedTrees {
-        nodes,
-        triangles,
-        instances,
-        slots,
-    }
+    instances
 }
 
 fn material_gpu(
@@ -466,4 +638,27 @@ fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {
             gpu
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stack sizes the uploads check are the ones the shaders declare.
+    #[test]
+    fn stack_limits_match_the_shaders() {
+        let glsl = include_str!("../../shaders/common/bvh.glsl");
+        let declared = |name: &str| -> u32 {
+            let line = glsl
+                .lines()
+                .find(|l| l.trim_start().starts_with(&format!("const int {name} = ")))
+                .unwrap_or_else(|| panic!("bvh.glsl declares no {name}"));
+            let value = line.split('=').nth(1).unwrap().split(';').next().unwrap();
+            value.trim().parse().unwrap()
+        };
+        assert_eq!(declared("BVH_STACK_SIZE"), MAX_BVH_STACK);
+        assert_eq!(declared("TOP_STACK_SIZE"), MAX_TOP_STACK);
+        assert_eq!(declared("BVH8_STACK_SIZE"), MAX_BVH8_STACK);
+        assert_eq!(declared("BVH8_TOP_STACK_SIZE"), MAX_TOP_STACK_GPU);
+    }
 }

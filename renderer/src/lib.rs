@@ -6,7 +6,8 @@
 //! `way_back` (the sampling grid → the screen, as the space chooses) → `frame` (what a frame is
 //! made of) → `view` (one eye's state) → `pipeline` (the engine: views, one submit per frame) →
 //! `frames` (frames in flight).
-//! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath.
+//! `vk`, `graph`, `layouts` and `shaders` are the plumbing underneath; `traversal` picks the BVH
+//! traversal the kernels that trace are compiled for.
 
 pub mod environment;
 pub mod error;
@@ -20,6 +21,7 @@ pub mod pipeline;
 pub mod sampling;
 pub mod shaders;
 pub mod texture_pack;
+pub mod traversal;
 pub mod view;
 pub mod vk;
 pub mod way_back;

@@ -6,14 +6,14 @@
 use crate::error::{Error, Result};
 use crate::frame::{
     CameraPose, EnvironmentSampling, FrameInput, FrameStats, FrameTarget, OffscreenSamples,
-    RenderSettings, StereoNoise, TextureLod, ViewInput, MAX_VIEWS,
+    RenderSettings, StereoNoise, TextureLod, ViewInput, MAX_VIEWS, SURFACE_CELL_RANGE,
 };
 use crate::frames::FrameRing;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{ExternalImage, FrameRecorder, PassTiming, SubmitSync};
 use crate::layouts::{
     FrameData, FRAME_FLAG_ALPHA_MASK, FRAME_FLAG_CULL_OFFSCREEN, FRAME_FLAG_HALTON_JITTER,
-    FRAME_FLAG_REFERENCE, FRAME_FLAG_TEXTURE_LOD,
+    FRAME_FLAG_REFERENCE, FRAME_FLAG_SURFACE_NOISE, FRAME_FLAG_TEXTURE_LOD,
 };
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::denoise::Denoiser;
@@ -95,6 +95,13 @@ impl Renderer {
             return Err(Error::Invalid(
                 "max depth must be at least 1 (1 = emission seen directly)".into(),
             ));
+        }
+        let (lo, hi) = SURFACE_CELL_RANGE;
+        if !(lo..=hi).contains(&settings.surface_cell) {
+            return Err(Error::Invalid(format!(
+                "surface noise cell {} must be in [{lo}, {hi}] footprints",
+                settings.surface_cell
+            )));
         }
         if spaces.is_empty() || spaces.len() > MAX_VIEWS {
             return Err(Error::Invalid(format!(
@@ -231,7 +238,7 @@ impl Renderer {
             StereoNoise::Independent => {
                 self.settings.seed ^ (view as u32).wrapping_mul(0x9E37_79B9)
             }
-            StereoNoise::Shared => self.settings.seed,
+            StereoNoise::Screen | StereoNoise::Surface => self.settings.seed,
         };
         let data = FrameData {
             world_from_view: camera.world_from_view,
@@ -256,7 +263,12 @@ impl Renderer {
                 }
             },
             environment_map: self.scene.environment_slots.1,
-            path: Vec4::new(self.settings.path_regularisation, 0.0, 0.0, 0.0),
+            path: Vec4::new(
+                self.settings.path_regularisation,
+                self.settings.surface_cell,
+                0.0,
+                0.0,
+            ),
             instancing: self.scene.instancing_slots,
         };
         v.slots[slot].frame_data.write(&[data])
@@ -329,13 +341,14 @@ impl Renderer {
         };
         // Every view's screen radiance first, then one exposure metered over all of them (both
         // eyes share it), then every view's display image.
-        let mut screens = Vec::with_capacity(inputs.len());
+        // A fixed array, not a Vec: the render loop makes no host allocation (tests/host_alloc.rs).
+        let mut screens: [Option<_>; MAX_VIEWS] = std::array::from_fn(|_| None);
         for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
             rec.set_view(v as u32);
-            screens.push(record_view(rec, view, slot, &shared, view_input)?);
+            screens[v] = Some(record_view(rec, view, slot, &shared, view_input)?);
         }
         if let Exposure::Auto(auto) = &self.settings.exposure {
-            for (v, screen) in screens.iter().enumerate() {
+            for (v, screen) in screens.iter().flatten().enumerate() {
                 rec.set_view(v as u32);
                 let metered = screen.screen.metered();
                 self.exposure.record_meter(
@@ -350,7 +363,7 @@ impl Renderer {
         rec.set_view(0);
         self.exposure
             .record_adapt(rec, &self.settings.exposure, input.frame_seconds, slot)?;
-        for (v, screen) in screens.into_iter().enumerate() {
+        for (v, screen) in screens.into_iter().flatten().enumerate() {
             rec.set_view(v as u32);
             let external = target.map(|t| (t.image, t.offsets[v]));
             record_display(rec, screen, &shared, external)?;
@@ -401,6 +414,10 @@ impl Renderer {
             0
         } | if self.settings.offscreen_samples == OffscreenSamples::Cull {
             FRAME_FLAG_CULL_OFFSCREEN
+        } else {
+            0
+        } | if self.settings.stereo_noise == StereoNoise::Surface {
+            FRAME_FLAG_SURFACE_NOISE
         } else {
             0
         };

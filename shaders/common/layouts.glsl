@@ -39,6 +39,12 @@ const uint FRAME_FLAG_TEXTURE_LOD = 8u;
 // Samples whose screen position lies farther off the screen than the way back and the filters
 // read (trace.comp, OFFSCREEN_CULL_*) are not traced: they hold no sample, like clipped texels.
 const uint FRAME_FLAG_CULL_OFFSCREEN = 16u;
+// The path's random numbers after the primary hit come from the hit's world position quantised
+// at the sample's footprint (random.glsl, surface_rng_seed; StereoNoise::Surface): samples of
+// both eyes that land in one cell draw one path. Never set for references.
+const uint FRAME_FLAG_SURFACE_NOISE = 32u;
+// Salt of the surface seed, apart from the screen seed's streams.
+const uint SURFACE_NOISE_SALT = 0x73757266u;
 
 // Salts of unit_hash (random.glsl) for the sparse spaces' choices, apart from the paths' streams:
 // whether linear falloff keeps a pixel, where a random-acuity sample lies.
@@ -65,7 +71,7 @@ struct FrameData {
     vec4 jitter;                // xy sub-texel sample offset in [0, 1)² (FRAME_FLAG_HALTON_JITTER), zw unused
     vec4 environment;           // what escaping rays see (Scene::environment_map): x cos, y sin of the map's rotation about +Y, z radiance scale, w probability that light selection picks it (0: not sampled)
     uvec4 environment_map;      // x width, y height (texels), z 1 when there is an environment (0: escaping rays see black), w unused
-    vec4 path;                  // x path regularisation strength (RenderSettings::path_regularisation; 0: off), yzw unused
+    vec4 path;                  // x path regularisation strength (RenderSettings::path_regularisation; 0: off), y footprints per surface-noise cell (RenderSettings::surface_cell), zw unused
     uvec4 instancing;           // x instances (0: none, the instance level is skipped), y flattened triangles (placed ids below are theirs), z top-level root node, w first bvh_triangles texel of its leaf entries
 };
 

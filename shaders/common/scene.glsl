@@ -6,8 +6,14 @@
 #include "layouts.glsl"
 #include "random.glsl"
 
+#if defined(BVH_TRAVERSAL_GPU)
+// The GPU traversal's compressed 8-wide tree: 5 uvec4 per node, 3 vec4 per leaf triangle (bvh.glsl).
+layout(std430, set = 0, binding = 0) readonly buffer Bvh8NodeBuffer { uvec4 data[]; } bvh8_nodes;
+layout(std430, set = 0, binding = 1) readonly buffer Bvh8TriangleBuffer { vec4 data[]; } bvh8_triangles;
+#else
 layout(set = 0, binding = 0) uniform samplerBuffer bvh_nodes;
 layout(set = 0, binding = 1) uniform samplerBuffer bvh_triangles;
+#endif
 layout(std430, set = 0, binding = 2) readonly buffer VertexBuffer { VertexGpu data[]; } vertices;
 layout(std430, set = 0, binding = 3) readonly buffer TriangleBuffer { TriangleGpu data[]; } triangles;
 layout(std430, set = 0, binding = 4) readonly buffer MaterialBuffer { MaterialGpu data[]; } materials;

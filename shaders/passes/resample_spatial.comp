@@ -8,6 +8,7 @@
 // tracer's colour and demodulated radiance before any denoiser runs. The combined reservoir is
 // next frame's history.
 //! variants per space
+//! traversals
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
 #include "../common/brdf.glsl"

@@ -8,6 +8,7 @@
 // reservoir joined, one from the previous frame's point (the unbiased 1/Z normalisation).
 // Writes this frame's reservoirs, which the spatial pass reads.
 //! variants per space
+//! traversals
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
 #include "../common/brdf.glsl"

@@ -13,6 +13,7 @@
 //! variants per trace space
 //! variants per gradient trace space _gradients: TRACE_GRADIENTS
 //! variants per resampling trace space _resampled: RESAMPLED_DI
+//! traversals
 
 #include "../common/scene.glsl"
 #include "../common/random.glsl"
@@ -172,6 +173,16 @@ void main() {
     vec2 prev_screen = vec2(-1.0);
     vec4 primary_hit = vec4(0.0);   // RESAMPLED_DI: barycentrics, ray-cone width
     bool found = bvh_trace(org, dir, 0.0, 1e30, false, hit);
+    float pixel_tan = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z;
+    float footprint = found ? texel_footprint(texel, jitter, screen) : 1.0;
+    // The angle this sample stands for on the screen (its footprint in pixels, wider in the
+    // Visual-Polar periphery; a pixel's angle shrinks off-axis by cos θ = 1/|view_dir|).
+    float spread = pixel_tan * footprint / length(view_dir);
+    // Surface noise: everything after the jitter is drawn from the hit's cell (dir is unit
+    // length: t is the distance, spread × t the footprint's width there; path.y footprints
+    // make a cell).
+    if (found && (frame.data.frame.w & FRAME_FLAG_SURFACE_NOISE) != 0u)
+        rng = surface_rng_seed(org + dir * hit.t, spread * hit.t * frame.data.path.y, frame.data.frame.x, frame.data.frame.y, push.p.config.x);
 #if defined(TRACE_GRADIENTS)
     gradient = gradient && found && hit.triangle == gs.surface.y - 1u;
     if (gradient) {
@@ -187,16 +198,9 @@ void main() {
         vec3 prev_view = mat3(prev_view_from_world) * dir;
         project_view(prev_view, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
     } else {
-        float pixel_tan = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z;
-        float footprint = texel_footprint(texel, jitter, screen);
-        // The ray cone (texture LOD): spread = the angle this sample stands for on the screen
-        // (its footprint in pixels, wider in the Visual-Polar periphery; a pixel's angle shrinks
-        // off-axis by cos θ = 1/|view_dir|); from a pinhole, width = spread × distance.
+        // The ray cone (texture LOD): from a pinhole, width = spread × distance.
         vec2 cone = vec2(0.0);
-        if ((frame.data.frame.w & FRAME_FLAG_TEXTURE_LOD) != 0u) {
-            float spread = pixel_tan * footprint / length(view_dir);
-            cone = vec2(spread * hit.t, spread);
-        }
+        if ((frame.data.frame.w & FRAME_FLAG_TEXTURE_LOD) != 0u) cone = vec2(spread * hit.t, spread);
         Surface s = fetch_surface(hit, dir, cone.x);
         vec3 p_rel = s.position - org;
         float depth = dot(p_rel, mat3(world_from_view) * vec3(0.0, 0.0, -1.0));

@@ -196,7 +196,7 @@ pub fn box_filter(density: &[f32], width: u32, height: u32, radius: u32) -> Vec<
 
 /// Viridis approximated by 5 stops (linear in between); `t` in [0, 1], clamped. Its top is yellow,
 /// so white (the gaze mark) and black (no sample) stay distinct.
-fn ramp(t: f32) -> [u8; 3] {
+pub(crate) fn ramp(t: f32) -> [u8; 3] {
     const STOPS: [[f32; 3]; 5] = [
         [68.0, 1.0, 84.0],
         [59.0, 82.0, 139.0],

@@ -1,6 +1,7 @@
 //! Library side of the `fovea` tools: everything the binary glues together (scene resolution,
 //! output writers, camera paths, commands), kept here so integration tests can call it.
 
+pub mod binocular;
 pub mod camera_keys;
 pub mod camera_path;
 pub mod commands;

@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
+use fovea_renderer::frame::StereoNoise;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_tools::commands;
@@ -29,6 +30,33 @@ struct DeviceArgs {
     /// Turn on Vulkan validation (always on in debug builds); any message fails the run.
     #[arg(long, global = true)]
     validation: bool,
+    /// BVH traversal of the kernels that trace: auto (gpu on a discrete, integrated or virtual
+    /// GPU, cpu-driver on a CPU driver such as lavapipe), cpu-driver (4-wide nodes in texel
+    /// buffers, stack in shared memory) or gpu (compressed 8-wide nodes in storage buffers,
+    /// children in order of distance, stack in private memory). `fovea bench` takes a comma list:
+    /// ray figures and traversal counters for each, frames with the first.
+    #[arg(long, global = true, default_value = "auto")]
+    traversal: String,
+}
+
+impl DeviceArgs {
+    /// `--traversal` of a command that renders: one traversal, the process's for every device it
+    /// opens.
+    fn choose_traversal(&self) -> Result<()> {
+        let [choice] = parse_traversals(&self.traversal)?[..] else {
+            bail!("--traversal: one of auto, cpu-driver, gpu (a list only for fovea bench)");
+        };
+        commands::choose_traversal(choice);
+        Ok(())
+    }
+}
+
+/// `--traversal` as a comma list.
+fn parse_traversals(spec: &str) -> Result<Vec<fovea_renderer::traversal::TraversalChoice>> {
+    spec.split(',')
+        .map(|s| s.trim().parse().map_err(anyhow::Error::msg))
+        .collect::<Result<Vec<_>>>()
+        .context("--traversal")
 }
 
 /// The camera and the default environment (every command that renders the scene camera).
@@ -84,6 +112,13 @@ struct SceneFlags {
     /// with --denoiser asvgf); parameters from the profile's [resampling].
     #[arg(long)]
     resampling: Option<String>,
+    /// How the two eyes' random numbers relate in a stereo run (docs/design/random-numbers.md):
+    /// screen (the default: texel (x, y) of both eyes draws the same numbers), independent (each
+    /// eye its own sequence) or surface (the path after the primary hit drawn from the hit's world position at
+    /// the sample's footprint: the noise lies on the surfaces). `fovea quality` takes a
+    /// comma-separated list and renders each.
+    #[arg(long)]
+    stereo_noise: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
     /// vertices' glossy lobes are widened so sunlight focused through them stops making
     /// fireflies; biased, 0 = off (the unbiased estimator).
@@ -184,7 +219,8 @@ struct RenderOpts {
     look: SceneFlags,
     #[command(flatten)]
     latency: LatencyFlags,
-    /// Scene name (cornell-box, stress, large) or a .gltf/.glb path.
+    /// Scene name (cornell-box, stress, large; sponza, breakfast-room, flight-helmet from the
+    /// shared scene folder, $FOVEA_SCENES or ../shared/data/scenes) or a .gltf/.glb path.
     #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
     scene: String,
     /// Sampling method: vp (Visual-Polar, Koskela et al. 2019) or cartesian (uniform, 1 spp).
@@ -330,6 +366,7 @@ impl RenderOpts {
             path_regularisation: self.look.path_regularisation,
             offscreen_samples: self.look.offscreen_samples.clone(),
             resampling: self.look.resampling.clone(),
+            stereo_noise: self.look.stereo_noise.clone(),
             gaze_timing: self.latency.timing()?,
         })
     }
@@ -365,6 +402,11 @@ struct QualityFlags {
     /// still and/or moving (the scene's default camera path).
     #[arg(long, value_delimiter = ',', default_value = "still,moving")]
     cameras: Vec<String>,
+    /// left, or both: every run renders both eyes (the headset's eye offsets), each eye is
+    /// judged against its own reference, and the binocular consistency measure is added
+    /// (the right eye warped into the left through the converged depth).
+    #[arg(long, default_value = "left")]
+    eyes: String,
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
     /// Equal-width rings from the gaze out to the farthest corner.
@@ -494,7 +536,9 @@ enum Command {
         #[arg(long, default_value = "fifo")]
         present_mode: String,
         /// The debug view shown first: off, grid (the sampling grid as traced), density (samples
-        /// per pixel) or rings (eccentricity rings at 5, 10, 20, 30, 40°); key v cycles them.
+        /// per pixel), rings (eccentricity rings at 5, 10, 20, 30, 40°) or stereo-diff (with
+        /// --eyes both: each eye's binocular difference as a heat map, the other eye warped into
+        /// it through the scene's depth); key v cycles them.
         #[arg(long, default_value = "off")]
         debug_view: String,
         #[command(flatten)]
@@ -542,7 +586,7 @@ enum Command {
     /// Benchmark: BVH build, rays per second, per-pass GPU milliseconds, the real-time loop (one
     /// run, one device).
     Bench {
-        /// Scenes of the BVH, ray and frame figures ("" skips them).
+        /// Scenes of the BVH, ray and frame figures, names or paths as --scene ("" skips them).
         #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
         scenes: Vec<String>,
         /// BVH builders to compare: binned, sbvh, sbvh:BUDGET (extra references per triangle).
@@ -570,10 +614,22 @@ enum Command {
         /// frames in flight, stereo vs two mono renders ("" skips them).
         #[arg(long, default_value = "320x360")]
         loop_size: String,
-        /// Timed frames of each real-time loop run (after 2 warm-up frames; at least 2). Each run
-        /// is made twice (order A B C C B A).
+        /// Timed frames of each run of the real-time loop and of the headset loop (after 2 warm-up
+        /// frames; at least 2). Each run is made twice (order A B C C B A).
         #[arg(long, default_value_t = 5)]
         loop_frames: u32,
+        /// Scenes of the headset loop: both eyes at each --loop-headsets size, the head on the
+        /// default orbit and the simulated gaze, VP + SVGF, VP + A-SVGF and Cartesian + SVGF (2
+        /// frames in flight, --loop-frames timed frames each, order A B C C B A): frames/s,
+        /// per-pass GPU ms and VP / Cartesian per size ("" skips it; names as --scenes, e.g.
+        /// sponza, breakfast-room from the shared scene folder).
+        #[arg(long, default_value = "")]
+        loop_scenes: String,
+        /// Headsets of the headset loop, each at its recommended per-eye size (names from `fovea
+        /// headsets` or profile paths), or per-eye sizes WxH (through the FOVE 0's frusta). The
+        /// frames run the first --traversal.
+        #[arg(long, default_value = fovea_tools::commands::bench_headsets::DEFAULT_HEADSETS)]
+        loop_headsets: String,
         /// A keyframe file (as `fovea render --camera-path FILE`) the VP vs Cartesian frames
         /// follow, frame i at i / 70 Hz (default: the scene camera, still).
         #[arg(long)]
@@ -862,6 +918,7 @@ fn run() -> Result<()> {
         device: DeviceArgs {
             device: None,
             validation: false,
+            traversal: "auto".into(),
         },
     });
     if matches!(
@@ -882,6 +939,7 @@ fn run() -> Result<()> {
             no_overview,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             let mut args = render_args(
@@ -907,6 +965,7 @@ fn run() -> Result<()> {
             debug_view,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             // Without --frames the run has no length: the camera path's period is a long one.
@@ -940,6 +999,7 @@ fn run() -> Result<()> {
             reference_space,
             device,
         } => {
+            device.choose_traversal()?;
             let profile = opts.profile()?;
             let camera = opts.look.camera()?;
             // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
@@ -987,6 +1047,8 @@ fn run() -> Result<()> {
             frames,
             loop_size,
             loop_frames,
+            loop_scenes,
+            loop_headsets,
             camera_path,
             out,
             dump_rays,
@@ -1019,6 +1081,19 @@ fn run() -> Result<()> {
                 .transpose()
                 .context("--loop-size")?;
             let scenes: Vec<String> = scenes.into_iter().filter(|s| !s.is_empty()).collect();
+            let loop_scenes: Vec<String> = loop_scenes
+                .split(',')
+                .map(str::trim)
+                .filter(|s| !s.is_empty())
+                .map(String::from)
+                .collect();
+            let loop_headsets = if loop_scenes.is_empty() {
+                Vec::new()
+            } else {
+                commands::bench_headsets::LoopHeadset::parse_list(&loop_headsets)?
+            };
+            let traversals = parse_traversals(&device.traversal)?;
+            commands::choose_traversal(traversals[0]);
             commands::bench::run(&commands::bench::BenchArgs {
                 scenes: &scenes,
                 builders: &builders,
@@ -1029,15 +1104,21 @@ fn run() -> Result<()> {
                 frames,
                 loop_size,
                 loop_frames,
+                loop_scenes: &loop_scenes,
+                loop_headsets: &loop_headsets,
                 camera_path: camera_path.as_ref(),
                 out: &out,
                 dump_rays,
+                traversals: &traversals,
                 device: device.device.as_deref(),
                 validation: device.validation,
             })
         }
         Command::Headsets => commands::headsets::run(),
-        Command::Info { device } => commands::info::run(device.device.as_deref()),
+        Command::Info { device } => {
+            device.choose_traversal()?;
+            commands::info::run(device.device.as_deref())
+        }
         Command::GenScene {
             kind,
             out,
@@ -1104,6 +1185,7 @@ fn with_quality_args(
     device: &DeviceArgs,
     run: &mut dyn FnMut(&commands::quality::QualityArgs) -> Result<()>,
 ) -> Result<()> {
+    device.choose_traversal()?;
     let QualityFlags {
         scene,
         width,
@@ -1116,6 +1198,7 @@ fn with_quality_args(
         denoisers,
         taa,
         cameras,
+        eyes,
         reference_spp,
         rings,
         seed,
@@ -1145,6 +1228,13 @@ fn with_quality_args(
         .iter()
         .map(|s| s.to_string())
         .collect();
+    let stereo_noises = match &look.stereo_noise {
+        Some(list) => list
+            .split(',')
+            .map(|n| StereoNoise::parse(n.trim()).context("--stereo-noise"))
+            .collect::<Result<Vec<_>>>()?,
+        None => Vec::new(),
+    };
     run(&commands::quality::QualityArgs {
         scene: &scene,
         width,
@@ -1165,6 +1255,8 @@ fn with_quality_args(
         rings,
         seed,
         profile,
+        eyes: commands::setup::Eyes::parse(&eyes)?,
+        stereo_noises: &stereo_noises,
         camera: &look.camera()?,
         out: &out,
         device: device.device.as_deref(),
@@ -1178,6 +1270,7 @@ fn with_replay_args(
     device: &DeviceArgs,
     run: &mut dyn FnMut(&commands::replay::ReplayArgs) -> Result<()>,
 ) -> Result<()> {
+    device.choose_traversal()?;
     let ReplayFlags {
         traces,
         baseline,
@@ -1233,6 +1326,7 @@ fn with_reference_args(
     device: &DeviceArgs,
     run: &mut dyn FnMut(&commands::reference::ReferenceArgs) -> Result<()>,
 ) -> Result<()> {
+    device.choose_traversal()?;
     let ReferenceFlags {
         scene,
         width,

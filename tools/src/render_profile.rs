@@ -10,7 +10,10 @@
 
 use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::{OffscreenSamples, TextureLod, DEFAULT_PATH_REGULARISATION};
+use fovea_renderer::frame::{
+    OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION, DEFAULT_SURFACE_CELL,
+    SURFACE_CELL_RANGE,
+};
 use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
 use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
 use fovea_renderer::passes::taa::TaaSettings;
@@ -50,6 +53,11 @@ pub struct RenderProfile {
     pub offscreen_samples: OffscreenSamples,
     /// `[resampling]` and `--resampling`: ReSTIR DI's mode and parameters (off by default).
     pub resampling: ResamplingSettings,
+    /// `[trace] stereo_noise`: how the two eyes' random numbers relate (`--stereo-noise`).
+    pub stereo_noise: StereoNoise,
+    /// `[trace] surface_cell`: the surface noise's cell edge in sample footprints
+    /// (`RenderSettings::surface_cell`); `None`: the engine's default.
+    pub surface_cell: Option<f32>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -158,6 +166,8 @@ impl<'de> DeserializeSeed<'de> for DenoiserSection<'_> {
 #[serde(deny_unknown_fields)]
 struct TraceSection {
     offscreen: Option<String>,
+    stereo_noise: Option<String>,
+    surface_cell: Option<f32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -251,6 +261,8 @@ pub struct ProfileOverrides {
     pub offscreen_samples: Option<String>,
     /// `--resampling`.
     pub resampling: Option<String>,
+    /// `--stereo-noise`.
+    pub stereo_noise: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
     pub gaze_timing: crate::gaze::GazeTiming,
 }
@@ -473,9 +485,24 @@ impl RenderProfile {
             profile.texture_lod =
                 TextureLod::parse(&lod).with_context(|| format!("{}.lod", at("textures")))?;
         }
-        if let Some(mode) = file.trace.and_then(|t| t.offscreen) {
+        let trace = file.trace.unwrap_or_default();
+        if let Some(mode) = trace.offscreen {
             profile.offscreen_samples = OffscreenSamples::parse(&mode)
                 .with_context(|| format!("{}.offscreen", at("trace")))?;
+        }
+        if let Some(mode) = trace.stereo_noise {
+            profile.stereo_noise = StereoNoise::parse(&mode)
+                .with_context(|| format!("{}.stereo_noise", at("trace")))?;
+        }
+        if let Some(cell) = trace.surface_cell {
+            let (lo, hi) = SURFACE_CELL_RANGE;
+            if !(lo..=hi).contains(&cell) {
+                bail!(
+                    "{}.surface_cell = {cell}: must be in [{lo}, {hi}] sample footprints",
+                    at("trace")
+                );
+            }
+            profile.surface_cell = Some(cell);
         }
         if let Some(resampling) = file.resampling {
             resampling.validate().with_context(|| at("resampling"))?;
@@ -542,6 +569,9 @@ impl RenderProfile {
             self.offscreen_samples =
                 OffscreenSamples::parse(mode).context("--offscreen-samples")?;
         }
+        if let Some(mode) = &o.stereo_noise {
+            self.stereo_noise = StereoNoise::parse(mode).context("--stereo-noise")?;
+        }
         if let Some(mode) = &o.resampling {
             let mode = ResamplingMode::parse(mode).context("--resampling")?;
             self.resampling = self.resampling.with_mode(mode);
@@ -550,6 +580,11 @@ impl RenderProfile {
             self.gaze_timing = o.gaze_timing;
         }
         Ok(self)
+    }
+
+    /// The surface noise's cell the engine runs with (footprints).
+    pub fn surface_cell(&self) -> f32 {
+        self.surface_cell.unwrap_or(DEFAULT_SURFACE_CELL)
     }
 
     /// The strength the engine runs with.
@@ -751,6 +786,8 @@ mod tests {
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);
         assert_eq!(p.path_regularisation(), DEFAULT_PATH_REGULARISATION);
+        assert_eq!(p.stereo_noise, StereoNoise::default());
+        assert_eq!(p.surface_cell(), DEFAULT_SURFACE_CELL);
         assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
         let sun = Some(crate::look::DEFAULT_SUN);
@@ -1267,6 +1304,59 @@ gradient_sigma_normal = 64
             RenderProfile::default().override_with(&bad).unwrap_err()
         )
         .contains("--env-intensity"));
+    }
+
+    /// `[trace] stereo_noise` and `surface_cell` (and `--stereo-noise`) reach the profile; bad
+    /// values are refused naming the file and key (or the flag) and the accepted ones.
+    #[test]
+    fn stereo_noise_and_surface_cell_from_file_and_flag() {
+        let p = load_str(
+            "stereo.toml",
+            "[trace]\nstereo_noise = \"surface\"\nsurface_cell = 2\n",
+        )
+        .unwrap();
+        assert_eq!(p.stereo_noise, StereoNoise::Surface);
+        assert_eq!(p.surface_cell(), 2.0);
+        assert_eq!(RenderProfile::default().stereo_noise, StereoNoise::Screen);
+        assert_eq!(
+            RenderProfile::default().surface_cell(),
+            DEFAULT_SURFACE_CELL
+        );
+        let o = ProfileOverrides {
+            stereo_noise: Some("independent".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            p.override_with(&o).unwrap().stereo_noise,
+            StereoNoise::Independent
+        );
+        let err = format!(
+            "{:#}",
+            load_str("stereo_bad.toml", "[trace]\nstereo_noise = \"eyes\"\n").unwrap_err()
+        );
+        assert!(
+            err.contains("stereo_bad.toml")
+                && err.contains("[trace].stereo_noise")
+                && err.contains("independent, screen, surface"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str("cell_bad.toml", "[trace]\nsurface_cell = 100\n").unwrap_err()
+        );
+        assert!(
+            err.contains("cell_bad.toml") && err.contains("surface_cell = 100"),
+            "{err}"
+        );
+        let bad = ProfileOverrides {
+            stereo_noise: Some("eyes".into()),
+            ..Default::default()
+        };
+        let err = format!(
+            "{:#}",
+            RenderProfile::default().override_with(&bad).unwrap_err()
+        );
+        assert!(err.contains("--stereo-noise"), "{err}");
     }
 
     /// `[resampling]`: the mode and parameters onto the engine's defaults, checked by name;

@@ -1,5 +1,7 @@
 //! Resolves `--scene <name|path>`: an existing path is loaded as given; a name is looked up in
-//! `./scenes/`, then in the repository's `scenes/`, and the project's own scenes are generated
+//! `./scenes/`, then in the repository's `scenes/`; the shared real scenes (sponza,
+//! breakfast-room, flight-helmet) in `$FOVEA_SCENES` or `../shared/data/scenes` beside the
+//! repository, an error naming the path when they are missing; the project's own scenes are generated
 //! on the fly (into the per-user cache, checked by SHA-256) when no copy is found, so `fovea`
 //! works from any directory.
 
@@ -21,6 +23,30 @@ fn generator_for(name: &str) -> Option<SceneKind> {
     }
 }
 
+/// The real scenes of the shared data folder, by name: (name, file under the folder).
+pub const SHARED_SCENES: [(&str, &str); 3] = [
+    ("sponza", "sponza/Sponza.gltf"),
+    ("breakfast-room", "breakfast-room/BreakfastRoom.gltf"),
+    ("flight-helmet", "flight-helmet/FlightHelmet.gltf"),
+];
+
+/// Overrides where the shared real scenes are looked for.
+pub const SHARED_SCENES_VAR: &str = "FOVEA_SCENES";
+
+fn shared_file(name: &str) -> Option<&'static str> {
+    SHARED_SCENES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, file)| *file)
+}
+
+/// `$FOVEA_SCENES`, else the repository's `../shared/data/scenes`.
+fn shared_dir() -> PathBuf {
+    std::env::var_os(SHARED_SCENES_VAR)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/scenes"))
+}
+
 /// Where a scene name or path is found (generating the project's scenes when needed).
 pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     let as_path = Path::new(name_or_path);
@@ -40,8 +66,20 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
             return Ok(candidate);
         }
     }
+    if let Some(file) = shared_file(name_or_path) {
+        let dir = shared_dir();
+        let path = dir.join(file);
+        if !path.is_file() {
+            bail!(
+                "scene '{name_or_path}' is one of the shared real scenes: {} does not exist (set {SHARED_SCENES_VAR} to the folder holding {})",
+                path.display(),
+                Path::new(file).parent().map_or("".into(), |p| p.display().to_string())
+            );
+        }
+        return Ok(path);
+    }
     let Some(kind) = generator_for(name_or_path) else {
-        bail!("unknown scene '{name_or_path}': give a .gltf/.glb path or one of cornell-box, stress, large");
+        bail!("unknown scene '{name_or_path}': give a .gltf/.glb path or one of cornell-box, stress, large, {}", SHARED_SCENES.map(|(n, _)| n).join(", "));
     };
     generated_in(&cache_dir()?, &kind)
 }
@@ -131,6 +169,29 @@ mod tests {
             std::env::temp_dir().join(format!("fovea-scene-cache-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         d
+    }
+
+    /// A shared scene's name resolves into the shared folder, and its absence is an error naming
+    /// the path looked at.
+    #[test]
+    fn shared_scene_names_resolve_or_name_the_missing_path() {
+        let path = resolve("breakfast-room");
+        match path {
+            Ok(p) => assert!(p.ends_with("breakfast-room/BreakfastRoom.gltf"), "{p:?}"),
+            Err(e) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("BreakfastRoom.gltf does not exist")
+                        && e.contains(SHARED_SCENES_VAR),
+                    "{e}"
+                );
+            }
+        }
+        let err = resolve("no-such-scene").unwrap_err().to_string();
+        assert!(
+            err.contains("sponza, breakfast-room, flight-helmet"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! `fovea sweep` without a scheduler: a small quality sweep run job by job (as a shell loop would)
-//! merges into what one `fovea quality` process writes; a reference split into sample batches
-//! merges into the same EXR bytes as `fovea reference`; failed, killed and repeated jobs leave no
-//! partial result and never reach the merge; bad plans are refused naming the file and field.
+//! merges into what one `fovea quality` process writes (a stereo one with two stereo noises too);
+//! a reference split into sample batches merges into the same EXR bytes as `fovea reference`;
+//! failed, killed and repeated jobs leave no partial result and never reach the merge; bad plans
+//! are refused naming the file and field.
 //! Then the same through a real Slurm (`scripts/sweep-slurm`, sbatch job arrays on the one-node
 //! cluster of scripts/slurm/setup): two scenes merged equal to one process's output, and a stage
 //! cancelled mid-run (scancel) rerun cleanly. Without a cluster that test says "skipped"; with
@@ -236,6 +237,95 @@ fn a_sweep_run_job_by_job_merges_into_the_one_process_quality_output() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A stereo study: both eyes, two stereo noises, moving camera (a reference per evaluated frame
+/// and eye), 40×36, 32-spp references in one job each.
+const STEREO: &[&str] = &[
+    "quality",
+    "--width",
+    "40",
+    "--height",
+    "36",
+    "--frames",
+    "3",
+    "--eval-frames",
+    "2",
+    "--methods",
+    "cartesian",
+    "--denoisers",
+    "none",
+    "--cameras",
+    "moving",
+    "--reference-spp",
+    "32",
+    "--rings",
+    "4",
+    "--eyes",
+    "both",
+    "--stereo-noise",
+    "independent,surface",
+];
+
+#[test]
+fn a_stereo_quality_sweep_merges_into_the_one_process_output() {
+    let dir = temp_dir("stereo");
+    let sweep = dir.join("sweep");
+    let sweep_arg = sweep.to_str().unwrap().to_string();
+    let mut plan = vec![
+        "sweep",
+        "plan",
+        "--out",
+        &sweep_arg,
+        "--batches-per-job",
+        "2",
+    ];
+    plan.extend(["--scenes", "cornell-box"]);
+    plan.extend(STEREO);
+    fovea_ok(&plan);
+    let jobs = read_jobs(&sweep);
+    let (references, runs): (Vec<_>, Vec<_>) = jobs.iter().partition(|j| j["stage"] == "reference");
+    assert_eq!(references.len(), 2 * 2, "2 frames × 2 eyes: {references:?}");
+    let eyes: Vec<&str> = references
+        .iter()
+        .map(|j| j["part"]["eye"].as_str().unwrap())
+        .collect();
+    assert_eq!(eyes, ["left", "right", "left", "right"]);
+    let noises: Vec<&str> = runs
+        .iter()
+        .map(|j| j["part"]["noise"].as_str().unwrap())
+        .collect();
+    assert_eq!(noises, ["independent", "surface"]);
+    for run in &runs {
+        assert_eq!(run["after"].as_array().unwrap().len(), 4, "{run}");
+    }
+    run_stage(&sweep, "reference");
+    run_stage(&sweep, "run");
+    fovea_ok(&["sweep", "merge", &sweep_arg]);
+
+    let one = dir.join("one");
+    let one_arg = one.to_str().unwrap().to_string();
+    let mut one_process: Vec<&str> = STEREO.to_vec();
+    one_process.extend(["--scene", "cornell-box", "--out", &one_arg]);
+    fovea_ok(&one_process);
+    let merged = sweep.join("merged/cornell-box");
+    assert_same_quality(&one, &merged);
+    for name in [
+        "reference_moving_right_0002.exr",
+        "run_moving_cartesian_none_taa-off_noise-surface/frame_0002_right.png",
+        "run_moving_cartesian_none_taa-off_noise-surface/binocular_0002.png",
+    ] {
+        assert!(
+            std::fs::read(one.join(name)).unwrap() == std::fs::read(merged.join(name)).unwrap(),
+            "{name} differs"
+        );
+    }
+    let report = quality_json(&merged);
+    assert_eq!(report["eyes"], "both");
+    for run in report["runs"].as_array().unwrap() {
+        assert!(run["binocular"]["frame"]["difference"].is_f64(), "{run}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// One long combination (24 frames) so a signal lands mid-run.
 const LONG: &[&str] = &[
     "quality",
@@ -352,11 +442,20 @@ fn attempt_has_frame(job_dir: &Path, pid: u32) -> bool {
         let name = e.file_name().to_string_lossy().into_owned();
         name.starts_with(".attempt-")
             && name.ends_with(&format!("-{pid}"))
-            && std::fs::read_dir(e.path()).is_ok_and(|runs| {
-                runs.filter_map(|r| r.ok())
-                    .any(|r| r.path().join("frame_0000.png").exists())
-            })
+            && holds_frame(&e.path(), 2)
     })
+}
+
+/// Whether `dir` or a folder up to `depth` levels below it holds a rendered frame: a run folder
+/// in an attempt, and the staging folder inside it where `fovea render` writes until it ends.
+fn holds_frame(dir: &Path, depth: u32) -> bool {
+    dir.join("frame_0000.png").exists()
+        || (depth > 0
+            && std::fs::read_dir(dir).is_ok_and(|entries| {
+                entries
+                    .filter_map(|e| e.ok())
+                    .any(|e| e.path().is_dir() && holds_frame(&e.path(), depth - 1))
+            }))
 }
 
 #[test]
@@ -484,7 +583,14 @@ fn a_replay_sweep_merges_into_the_one_process_report_and_exit_status() {
     assert!(report.contains("REGRESSION"), "{report}");
     assert_eq!(report, no_costs(&one));
     let mut compared = 0;
-    for run in ["run_sim-1", "run_example_trace"] {
+    // Run folders are named by the baseline folder: `run_<stem>-<SHA-256 prefix>`.
+    let runs: Vec<String> = std::fs::read_dir(&one)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("run_sim-1-") || n.starts_with("run_example_trace-"))
+        .collect();
+    assert_eq!(runs.len(), 2, "{runs:?}");
+    for run in &runs {
         for entry in std::fs::read_dir(one.join(run)).unwrap() {
             let path = entry.unwrap().path();
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -778,10 +884,7 @@ fn a_sweep_through_slurm_is_cancelled_mid_run_rerun_and_merges_into_one_process_
             std::fs::read_dir(d).is_ok_and(|entries| {
                 entries.filter_map(|e| e.ok()).any(|e| {
                     e.file_name().to_string_lossy().starts_with(".attempt-")
-                        && std::fs::read_dir(e.path()).is_ok_and(|runs| {
-                            runs.filter_map(|r| r.ok())
-                                .any(|r| r.path().join("frame_0000.png").exists())
-                        })
+                        && holds_frame(&e.path(), 2)
                 })
             })
         });

@@ -155,7 +155,8 @@ fn view_screenshot_of_both_eyes_matches_the_offline_stereo_render() {
 
 /// The debug views in the window: the density view of frame N − 1 equals `fovea render
 /// --debug-views`' density picture of that frame byte for byte; the grid and rings views show
-/// something else than the frame (stereo for the rings: both eyes get them).
+/// something else than the frame (stereo for the rings: both eyes get them); stereo-diff shows
+/// each eye's binocular heat map, measured on most of the Cornell box's pixels.
 #[test]
 fn debug_views_in_the_window() {
     let x = Xvfb::start();
@@ -207,5 +208,20 @@ fn debug_views_in_the_window() {
         "rings drawn in both eyes: {} and {} white pixels",
         white(0),
         white(80)
+    );
+    let diff = shot("stereo-diff", &["--eyes", "both", "--denoiser", "svgf"]);
+    assert_eq!(diff.dimensions(), (160, 90));
+    // Black: seen by one eye only (the walls near each eye's outer edge, occlusions).
+    let measured = |x0: u32| {
+        (0..90)
+            .flat_map(|y| (x0..x0 + 80).map(move |x| (x, y)))
+            .filter(|&(x, y)| diff.get_pixel(x, y).0 != [0, 0, 0, 255])
+            .count()
+    };
+    assert!(
+        measured(0) > 80 * 90 * 7 / 10 && measured(80) > 80 * 90 * 7 / 10,
+        "heat maps cover most of both eyes: {} and {} pixels",
+        measured(0),
+        measured(80)
     );
 }

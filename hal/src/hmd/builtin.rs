@@ -29,6 +29,10 @@ const BUILTIN: &[(&str, &str)] = &[
         "pimax_crystal",
         include_str!("../../../config/headsets/pimax_crystal.toml"),
     ),
+    (
+        "varjo_xr4",
+        include_str!("../../../config/headsets/varjo_xr4.toml"),
+    ),
 ];
 
 /// Names of the compiled-in profiles, default (`fove0`) first.

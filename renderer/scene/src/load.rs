@@ -68,15 +68,62 @@ pub(crate) fn load(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError
     })
 }
 
+/// The JSON text just before a parse error (where a value is refused, its key): the parser's
+/// message names only a line and column. `bytes` is a .gltf file or a GLB (its JSON chunk).
+fn json_context(bytes: &[u8], error: &serde_json::Error) -> Option<String> {
+    const BEFORE: usize = 48;
+    let json = match bytes.get(..4) {
+        Some(b"glTF") => {
+            let length = u32::from_le_bytes(bytes.get(12..16)?.try_into().ok()?) as usize;
+            bytes.get(20..20usize.checked_add(length)?)?
+        }
+        _ => bytes,
+    };
+    let line = json
+        .split(|&b| b == b'\n')
+        .nth(error.line().checked_sub(1)?)?;
+    let end = error.column().min(line.len());
+    let start = end.saturating_sub(BEFORE);
+    let near = String::from_utf8_lossy(&line[start..end]);
+    let near: String = near.split_whitespace().collect::<Vec<_>>().join(" ");
+    (!near.is_empty()).then(|| format!("{}{near}", if start > 0 { "…" } else { "" }))
+}
+
+/// A binary glTF's header length must cover the 12-byte header itself: the gltf crate subtracts
+/// the header's size from it unchecked (an overflow panic where overflow checks are on).
+fn check_glb_header(bytes: &[u8], file: &Path) -> Result<(), SceneError> {
+    const HEADER: usize = 12;
+    if bytes.len() < HEADER || &bytes[..4] != b"glTF" {
+        return Ok(());
+    }
+    let length = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+    if (length as usize) < HEADER {
+        return Err(SceneError::Malformed {
+            file: file.to_path_buf(),
+            detail: format!(
+                "GLB header: length {length} is shorter than the {HEADER}-byte header itself"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The whole load without the panic backstop (the fuzz test calls this, so a panic fails it).
 pub(crate) fn load_unguarded(path: &Path, limits: &LoadLimits) -> Result<Scene, SceneError> {
     let file = path.to_path_buf();
     let mut budget = ByteBudget::new(limits.max_bytes);
     let bytes = read_scene_file(path, &mut budget)?;
+    check_glb_header(&bytes, &file)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| SceneError::Malformed {
             file: file.clone(),
-            detail: e.to_string(),
+            detail: match &e {
+                gltf::Error::Deserialize(json) => match json_context(&bytes, json) {
+                    Some(near) => format!("{e}, at `{near}`"),
+                    None => e.to_string(),
+                },
+                _ => e.to_string(),
+            },
         })?;
     drop(bytes);
 

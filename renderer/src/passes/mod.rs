@@ -47,6 +47,20 @@ impl<K: Kernel> Pass<K> {
         Self::from_shader(ctx, K::SHADER)
     }
 
+    /// [`Pass::new`] compiled for `traversal` rather than the context's (a kernel that traces).
+    pub fn for_traversal(
+        ctx: &Arc<Context>,
+        variant: &str,
+        traversal: crate::traversal::Traversal,
+    ) -> Result<Self> {
+        let shader = format!("{}.{variant}", K::SHADER);
+        let push = std::mem::size_of::<K::Push>() as u32;
+        Ok(Pass {
+            pipeline: ComputePipeline::shared_for(ctx, &shader, push, traversal)?,
+            kernel: PhantomData,
+        })
+    }
+
     fn from_shader(ctx: &Arc<Context>, shader: &str) -> Result<Self> {
         let push = std::mem::size_of::<K::Push>() as u32;
         Ok(Pass {

@@ -79,6 +79,8 @@ pub struct ContextOptions {
     /// Who creates the instance and device (and picks the physical device); `None`: the engine,
     /// by `device`.
     pub creator: Option<Arc<dyn DeviceCreator>>,
+    /// The BVH traversal of the kernels that trace (`auto`: by the device's type).
+    pub traversal: crate::traversal::TraversalChoice,
 }
 
 impl std::fmt::Debug for ContextOptions {
@@ -94,6 +96,7 @@ impl std::fmt::Debug for ContextOptions {
                 &self.require_storage_write_without_format,
             )
             .field("creator", &self.creator.as_ref().map(|_| "external"))
+            .field("traversal", &self.traversal)
             .finish()
     }
 }
@@ -120,6 +123,7 @@ pub struct DeviceInfo {
     pub index: usize,
     pub name: String,
     pub kind: String,
+    pub device_type: vk::PhysicalDeviceType,
     pub api_version: String,
     pub max_compute_workgroup_invocations: u32,
     pub max_storage_buffer_range: u32,
@@ -138,6 +142,9 @@ pub struct Context {
     pub queue: vk::Queue,
     pub queue_family: u32,
     pub info: DeviceInfo,
+    /// The BVH traversal pipelines and scene uploads use unless told otherwise
+    /// ([`ContextOptions::traversal`] resolved for this device).
+    pub traversal: crate::traversal::Traversal,
     pub push_descriptor: ash::khr::push_descriptor::Device,
     /// Present when VK_EXT_debug_utils is: names objects and labels passes.
     pub debug_utils: Option<ash::ext::debug_utils::Device>,
@@ -270,6 +277,7 @@ impl Context {
             queue,
             queue_family,
             info: chosen.clone(),
+            traversal: options.traversal.resolve(chosen.device_type),
             debug_instance,
             validation,
             allocator: Mutex::new(Some(allocator)),
@@ -534,6 +542,7 @@ fn list_devices(instance: &ash::Instance) -> Result<Vec<DeviceInfo>> {
                     .map(|c| c.to_string_lossy().into_owned())
                     .unwrap_or_default(),
                 kind: format!("{:?}", props.device_type),
+                device_type: props.device_type,
                 api_version: format!(
                     "{}.{}.{}",
                     vk::api_version_major(v),

@@ -125,12 +125,25 @@ impl ComputePipeline {
     }
 
     /// The one pipeline of `shader` on this context, built on first use and shared by every pass
-    /// and view that runs the kernel (stereo views share their pipelines).
+    /// and view that runs the kernel (stereo views share their pipelines). A kernel that traces
+    /// rays runs the context's BVH traversal ([`Context::traversal`]).
     pub fn shared(
         ctx: &Arc<Context>,
         shader: &str,
         push_size: u32,
     ) -> Result<Arc<ComputePipeline>> {
+        ComputePipeline::shared_for(ctx, shader, push_size, ctx.traversal)
+    }
+
+    /// [`ComputePipeline::shared`] with the kernel compiled for `traversal`.
+    pub fn shared_for(
+        ctx: &Arc<Context>,
+        shader: &str,
+        push_size: u32,
+        traversal: crate::traversal::Traversal,
+    ) -> Result<Arc<ComputePipeline>> {
+        let resolved = traversal.shader_name(shader);
+        let shader: &str = &resolved;
         let mut cache = ctx.pipelines.lock().expect("pipeline cache lock");
         let cached = cache.get(shader).and_then(|w| w.upgrade());
         if let Some(p) = cached.and_then(|p| p.downcast::<ComputePipeline>().ok()) {

@@ -4,6 +4,7 @@
 //! Cartesian comparison lives in `bench_vp.rs`, the real-time loop (frames in flight, stereo vs
 //! two mono renders, host CPU time) in `bench_loop.rs`.
 
+use super::bench_rays::{primary_rays, timed_trace};
 use anyhow::{bail, Result};
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -11,11 +12,13 @@ use fovea_renderer::layouts::{HitGpu, RayGpu};
 use fovea_renderer::passes::raycast::RayCaster;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::bvh::compressed::Bvh8;
 use fovea_renderer::scene::bvh::instanced::InstancingStats;
 use fovea_renderer::scene::bvh::wide::Bvh4;
 use fovea_renderer::scene::bvh::{Bvh, BvhBuilder, BvhStats};
 use fovea_renderer::scene::lights::{build_light_table, sample_alias, LightKind};
 use fovea_renderer::scene::{PunctualLight, Scene};
+use fovea_renderer::traversal::{Traversal, TraversalChoice};
 use glam::{UVec2, Vec3, Vec4};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -44,6 +47,10 @@ pub struct BenchArgs<'a> {
     pub loop_size: Option<(u32, u32)>,
     /// Timed frames of each loop run (after `bench_loop::WARMUP_FRAMES` warm-up frames).
     pub loop_frames: u32,
+    /// Scenes and per-eye sizes of the headset loop (`--loop-scenes`, `--loop-headsets`; no
+    /// scenes: skip it).
+    pub loop_scenes: &'a [String],
+    pub loop_headsets: &'a [super::bench_headsets::LoopHeadset],
     /// Keyframes the VP vs Cartesian frames follow and the ray rates are measured along
     /// (`--camera-path FILE`; none: the still camera).
     pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
@@ -52,6 +59,9 @@ pub struct BenchArgs<'a> {
     /// into `out` (`--dump-rays`, files `rays_*.bin`), for a CPU tracer to time the very same rays
     /// (`scripts/embree-rays`).
     pub dump_rays: bool,
+    /// `--traversal`: the ray figures and traversal counters are measured for each (after the
+    /// builders, A B … B A over every pair); frames, VP and the loop run the first.
+    pub traversals: &'a [TraversalChoice],
     pub device: Option<&'a str>,
     pub validation: bool,
 }
@@ -69,6 +79,8 @@ struct BvhReport {
     depth: u32,
     wide_depth: u32,
     wide_nodes: usize,
+    /// The compressed 8-wide tree of the GPU traversal collapsed from the same binary tree.
+    compressed: CompressedReport,
     stats: BvhStats,
     /// Instances and what instancing keeps off the GPU (the tree above is the world tree over
     /// the flattened triangles; `memory_bytes` counts it alone).
@@ -76,16 +88,29 @@ struct BvhReport {
 }
 
 #[derive(Serialize)]
+struct CompressedReport {
+    nodes: usize,
+    depth: u32,
+    /// Entries its traversal stack may need (`Bvh8::max_stack`; the shaders hold
+    /// `gpu_scene::MAX_BVH8_STACK`).
+    max_stack: u32,
+    /// 80 B per node plus 48 per leaf entry.
+    memory_bytes: usize,
+}
+
+#[derive(Serialize)]
 struct RayReport {
     scene: String,
     builder: String,
+    /// The traversal that traced these rays (cpu-driver or gpu).
+    traversal: String,
     /// 1 on the way there, 2 on the way back (A B … B A); a single builder measures once.
     pass: u32,
     width: u32,
     height: u32,
     primary_mrays_per_s: f64,
-    /// `null` when the scene has no light to aim shadow rays at (Sponza, the Breakfast Room: the
-    /// default sun is the renderer's, not the scene's).
+    /// `null` when the scene has no point-like light to aim shadow rays at (only an environment;
+    /// a scene its own lights do not light gets the default sun, as `fovea render` gives it).
     shadow_mrays_per_s: Option<f64>,
     indirect_mrays_per_s: f64,
     frame_passes_ms: BTreeMap<String, f64>,
@@ -94,8 +119,12 @@ struct RayReport {
     /// [`PATH_RAY_POSES`] frames spread over the keyframes (each a whole w×h frame of rays).
     ray_poses: usize,
     /// Primary rays whose hit (hit or miss, or distance beyond 1e-5 relative) differs from the
-    /// first builder's: every tree must find the same surfaces, so anything but 0 is a bug.
+    /// first builder's and traversal's: every tree and traversal must find the same surfaces, so
+    /// anything but 0 is a bug.
     primary_hits_differ: usize,
+    /// What the traversal read per ray of each set, counted on the device by the counting kernel
+    /// (on the way there only; `null` on the way back).
+    counters: Option<super::bench_counters::RaySetCounters>,
 }
 
 #[derive(Serialize)]
@@ -107,10 +136,12 @@ struct BenchReport {
     /// The real-time loop section (`null` when skipped).
     #[serde(rename = "loop")]
     real_time_loop: Option<super::bench_loop::LoopReport>,
+    /// The headset loop: one entry per scene and size (empty when skipped).
+    headset_loop: Vec<super::bench_headsets::HeadsetLoopReport>,
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    if args.loop_size.is_some() {
+    if args.loop_size.is_some() || !args.loop_scenes.is_empty() {
         super::bench_loop::check_frames(args.loop_frames)?;
     }
     let _out_dir = crate::output::prepare_output_dir(args.out)?;
@@ -121,9 +152,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         rays: Vec::new(),
         visual_polar: Vec::new(),
         real_time_loop: None,
+        headset_loop: Vec::new(),
     };
     for name in args.scenes {
-        let scene = crate::scenes::load(name)?;
+        let mut scene = crate::scenes::load(name)?;
+        // Lit as `fovea render` lights it: a scene its own emitters do not light (Sponza, the
+        // Breakfast Room) gets the default sun and sky, so its shadow rays aim at the sun.
+        if let Some(notice) =
+            crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())
+        {
+            println!("{notice}");
+        }
         let scene = if args.flatten {
             scene.flattened()
         } else {
@@ -136,6 +175,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let Some(camera) = scene.default_camera() else {
             bail!("{name}: no camera")
         };
+        // Each builder's tree, uploaded for each traversal: (builder, traversal, tree, upload).
+        let traversals = resolve_traversals(args.traversals, &ctx);
         let mut variants = Vec::new();
         for &builder in args.builders {
             let started = Instant::now();
@@ -143,7 +184,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let seconds = started.elapsed().as_secs_f64();
             let stats = bvh.stats(&positions);
             let wide = Bvh4::from_binary(&bvh);
-            let gpu = GpuScene::upload_with_bvh(&ctx, &scene, &positions, &bvh)?;
+            let eight = Bvh8::from_binary(&bvh, &positions);
+            let bvh = std::rc::Rc::new(bvh);
+            let mut instancing = None;
+            for &traversal in &traversals {
+                let gpu = GpuScene::upload_for(&ctx, &scene, &positions, &bvh, traversal)?;
+                instancing.get_or_insert_with(|| gpu.instancing_stats.clone());
+                variants.push((builder, traversal, bvh.clone(), gpu));
+            }
             let bvh_report = BvhReport {
                 scene: name.clone(),
                 builder: builder.name(),
@@ -154,12 +202,18 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 depth: bvh.depth(),
                 wide_depth: wide.depth(),
                 wide_nodes: wide.nodes.len(),
+                compressed: CompressedReport {
+                    nodes: eight.nodes.len(),
+                    depth: eight.depth(),
+                    max_stack: eight.max_stack(),
+                    memory_bytes: eight.memory_bytes(),
+                },
                 stats,
-                instancing: gpu.instancing_stats.clone(),
+                instancing: instancing.unwrap_or_default(),
             };
             let s = &bvh_report.stats;
             println!(
-                "{name} [{}]: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB on the GPU (4-wide: {} nodes, depth {}), binary depth {}, {} nodes, {} references, \
+                "{name} [{}]: BVH of {} triangles in {:.3} s ({:.2} M triangles/s), {:.1} MiB on the GPU (4-wide: {} nodes, depth {}; compressed 8-wide: {:.1} MiB, {} nodes, depth {}), binary depth {}, {} nodes, {} references, \
                  mean leaf {:.2} at depth {:.1}, SAH {:.1} (nodes {:.1}), child overlap {:.3}, {} thin / {} large triangles",
                 bvh_report.builder,
                 bvh_report.triangles,
@@ -168,6 +222,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 bvh_report.memory_bytes as f64 / (1 << 20) as f64,
                 bvh_report.wide_nodes,
                 bvh_report.wide_depth,
+                bvh_report.compressed.memory_bytes as f64 / (1 << 20) as f64,
+                bvh_report.compressed.nodes,
+                bvh_report.compressed.depth,
                 bvh_report.depth,
                 s.nodes,
                 s.references,
@@ -190,7 +247,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 inst.bytes_saved as f64 / (1 << 20) as f64
             );
             report.bvh.push(bvh_report);
-            variants.push((builder, bvh, gpu));
         }
         let mut caster = RayCaster::new(&ctx)?;
         // A B … B A: a drift of the machine's load over the run hits every builder alike.
@@ -206,15 +262,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let pose = CameraPose::from_scene_camera(camera, w, h);
             let poses = ray_poses(args.camera_path, &pose);
             let primary: Vec<RayGpu> = poses.iter().flat_map(|p| primary_rays(p, w, h)).collect();
-            // The secondary rays start from the first builder's hits so that every builder traces
-            // the same rays (hits may differ in the last bit between trees).
-            let (hits, _) = caster.trace(&variants[0].2, &primary, false)?;
+            // The secondary rays start from the first variant's hits so that every builder and
+            // traversal traces the same rays (hits may differ in the last bit between trees).
+            let (hits, _) = caster.trace(&variants[0].3, &primary, false)?;
             let (shadow, indirect) = secondary_rays(&scene, &placed, &primary, &hits);
             if args.dump_rays {
                 dump_rays(args.out, name, (w, h), &placed, &primary, &indirect)?;
             }
             for &(v, pass) in &order {
-                let (builder, bvh, gpu) = &variants[v];
+                let (builder, traversal, bvh, gpu) = &variants[v];
                 let (primary_hits, primary_ms) = timed_trace(&mut caster, gpu, &primary, false)?;
                 let primary_hits_differ = hits
                     .iter()
@@ -231,8 +287,21 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 };
                 let (_, indirect_ms) = timed_trace(&mut caster, gpu, &indirect, false)?;
                 let rate = |n: usize, ms: f64| n as f64 / (ms * 1e-3) * 1e-6;
-                // Whole frames once per builder (on the way there).
-                let (sums, frame_rays) = if pass == 1 {
+                // What each ray read, counted once per variant (untimed).
+                let counters = if pass == 1 {
+                    Some(super::bench_counters::count_sets(
+                        &mut caster,
+                        gpu,
+                        &primary,
+                        &shadow,
+                        &indirect,
+                    )?)
+                } else {
+                    None
+                };
+                // Whole frames once per builder (on the way there), with the context's traversal
+                // (the renderer's kernels run it).
+                let (sums, frame_rays) = if pass == 1 && *traversal == ctx.traversal {
                     let space = Box::new(Cartesian::new(UVec2::new(w, h)));
                     let upload = GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?;
                     let mut renderer =
@@ -249,6 +318,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 let r = RayReport {
                     scene: name.clone(),
                     builder: builder.name(),
+                    traversal: traversal.name().to_string(),
                     pass,
                     width: w,
                     height: h,
@@ -259,10 +329,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     frame_rays,
                     ray_poses: poses.len(),
                     primary_hits_differ,
+                    counters,
                 };
                 println!(
-                    "{name} {w}×{h} [{} pass {pass}]: primary {:.2} Mrays/s, shadow {}, indirect {:.2} Mrays/s; frame passes (ms) {:?} (load {}); {} primary hits differ from the first builder's",
+                    "{name} {w}×{h} [{}, {} traversal, pass {pass}]: primary {:.2} Mrays/s, shadow {}, indirect {:.2} Mrays/s; frame passes (ms) {:?} (load {}); {} primary hits differ from the first builder's and traversal's",
                     r.builder,
+                    r.traversal,
                     r.primary_mrays_per_s,
                     r.shadow_mrays_per_s.map_or("- (no light)".into(), |m| format!("{m:.2} Mrays/s")),
                     r.indirect_mrays_per_s,
@@ -270,19 +342,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     load_average(),
                     r.primary_hits_differ
                 );
+                if let Some(c) = &r.counters {
+                    super::bench_counters::print(name, (w, h), &r.builder, &r.traversal, c);
+                }
                 report.rays.push(r);
             }
         }
-        let (_, bvh, _) = &variants[0];
+        let bvh = &variants[0].2;
         for &size in args.vp_sizes {
             let make_scene = || Ok(GpuScene::upload_with_bvh(&ctx, &scene, &positions, bvh)?);
-            report.visual_polar.push(super::bench_vp::measure(
-                &ctx,
+            let scene = super::bench_vp::VpBenchScene {
+                ctx: &ctx,
                 name,
-                &make_scene,
-                &mut caster,
+                make_scene: &make_scene,
+                caster: &mut caster,
                 camera,
-                args.camera_path,
+                camera_path: args.camera_path,
+            };
+            report.visual_polar.push(super::bench_vp::measure(
+                scene,
                 size,
                 args.vp_gaze,
                 args.frames,
@@ -292,11 +370,37 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if let Some(size) = args.loop_size {
         report.real_time_loop = Some(super::bench_loop::measure(&ctx, size, args.loop_frames)?);
     }
+    if !args.loop_scenes.is_empty() {
+        report.headset_loop = super::bench_headsets::measure(
+            &ctx,
+            args.loop_scenes,
+            args.loop_headsets,
+            args.loop_frames,
+        )?;
+    }
     super::check_validation(&ctx)?;
     let path = args.out.join("report.json");
     crate::output::write_json(&path, &report)?;
     println!("wrote {}", path.display());
     Ok(())
+}
+
+/// `--traversal`'s choices resolved for the device, each once, in the order given.
+fn resolve_traversals(
+    choices: &[TraversalChoice],
+    ctx: &fovea_renderer::vk::Context,
+) -> Vec<Traversal> {
+    let mut out: Vec<Traversal> = Vec::new();
+    for c in choices {
+        let t = c.resolve(ctx.info.device_type);
+        if !out.contains(&t) {
+            out.push(t);
+        }
+    }
+    if out.is_empty() {
+        out.push(ctx.traversal);
+    }
+    out
 }
 
 /// The 1-minute load average (`/proc/loadavg`), printed beside each ray figure: on a shared
@@ -306,26 +410,6 @@ fn load_average() -> String {
         .ok()
         .and_then(|s| s.split_whitespace().next().map(str::to_owned))
         .unwrap_or_else(|| "?".into())
-}
-
-/// Runs of each ray set after the untimed warm-up; the median GPU time is reported.
-const TIMED_RUNS: usize = 5;
-
-/// Traces `rays` once untimed (warm-up), then `TIMED_RUNS` times; returns the hits and the
-/// median GPU milliseconds.
-pub(crate) fn timed_trace(
-    caster: &mut RayCaster,
-    gpu: &GpuScene,
-    rays: &[RayGpu],
-    any_hit: bool,
-) -> Result<(Vec<HitGpu>, f64)> {
-    let (hits, _) = caster.trace(gpu, rays, any_hit)?;
-    let mut ms = Vec::with_capacity(TIMED_RUNS);
-    for _ in 0..TIMED_RUNS {
-        ms.push(caster.trace(gpu, rays, any_hit)?.1);
-    }
-    ms.sort_by(f64::total_cmp);
-    Ok((hits, ms[TIMED_RUNS / 2]))
 }
 
 /// Frames of primary rays the ray-rate figures take along a camera path: its start, its end and
@@ -346,25 +430,6 @@ fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) 
             )
         })
         .collect()
-}
-
-pub(super) fn primary_rays(pose: &CameraPose, w: u32, h: u32) -> Vec<RayGpu> {
-    let origin = pose.world_from_view.w_axis.truncate();
-    let t = pose.fov_tan;
-    let mut rays = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let fx = (x as f32 + 0.5) / w as f32;
-            let fy = (y as f32 + 0.5) / h as f32;
-            let view = Vec3::new(t.x + fx * (t.y - t.x), t.w + fy * (t.z - t.w), -1.0);
-            let dir = pose.world_from_view.transform_vector3(view).normalize();
-            rays.push(RayGpu {
-                origin_tmin: origin.extend(0.0),
-                direction_tmax: dir.extend(1e30),
-            });
-        }
-    }
-    rays
 }
 
 /// `DIR/rays_SCENE-WxH.{triangles,primary,indirect}.bin`: little-endian f32, 9 per triangle

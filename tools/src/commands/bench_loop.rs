@@ -16,7 +16,10 @@ use fovea_hal::{Eye, HmdDescription};
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::pipeline::Renderer;
+use fovea_renderer::scene::bvh::Bvh;
+use fovea_renderer::scene::Scene;
 use fovea_renderer::vk::{Context, EngineCounters};
+use glam::{Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -99,13 +102,18 @@ pub struct LoopRun {
 type Spec = &'static [Eye];
 
 /// One run's renderers and their frame slots.
-struct Config {
+pub(super) struct Config {
     specs: &'static [Spec],
     in_flight: usize,
 }
 
 const STEREO: &[Spec] = &[&[Eye::Left, Eye::Right]];
 const TWO_MONO: &[Spec] = &[&[Eye::Left], &[Eye::Right]];
+/// The stereo renderer with 2 frames in flight (the headset loop's one run shape).
+pub(super) const STEREO_2: Config = Config {
+    specs: STEREO,
+    in_flight: 2,
+};
 const CONFIGS: [Config; 3] = [
     Config {
         specs: STEREO,
@@ -123,15 +131,57 @@ const CONFIGS: [Config; 3] = [
 /// Forwards, then backwards.
 const ORDER: [usize; 6] = [0, 1, 2, 2, 1, 0];
 
+/// A scene with its world tree, built once for every loop run over it (each run uploads it).
+pub struct LoopScene {
+    pub name: String,
+    scene: Scene,
+    positions: Vec<[Vec3; 3]>,
+    bvh: Bvh,
+}
+
+impl LoopScene {
+    /// Loads `name` lit as `fovea render` lights it (the default sun and sky where the scene's
+    /// own emitters do not light it) and builds its tree.
+    pub fn load(name: &str) -> Result<LoopScene> {
+        let mut scene = crate::scenes::load(name)?;
+        if let Some(notice) =
+            crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())
+        {
+            println!("{notice}");
+        }
+        let positions = scene.flat_positions();
+        let bvh = Bvh::build(&positions);
+        Ok(LoopScene {
+            name: name.to_string(),
+            scene,
+            positions,
+            bvh,
+        })
+    }
+}
+
+/// The moving head and gaze of a run: the default orbit over the run's frames and the simulated
+/// gaze (`--gaze sim:1`), each eye's gaze point per frame.
+struct Motion {
+    scene_centre: Vec3,
+    frames: u32,
+    gazes: Vec<[Vec2; 2]>,
+}
+
+/// The simulated gaze of the moving runs (as `fovea render --gaze sim:1`).
+pub const MOVING_GAZE: &str = "sim:1";
+
 /// What every run shares: the scene, the eyes' cameras and gazes, the settings.
-struct LoopSetup {
-    scene: fovea_renderer::scene::Scene,
+pub(super) struct LoopSetup<'a> {
+    scene: &'a LoopScene,
     hmd: HmdDescription,
+    method: String,
     profile: RenderProfile,
     settings: RenderSettings,
     screen: glam::UVec2,
     head: CameraPose,
     rig: EyeRig,
+    motion: Option<Motion>,
 }
 
 /// `--loop-frames` checked (before the bench's other, slower parts run).
@@ -144,7 +194,9 @@ pub fn check_frames(frames: u32) -> Result<()> {
 
 pub fn measure(ctx: &Arc<Context>, (width, height): (u32, u32), frames: u32) -> Result<LoopReport> {
     check_frames(frames)?;
-    let setup = LoopSetup::new(width, height)?;
+    let scene = LoopScene::load(LOOP_SCENE)?;
+    let hmd = HmdDescription::resolve(HEADSET).with_context(|| format!("headset {HEADSET}"))?;
+    let setup = LoopSetup::new(&scene, hmd, (width, height), (METHOD, DENOISER), None)?;
     let mut sums: [Sums; 3] = Default::default();
     for i in ORDER {
         sums[i].add(run(ctx, &setup, &CONFIGS[i], frames)?);
@@ -172,20 +224,26 @@ pub fn measure(ctx: &Arc<Context>, (width, height): (u32, u32), frames: u32) -> 
     Ok(report)
 }
 
-impl LoopSetup {
-    fn new(width: u32, height: u32) -> Result<LoopSetup> {
-        let hmd = HmdDescription::resolve(HEADSET).with_context(|| format!("headset {HEADSET}"))?;
+impl<'a> LoopSetup<'a> {
+    /// `moving`: `Some(frames)` moves the head along the default orbit and the gaze as the
+    /// simulated gaze over that many frames; `None` keeps the scene camera and the centred gaze.
+    pub(super) fn new(
+        scene: &'a LoopScene,
+        hmd: HmdDescription,
+        (width, height): (u32, u32),
+        (method, denoiser): (&str, &str),
+        moving: Option<u32>,
+    ) -> Result<LoopSetup<'a>> {
         let profile = RenderProfile::default();
-        let (denoiser, taa) = filters(DENOISER, "off", &profile)?;
+        let (denoiser, taa) = filters(denoiser, "off", &profile)?;
         let settings = RenderSettings {
             blur: profile.blur,
             denoiser,
             taa,
             ..Default::default()
         };
-        let scene = crate::scenes::load(LOOP_SCENE)?;
-        let Some(camera) = scene.default_camera() else {
-            bail!("{LOOP_SCENE}: no camera")
+        let Some(camera) = scene.scene.default_camera() else {
+            bail!("{}: no camera", scene.name)
         };
         let rig = EyeRig {
             projection: Projection::Headset,
@@ -196,14 +254,36 @@ impl LoopSetup {
             metres_per_unit: 1.0,
         };
         let head = rig.head(camera);
+        let motion = match moving {
+            None => None,
+            Some(frames) => {
+                let mut gaze = crate::gaze::GazeDriver::open_timed(
+                    MOVING_GAZE,
+                    &hmd,
+                    width,
+                    height,
+                    &profile.gaze_timing,
+                )?;
+                let gazes = (0..frames)
+                    .map(|f| Ok(gaze.frame(f, &[Eye::Left, Eye::Right])?.pixels))
+                    .collect::<Result<_>>()?;
+                Some(Motion {
+                    scene_centre: scene.scene.bounds().center(),
+                    frames,
+                    gazes,
+                })
+            }
+        };
         Ok(LoopSetup {
             rig,
             scene,
             hmd,
+            method: method.to_string(),
             profile,
             settings,
             screen: glam::UVec2::new(width, height),
             head,
+            motion,
         })
     }
 
@@ -217,10 +297,11 @@ impl LoopSetup {
     ) -> Result<(Renderer, i64)> {
         let spaces = eyes
             .iter()
-            .map(|&eye| space_for(METHOD, &self.profile, &self.hmd, eye, self.screen))
+            .map(|&eye| space_for(&self.method, &self.profile, &self.hmd, eye, self.screen))
             .collect::<Result<_>>()?;
         let before = ctx.allocated_bytes();
-        let scene = GpuScene::upload(ctx, &self.scene)?;
+        let s = self.scene;
+        let scene = GpuScene::upload_with_bvh(ctx, &s.scene, &s.positions, &s.bvh)?;
         let scene_bytes = ctx.allocated_bytes() - before;
         Ok((
             Renderer::with_views(ctx, scene, spaces, self.settings, in_flight)?,
@@ -228,17 +309,37 @@ impl LoopSetup {
         ))
     }
 
-    /// Frame `frame` of `eyes`: the still head pose offset by each eye, gaze at the centre.
+    /// Frame `frame` of `eyes`: the head pose (still, or on the orbit) offset by each eye, the
+    /// gaze at the centre or the simulated gaze.
     fn input(&self, eyes: Spec, frame: u32) -> Result<FrameInput> {
-        let gaze = Some(self.screen.as_vec2() * 0.5);
+        let centre = self.screen.as_vec2() * 0.5;
+        let head = match &self.motion {
+            None => self.head,
+            Some(m) => crate::camera_path::pose(
+                &self.head,
+                m.scene_centre,
+                frame,
+                m.frames,
+                &crate::camera_path::CameraMotion::Orbit,
+                self.hmd.refresh_hz,
+            ),
+        };
         let views: Vec<ViewInput> = eyes
             .iter()
             .map(|&eye| ViewInput {
-                camera: self.rig.eye(&self.head, eye),
-                gaze,
+                camera: self.rig.eye(&head, eye),
+                gaze: Some(match &self.motion {
+                    None => centre,
+                    Some(m) => m.gazes[frame as usize][eye.index()],
+                }),
             })
             .collect();
-        Ok(FrameInput::views(&views, frame)?)
+        let mut input = FrameInput::views(&views, frame)?;
+        if self.motion.is_some() {
+            // Frames follow each other at the headset's refresh (the orbit's clock too).
+            input.frame_seconds = 1.0 / self.hmd.refresh_hz;
+        }
+        Ok(input)
     }
 }
 
@@ -294,7 +395,7 @@ impl Counts {
 
 /// One run's sums over its timed frames, over every time it was made.
 #[derive(Default)]
-struct Sums {
+pub(super) struct Sums {
     renderers: usize,
     views_per_renderer: usize,
     in_flight: usize,
@@ -309,7 +410,7 @@ struct Sums {
 }
 
 impl Sums {
-    fn add(&mut self, other: Sums) {
+    pub(super) fn add(&mut self, other: Sums) {
         let first = self.frames == 0;
         for (pass, ms) in other.pass_ms {
             *self.pass_ms.entry(pass).or_default() += ms;
@@ -331,7 +432,7 @@ impl Sums {
         self.in_flight = other.in_flight;
     }
 
-    fn report(self) -> LoopRun {
+    pub(super) fn report(self) -> LoopRun {
         let n = self.frames as f64;
         let passes_ms: BTreeMap<String, f64> =
             self.pass_ms.into_iter().map(|(k, v)| (k, v / n)).collect();
@@ -358,7 +459,12 @@ impl Sums {
 }
 
 /// Runs `WARMUP_FRAMES + frames` frames of `config` on fresh renderers (one scene upload each).
-fn run(ctx: &Arc<Context>, setup: &LoopSetup, config: &Config, frames: u32) -> Result<Sums> {
+pub(super) fn run(
+    ctx: &Arc<Context>,
+    setup: &LoopSetup,
+    config: &Config,
+    frames: u32,
+) -> Result<Sums> {
     let (specs, in_flight) = (config.specs, config.in_flight);
     let bytes_before = ctx.allocated_bytes();
     let (mut renderers, scene_bytes): (Vec<Renderer>, Vec<i64>) = specs
@@ -489,4 +595,59 @@ fn print_summary(r: &LoopReport, device: &str) {
         "2 vs 1 in flight: {:.3}× frames/s; stereo / (2 × mono): frame time {:.3}, GPU ms {:.3}, GPU bytes {:.3}",
         r.in_flight_2_vs_1_fps, r.stereo_vs_two_mono_frame_time, r.stereo_vs_two_mono_gpu_ms, r.stereo_vs_two_mono_bytes
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A moving setup swings the head along the orbit from the still pose, gives each eye the
+    /// simulated gaze of that frame and spaces frames by the headset's refresh; a still one keeps
+    /// the head and the centred gaze.
+    #[test]
+    fn moving_runs_follow_the_orbit_and_the_simulated_gaze() {
+        let scene = LoopScene::load(LOOP_SCENE).unwrap();
+        let hmd = HmdDescription::resolve("psvr2").unwrap();
+        let (size, frames) = ((96, 108), 180);
+        let moving =
+            LoopSetup::new(&scene, hmd.clone(), size, (METHOD, DENOISER), Some(frames)).unwrap();
+        let still = LoopSetup::new(&scene, hmd.clone(), size, (METHOD, DENOISER), None).unwrap();
+        let mut gaze = crate::gaze::GazeDriver::open_timed(
+            MOVING_GAZE,
+            &hmd,
+            size.0,
+            size.1,
+            &RenderProfile::default().gaze_timing,
+        )
+        .unwrap();
+        let centre = Vec2::new(48.0, 54.0);
+        let still_views = still.input(STEREO[0], 0).unwrap().view_inputs().to_vec();
+        let mut gazes_seen = Vec::new();
+        for f in 0..frames {
+            let input = moving.input(STEREO[0], f).unwrap();
+            assert_eq!(input.frame_seconds, 1.0 / hmd.refresh_hz);
+            let expected = gaze.frame(f, &[Eye::Left, Eye::Right]).unwrap().pixels;
+            for (i, view) in input.view_inputs().iter().enumerate() {
+                assert_eq!(view.gaze, Some(expected[i]), "frame {f}, view {i}");
+                // Phase 0 of the swing is the still pose; a quarter of the run later it is 8° off.
+                let forward = |c: &CameraPose| c.world_from_view.z_axis.truncate().normalize();
+                let degrees = forward(&view.camera)
+                    .angle_between(forward(&still_views[i].camera))
+                    .to_degrees();
+                if f == 0 {
+                    assert_eq!(view.camera, still_views[i].camera, "view {i}");
+                } else if f == frames / 4 {
+                    assert!((degrees - 8.0).abs() < 1e-2, "view {i}: {degrees}°");
+                }
+            }
+            gazes_seen.push(expected[0]);
+            let s = still.input(STEREO[0], f).unwrap();
+            assert!(s.view_inputs().iter().all(|v| v.gaze == Some(centre)));
+            assert_eq!(s.view_inputs()[0].camera, still_views[0].camera);
+        }
+        assert!(
+            gazes_seen.iter().any(|g| *g != gazes_seen[0]),
+            "the simulated gaze never moved in {frames} frames"
+        );
+    }
 }

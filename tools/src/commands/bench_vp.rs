@@ -292,18 +292,31 @@ fn frame_ms(passes: &BTreeMap<String, f64>) -> f64 {
         .sum()
 }
 
-#[allow(clippy::too_many_arguments)]
+/// What a Visual-Polar frame measurement renders: the device, the scene (its name and a fresh GPU
+/// upload per renderer), the ray caster of the ray-order figures, the camera and its path.
+pub struct VpBenchScene<'a> {
+    pub ctx: &'a std::sync::Arc<fovea_renderer::vk::Context>,
+    pub name: &'a str,
+    pub make_scene: &'a dyn Fn() -> Result<GpuScene>,
+    pub caster: &'a mut RayCaster,
+    pub camera: &'a fovea_renderer::scene::Camera,
+    pub camera_path: Option<&'a CameraKeys>,
+}
+
 pub fn measure(
-    ctx: &std::sync::Arc<fovea_renderer::vk::Context>,
-    scene_name: &str,
-    make_scene: &dyn Fn() -> Result<GpuScene>,
-    caster: &mut RayCaster,
-    camera: &fovea_renderer::scene::Camera,
-    camera_path: Option<&CameraKeys>,
+    scene: VpBenchScene,
     (w, h): (u32, u32),
     gaze_fraction: Vec2,
     frames: u32,
 ) -> Result<VpFrameReport> {
+    let VpBenchScene {
+        ctx,
+        name: scene_name,
+        make_scene,
+        caster,
+        camera,
+        camera_path,
+    } = scene;
     let screen = UVec2::new(w, h);
     let gaze = screen.as_vec2() * gaze_fraction;
     let pose = CameraPose::from_scene_camera(camera, w, h);
@@ -460,13 +473,13 @@ pub fn measure(
 
     let rays = vp_primary_rays(&vp, &pose);
     let gpu = make_scene()?;
-    let (_, ordered_ms) = super::bench::timed_trace(caster, &gpu, &rays, false)?;
+    let (_, ordered_ms) = super::bench_rays::timed_trace(caster, &gpu, &rays, false)?;
     let shuffled = shuffle(rays.clone());
-    let (_, shuffled_ms) = super::bench::timed_trace(caster, &gpu, &shuffled, false)?;
-    let screen_rays = super::bench::primary_rays(&pose, w, h);
-    let (_, screen_ms) = super::bench::timed_trace(caster, &gpu, &screen_rays, false)?;
+    let (_, shuffled_ms) = super::bench_rays::timed_trace(caster, &gpu, &shuffled, false)?;
+    let screen_rays = super::bench_rays::primary_rays(&pose, w, h);
+    let (_, screen_ms) = super::bench_rays::timed_trace(caster, &gpu, &screen_rays, false)?;
     let (_, screen_shuffled_ms) =
-        super::bench::timed_trace(caster, &gpu, &shuffle(screen_rays.clone()), false)?;
+        super::bench_rays::timed_trace(caster, &gpu, &shuffle(screen_rays.clone()), false)?;
     let rate = |ms: f64| rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let screen_rate = |ms: f64| screen_rays.len() as f64 / (ms * 1e-3) * 1e-6;
     let grid = vp.grid_size();

@@ -22,6 +22,10 @@ pub fn run(device: Option<&str>) -> Result<()> {
     let i = &ctx.info;
     println!("\nchosen: [{}] {}", i.index, i.name);
     println!(
+        "  BVH traversal:                     {} (--traversal)",
+        ctx.traversal.name()
+    );
+    println!(
         "  max compute workgroup invocations: {}",
         i.max_compute_workgroup_invocations
     );

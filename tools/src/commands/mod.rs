@@ -1,5 +1,8 @@
 pub mod bench;
+mod bench_counters;
+pub mod bench_headsets;
 mod bench_loop;
+mod bench_rays;
 pub mod bench_vp;
 pub mod debug_views;
 pub mod eval;
@@ -11,6 +14,7 @@ pub mod method_table;
 pub mod methods;
 pub mod overview;
 pub mod quality;
+mod quality_stereo;
 pub mod reference;
 pub mod render;
 pub mod render_args;
@@ -21,8 +25,17 @@ pub mod xr;
 mod xr_report;
 
 use anyhow::{Context as _, Result};
+use fovea_renderer::traversal::TraversalChoice;
 use fovea_renderer::vk::{Context, ContextOptions, DeviceSelector};
 use std::sync::Arc;
+
+/// The BVH traversal every device this process opens runs (`--traversal`; auto unless chosen).
+static TRAVERSAL: std::sync::OnceLock<TraversalChoice> = std::sync::OnceLock::new();
+
+/// Sets the process's `--traversal` (the first call wins: a command chooses once).
+pub fn choose_traversal(choice: TraversalChoice) {
+    let _ = TRAVERSAL.set(choice);
+}
 
 /// Opens the Vulkan device. Validation is on in debug builds and with `--validation`.
 pub fn open_device(device: Option<&str>, validation: bool) -> Result<Arc<Context>> {
@@ -36,6 +49,7 @@ pub fn device_options(device: Option<&str>, validation: bool) -> ContextOptions 
         device: device
             .map(|d| d.parse::<DeviceSelector>().expect("infallible"))
             .unwrap_or_default(),
+        traversal: TRAVERSAL.get().copied().unwrap_or_default(),
         ..Default::default()
     }
 }

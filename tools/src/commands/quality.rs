@@ -4,22 +4,27 @@
 //! `DIR/run_*`; its last `--eval-frames` frames are compared with converged Cartesian references of
 //! the same camera poses (`DIR/reference_*.exr`), per ring of eccentricity around each frame's own
 //! gaze, and the ring metrics are averaged over those frames → `DIR/quality.json` +
-//! `DIR/quality.md`.
+//! `DIR/quality.md`. With `--eyes both` every run renders both eyes, each eye is judged against
+//! its own reference, and the binocular consistency measure (`quality_stereo`) compares the eyes.
 
+use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
+use super::setup::Eyes;
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
 use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
-use fovea_renderer::frame::RenderSettings;
+use fovea_hal::Eye;
+use fovea_renderer::frame::{CameraPose, RenderSettings, StereoNoise};
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::passes::resampling::ResamplingMode;
 use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
+use fovea_renderer::scene::Scene;
 use glam::{UVec2, Vec2};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -43,6 +48,11 @@ pub struct QualityArgs<'a> {
     pub rings: usize,
     pub seed: u32,
     pub profile: RenderProfile,
+    /// `left` or `both` (stereo runs, the binocular consistency measure added).
+    pub eyes: Eyes,
+    /// How the eyes' random numbers relate, one run each; empty: the profile's, and the run
+    /// folders keep their names without it.
+    pub stereo_noises: &'a [StereoNoise],
     pub camera: &'a crate::look::CameraOptions,
     pub out: &'a Path,
     pub device: Option<&'a str>,
@@ -58,6 +68,8 @@ pub struct RunQuality {
     method: String,
     denoiser: String,
     taa: String,
+    /// How the eyes' random numbers related (`--stereo-noise`).
+    stereo_noise: String,
     frame_gpu_ms: f64,
     /// Samples and rays per frame (the run's mean, its report.json).
     samples_traced: u64,
@@ -65,6 +77,7 @@ pub struct RunQuality {
     /// Frames whose metrics are averaged, and their gaze points (render pixels).
     frames: Vec<u32>,
     gaze: Vec<[f32; 2]>,
+    /// The left eye's (the only one of a one-eye run).
     rings: Vec<RingMean>,
     frame_rmse: f64,
     frame_ssim: f64,
@@ -86,14 +99,38 @@ pub struct RunQuality {
     foveal_flip: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     foveal_flip_true_gaze: Option<f64>,
+    /// A stereo run (`--eyes both`): the binocular consistency measure (`quality_stereo`) and
+    /// the right eye's own quality.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    binocular: Option<Binocular>,
+}
+
+/// quality.json's `binocular`: the measure, and the right eye judged as the left is (its rings
+/// around its own gaze).
+#[derive(Serialize, Deserialize)]
+struct Binocular {
+    #[serde(flatten)]
+    measure: BinocularQuality,
+    right_eye: EyeQuality,
+}
+
+/// One eye's quality against its own reference.
+#[derive(Serialize, Deserialize)]
+struct EyeQuality {
+    rings: Vec<RingMean>,
+    frame_rmse: f64,
+    frame_ssim: f64,
+    frame_flip: f64,
+    frame_flicker: Option<f64>,
 }
 
 /// Rings of the fovea in `foveal_flip*`: the innermost two.
 const FOVEAL_RINGS: usize = 2;
 
 /// A combination the method cannot run (a denoiser or TAA on a space without temporal filters):
-/// listed in the table with the reason instead of silently left out.
-#[derive(Serialize, Deserialize)]
+/// listed in the table with the reason instead of silently left out (once, whatever the stereo
+/// noise).
+#[derive(Serialize, Deserialize, PartialEq)]
 pub struct RefusedRun {
     camera: String,
     method: String,
@@ -120,6 +157,8 @@ struct Report<'a> {
     height: u32,
     headset: &'a str,
     gaze_source: &'a str,
+    /// `left` or `both`.
+    eyes: &'static str,
     frames: u32,
     eval_frames: u32,
     reference_spp: u32,
@@ -203,19 +242,25 @@ fn resampling_refusal(args: &QualityArgs, combination: &Combination) -> Option<R
     })
 }
 
-/// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser and a TAA mode.
+/// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser, a TAA mode and,
+/// where `--stereo-noise` is given, how the eyes' random numbers relate.
 pub struct Combination<'a> {
     pub camera: &'a str,
     pub method: &'a str,
     pub denoiser: &'a str,
     pub taa: &'a str,
+    /// `None`: the profile's, and the folder named as without `--stereo-noise`.
+    pub noise: Option<StereoNoise>,
 }
 
 impl Combination<'_> {
     /// The `fovea render` folder of this combination inside the output folder.
     pub fn run_dir_name(&self) -> String {
+        let noise = self
+            .noise
+            .map_or(String::new(), |n| format!("_noise-{}", n.name()));
         format!(
-            "run_{}_{}_{}_taa-{}",
+            "run_{}_{}_{}_taa-{}{noise}",
             self.camera, self.method, self.denoiser, self.taa
         )
     }
@@ -236,11 +281,20 @@ impl Combination<'_> {
     }
 }
 
-/// What one combination gives: its metrics, or why the method cannot run it.
+/// The stereo noises of the grid: `--stereo-noise`'s, or only the profile's (`None`).
+pub fn stereo_noises(args: &QualityArgs) -> Vec<Option<StereoNoise>> {
+    match args.stereo_noises {
+        [] => vec![None],
+        given => given.iter().copied().map(Some).collect(),
+    }
+}
+
+/// What one combination gives: its metrics (boxed: a stereo run's outweigh a refusal), or why
+/// the method cannot run it.
 #[derive(Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
-    Run(RunQuality),
+    Run(Box<RunQuality>),
     Refused(RefusedRun),
 }
 
@@ -259,6 +313,9 @@ pub fn prepare(args: &QualityArgs) -> Result<Prepared> {
     check_names("--denoisers", args.denoisers, DenoiserSettings::NAMES)?;
     check_names("--taa", args.taa, TaaMode::NAMES)?;
     check_names("--cameras", args.cameras, CAMERAS)?;
+    if args.eyes == Eyes::Right {
+        bail!("--eyes right: fovea quality judges the left eye or both (left, both)");
+    }
     if args.eval_frames == 0 || args.eval_frames > args.frames {
         bail!(
             "--eval-frames {} must be in 1..={} (--frames)",
@@ -302,6 +359,7 @@ pub fn prepare(args: &QualityArgs) -> Result<Prepared> {
 pub fn run(args: &QualityArgs) -> Result<()> {
     let prepared = prepare(args)?;
     let _out_dir = prepare_output_dir(args.out)?;
+    let noises = stereo_noises(args);
     let mut outcomes = Vec::new();
     for camera in args.cameras {
         let references = references(args, camera, &prepared.evaluated)?;
@@ -317,28 +375,31 @@ pub fn run(args: &QualityArgs) -> Result<()> {
             };
             for denoiser in args.denoisers {
                 for taa in args.taa {
-                    let combination = Combination {
-                        camera,
-                        method,
-                        denoiser,
-                        taa,
-                    };
-                    let dir = args.out.join(combination.run_dir_name());
-                    let needs_filters = resampled(args) || combination.filtered();
-                    let refused = match (&refusal, needs_filters) {
-                        (Some(reason), true) => Some(combination.refused(reason.clone())),
-                        _ => resampling_refusal(args, &combination),
-                    };
-                    outcomes.push(match refused {
-                        Some(refused) => Outcome::Refused(refused),
-                        None => Outcome::Run(run_combination(
-                            args,
-                            &prepared,
-                            &combination,
-                            &references,
-                            &dir,
-                        )?),
-                    });
+                    for &noise in &noises {
+                        let combination = Combination {
+                            camera,
+                            method,
+                            denoiser,
+                            taa,
+                            noise,
+                        };
+                        let dir = args.out.join(combination.run_dir_name());
+                        let needs_filters = resampled(args) || combination.filtered();
+                        let refused = match (&refusal, needs_filters) {
+                            (Some(reason), true) => Some(combination.refused(reason.clone())),
+                            _ => resampling_refusal(args, &combination),
+                        };
+                        outcomes.push(match refused {
+                            Some(refused) => Outcome::Refused(refused),
+                            None => Outcome::Run(Box::new(run_combination(
+                                args,
+                                &prepared,
+                                &combination,
+                                &references,
+                                &dir,
+                            )?)),
+                        });
+                    }
                 }
             }
         }
@@ -362,13 +423,14 @@ pub fn refusal(
         .map(|reason| combination.refused(reason)))
 }
 
-/// Renders one combination into `dir` (a `fovea render` folder) and measures its evaluated frames
-/// against `references` (one per evaluated frame).
+/// Renders one combination into `dir` (a `fovea render` folder, both eyes in a stereo run) and
+/// measures its evaluated frames against `references`: each eye against its own, and in a stereo
+/// run the eyes against each other.
 pub fn run_combination(
     args: &QualityArgs,
     prepared: &Prepared,
     combination: &Combination,
-    references: &[Vec<[f32; 4]>],
+    references: &References,
     dir: &Path,
 ) -> Result<RunQuality> {
     let Combination {
@@ -376,7 +438,12 @@ pub fn run_combination(
         method,
         denoiser,
         taa,
+        noise,
     } = *combination;
+    let mut profile = args.profile.clone();
+    if let Some(noise) = noise {
+        profile.stereo_noise = noise;
+    }
     let render_args = RenderArgs {
         scene: args.scene,
         method,
@@ -398,32 +465,64 @@ pub fn run_combination(
         // Every method is judged at one fixed exposure and curve, its reference's
         // (`tonemap_preview`).
         exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
-        tone: fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        tone: ToneCurve::Aces,
         overview: false,
-        profile: args.profile.clone(),
+        profile: profile.clone(),
         debug_views: false,
         denoiser,
         taa,
         device: args.device,
         validation: args.validation,
-        eyes: super::setup::Eyes::Left,
+        eyes: args.eyes,
         frames_in_flight: 2,
         camera: args.camera,
     };
-    render::run(&render_args)
-        .with_context(|| format!("{camera} camera, {method} + {denoiser}, taa {taa}"))?;
-    let mut q = measure(args, dir, &prepared.evaluated, references, prepared.ppd)?;
-    (q.camera, q.method, q.denoiser, q.taa) = (
+    let what = format!(
+        "{camera} camera, {method} + {denoiser}, taa {taa}, stereo noise {}",
+        profile.stereo_noise.name()
+    );
+    render::run(&render_args).with_context(|| what.clone())?;
+    let evaluated = &prepared.evaluated;
+    let stereo = references.stereo.as_ref();
+    let left = match stereo {
+        Some(_) => EyeFiles::LEFT,
+        None => EyeFiles::MONO,
+    };
+    let mut q = measure(args, dir, evaluated, &references.left, prepared.ppd, &left)?;
+    if let Some(stereo) = stereo {
+        let right = measure(
+            args,
+            dir,
+            evaluated,
+            &stereo.right,
+            prepared.ppd,
+            &EyeFiles::RIGHT,
+        )?;
+        let measure = quality_stereo::measure(dir, evaluated, &references.left, stereo, args.rings)
+            .with_context(|| what.clone())?;
+        q.binocular = Some(Binocular {
+            measure,
+            right_eye: EyeQuality {
+                rings: right.rings,
+                frame_rmse: right.frame_rmse,
+                frame_ssim: right.frame_ssim,
+                frame_flip: right.frame_flip,
+                frame_flicker: right.frame_flicker,
+            },
+        });
+    }
+    (q.camera, q.method, q.denoiser, q.taa, q.stereo_noise) = (
         camera.to_string(),
         method.to_string(),
         denoiser.to_string(),
         taa.to_string(),
+        profile.stereo_noise.name().to_string(),
     );
     Ok(q)
 }
 
 /// Writes `out/quality.json` and `out/quality.md` from the outcomes in the order of the grid
-/// (cameras, methods, denoisers, TAA modes), and prints the table.
+/// (cameras, methods, denoisers, TAA modes, stereo noises), and prints the table.
 pub fn write_report(
     args: &QualityArgs,
     prepared: &Prepared,
@@ -433,8 +532,10 @@ pub fn write_report(
     let (mut runs, mut refused) = (Vec::new(), Vec::new());
     for outcome in outcomes {
         match outcome {
-            Outcome::Run(q) => runs.push(q),
-            Outcome::Refused(r) => refused.push(r),
+            Outcome::Run(q) => runs.push(*q),
+            // A refusal holds for every stereo noise: listed once.
+            Outcome::Refused(r) if !refused.contains(&r) => refused.push(r),
+            Outcome::Refused(_) => {}
         }
     }
     let model = prepared.model.as_ref();
@@ -444,6 +545,7 @@ pub fn write_report(
         height: args.height,
         headset: args.headset,
         gaze_source: args.gaze,
+        eyes: args.eyes.name(),
         frames: args.frames,
         eval_frames: args.eval_frames,
         reference_spp: args.reference_spp,
@@ -472,33 +574,59 @@ pub fn reference_frames(camera: &str, evaluated: &[u32]) -> Vec<u32> {
     }
 }
 
-/// The name of the reference of `camera` at `frame` in the output folder.
-pub fn reference_file_name(camera: &str, frame: u32) -> String {
-    format!("reference_{camera}_{frame:04}.exr")
+/// The eyes that get converged references: the left, and in a stereo run the right after it.
+pub fn reference_eyes(args: &QualityArgs) -> &'static [Eye] {
+    match args.eyes {
+        Eyes::Both => Eyes::Both.list(),
+        Eyes::Left | Eyes::Right => Eyes::Left.list(),
+    }
 }
 
-/// A Cartesian renderer set up for the references of `camera`, and the eye pose of each frame of
-/// [`reference_frames`].
-pub struct ReferenceRenderer {
-    pub ctx: std::sync::Arc<fovea_renderer::vk::Context>,
-    pub renderer: Renderer,
-    pub poses: Vec<(u32, fovea_renderer::frame::CameraPose)>,
+/// The name of the reference of `camera` at `frame` for `eye` in the output folder; the eye is
+/// named in a stereo run (`eyes` both) only.
+pub fn reference_file_name(eyes: Eyes, camera: &str, eye: Eye, frame: u32) -> String {
+    match eyes {
+        Eyes::Both => format!(
+            "reference_{camera}_{}_{frame:04}.exr",
+            super::setup::eye_name(eye)
+        ),
+        Eyes::Left | Eyes::Right => format!("reference_{camera}_{frame:04}.exr"),
+    }
 }
 
-pub fn reference_renderer(
+/// The scene and the head of the references of one camera: the eyes `fovea render --eyes
+/// left|both` renders, through the same projection, at each frame of [`reference_frames`].
+pub struct ReferenceViews {
+    scene: Scene,
+    rig: crate::projection::EyeRig,
+    /// The head pose at each reference frame.
+    heads: Vec<(u32, CameraPose)>,
+}
+
+impl ReferenceViews {
+    /// The pose of `eye` at reference frame `frame`.
+    pub fn pose(&self, frame: u32, eye: Eye) -> Option<CameraPose> {
+        self.heads
+            .iter()
+            .find(|(f, _)| *f == frame)
+            .map(|(_, head)| self.rig.eye(head, eye))
+    }
+}
+
+/// Loads the scene (no device) and places the head at each frame of [`reference_frames`].
+pub fn reference_views(
     args: &QualityArgs,
     camera: &str,
     evaluated: &[u32],
-) -> Result<ReferenceRenderer> {
+) -> Result<ReferenceViews> {
     let moving = camera == "moving";
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    // The frames are the left eye's (`fovea render --eyes left`): the same eye through the same
-    // projection.
+    // A stereo run offsets the eyes (in either projection): the references see what the runs do.
     let rig = crate::projection::EyeRig {
         projection: args.camera.projection,
         hmd,
-        stereo: false,
+        stereo: args.eyes == Eyes::Both,
         width: args.width,
         height: args.height,
         metres_per_unit: args.camera.world_scale,
@@ -511,14 +639,7 @@ pub fn reference_renderer(
     )?;
     let start = rig.head(&scene_camera);
     let centre = scene.bounds().center();
-    let ctx = super::open_device(args.device, args.validation)?;
-    let size = UVec2::new(args.width, args.height);
-    let settings = RenderSettings {
-        seed: args.seed.wrapping_add(0x5eed),
-        ..Default::default()
-    };
-    let renderer = Renderer::new(&ctx, &scene, Box::new(Cartesian::new(size)), settings)?;
-    let poses = reference_frames(camera, evaluated)
+    let heads = reference_frames(camera, evaluated)
         .into_iter()
         .map(|f| {
             let head = if moving {
@@ -526,44 +647,122 @@ pub fn reference_renderer(
             } else {
                 start
             };
-            (f, rig.eye(&head, fovea_hal::Eye::Left))
+            (f, head)
         })
         .collect();
+    Ok(ReferenceViews { scene, rig, heads })
+}
+
+/// A Cartesian renderer set up for the references of `camera`, and their views.
+pub struct ReferenceRenderer {
+    pub ctx: std::sync::Arc<fovea_renderer::vk::Context>,
+    pub renderer: Renderer,
+    pub views: ReferenceViews,
+}
+
+pub fn reference_renderer(
+    args: &QualityArgs,
+    camera: &str,
+    evaluated: &[u32],
+) -> Result<ReferenceRenderer> {
+    let views = reference_views(args, camera, evaluated)?;
+    let ctx = super::open_device(args.device, args.validation)?;
+    let size = UVec2::new(args.width, args.height);
+    let settings = RenderSettings {
+        seed: args.seed.wrapping_add(0x5eed),
+        ..Default::default()
+    };
+    let renderer = Renderer::new(&ctx, &views.scene, Box::new(Cartesian::new(size)), settings)?;
     Ok(ReferenceRenderer {
         ctx,
         renderer,
-        poses,
+        views,
     })
 }
 
+/// The converged references of one camera, one per evaluated frame: the left eye's, and in a
+/// stereo run the right eye's with the warp of the right eye into the left.
+pub struct References {
+    left: Vec<Vec<[f32; 4]>>,
+    stereo: Option<StereoReferences>,
+}
+
+impl References {
+    /// From the images of [`reference_frames`] of each eye of [`reference_eyes`], in that order
+    /// (`images[eye][frame]`); a still camera's one image stands for every evaluated frame. A
+    /// stereo run needs the references' views (the eyes' depth for the warp).
+    pub fn new(
+        args: &QualityArgs,
+        camera: &str,
+        evaluated: &[u32],
+        images: Vec<Vec<Vec<[f32; 4]>>>,
+        views: Option<&ReferenceViews>,
+    ) -> Result<References> {
+        let eyes = reference_eyes(args);
+        if images.len() != eyes.len() {
+            bail!(
+                "{} eyes' references for a run of {} eyes",
+                images.len(),
+                eyes.len()
+            );
+        }
+        let mut per_eye = images
+            .into_iter()
+            .map(|v| per_evaluated_frame(camera, v, evaluated));
+        let left = per_eye.next().context("the left eye's references")?;
+        let stereo = match (per_eye.next(), views) {
+            (None, _) => None,
+            (Some(right), Some(views)) => {
+                let heads: Vec<CameraPose> = views.heads.iter().map(|(_, h)| *h).collect();
+                Some(StereoReferences::new(
+                    &views.scene,
+                    &views.rig,
+                    &heads,
+                    right,
+                ))
+            }
+            (Some(_), None) => bail!("a stereo run's references need their views"),
+        };
+        Ok(References { left, stereo })
+    }
+}
+
 /// Converged references of the evaluated frames' camera poses (one for a still camera, the same
-/// for every evaluated frame), written to `DIR/reference_<camera>_NNNN.exr`.
-fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Vec<Vec<[f32; 4]>>> {
+/// for every evaluated frame) for each eye of [`reference_eyes`], written to
+/// `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`).
+fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<References> {
     let mut r = reference_renderer(args, camera, evaluated)?;
-    let mut out = Vec::new();
-    for (f, pose) in &r.poses {
-        let reference = crate::reference_sum::render(
-            &mut r.renderer,
-            pose,
-            args.reference_spp,
-            fovea_renderer::frame::REALTIME_MAX_DEPTH,
-            &mut |_| Ok(()),
-        )?;
-        write_exr(
-            &args.out.join(reference_file_name(camera, *f)),
-            args.width,
-            args.height,
-            &reference,
-        )?;
-        out.push(reference);
+    let mut images = Vec::new();
+    for &eye in reference_eyes(args) {
+        let mut eye_images = Vec::new();
+        for f in reference_frames(camera, evaluated) {
+            let pose = r.views.pose(f, eye).context("a reference frame's pose")?;
+            let reference = crate::reference_sum::render(
+                &mut r.renderer,
+                &pose,
+                args.reference_spp,
+                fovea_renderer::frame::REALTIME_MAX_DEPTH,
+                &mut |_| Ok(()),
+            )?;
+            write_exr(
+                &args
+                    .out
+                    .join(reference_file_name(args.eyes, camera, eye, f)),
+                args.width,
+                args.height,
+                &reference,
+            )?;
+            eye_images.push(reference);
+        }
+        images.push(eye_images);
     }
     super::check_validation(&r.ctx)?;
-    Ok(per_evaluated_frame(camera, out, evaluated))
+    References::new(args, camera, evaluated, images, Some(&r.views))
 }
 
 /// The references of [`reference_frames`] as one per evaluated frame (the still camera's one
 /// repeated).
-pub fn per_evaluated_frame(
+fn per_evaluated_frame(
     camera: &str,
     mut references: Vec<Vec<[f32; 4]>>,
     evaluated: &[u32],
@@ -582,6 +781,7 @@ fn measure(
     evaluated: &[u32],
     references: &[Vec<[f32; 4]>],
     ppd: f32,
+    eye: &EyeFiles,
 ) -> Result<RunQuality> {
     let report_path = dir.join("report.json");
     let report: serde_json::Value =
@@ -593,22 +793,22 @@ fn measure(
     let mut flickers: Vec<(Vec<Option<f64>>, Option<f64>)> = Vec::new();
     let mut previous: Option<(u32, Vec<u8>, Vec<u8>)> = None;
     // With the latency model: the frames judged around the true gaze.
-    let latency = report.get("gaze_true").is_some();
+    let latency = eye.latency && report.get("gaze_true").is_some();
     let (mut evals_true, mut gazes_true, mut foveal, mut foveal_true) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (&f, reference) in evaluated.iter().zip(references) {
-        let gaze = &report["gaze"][f as usize];
+        let gaze = &report[eye.gaze_key][f as usize];
         let gaze = Vec2::new(
             gaze[0].as_f64().unwrap_or(0.0) as f32,
             gaze[1].as_f64().unwrap_or(0.0) as f32,
         );
-        let path: PathBuf = dir.join(format!("frame_{f:04}.exr"));
+        let path: PathBuf = dir.join(format!("frame_{f:04}{}.exr", eye.suffix));
         let size = Some((args.width, args.height));
         let (_, _, test) = crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
         let displayed = crate::decode::read_rgba8(
-            &dir.join(format!("frame_{f:04}.png")),
+            &dir.join(format!("frame_{f:04}{}.png", eye.suffix)),
             crate::decode::MAX_IMAGE_PIXELS,
             size,
         )?
@@ -701,6 +901,7 @@ fn measure(
         method: String::new(),
         denoiser: String::new(),
         taa: String::new(),
+        stereo_noise: String::new(),
         frame_gpu_ms: report["frame_gpu_ms"].as_f64().unwrap_or(0.0),
         samples_traced: report["samples_traced"].as_u64().unwrap_or(0),
         rays_traced: report["rays_traced"].as_u64().unwrap_or(0),
@@ -730,6 +931,7 @@ fn measure(
         rings_true_gaze,
         foveal_flip: mean_of(&foveal),
         foveal_flip_true_gaze: mean_of(&foveal_true),
+        binocular: None,
     })
 }
 
@@ -738,6 +940,19 @@ fn flip_ppd(args: &QualityArgs) -> Result<f32> {
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
     Ok(crate::flip::headset_ppd(&hmd, args.width))
+}
+
+/// A run's row label: method + denoiser, TAA, and the stereo noise where runs differ in it or
+/// render both eyes.
+fn label(r: &Report, q: &RunQuality) -> String {
+    let noises_differ = r.runs.iter().any(|o| o.stereo_noise != q.stereo_noise);
+    match noises_differ || r.eyes == "both" {
+        true => format!(
+            "{} + {}, {}, {}",
+            q.method, q.denoiser, q.taa, q.stereo_noise
+        ),
+        false => format!("{} + {}, {}", q.method, q.denoiser, q.taa),
+    }
 }
 
 /// Per camera: one row per combination, RMSE / SSIM per ring and whole frame; then, per filter,
@@ -774,7 +989,7 @@ fn markdown(r: &Report) -> String {
         let _ = writeln!(s, " frame | GPU ms |");
         let _ = writeln!(s, "|---|{}---|---|", "---|".repeat(first.rings.len()));
         for q in &runs {
-            let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+            let _ = write!(s, "| {} |", label(r, q));
             for ring in &q.rings {
                 match (ring.rmse, ring.ssim, ring.flip) {
                     (Some(e), Some(m), Some(f)) => {
@@ -808,7 +1023,7 @@ fn markdown(r: &Report) -> String {
             }
             let _ = writeln!(s, " frame |\n|---|{}---|", "---|".repeat(first.rings.len()));
             for q in &runs {
-                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                let _ = write!(s, "| {} |", label(r, q));
                 for ring in &q.rings {
                     let _ = write!(
                         s,
@@ -842,7 +1057,7 @@ fn markdown(r: &Report) -> String {
             );
             let cell = |v: Option<f64>| v.map_or("–".to_string(), |f| format!("{f:.4}"));
             for q in &runs {
-                let _ = write!(s, "| {} + {}, {} |", q.method, q.denoiser, q.taa);
+                let _ = write!(s, "| {} |", label(r, q));
                 for ring in q.rings_true_gaze.iter().flatten() {
                     let _ = write!(s, " {} |", cell(ring.flip));
                 }
@@ -855,10 +1070,26 @@ fn markdown(r: &Report) -> String {
             }
             s.push('\n');
         }
+        let stereo: Vec<quality_stereo::StereoRow> = runs
+            .iter()
+            .filter_map(|q| {
+                let b = q.binocular.as_ref()?;
+                Some(quality_stereo::StereoRow {
+                    label: label(r, q),
+                    binocular: &b.measure,
+                    flip: [q.frame_flip, b.right_eye.frame_flip],
+                    flicker: [q.frame_flicker, b.right_eye.frame_flicker],
+                })
+            })
+            .collect();
+        s.push_str(&quality_stereo::markdown(&stereo));
         for vp in runs.iter().filter(|q| q.method == "vp") {
-            let cartesian = runs
-                .iter()
-                .find(|q| q.method == "cartesian" && q.denoiser == vp.denoiser && q.taa == vp.taa);
+            let cartesian = runs.iter().find(|q| {
+                q.method == "cartesian"
+                    && q.denoiser == vp.denoiser
+                    && q.taa == vp.taa
+                    && q.stereo_noise == vp.stereo_noise
+            });
             if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
                 if let Some(c_rmse) = c.rings[0].rmse {
                     let verdict = if v_rmse < c_rmse {

@@ -32,6 +32,11 @@ struct Report {
     offscreen_samples: &'static str,
     /// `off` or `di` (ReSTIR DI at the primary hit, `--resampling`).
     resampling: &'static str,
+    /// How the eyes' random numbers relate: `independent`, `screen` or `surface`.
+    stereo_noise: &'static str,
+    /// `surface` noise: its cells' edge in sample footprints.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    surface_cell: Option<f32>,
     scene: String,
     headset: String,
     /// `headset` (each eye through the profile's frustum, the camera the head) or
@@ -44,6 +49,9 @@ struct Report {
     /// Gaze point per frame in the left eye's render pixels (the Cartesian method traces uniformly and only
     /// records it; foveated methods centre their sampling on it).
     gaze: Vec<[f32; 2]>,
+    /// A run of both eyes: the same gaze per frame in the right eye's render pixels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaze_right: Option<Vec<[f32; 2]>>,
     /// Per frame: live, held or centre (`fovea replay` checks the playback frame by frame).
     gaze_origin: Vec<&'static str>,
     /// Frames whose gaze was live / held after a lost sample / the view centre.
@@ -181,6 +189,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     )?);
     let started = std::time::Instant::now();
     let mut gaze_points = Vec::with_capacity(frames as usize);
+    let mut gaze_right = Vec::with_capacity(frames as usize);
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut outside_view = 0u32;
@@ -194,6 +203,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         let (input, frame_gaze) = setup.frame_input(frame)?;
         gaze_points.push(frame_gaze.pixel.to_array());
+        gaze_right.push(frame_gaze.pixels[fovea_hal::Eye::Right.index()].to_array());
         gaze_origin.push(frame_gaze.origin.name());
         origins[match frame_gaze.origin {
             GazeOrigin::Live => 0,
@@ -273,6 +283,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples.name(),
         resampling: args.profile.resampling.mode.name(),
+        stereo_noise: args.profile.stereo_noise.name(),
+        surface_cell: (args.profile.stereo_noise == fovea_renderer::frame::StereoNoise::Surface)
+            .then(|| args.profile.surface_cell()),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         projection: args.camera.projection.name(),
@@ -280,6 +293,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frames_in_flight: in_flight,
         gaze_source: args.gaze.to_string(),
         gaze: gaze_points,
+        gaze_right: (eyes == Eyes::Both).then_some(gaze_right),
         gaze_origin,
         gaze_live: origins[0],
         gaze_held: origins[1],

@@ -360,6 +360,8 @@ pub fn render_settings(
         path_regularisation: args.profile.path_regularisation(),
         offscreen_samples: args.profile.offscreen_samples,
         resampling: args.profile.resampling,
+        stereo_noise: args.profile.stereo_noise,
+        surface_cell: args.profile.surface_cell(),
         ..Default::default()
     }
 }

@@ -7,8 +7,8 @@
 //! saves the last presented image.
 
 use super::render::RenderArgs;
-use super::setup::{method_names, space_for, Setup};
-use crate::viewer::debug::{compose, DebugView};
+use super::setup::{method_names, space_for, Eyes, Setup};
+use crate::viewer::debug::{compose, DebugView, StereoScene};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::vk;
@@ -19,6 +19,8 @@ use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
 use fovea_renderer::passes::denoise::DenoiserSettings;
 use fovea_renderer::pipeline::Renderer;
+use fovea_renderer::scene::bvh::instanced::SceneBvh;
+use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_renderer::vk::{Buffer, Context};
 use glam::{Mat4, Quat, UVec2, Vec2, Vec3};
 use gpu_allocator::MemoryLocation;
@@ -66,6 +68,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     if args.screenshot.is_some() && args.frames.is_none() {
         bail!("--screenshot needs --frames N (the screenshot is of frame N − 1)");
     }
+    if args.debug_view == DebugView::StereoDiff && args.render.eyes != Eyes::Both {
+        bail!("--debug-view stereo-diff compares the eyes: it needs --eyes both");
+    }
     if let Some(path) = args.screenshot {
         // Before the window opens: an existing file is not replaced without --force.
         crate::output::check_new_file(path, args.force)
@@ -111,6 +116,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         denoiser: args.render.denoiser.to_string(),
         taa: args.render.taa.to_string(),
         debug: args.debug_view,
+        stereo_bvh: None,
         title_at: Instant::now(),
         frames_since_title: 0,
         gpu_ms: None,
@@ -157,6 +163,8 @@ struct Viewer<'a> {
     denoiser: String,
     taa: String,
     debug: DebugView,
+    /// The scene's CPU BVH for the stereo-diff view (built when first shown).
+    stereo_bvh: Option<SceneBvh>,
     title_at: Instant,
     frames_since_title: u32,
     /// The newest completed frame's GPU ms (all passes, the trace's), read when its slot is retired.
@@ -496,7 +504,7 @@ impl Viewer<'_> {
                 return Ok(());
             }
             Key::Character("v") => {
-                self.debug = self.debug.next();
+                self.debug = self.debug.next(self.setup.eyes == Eyes::Both);
                 return Ok(());
             }
             _ => return Ok(()),
@@ -644,9 +652,20 @@ impl Viewer<'_> {
     /// on the CPU and copied into the swapchain image (and saved as the screenshot of a last frame).
     fn redraw_debug(&mut self) -> Result<()> {
         let input = self.frame_input()?.with_grid(self.debug == DebugView::Grid);
+        let stereo_diff = self.debug == DebugView::StereoDiff;
+        if stereo_diff && self.stereo_bvh.is_none() {
+            self.stereo_bvh = Some(SceneBvh::build(&self.setup.scene, BvhBuilder::BINNED));
+        }
         let frame = self.renderer.submit(&input, None)?;
         self.renderer.finish()?;
         self.note_timings(frame)?;
+        let stereo = match (stereo_diff, &self.stereo_bvh, input.view_inputs()) {
+            (true, Some(bvh), [left, right]) => Some(StereoScene {
+                bvh,
+                cameras: [left.camera, right.camera],
+            }),
+            _ => None,
+        };
         let eye = self.setup.screen();
         let pixels = compose(
             self.debug,
@@ -655,6 +674,7 @@ impl Viewer<'_> {
             eye,
             &self.setup.hmd,
             self.setup.eyes.list(),
+            stereo.as_ref(),
         )?;
         let last = self.args.frames.is_some_and(|n| self.frame + 1 == n);
         let Some(w) = self.window.as_mut() else {

@@ -366,7 +366,8 @@ pub fn parse_manifest(bytes: &[u8], name: &str, id: &TraceId) -> Result<Baseline
         bail!("{name}: format '{format}', expected '{FORMAT}' (remake the baseline with --update-baseline)");
     }
     let b: Baseline =
-        serde_json::from_str(text).with_context(|| format!("{name}: not a replay baseline"))?;
+        serde_path_to_error::deserialize(&mut serde_json::Deserializer::from_str(text))
+            .map_err(|e| anyhow!("{name}: not a replay baseline: {}: {}", e.path(), e.inner()))?;
     if b.trace_sha256 != id.sha256 {
         bail!(
             "{name}: trace_sha256 {} is not this trace's {} (the folder belongs to another trace)",

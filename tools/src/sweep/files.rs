@@ -4,7 +4,9 @@
 use crate::commands::quality::QualityArgs;
 use crate::commands::reference::ReferenceArgs;
 use crate::commands::replay::ReplayArgs;
+use crate::commands::setup::{eye_name, Eyes};
 use anyhow::Result;
+use fovea_hal::Eye;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -112,21 +114,33 @@ pub struct Job {
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Part {
     /// Batches `batches[0]..batches[1]` of a reference: of the camera's pose at `frame` for a
-    /// quality study, of the one reference for a reference study.
+    /// quality study (and of `eye`, `left` or `right`, in a stereo one: `--eyes both`), of the one
+    /// reference for a reference study.
     Reference {
         camera: Option<String>,
         frame: Option<u32>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eye: Option<String>,
         batches: [u32; 2],
     },
-    /// One combination of a quality study: rendered, measured against its references.
+    /// One combination of a quality study: rendered, measured against its references. `noise`:
+    /// its `--stereo-noise`, where the command gives that flag.
     Run {
         camera: String,
         method: String,
         denoiser: String,
         taa: String,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        noise: Option<String>,
     },
     /// One trace of a replay study: rendered and checked against its baseline.
     Trace { trace: String },
+}
+
+/// How a quality study's reference parts name `eye`: by name in a stereo study (`--eyes both`),
+/// not at all in a one-eye study.
+pub(super) fn eye_key(q: &QualityArgs, eye: Eye) -> Option<String> {
+    (q.eyes == Eyes::Both).then(|| eye_name(eye).to_string())
 }
 
 /// What a finished job recorded (`result/job.json`).

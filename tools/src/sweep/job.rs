@@ -3,15 +3,18 @@
 //! killed attempt's folder is removed, and a failed attempt leaves only `failed.json`.
 
 use super::files::{
-    commit, host_name, Failure, Job, JobRecord, Parse, Part, Study, ATTEMPT_PREFIX, FAILURE,
-    JOBS_FILE, LOCK, RECORD,
+    commit, eye_key, host_name, Failure, Job, JobRecord, Parse, Part, Study, ATTEMPT_PREFIX,
+    FAILURE, JOBS_FILE, LOCK, RECORD,
 };
 use super::open::Sweep;
 use super::status::{done, State};
-use crate::commands::quality::{self, Combination, Outcome};
+use crate::commands::quality::{self, Combination, Outcome, QualityArgs};
+use crate::commands::setup::Eyes;
 use crate::output::write_json;
 use crate::reference_sum::{self, SampleSum};
 use anyhow::{anyhow, bail, Context, Result};
+use fovea_hal::Eye;
+use fovea_renderer::frame::StereoNoise;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::Path;
@@ -202,16 +205,16 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                 Part::Reference {
                     camera: Some(camera),
                     frame: Some(frame),
+                    eye,
                     batches,
                 },
             ) => {
                 let prepared = quality::prepare(q)?;
+                let eye = eye_of(q, eye.as_deref())?;
                 let mut r = quality::reference_renderer(q, camera, &prepared.evaluated)?;
                 let pose = r
-                    .poses
-                    .iter()
-                    .find(|(f, _)| f == frame)
-                    .map(|(_, pose)| *pose)
+                    .views
+                    .pose(*frame, eye)
                     .with_context(|| format!("frame {frame} has no reference pose"))?;
                 let sum = reference_sum::render_sum(
                     &mut r.renderer,
@@ -230,6 +233,7 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                 Part::Reference {
                     camera: None,
                     frame: None,
+                    eye: None,
                     batches,
                 },
             ) => {
@@ -254,6 +258,7 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                     method,
                     denoiser,
                     taa,
+                    noise,
                 },
             ) => {
                 let prepared = quality::prepare(q)?;
@@ -262,29 +267,49 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                     method,
                     denoiser,
                     taa,
+                    noise: noise.as_deref().map(StereoNoise::parse).transpose()?,
                 };
                 if let Some(refused) = quality::refusal(q, &prepared, &combination)? {
                     write_json(&attempt.join(OUTCOME_FILE), &Outcome::Refused(refused))?;
                     None
                 } else {
-                    let references = quality::reference_frames(camera, &prepared.evaluated)
-                        .into_iter()
-                        .map(|frame| {
-                            let sum = reference_of(sweep, job.study, Some(camera), Some(frame))?;
-                            if (sum.width, sum.height) != (q.width, q.height) {
-                                bail!(
-                                    "the reference parts are {}×{}, the command renders {}×{}",
-                                    sum.width,
-                                    sum.height,
-                                    q.width,
-                                    q.height
-                                );
-                            }
-                            sum.mean()
-                        })
-                        .collect::<Result<Vec<_>>>()?;
+                    let evaluated = &prepared.evaluated;
+                    let mut images = Vec::new();
+                    for &eye in quality::reference_eyes(q) {
+                        let key = eye_key(q, eye);
+                        images.push(
+                            quality::reference_frames(camera, evaluated)
+                                .into_iter()
+                                .map(|frame| {
+                                    let sum = reference_of(
+                                        sweep,
+                                        job.study,
+                                        Some(camera),
+                                        Some(frame),
+                                        key.as_deref(),
+                                    )?;
+                                    if (sum.width, sum.height) != (q.width, q.height) {
+                                        bail!(
+                                            "the reference parts are {}×{}, the command renders \
+                                             {}×{}",
+                                            sum.width,
+                                            sum.height,
+                                            q.width,
+                                            q.height
+                                        );
+                                    }
+                                    sum.mean()
+                                })
+                                .collect::<Result<Vec<_>>>()?,
+                        );
+                    }
+                    // The warp between the eyes needs the scene (a stereo study only).
+                    let views = match q.eyes {
+                        Eyes::Both => Some(quality::reference_views(q, camera, evaluated)?),
+                        Eyes::Left | Eyes::Right => None,
+                    };
                     let references =
-                        quality::per_evaluated_frame(camera, references, &prepared.evaluated);
+                        quality::References::new(q, camera, evaluated, images, views.as_ref())?;
                     let run_dir = attempt.join(combination.run_dir_name());
                     let measured = quality::run_combination(
                         q,
@@ -293,7 +318,10 @@ fn execute(sweep: &Sweep, job: &Job, attempt: &Path, parse: Parse) -> Result<Opt
                         &references,
                         &run_dir,
                     )?;
-                    write_json(&attempt.join(OUTCOME_FILE), &Outcome::Run(measured))?;
+                    write_json(
+                        &attempt.join(OUTCOME_FILE),
+                        &Outcome::Run(Box::new(measured)),
+                    )?;
                     Some(render_device(&run_dir)?)
                 }
             }
@@ -331,25 +359,44 @@ fn render_device(run_dir: &Path) -> Result<String> {
         .with_context(|| format!("{}: no field `device`", path.display()))
 }
 
-/// The whole reference of a study's camera pose (quality) or of the study (reference), from the
-/// sums of its finished reference jobs.
+/// The eye a reference part names (none: the left eye of a one-eye study).
+fn eye_of(q: &QualityArgs, key: Option<&str>) -> Result<Eye> {
+    let eye = match key {
+        None | Some("left") => Eye::Left,
+        Some("right") => Eye::Right,
+        Some(other) => bail!("reference part eye '{other}': expected left or right"),
+    };
+    if eye_key(q, eye).as_deref() != key {
+        bail!(
+            "a reference part of eye {} in a study of --eyes {}",
+            key.unwrap_or("(none)"),
+            q.eyes.name()
+        );
+    }
+    Ok(eye)
+}
+
+/// The whole reference of a study's camera pose and eye (quality) or of the study (reference),
+/// from the sums of its finished reference jobs.
 pub(super) fn reference_of(
     sweep: &Sweep,
     study: u32,
     camera: Option<&str>,
     frame: Option<u32>,
+    eye: Option<&str>,
 ) -> Result<SampleSum> {
     let mut parts = Vec::new();
     for job in &sweep.jobs {
         let Part::Reference {
             camera: c,
             frame: f,
+            eye: e,
             ..
         } = &job.part
         else {
             continue;
         };
-        if job.study != study || c.as_deref() != camera || *f != frame {
+        if job.study != study || c.as_deref() != camera || *f != frame || e.as_deref() != eye {
             continue;
         }
         let path = sweep.result_dir(job).join(SUM_FILE);
@@ -360,10 +407,11 @@ pub(super) fn reference_of(
     }
     let sum = reference_sum::merge(&parts).with_context(|| {
         format!(
-            "the reference of study {}{}{}",
+            "the reference of study {}{}{}{}",
             sweep.file.studies[study as usize].name,
             camera.map_or(String::new(), |c| format!(", {c} camera")),
-            frame.map_or(String::new(), |f| format!(", frame {f}"))
+            frame.map_or(String::new(), |f| format!(", frame {f}")),
+            eye.map_or(String::new(), |e| format!(", {e} eye"))
         )
     })?;
     if sum.batches != (0..reference_sum::batch_count(sum.spp)) {

@@ -4,7 +4,7 @@
 //! replay.json, replay.md and `run_*` folders (exit status 1 on a regression, as `fovea replay`).
 //! Each study's folder is built beside its place and renamed into it whole.
 
-use super::files::{Parse, Part, Study};
+use super::files::{eye_key, Parse, Part, Study};
 use super::job::{reference_of, OUTCOME_FILE};
 use super::open::Sweep;
 use super::status::{done, state, State};
@@ -12,6 +12,7 @@ use crate::commands::quality::{self, Combination, Outcome};
 use crate::commands::replay::{self, Regression, ReplayArgs, TraceResult};
 use crate::output::write_exr;
 use anyhow::{bail, Context, Result};
+use fovea_renderer::frame::StereoNoise;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -65,7 +66,7 @@ pub fn merge(dir: &Path, parse: Parse) -> Result<()> {
                 Ok(())
             }
             Study::Reference(r) => {
-                let image = reference_of(&sweep, i as u32, None, None)?.mean()?;
+                let image = reference_of(&sweep, i as u32, None, None, None)?.mean()?;
                 let name = r
                     .out
                     .file_name()
@@ -131,14 +132,18 @@ fn check_one_device(sweep: &Sweep) -> Result<()> {
 fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path) -> Result<()> {
     let prepared = quality::prepare(q)?;
     for camera in q.cameras {
-        for frame in quality::reference_frames(camera, &prepared.evaluated) {
-            let image = reference_of(sweep, study, Some(camera), Some(frame))?.mean()?;
-            write_exr(
-                &out.join(quality::reference_file_name(camera, frame)),
-                q.width,
-                q.height,
-                &image,
-            )?;
+        for &eye in quality::reference_eyes(q) {
+            let key = eye_key(q, eye);
+            for frame in quality::reference_frames(camera, &prepared.evaluated) {
+                let image = reference_of(sweep, study, Some(camera), Some(frame), key.as_deref())?
+                    .mean()?;
+                write_exr(
+                    &out.join(quality::reference_file_name(q.eyes, camera, eye, frame)),
+                    q.width,
+                    q.height,
+                    &image,
+                )?;
+            }
         }
     }
     let mut outcomes = Vec::new();
@@ -148,6 +153,7 @@ fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path
             method,
             denoiser,
             taa,
+            noise,
         } = &job.part
         else {
             continue;
@@ -164,6 +170,7 @@ fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path
                 method,
                 denoiser,
                 taa,
+                noise: noise.as_deref().map(StereoNoise::parse).transpose()?,
             }
             .run_dir_name();
             link_tree(&result.join(&name), &out.join(&name))?;

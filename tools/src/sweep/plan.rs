@@ -1,8 +1,8 @@
 //! `fovea sweep plan`: the studies of a command and its axes, and their jobs.
 
 use super::files::{
-    commit, Axes, DeviceRequirement, Job, Parse, Part, Study, StudyEntry, SweepFile, FORMAT,
-    JOBS_FILE, SWEEP_FILE,
+    commit, eye_key, Axes, DeviceRequirement, Job, Parse, Part, Study, StudyEntry, SweepFile,
+    FORMAT, JOBS_FILE, SWEEP_FILE,
 };
 use crate::commands::quality::{self, QualityArgs};
 use crate::output::{write_json, write_text};
@@ -169,6 +169,10 @@ enum Shape {
         methods: Vec<String>,
         denoisers: Vec<String>,
         taa: Vec<String>,
+        /// `--stereo-noise`'s names (one `None`: the flag not given).
+        noises: Vec<Option<String>>,
+        /// The eyes with references, as the reference parts name them (`None`: a one-eye run).
+        eyes: Vec<Option<String>>,
         evaluated: Vec<u32>,
         spp: u32,
     },
@@ -214,14 +218,22 @@ fn quality_shape(q: &QualityArgs) -> Result<Shape> {
         methods: q.methods.to_vec(),
         denoisers: q.denoisers.to_vec(),
         taa: q.taa.to_vec(),
+        noises: quality::stereo_noises(q)
+            .into_iter()
+            .map(|n| n.map(|n| n.name().to_string()))
+            .collect(),
+        eyes: quality::reference_eyes(q)
+            .iter()
+            .map(|&eye| eye_key(q, eye))
+            .collect(),
         evaluated: prepared.evaluated,
         spp: q.reference_spp,
     })
 }
 
-/// The stages and jobs of the studies: every reference part first (stage `reference`), then
-/// every quality combination after the parts of its study's camera and every replay trace (stage
-/// `run`).
+/// The stages and jobs of the studies: every reference part first (stage `reference`; each eye's
+/// in a stereo quality study), then every quality combination after the parts of its study's
+/// camera and every replay trace (stage `run`).
 pub(super) fn jobs(
     studies: &[StudyEntry],
     batches_per_job: u32,
@@ -260,6 +272,7 @@ pub(super) fn jobs(
         match shape {
             Shape::Quality {
                 cameras,
+                eyes,
                 evaluated,
                 spp,
                 ..
@@ -268,17 +281,30 @@ pub(super) fn jobs(
                     let args = set_flag(&study.args, "--cameras", camera);
                     let mut indices = Vec::new();
                     for frame in quality::reference_frames(camera, evaluated) {
-                        for b in blocks(batch_count(*spp), batches_per_job) {
-                            let name = format!(
-                                "{}: reference, {camera} camera, frame {frame}, batches {}..{}",
-                                study.name, b.start, b.end
-                            );
-                            let part = Part::Reference {
-                                camera: Some(camera.clone()),
-                                frame: Some(frame),
-                                batches: [b.start, b.end],
-                            };
-                            indices.push(push("reference", name, i, args.clone(), part, vec![]));
+                        for eye in eyes {
+                            let eye_words =
+                                eye.as_ref().map_or(String::new(), |e| format!(", {e} eye"));
+                            for b in blocks(batch_count(*spp), batches_per_job) {
+                                let name = format!(
+                                    "{}: reference, {camera} camera, frame {frame}{eye_words}, \
+                                     batches {}..{}",
+                                    study.name, b.start, b.end
+                                );
+                                let part = Part::Reference {
+                                    camera: Some(camera.clone()),
+                                    frame: Some(frame),
+                                    eye: eye.clone(),
+                                    batches: [b.start, b.end],
+                                };
+                                indices.push(push(
+                                    "reference",
+                                    name,
+                                    i,
+                                    args.clone(),
+                                    part,
+                                    vec![],
+                                ));
+                            }
                         }
                     }
                     parts_of.push((i, Some(camera.clone()), indices));
@@ -290,6 +316,7 @@ pub(super) fn jobs(
                     let part = Part::Reference {
                         camera: None,
                         frame: None,
+                        eye: None,
                         batches: [b.start, b.end],
                     };
                     push("reference", name, i, study.args.clone(), part, vec![]);
@@ -314,6 +341,7 @@ pub(super) fn jobs(
             methods,
             denoisers,
             taa,
+            noises,
             ..
         } = shape
         else {
@@ -328,25 +356,32 @@ pub(super) fn jobs(
             for method in methods {
                 for denoiser in denoisers {
                     for t in taa {
-                        let mut args = set_flag(&study.args, "--cameras", camera);
-                        for (flag, v) in [
-                            ("--methods", method),
-                            ("--denoisers", denoiser),
-                            ("--taa", t),
-                        ] {
-                            args = set_flag(&args, flag, v);
+                        for noise in noises {
+                            let mut args = set_flag(&study.args, "--cameras", camera);
+                            for (flag, v) in [
+                                ("--methods", method),
+                                ("--denoisers", denoiser),
+                                ("--taa", t),
+                            ] {
+                                args = set_flag(&args, flag, v);
+                            }
+                            let mut name = format!(
+                                "{}: {camera} camera, {method} + {denoiser}, TAA {t}",
+                                study.name
+                            );
+                            if let Some(noise) = noise {
+                                args = set_flag(&args, "--stereo-noise", noise);
+                                name = format!("{name}, stereo noise {noise}");
+                            }
+                            let part = Part::Run {
+                                camera: camera.clone(),
+                                method: method.clone(),
+                                denoiser: denoiser.clone(),
+                                taa: t.clone(),
+                                noise: noise.clone(),
+                            };
+                            push("run", name, i, args, part, after.clone());
                         }
-                        let name = format!(
-                            "{}: {camera} camera, {method} + {denoiser}, TAA {t}",
-                            study.name
-                        );
-                        let part = Part::Run {
-                            camera: camera.clone(),
-                            method: method.clone(),
-                            denoiser: denoiser.clone(),
-                            taa: t.clone(),
-                        };
-                        push("run", name, i, args, part, after.clone());
                     }
                 }
             }

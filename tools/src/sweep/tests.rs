@@ -117,6 +117,7 @@ fn job(index: u32) -> Job {
             method: "vp".into(),
             denoiser: "none".into(),
             taa: "off".into(),
+            noise: None,
         },
         out: format!("jobs/{index:04}"),
         after: vec![],

@@ -1,12 +1,16 @@
 //! `fovea view`'s debug views (key v, or `--debug-view`): the sampling grid as traced, the
-//! screen-space sample density, or eccentricity rings over the image. They are the same pictures
+//! screen-space sample density, eccentricity rings over the image, or (both eyes) the binocular
+//! difference as a heat map. They are the same pictures
 //! `fovea render --debug-views` writes (the density one byte for byte), made on the CPU from the
 //! finished frame and copied into the swapchain image: a debug frame waits for its GPU work.
 
+use crate::binocular::{heat_map, EyeGeometry, Warp};
 use crate::density::{box_filter, heatmap_rgba, samples_per_pixel};
 use anyhow::{bail, Result};
 use fovea_hal::{Eye, HmdDescription};
+use fovea_renderer::frame::CameraPose;
 use fovea_renderer::pipeline::Renderer;
+use fovea_renderer::scene::bvh::instanced::SceneBvh;
 use glam::{UVec2, Vec2};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,13 +22,22 @@ pub enum DebugView {
     Density,
     /// The image with rings at `RINGS_DEG` of true eccentricity from the gaze.
     Rings,
+    /// Both eyes: each eye's binocular difference (`crate::binocular`: the other eye warped into
+    /// it through the scene's depth) as a heat map, black where only one eye sees the surface.
+    StereoDiff,
+}
+
+/// What the stereo-diff view needs besides the frame: the scene's CPU BVH and the frame's cameras.
+pub struct StereoScene<'a> {
+    pub bvh: &'a SceneBvh,
+    pub cameras: [CameraPose; 2],
 }
 
 /// Ring eccentricities in degrees (through the headset eye's FOV).
 pub const RINGS_DEG: [f32; 5] = [5.0, 10.0, 20.0, 30.0, 40.0];
 
 impl DebugView {
-    pub const NAMES: &'static [&'static str] = &["off", "grid", "density", "rings"];
+    pub const NAMES: &'static [&'static str] = &["off", "grid", "density", "rings", "stereo-diff"];
 
     pub fn parse(name: &str) -> Result<DebugView> {
         Ok(match name {
@@ -32,6 +45,7 @@ impl DebugView {
             "grid" => DebugView::Grid,
             "density" => DebugView::Density,
             "rings" => DebugView::Rings,
+            "stereo-diff" => DebugView::StereoDiff,
             _ => bail!(
                 "--debug-view {name}: expected one of {}",
                 DebugView::NAMES.join(", ")
@@ -43,18 +57,22 @@ impl DebugView {
         DebugView::NAMES[self as usize]
     }
 
-    pub fn next(self) -> DebugView {
+    /// The next view of the key v cycle; `stereo`: both eyes are rendered (only then does the
+    /// cycle visit stereo-diff).
+    pub fn next(self, stereo: bool) -> DebugView {
         match self {
             DebugView::Off => DebugView::Grid,
             DebugView::Grid => DebugView::Density,
             DebugView::Density => DebugView::Rings,
-            DebugView::Rings => DebugView::Off,
+            DebugView::Rings if stereo => DebugView::StereoDiff,
+            DebugView::Rings | DebugView::StereoDiff => DebugView::Off,
         }
     }
 }
 
 /// The debug picture of every view of completed frame `frame`, side by side (RGBA8, each view
-/// `eye.x` × `eye.y`). `eyes`: which headset eye each view is (for the rings' FOV).
+/// `eye.x` × `eye.y`). `eyes`: which headset eye each view is (for the rings' FOV); `stereo`:
+/// the scene and cameras of a two-eye frame (the stereo-diff view needs them).
 pub fn compose(
     mode: DebugView,
     renderer: &Renderer,
@@ -62,11 +80,21 @@ pub fn compose(
     eye: UVec2,
     hmd: &HmdDescription,
     eyes: &[Eye],
+    stereo: Option<&StereoScene>,
 ) -> Result<Vec<u8>> {
     let (w, h) = (eye.x as usize, eye.y as usize);
     let width = w * eyes.len();
     let mut out = vec![0u8; width * h * 4];
     let mut pixels = Vec::new();
+    let stereo_pictures = match (mode, stereo) {
+        (DebugView::StereoDiff, Some(s)) if eyes.len() == 2 => {
+            Some(stereo_heat_maps(renderer, frame, eye, s)?)
+        }
+        (DebugView::StereoDiff, _) => {
+            bail!("--debug-view stereo-diff needs both eyes (--eyes both)")
+        }
+        _ => None,
+    };
     for (v, &headset_eye) in eyes.iter().enumerate() {
         let space = renderer.view(v).space.as_ref();
         let picture = match mode {
@@ -90,6 +118,7 @@ pub fn compose(
                 draw_rings(&mut pixels, eye, space.gaze(), hmd, headset_eye);
                 std::mem::take(&mut pixels)
             }
+            DebugView::StereoDiff => stereo_pictures.as_ref().expect("made above")[v].clone(),
         };
         for y in 0..h {
             let row = &picture[y * w * 4..(y + 1) * w * 4];
@@ -97,6 +126,26 @@ pub fn compose(
         }
     }
     Ok(out)
+}
+
+/// Each eye's binocular heat map: the other eye warped into it through the depth the CPU BVH
+/// finds through its pixel centres.
+fn stereo_heat_maps(
+    renderer: &Renderer,
+    frame: u64,
+    eye: UVec2,
+    stereo: &StereoScene,
+) -> Result<[Vec<u8>; 2]> {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    renderer.read_view_ldr(frame, 0, &mut left)?;
+    renderer.read_view_ldr(frame, 1, &mut right)?;
+    let [l, r] = stereo
+        .cameras
+        .map(|camera| EyeGeometry::trace(stereo.bvh, camera, eye.x, eye.y));
+    Ok([
+        heat_map(&left, &right, &Warp::new(&l, &r)),
+        heat_map(&right, &left, &Warp::new(&r, &l)),
+    ])
 }
 
 /// Nearest-texel scaling of an RGBA8 image from `from` to `to`.
@@ -147,9 +196,11 @@ mod tests {
         for name in DebugView::NAMES {
             assert_eq!(DebugView::parse(name).unwrap(), m);
             assert_eq!(m.name(), *name);
-            m = m.next();
+            m = m.next(true);
         }
         assert_eq!(m, DebugView::Off);
+        // One eye: the cycle leaves stereo-diff out.
+        assert_eq!(DebugView::Rings.next(false), DebugView::Off);
         assert!(DebugView::parse("heat")
             .unwrap_err()
             .to_string()

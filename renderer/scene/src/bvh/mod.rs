@@ -23,7 +23,12 @@
 //!
 //! [`Bvh::stats`] reports what a tree looks like (depth, leaf sizes, SAH cost, child overlap,
 //! long thin and large triangles); `fovea bench` prints it for each scene and builder.
+//!
+//! Two GPU layouts are made from the binary tree, one per traversal: [`wide::Bvh4`] (the
+//! traversal shaped for CPU drivers such as lavapipe) and [`compressed::Bvh8`] (the one shaped for
+//! GPUs: compressed 8-wide nodes).
 
+pub mod compressed;
 pub mod instanced;
 mod sbvh;
 #[cfg(test)]
@@ -31,8 +36,26 @@ mod tests;
 mod traverse;
 pub mod wide;
 
+use crate::intersect::Hit;
 use crate::Aabb;
 use glam::{Vec3, Vec3A};
+
+/// What a traversal read: nodes opened, leaf triangles tested and the bytes of node and triangle
+/// data fetched for them (the CPU references count what the GPU kernels count).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalCounts {
+    pub nodes: u64,
+    pub triangles: u64,
+    pub bytes: u64,
+}
+
+/// What a traversal carries from tree to tree (the world tree, then instances): the closest hit
+/// so far and the counts.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TraceState {
+    pub best: Option<Hit>,
+    pub counts: TraversalCounts,
+}
 
 /// One BVH node with the boxes of all its `W` children, so a traversal tests them per node fetch
 /// (see the module doc for the meaning of the fields): [`BvhNode`] (binary, what the builders
@@ -175,8 +198,9 @@ pub struct BvhBuilder {
     /// `None`: object splits only (binned SAH), every triangle in exactly one leaf. `Some(b)`:
     /// object and spatial splits (SBVH), at most `b` × triangles extra leaf references.
     pub spatial_budget: Option<f32>,
-    /// Ranges of at most this many triangles always become leaves (larger ones up to 8 when no
-    /// split is cheaper by SAH).
+    /// Ranges of at most this many triangles become leaves (larger ones up to 8 when no split is
+    /// cheaper by SAH; the SBVH splits small ranges too where an object split costs less than
+    /// three quarters of the leaf).
     pub leaf_target: usize,
     /// Cost of one node visit relative to one triangle test, in the SAH.
     pub node_cost: f32,

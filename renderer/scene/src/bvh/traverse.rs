@@ -68,20 +68,37 @@ pub(super) fn test_leaf(
     None
 }
 
+/// 3 texels per leaf entry in `order`: (v0, bits(original index)), (v1, bits(flags)), (v2, 0),
+/// the flag [`super::compressed::TRIANGLE_ALPHA_TESTED`] where `alpha_tested(original index)`.
+pub(super) fn triangle_texels(
+    order: &[u32],
+    tris: &[[Vec3; 3]],
+    alpha_tested: &dyn Fn(u32) -> bool,
+) -> Vec<[f32; 4]> {
+    let flag = |i: u32| {
+        f32::from_bits(if alpha_tested(i) {
+            super::compressed::TRIANGLE_ALPHA_TESTED
+        } else {
+            0
+        })
+    };
+    order
+        .iter()
+        .flat_map(|&i| {
+            let [a, b, c] = tris[i as usize];
+            [
+                [a.x, a.y, a.z, f32::from_bits(i)],
+                [b.x, b.y, b.z, flag(i)],
+                [c.x, c.y, c.z, 0.0],
+            ]
+        })
+        .collect()
+}
+
 impl Bvh {
     /// 3 texels per triangle in `tri_order` order: (v0, bits(original index)), (v1, 0), (v2, 0).
     pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
-        self.tri_order
-            .iter()
-            .flat_map(|&i| {
-                let [a, b, c] = tris[i as usize];
-                [
-                    [a.x, a.y, a.z, f32::from_bits(i)],
-                    [b.x, b.y, b.z, 0.0],
-                    [c.x, c.y, c.z, 0.0],
-                ]
-            })
-            .collect()
+        triangle_texels(&self.tri_order, tris, &|_| false)
     }
 
     /// Closest hit (ties by the rule in [`crate::intersect`]) or, with `any_hit`, the first hit

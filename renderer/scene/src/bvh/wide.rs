@@ -11,12 +11,15 @@
 //! bits(child_ref), bits(child_count).
 
 use super::traverse::{safe_inverse_dir, slab_test, test_leaf};
-use super::{Bvh, BvhNode, NodeOf};
+use super::{Bvh, BvhNode, NodeOf, TraceState};
 use crate::intersect::{Hit, Ray, WatertightRay};
 use crate::Aabb;
 use glam::Vec3;
 
 pub const WIDTH: usize = 4;
+/// Bytes the traversal reads per node visited and per leaf triangle tested (texel buffers).
+pub const NODE_BYTES: u64 = 128;
+pub const TRIANGLE_BYTES: u64 = 48;
 
 /// One 4-wide node: the four children's boxes, refs and counts (as [`BvhNode`]'s two).
 pub type Bvh4Node = NodeOf<WIDTH>;
@@ -140,13 +143,14 @@ impl Bvh4 {
         t_max: f32,
         any_hit: bool,
     ) -> Option<Hit> {
-        let mut best = None;
-        self.intersect_into(tris, ray, t_max, any_hit, 0, &mut best)
-            .or(best)
+        let mut state = TraceState::default();
+        self.intersect_into(tris, ray, t_max, any_hit, 0, &mut state)
+            .or(state.best)
     }
 
-    /// [`Bvh4::intersect`] continuing from `best` (boxes beyond it are skipped, closer hits
-    /// replace it), hit ids offset by `id_base` (an instance's BLAS); returns the any-hit answer.
+    /// [`Bvh4::intersect`] continuing from `state.best` (boxes beyond it are skipped, closer hits
+    /// replace it), hit ids offset by `id_base` (an instance's BLAS), nodes and triangles counted
+    /// as `bvh_walk` in shaders/common/bvh.glsl counts them; returns the any-hit answer.
     pub fn intersect_into(
         &self,
         tris: &[[Vec3; 3]],
@@ -154,7 +158,7 @@ impl Bvh4 {
         t_max: f32,
         any_hit: bool,
         id_base: u32,
-        best: &mut Option<Hit>,
+        state: &mut TraceState,
     ) -> Option<Hit> {
         let wray = WatertightRay::new(ray);
         let inv_dir = safe_inverse_dir(ray.dir);
@@ -162,7 +166,9 @@ impl Bvh4 {
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let limit = best.map_or(t_max, |h| h.t);
+            state.counts.nodes += 1;
+            state.counts.bytes += NODE_BYTES;
+            let limit = state.best.map_or(t_max, |h| h.t);
             let near: [Option<f32>; WIDTH] = std::array::from_fn(|c| {
                 if n.is_empty_child(c) {
                     None
@@ -172,46 +178,51 @@ impl Bvh4 {
             });
             for c in (0..WIDTH).filter(|&c| near[c].is_some() && n.child_count[c] > 0) {
                 let start = n.child_ref[c] as usize;
-                if let Some(hit) = test_leaf(
-                    tris,
-                    &self.tri_order[start..start + n.child_count[c] as usize],
-                    &wray,
-                    t_max,
-                    any_hit,
-                    id_base,
-                    best,
-                ) {
-                    return Some(hit);
+                // One at a time, so an any-hit walk counts only the triangles it tested.
+                for tri in self.tri_order[start..start + n.child_count[c] as usize].chunks(1) {
+                    state.counts.triangles += 1;
+                    state.counts.bytes += TRIANGLE_BYTES;
+                    if let Some(hit) =
+                        test_leaf(tris, tri, &wray, t_max, any_hit, id_base, &mut state.best)
+                    {
+                        return Some(hit);
+                    }
                 }
             }
-            // Interior children nearest first: the farther ones are pushed, farthest deepest.
-            let mut inner: Vec<(f32, u32)> = (0..WIDTH)
-                .filter_map(|c| {
-                    near[c]
-                        .filter(|_| n.child_count[c] == 0)
-                        .map(|t| (t, n.child_ref[c]))
-                })
-                .collect();
-            inner.sort_by(|a, b| a.0.total_cmp(&b.0));
-            match inner.split_first() {
-                Some((first, rest)) => {
-                    stack.extend(rest.iter().rev().map(|c| c.1));
-                    node = first.1;
+            // Interior children nearest first, ordered by the GLSL's comparator network (so equal
+            // entry distances come out in the same order): the farther ones are pushed,
+            // farthest deepest.
+            let mut keyed: [(f32, u32); WIDTH] = std::array::from_fn(|c| match near[c] {
+                Some(t) if n.child_count[c] == 0 => (t, n.child_ref[c]),
+                _ => (1e30, n.child_ref[c]),
+            });
+            let inner = (0..WIDTH)
+                .filter(|&c| near[c].is_some() && n.child_count[c] == 0)
+                .count();
+            for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+                if keyed[b].0 < keyed[a].0 {
+                    keyed.swap(a, b);
                 }
-                None => match stack.pop() {
+            }
+            if inner == 0 {
+                match stack.pop() {
                     Some(a) => node = a,
                     None => return None,
-                },
+                }
+            } else {
+                stack.extend(keyed[1..inner].iter().rev().map(|c| c.1));
+                node = keyed[0].1;
             }
         }
     }
 
-    /// 3 texels per leaf reference, as [`Bvh::triangle_texels`] (the same leaf order).
-    pub fn triangle_texels(&self, tris: &[[Vec3; 3]]) -> Vec<[f32; 4]> {
-        Bvh {
-            nodes: Vec::new(),
-            tri_order: self.tri_order.clone(),
-        }
-        .triangle_texels(tris)
+    /// 3 texels per leaf reference in leaf order, flagged where `alpha_tested(original index)`
+    /// (see [`super::compressed::Bvh8::triangle_words`], the same format).
+    pub fn triangle_texels(
+        &self,
+        tris: &[[Vec3; 3]],
+        alpha_tested: &dyn Fn(u32) -> bool,
+    ) -> Vec<[f32; 4]> {
+        super::traverse::triangle_texels(&self.tri_order, tris, alpha_tested)
     }
 }
