@@ -74,7 +74,14 @@ pub fn run(dir: &Path, index: Option<u32>, offset: u32, parse: Parse) -> Result<
     let outcome = (|| -> Result<()> {
         check_dependencies(&sweep, job)?;
         std::fs::create_dir(&attempt).with_context(|| format!("creating {}", attempt.display()))?;
+        // From here a signal is a request: the job stops at its next check (a render's next
+        // frame, a reference's next batch), removes its attempt and records why, also while it is
+        // still loading the scene or opening the device.
+        crate::interrupt::running();
+        stop_requested()?;
         let device = execute(&sweep, job, &attempt, parse)?;
+        // A signal that came while the last piece was measured: cancelled, not done.
+        stop_requested()?;
         write_json(
             &attempt.join(RECORD),
             &JobRecord {
