@@ -261,6 +261,7 @@ fn quality_args<'a>(
         eyes: fovea_tools::commands::setup::Eyes::Left,
         stereo_noises: &[],
         camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        references: None,
         out,
         device: None,
         validation: true,
@@ -323,6 +324,32 @@ fn quality_command_measures_every_combination() {
     ] {
         assert!(out.join(name).is_file(), "{name} missing");
     }
+    // Each reference also as displayed (what scripts/perceptual judges): the EXR through the
+    // runs' exposure and tone curve.
+    for name in ["reference_still_0000", "reference_moving_0002"] {
+        let (_, _, linear) =
+            fovea_tools::output::read_exr(&out.join(format!("{name}.exr"))).unwrap();
+        let displayed = image::open(out.join(format!("{name}.png")))
+            .unwrap()
+            .to_rgba8();
+        let expected = fovea_tools::output::tonemap_preview(
+            &linear,
+            1.0,
+            fovea_renderer::passes::tonemap::ToneCurve::Aces,
+        );
+        assert_eq!(displayed.as_raw(), &expected, "{name}.png");
+    }
+    // What a video metric needs of the display, and where each run's frames are.
+    assert_eq!(report["refresh_hz"], 70.0);
+    assert_eq!(
+        report["eye_fov_deg"][1].as_f64().map(|d| d.round()),
+        Some(45.0)
+    );
+    for r in runs {
+        let dir = out.join(r["run_dir"].as_str().unwrap());
+        assert!(dir.join("frame_0002.png").is_file(), "{r}");
+    }
+    perceptual_report_reads_the_scores(&out, runs);
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
     assert!(
         table.contains("**moving camera**")
@@ -336,6 +363,124 @@ fn quality_command_measures_every_combination() {
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let err = format!("{:#}", run(&args(&denoisers)).unwrap_err());
     assert!(err.contains("notes.txt"), "{err}");
+}
+
+/// `fovea quality --references`: a run at another sample budget (a profile's VP grid) takes an
+/// earlier folder's references byte for byte instead of rendering them, and is judged against
+/// them; a folder of other reference settings is refused, naming the key.
+#[test]
+fn quality_reuses_the_references_of_the_same_settings() {
+    use fovea_tools::commands::quality::{run, QualityArgs};
+    let (first, second) = (temp_dir("references-a"), temp_dir("references-b"));
+    let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (methods, denoisers, taa, cameras) = (
+        strings(&["vp"]),
+        strings(&["none"]),
+        strings(&["off"]),
+        strings(&["still"]),
+    );
+    run(&quality_args(
+        [&methods, &denoisers, &taa, &cameras],
+        &first,
+    ))
+    .unwrap();
+    let mut profile = fovea_tools::render_profile::RenderProfile::default();
+    profile.visual_polar.axis_scale = 0.5;
+    let reusing = QualityArgs {
+        profile,
+        references: Some(&first),
+        ..quality_args([&methods, &denoisers, &taa, &cameras], &second)
+    };
+    run(&reusing).unwrap();
+    for name in ["reference_still_0000.exr", "reference_still_0000.png"] {
+        assert_eq!(
+            std::fs::read(first.join(name)).unwrap(),
+            std::fs::read(second.join(name)).unwrap(),
+            "{name}"
+        );
+    }
+    let samples = |dir: &Path| {
+        let q: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("quality.json")).unwrap())
+                .unwrap();
+        assert!(q["runs"][0]["frame_rmse"].as_f64().unwrap() > 0.0, "{q}");
+        q["runs"][0]["samples_traced"].as_u64().unwrap()
+    };
+    assert!(samples(&second) < samples(&first));
+    let other = QualityArgs {
+        reference_spp: 8,
+        ..reusing
+    };
+    let err = format!("{:#}", run(&other).unwrap_err());
+    assert!(
+        err.contains("reference_key") && err.contains("spp 8"),
+        "{err}"
+    );
+}
+
+/// `fovea perceptual-report` on a quality folder with hand-written FovVideoVDP scores (the
+/// scorer itself, scripts/perceptual, is offline): one table row per run with its JOD and
+/// samples, a plot per cost axis and camera; missing or stale scores are refused by name.
+fn perceptual_report_reads_the_scores(quality: &Path, runs: &[serde_json::Value]) {
+    use fovea_tools::commands::perceptual_report::{run, PerceptualReportArgs};
+    let out = quality.with_extension("perceptual");
+    let _ = std::fs::remove_dir_all(&out);
+    let folders = [quality.to_path_buf()];
+    let args = PerceptualReportArgs {
+        folders: &folders,
+        out: &out,
+    };
+    let err = format!("{:#}", run(&args).unwrap_err());
+    assert!(
+        err.contains("no perceptual.json") && err.contains("scripts/perceptual"),
+        "{err}"
+    );
+    let scored: Vec<serde_json::Value> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| serde_json::json!({ "run_dir": r["run_dir"], "jod": 5.0 + i as f64 * 0.125 }))
+        .collect();
+    let perceptual = |runs: &[serde_json::Value]| {
+        serde_json::json!({
+            "metric": "FovVideoVDP", "scene": "cornell-box", "width": 40, "height": 36,
+            "gaze_source": "sim:2", "frames_per_second": 70.0, "pixels_per_degree": 0.5,
+            "runs": runs,
+        })
+        .to_string()
+    };
+    let path = quality.join("perceptual.json");
+    std::fs::write(&path, perceptual(&scored)).unwrap();
+    run(&args).unwrap();
+    let md = std::fs::read_to_string(out.join("perceptual.md")).unwrap();
+    for (i, r) in runs.iter().enumerate() {
+        let row = format!(
+            "| {} + {}, taa {} | {} |",
+            r["method"].as_str().unwrap(),
+            r["denoiser"].as_str().unwrap(),
+            r["taa"].as_str().unwrap(),
+            r["samples_traced"]
+        );
+        let jod = format!("{:.3} |", 5.0 + i as f64 * 0.125);
+        assert!(
+            md.lines().any(|l| l.contains(&row) && l.contains(&jod)),
+            "no row {row} … {jod} in\n{md}"
+        );
+    }
+    for camera in ["still", "moving"] {
+        for axis in ["samples", "gpu_ms"] {
+            let png = out.join(format!("jod_{axis}_cornell-box_40x36_sim-2_{camera}.png"));
+            assert!(png.is_file(), "{} missing", png.display());
+        }
+    }
+    let mut stale = scored.clone();
+    stale[0]["run_dir"] = "run_still_gone_none_taa-off".into();
+    std::fs::write(&path, perceptual(&stale)).unwrap();
+    let err = format!("{:#}", run(&args).unwrap_err());
+    assert!(
+        err.contains("run_still_gone_none_taa-off") && err.contains("score the folder again"),
+        "{err}"
+    );
+    std::fs::remove_file(&path).unwrap();
 }
 
 /// `fovea quality --eyes both --stereo-noise independent,surface`: each run renders both eyes,

@@ -409,6 +409,12 @@ struct QualityFlags {
     eyes: String,
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
+    /// Take the converged references from an earlier `fovea quality` folder instead of rendering
+    /// them: its quality.json must record the same reference settings (scene, size, headset,
+    /// eyes, frames, samples, seed, camera and light flags); they are copied into --out. E.g. the
+    /// same scene at several sample budgets (profiles) with one set of references
+    #[arg(long)]
+    references: Option<PathBuf>,
     /// Equal-width rings from the gaze out to the farthest corner.
     #[arg(long, default_value_t = 10)]
     rings: usize,
@@ -716,6 +722,16 @@ enum Command {
         /// method at VP's sample count (a profile's budget knob): one claim line each.
         #[arg(long, value_delimiter = ',')]
         equal_samples: Vec<PathBuf>,
+    },
+    /// Perceived quality against cost: `fovea quality` folders scored by FovVideoVDP
+    /// (scripts/perceptual) → per scene, size, gaze and camera a table and plots of JOD against
+    /// samples and GPU time per frame, one line per method + filters → DIR/perceptual.md + jod_*.png
+    PerceptualReport {
+        /// `fovea quality` folders, each with the perceptual.json of scripts/perceptual.
+        #[arg(required = true)]
+        folders: Vec<PathBuf>,
+        #[arg(long, default_value = "out/perceptual")]
+        out: PathBuf,
     },
     /// Compare a frame with a reference (RMSE, PSNR, SSIM), whole-frame and per eccentricity ring.
     Eval {
@@ -1146,6 +1162,12 @@ fn run() -> Result<()> {
             predict: &gaze_predict,
             out: &out,
         }),
+        Command::PerceptualReport { folders, out } => {
+            commands::perceptual_report::run(&commands::perceptual_report::PerceptualReportArgs {
+                folders: &folders,
+                out: &out,
+            })
+        }
         Command::MethodTable {
             quality,
             bench,
@@ -1200,6 +1222,7 @@ fn with_quality_args(
         cameras,
         eyes,
         reference_spp,
+        references,
         rings,
         seed,
         profile,
@@ -1258,6 +1281,7 @@ fn with_quality_args(
         eyes: commands::setup::Eyes::parse(&eyes)?,
         stereo_noises: &stereo_noises,
         camera: &look.camera()?,
+        references: references.as_deref(),
         out: &out,
         device: device.device.as_deref(),
         validation: device.validation,

@@ -248,11 +248,14 @@ fn is_fovea_file(name: &str) -> bool {
             | "replay.json"
             | "replay.md"
             | "overview.png"
-    ) || (name.starts_with("reference_") && name.ends_with(".exr"))
+            | "perceptual.json"
+            | "perceptual.md"
+    ) || (name.starts_with("reference_") && (name.ends_with(".exr") || name.ends_with(".png")))
         || (name.starts_with("frame_") && (name.ends_with(".png") || name.ends_with(".exr")))
         || (name.starts_with("debug_")
             && [".png", ".exr", ".json"].iter().any(|e| name.ends_with(e)))
         || (name.starts_with("rays_") && name.ends_with(".bin"))
+        || (name.starts_with("jod_") && name.ends_with(".png"))
 }
 
 /// A temporary of [`write_atomic`] (left behind only by a killed process).

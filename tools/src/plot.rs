@@ -11,6 +11,8 @@ use std::sync::OnceLock;
 pub const FONT_PATH: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 const FONT: &str = "fovea-sans";
 const SIZE: (u32, u32) = (900, 600);
+/// Series of at most this many points get a marker at each.
+const MARKED_POINTS: usize = 16;
 const COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -123,6 +125,12 @@ where
             .map_err(|e| e.to_string())?
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], colour.stroke_width(2)));
+        // A few measured points (one per budget, say) are marked: a single one draws no line.
+        if points.len() <= MARKED_POINTS {
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .map_err(|e| e.to_string())?;
+        }
     }
     chart
         .configure_series_labels()

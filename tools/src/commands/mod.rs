@@ -13,6 +13,7 @@ pub mod info;
 pub mod method_table;
 pub mod methods;
 pub mod overview;
+pub mod perceptual_report;
 pub mod quality;
 mod quality_stereo;
 pub mod reference;

@@ -13,7 +13,9 @@ use super::setup::Eyes;
 use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
-use crate::output::{prepare_output_dir, tonemap_preview, write_exr, write_json, write_text};
+use crate::output::{
+    prepare_output_dir, tonemap_preview, write_exr, write_json, write_png, write_text,
+};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::Eye;
@@ -54,6 +56,9 @@ pub struct QualityArgs<'a> {
     /// folders keep their names without it.
     pub stereo_noises: &'a [StereoNoise],
     pub camera: &'a crate::look::CameraOptions,
+    /// An earlier quality folder whose references (of the same [`reference_key`]) are copied
+    /// instead of rendered.
+    pub references: Option<&'a Path>,
     pub out: &'a Path,
     pub device: Option<&'a str>,
     pub validation: bool,
@@ -64,6 +69,10 @@ pub const CAMERAS: &[&str] = &["still", "moving"];
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
 #[derive(Serialize, Deserialize)]
 pub struct RunQuality {
+    /// The run's `fovea render` folder inside the output folder (read by the offline perceptual
+    /// scorer, scripts/perceptual).
+    #[serde(default)]
+    run_dir: String,
     camera: String,
     method: String,
     denoiser: String,
@@ -167,6 +176,13 @@ struct Report<'a> {
     resampling: &'static str,
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
+    /// Everything the converged references depend on ([`reference_key`]): `--references`
+    /// takes another folder's only when its key is this.
+    reference_key: String,
+    /// The display the frames are shown on, for video metrics: the headset's refresh (frames per
+    /// second) and the left eye's FOV in degrees (left, right, down, up; left and down negative).
+    refresh_hz: f32,
+    eye_fov_deg: [f32; 4],
     /// With the latency model: its latency and predictor (the runs' report.json `gaze_latency`).
     #[serde(skip_serializing_if = "Option::is_none")]
     latency: Option<String>,
@@ -511,6 +527,10 @@ pub fn run_combination(
             },
         });
     }
+    q.run_dir = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     (q.camera, q.method, q.denoiser, q.taa, q.stereo_noise) = (
         camera.to_string(),
         method.to_string(),
@@ -552,6 +572,18 @@ pub fn write_report(
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
         resampling: args.profile.resampling.mode.name(),
         flip_ppd: prepared.ppd,
+        reference_key: reference_key(args),
+        refresh_hz: prepared.hmd.refresh_hz,
+        eye_fov_deg: {
+            let fov = prepared.hmd.eye(Eye::Left).fov;
+            [
+                fov.angle_left,
+                fov.angle_right,
+                fov.angle_down,
+                fov.angle_up,
+            ]
+            .map(f32::to_degrees)
+        },
         latency: model.map(|m| m.describe()),
         gaze_predict: model.map(|_| args.profile.gaze_timing.mode().name().to_string()),
         runs: &runs,
@@ -592,6 +624,27 @@ pub fn reference_file_name(eyes: Eyes, camera: &str, eye: Eye, frame: u32) -> St
         ),
         Eyes::Left | Eyes::Right => format!("reference_{camera}_{frame:04}.exr"),
     }
+}
+
+/// Writes a converged reference into `out` ([`reference_file_name`]) and, beside it
+/// (`.png`), as displayed: through the one exposure and curve every run is judged at, for
+/// metrics that read displayed images (scripts/perceptual).
+pub fn write_reference(
+    out: &Path,
+    args: &QualityArgs,
+    camera: &str,
+    eye: Eye,
+    frame: u32,
+    image: &[[f32; 4]],
+) -> Result<()> {
+    let path = out.join(reference_file_name(args.eyes, camera, eye, frame));
+    write_exr(&path, args.width, args.height, image)?;
+    write_png(
+        &path.with_extension("png"),
+        args.width,
+        args.height,
+        &tonemap_preview(image, 1.0, ToneCurve::Aces),
+    )
 }
 
 /// The scene and the head of the references of one camera: the eyes `fovea render --eyes
@@ -729,8 +782,12 @@ impl References {
 
 /// Converged references of the evaluated frames' camera poses (one for a still camera, the same
 /// for every evaluated frame) for each eye of [`reference_eyes`], written to
-/// `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`).
+/// `DIR/reference_<camera>_NNNN.exr` (a stereo run: `reference_<camera>_<eye>_NNNN.exr`), and
+/// each as displayed beside it (`.png`).
 fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<References> {
+    if let Some(from) = args.references {
+        return copied_references(args, from, camera, evaluated);
+    }
     let mut r = reference_renderer(args, camera, evaluated)?;
     let mut images = Vec::new();
     for &eye in reference_eyes(args) {
@@ -744,20 +801,81 @@ fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Ref
                 fovea_renderer::frame::REALTIME_MAX_DEPTH,
                 &mut |_| Ok(()),
             )?;
-            write_exr(
-                &args
-                    .out
-                    .join(reference_file_name(args.eyes, camera, eye, f)),
-                args.width,
-                args.height,
-                &reference,
-            )?;
+            write_reference(args.out, args, camera, eye, f, &reference)?;
             eye_images.push(reference);
         }
         images.push(eye_images);
     }
     super::check_validation(&r.ctx)?;
     References::new(args, camera, evaluated, images, Some(&r.views))
+}
+
+/// What the converged references of a quality run depend on, as one string: the scene, size,
+/// headset, eyes, frames, samples, seed and the camera and light flags (the render profile's
+/// sampling settings do not touch them: references trace every pixel with the engine's defaults).
+/// A file named in it (scene, environment map) is named, not hashed.
+pub fn reference_key(args: &QualityArgs) -> String {
+    format!(
+        "{} {}x{} {} eyes {} frames {}/{} spp {} seed {} {:?} {:?}",
+        args.scene,
+        args.width,
+        args.height,
+        args.headset,
+        args.eyes.name(),
+        args.frames,
+        args.eval_frames,
+        args.reference_spp,
+        args.seed,
+        args.camera,
+        args.profile.environment
+    )
+}
+
+/// `--references FROM`: the references of `camera` read from an earlier quality folder whose
+/// quality.json has this run's [`reference_key`], and copied into this run's folder.
+fn copied_references(
+    args: &QualityArgs,
+    from: &Path,
+    camera: &str,
+    evaluated: &[u32],
+) -> Result<References> {
+    let report_path = from.join("quality.json");
+    let text = std::fs::read_to_string(&report_path)
+        .with_context(|| format!("--references: reading {}", report_path.display()))?;
+    let report: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("--references: {}", report_path.display()))?;
+    let key = reference_key(args);
+    match report["reference_key"].as_str() {
+        Some(theirs) if theirs == key => {}
+        Some(theirs) => bail!(
+            "--references {}: its references are of other settings (quality.json reference_key \
+             \"{theirs}\", this run's \"{key}\")",
+            from.display()
+        ),
+        None => bail!(
+            "--references {}: quality.json has no reference_key (written by an older fovea)",
+            from.display()
+        ),
+    }
+    let size = Some((args.width, args.height));
+    let mut images = Vec::new();
+    for &eye in reference_eyes(args) {
+        let mut eye_images = Vec::new();
+        for f in reference_frames(camera, evaluated) {
+            let path = from.join(reference_file_name(args.eyes, camera, eye, f));
+            let (_, _, image) =
+                crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)
+                    .with_context(|| format!("--references: {}", path.display()))?;
+            write_reference(args.out, args, camera, eye, f, &image)?;
+            eye_images.push(image);
+        }
+        images.push(eye_images);
+    }
+    let views = match args.eyes {
+        Eyes::Both => Some(reference_views(args, camera, evaluated)?),
+        Eyes::Left | Eyes::Right => None,
+    };
+    References::new(args, camera, evaluated, images, views.as_ref())
 }
 
 /// The references of [`reference_frames`] as one per evaluated frame (the still camera's one
@@ -897,6 +1015,7 @@ fn measure(
         })
         .collect();
     Ok(RunQuality {
+        run_dir: String::new(),
         camera: String::new(),
         method: String::new(),
         denoiser: String::new(),

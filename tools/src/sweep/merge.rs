@@ -10,7 +10,6 @@ use super::open::Sweep;
 use super::status::{done, state, State};
 use crate::commands::quality::{self, Combination, Outcome};
 use crate::commands::replay::{self, Regression, ReplayArgs, TraceResult};
-use crate::output::write_exr;
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::StereoNoise;
 use std::collections::BTreeMap;
@@ -137,12 +136,7 @@ fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path
             for frame in quality::reference_frames(camera, &prepared.evaluated) {
                 let image = reference_of(sweep, study, Some(camera), Some(frame), key.as_deref())?
                     .mean()?;
-                write_exr(
-                    &out.join(quality::reference_file_name(q.eyes, camera, eye, frame)),
-                    q.width,
-                    q.height,
-                    &image,
-                )?;
+                quality::write_reference(out, q, camera, eye, frame, &image)?;
             }
         }
     }

@@ -212,6 +212,12 @@ fn shape(args: &[String], parse: Parse) -> Result<Shape> {
 }
 
 fn quality_shape(q: &QualityArgs) -> Result<Shape> {
+    if let Some(from) = q.references {
+        bail!(
+            "quality --references {}: a sweep renders its references as jobs of their own; plan it without --references",
+            from.display()
+        );
+    }
     let prepared = quality::prepare(q)?;
     Ok(Shape::Quality {
         cameras: q.cameras.to_vec(),
