@@ -54,14 +54,16 @@ fn render_writes_frames_and_a_report_with_exact_counts() {
     render(&render_args("cornell-box", &out)).unwrap();
 }
 
-/// `--method vp`: the grid and its exact sample count, off-screen samples, the passes back to the
-/// screen, and the debug views (grid image, density heat map per frame, one density plot).
+/// `--method vp-paper`: the grid and its exact sample count, off-screen samples, the passes back
+/// to the screen, and the debug views (grid image, density heat map per frame, one density plot);
+/// `--method vp` (the default screen-clipped layout) keeps its whole budget with the gaze in the
+/// corner.
 #[test]
 fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
     use fovea_renderer::sampling::{VisualPolar, VisualPolarParams};
     let out = temp_dir("render-vp");
     let mut args = render_args("cornell-box", &out);
-    args.method = "vp";
+    args.method = "vp-paper";
     args.gaze = "2,3";
     args.camera_path = Default::default();
     args.debug_views = true;
@@ -74,7 +76,8 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
         VisualPolarParams::default(),
     )
     .unwrap();
-    assert_eq!(report["method"], "vp");
+    assert_eq!(report["method"], "vp-paper");
+    assert_eq!(report["visual_polar"]["layout"], "paper");
     assert_eq!(report["vp_width"], vp.grid_size().x);
     assert_eq!(report["vp_height"], vp.grid_size().y);
     assert_eq!(report["screen_pixels"], 40 * 36);
@@ -113,6 +116,22 @@ fn visual_polar_render_reports_its_grid_and_writes_debug_views() {
         (grid.width(), grid.height()),
         (vp.grid_size().x, vp.grid_size().y)
     );
+    // The default layout at the same corner gaze: every sample on the screen, none culled.
+    let out = temp_dir("render-vp-default");
+    let mut args = render_args("cornell-box", &out);
+    args.method = "vp";
+    args.gaze = "2,3";
+    args.camera_path = Default::default();
+    render(&args).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["visual_polar"]["layout"], "screen-clipped");
+    let count = |key: &str| report[key].as_u64().unwrap();
+    assert_eq!(count("samples_culled"), 0, "{report}");
+    assert!(
+        count("samples_traced").abs_diff(vp.sample_count()) <= 1,
+        "{report}"
+    );
 }
 
 /// `--vp-eccentricity headset` through every VP pass (trace, SVGF, TAA, φ-mips, remap, blur)
@@ -139,6 +158,8 @@ fn headset_eccentricity_runs_every_vp_pass() {
         args.denoiser = "svgf";
         args.taa = "vp";
         args.profile.eccentricity = mode;
+        // The headset axis exists for the paper layout: both axes are compared on it.
+        args.profile.visual_polar.layout = fovea_renderer::sampling::VpLayout::Paper;
         render(&args).unwrap();
         let report: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
@@ -1050,6 +1071,7 @@ fn bench_vp_frames_follow_a_camera_path() {
             "random-acuity",
             "pixel-blocks",
             "composite",
+            "vp-paper",
             "vp-screen-clipped",
             "vp-screen-aware",
             "vp-headset",
@@ -1068,22 +1090,28 @@ fn bench_vp_frames_follow_a_camera_path() {
     // Random acuity traces Visual-Polar's samples.
     assert_eq!(comparators[3]["samples"], vp["vp_samples"]);
     // Fixed foveation: VP's samples, but around the lens centre, so far fewer of them lie off the
-    // screen than VP's around the gaze near the corner below.
-    assert_eq!(comparators[9]["samples"], vp["vp_samples"]);
+    // screen than the paper layout's around the gaze near the corner below.
+    let (paper, fixed) = (&comparators[6], &comparators[10]);
+    assert_eq!(fixed["samples"], vp["vp_samples"]);
     assert!(
-        comparators[9]["samples_traced"].as_u64() > vp["vp_samples_traced"].as_u64(),
-        "{}",
-        comparators[9]
+        fixed["samples_traced"].as_u64() > paper["samples_traced"].as_u64(),
+        "{fixed}"
     );
-    // --vp-gaze near the top-left corner: most of VP's circle lies off the screen, and the samples
-    // far off it are culled; with every sample traced (the paper's way) all of them are.
+    // --vp-gaze near the top-left corner: most of the paper layout's circle lies off the screen,
+    // and the samples far off it are culled; with every sample traced (the paper's way) all of
+    // them are. The default layout keeps its whole budget on the screen.
     assert_eq!(vp["gaze"][0].as_f64(), Some(6.4), "{vp}");
     let (samples, traced) = (
         vp["vp_samples"].as_u64().unwrap(),
-        vp["vp_samples_traced"].as_u64().unwrap(),
+        paper["samples_traced"].as_u64().unwrap(),
     );
+    assert_eq!(paper["samples"].as_u64(), Some(samples), "{paper}");
     // (At 64×72 the culling margin, three footprints and three pixels, keeps a large share.)
-    assert!(traced < samples * 3 / 4, "{vp}");
+    assert!(traced < samples * 3 / 4, "{paper}");
+    assert!(
+        vp["vp_samples_traced"].as_u64().unwrap().abs_diff(samples) <= 1,
+        "{vp}"
+    );
     assert_eq!(
         vp["vp_offscreen_traced"]["samples_traced"].as_u64(),
         Some(samples),

@@ -410,9 +410,10 @@ struct QualityFlags {
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
     /// Take the converged references from an earlier `fovea quality` folder instead of rendering
-    /// them: its quality.json must record the same reference settings (scene, size, headset,
-    /// eyes, frames, samples, seed, camera and light flags); they are copied into --out. E.g. the
-    /// same scene at several sample budgets (profiles) with one set of references
+    /// them: its quality.json must record the same reference settings for each camera (scene,
+    /// size, headset, eyes, samples, seed, camera and light flags; the frames for the moving
+    /// camera); they are copied into --out. E.g. the same scene at several sample budgets
+    /// (profiles) or gaze sources with one set of references
     #[arg(long)]
     references: Option<PathBuf>,
     /// Equal-width rings from the gaze out to the farthest corner.

@@ -26,7 +26,7 @@ use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
 
-#[derive(Clone, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderProfile {
     pub visual_polar: VisualPolarParams,
     /// `[log_polar]`: `--method log-polar` (Meng et al. 2018; σ, α, the extent L comes from).
@@ -60,6 +60,38 @@ pub struct RenderProfile {
     pub surface_cell: Option<f32>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: crate::gaze::GazeTiming,
+}
+
+/// The Visual-Polar layout of the product's default profile: the paper's grid with each column's
+/// rows on its on-screen arcs, so the sample budget does not fall when the eye looks toward a
+/// corner (the paper layout loses up to 54 % there), at the paper layout's perceived quality
+/// (docs/perceptual.md). The renderer's own default stays the paper's.
+pub const DEFAULT_VP_LAYOUT: VpLayout = VpLayout::ScreenClipped;
+
+impl Default for RenderProfile {
+    fn default() -> Self {
+        RenderProfile {
+            visual_polar: VisualPolarParams {
+                layout: DEFAULT_VP_LAYOUT,
+                ..VisualPolarParams::default()
+            },
+            log_polar: Default::default(),
+            composite_mode: Default::default(),
+            composite_sigma: None,
+            eccentricity: Default::default(),
+            blur: Default::default(),
+            denoisers: Default::default(),
+            taa: Default::default(),
+            environment: Default::default(),
+            texture_lod: Default::default(),
+            path_regularisation: None,
+            offscreen_samples: Default::default(),
+            resampling: Default::default(),
+            stereo_noise: Default::default(),
+            surface_cell: None,
+            gaze_timing: Default::default(),
+        }
+    }
 }
 
 /// A render profile as written: the fixed sections, and the registered denoisers' sections
@@ -392,13 +424,18 @@ impl RenderProfile {
                 p.radius_mode = parse_radius(&text)
                     .with_context(|| format!("{}.radius", at("visual_polar")))?;
             }
-            if let Some(layout) = vp.layout {
-                p.layout = parse_layout(&layout)
+            if let Some(layout) = &vp.layout {
+                p.layout = parse_layout(layout)
                     .with_context(|| format!("{}.layout", at("visual_polar")))?;
             }
             if let Some(mode) = vp.eccentricity {
                 profile.eccentricity = parse_eccentricity(&mode)
                     .with_context(|| format!("{}.eccentricity", at("visual_polar")))?;
+                // The headset axis exists for the paper layout only: asking for it without a
+                // layout asks for that one.
+                if profile.eccentricity == EccentricityMode::Headset && vp.layout.is_none() {
+                    p.layout = VpLayout::Paper;
+                }
             }
             p.validate().with_context(|| at("visual_polar"))?;
             profile
@@ -533,10 +570,14 @@ impl RenderProfile {
         if let Some(layout) = &o.layout {
             p.layout = parse_layout(layout).context("--vp-layout")?;
         }
-        p.validate().context("Visual-Polar flags")?;
         if let Some(mode) = &o.eccentricity {
             self.eccentricity = parse_eccentricity(mode).context("--vp-eccentricity")?;
+            // As in a profile: the headset axis without a layout takes the paper's, its only one.
+            if self.eccentricity == EccentricityMode::Headset && o.layout.is_none() {
+                self.visual_polar.layout = VpLayout::Paper;
+            }
         }
+        self.visual_polar.validate().context("Visual-Polar flags")?;
         self.check_eccentricity().context("--vp-eccentricity")?;
         if let Some(extent) = &o.log_polar_extent {
             self.log_polar.extent = parse_log_polar_extent(extent).context("--log-polar-extent")?;
@@ -771,7 +812,7 @@ mod tests {
     }
 
     #[test]
-    fn shipped_default_profile_is_the_paper_defaults() {
+    fn shipped_default_profile_is_the_built_in_default() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/render/default.toml");
         let p = RenderProfile::load(&path).unwrap();
         let d = VisualPolarParams::default();
@@ -779,7 +820,7 @@ mod tests {
         assert_eq!(p.visual_polar.clip_fraction, d.clip_fraction);
         assert_eq!(p.visual_polar.inverse_cdf, InverseCdf::Polynomial);
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
-        assert_eq!(p.visual_polar.layout, VpLayout::Paper);
+        assert_eq!(p.visual_polar.layout, DEFAULT_VP_LAYOUT);
         assert_eq!(p.eccentricity, EccentricityMode::Normalized);
         assert_eq!(p.blur.sigma_at_30, 6.8);
         assert_eq!(p.denoisers, DenoiserProfile::default());

@@ -257,7 +257,10 @@ const MEASURED_APART: &[&str] = &["vp", "cartesian"];
 /// Every other method of the registry (`methods::METHODS`: the comparators with
 /// their papers' defaults, VP's variants, fixed foveation), as `fovea render` builds it with the
 /// default profile for the FOVE 0's left eye, around `gaze`; each one measured beside `vp`.
-fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSpace>>> {
+fn comparator_spaces(
+    screen: UVec2,
+    gaze: Vec2,
+) -> Result<Vec<(&'static str, Box<dyn SamplingSpace>)>> {
     let (profile, hmd) = (
         crate::render_profile::RenderProfile::default(),
         fovea_hal::HmdDescription::resolve("fove0")?,
@@ -270,9 +273,14 @@ fn comparator_spaces(screen: UVec2, gaze: Vec2) -> Result<Vec<Box<dyn SamplingSp
             let mut space =
                 super::setup::space_for(name, &profile, &hmd, fovea_hal::Eye::Left, screen)?;
             space.set_gaze(gaze)?;
-            Ok(space)
+            Ok((name, space))
         })
         .collect()
+}
+
+/// The parameters of `--method vp` with the default profile (its layout).
+fn default_vp_params() -> VisualPolarParams {
+    crate::render_profile::RenderProfile::default().visual_polar
 }
 
 /// The FOVE 0 left eye's FOV from its headset profile, for the headset-axis variant.
@@ -323,7 +331,10 @@ pub fn measure(
     let camera_at = |frame: u32| {
         camera_path.map_or(pose, |keys| keys.pose(frame as f64 / CAMERA_PATH_HZ, &pose))
     };
-    let vp = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
+    // `vp` as `fovea render` builds it (the default profile's layout); the variants that trace
+    // off-screen samples or blur in the grid are of the paper layout, the one they change.
+    let vp = VisualPolar::new(screen, gaze, default_vp_params())?;
+    let paper = VisualPolar::new(screen, gaze, VisualPolarParams::default())?;
     // One renderer per space (Cartesian first, gaze-less) with these settings, their frames
     // interleaved: each one's pass medians and denoiser history bytes (the renderers are dropped
     // before the next measurement).
@@ -362,7 +373,7 @@ pub fn measure(
     };
     // Without a denoiser the comparators join the same interleaved run.
     let comparator_spaces = comparator_spaces(screen, gaze)?;
-    let described_vp = |name| (name, vp.grid_size().to_array(), vp.sample_count());
+    let described_vp = |name| (name, paper.grid_size().to_array(), paper.sample_count());
     let mut described: Vec<(&'static str, [u32; 2], u64)> = vec![
         described_vp(VP_OFFSCREEN_TRACED),
         described_vp(VP_GRID_BLUR),
@@ -370,7 +381,7 @@ pub fn measure(
     described.extend(
         comparator_spaces
             .iter()
-            .map(|s| (s.name(), s.grid_size().to_array(), s.sample_count())),
+            .map(|(name, s)| (*name, s.grid_size().to_array(), s.sample_count())),
     );
     let traced_everywhere = RenderSettings {
         offscreen_samples: OffscreenSamples::Trace,
@@ -385,10 +396,10 @@ pub fn measure(
     };
     let mut spaces: Vec<(Box<dyn SamplingSpace>, Option<RenderSettings>)> = vec![
         (Box::new(vp), None),
-        (Box::new(vp), Some(traced_everywhere)),
-        (Box::new(vp), Some(blur_in_grid)),
+        (Box::new(paper), Some(traced_everywhere)),
+        (Box::new(paper), Some(blur_in_grid)),
     ];
-    spaces.extend(comparator_spaces.into_iter().map(|s| (s, None)));
+    spaces.extend(comparator_spaces.into_iter().map(|(_, s)| (s, None)));
     let mut plain = measure(RenderSettings::default(), spaces)?
         .into_iter()
         .map(|(medians, _)| medians);
@@ -698,13 +709,13 @@ mod tests {
         let screen = UVec2::new(320, 360);
         let gaze = Vec2::new(100.0, 120.0);
         let spaces = comparator_spaces(screen, gaze).unwrap();
-        let names: Vec<_> = spaces.iter().map(|s| s.name()).collect();
+        let names: Vec<_> = spaces.iter().map(|(name, _)| *name).collect();
         let expected: Vec<_> = super::super::methods::names()
             .into_iter()
             .filter(|n| !MEASURED_APART.contains(n))
             .collect();
         assert_eq!(names, expected);
-        assert!(spaces.iter().all(|s| s.gaze() == gaze), "{names:?}");
+        assert!(spaces.iter().all(|(_, s)| s.gaze() == gaze), "{names:?}");
         let (profile, hmd) = (
             crate::render_profile::RenderProfile::default(),
             fovea_hal::HmdDescription::resolve("fove0").unwrap(),
@@ -713,7 +724,11 @@ mod tests {
             super::super::setup::space_for("vp", &profile, &hmd, fovea_hal::Eye::Left, screen)
                 .unwrap();
         let bench_vp =
-            VisualPolar::new(screen, screen.as_vec2() * 0.5, VisualPolarParams::default()).unwrap();
+            VisualPolar::new(screen, screen.as_vec2() * 0.5, default_vp_params()).unwrap();
         assert_eq!(registry_vp.params(), bench_vp.sampling_params());
+        assert_eq!(
+            default_vp_params().layout,
+            crate::render_profile::DEFAULT_VP_LAYOUT
+        );
     }
 }

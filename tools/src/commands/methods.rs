@@ -30,6 +30,7 @@ pub enum ScreenNeeds {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VpVariant {
     Profile,
+    Paper,
     ScreenClipped,
     ScreenAware,
     Headset,
@@ -155,8 +156,13 @@ pub const METHODS: &[Method] = &[
         blurs: true,
         report: ReportSection::None,
         build: |i| {
+            // Drawn from the paper layout's density, whatever the profile's layout.
+            let paper = VisualPolarParams {
+                layout: VpLayout::Paper,
+                ..i.vp
+            };
             Ok(Box::new(
-                RandomAcuity::new(i.screen, i.centre(), i.vp).context("random acuity")?,
+                RandomAcuity::new(i.screen, i.centre(), paper).context("random acuity")?,
             ))
         },
     },
@@ -187,6 +193,21 @@ pub const METHODS: &[Method] = &[
         },
     },
     // Visual-Polar's variants as methods of their own (the method table's rows).
+    Method {
+        name: "vp-paper",
+        screen: ScreenNeeds::VisualPolarGrid,
+        blurs: true,
+        report: ReportSection::VisualPolar(VpVariant::Paper),
+        build: |i| {
+            i.visual_polar(
+                VisualPolarParams {
+                    layout: VpLayout::Paper,
+                    ..i.vp
+                },
+                "Visual-Polar space, the paper's layout",
+            )
+        },
+    },
     Method {
         name: "vp-screen-clipped",
         screen: ScreenNeeds::VisualPolarGrid,
@@ -254,8 +275,13 @@ pub const METHODS: &[Method] = &[
         blurs: true,
         report: ReportSection::None,
         build: |i| {
+            // Tiles follow the paper layout's density, whatever the profile's layout.
+            let paper = VisualPolarParams {
+                layout: VpLayout::Paper,
+                ..i.vp
+            };
             Ok(Box::new(
-                VrsTiles::new(i.screen, i.centre(), i.vp).context("vrs tiles")?,
+                VrsTiles::new(i.screen, i.centre(), paper).context("vrs tiles")?,
             ))
         },
     },

@@ -176,9 +176,9 @@ struct Report<'a> {
     resampling: &'static str,
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
-    /// Everything the converged references depend on ([`reference_key`]): `--references`
-    /// takes another folder's only when its key is this.
-    reference_key: String,
+    /// Per camera, everything its converged references depend on ([`reference_key`]):
+    /// `--references` takes another folder's only where its key is this.
+    reference_keys: std::collections::BTreeMap<&'a str, String>,
     /// The display the frames are shown on, for video metrics: the headset's refresh (frames per
     /// second) and the left eye's FOV in degrees (left, right, down, up; left and down negative).
     refresh_hz: f32,
@@ -572,7 +572,11 @@ pub fn write_report(
         blur_sigma_at_30: args.profile.blur.sigma_at_30,
         resampling: args.profile.resampling.mode.name(),
         flip_ppd: prepared.ppd,
-        reference_key: reference_key(args),
+        reference_keys: args
+            .cameras
+            .iter()
+            .map(|c| (c.as_str(), reference_key(args, c)))
+            .collect(),
         refresh_hz: prepared.hmd.refresh_hz,
         eye_fov_deg: {
             let fov = prepared.hmd.eye(Eye::Left).fov;
@@ -810,20 +814,23 @@ fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Ref
     References::new(args, camera, evaluated, images, Some(&r.views))
 }
 
-/// What the converged references of a quality run depend on, as one string: the scene, size,
-/// headset, eyes, frames, samples, seed and the camera and light flags (the render profile's
-/// sampling settings do not touch them: references trace every pixel with the engine's defaults).
-/// A file named in it (scene, environment map) is named, not hashed.
-pub fn reference_key(args: &QualityArgs) -> String {
+/// What the converged references of `camera` depend on, as one string: the scene, size,
+/// headset, eyes, samples, seed, the camera and light flags and, for the moving camera, the frames
+/// (its poses). The gaze and the render profile's sampling settings do not touch them: references
+/// trace every pixel with the engine's defaults. A file named in it (scene, environment map) is
+/// named, not hashed.
+pub fn reference_key(args: &QualityArgs, camera: &str) -> String {
+    let poses = match camera {
+        "moving" => format!("frames {}/{}", args.frames, args.eval_frames),
+        _ => "still".to_string(),
+    };
     format!(
-        "{} {}x{} {} eyes {} frames {}/{} spp {} seed {} {:?} {:?}",
+        "{} {}x{} {} eyes {} {poses} spp {} seed {} {:?} {:?}",
         args.scene,
         args.width,
         args.height,
         args.headset,
         args.eyes.name(),
-        args.frames,
-        args.eval_frames,
         args.reference_spp,
         args.seed,
         args.camera,
@@ -844,16 +851,17 @@ fn copied_references(
         .with_context(|| format!("--references: reading {}", report_path.display()))?;
     let report: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("--references: {}", report_path.display()))?;
-    let key = reference_key(args);
-    match report["reference_key"].as_str() {
+    let key = reference_key(args, camera);
+    match report["reference_keys"][camera].as_str() {
         Some(theirs) if theirs == key => {}
         Some(theirs) => bail!(
-            "--references {}: its references are of other settings (quality.json reference_key \
-             \"{theirs}\", this run's \"{key}\")",
+            "--references {}: its {camera} camera's references are of other settings \
+             (quality.json reference_keys.{camera} \"{theirs}\", this run's \"{key}\")",
             from.display()
         ),
         None => bail!(
-            "--references {}: quality.json has no reference_key (written by an older fovea)",
+            "--references {}: quality.json has no reference_keys.{camera} (no {camera} camera \
+             in that run, or written by an older fovea)",
             from.display()
         ),
     }

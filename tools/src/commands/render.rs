@@ -443,7 +443,7 @@ pub fn exposure_name(exposure: &fovea_renderer::passes::exposure::Exposure) -> S
 }
 
 /// `variant`: the profile's Visual-Polar, or a variant that sets the layout or the axis whatever
-/// the profile says (`vp-screen-clipped`, `vp-screen-aware`, `vp-headset`).
+/// the profile says (`vp-paper`, `vp-screen-clipped`, `vp-screen-aware`, `vp-headset`).
 fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
     use fovea_renderer::sampling::{InverseCdf, RadiusMode};
     let p = &profile.visual_polar;
@@ -466,7 +466,8 @@ fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
         layout: match variant {
             VpVariant::ScreenClipped => "screen-clipped".into(),
             VpVariant::ScreenAware => "screen-aware".into(),
-            _ => crate::render_profile::layout_name(p.layout).into(),
+            VpVariant::Paper | VpVariant::Headset => "paper".into(),
+            VpVariant::Profile => crate::render_profile::layout_name(p.layout).into(),
         },
         eccentricity: if headset {
             "headset".into()
