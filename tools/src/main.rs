@@ -301,8 +301,10 @@ struct RenderOpts {
     /// VP radius: corner (largest gaze-to-corner distance, default) or pixels.
     #[arg(long)]
     vp_radius: Option<String>,
-    /// VP layout: paper (default), screen-clipped (each column's rows on its on-screen arcs) or
-    /// screen-aware (screen-clipped rows, columns placed by the on-screen acuity mass).
+    /// VP layout: screen-clipped (the default: each column's rows on its on-screen arcs, so the
+    /// budget holds when the eye looks toward a corner), paper (every column's rows on its whole
+    /// circle; samples far off the screen are culled) or screen-aware (screen-clipped rows,
+    /// columns placed by the on-screen acuity mass).
     #[arg(long)]
     vp_layout: Option<String>,
     /// VP eccentricity axis: normalized (the paper's, 80 ↦ farthest corner; default) or headset

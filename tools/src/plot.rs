@@ -134,7 +134,7 @@ where
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(emptiest_corner(kept, (x0, x1)))
         .label_font((FONT, 15))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
@@ -142,6 +142,32 @@ where
         .map_err(|e| e.to_string())?;
     root.present().map_err(|e| e.to_string())?;
     Ok(())
+}
+
+/// The corner of the plot whose quarter holds the fewest points, for the legend (which would
+/// hide what it covers).
+fn emptiest_corner(kept: &[Vec<(f64, f64)>], (x0, x1): (f64, f64)) -> SeriesLabelPosition {
+    let points: Vec<(f64, f64)> = kept.iter().flatten().copied().collect();
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(_, y) in &points {
+        (y0, y1) = (y0.min(y), y1.max(y));
+    }
+    let (xm, ym) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    let count = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|&&(x, y)| (x >= xm) == right && (y >= ym) == upper)
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperRight, count(true, true)),
+        (SeriesLabelPosition::UpperLeft, count(false, true)),
+        (SeriesLabelPosition::LowerRight, count(true, false)),
+        (SeriesLabelPosition::LowerLeft, count(false, false)),
+    ]
+    .into_iter()
+    .min_by_key(|(_, n)| *n)
+    .map_or(SeriesLabelPosition::UpperRight, |(p, _)| p)
 }
 
 /// Data range with a small margin; never empty (plotters needs lo < hi), positive on log axes.

@@ -15,7 +15,8 @@
 //! (φ = 2π·y/n(floor x)), so forward and inverse are exact inverses and a jittered texel stays in its
 //! column. Removed area ≈ u_f/2 of the grid, so u_f = 2 · clip_fraction.
 //!
-//! That is the paper's layout (`VpLayout::Paper`, the default). `VpLayout::ScreenClipped` keeps
+//! That is the paper's layout (`VpLayout::Paper`, this type's default; `fovea`'s render profile
+//! defaults to the screen-clipped one). `VpLayout::ScreenClipped` keeps
 //! the grid and the row counts but lays each column's rows on the on-screen part of its circle
 //! only: `visual_polar_clipped.rs`. `VpLayout::ScreenAware` adds a ρ axis placed by the on-screen
 //! acuity mass: `visual_polar_screen_axis.rs`.
