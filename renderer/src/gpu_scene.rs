@@ -53,6 +53,29 @@ pub struct SceneBinds<'a> {
     pub instances: Bind<'a>,
 }
 
+/// The bindings of a kernel that reads the whole scene: the scene's ten ([`SceneBinds`], in the
+/// order of the GLSL bindings 0–9 of `common/scene.glsl`) then `rest`, as one fixed array (no host
+/// allocation per dispatch): `scene_then!(scene.binds(); read_buffer("frame", …), …)`.
+macro_rules! scene_then {
+    ($scene:expr; $($rest:expr),* $(,)?) => {{
+        let s: $crate::gpu_scene::SceneBinds = $scene;
+        [
+            s.bvh_nodes,
+            s.bvh_triangles,
+            s.vertices,
+            s.triangles,
+            s.materials,
+            s.textures,
+            s.texels,
+            s.lights,
+            s.environment,
+            s.instances,
+            $($rest),*
+        ]
+    }};
+}
+pub(crate) use scene_then;
+
 pub struct GpuScene {
     /// The traversal whose tree layout the BVH buffers hold (kernels of the other cannot bind it).
     pub traversal: Traversal,

@@ -6,6 +6,7 @@ use super::grid::{GradientTargets, GridFrame};
 use super::trace_clear::TraceClearPass;
 use super::{Kernel, Pass};
 use crate::error::Result;
+use crate::gpu_scene::scene_then;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_texels, write_buffer, write_image, FrameRecorder};
 use crate::layouts::TracePush;
@@ -83,17 +84,7 @@ impl TracePass {
             (None, None) => ([s.bvh_nodes; 3], 0),
         };
         let g = out.write_binds();
-        let binds = [
-            s.bvh_nodes,
-            s.bvh_triangles,
-            s.vertices,
-            s.triangles,
-            s.materials,
-            s.textures,
-            s.texels,
-            s.lights,
-            s.environment,
-            s.instances,
+        let binds = scene_then!(s;
             read_buffer("frame", frame.frame_data),
             read_buffer("sampling", frame.sampling),
             read_texels("sampling_table", frame.sampling_table),
@@ -109,7 +100,7 @@ impl TracePass {
             extra[0],
             extra[1],
             extra[2],
-        ];
+        );
         let binds = &binds[..binds.len() - 3 + extra_count];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush {

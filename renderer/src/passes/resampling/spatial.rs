@@ -5,6 +5,7 @@
 use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
 use crate::error::Result;
+use crate::gpu_scene::scene_then;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{
     read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
@@ -34,18 +35,7 @@ impl Pass<Spatial> {
         settings: &ResamplingSettings,
     ) -> Result<()> {
         let g = frame.gbuffer;
-        let s = scene.binds();
-        let binds = [
-            s.bvh_nodes,
-            s.bvh_triangles,
-            s.vertices,
-            s.triangles,
-            s.materials,
-            s.textures,
-            s.texels,
-            s.lights,
-            s.environment,
-            s.instances,
+        let binds = scene_then!(scene.binds();
             read_buffer("frame", frame.frame_data),
             write_image("color", &g.color),
             write_image("radiance", &g.radiance),
@@ -57,7 +47,7 @@ impl Pass<Spatial> {
             write_buffer("history", &reservoirs.history),
             write_buffer("ray_counters", ray_counters),
             read_texels("grid_columns", frame.sampling_table),
-        ];
+        );
         let push = ResampleSpatialPush {
             space: frame.current,
             params: Vec4::new(settings.neighbours as f32, settings.radius, 0.0, 0.0),

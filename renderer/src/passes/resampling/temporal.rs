@@ -4,6 +4,7 @@
 use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
 use crate::error::Result;
+use crate::gpu_scene::scene_then;
 use crate::gpu_scene::GpuScene;
 use crate::graph::{read_buffer, read_image, read_texels, write_buffer, FrameRecorder};
 use crate::layouts::ResampleTemporalPush;
@@ -31,18 +32,7 @@ impl Pass<Temporal> {
         settings: &ResamplingSettings,
     ) -> Result<()> {
         let g = frame.gbuffer;
-        let s = scene.binds();
-        let binds = [
-            s.bvh_nodes,
-            s.bvh_triangles,
-            s.vertices,
-            s.triangles,
-            s.materials,
-            s.textures,
-            s.texels,
-            s.lights,
-            s.environment,
-            s.instances,
+        let binds = scene_then!(scene.binds();
             read_buffer("frame", frame.frame_data),
             read_image("normal_depth", &g.normal_depth),
             read_image("position", &g.position),
@@ -53,7 +43,7 @@ impl Pass<Temporal> {
             write_buffer("fresh", &reservoirs.fresh),
             write_buffer("ray_counters", ray_counters),
             read_texels("grid_columns", frame.sampling_table),
-        ];
+        );
         let current = &frame.current;
         let previous = frame.previous.filter(|_| !fresh_start);
         let p = previous.as_ref().unwrap_or(current);
