@@ -226,7 +226,7 @@ fn output_folders_with_user_files_are_refused() {
         preview: false,
         device: None,
         validation: true,
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        camera: &fovea_stage::look::NO_CAMERA_FLAGS,
         headset: "fove0",
         eye: fovea_hal::Eye::Left,
         environment: Default::default(),
@@ -461,7 +461,7 @@ fn reference_force_refuses_non_regular_targets() {
                 preview: false,
                 device: None,
                 validation: true,
-                camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+                camera: &fovea_stage::look::NO_CAMERA_FLAGS,
                 headset: "fove0",
                 eye: fovea_hal::Eye::Left,
                 environment: Default::default(),
@@ -848,7 +848,7 @@ fn meaningless_values_are_refused_with_the_flag_named() {
             preview: false,
             device: None,
             validation: true,
-            camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+            camera: &fovea_stage::look::NO_CAMERA_FLAGS,
             headset: "fove0",
             eye: fovea_hal::Eye::Left,
             environment: Default::default(),
@@ -880,7 +880,7 @@ fn gaze_outside_the_view_is_reported_as_centre() {
     ];
     for (k, d) in directions.iter().enumerate() {
         writer.write(&GazeSample::looking(
-            fovea_tools::gaze::frame_time(1e9 / hmd.refresh_hz as f64, k as u32),
+            fovea_stage::gaze::frame_time(1e9 / hmd.refresh_hz as f64, k as u32),
             k as u64,
             *d,
         ));
@@ -925,7 +925,7 @@ fn gaze_outside_the_view_is_reported_as_centre() {
 /// report.json says which motion ran; a bad file is named.
 #[test]
 fn camera_path_files_drive_the_camera() {
-    use fovea_tools::camera_path::CameraMotion;
+    use fovea_stage::camera_path::CameraMotion;
     let dir = temp_dir("camera-keys");
     std::fs::create_dir_all(&dir).unwrap();
     let still = dir.join("still.toml");
@@ -940,12 +940,12 @@ fn camera_path_files_drive_the_camera() {
             .collect::<Vec<_>>()
     };
 
-    let free = fovea_tools::look::CameraOptions {
+    let free = fovea_stage::look::CameraOptions {
         position: Some("0.2,1.0,3.4".into()),
         look: Some("0,1,0".into()),
         fov: Some(50.0),
         camera: None,
-        projection: fovea_tools::look::Projection::SceneCamera,
+        projection: fovea_stage::look::Projection::SceneCamera,
         world_scale: 1.0,
     };
     let out_free = dir.join("free");
@@ -956,8 +956,8 @@ fn camera_path_files_drive_the_camera() {
     };
     render(&args).unwrap();
     // The keys' fov is the scene camera's: both runs render through it.
-    let scene_camera = fovea_tools::look::CameraOptions {
-        projection: fovea_tools::look::Projection::SceneCamera,
+    let scene_camera = fovea_stage::look::CameraOptions {
+        projection: fovea_stage::look::Projection::SceneCamera,
         ..Default::default()
     };
     let out_still = dir.join("still");
@@ -1016,7 +1016,7 @@ fn camera_path_files_drive_the_camera() {
 /// rates take their primary rays from frames along it, and the report says so.
 #[test]
 fn bench_vp_frames_follow_a_camera_path() {
-    use fovea_tools::camera_keys::{CameraKeys, Key};
+    use fovea_stage::camera_keys::{CameraKeys, Key};
     use fovea_tools::commands::bench::{run as bench, BenchArgs};
     use glam::Vec3;
     let out = temp_dir("bench-camera-path");

@@ -7,9 +7,9 @@ use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, EnvironmentMap, Scene, Sky, Triangle, Vertex};
+use fovea_stage::look::{self, EnvironmentOptions, NO_CAMERA_FLAGS};
 use fovea_tests::scenes::{add_quad, lambert};
 use fovea_tests::{assert_clean, gpu, mean_rgb, save_preview, shared_data};
-use fovea_tools::look::{self, EnvironmentOptions, NO_CAMERA_FLAGS};
 use glam::{UVec2, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -278,7 +278,7 @@ fn luminance(pixels: &[[f32; 4]]) -> f64 {
 /// bake, its scale and the importance sampling of a map with a circumsolar peak at once.
 #[test]
 fn preetham_and_gradient_skies_light_an_upward_plane_alike() {
-    use fovea_tools::sky_model::{upward_irradiance, SkyModel};
+    use fovea_stage::sky_model::{upward_irradiance, SkyModel};
     let ctx = gpu();
     let albedo = 0.8f32;
     let luminance = |p: &[f32; 4]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];

@@ -361,7 +361,7 @@ fn write_exr(
 }
 
 fn load_error(path: &Path) -> String {
-    let err = fovea_tools::env_map::load(path, 0.0, 1.0).unwrap_err();
+    let err = fovea_stage::env_map::load(path, 0.0, 1.0).unwrap_err();
     let text = format!("{err:#}");
     assert!(
         text.contains(&path.display().to_string()),
@@ -375,7 +375,7 @@ fn valid_exr_and_hdr_maps_load_with_their_texels() {
     let dir = temp_dir("valid");
     let exr = dir.join("grad.exr");
     write_exr(&exr, 8, 4, |x, y| [x as f32, y as f32, 0.5]);
-    let m = fovea_tools::env_map::load(&exr, 90.0, 2.0).unwrap();
+    let m = fovea_stage::env_map::load(&exr, 90.0, 2.0).unwrap();
     assert_eq!(
         (m.width, m.height, m.texels[3 * 8 + 5]),
         (8, 4, Vec3::new(5.0, 3.0, 0.5))
@@ -388,7 +388,7 @@ fn valid_exr_and_hdr_maps_load_with_their_texels() {
     image::codecs::hdr::HdrEncoder::new(std::fs::File::create(&hdr).unwrap())
         .encode(&pixels, 8, 4)
         .unwrap();
-    let m = fovea_tools::env_map::load(&hdr, 0.0, 1.0).unwrap();
+    let m = fovea_stage::env_map::load(&hdr, 0.0, 1.0).unwrap();
     // RGBE keeps 8 mantissa bits: 5 and 0.25 are exact.
     assert_eq!(
         (m.width, m.height, m.texels[8 + 5]),

@@ -260,7 +260,7 @@ fn quality_args<'a>(
         profile: Default::default(),
         eyes: fovea_tools::commands::setup::Eyes::Left,
         stereo_noises: &[],
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        camera: &fovea_stage::look::NO_CAMERA_FLAGS,
         references: None,
         out,
         device: None,

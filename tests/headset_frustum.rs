@@ -2,10 +2,10 @@
 //! asymmetric profile, the fovea lies where the eye's view direction crosses the rendered image,
 //! and eccentricities measured on that image (`fovea eval --headset`'s axis) are true angles.
 
+use fovea_stage::look::{CameraOptions, DefaultLight, EnvironmentOptions};
+use fovea_stage::scenegen::gltf_writer::GltfWriter;
+use fovea_stage::scenegen::shapes::quad;
 use fovea_tools::commands::render::{run as render, RenderArgs};
-use fovea_tools::look::{CameraOptions, DefaultLight, EnvironmentOptions};
-use fovea_tools::scenegen::gltf_writer::GltfWriter;
-use fovea_tools::scenegen::shapes::quad;
 use glam::{UVec2, Vec2, Vec3};
 use serde_json::json;
 use std::path::Path;
@@ -101,7 +101,7 @@ fn the_fovea_and_the_rings_describe_the_image_the_headset_shows() {
         height: Some(SIZE.y),
         frames: 1,
         exr: false,
-        camera_path: fovea_tools::camera_path::CameraMotion::Still,
+        camera_path: fovea_stage::camera_path::CameraMotion::Still,
         camera: &camera,
         profile,
         ..fovea_tests::small_render_args(scene.to_str().unwrap(), &out)

@@ -1,12 +1,12 @@
-//! No import cycles between the modules of the engine (renderer/) and the tools (tools/): a type
-//! two modules share lives where both can import it. The test reads every source file of the two
-//! crates with `syn`, builds the module tree from the `mod` items (`#[path]` included), and draws
+//! No import cycles between the modules of the engine (renderer/), the embedding library
+//! (renderer/stage/) and the tools (tools/): a type two modules share lives where both can import
+//! it. The test reads every source file of the three crates with `syn`, builds the module tree from the `mod` items (`#[path]` included), and draws
 //! an edge from a module to the module that defines each name it reaches through a `crate::`,
 //! `super::`, `self::` or child-module path — in `use` items, in code and in macro arguments.
 //! `pub use` re-exports are followed to the defining module and are no edge themselves (a facade
 //! is not a dependency). A cycle is a strongly connected component of that graph.
 //!
-//! Neither crate has a cycle. `KNOWN_TOOLS_CYCLES` tolerates a listed tools cycle while it is
+//! No crate has a cycle. `KNOWN_TOOLS_CYCLES` tolerates a listed tools cycle while it is
 //! being broken (and fails on a listed one it cannot find); it is empty.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -430,9 +430,9 @@ fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-#[test]
-fn the_engine_has_no_import_cycle() {
-    let krate = Crate::load("fovea_renderer", &workspace().join("renderer/src/lib.rs"));
+/// Fails with every cycle found in the crate rooted at `root` (relative to the workspace).
+fn assert_no_cycle(name: &str, root: &str) {
+    let krate = Crate::load(name, &workspace().join(root));
     let found = crate_cycles(&krate);
     let report: Vec<String> = found
         .iter()
@@ -440,9 +440,19 @@ fn the_engine_has_no_import_cycle() {
         .collect();
     assert!(
         found.is_empty(),
-        "import cycles in renderer/ (move the shared item where both modules can import it):\n{}",
+        "import cycles in {root} (move the shared item where both modules can import it):\n{}",
         report.join("\n")
     );
+}
+
+#[test]
+fn the_engine_has_no_import_cycle() {
+    assert_no_cycle("fovea_renderer", "renderer/src/lib.rs");
+}
+
+#[test]
+fn the_embedding_library_has_no_import_cycle() {
+    assert_no_cycle("fovea_stage", "renderer/stage/src/lib.rs");
 }
 
 #[test]

@@ -318,7 +318,7 @@ fn render_ring(ctx: &Arc<Context>, in_flight: usize, frames: u32) -> (Vec<Vec<u8
         let gaze = Vec2::new(20.0 + 4.0 * f as f32, 30.0);
         r.submit(
             &FrameInput::mono(
-                fovea_tools::camera_path::orbit(&head, Vec3::ZERO, f, frames),
+                fovea_stage::camera_path::orbit(&head, Vec3::ZERO, f, frames),
                 f,
                 Some(gaze),
             ),

@@ -52,7 +52,7 @@ fn a_thousand_frames_hold_gpu_and_host_memory_flat_without_validation_messages()
         args.gaze,
     ) = ("vp", "svgf", Some(64), Some(72), "sim:1");
     (args.frames, args.exr, args.camera_path) =
-        (FRAMES, false, fovea_tools::camera_path::CameraMotion::Orbit);
+        (FRAMES, false, fovea_stage::camera_path::CameraMotion::Orbit);
     let mut setup = Setup::new(&args, FRAMES).unwrap();
     let spaces = setup.spaces(args.method, &args.profile).unwrap();
     let scene = GpuScene::upload(&ctx, &setup.scene).unwrap();

@@ -94,7 +94,7 @@ pub fn render_profile(data: &[u8]) {
 /// A camera path file: once it loads, every time gives a finite pose with a view direction.
 pub fn camera_path(data: &[u8]) {
     let path = write("path.toml", data);
-    let Ok(keys) = fovea_tools::camera_keys::CameraKeys::load(&path) else {
+    let Ok(keys) = fovea_stage::camera_keys::CameraKeys::load(&path) else {
         return;
     };
     let start = fovea_renderer::frame::CameraPose {
@@ -125,21 +125,21 @@ pub fn baseline_manifest(data: &[u8]) {
 
 /// A PNG or JPEG, as `fovea eval` and the baselines decode them.
 pub fn png(data: &[u8]) {
-    if let Ok((w, h, px)) = fovea_tools::decode::decode_rgba8(data, "fuzz.png", MAX_PIXELS, None) {
+    if let Ok((w, h, px)) = fovea_stage::decode::decode_rgba8(data, "fuzz.png", MAX_PIXELS, None) {
         assert_eq!(px.len() as u64, w as u64 * h as u64 * 4);
     }
 }
 
 /// An OpenEXR image, as references and environment maps are decoded.
 pub fn exr(data: &[u8]) {
-    if let Ok((w, h, px)) = fovea_tools::decode::decode_exr(data, "fuzz.exr", MAX_PIXELS, None) {
+    if let Ok((w, h, px)) = fovea_stage::decode::decode_exr(data, "fuzz.exr", MAX_PIXELS, None) {
         assert_eq!(px.len() as u64, w as u64 * h as u64);
     }
 }
 
 /// A Radiance HDR image, then the environment map's checks on it.
 pub fn hdr(data: &[u8]) {
-    if let Ok((w, h, px)) = fovea_tools::decode::decode_hdr(data, "fuzz.hdr", MAX_PIXELS) {
+    if let Ok((w, h, px)) = fovea_stage::decode::decode_hdr(data, "fuzz.hdr", MAX_PIXELS) {
         assert_eq!(px.len() as u64, w as u64 * h as u64);
         let texels = px.into_iter().map(glam::Vec3::from_array).collect();
         let _ = fovea_scene::EnvironmentMap::new(w, h, texels);

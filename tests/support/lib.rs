@@ -176,7 +176,7 @@ pub fn small_render_args<'a>(
         frames: 2,
         out,
         exr: true,
-        camera_path: fovea_tools::camera_path::CameraMotion::Orbit,
+        camera_path: fovea_stage::camera_path::CameraMotion::Orbit,
         seed: 1,
         max_depth: 3,
         exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
@@ -190,7 +190,7 @@ pub fn small_render_args<'a>(
         validation: true,
         eyes: fovea_tools::commands::setup::Eyes::Left,
         frames_in_flight: 2,
-        camera: &fovea_tools::look::NO_CAMERA_FLAGS,
+        camera: &fovea_stage::look::NO_CAMERA_FLAGS,
     }
 }
 

@@ -147,23 +147,23 @@ struct SceneFlags {
 }
 
 impl SceneFlags {
-    fn camera(&self) -> Result<fovea_tools::look::CameraOptions> {
-        Ok(fovea_tools::look::CameraOptions {
+    fn camera(&self) -> Result<fovea_stage::look::CameraOptions> {
+        Ok(fovea_stage::look::CameraOptions {
             camera: self.camera.clone(),
             position: self.camera_pos.clone(),
             look: self.camera_look.clone(),
             fov: self.fov,
-            projection: fovea_tools::look::Projection::parse(&self.projection)?,
+            projection: fovea_stage::look::Projection::parse(&self.projection)?,
             world_scale: self.world_scale,
         })
     }
 
-    fn environment(&self) -> Result<fovea_tools::look::EnvironmentOptions> {
-        Ok(fovea_tools::look::EnvironmentOptions {
+    fn environment(&self) -> Result<fovea_stage::look::EnvironmentOptions> {
+        Ok(fovea_stage::look::EnvironmentOptions {
             sun: self
                 .sun
                 .as_deref()
-                .map(fovea_tools::look::parse_sun)
+                .map(fovea_stage::look::parse_sun)
                 .transpose()?,
             sun_intensity: self.sun_intensity,
             sky_intensity: self.sky_intensity,
@@ -173,13 +173,13 @@ impl SceneFlags {
             sky: self
                 .sky
                 .as_deref()
-                .map(fovea_tools::sky_model::SkyModel::parse)
+                .map(fovea_stage::sky_model::SkyModel::parse)
                 .transpose()
                 .context("--sky")?,
             default_light: self
                 .default_light
                 .as_deref()
-                .map(fovea_tools::look::DefaultLight::parse)
+                .map(fovea_stage::look::DefaultLight::parse)
                 .transpose()?,
         })
     }
@@ -204,8 +204,8 @@ struct LatencyFlags {
 }
 
 impl LatencyFlags {
-    fn timing(&self) -> Result<fovea_tools::gaze::GazeTiming> {
-        fovea_tools::gaze::GazeTiming::from_flags(
+    fn timing(&self) -> Result<fovea_stage::gaze::GazeTiming> {
+        fovea_stage::gaze::GazeTiming::from_flags(
             self.latency_ms,
             self.tracker_hz,
             self.gaze_predict.as_deref(),
@@ -221,7 +221,7 @@ struct RenderOpts {
     latency: LatencyFlags,
     /// Scene name (cornell-box, stress, large; sponza, breakfast-room, flight-helmet from the
     /// shared scene folder, $FOVEA_SCENES or ../shared/data/scenes) or a .gltf/.glb path.
-    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    #[arg(long, default_value = fovea_stage::scenes::DEFAULT_SCENE)]
     scene: String,
     /// Sampling method: vp (Visual-Polar, Koskela et al. 2019) or cartesian (uniform, 1 spp).
     #[arg(long, default_value = "vp")]
@@ -377,7 +377,7 @@ impl RenderOpts {
 /// `fovea quality`'s flags (also the command a quality sweep splits).
 #[derive(clap::Args)]
 struct QualityFlags {
-    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    #[arg(long, default_value = fovea_stage::scenes::DEFAULT_SCENE)]
     scene: String,
     #[arg(long, default_value_t = 160)]
     width: u32,
@@ -475,7 +475,7 @@ struct ReplayFlags {
 /// `fovea reference`'s flags (also the command a reference sweep splits).
 #[derive(clap::Args)]
 struct ReferenceFlags {
-    #[arg(long, default_value = fovea_tools::scenes::DEFAULT_SCENE)]
+    #[arg(long, default_value = fovea_stage::scenes::DEFAULT_SCENE)]
     scene: String,
     #[arg(long, default_value_t = 256)]
     width: u32,
@@ -872,7 +872,7 @@ const DEFAULT_SCALE: f32 = 0.25;
 /// The flags `fovea render` and `fovea view` share, checked.
 fn render_args<'a>(
     opts: &'a RenderOpts,
-    camera: &'a fovea_tools::look::CameraOptions,
+    camera: &'a fovea_stage::look::CameraOptions,
     device: &'a DeviceArgs,
     profile: &RenderProfile,
     defaults: RenderDefaults,
@@ -891,7 +891,7 @@ fn render_args<'a>(
             .as_deref()
             .unwrap_or(std::path::Path::new(defaults.out)),
         exr: opts.exr,
-        camera_path: fovea_tools::camera_path::CameraMotion::from_flag(
+        camera_path: fovea_stage::camera_path::CameraMotion::from_flag(
             opts.camera_path.as_deref(),
         )?,
         seed: opts.seed,
@@ -1074,7 +1074,7 @@ fn run() -> Result<()> {
             device,
         } => {
             let camera_path = camera_path
-                .map(|f| fovea_tools::camera_keys::CameraKeys::load(&f))
+                .map(|f| fovea_stage::camera_keys::CameraKeys::load(&f))
                 .transpose()
                 .context("--camera-path")?;
             let builders = bvh

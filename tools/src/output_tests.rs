@@ -25,27 +25,6 @@ fn mkfifo(path: &Path) {
 }
 
 #[test]
-fn a_failed_write_keeps_the_old_file_and_leaves_no_temporary() {
-    let d = dir("failed");
-    let target = d.join("report.json");
-    std::fs::write(&target, "old").unwrap();
-    let err = write_atomic(&target, |w| {
-        w.write_all(b"half of the new")?;
-        bail!("disk on fire")
-    })
-    .unwrap_err();
-    assert!(
-        format!("{err:#}").contains("report.json") && format!("{err:#}").contains("disk on fire"),
-        "{err:#}"
-    );
-    assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
-    assert_eq!(names(&d), vec!["report.json"], "the temporary is removed");
-    write_text(&target, "new").unwrap();
-    assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
-    assert_eq!(names(&d), vec!["report.json"]);
-}
-
-#[test]
 fn links_fifos_and_folders_are_never_written_through() {
     let d = dir("targets");
     std::fs::write(d.join("victim.txt"), "keep").unwrap();

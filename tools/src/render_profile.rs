@@ -8,7 +8,6 @@
 //! `eccentricity = "headset"` only names the axis: the command glues in the headset's FOV
 //! (`RenderProfile::visual_polar_for`).
 
-use crate::look::{EnvironmentNames, EnvironmentOptions};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::{
     OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION, DEFAULT_SURFACE_CELL,
@@ -22,6 +21,7 @@ use fovea_renderer::sampling::{
     LogPolarParams, RadialLaw, RadiusMode, VisualPolarParams, VpLayout,
 };
 use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
+use fovea_stage::look::{EnvironmentNames, EnvironmentOptions};
 use serde::de::{self, DeserializeSeed, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
@@ -43,7 +43,7 @@ pub struct RenderProfile {
     /// Every registered denoiser's parameters (`--denoiser` picks one: `denoisers.get`).
     pub denoisers: DenoiserProfile,
     pub taa: TaaSettings,
-    /// `[environment]`: the default sun and sky (`crate::look`), flags applied on top.
+    /// `[environment]`: the default sun and sky (`fovea_stage::look`), flags applied on top.
     pub environment: EnvironmentOptions,
     /// `[textures] lod`: mip-level selection (`cones` or `off`).
     pub texture_lod: TextureLod,
@@ -59,7 +59,7 @@ pub struct RenderProfile {
     /// (`RenderSettings::surface_cell`); `None`: the engine's default.
     pub surface_cell: Option<f32>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
-    pub gaze_timing: crate::gaze::GazeTiming,
+    pub gaze_timing: fovea_stage::gaze::GazeTiming,
 }
 
 /// The Visual-Polar layout of the product's default profile: the paper's grid with each column's
@@ -296,7 +296,7 @@ pub struct ProfileOverrides {
     /// `--stereo-noise`.
     pub stereo_noise: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
-    pub gaze_timing: crate::gaze::GazeTiming,
+    pub gaze_timing: fovea_stage::gaze::GazeTiming,
 }
 
 /// What the Visual-Polar ρ axis measures.
@@ -500,13 +500,13 @@ impl RenderProfile {
                 sky: f
                     .sky
                     .as_deref()
-                    .map(crate::sky_model::SkyModel::parse)
+                    .map(fovea_stage::sky_model::SkyModel::parse)
                     .transpose()
                     .with_context(|| format!("{}.sky", at("environment")))?,
                 default_light: f
                     .default_light
                     .as_deref()
-                    .map(crate::look::DefaultLight::parse)
+                    .map(fovea_stage::look::DefaultLight::parse)
                     .transpose()
                     .with_context(|| format!("{}.default_light", at("environment")))?,
             };
@@ -514,7 +514,7 @@ impl RenderProfile {
                 .environment
                 .validate(&EnvironmentNames::profile(&path.display().to_string()))?;
             if let Some(env) = &profile.environment.env {
-                crate::env_map::check_path(env)
+                fovea_stage::env_map::check_path(env)
                     .with_context(|| format!("{}: [environment].env", path.display()))?;
             }
         }
@@ -753,7 +753,7 @@ fn confined_env_path(profile: &Path, env: &Path) -> Result<std::path::PathBuf> {
         dir
     };
     let joined = dir.join(env);
-    crate::env_map::check_path(&joined).with_context(key)?;
+    fovea_stage::env_map::check_path(&joined).with_context(key)?;
     let (inside, folder) = (
         joined.canonicalize().with_context(key)?,
         dir.canonicalize().with_context(key)?,
@@ -831,12 +831,12 @@ mod tests {
         assert_eq!(p.surface_cell(), DEFAULT_SURFACE_CELL);
         assert_eq!(p.offscreen_samples, OffscreenSamples::Cull);
         // The shipped values are the built-in defaults of the sun (no sky key: see the file).
-        let sun = Some(crate::look::DEFAULT_SUN);
+        let sun = Some(fovea_stage::look::DEFAULT_SUN);
         assert_eq!(
             p.environment,
             EnvironmentOptions {
                 sun,
-                sun_intensity: Some(crate::look::DEFAULT_SUN_INTENSITY),
+                sun_intensity: Some(fovea_stage::look::DEFAULT_SUN_INTENSITY),
                 sky_intensity: None,
                 ..Default::default()
             }

@@ -240,6 +240,33 @@ pub fn assert_pictures_equal(label: &str, actual: &Picture, expected: &Picture) 
     );
 }
 
+/// A 4×4 EXR whose header is rewritten to declare `width` × `height` pixels (the pixel data
+/// stays that of the small image): a file that would make a trusting decoder allocate
+/// `width × height` pixels before it found the data short.
+pub fn exr_declaring(width: i32, height: i32) -> Vec<u8> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let grey = exr::prelude::SpecificChannels::rgba(|_: exr::prelude::Vec2<usize>| {
+        (0.5f32, 0.5f32, 0.5f32, 0.5f32)
+    });
+    use exr::prelude::WritableImage;
+    exr::prelude::Image::from_channels((4, 4), grey)
+        .write()
+        .to_buffered(&mut bytes)
+        .expect("a 4×4 EXR in memory");
+    let mut bytes = bytes.into_inner();
+    for attribute in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
+        let at = bytes
+            .windows(attribute.len())
+            .position(|w| w == attribute)
+            .expect("the attribute")
+            + attribute.len()
+            + 4; // the attribute's size
+        bytes[at + 8..at + 12].copy_from_slice(&(width - 1).to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&(height - 1).to_le_bytes());
+    }
+    bytes
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

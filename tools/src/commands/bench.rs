@@ -53,7 +53,7 @@ pub struct BenchArgs<'a> {
     pub loop_headsets: &'a [super::bench_headsets::LoopHeadset],
     /// Keyframes the VP vs Cartesian frames follow and the ray rates are measured along
     /// (`--camera-path FILE`; none: the still camera).
-    pub camera_path: Option<&'a crate::camera_keys::CameraKeys>,
+    pub camera_path: Option<&'a fovea_stage::camera_keys::CameraKeys>,
     pub out: &'a Path,
     /// Also write each scene's world-space triangles and each size's primary and indirect rays
     /// into `out` (`--dump-rays`, files `rays_*.bin`), for a CPU tracer to time the very same rays
@@ -155,12 +155,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         headset_loop: Vec::new(),
     };
     for name in args.scenes {
-        let mut scene = crate::scenes::load(name)?;
+        let mut scene = fovea_stage::scenes::load(name)?;
         // Lit as `fovea render` lights it: a scene its own emitters do not light (Sponza, the
         // Breakfast Room) gets the default sun and sky, so its shadow rays aim at the sun.
-        if let Some(notice) =
-            crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())
-        {
+        if let Some(notice) = fovea_stage::look::apply_environment(
+            &mut scene,
+            &fovea_stage::look::EnvironmentOptions::default(),
+        ) {
             println!("{notice}");
         }
         let scene = if args.flatten {
@@ -417,7 +418,10 @@ fn load_average() -> String {
 pub const PATH_RAY_POSES: usize = 4;
 
 /// The poses of the ray-rate figures: the still camera, or [`PATH_RAY_POSES`] along the keyframes.
-fn ray_poses(path: Option<&crate::camera_keys::CameraKeys>, still: &CameraPose) -> Vec<CameraPose> {
+fn ray_poses(
+    path: Option<&fovea_stage::camera_keys::CameraKeys>,
+    still: &CameraPose,
+) -> Vec<CameraPose> {
     let Some(keys) = path else {
         return vec![*still];
     };

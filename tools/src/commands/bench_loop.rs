@@ -9,7 +9,6 @@
 
 use super::setup::{filters, space_for};
 use crate::cpu_time::{CpuTimes, CpuUse};
-use crate::projection::{EyeRig, Projection};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context as _, Result};
 use fovea_hal::{Eye, HmdDescription};
@@ -19,6 +18,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::scene::bvh::Bvh;
 use fovea_renderer::scene::Scene;
 use fovea_renderer::vk::{Context, EngineCounters};
+use fovea_stage::projection::{EyeRig, Projection};
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -143,10 +143,11 @@ impl LoopScene {
     /// Loads `name` lit as `fovea render` lights it (the default sun and sky where the scene's
     /// own emitters do not light it) and builds its tree.
     pub fn load(name: &str) -> Result<LoopScene> {
-        let mut scene = crate::scenes::load(name)?;
-        if let Some(notice) =
-            crate::look::apply_environment(&mut scene, &crate::look::EnvironmentOptions::default())
-        {
+        let mut scene = fovea_stage::scenes::load(name)?;
+        if let Some(notice) = fovea_stage::look::apply_environment(
+            &mut scene,
+            &fovea_stage::look::EnvironmentOptions::default(),
+        ) {
             println!("{notice}");
         }
         let positions = scene.flat_positions();
@@ -257,7 +258,7 @@ impl<'a> LoopSetup<'a> {
         let motion = match moving {
             None => None,
             Some(frames) => {
-                let mut gaze = crate::gaze::GazeDriver::open_timed(
+                let mut gaze = fovea_stage::gaze::GazeDriver::open_timed(
                     MOVING_GAZE,
                     &hmd,
                     width,
@@ -315,12 +316,12 @@ impl<'a> LoopSetup<'a> {
         let centre = self.screen.as_vec2() * 0.5;
         let head = match &self.motion {
             None => self.head,
-            Some(m) => crate::camera_path::pose(
+            Some(m) => fovea_stage::camera_path::pose(
                 &self.head,
                 m.scene_centre,
                 frame,
                 m.frames,
-                &crate::camera_path::CameraMotion::Orbit,
+                &fovea_stage::camera_path::CameraMotion::Orbit,
                 self.hmd.refresh_hz,
             ),
         };
@@ -612,7 +613,7 @@ mod tests {
         let moving =
             LoopSetup::new(&scene, hmd.clone(), size, (METHOD, DENOISER), Some(frames)).unwrap();
         let still = LoopSetup::new(&scene, hmd.clone(), size, (METHOD, DENOISER), None).unwrap();
-        let mut gaze = crate::gaze::GazeDriver::open_timed(
+        let mut gaze = fovea_stage::gaze::GazeDriver::open_timed(
             MOVING_GAZE,
             &hmd,
             size.0,

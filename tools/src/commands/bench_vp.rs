@@ -3,7 +3,6 @@
 //! screen (φ-mips + remap + blur); and primary-ray coherence: the VP samples traced in VP order
 //! vs the same rays shuffled.
 
-use crate::camera_keys::CameraKeys;
 use anyhow::Result;
 use fovea_renderer::frame::{CameraPose, FrameInput, OffscreenSamples, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -16,6 +15,7 @@ use fovea_renderer::sampling::{
     Cartesian, FovTangents, SamplingSpace, VisualPolar, VisualPolarParams,
 };
 use fovea_renderer::way_back::blur::{BlurSettings, BlurSpace};
+use fovea_stage::camera_keys::CameraKeys;
 use glam::{UVec2, Vec2, Vec3};
 use serde::Serialize;
 use std::collections::BTreeMap;

@@ -174,7 +174,7 @@ fn read_input(path: &Path) -> Result<Input> {
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if png {
         let (width, height, displayed) =
-            crate::decode::read_rgba8(path, crate::decode::MAX_IMAGE_PIXELS, None)?;
+            fovea_stage::decode::read_rgba8(path, fovea_stage::decode::MAX_IMAGE_PIXELS, None)?;
         let values = displayed
             .chunks_exact(4)
             .map(|p| [p[0], p[1], p[2], p[3]].map(|c| c as f32 / 255.0))

@@ -1,7 +1,7 @@
 //! `fovea gen-scene`: writes one of the project's procedural scenes as glTF.
 
-use crate::scenegen::{write_scene, SceneKind, DEFAULT_LARGE_TRIANGLES};
 use anyhow::{bail, Result};
+use fovea_stage::scenegen::{write_scene, SceneKind, DEFAULT_LARGE_TRIANGLES};
 use std::path::Path;
 
 /// `--min-triangles`: at most the scene loader's triangle budget (`FOVEA_MAX_TRIANGLES`, default

@@ -323,8 +323,11 @@ fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, 
             .join(format!("run_still_{}_none_taa-off", run.method));
         let frame_path = dir.join(format!("frame_{last:04}.png"));
         // The frame must have the reference's size (FLIP compares pixel by pixel).
-        let (_, _, frame) =
-            crate::decode::read_rgba8(&frame_path, crate::decode::MAX_IMAGE_PIXELS, Some((w, h)))?;
+        let (_, _, frame) = fovea_stage::decode::read_rgba8(
+            &frame_path,
+            fovea_stage::decode::MAX_IMAGE_PIXELS,
+            Some((w, h)),
+        )?;
         let map = flip_image(&flip_map(&reference, &frame, w, h, ppd), w, h);
         let (frame_name, map_name) = (
             format!("{}.png", run.method),

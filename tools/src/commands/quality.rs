@@ -10,7 +10,6 @@
 use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
 use super::setup::Eyes;
-use crate::camera_path;
 use crate::flip::flip_map;
 use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
 use crate::output::{
@@ -27,6 +26,7 @@ use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::scene::Scene;
+use fovea_stage::camera_path;
 use glam::{UVec2, Vec2};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -55,7 +55,7 @@ pub struct QualityArgs<'a> {
     /// How the eyes' random numbers relate, one run each; empty: the profile's, and the run
     /// folders keep their names without it.
     pub stereo_noises: &'a [StereoNoise],
-    pub camera: &'a crate::look::CameraOptions,
+    pub camera: &'a fovea_stage::look::CameraOptions,
     /// An earlier quality folder whose references (of the same [`reference_key`]) are copied
     /// instead of rendered.
     pub references: Option<&'a Path>,
@@ -350,7 +350,7 @@ pub fn prepare(args: &QualityArgs) -> Result<Prepared> {
         );
     }
     // Every frame is read back within the image budget: a larger run would render for nothing.
-    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
+    let max_pixels = fovea_stage::decode::MAX_IMAGE_PIXELS;
     if args.width as u64 * args.height as u64 > max_pixels {
         bail!(
             "--width {} --height {}: at most {max_pixels} pixels (the frames are read back for the figures)",
@@ -655,7 +655,7 @@ pub fn write_reference(
 /// left|both` renders, through the same projection, at each frame of [`reference_frames`].
 pub struct ReferenceViews {
     scene: Scene,
-    rig: crate::projection::EyeRig,
+    rig: fovea_stage::projection::EyeRig,
     /// The head pose at each reference frame.
     heads: Vec<(u32, CameraPose)>,
 }
@@ -680,7 +680,7 @@ pub fn reference_views(
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
     // A stereo run offsets the eyes (in either projection): the references see what the runs do.
-    let rig = crate::projection::EyeRig {
+    let rig = fovea_stage::projection::EyeRig {
         projection: args.camera.projection,
         hmd,
         stereo: args.eyes == Eyes::Both,
@@ -688,7 +688,7 @@ pub fn reference_views(
         height: args.height,
         metres_per_unit: args.camera.world_scale,
     };
-    let (scene, scene_camera) = crate::look::load(
+    let (scene, scene_camera) = fovea_stage::look::load(
         args.scene,
         args.camera,
         &args.profile.environment,
@@ -872,7 +872,7 @@ fn copied_references(
         for f in reference_frames(camera, evaluated) {
             let path = from.join(reference_file_name(args.eyes, camera, eye, f));
             let (_, _, image) =
-                crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)
+                fovea_stage::decode::read_exr(&path, fovea_stage::decode::MAX_IMAGE_PIXELS, size)
                     .with_context(|| format!("--references: {}", path.display()))?;
             write_reference(args.out, args, camera, eye, f, &image)?;
             eye_images.push(image);
@@ -930,12 +930,13 @@ fn measure(
         );
         let path: PathBuf = dir.join(format!("frame_{f:04}{}.exr", eye.suffix));
         let size = Some((args.width, args.height));
-        let (_, _, test) = crate::decode::read_exr(&path, crate::decode::MAX_IMAGE_PIXELS, size)?;
+        let (_, _, test) =
+            fovea_stage::decode::read_exr(&path, fovea_stage::decode::MAX_IMAGE_PIXELS, size)?;
         let mut eval = evaluate(reference, &test, args.width, args.height, gaze, args.rings);
         // FLIP on what is displayed: the frame's PNG against the reference through the tone curve.
-        let displayed = crate::decode::read_rgba8(
+        let displayed = fovea_stage::decode::read_rgba8(
             &dir.join(format!("frame_{f:04}{}.png", eye.suffix)),
-            crate::decode::MAX_IMAGE_PIXELS,
+            fovea_stage::decode::MAX_IMAGE_PIXELS,
             size,
         )?
         .2;

@@ -11,7 +11,6 @@ use crate::binocular::{
 };
 use crate::metrics::{mean, Rings};
 use crate::output::{tonemap_preview, write_png};
-use crate::projection::EyeRig;
 use anyhow::{Context, Result};
 use fovea_hal::Eye;
 use fovea_renderer::frame::CameraPose;
@@ -19,6 +18,7 @@ use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::scene::bvh::instanced::SceneBvh;
 use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_renderer::scene::Scene;
+use fovea_stage::projection::EyeRig;
 use glam::Vec2;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -142,8 +142,8 @@ fn ring_means(rings: &Rings, map: &[f64]) -> Vec<Option<f64>> {
 
 /// A displayed frame of the run (bounded read, its size checked from the header).
 fn read_png(path: &Path, width: u32, height: u32) -> Result<Vec<u8>> {
-    let max_pixels = crate::decode::MAX_IMAGE_PIXELS;
-    Ok(crate::decode::read_rgba8(path, max_pixels, Some((width, height)))?.2)
+    let max_pixels = fovea_stage::decode::MAX_IMAGE_PIXELS;
+    Ok(fovea_stage::decode::read_rgba8(path, max_pixels, Some((width, height)))?.2)
 }
 
 /// The binocular measure of the run in `dir` over the evaluated frames, in `rings` rings.

@@ -25,11 +25,11 @@ pub struct ReferenceArgs<'a> {
     pub preview: bool,
     pub device: Option<&'a str>,
     pub validation: bool,
-    pub camera: &'a crate::look::CameraOptions,
+    pub camera: &'a fovea_stage::look::CameraOptions,
     /// The headset whose eye is rendered (`--projection headset`) and which eye.
     pub headset: &'a str,
     pub eye: fovea_hal::Eye,
-    pub environment: crate::look::EnvironmentOptions,
+    pub environment: fovea_stage::look::EnvironmentOptions,
     /// `RenderSettings::path_regularisation` (already checked).
     pub path_regularisation: f32,
 }
@@ -69,7 +69,7 @@ pub fn check(args: &ReferenceArgs) -> Result<()> {
 
 /// The Cartesian renderer of the reference and the eye's pose.
 pub fn renderer(args: &ReferenceArgs) -> Result<(Arc<Context>, Renderer, CameraPose)> {
-    let rig = crate::projection::EyeRig {
+    let rig = fovea_stage::projection::EyeRig {
         projection: args.camera.projection,
         hmd: fovea_hal::HmdDescription::resolve(args.headset)
             .with_context(|| format!("--headset {}", args.headset))?,
@@ -79,7 +79,7 @@ pub fn renderer(args: &ReferenceArgs) -> Result<(Arc<Context>, Renderer, CameraP
         metres_per_unit: args.camera.world_scale,
     };
     let (scene, camera) =
-        crate::look::load(args.scene, args.camera, &args.environment, rig.framing())?;
+        fovea_stage::look::load(args.scene, args.camera, &args.environment, rig.framing())?;
     let pose = rig.eye(&rig.head(&camera), args.eye);
     let ctx = super::open_device(args.device, args.validation)?;
     let settings = RenderSettings {

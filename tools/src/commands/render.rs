@@ -67,7 +67,7 @@ struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     gaze_true: Option<Vec<Option<[f32; 2]>>>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    gaze_latency: Option<crate::gaze::LatencyLog>,
+    gaze_latency: Option<fovea_stage::gaze::LatencyLog>,
     device: String,
     width: u32,
     height: u32,
@@ -193,7 +193,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut gaze_origin = Vec::with_capacity(frames as usize);
     let mut origins = [0u32; 3];
     let mut outside_view = 0u32;
-    let mut latency_log = crate::gaze::LatencyLog::for_driver(&setup.gaze);
+    let mut latency_log = fovea_stage::gaze::LatencyLog::for_driver(&setup.gaze);
     let mut submitted = 0u32;
     let mut recent = super::overview::RecentFrames::default();
     crate::interrupt::running(); // a signal from here on stops after the frames in flight

@@ -57,7 +57,7 @@ pub struct RenderArgs<'a> {
     pub out: &'a Path,
     pub exr: bool,
     /// Still, the default orbit, or keyframes (`--camera-path [FILE]`).
-    pub camera_path: crate::camera_path::CameraMotion,
+    pub camera_path: fovea_stage::camera_path::CameraMotion,
     pub seed: u32,
     pub max_depth: u32,
     /// `--exposure`: automatic (the default) or fixed.
@@ -81,5 +81,5 @@ pub struct RenderArgs<'a> {
     /// Frames kept on the GPU at once (a frame's images are written while later ones render).
     pub frames_in_flight: usize,
     /// `--camera`, `--camera-pos/--camera-look`, `--fov` (the environment is in `profile`).
-    pub camera: &'a crate::look::CameraOptions,
+    pub camera: &'a fovea_stage::look::CameraOptions,
 }

@@ -208,7 +208,7 @@ pub fn replay_trace(
 ) -> Result<TraceResult> {
     // The trace first: a file that is not one is named as such, not as a missing baseline.
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
-    crate::gaze::GazeDriver::open(
+    fovea_stage::gaze::GazeDriver::open(
         trace,
         &hmd,
         args.render.width.unwrap_or(64),
@@ -284,7 +284,7 @@ pub fn replay_trace(
     let mut checks = Vec::new();
     let (mut foveal, mut foveal_true) = (Vec::new(), Vec::new());
     for k in 0..frames {
-        let (_, _, ldr) = crate::decode::read_rgba8(
+        let (_, _, ldr) = fovea_stage::decode::read_rgba8(
             &run_dir.join(format!("frame_{k:04}.png")),
             MAX_PIXELS,
             Some((width, height)),
@@ -434,7 +434,7 @@ fn params_of(args: &ReplayArgs, r: &RenderArgs, width: u32, height: u32) -> Para
         rings: args.rings,
         camera: format!("{:?}", r.camera),
         environment: r.profile.environment.describe(),
-        gaze_timing: crate::gaze::describe_timing(&r.profile.gaze_timing),
+        gaze_timing: fovea_stage::gaze::describe_timing(&r.profile.gaze_timing),
     }
 }
 
@@ -465,7 +465,7 @@ fn reference_for(
     width: u32,
     height: u32,
 ) -> Result<Vec<[f32; 4]>> {
-    let rig = crate::projection::EyeRig {
+    let rig = fovea_stage::projection::EyeRig {
         projection: r.camera.projection,
         hmd: fovea_hal::HmdDescription::resolve(r.headset)?,
         stereo: false,
@@ -474,7 +474,7 @@ fn reference_for(
         metres_per_unit: r.camera.world_scale,
     };
     let (scene, camera) =
-        crate::look::load(r.scene, r.camera, &r.profile.environment, rig.framing())?;
+        fovea_stage::look::load(r.scene, r.camera, &r.profile.environment, rig.framing())?;
     let ctx = super::open_device(r.device, r.validation)?;
     let settings = RenderSettings {
         seed: r.seed.wrapping_add(0x5eed),

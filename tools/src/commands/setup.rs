@@ -5,9 +5,6 @@
 
 pub use super::render_args::Eyes;
 use super::render_args::RenderArgs;
-use crate::camera_path;
-use crate::gaze::{FrameGaze, GazeDriver};
-use crate::projection::EyeRig;
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::{Eye, EyeView, HmdDescription};
@@ -18,6 +15,9 @@ use fovea_renderer::passes::taa::TaaMode;
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::sampling::SamplingSpace;
 use fovea_renderer::scene::Scene;
+use fovea_stage::camera_path;
+use fovea_stage::gaze::{FrameGaze, GazeDriver};
+use fovea_stage::projection::EyeRig;
 use glam::{UVec2, Vec3};
 
 pub use super::methods::{method, names as method_names};
@@ -69,7 +69,7 @@ impl Setup {
             height,
             metres_per_unit: args.camera.world_scale,
         };
-        let (scene, camera) = crate::look::load(
+        let (scene, camera) = fovea_stage::look::load(
             args.scene,
             args.camera,
             &args.profile.environment,

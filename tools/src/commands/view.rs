@@ -524,7 +524,7 @@ impl Viewer<'_> {
     /// The free camera, made at the head's pose of this frame on its first use.
     fn free_camera(&mut self) -> &mut FreeCamera {
         if self.free.is_none() {
-            let head = crate::camera_path::pose(
+            let head = fovea_stage::camera_path::pose(
                 &self.setup.start_pose,
                 self.setup.scene_centre,
                 self.frame,

@@ -6,7 +6,6 @@
 
 use super::render::RenderArgs;
 use super::setup::{check_common, filters_for_method, render_settings, scaled_eye_size, space_for};
-use crate::gaze::GazeDriver;
 use crate::output::{prepare_output_dir, write_json};
 use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
 use crate::xr::gaze::{Timebase, XrFrameGaze, XrGaze};
@@ -24,6 +23,7 @@ use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::graph::SubmitSync;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::vk::{Buffer, Context};
+use fovea_stage::gaze::GazeDriver;
 use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::collections::BTreeMap;
@@ -166,12 +166,13 @@ pub fn run(args: &XrArgs) -> Result<()> {
         HmdDescription::resolve(r.headset).with_context(|| format!("--headset {}", r.headset))?;
     let (denoiser, taa) = filters_for_method(r.denoiser, r.taa, r.method, &r.profile, &base)?;
     // The runtime's views are known only later; the profile's frustums frame the scene.
-    let (yfov, aspect) = crate::projection::inscribed_view(&base);
-    let framing = crate::look::Framing {
+    let (yfov, aspect) = fovea_stage::projection::inscribed_view(&base);
+    let framing = fovea_stage::look::Framing {
         yfov: Some(yfov),
         aspect,
     };
-    let (scene, camera) = crate::look::load(r.scene, r.camera, &r.profile.environment, framing)?;
+    let (scene, camera) =
+        fovea_stage::look::load(r.scene, r.camera, &r.profile.environment, framing)?;
     let camera = &camera;
     let out_dir = prepare_output_dir(r.out)?;
     let rt = Arc::new(

@@ -19,9 +19,9 @@
 //! size decoded within that size, finite non-negative reference values) before anything renders.
 //! Any mismatch is an error naming the file and the field.
 
-use crate::decode;
 use crate::output::LOCK_FILE;
 use anyhow::{anyhow, bail, Context, Result};
+use fovea_stage::decode;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;

@@ -173,7 +173,7 @@ fn a_reference_declaring_100000_squared_pixels_is_refused_from_its_header() {
     replace_listed(
         &dir,
         REFERENCE,
-        &crate::decode::tests::exr_declaring(100_000, 100_000),
+        &fovea_test_kit::pictures::exr_declaring(100_000, 100_000),
     );
     let err = load_err(&root, &id);
     assert!(

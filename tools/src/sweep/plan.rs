@@ -120,7 +120,7 @@ pub(super) fn studies(command: &[String], axes: &Axes) -> Result<Vec<StudyEntry>
     let scene_of = |s: &Option<String>| {
         s.clone()
             .or_else(|| flag_value(command, "--scene"))
-            .unwrap_or_else(|| crate::scenes::DEFAULT_SCENE.to_string())
+            .unwrap_or_else(|| fovea_stage::scenes::DEFAULT_SCENE.to_string())
     };
     let mut studies: Vec<StudyEntry> = Vec::new();
     for scene in or_own(&axes.scenes) {

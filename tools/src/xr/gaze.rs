@@ -5,12 +5,12 @@
 //! TRACE.csv` replays the session.
 
 use super::frame_log::LatencyRow;
-use crate::gaze::{project_gaze, GazeDriver};
 use anyhow::{Context, Result};
 use fovea_hal::openxr::xr;
 use fovea_hal::{
     EyeView, Fov, GazeOrigin, GazeSample, HmdDescription, SampleTimeKind, TraceWriter, XrTime,
 };
+use fovea_stage::gaze::{project_gaze, GazeDriver};
 use glam::{Quat, Vec2, Vec3};
 use std::path::Path;
 
@@ -172,7 +172,7 @@ impl XrGaze {
         let Some(recorder) = self.recorder.as_mut() else {
             return Ok(());
         };
-        let t = crate::gaze::frame_time(self.record_period_ns, render_index);
+        let t = fovea_stage::gaze::frame_time(self.record_period_ns, render_index);
         // Held gaze is written as the direction it held, so the replay shows the same pixels; no
         // gaze stays no gaze (the replay's invalid-gaze policy decides again, on its frame times).
         let sample = match gaze.origin {

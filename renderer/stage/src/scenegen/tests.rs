@@ -4,7 +4,7 @@ use fovea_scene::{build_light_table, Bvh, LightKind, PunctualLight, Scene};
 use std::path::PathBuf;
 
 fn scenes_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
 }
 
 fn temp_path(name: &str) -> PathBuf {

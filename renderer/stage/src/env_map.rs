@@ -24,7 +24,7 @@ pub fn check_path(path: &Path) -> Result<()> {
 
 fn format_of(path: &Path) -> Result<Format> {
     let name = path.display();
-    crate::output::check_regular_input(path).with_context(|| format!("environment map {name}"))?;
+    crate::files::check_regular_input(path).with_context(|| format!("environment map {name}"))?;
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("exr") => Ok(Format::Exr),
         Some("hdr") => Ok(Format::Hdr),

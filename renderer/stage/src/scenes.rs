@@ -44,7 +44,9 @@ fn shared_file(name: &str) -> Option<&'static str> {
 fn shared_dir() -> PathBuf {
     std::env::var_os(SHARED_SCENES_VAR)
         .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/scenes"))
+        .unwrap_or_else(|| {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/scenes")
+        })
 }
 
 /// Where a scene name or path is found (generating the project's scenes when needed).
@@ -59,7 +61,7 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     if looks_like_path {
         bail!("scene file {name_or_path} does not exist");
     }
-    let repo_scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let repo_scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     for dir in [PathBuf::from("scenes"), repo_scenes] {
         let candidate = dir.join(format!("{name_or_path}.gltf"));
         if candidate.exists() {
@@ -111,7 +113,7 @@ pub fn generated_in(cache: &Path, kind: &SceneKind) -> Result<PathBuf> {
     let tmp = cache.join(format!(".{}.{}", kind.file_name(), std::process::id()));
     write_scene(kind, &tmp, true)?;
     let sum = sha256_hex(&tmp)?;
-    crate::output::write_text(&sum_file, &format!("{sum}\n"))?;
+    crate::files::write_text(&sum_file, &format!("{sum}\n"))?;
     std::fs::rename(&tmp, &file)
         .with_context(|| format!("moving the generated scene to {}", file.display()))?;
     Ok(file)

@@ -71,7 +71,7 @@ pub fn write_scene(kind: &SceneKind, out: &Path, overwrite: bool) -> anyhow::Res
     }
     let (doc, triangles) = scene_json(kind);
     let text = serde_json::to_string(&doc).context("serialising the glTF JSON")?;
-    crate::output::write_text(out, &text)?;
+    crate::files::write_text(out, &text)?;
     let count = |key: &str| doc.get(key).and_then(|v| v.as_array()).map_or(0, Vec::len);
     Ok(SceneStats {
         triangles,

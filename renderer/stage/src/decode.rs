@@ -225,4 +225,4 @@ pub fn decode_hdr(bytes: &[u8], name: &str, max_pixels: u64) -> Result<(u32, u32
 
 #[cfg(test)]
 #[path = "decode_tests.rs"]
-pub(crate) mod tests;
+mod tests;

@@ -1,4 +1,5 @@
 use super::*;
+use fovea_test_kit::pictures::exr_declaring;
 use std::path::PathBuf;
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -25,28 +26,6 @@ fn an_8000_squared_png_is_refused_from_its_header() {
     );
 }
 
-/// A small EXR whose header is rewritten to declare `width` × `height` pixels (the pixel data
-/// stays that of the small image).
-pub(crate) fn exr_declaring(width: i32, height: i32) -> Vec<u8> {
-    static N: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let dir = temp_dir(&format!("exr-src-{n}"));
-    let path = dir.join("small.exr");
-    crate::output::write_exr(&path, 4, 4, &[[0.5; 4]; 16]).unwrap();
-    let mut bytes = std::fs::read(&path).unwrap();
-    for attribute in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
-        let at = bytes
-            .windows(attribute.len())
-            .position(|w| w == attribute)
-            .expect("the attribute")
-            + attribute.len()
-            + 4; // the attribute's size
-        bytes[at + 8..at + 12].copy_from_slice(&(width - 1).to_le_bytes());
-        bytes[at + 12..at + 16].copy_from_slice(&(height - 1).to_le_bytes());
-    }
-    bytes
-}
-
 /// An EXR declaring 100000² pixels aborted `fovea eval` and `replay` on allocation (exit 134).
 #[test]
 fn an_exr_declaring_100000_squared_pixels_is_an_error_not_an_abort() {
@@ -61,7 +40,7 @@ fn an_exr_declaring_100000_squared_pixels_is_an_error_not_an_abort() {
     );
     let path = temp_dir("exr-huge").join("huge.exr");
     std::fs::write(&path, &bytes).unwrap();
-    let err = format!("{:#}", crate::output::read_exr(&path).unwrap_err());
+    let err = format!("{:#}", read_exr(&path, MAX_IMAGE_PIXELS, None).unwrap_err());
     assert!(
         err.contains("huge.exr") && err.contains("pixel limit"),
         "{err}"
