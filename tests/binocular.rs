@@ -1,5 +1,5 @@
 //! Binocular consistency in stereo (docs/design/random-numbers.md): the measure of
-//! `fovea quality --eyes both` (`fovea_tools::binocular`: the right eye warped into the left
+//! `fovea quality --eyes both` (`fovea_tools::eval::binocular`: the right eye warped into the left
 //! through the converged depth) on the engine's two views, and the surface-correlated noise
 //! (`StereoNoise::Surface`): its random numbers are uniform in every ring of eccentricity and
 //! independent between neighbouring cells, and one eye's quality is not worse for it.
@@ -15,8 +15,8 @@ use fovea_renderer::scene::bvh::BvhBuilder;
 use fovea_renderer::scene::Scene;
 use fovea_renderer::vk::Context;
 use fovea_tests::{assert_clean, assert_pictures_equal, gpu, Picture};
-use fovea_tools::binocular::{difference_map, EyeGeometry, Warp};
-use fovea_tools::metrics::{mean, Rings};
+use fovea_tools::eval::binocular::{difference_map, EyeGeometry, Warp};
+use fovea_tools::eval::metrics::{mean, Rings};
 use fovea_tools::output::tonemap_preview;
 use glam::{Mat4, UVec2, Vec3};
 use std::sync::Arc;
@@ -377,7 +377,8 @@ fn surface_noise_keeps_each_eyes_flip() {
             if f >= 6 {
                 let mut left = Vec::new();
                 r.read_view_ldr(frame, 0, &mut left).unwrap();
-                let map = fovea_tools::flip::flip_map(&reference, &left, SCREEN.x, SCREEN.y, ppd);
+                let map =
+                    fovea_tools::eval::flip::flip_map(&reference, &left, SCREEN.x, SCREEN.y, ppd);
                 sum += mean(&map).unwrap();
             }
         }

@@ -58,7 +58,10 @@ fn identical_frames_score_perfectly() {
     );
     assert_eq!(json["frame"]["rmse"], 0.0);
     assert_eq!(json["frame"]["ssim"], 1.0);
-    assert_eq!(json["frame"]["psnr"], fovea_tools::metrics::PSNR_CAP_DB);
+    assert_eq!(
+        json["frame"]["psnr"],
+        fovea_tools::eval::metrics::PSNR_CAP_DB
+    );
     assert_eq!(json["frame"]["pixels"], W * H);
     let rings = json["rings"].as_array().unwrap();
     assert_eq!(rings.len(), 10);
@@ -1104,7 +1107,7 @@ fn flip_map_matches_nvidias_tool_pixel_by_pixel() {
     ];
     let (w, h) = reference.dimensions();
     for (test, ppd, pixels, max) in cases {
-        let map = fovea_tools::flip::flip_map(&reference, &rgba(test), w, h, ppd);
+        let map = fovea_tools::eval::flip::flip_map(&reference, &rgba(test), w, h, ppd);
         for ((x, y), want) in [(0, 0), (80, 90), (159, 179)].into_iter().zip(pixels) {
             let got = map[(y * w + x) as usize];
             assert!(

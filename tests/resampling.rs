@@ -188,7 +188,8 @@ fn error_around(frame: &[[f32; 4]], reference: &[[f32; 4]], gaze: Vec2, radius: 
     };
     let (a, b) = (pick(frame), pick(reference));
     let ldr = |img: &[[f32; 4]]| fovea_tools::output::tonemap_preview(img, 1.0, ToneCurve::Aces);
-    let flip = fovea_tools::flip::flip_map(&ldr(reference), &ldr(frame), SIZE.x, SIZE.y, 20.0);
+    let flip =
+        fovea_tools::eval::flip::flip_map(&ldr(reference), &ldr(frame), SIZE.x, SIZE.y, 20.0);
     let mean_flip = flip
         .iter()
         .zip(&keep)

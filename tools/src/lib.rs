@@ -1,15 +1,13 @@
-//! Library side of the `fovea` tools: everything the binary glues together (scene resolution,
-//! output writers, camera paths, commands), kept here so integration tests can call it.
+//! Library side of the `fovea` command line: the commands, their output folders and writers, the
+//! render profiles, evaluation (metrics, density, plots), replay, sweeps, the window and the
+//! headset loop, kept here so integration tests can call them. What a program embedding the
+//! renderer needs lives in `fovea_stage`.
 
-pub mod binocular;
 pub mod commands;
 pub mod cpu_time;
-pub mod density;
-pub mod flip;
+pub mod eval;
 pub mod interrupt;
-pub mod metrics;
 pub mod output;
-pub mod plot;
 pub mod reference_sum;
 pub mod render_profile;
 pub mod replay;

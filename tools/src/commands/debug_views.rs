@@ -3,7 +3,7 @@
 //! heat map laid over it; once per run a plot of samples per pixel against eccentricity (VP vs
 //! the acuity target vs uniform).
 
-use crate::density::{box_filter, density_plot, heatmap_rgba, overlay, samples_per_pixel};
+use crate::eval::density::{box_filter, density_plot, heatmap_rgba, overlay, samples_per_pixel};
 use crate::output::write_png;
 use anyhow::Result;
 use fovea_renderer::pipeline::Renderer;

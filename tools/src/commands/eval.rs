@@ -3,12 +3,12 @@
 //! given (linear EXR, or PNG as it is), FLIP on the images as displayed (EXR through the
 //! project's tone curve, PNG as it is) at the headset's pixels per degree.
 
-use crate::flip::flip_map;
-use crate::metrics::{
+use crate::eval::flip::flip_map;
+use crate::eval::metrics::{
     add_flip, add_flip_rings, evaluate, evaluate_rings, CoordinateRing, Evaluation, Rings,
 };
+use crate::eval::plot::{line_plot, Series};
 use crate::output::{prepare_output_dir, read_exr, tonemap_preview, write_json};
-use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::tonemap::ToneCurve;
 use glam::Vec2;
@@ -211,7 +211,7 @@ fn flip_ppd(
         return Ok(ppd);
     }
     let fove0 = fovea_hal::HmdDescription::fove0();
-    Ok(crate::flip::headset_ppd(hmd.unwrap_or(&fove0), width))
+    Ok(crate::eval::flip::headset_ppd(hmd.unwrap_or(&fove0), width))
 }
 
 /// Reads an EXR, refusing NaN and infinite pixels (they would silently poison every mean).
@@ -252,14 +252,15 @@ fn parse_gaze(spec: &str, width: u32, height: u32) -> Result<Vec2> {
 }
 
 fn write_plot(path: &Path, eval: &Evaluation) -> Result<()> {
-    let per_ring = |label: &str, value: &dyn Fn(&crate::metrics::Metrics) -> Option<f64>| Series {
-        label: label.into(),
-        points: eval
-            .rings
-            .iter()
-            .filter_map(|r| Some((0.5 * (r.ecc_inner + r.ecc_outer), value(&r.metrics)?)))
-            .collect(),
-    };
+    let per_ring =
+        |label: &str, value: &dyn Fn(&crate::eval::metrics::Metrics) -> Option<f64>| Series {
+            label: label.into(),
+            points: eval
+                .rings
+                .iter()
+                .filter_map(|r| Some((0.5 * (r.ecc_inner + r.ecc_outer), value(&r.metrics)?)))
+                .collect(),
+        };
     let series = [
         per_ring("RMSE (linear RGB)", &|m| m.rmse),
         per_ring("SSIM (luma)", &|m| m.ssim),

@@ -5,7 +5,7 @@
 //! (each method's last evaluated still frame and its FLIP map against the reference) and the
 //! papers' claims each figure confirms or refutes.
 
-use crate::flip::{flip_image, flip_map};
+use crate::eval::flip::{flip_image, flip_map};
 use crate::output::{read_exr, tonemap_preview, write_png, write_text};
 use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::tonemap::ToneCurve;
@@ -308,7 +308,7 @@ fn pictures(args: &MethodTableArgs, q: &Quality) -> Result<Vec<(String, String, 
     std::fs::create_dir_all(args.pictures)
         .with_context(|| format!("creating {}", args.pictures.display()))?;
     write_png(&args.pictures.join("reference.png"), w, h, &reference)?;
-    let ppd = crate::flip::headset_ppd(&fovea_hal::HmdDescription::resolve("fove0")?, w);
+    let ppd = crate::eval::flip::headset_ppd(&fovea_hal::HmdDescription::resolve("fove0")?, w);
     let mut out = Vec::new();
     for run in q
         .runs

@@ -3,7 +3,7 @@
 //! exposure and tone curve) and the method's samples per pixel as a heat map with the gaze.
 
 use super::setup::Setup;
-use crate::density::{box_filter, heatmap_rgba, samples_per_pixel};
+use crate::eval::density::{box_filter, heatmap_rgba, samples_per_pixel};
 use crate::output::write_png;
 use anyhow::Result;
 use fovea_renderer::frame::{FrameInput, RenderSettings};

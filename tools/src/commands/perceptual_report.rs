@@ -4,8 +4,8 @@
 //! against samples per frame and against GPU time per frame, one line per method + filters over
 //! the folders (e.g. one folder per sample budget) → `DIR/perceptual.md`, `DIR/jod_*.png`.
 
+use crate::eval::plot::{line_plot, Series};
 use crate::output::{prepare_output_dir, write_text};
-use crate::plot::{line_plot, Series};
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;

@@ -10,8 +10,10 @@
 use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
 use super::setup::Eyes;
-use crate::flip::flip_map;
-use crate::metrics::{add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings};
+use crate::eval::flip::flip_map;
+use crate::eval::metrics::{
+    add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings,
+};
 use crate::output::{
     prepare_output_dir, tonemap_preview, write_exr, write_json, write_png, write_text,
 };
@@ -1067,7 +1069,7 @@ fn measure(
 fn flip_ppd(args: &QualityArgs) -> Result<f32> {
     let hmd = fovea_hal::HmdDescription::resolve(args.headset)
         .with_context(|| format!("--headset {}", args.headset))?;
-    Ok(crate::flip::headset_ppd(&hmd, args.width))
+    Ok(crate::eval::flip::headset_ppd(&hmd, args.width))
 }
 
 /// A run's row label: method + denoiser, TAA, and the stereo noise where runs differ in it or

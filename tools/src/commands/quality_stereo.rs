@@ -1,15 +1,15 @@
 //! `fovea quality --eyes both`: the binocular consistency of a stereo run. Each evaluated frame's
-//! right eye is warped into the left through the converged depth (`crate::binocular`: surfaces
+//! right eye is warped into the left through the converged depth (`crate::eval::binocular`: surfaces
 //! both eyes see; occlusions and off-screen points masked) and the eyes' displayed difference is
 //! averaged per eccentricity ring around the left eye's gaze, beside the same measure on the
 //! converged reference pair. The flicker of the difference (its change from frame to frame beyond
 //! the reference pair's) joins each eye's own flicker. Each evaluated frame's difference is also
 //! written as a heat map, `binocular_NNNN.png` in the run's folder (`binocular::heat_map`).
 
-use crate::binocular::{
+use crate::eval::binocular::{
     difference_flicker_map, difference_map, heat_map, signed_difference_map, EyeGeometry, Warp,
 };
-use crate::metrics::{mean, Rings};
+use crate::eval::metrics::{mean, Rings};
 use crate::output::{tonemap_preview, write_png};
 use anyhow::{Context, Result};
 use fovea_hal::Eye;
@@ -170,7 +170,7 @@ pub(super) fn measure(
         );
         let ring_set = Rings::new(width, height, gaze, rings);
         if edges.is_empty() {
-            let ecc = |r: f64| r / ring_set.r_max * crate::metrics::ECC_MAX;
+            let ecc = |r: f64| r / ring_set.r_max * crate::eval::metrics::ECC_MAX;
             edges = (0..rings)
                 .map(|r| ring_set.bounds(r))
                 .map(|(inner, outer)| (ecc(inner), ecc(outer)))

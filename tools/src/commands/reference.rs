@@ -154,6 +154,6 @@ pub fn fireflies(args: &ReferenceArgs, image: &[[f32; 4]]) {
     let displayed = tonemap_preview(image, 1.0, ToneCurve::Aces);
     let (w, h) = (args.width as usize, args.height as usize);
     let [ff30, ff60, ff100] = [30.0, 60.0, 100.0]
-        .map(|levels| crate::metrics::isolated_bright_pixels(&displayed, w, h, levels));
+        .map(|levels| crate::eval::metrics::isolated_bright_pixels(&displayed, w, h, levels));
     println!("fireflies (pixels of the tonemapped image brighter than all 8 neighbours by > 30 / 60 / 100 of 255 levels): {ff30} / {ff60} / {ff100} of {}", w * h);
 }

@@ -5,8 +5,8 @@
 //! a regression, 2 on bad input. `--update-baseline` writes the baseline instead.
 
 use super::render::RenderArgs;
-use crate::flip::{flip_image, flip_map};
-use crate::metrics::Rings;
+use crate::eval::flip::{flip_image, flip_map};
+use crate::eval::metrics::Rings;
 use crate::output::{prepare_output_dir, tonemap_preview, write_json, write_png, write_text};
 use crate::replay::baseline::{
     current_commit, Baseline, FrameRecord, Params, Store, TraceId, FORMAT, MAX_FRAMES, MAX_PIXELS,
@@ -496,7 +496,7 @@ fn reference_for(
 /// FLIP's viewing condition: the render stretched over the headset eye's horizontal FOV.
 fn pixels_per_degree(args: &ReplayArgs, width: u32) -> Result<f32> {
     let hmd = fovea_hal::HmdDescription::resolve(args.render.headset)?;
-    Ok(crate::flip::headset_ppd(&hmd, width))
+    Ok(crate::eval::flip::headset_ppd(&hmd, width))
 }
 
 fn markdown(r: &ReplayReport) -> String {

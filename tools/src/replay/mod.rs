@@ -5,7 +5,7 @@
 
 pub mod baseline;
 
-use crate::metrics::Rings;
+use crate::eval::metrics::Rings;
 use baseline::FrameRecord;
 use glam::Vec2;
 use serde::{Deserialize, Serialize};

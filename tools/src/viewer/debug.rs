@@ -4,8 +4,8 @@
 //! `fovea render --debug-views` writes (the density one byte for byte), made on the CPU from the
 //! finished frame and copied into the swapchain image: a debug frame waits for its GPU work.
 
-use crate::binocular::{heat_map, EyeGeometry, Warp};
-use crate::density::{box_filter, heatmap_rgba, samples_per_pixel};
+use crate::eval::binocular::{heat_map, EyeGeometry, Warp};
+use crate::eval::density::{box_filter, heatmap_rgba, samples_per_pixel};
 use anyhow::{bail, Result};
 use fovea_hal::{Eye, HmdDescription};
 use fovea_renderer::frame::CameraPose;
@@ -22,7 +22,7 @@ pub enum DebugView {
     Density,
     /// The image with rings at `RINGS_DEG` of true eccentricity from the gaze.
     Rings,
-    /// Both eyes: each eye's binocular difference (`crate::binocular`: the other eye warped into
+    /// Both eyes: each eye's binocular difference (`crate::eval::binocular`: the other eye warped into
     /// it through the scene's depth) as a heat map, black where only one eye sees the surface.
     StereoDiff,
 }

@@ -3,8 +3,8 @@
 //! at the same budget and Cartesian 1 spp (and the paper's layout when the space is screen-clipped);
 //! the per-ring density gain of one space over another (`ring_density_gain`).
 
-use crate::metrics::{Rings, ECC_MAX};
-use crate::plot::{line_plot, Series};
+use crate::eval::metrics::{Rings, ECC_MAX};
+use crate::eval::plot::{line_plot, Series};
 use anyhow::Result;
 use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use glam::Vec2;

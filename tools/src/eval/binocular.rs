@@ -250,7 +250,7 @@ pub fn heat_map(to_rgba: &[u8], from_rgba: &[u8], warp: &Warp) -> Vec<u8> {
         .flat_map(|d| {
             let [r, g, b] = match d.is_nan() {
                 true => [0, 0, 0],
-                false => crate::density::ramp((d / HEAT_MAP_MAX) as f32),
+                false => crate::eval::density::ramp((d / HEAT_MAP_MAX) as f32),
             };
             [r, g, b, 255]
         })
