@@ -4,9 +4,9 @@
 //! development narrative). A unit-test module of the binary, so it reaches the private `Cli`
 //! without moving the definitions out of main.rs.
 
-use super::Cli;
 use clap::error::ErrorKind;
 use clap::Parser;
+use fovea_tools::cli::Cli;
 use pulldown_cmark::{CodeBlockKind, Event, Options, Parser as Markdown, Tag, TagEnd};
 use regex::Regex;
 use std::collections::{BTreeMap, BTreeSet};
@@ -95,7 +95,7 @@ fn cli_reference() -> String {
         .show_footer(false);
     let body = clap_markdown::help_markdown_custom::<Cli>(&options);
     format!(
-        "<!-- Generated from tools/src/main.rs by clap-markdown; do not edit. Regenerate with\n     \
+        "<!-- Generated from tools/src/cli/mod.rs by clap-markdown; do not edit. Regenerate with\n     \
          {UPDATE_VAR}=1 cargo test -p fovea-tools --bin fovea cli_reference -->\n\n{}\n",
         body.trim_end()
     )

@@ -3,6 +3,7 @@
 //! headset loop, kept here so integration tests can call them. What a program embedding the
 //! renderer needs lives in `fovea_stage`.
 
+pub mod cli;
 pub mod commands;
 pub mod cpu_time;
 pub mod eval;

@@ -5,6 +5,8 @@
 //! two mono renders, host CPU time) in `bench_loop.rs`.
 
 use super::bench_rays::{primary_rays, timed_trace};
+use super::flags::{parse_traversals, DeviceArgs};
+use anyhow::Context as _;
 use anyhow::{bail, Result};
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings};
 use fovea_renderer::gpu_scene::GpuScene;
@@ -22,7 +24,7 @@ use fovea_renderer::traversal::{Traversal, TraversalChoice};
 use glam::{UVec2, Vec3, Vec4};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// `BenchArgs::vp_gaze` by default: the screen's centre.
@@ -541,4 +543,161 @@ fn secondary_rays(
         });
     }
     (shadow, indirect)
+}
+
+// `fovea bench` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct BenchCommand {
+    /// Scenes of the BVH, ray and frame figures, names or paths as --scene ("" skips them).
+    #[arg(long, value_delimiter = ',', default_value = "cornell-box,large")]
+    pub scenes: Vec<String>,
+    /// BVH builders to compare: binned, sbvh, sbvh:BUDGET (extra references per triangle).
+    /// The first also serves the frame and VP figures; several are measured A B … B A.
+    #[arg(long, value_delimiter = ',', default_value = "sbvh")]
+    pub bvh: Vec<String>,
+    /// Copy every instance into world space (meshes placed by several nodes copied per
+    /// node, no instancing): the comparison of the two in one build.
+    #[arg(long)]
+    pub flatten: bool,
+    /// Frame sizes WxH of the ray-throughput and Cartesian frame figures ("" skips them).
+    #[arg(long, value_delimiter = ',', default_value = "320x360,1280x1440")]
+    pub sizes: Vec<String>,
+    /// Screen sizes WxH of the Visual-Polar vs Cartesian comparison ("" skips it).
+    #[arg(long, value_delimiter = ',', default_value = "640x720,1280x1440")]
+    pub vp_sizes: Vec<String>,
+    /// Gaze of the Visual-Polar vs Cartesian frames as FX,FY, fractions of the screen in
+    /// [0, 1] (0,0: the top-left corner; default 0.5,0.5: the centre).
+    #[arg(long, default_value = "0.5,0.5")]
+    pub vp_gaze: String,
+    /// Whole frames rendered per size for the per-pass timings.
+    #[arg(long, default_value_t = 2)]
+    pub frames: u32,
+    /// Per-eye size WxH of the real-time loop figures: Cornell box, both eyes, VP + SVGF, 1 vs 2
+    /// frames in flight, stereo vs two mono renders ("" skips them).
+    #[arg(long, default_value = "320x360")]
+    pub loop_size: String,
+    /// Timed frames of each run of the real-time loop and of the headset loop (after 2 warm-up
+    /// frames; at least 2). Each run is made twice (order A B C C B A).
+    #[arg(long, default_value_t = 5)]
+    pub loop_frames: u32,
+    /// Scenes of the headset loop: both eyes at each --loop-headsets size, the head on the
+    /// default orbit and the simulated gaze, VP + SVGF, VP + A-SVGF and Cartesian + SVGF (2
+    /// frames in flight, --loop-frames timed frames each, order A B C C B A): frames/s,
+    /// per-pass GPU ms and VP / Cartesian per size ("" skips it; names as --scenes, e.g.
+    /// sponza, breakfast-room from the shared scene folder).
+    #[arg(long, default_value = "")]
+    pub loop_scenes: String,
+    /// Headsets of the headset loop, each at its recommended per-eye size (names from `fovea
+    /// headsets` or profile paths), or per-eye sizes WxH (through the FOVE 0's frusta). The
+    /// frames run the first --traversal.
+    #[arg(long, default_value = super::bench_headsets::DEFAULT_HEADSETS)]
+    pub loop_headsets: String,
+    /// A keyframe file (as `fovea render --camera-path FILE`) the VP vs Cartesian frames
+    /// follow, frame i at i / 70 Hz (default: the scene camera, still).
+    #[arg(long)]
+    pub camera_path: Option<PathBuf>,
+    #[arg(long, default_value = "out/bench")]
+    pub out: PathBuf,
+    /// Also write each scene's triangles and each `--sizes` size's primary and indirect rays
+    /// into OUT as rays_*.bin (for `scripts/embree-rays`: Embree timing the same rays).
+    #[arg(long)]
+    pub dump_rays: bool,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl BenchCommand {
+    pub fn run(self) -> Result<()> {
+        let camera_path = self
+            .camera_path
+            .map(|f| fovea_stage::camera_keys::CameraKeys::load(&f))
+            .transpose()
+            .context("--camera-path")?;
+        let builders = self
+            .bvh
+            .iter()
+            .map(|b| BvhBuilder::parse(b).map_err(anyhow::Error::msg))
+            .collect::<Result<Vec<_>>>()
+            .context("--bvh")?;
+        if builders.is_empty() {
+            bail!("--bvh: name at least one builder");
+        }
+        let parse = |v: &[String]| {
+            v.iter()
+                .filter(|s| !s.is_empty())
+                .map(|s| parse_size(s))
+                .collect::<Result<Vec<_>>>()
+        };
+        let (sizes, vp_sizes) = (
+            parse(&self.sizes).context("--sizes")?,
+            parse(&self.vp_sizes).context("--vp-sizes")?,
+        );
+        let loop_size = (!self.loop_size.is_empty())
+            .then(|| parse_size(&self.loop_size))
+            .transpose()
+            .context("--loop-size")?;
+        let scenes: Vec<String> = self.scenes.into_iter().filter(|s| !s.is_empty()).collect();
+        let loop_scenes: Vec<String> = self
+            .loop_scenes
+            .split(',')
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .map(String::from)
+            .collect();
+        let loop_headsets = if loop_scenes.is_empty() {
+            Vec::new()
+        } else {
+            super::bench_headsets::LoopHeadset::parse_list(&self.loop_headsets)?
+        };
+        let traversals = parse_traversals(&self.device.traversal)?;
+        super::choose_traversal(traversals[0]);
+        run(&BenchArgs {
+            scenes: &scenes,
+            builders: &builders,
+            flatten: self.flatten,
+            sizes: &sizes,
+            vp_sizes: &vp_sizes,
+            vp_gaze: parse_gaze_fraction(&self.vp_gaze).context("--vp-gaze")?,
+            frames: self.frames,
+            loop_size,
+            loop_frames: self.loop_frames,
+            loop_scenes: &loop_scenes,
+            loop_headsets: &loop_headsets,
+            camera_path: camera_path.as_ref(),
+            out: &self.out,
+            dump_rays: self.dump_rays,
+            traversals: &traversals,
+            device: self.device.device.as_deref(),
+            validation: self.device.validation,
+        })
+    }
+}
+
+/// `WxH`, each at least 1.
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let parsed = s
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => bail!("size '{s}' is not WIDTHxHEIGHT (e.g. 320x360)"),
+    }
+}
+
+/// `--vp-gaze FX,FY`: two fractions of the screen, each in [0, 1].
+pub fn parse_gaze_fraction(spec: &str) -> Result<glam::Vec2> {
+    let parts: Vec<&str> = spec.split(',').map(str::trim).collect();
+    let [x, y] = parts[..] else {
+        bail!("'{spec}' is not FX,FY (two fractions of the screen)")
+    };
+    let fraction = |s: &str| -> Result<f32> {
+        let v: f32 = s
+            .parse()
+            .with_context(|| format!("'{s}' is not a number"))?;
+        if !(0.0..=1.0).contains(&v) {
+            bail!("{v} is not a fraction of the screen in [0, 1]");
+        }
+        Ok(v)
+    };
+    Ok(glam::Vec2::new(fraction(x)?, fraction(y)?))
 }

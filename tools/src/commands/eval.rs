@@ -13,7 +13,7 @@ use anyhow::{bail, Context, Result};
 use fovea_renderer::passes::tonemap::ToneCurve;
 use glam::Vec2;
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub struct EvalArgs<'a> {
     pub reference: &'a Path,
@@ -277,4 +277,46 @@ fn write_plot(path: &Path, eval: &Evaluation) -> Result<()> {
         &series,
         false,
     )
+}
+
+// `fovea eval` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct EvalCommand {
+    /// Reference: a linear EXR (e.g. from `fovea reference`) or a PNG (taken as displayed).
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Frame to evaluate, of the reference's size and kind (e.g. `fovea render --exr`, or its PNG).
+    #[arg(long)]
+    pub test: PathBuf,
+    /// Gaze point X,Y in image pixels (y down), or center; rings are centred on it.
+    #[arg(long)]
+    pub gaze: String,
+    /// Equal-width rings from the gaze out to the farthest image corner.
+    #[arg(long, default_value_t = 20)]
+    pub rings: usize,
+    /// Output folder for eval.json and eval.png (must hold only fovea's own outputs).
+    #[arg(long, default_value = "out/eval")]
+    pub out: PathBuf,
+    /// Also report rings of true eccentricity (degrees) through this headset's left-eye FOV
+    /// (eval.json `true_eccentricity`).
+    #[arg(long)]
+    pub headset: Option<String>,
+    /// FLIP's pixels per degree (default: the image width over the --headset eye's
+    /// horizontal FOV, the FOVE 0's without --headset); eval.json `flip_ppd`.
+    #[arg(long)]
+    pub ppd: Option<f32>,
+}
+
+impl EvalCommand {
+    pub fn run(self) -> Result<()> {
+        run(&EvalArgs {
+            reference: &self.reference,
+            test: &self.test,
+            gaze: &self.gaze,
+            rings: self.rings,
+            out: &self.out,
+            headset: self.headset.as_deref(),
+            ppd: self.ppd,
+        })
+    }
 }

@@ -12,7 +12,7 @@ use fovea_hal::predict::PredictorParams;
 use fovea_hal::{GazeSpec, HmdDescription, LatencyModel, PredictMode};
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub struct GazeEvalArgs<'a> {
     pub traces: &'a [String],
@@ -289,4 +289,44 @@ fn markdown(r: &Report) -> String {
         );
     }
     s
+}
+
+// `fovea gaze-eval` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct GazeEvalCommand {
+    /// Recordings: degrees CSVs (t_s,x_deg,y_deg,valid), fovea gaze traces, degrees:FILE or
+    /// gazebase:FILE.
+    #[arg(required = true)]
+    pub traces: Vec<String>,
+    /// Headset profile (its left eye's view, tracker and latency).
+    #[arg(long, default_value = "fove0")]
+    pub headset: String,
+    /// Sample-to-photon latency in ms (default: the profile's tracker + render + display).
+    #[arg(long, allow_hyphen_values = true)]
+    pub latency_ms: Option<f64>,
+    /// Tracker rate in Hz (default: the profile's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub tracker_hz: Option<f64>,
+    /// Display rate in Hz (default: the profile's refresh).
+    #[arg(long, allow_hyphen_values = true)]
+    pub display_hz: Option<f64>,
+    /// Predictors, comma-separated: off, hold, linear, saccade (default: all).
+    #[arg(long, value_delimiter = ',')]
+    pub gaze_predict: Vec<String>,
+    #[arg(long, default_value = "out/gaze-eval")]
+    pub out: PathBuf,
+}
+
+impl GazeEvalCommand {
+    pub fn run(self) -> Result<()> {
+        run(&GazeEvalArgs {
+            traces: &self.traces,
+            headset: &self.headset,
+            latency_ms: self.latency_ms,
+            tracker_hz: self.tracker_hz,
+            display_hz: self.display_hz,
+            predict: &self.gaze_predict,
+            out: &self.out,
+        })
+    }
 }

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 use fovea_stage::scenegen::{write_scene, SceneKind, DEFAULT_LARGE_TRIANGLES};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// `--min-triangles`: at most the scene loader's triangle budget (`FOVEA_MAX_TRIANGLES`, default
 /// 4,000,000), so every scene written loads (1e11 took 18.8 GB and wrote a file fovea refused).
@@ -37,4 +37,24 @@ pub fn run(kind: &str, out: &Path, min_triangles: Option<usize>, force: bool) ->
         stats.bytes
     );
     Ok(())
+}
+
+// `fovea gen-scene` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct GenSceneCommand {
+    /// cornell-box, stress or large.
+    pub kind: String,
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Minimum triangle count of the large scene.
+    #[arg(long)]
+    pub min_triangles: Option<usize>,
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl GenSceneCommand {
+    pub fn run(self) -> Result<()> {
+        run(&self.kind, &self.out, self.min_triangles, self.force)
+    }
 }

@@ -1,5 +1,6 @@
 //! `fovea info`: Vulkan devices, the one `fovea` would choose, and its limits.
 
+use super::flags::DeviceArgs;
 use anyhow::Result;
 use fovea_renderer::vk::Context;
 
@@ -50,4 +51,18 @@ pub fn run(device: Option<&str>) -> Result<()> {
         i.timestamp_period_ns
     );
     Ok(())
+}
+
+// `fovea info` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct InfoCommand {
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl InfoCommand {
+    pub fn run(self) -> Result<()> {
+        self.device.choose_traversal()?;
+        run(self.device.device.as_deref())
+    }
 }

@@ -12,7 +12,7 @@ use fovea_renderer::passes::tonemap::ToneCurve;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub const BEGIN: &str = "<!-- method-table:begin -->";
 pub const END: &str = "<!-- method-table:end -->";
@@ -584,6 +584,40 @@ fn write_equal_samples_claim(s: &mut String, path: &Path, q: &Quality) -> Result
         figures.join("; ")
     );
     Ok(())
+}
+
+// `fovea method-table` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct MethodTableCommand {
+    /// A `fovea quality` output folder (e.g. run with `--methods all`).
+    #[arg(long)]
+    pub quality: PathBuf,
+    /// `fovea bench` report.json files, comma-separated: the first one's first `--vp-sizes`
+    /// screen gives the table's costs; every screen of every one a figure in the claims.
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub bench: Vec<PathBuf>,
+    /// The Markdown document to write the table into, between its method-table markers.
+    #[arg(long, alias = "readme", default_value = "docs/quality.md")]
+    pub doc: PathBuf,
+    /// Folder for the picture row's images.
+    #[arg(long, default_value = "docs/methods")]
+    pub pictures: PathBuf,
+    /// `fovea quality` reports (quality.json), comma-separated, each of `vp` and one other
+    /// method at VP's sample count (a profile's budget knob): one claim line each.
+    #[arg(long, value_delimiter = ',')]
+    pub equal_samples: Vec<PathBuf>,
+}
+
+impl MethodTableCommand {
+    pub fn run(self) -> Result<()> {
+        run(&MethodTableArgs {
+            quality: &self.quality,
+            bench: &self.bench,
+            doc: &self.doc,
+            pictures: &self.pictures,
+            equal_samples: &self.equal_samples,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@ mod bench_rays;
 pub mod bench_vp;
 pub mod debug_views;
 pub mod eval;
+pub mod flags;
 pub mod gaze_eval;
 pub mod gen_scene;
 pub mod headsets;

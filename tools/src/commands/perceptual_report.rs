@@ -309,3 +309,22 @@ pub fn run(args: &PerceptualReportArgs) -> Result<()> {
     print!("{md}");
     Ok(())
 }
+
+// `fovea perceptual-report` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct PerceptualReportCommand {
+    /// `fovea quality` folders, each with the perceptual.json of scripts/perceptual.
+    #[arg(required = true)]
+    pub folders: Vec<PathBuf>,
+    #[arg(long, default_value = "out/perceptual")]
+    pub out: PathBuf,
+}
+
+impl PerceptualReportCommand {
+    pub fn run(self) -> Result<()> {
+        run(&PerceptualReportArgs {
+            folders: &self.folders,
+            out: &self.out,
+        })
+    }
+}

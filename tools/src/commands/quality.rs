@@ -7,6 +7,7 @@
 //! `DIR/quality.md`. With `--eyes both` every run renders both eyes, each eye is judged against
 //! its own reference, and the binocular consistency measure (`quality_stereo`) compares the eyes.
 
+use super::flags::{DeviceArgs, LatencyFlags, SceneFlags};
 use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
 use super::setup::Eyes;
@@ -17,6 +18,7 @@ use crate::eval::metrics::{
 use crate::output::{
     prepare_output_dir, tonemap_preview, write_exr, write_json, write_png, write_text,
 };
+use crate::render_profile::ProfileOverrides;
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context, Result};
 use fovea_hal::Eye;
@@ -1240,4 +1242,163 @@ fn markdown(r: &Report) -> String {
         s.push('\n');
     }
     s
+}
+
+// `fovea quality`'s flags (also the command a quality sweep splits; its help is the variant's in
+// `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct QualityCommand {
+    #[arg(long, default_value = fovea_stage::scenes::DEFAULT_SCENE)]
+    pub scene: String,
+    #[arg(long, default_value_t = 160)]
+    pub width: u32,
+    #[arg(long, default_value_t = 180)]
+    pub height: u32,
+    #[arg(long, default_value = "fove0")]
+    pub headset: String,
+    /// Gaze source of every run (as for `render`); rings follow each frame's gaze.
+    #[arg(long, default_value = "sim:1")]
+    pub gaze: String,
+    #[arg(long, default_value_t = 16)]
+    pub frames: u32,
+    /// The last this many frames are evaluated and averaged.
+    #[arg(long, default_value_t = 4)]
+    pub eval_frames: u32,
+    /// Sampling methods (`all`: every `--method` of `fovea render`).
+    #[arg(long, value_delimiter = ',', default_value = "vp,cartesian")]
+    pub methods: Vec<String>,
+    /// Denoisers to compare (default: every one built in).
+    #[arg(long, value_delimiter = ',')]
+    pub denoisers: Vec<String>,
+    #[arg(long, value_delimiter = ',', default_value = "off")]
+    pub taa: Vec<String>,
+    /// still and/or moving (the scene's default camera path).
+    #[arg(long, value_delimiter = ',', default_value = "still,moving")]
+    pub cameras: Vec<String>,
+    /// left, or both: every run renders both eyes (the headset's eye offsets), each eye is
+    /// judged against its own reference, and the binocular consistency measure is added
+    /// (the right eye warped into the left through the converged depth).
+    #[arg(long, default_value = "left")]
+    pub eyes: String,
+    #[arg(long, default_value_t = 256)]
+    pub reference_spp: u32,
+    /// Take the converged references from an earlier `fovea quality` folder instead of rendering
+    /// them: its quality.json must record the same reference settings for each camera (scene,
+    /// size, headset, eyes, samples, seed, camera and light flags; the frames for the moving
+    /// camera); they are copied into --out. E.g. the same scene at several sample budgets
+    /// (profiles) or gaze sources with one set of references
+    #[arg(long)]
+    pub references: Option<PathBuf>,
+    /// Equal-width rings from the gaze out to the farthest corner.
+    #[arg(long, default_value_t = 10)]
+    pub rings: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// Render profile (TOML) for every run; flags below override it.
+    #[arg(long)]
+    pub profile: Option<PathBuf>,
+    /// Foveated blur σ at 30° (0 turns it off).
+    #[arg(long)]
+    pub blur_sigma: Option<f32>,
+    /// Where the foveated blur runs: screen | grid (see `fovea render --blur-space`).
+    #[arg(long)]
+    pub blur_space: Option<String>,
+    #[arg(long, default_value = "out/quality")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub look: SceneFlags,
+    #[command(flatten)]
+    pub latency: LatencyFlags,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl QualityCommand {
+    pub fn run(self) -> Result<()> {
+        self.with_args(&mut run)
+    }
+
+    /// The flags as the command's arguments, handed to `run` (the command itself, or a sweep).
+    pub fn with_args(self, run: &mut dyn FnMut(&QualityArgs) -> Result<()>) -> Result<()> {
+        let QualityCommand {
+            scene,
+            width,
+            height,
+            headset,
+            gaze,
+            frames,
+            eval_frames,
+            methods,
+            denoisers,
+            taa,
+            cameras,
+            eyes,
+            reference_spp,
+            references,
+            rings,
+            seed,
+            profile,
+            blur_sigma,
+            blur_space,
+            out,
+            look,
+            latency,
+            device,
+        } = self;
+        device.choose_traversal()?;
+        let base = match &profile {
+            Some(path) => RenderProfile::load(path)?,
+            None => RenderProfile::default(),
+        };
+        let profile = base.override_with(&ProfileOverrides {
+            blur_sigma,
+            blur_space,
+            environment: look.environment()?,
+            texture_lod: look.texture_lod.clone(),
+            path_regularisation: look.path_regularisation,
+            offscreen_samples: look.offscreen_samples.clone(),
+            resampling: look.resampling.clone(),
+            gaze_timing: latency.timing()?,
+            ..Default::default()
+        })?;
+        let all: Vec<String> = DenoiserSettings::NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let stereo_noises = match &look.stereo_noise {
+            Some(list) => list
+                .split(',')
+                .map(|n| StereoNoise::parse(n.trim()).context("--stereo-noise"))
+                .collect::<Result<Vec<_>>>()?,
+            None => Vec::new(),
+        };
+        run(&QualityArgs {
+            scene: &scene,
+            width,
+            height,
+            headset: &headset,
+            gaze: &gaze,
+            frames,
+            eval_frames,
+            methods: &expand_methods(methods),
+            denoisers: if denoisers.is_empty() {
+                &all
+            } else {
+                &denoisers
+            },
+            taa: &taa,
+            cameras: &cameras,
+            reference_spp,
+            rings,
+            seed,
+            profile,
+            eyes: Eyes::parse(&eyes)?,
+            stereo_noises: &stereo_noises,
+            camera: &look.camera()?,
+            references: references.as_deref(),
+            out: &out,
+            device: device.device.as_deref(),
+            validation: device.validation,
+        })
+    }
 }

@@ -1,5 +1,7 @@
 //! `fovea reference`: a converged linear-radiance EXR (many samples per pixel, chosen depth).
 
+use super::flags::{DeviceArgs, SceneFlags};
+use super::render_args::Eyes;
 use crate::output::{check_new_file, tonemap_preview, write_exr, write_png};
 use anyhow::{bail, Context as _, Result};
 use fovea_renderer::frame::{CameraPose, RenderSettings};
@@ -9,7 +11,7 @@ use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::Context;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 pub struct ReferenceArgs<'a> {
@@ -156,4 +158,91 @@ pub fn fireflies(args: &ReferenceArgs, image: &[[f32; 4]]) {
     let [ff30, ff60, ff100] = [30.0, 60.0, 100.0]
         .map(|levels| crate::eval::metrics::isolated_bright_pixels(&displayed, w, h, levels));
     println!("fireflies (pixels of the tonemapped image brighter than all 8 neighbours by > 30 / 60 / 100 of 255 levels): {ff30} / {ff60} / {ff100} of {}", w * h);
+}
+
+// `fovea reference`'s flags (also the command a reference sweep splits; its help is the
+// variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct ReferenceCommand {
+    #[arg(long, default_value = fovea_stage::scenes::DEFAULT_SCENE)]
+    pub scene: String,
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    #[arg(long, default_value_t = 1024)]
+    pub spp: u32,
+    #[arg(long, default_value_t = 3)]
+    pub max_depth: u32,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub look: SceneFlags,
+    /// Headset profile whose eye is rendered (with --projection headset, the default).
+    #[arg(long, default_value = "fove0")]
+    pub headset: String,
+    /// The eye: left (as `fovea render` writes by default) or right.
+    #[arg(long, default_value = "left")]
+    pub eye: String,
+    /// Replace FILE if it exists.
+    #[arg(long)]
+    pub force: bool,
+    /// Also write a tonemapped PNG preview (FILE with .png).
+    #[arg(long)]
+    pub preview: bool,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl ReferenceCommand {
+    pub fn run(self) -> Result<()> {
+        self.with_args(&mut run)
+    }
+
+    /// The flags as the command's arguments, handed to `run` (the command itself, or a sweep).
+    pub fn with_args(self, run: &mut dyn FnMut(&ReferenceArgs) -> Result<()>) -> Result<()> {
+        let ReferenceCommand {
+            scene,
+            width,
+            height,
+            spp,
+            max_depth,
+            seed,
+            out,
+            look,
+            headset,
+            eye,
+            force,
+            preview,
+            device,
+        } = self;
+        device.choose_traversal()?;
+        run(&ReferenceArgs {
+            camera: &look.camera()?,
+            headset: &headset,
+            eye: match Eyes::parse(&eye)? {
+                Eyes::Left => fovea_hal::Eye::Left,
+                Eyes::Right => fovea_hal::Eye::Right,
+                Eyes::Both => bail!("--eye both: a reference is one eye (left or right)"),
+            },
+            environment: look.environment()?,
+            path_regularisation: crate::render_profile::check_path_regularisation(
+                look.path_regularisation,
+                "--path-regularisation",
+            )?,
+            scene: &scene,
+            width,
+            height,
+            spp,
+            max_depth,
+            seed,
+            out: &out,
+            force,
+            preview,
+            device: device.device.as_deref(),
+            validation: device.validation,
+        })
+    }
 }

@@ -1,9 +1,11 @@
 //! `fovea render`: N frames of the scene, written as PNG (and linear EXR), plus report.json with
 //! exact sample/ray counts and mean GPU milliseconds per pass.
 
+use super::flags::DeviceArgs;
 use super::methods::{ReportSection, VpVariant};
 use super::render_args::Eyes;
 pub use super::render_args::RenderArgs;
+use super::render_args::{RenderDefaults, RenderOpts, DEFAULT_SCALE};
 use super::setup::Setup;
 use crate::output::{prepare_output_dir, write_exr, write_json, write_png};
 use crate::render_profile::RenderProfile;
@@ -474,5 +476,89 @@ fn vp_report(profile: &RenderProfile, variant: VpVariant) -> VpReport {
         } else {
             crate::render_profile::eccentricity_name(profile.eccentricity).into()
         },
+    }
+}
+
+/// `fovea render`'s length without `--frames`.
+pub const DEFAULT_RENDER_FRAMES: u32 = 24;
+
+// `fovea render` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct RenderCommand {
+    // Boxed: the render options dwarf every other command's.
+    #[command(flatten)]
+    pub opts: Box<RenderOpts>,
+    /// Skip overview.png (the last frame beside the same frame at full cost, every pixel
+    /// traced, and the sample density with the gaze; the full-cost frame renders the last
+    /// 8 frames again without foveation).
+    #[arg(long)]
+    pub no_overview: bool,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl RenderCommand {
+    pub fn run(self) -> Result<()> {
+        self.device.choose_traversal()?;
+        let profile = self.opts.profile()?;
+        let camera = self.opts.look.camera()?;
+        let mut args = self.opts.args(
+            &camera,
+            &self.device,
+            &profile,
+            RenderDefaults {
+                frames: DEFAULT_RENDER_FRAMES,
+                gaze: "sim:1",
+                out: "out/render",
+                scale: DEFAULT_SCALE,
+            },
+        )?;
+        args.overview = !self.no_overview;
+        run(&args)
+    }
+}
+
+impl RenderOpts {
+    /// The flags `fovea render`, `view`, `xr` and `replay` share, checked, as the commands read
+    /// them.
+    pub fn args<'a>(
+        &'a self,
+        camera: &'a fovea_stage::look::CameraOptions,
+        device: &'a DeviceArgs,
+        profile: &RenderProfile,
+        defaults: RenderDefaults,
+    ) -> Result<RenderArgs<'a>> {
+        Ok(RenderArgs {
+            scene: &self.scene,
+            method: &self.method,
+            width: self.width,
+            height: self.height,
+            scale: self.scale.unwrap_or(defaults.scale),
+            headset: &self.headset,
+            gaze: self.gaze.as_deref().unwrap_or(defaults.gaze),
+            frames: self.frames.unwrap_or(defaults.frames),
+            out: self
+                .out
+                .as_deref()
+                .unwrap_or(std::path::Path::new(defaults.out)),
+            exr: self.exr,
+            camera_path: fovea_stage::camera_path::CameraMotion::from_flag(
+                self.camera_path.as_deref(),
+            )?,
+            seed: self.seed,
+            max_depth: self.max_depth,
+            exposure: super::setup::parse_exposure(&self.exposure)?,
+            tone: super::setup::parse_tone(&self.tone)?,
+            overview: false,
+            profile: profile.clone(),
+            debug_views: self.debug_views,
+            denoiser: &self.denoiser,
+            taa: &self.taa,
+            device: device.device.as_deref(),
+            validation: device.validation,
+            eyes: Eyes::parse(&self.eyes)?,
+            frames_in_flight: self.frames_in_flight,
+            camera,
+        })
     }
 }

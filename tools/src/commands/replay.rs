@@ -4,7 +4,9 @@
 //! the gaze used (the playback), cost (reported, never a failure). Exit 0 within tolerance, 1 on
 //! a regression, 2 on bad input. `--update-baseline` writes the baseline instead.
 
+use super::flags::DeviceArgs;
 use super::render::RenderArgs;
+use super::render_args::{RenderDefaults, RenderOpts, DEFAULT_SCALE};
 use crate::eval::flip::{flip_image, flip_map};
 use crate::eval::metrics::Rings;
 use crate::output::{prepare_output_dir, tonemap_preview, write_json, write_png, write_text};
@@ -20,7 +22,7 @@ use fovea_renderer::sampling::Cartesian;
 use glam::{UVec2, Vec2};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub struct ReplayArgs<'a> {
     pub traces: &'a [String],
@@ -583,4 +585,97 @@ fn markdown(r: &ReplayReport) -> String {
         }
     }
     s
+}
+
+// `fovea replay`'s flags (also the command a replay sweep splits; its help is the variant's in
+// `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct ReplayCommand {
+    /// Gaze traces (files) or gaze sources (sim:SEED, center, X,Y), one baseline each.
+    pub traces: Vec<String>,
+    /// Baseline folder (one subfolder per trace).
+    #[arg(long)]
+    pub baseline: PathBuf,
+    /// Write the baselines from this run instead of comparing (overwrites them).
+    #[arg(long)]
+    pub update_baseline: bool,
+    /// Samples per pixel of the converged reference made with a new baseline.
+    #[arg(long, default_value_t = 256)]
+    pub reference_spp: u32,
+    /// Rings of distance from the gaze for every per-ring figure.
+    #[arg(long, default_value_t = 4)]
+    pub rings: usize,
+    /// Largest mean FLIP per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_flip)]
+    pub change_flip: f64,
+    /// Largest sRGB RMSE (0…1) per ring against the baseline's frame.
+    #[arg(long, default_value_t = Tolerances::default().change_rmse)]
+    pub change_rmse: f64,
+    /// A ring's error against the reference may grow to baseline × (1 + this) + --quality-abs.
+    #[arg(long, default_value_t = Tolerances::default().quality_rel)]
+    pub quality_rel: f64,
+    #[arg(long, default_value_t = Tolerances::default().quality_abs)]
+    pub quality_abs: f64,
+    #[command(flatten)]
+    pub opts: Box<RenderOpts>,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl ReplayCommand {
+    pub fn run(self) -> Result<()> {
+        self.with_args(&mut run)
+    }
+
+    /// The flags as the command's arguments, handed to `run` (the command itself, or a sweep).
+    pub fn with_args(self, run: &mut dyn FnMut(&ReplayArgs) -> Result<()>) -> Result<()> {
+        let ReplayCommand {
+            traces,
+            baseline,
+            update_baseline,
+            reference_spp,
+            rings,
+            change_flip,
+            change_rmse,
+            quality_rel,
+            quality_abs,
+            opts,
+            device,
+        } = self;
+        device.choose_traversal()?;
+        let profile = opts.profile()?;
+        let camera = opts.look.camera()?;
+        let mut render = opts.args(
+            &camera,
+            &device,
+            &profile,
+            RenderDefaults {
+                frames: DEFAULT_FRAMES,
+                gaze: "center",
+                out: "out/replay",
+                scale: DEFAULT_SCALE,
+            },
+        )?;
+        // Small by default: replays run in the test suite.
+        render.width = Some(opts.width.unwrap_or(64));
+        render.height = Some(opts.height.unwrap_or(72));
+        let tolerances = Tolerances {
+            change_flip,
+            change_rmse,
+            quality_rel,
+            quality_abs,
+            ..Tolerances::default()
+        };
+        run(&ReplayArgs {
+            traces: &traces,
+            baseline: &baseline,
+            frames: opts.frames,
+            out: render.out,
+            render,
+            update: update_baseline,
+            reference_spp,
+            rings,
+            tolerances,
+        })
+    }
 }

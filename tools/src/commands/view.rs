@@ -6,7 +6,9 @@
 //! there. `--frames N --screenshot FILE` renders frames 0…N−1 exactly as `fovea render` does and
 //! saves the last presented image.
 
+use super::flags::DeviceArgs;
 use super::render::RenderArgs;
+use super::render_args::{RenderDefaults, RenderOpts, DEFAULT_SCALE};
 use super::setup::{method_names, space_for, Eyes, Setup};
 use crate::viewer::debug::{compose, DebugView, StereoScene};
 use crate::viewer::swapchain::{Swapchain, PRESENT_MODES};
@@ -26,7 +28,7 @@ use glam::{Mat4, Quat, UVec2, Vec2, Vec3};
 use gpu_allocator::MemoryLocation;
 use std::collections::HashSet;
 use std::ffi::CString;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
@@ -806,6 +808,60 @@ fn scaled_fov(fov: glam::Vec4, eye: UVec2) -> glam::Vec4 {
     let ty = fov.w;
     let tx = ty * eye.x as f32 / eye.y as f32;
     glam::Vec4::new(-tx, tx, fov.z, fov.w)
+}
+
+// `fovea view` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct ViewCommand {
+    #[command(flatten)]
+    pub opts: Box<RenderOpts>,
+    /// Save the last presented image (both eyes side by side) as PNG; needs --frames N. An
+    /// existing file is replaced only with --force.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Let --screenshot replace an existing file.
+    #[arg(long)]
+    pub force: bool,
+    /// fifo (vsync, default), mailbox or immediate (fifo when the surface lacks it).
+    #[arg(long, default_value = "fifo")]
+    pub present_mode: String,
+    /// The debug view shown first: off, grid (the sampling grid as traced), density (samples
+    /// per pixel), rings (eccentricity rings at 5, 10, 20, 30, 40°) or stereo-diff (with
+    /// --eyes both: each eye's binocular difference as a heat map, the other eye warped into
+    /// it through the scene's depth); key v cycles them.
+    #[arg(long, default_value = "off")]
+    pub debug_view: String,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl ViewCommand {
+    pub fn run(self) -> Result<()> {
+        self.device.choose_traversal()?;
+        let profile = self.opts.profile()?;
+        let camera = self.opts.look.camera()?;
+        // Without --frames the run has no length: the camera path's period is a long one.
+        let render = self.opts.args(
+            &camera,
+            &self.device,
+            &profile,
+            RenderDefaults {
+                frames: u32::MAX,
+                gaze: "center",
+                out: "out/render",
+                scale: DEFAULT_SCALE,
+            },
+        )?;
+        run(&ViewArgs {
+            frames: self.opts.frames,
+            screenshot: self.screenshot.as_deref(),
+            force: self.force,
+            present_mode: &self.present_mode,
+            mouse_gaze: self.opts.gaze.is_none(),
+            debug_view: DebugView::parse(&self.debug_view)?,
+            render,
+        })
+    }
 }
 
 #[cfg(test)]

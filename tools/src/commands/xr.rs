@@ -4,7 +4,9 @@
 //! swapchain image (side by side) → xrEndFrame with one projection layer. Writes
 //! `DIR/frames.jsonl` (one row per frame) and `DIR/report.json`.
 
+use super::flags::DeviceArgs;
 use super::render::RenderArgs;
+use super::render_args::{RenderDefaults, RenderOpts};
 use super::setup::{check_common, filters_for_method, render_settings, scaled_eye_size, space_for};
 use crate::output::{prepare_output_dir, write_json};
 use crate::xr::frame_log::{FrameLog, FrameRow, GazeRow, ViewRow};
@@ -27,7 +29,7 @@ use fovea_stage::gaze::GazeDriver;
 use glam::{Mat4, Quat, UVec2, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -682,5 +684,64 @@ mod placement_tests {
             .unwrap_err()
             .to_string()
             .contains("local, stage"));
+    }
+}
+
+// `fovea xr` (its help is the variant's in `crate::cli::Command`).
+#[derive(clap::Args)]
+pub struct XrCommand {
+    #[command(flatten)]
+    pub opts: Box<RenderOpts>,
+    /// Write the gaze that drove the session as a trace (a new file), replayable with
+    /// `fovea render --headset <same> --gaze TRACE.csv`.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// Save the last rendered frame as submitted (both eyes side by side) as PNG; needs
+    /// --frames. An existing file is replaced only with --force.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Let --screenshot replace an existing file.
+    #[arg(long)]
+    pub force: bool,
+    /// The runtime space the scene camera stands in: local (the default: where the head was
+    /// when the session started) or stage (the play area's floor is the scene's y = 0).
+    #[arg(long, default_value = "local")]
+    pub reference_space: String,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+impl XrCommand {
+    pub fn run(self) -> Result<()> {
+        self.device.choose_traversal()?;
+        let profile = self.opts.profile()?;
+        let camera = self.opts.look.camera()?;
+        // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
+        let render = self.opts.args(
+            &camera,
+            &self.device,
+            &profile,
+            RenderDefaults {
+                frames: u32::MAX,
+                gaze: "center",
+                out: "out/xr",
+                scale: 1.0,
+            },
+        )?;
+        if self.opts.eyes != "left" && self.opts.eyes != "both" {
+            bail!(
+                "fovea xr renders both eyes; --eyes {} does not apply",
+                self.opts.eyes
+            );
+        }
+        run(&XrArgs {
+            render,
+            frames: self.opts.frames,
+            gaze: self.opts.gaze.as_deref(),
+            record: self.record.as_deref(),
+            screenshot: self.screenshot.as_deref(),
+            force: self.force,
+            reference_space: ReferenceSpace::parse(&self.reference_space)?,
+        })
     }
 }
