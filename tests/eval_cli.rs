@@ -265,6 +265,7 @@ fn quality_args<'a>(
         stereo_noises: &[],
         camera: &fovea_stage::look::NO_CAMERA_FLAGS,
         references: None,
+        display_exposure: fovea_tools::commands::quality::DisplayExposure::Stops(0.0),
         out,
         device: None,
         validation: true,
@@ -373,7 +374,9 @@ fn quality_command_measures_every_combination() {
 /// them; a folder of other reference settings is refused, naming the key.
 #[test]
 fn quality_reuses_the_references_of_the_same_settings() {
-    use fovea_tools::commands::quality::{run, QualityArgs};
+    use fovea_renderer::passes::exposure::{metered_exposure, AutoExposure};
+    use fovea_renderer::passes::tonemap::ToneCurve;
+    use fovea_tools::commands::quality::{run, DisplayExposure, QualityArgs};
     let (first, second) = (temp_dir("references-a"), temp_dir("references-b"));
     let strings = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     let (methods, denoisers, taa, cameras) = (
@@ -410,6 +413,48 @@ fn quality_reuses_the_references_of_the_same_settings() {
         q["runs"][0]["samples_traced"].as_u64().unwrap()
     };
     assert!(samples(&second) < samples(&first));
+
+    // Displayed at the exposure metered on the reference: the references' PNGs and the run's
+    // frames at that one exposure, recorded per run.
+    let metered_dir = temp_dir("references-metered");
+    run(&QualityArgs {
+        display_exposure: DisplayExposure::Metered,
+        out: &metered_dir,
+        ..reusing.clone()
+    })
+    .unwrap();
+    let (w, h, reference) =
+        fovea_tools::output::read_exr(&metered_dir.join("reference_still_0000.exr")).unwrap();
+    let flat = AutoExposure {
+        gaze_boost: 0.0,
+        ..Default::default()
+    };
+    let m = metered_exposure(&reference, w, h, &flat, glam::Vec2::ZERO, 1.0);
+    assert!(
+        m > 1.2,
+        "the Cornell box meters brighter than exposure 1: {m}"
+    );
+    let png = |dir: &Path, name: &str| image::open(dir.join(name)).unwrap().to_rgba8().into_raw();
+    assert_eq!(
+        png(&metered_dir, "reference_still_0000.png"),
+        fovea_tools::output::tonemap_preview(&reference, m, ToneCurve::Aces),
+        "the reference as displayed at the metered exposure"
+    );
+    let q: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(metered_dir.join("quality.json")).unwrap())
+            .unwrap();
+    assert_eq!(q["runs"][0]["display_exposure"].as_f64().unwrap() as f32, m);
+    let run_dir = q["runs"][0]["run_dir"].as_str().unwrap();
+    let mean = |v: Vec<u8>| v.iter().map(|&b| b as f64).sum::<f64>() / v.len() as f64;
+    let (bright, plain) = (
+        mean(png(&metered_dir.join(run_dir), "frame_0002.png")),
+        mean(png(&second.join(run_dir), "frame_0002.png")),
+    );
+    assert!(
+        bright > plain * 1.1,
+        "the run's frames are displayed at the metered exposure: mean {bright} vs {plain} at 1"
+    );
+
     let other = QualityArgs {
         reference_spp: 8,
         ..reusing

@@ -5,7 +5,7 @@
 
 use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::gpu_scene::GpuScene;
-use fovea_renderer::passes::exposure::{AutoExposure, Exposure};
+use fovea_renderer::passes::exposure::{metered_exposure, AutoExposure, Exposure};
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace};
@@ -166,6 +166,38 @@ fn the_meter_weighs_the_gaze() {
         light < floor * 0.9,
         "gaze on the light: {light}, on the floor: {floor}"
     );
+    assert_clean(&ctx);
+}
+
+/// The CPU meter (`metered_exposure`, what `fovea quality --display-exposure metered` holds fixed)
+/// gives the device's first metered exposure of the same screen radiance, with the gaze weighted
+/// and flat, on the Cornell box and on a scene 100× brighter.
+#[test]
+fn the_cpu_meter_gives_the_devices_first_exposure() {
+    let ctx = gpu();
+    let (scene, camera) = cornell();
+    let light = light_material(&scene);
+    let span = camera.fov_tan.y.atan() - camera.fov_tan.x.atan();
+    let ppd = SCREEN.x as f32 / span.to_degrees();
+    for (boost, brightness) in [(4.0, 1.0), (0.0, 1.0), (4.0, 100.0)] {
+        let settings = AutoExposure {
+            gaze_boost: boost,
+            ..Default::default()
+        };
+        let mut r = renderer(&ctx, &scene, 1, Exposure::Auto(settings));
+        r.set_emission_scale(&scene, light, brightness).unwrap();
+        let gaze = Vec2::new(SCREEN.x as f32 * 0.3, SCREEN.y as f32 * 0.2);
+        let f = frame(&mut r, &mono(camera, gaze), 0, 0.05, true);
+        let device = r.frame_exposure(f).unwrap();
+        let mut radiance = Vec::new();
+        r.read_view_hdr(f, 0, &mut radiance).unwrap();
+        let cpu = metered_exposure(&radiance, SCREEN.x, SCREEN.y, &settings, gaze, ppd);
+        println!("gaze boost {boost}, light ×{brightness}: device {device}, CPU {cpu}");
+        assert!(
+            (device / cpu).log2().abs() < 0.01,
+            "gaze boost {boost}, light ×{brightness}: the device metered {device}, the CPU {cpu}"
+        );
+    }
     assert_clean(&ctx);
 }
 

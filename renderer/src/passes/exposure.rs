@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::graph::{read_image, write_buffer, FrameRecorder};
 use crate::layouts::{
     ExposureAdaptPush, ExposureMeterPush, ExposureState, EXPOSURE_BINS, EXPOSURE_LOG2_MAX,
-    EXPOSURE_LOG2_MIN,
+    EXPOSURE_LOG2_MIN, EXPOSURE_WEIGHT_SCALE,
 };
 use crate::passes::{Kernel, Pass};
 use crate::vk::{Buffer, Context, Image};
@@ -128,6 +128,81 @@ impl Kernel for Adapt {
 /// without a denoiser).
 const METERED_BLOCKS: u32 = 1 << 15;
 const MIN_BLOCK: u32 = 4;
+
+/// The exposure automatic metering gives a view's screen radiance (`width` × `height`, rows top
+/// to bottom) on its first frame, before any adaptation: `exposure_meter.comp` and the target of
+/// `exposure_adapt.comp` on the CPU (the same blocks, taps, weights, bins and trimmed mean), for
+/// an exposure held fixed over a comparison (`fovea quality --display-exposure metered`).
+/// `tests/exposure.rs` holds it to the device's.
+pub fn metered_exposure(
+    radiance: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    settings: &AutoExposure,
+    gaze: Vec2,
+    pixels_per_degree: f32,
+) -> f32 {
+    const TAPS: u32 = 4;
+    let block = (((width * height) as f32 / METERED_BLOCKS as f32)
+        .sqrt()
+        .ceil() as u32)
+        .max(MIN_BLOCK);
+    let inverse_radius = 1.0 / (settings.gaze_radius_deg * pixels_per_degree).max(1.0);
+    let mut bins = vec![0u32; EXPOSURE_BINS as usize];
+    for oy in (0..height).step_by(block as usize) {
+        for ox in (0..width).step_by(block as usize) {
+            let extent = (block.min(width - ox), block.min(height - oy));
+            let (mut sum, mut n) = (0.0f32, 0u32);
+            for ty in 0..TAPS {
+                for tx in 0..TAPS {
+                    let x = ox + (tx * extent.0 + extent.0 / 2) / TAPS;
+                    let y = oy + (ty * extent.1 + extent.1 / 2) / TAPS;
+                    let c = radiance[(y * width + x) as usize];
+                    let l = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                    // NaN and infinity are left out, as on the device.
+                    if (0.0..3.0e38).contains(&l) {
+                        sum += l;
+                        n += 1;
+                    }
+                }
+            }
+            let mean = if n > 0 { sum / n as f32 } else { 0.0 };
+            if mean > EXPOSURE_LOG2_MIN.exp2() && mean < 3.0e38 {
+                let t = (mean.log2() - EXPOSURE_LOG2_MIN) / (EXPOSURE_LOG2_MAX - EXPOSURE_LOG2_MIN);
+                let bin =
+                    (t * EXPOSURE_BINS as f32).clamp(0.0, (EXPOSURE_BINS - 1) as f32) as usize;
+                let centre = Vec2::new(ox as f32, oy as f32)
+                    + 0.5 * Vec2::new(extent.0 as f32, extent.1 as f32);
+                let d = (centre - gaze).length() * inverse_radius;
+                let w = 1.0 + settings.gaze_boost * (-d * d).exp();
+                bins[bin] += (EXPOSURE_WEIGHT_SCALE * w).round() as u32;
+            }
+        }
+    }
+    let total: f32 = bins.iter().map(|&b| b as f32).sum();
+    if total <= 0.0 {
+        return 1.0;
+    }
+    let (lo, hi) = (
+        total * settings.dark_share,
+        total * (1.0 - settings.bright_share),
+    );
+    let bin_log2 = (EXPOSURE_LOG2_MAX - EXPOSURE_LOG2_MIN) / EXPOSURE_BINS as f32;
+    let (mut below, mut sum, mut weight) = (0.0f32, 0.0f32, 0.0f32);
+    for (i, &b) in bins.iter().enumerate() {
+        let w = b as f32;
+        let kept = ((below + w).min(hi) - below.max(lo)).max(0.0);
+        below += w;
+        sum += kept * (EXPOSURE_LOG2_MIN + (i as f32 + 0.5) * bin_log2);
+        weight += kept;
+    }
+    let mean = if weight > 0.0 { sum / weight } else { 0.0 };
+    let target = (settings.key.log2() - mean + settings.compensation_ev).clamp(
+        settings.min_ev.max(EXPOSURE_LOG2_MIN),
+        settings.max_ev.min(EXPOSURE_LOG2_MAX),
+    );
+    target.exp2()
+}
 
 /// The exposure passes and their buffers, one per renderer.
 pub struct ExposurePass {

@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+#[derive(Clone)]
 pub struct QualityArgs<'a> {
     pub scene: &'a str,
     pub width: u32,
@@ -63,12 +64,64 @@ pub struct QualityArgs<'a> {
     /// An earlier quality folder whose references (of the same [`reference_key`]) are copied
     /// instead of rendered.
     pub references: Option<&'a Path>,
+    /// The one exposure every run and reference is displayed at (FLIP, flicker, the PNGs).
+    pub display_exposure: DisplayExposure,
     pub out: &'a Path,
     pub device: Option<&'a str>,
     pub validation: bool,
 }
 
+/// `--display-exposure`: how frames and references are displayed for the figures judged on what
+/// is shown (FLIP, flicker, the PNGs scripts/perceptual scores). Every run of a camera is shown at
+/// the one exposure of its references, so the methods are compared on equal terms.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DisplayExposure {
+    /// A fixed exposure in stops (0: radiance as it is).
+    Stops(f32),
+    /// What automatic exposure meters on the camera's first converged reference (flat, without
+    /// the gaze's weight: the display does not follow any one gaze), held for every frame.
+    Metered,
+}
+
+impl DisplayExposure {
+    pub fn parse(text: &str) -> Result<DisplayExposure> {
+        if text == "metered" {
+            return Ok(DisplayExposure::Metered);
+        }
+        match text.parse::<f32>() {
+            Ok(ev) if ev.is_finite() && ev.abs() <= 13.0 => Ok(DisplayExposure::Stops(ev)),
+            _ => bail!("--display-exposure {text}: expected metered or stops in [-13, 13]"),
+        }
+    }
+
+    /// The multiplier radiance is displayed at, given the camera's first reference.
+    pub fn multiplier(self, first_reference: &[[f32; 4]], width: u32, height: u32) -> f32 {
+        match self {
+            DisplayExposure::Stops(ev) => ev.exp2(),
+            DisplayExposure::Metered => {
+                let flat = fovea_renderer::passes::exposure::AutoExposure {
+                    gaze_boost: 0.0,
+                    ..Default::default()
+                };
+                fovea_renderer::passes::exposure::metered_exposure(
+                    first_reference,
+                    width,
+                    height,
+                    &flat,
+                    glam::Vec2::ZERO,
+                    1.0,
+                )
+            }
+        }
+    }
+}
+
 pub const CAMERAS: &[&str] = &["still", "moving"];
+
+/// The display exposure of a report written without one.
+fn unit_exposure() -> f32 {
+    1.0
+}
 
 /// One combination's metrics: per ring (mean over the evaluated frames) and whole frame.
 #[derive(Serialize, Deserialize)]
@@ -83,6 +136,10 @@ pub struct RunQuality {
     taa: String,
     /// How the eyes' random numbers related (`--stereo-noise`).
     stereo_noise: String,
+    /// The exposure multiplier its frames and references were displayed at
+    /// (`--display-exposure`).
+    #[serde(default = "unit_exposure")]
+    display_exposure: f32,
     frame_gpu_ms: f64,
     /// Samples and rays per frame (the run's mean, its report.json).
     samples_traced: u64,
@@ -482,9 +539,9 @@ pub fn run_combination(
         },
         seed: args.seed,
         max_depth: fovea_renderer::frame::REALTIME_MAX_DEPTH,
-        // Every method is judged at one fixed exposure and curve, its reference's
-        // (`tonemap_preview`).
-        exposure: fovea_renderer::passes::exposure::Exposure::Manual(1.0),
+        // Every method is judged at one fixed exposure and curve, its references'
+        // (`write_displayed_references`).
+        exposure: fovea_renderer::passes::exposure::Exposure::Manual(references.exposure),
         tone: ToneCurve::Aces,
         overview: false,
         profile: profile.clone(),
@@ -508,13 +565,21 @@ pub fn run_combination(
         Some(_) => EyeFiles::LEFT,
         None => EyeFiles::MONO,
     };
-    let mut q = measure(args, dir, evaluated, &references.left, prepared.ppd, &left)?;
+    let exposure = references.exposure;
+    let mut q = measure(
+        args,
+        dir,
+        evaluated,
+        (&references.left, exposure),
+        prepared.ppd,
+        &left,
+    )?;
     if let Some(stereo) = stereo {
         let right = measure(
             args,
             dir,
             evaluated,
-            &stereo.right,
+            (&stereo.right, exposure),
             prepared.ppd,
             &EyeFiles::RIGHT,
         )?;
@@ -634,9 +699,9 @@ pub fn reference_file_name(eyes: Eyes, camera: &str, eye: Eye, frame: u32) -> St
     }
 }
 
-/// Writes a converged reference into `out` ([`reference_file_name`]) and, beside it
-/// (`.png`), as displayed: through the one exposure and curve every run is judged at, for
-/// metrics that read displayed images (scripts/perceptual).
+/// Writes a converged reference into `out` ([`reference_file_name`]); the displayed `.png`
+/// beside it follows once the camera's display exposure is known
+/// ([`write_displayed_references`]).
 pub fn write_reference(
     out: &Path,
     args: &QualityArgs,
@@ -646,13 +711,7 @@ pub fn write_reference(
     image: &[[f32; 4]],
 ) -> Result<()> {
     let path = out.join(reference_file_name(args.eyes, camera, eye, frame));
-    write_exr(&path, args.width, args.height, image)?;
-    write_png(
-        &path.with_extension("png"),
-        args.width,
-        args.height,
-        &tonemap_preview(image, 1.0, ToneCurve::Aces),
-    )
+    write_exr(&path, args.width, args.height, image)
 }
 
 /// The scene and the head of the references of one camera: the eyes `fovea render --eyes
@@ -746,6 +805,8 @@ pub fn reference_renderer(
 pub struct References {
     left: Vec<Vec<[f32; 4]>>,
     stereo: Option<StereoReferences>,
+    /// The display exposure of every run of this camera ([`QualityArgs::display_exposure`]).
+    exposure: f32,
 }
 
 impl References {
@@ -767,6 +828,7 @@ impl References {
                 eyes.len()
             );
         }
+        let exposure = display_multiplier(args, &images)?;
         let mut per_eye = images
             .into_iter()
             .map(|v| per_evaluated_frame(camera, v, evaluated));
@@ -780,12 +842,56 @@ impl References {
                     &views.rig,
                     &heads,
                     right,
+                    exposure,
                 ))
             }
             (Some(_), None) => bail!("a stereo run's references need their views"),
         };
-        Ok(References { left, stereo })
+        Ok(References {
+            left,
+            stereo,
+            exposure,
+        })
     }
+}
+
+/// The display exposure of a camera whose references are `images[eye][frame]`: metered on the
+/// left eye's first.
+fn display_multiplier(args: &QualityArgs, images: &[Vec<Vec<[f32; 4]>>]) -> Result<f32> {
+    let first = images
+        .first()
+        .and_then(|eye| eye.first())
+        .context("a camera without references")?;
+    Ok(args
+        .display_exposure
+        .multiplier(first, args.width, args.height))
+}
+
+/// Writes the references of `camera` as displayed (`.png` beside each `.exr`), at the display
+/// exposure of [`display_multiplier`].
+pub fn write_displayed_references(
+    out: &Path,
+    args: &QualityArgs,
+    camera: &str,
+    evaluated: &[u32],
+    images: &[Vec<Vec<[f32; 4]>>],
+) -> Result<()> {
+    let exposure = display_multiplier(args, images)?;
+    for (&eye, eye_images) in reference_eyes(args).iter().zip(images) {
+        for (f, image) in reference_frames(camera, evaluated)
+            .into_iter()
+            .zip(eye_images)
+        {
+            let path = out.join(reference_file_name(args.eyes, camera, eye, f));
+            write_png(
+                &path.with_extension("png"),
+                args.width,
+                args.height,
+                &tonemap_preview(image, exposure, ToneCurve::Aces),
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// Converged references of the evaluated frames' camera poses (one for a still camera, the same
@@ -815,6 +921,7 @@ fn references(args: &QualityArgs, camera: &str, evaluated: &[u32]) -> Result<Ref
         images.push(eye_images);
     }
     super::check_validation(&r.ctx)?;
+    write_displayed_references(args.out, args, camera, evaluated, &images)?;
     References::new(args, camera, evaluated, images, Some(&r.views))
 }
 
@@ -883,6 +990,7 @@ fn copied_references(
         }
         images.push(eye_images);
     }
+    write_displayed_references(args.out, args, camera, evaluated, &images)?;
     let views = match args.eyes {
         Eyes::Both => Some(reference_views(args, camera, evaluated)?),
         Eyes::Left | Eyes::Right => None,
@@ -909,7 +1017,7 @@ fn measure(
     args: &QualityArgs,
     dir: &Path,
     evaluated: &[u32],
-    references: &[Vec<[f32; 4]>],
+    (references, exposure): (&[Vec<[f32; 4]>], f32),
     ppd: f32,
     eye: &EyeFiles,
 ) -> Result<RunQuality> {
@@ -944,7 +1052,7 @@ fn measure(
             size,
         )?
         .2;
-        let reference_displayed = tonemap_preview(reference, 1.0, ToneCurve::Aces);
+        let reference_displayed = tonemap_preview(reference, exposure, ToneCurve::Aces);
         let flip = flip_map(
             &reference_displayed,
             &displayed,
@@ -1028,6 +1136,7 @@ fn measure(
         })
         .collect();
     Ok(RunQuality {
+        display_exposure: exposure,
         run_dir: String::new(),
         camera: String::new(),
         method: String::new(),
@@ -1303,6 +1412,11 @@ pub struct QualityCommand {
     /// Where the foveated blur runs: screen | grid (see `fovea render --blur-space`).
     #[arg(long)]
     pub blur_space: Option<String>,
+    /// The one exposure every run and reference of a camera is displayed at (FLIP, flicker, the
+    /// PNGs): stops (0: radiance as it is), or metered (automatic exposure's meter on the
+    /// camera's first converged reference, flat over the image, held for every frame).
+    #[arg(long, default_value = "0", allow_hyphen_values = true)]
+    pub display_exposure: String,
     #[arg(long, default_value = "out/quality")]
     pub out: PathBuf,
     #[command(flatten)]
@@ -1340,6 +1454,7 @@ impl QualityCommand {
             profile,
             blur_sigma,
             blur_space,
+            display_exposure,
             out,
             look,
             latency,
@@ -1396,6 +1511,7 @@ impl QualityCommand {
             stereo_noises: &stereo_noises,
             camera: &look.camera()?,
             references: references.as_deref(),
+            display_exposure: DisplayExposure::parse(&display_exposure)?,
             out: &out,
             device: device.device.as_deref(),
             validation: device.validation,

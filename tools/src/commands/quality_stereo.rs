@@ -56,6 +56,8 @@ impl EyeFiles {
 /// the left (one for a still camera).
 pub(super) struct StereoReferences {
     pub right: Vec<Vec<[f32; 4]>>,
+    /// The display exposure both eyes' frames and references are judged at.
+    pub exposure: f32,
     warps: Vec<Warp>,
     width: u32,
     height: u32,
@@ -68,6 +70,7 @@ impl StereoReferences {
         rig: &EyeRig,
         heads: &[CameraPose],
         right: Vec<Vec<[f32; 4]>>,
+        exposure: f32,
     ) -> StereoReferences {
         // The binned builder: the measure needs correct hits, not the GPU's traversal speed.
         let bvh = SceneBvh::build(scene, BvhBuilder::BINNED);
@@ -80,6 +83,7 @@ impl StereoReferences {
             .collect();
         StereoReferences {
             right,
+            exposure,
             warps,
             width: rig.width,
             height: rig.height,
@@ -178,8 +182,8 @@ pub(super) fn measure(
         }
         let left = read_png(&dir.join(format!("frame_{f:04}_left.png")), width, height)?;
         let right = read_png(&dir.join(format!("frame_{f:04}_right.png")), width, height)?;
-        let reference_left = tonemap_preview(&left_references[i], 1.0, ToneCurve::Aces);
-        let reference_right = tonemap_preview(&stereo.right[i], 1.0, ToneCurve::Aces);
+        let reference_left = tonemap_preview(&left_references[i], stereo.exposure, ToneCurve::Aces);
+        let reference_right = tonemap_preview(&stereo.right[i], stereo.exposure, ToneCurve::Aces);
         let warp = stereo.warp(i);
         write_png(
             &dir.join(format!("binocular_{f:04}.png")),

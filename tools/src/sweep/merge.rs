@@ -131,14 +131,19 @@ fn check_one_device(sweep: &Sweep) -> Result<()> {
 fn merge_quality(sweep: &Sweep, study: u32, q: &quality::QualityArgs, out: &Path) -> Result<()> {
     let prepared = quality::prepare(q)?;
     for camera in q.cameras {
+        let mut images = Vec::new();
         for &eye in quality::reference_eyes(q) {
             let key = eye_key(q, eye);
+            let mut eye_images = Vec::new();
             for frame in quality::reference_frames(camera, &prepared.evaluated) {
                 let image = reference_of(sweep, study, Some(camera), Some(frame), key.as_deref())?
                     .mean()?;
                 quality::write_reference(out, q, camera, eye, frame, &image)?;
+                eye_images.push(image);
             }
+            images.push(eye_images);
         }
+        quality::write_displayed_references(out, q, camera, &prepared.evaluated, &images)?;
     }
     let mut outcomes = Vec::new();
     for job in sweep.jobs.iter().filter(|j| j.study == study) {
