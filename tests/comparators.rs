@@ -126,7 +126,7 @@ fn linear_falloff_refuses_the_filters_and_the_cli_reports_it() {
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(falloff()));
     assert_clean(&ctx);
 
-    let report = fovea_tests::render_report("linear-falloff", Default::default());
+    let report = fovea_tests::render_report("linear-falloff", fovea_tests::profile_with_blur());
     assert_eq!(report["method"], "linear-falloff");
     assert!(
         report["passes"]["fill_push"].as_f64().is_some()
@@ -347,7 +347,7 @@ fn random_acuity_traces_visual_polars_count_and_converges_like_one_sample_per_pi
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(host));
     assert_clean(&ctx);
 
-    let report = fovea_tests::render_report("random-acuity", Default::default());
+    let report = fovea_tests::render_report("random-acuity", fovea_tests::profile_with_blur());
     assert_eq!(report["method"], "random-acuity");
     for pass in ["splat_scatter", "splat_resolve", "fill_push", "blur_v"] {
         assert!(
@@ -526,7 +526,7 @@ fn vrs_tiles_trace_the_rust_rules_pixels_and_converge_like_one_sample_per_pixel(
     fovea_tests::assert_refuses_svgf(&ctx, &scene, Box::new(tiles(SCREEN.as_vec2() * 0.5)));
     assert_clean(&ctx);
 
-    let report = fovea_tests::render_report("vrs-tiles", Default::default());
+    let report = fovea_tests::render_report("vrs-tiles", fovea_tests::profile_with_blur());
     assert_eq!(report["method"], "vrs-tiles");
     assert!(
         report["passes"]["splat_scatter"].as_f64().is_some()

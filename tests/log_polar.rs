@@ -88,7 +88,7 @@ fn log_polar_traces_exactly_its_buffer() {
 fn render_command_runs_log_polar_and_reports_it() {
     let out = fovea_tests::artifacts_dir().join(format!("log-polar-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let profile = RenderProfile::default()
+    let profile = fovea_tests::profile_with_blur()
         .override_with(&ProfileOverrides {
             log_polar_extent: Some("diagonal".into()),
             ..Default::default()

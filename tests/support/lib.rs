@@ -374,6 +374,14 @@ pub fn probe(
 }
 
 /// `fovea render --method METHOD` of the Cornell box at 64×72 (`small_render_args` otherwise,
+/// The default render profile with the paper's foveated blur on (σ 6.8 px at 30° for the FOVE 0
+/// eye; the product default is off), for tests of the way back's blur passes.
+pub fn profile_with_blur() -> fovea_tools::render_profile::RenderProfile {
+    let mut profile = fovea_tools::render_profile::RenderProfile::default();
+    profile.blur.sigma_at_30 = fovea_renderer::way_back::blur::FOVE_SIGMA_AT_30;
+    profile
+}
+
 /// with `profile`): its report.json (the output folder is removed).
 pub fn render_report(
     method: &str,

@@ -68,6 +68,13 @@ pub struct RenderProfile {
 /// (docs/perceptual.md). The renderer's own default stays the paper's.
 pub const DEFAULT_VP_LAYOUT: VpLayout = VpLayout::ScreenClipped;
 
+/// The foveated blur's σ at 30° in the product's default profile: off. Koskela et al.'s 6.8 px
+/// (the renderer's own default) lowered the perceived quality of every foveated method in every
+/// run scored (FovVideoVDP at the FOVE 0's resolution, still camera: 0.7–1.0 JOD; moving camera:
+/// 0.7 JOD), and the blurred periphery flickered more, not less, under a moving camera
+/// (docs/perceptual.md). `--blur-sigma` / `[blur] sigma_at_30` turn it on.
+pub const DEFAULT_BLUR_SIGMA_AT_30: f32 = 0.0;
+
 impl Default for RenderProfile {
     fn default() -> Self {
         RenderProfile {
@@ -79,7 +86,10 @@ impl Default for RenderProfile {
             composite_mode: Default::default(),
             composite_sigma: None,
             eccentricity: Default::default(),
-            blur: Default::default(),
+            blur: BlurSettings {
+                sigma_at_30: DEFAULT_BLUR_SIGMA_AT_30,
+                ..Default::default()
+            },
             denoisers: Default::default(),
             taa: Default::default(),
             environment: Default::default(),
@@ -822,7 +832,7 @@ mod tests {
         assert_eq!(p.visual_polar.radius_mode, RadiusMode::FarthestCorner);
         assert_eq!(p.visual_polar.layout, DEFAULT_VP_LAYOUT);
         assert_eq!(p.eccentricity, EccentricityMode::Normalized);
-        assert_eq!(p.blur.sigma_at_30, 6.8);
+        assert_eq!(p.blur.sigma_at_30, DEFAULT_BLUR_SIGMA_AT_30);
         assert_eq!(p.denoisers, DenoiserProfile::default());
         assert_eq!(p.taa, TaaSettings::default());
         assert_eq!(p.texture_lod, TextureLod::RayCones);

@@ -1,8 +1,9 @@
 //! A program embedding fovea with its libraries alone (no command line crate): a scene lit and
 //! framed as `fovea render` sees it, both eyes of the FOVE 0 through their own frusta, the
 //! simulated eye tracker timed to the frames, Visual-Polar sampling around each eye's gaze in the
-//! screen-clipped layout with BMFR and TAA in the grid, automatic exposure, and the last frame's
-//! left and right eyes written side by side as a PNG.
+//! screen-clipped layout with BMFR and TAA in the grid, no foveated blur, automatic exposure (the
+//! settings of `fovea render`'s default profile), and the last frame's left and right eyes
+//! written side by side as a PNG.
 //!
 //! ```text
 //! cargo run --release -p fovea-stage --example render_frame -- [SCENE] [OUT.png]
@@ -19,6 +20,7 @@ use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{SamplingSpace, VisualPolar, VisualPolarParams, VpLayout};
 use fovea_renderer::vk::{Context, ContextOptions};
+use fovea_renderer::way_back::blur::BlurSettings;
 use fovea_stage::gaze::GazeDriver;
 use fovea_stage::look::{CameraOptions, EnvironmentOptions};
 use fovea_stage::projection::EyeRig;
@@ -86,6 +88,11 @@ pub fn render(options: &Options) -> Result<Rendered> {
         exposure: Exposure::auto(),
         denoiser: DenoiserSettings::Bmfr(BmfrSettings::default()),
         taa: TaaMode::SamplingGrid(TaaSettings::default()),
+        // The renderer's default is the paper's blur; fovea's profile turns it off.
+        blur: BlurSettings {
+            sigma_at_30: 0.0,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let gpu_scene = fovea_renderer::gpu_scene::GpuScene::upload(&ctx, &scene)?;

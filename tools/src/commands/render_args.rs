@@ -191,7 +191,8 @@ pub struct RenderOpts {
     /// (default composite).
     #[arg(long)]
     pub composite_mode: Option<String>,
-    /// Foveated blur σ in pixels at 30° for a 1280×1440 eye (scaled with resolution; 0 = off).
+    /// Foveated blur σ in pixels at 30° for a 1280×1440 eye, scaled with resolution (default 0:
+    /// off, the perceptual evaluation's choice; Koskela et al.'s is 6.8).
     #[arg(long)]
     pub blur_sigma: Option<f32>,
     /// Where the foveated blur runs: screen (after the remap, the paper's) | grid (in the VP grid
