@@ -500,12 +500,10 @@ pub struct RenderCommand {
 impl RenderCommand {
     pub fn run(self) -> Result<()> {
         self.device.choose_traversal()?;
-        let profile = self.opts.profile()?;
         let camera = self.opts.look.camera()?;
         let mut args = self.opts.args(
             &camera,
             &self.device,
-            &profile,
             RenderDefaults {
                 frames: DEFAULT_RENDER_FRAMES,
                 gaze: "sim:1",
@@ -525,7 +523,6 @@ impl RenderOpts {
         &'a self,
         camera: &'a fovea_stage::look::CameraOptions,
         device: &'a DeviceArgs,
-        profile: &RenderProfile,
         defaults: RenderDefaults,
     ) -> Result<RenderArgs<'a>> {
         Ok(RenderArgs {
@@ -550,7 +547,7 @@ impl RenderOpts {
             exposure: super::setup::parse_exposure(&self.exposure)?,
             tone: super::setup::parse_tone(&self.tone)?,
             overview: false,
-            profile: profile.clone(),
+            profile: self.profile()?,
             debug_views: self.debug_views,
             denoiser: &self.denoiser,
             taa: &self.taa,

@@ -643,12 +643,10 @@ impl ReplayCommand {
             device,
         } = self;
         device.choose_traversal()?;
-        let profile = opts.profile()?;
         let camera = opts.look.camera()?;
         let mut render = opts.args(
             &camera,
             &device,
-            &profile,
             RenderDefaults {
                 frames: DEFAULT_FRAMES,
                 gaze: "center",

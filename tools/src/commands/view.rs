@@ -838,13 +838,11 @@ pub struct ViewCommand {
 impl ViewCommand {
     pub fn run(self) -> Result<()> {
         self.device.choose_traversal()?;
-        let profile = self.opts.profile()?;
         let camera = self.opts.look.camera()?;
         // Without --frames the run has no length: the camera path's period is a long one.
         let render = self.opts.args(
             &camera,
             &self.device,
-            &profile,
             RenderDefaults {
                 frames: u32::MAX,
                 gaze: "center",

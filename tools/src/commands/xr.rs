@@ -692,7 +692,7 @@ mod placement_tests {
 pub struct XrCommand {
     #[command(flatten)]
     pub opts: Box<RenderOpts>,
-    /// Write the gaze that drove the session as a trace (a new file), replayable with
+    /// Write the gaze that drove the OpenXR session as a trace (a new file), replayable with
     /// `fovea render --headset <same> --gaze TRACE.csv`.
     #[arg(long)]
     pub record: Option<PathBuf>,
@@ -704,7 +704,7 @@ pub struct XrCommand {
     #[arg(long)]
     pub force: bool,
     /// The runtime space the scene camera stands in: local (the default: where the head was
-    /// when the session started) or stage (the play area's floor is the scene's y = 0).
+    /// when the OpenXR session started) or stage (the play area's floor is the scene's y = 0).
     #[arg(long, default_value = "local")]
     pub reference_space: String,
     #[command(flatten)]
@@ -714,13 +714,12 @@ pub struct XrCommand {
 impl XrCommand {
     pub fn run(self) -> Result<()> {
         self.device.choose_traversal()?;
-        let profile = self.opts.profile()?;
         let camera = self.opts.look.camera()?;
-        // The `frames` of RenderArgs is unused: xr ends on --frames rendered frames or the session.
+        // The `frames` of RenderArgs is unused: xr ends after --frames rendered frames or when the
+        // OpenXR session ends.
         let render = self.opts.args(
             &camera,
             &self.device,
-            &profile,
             RenderDefaults {
                 frames: u32::MAX,
                 gaze: "center",
