@@ -10,7 +10,7 @@
 use super::flags::{DeviceArgs, LatencyFlags, SceneFlags};
 use super::quality_stereo::{self, BinocularQuality, EyeFiles, StereoReferences};
 use super::render::{self, RenderArgs};
-use super::setup::Eyes;
+use super::setup::{Eyes, EXPOSURE_STOPS};
 use crate::eval::flip::flip_map;
 use crate::eval::metrics::{
     add_flip, evaluate, flicker_map, mean as metrics_mean, Evaluation, Rings,
@@ -89,8 +89,12 @@ impl DisplayExposure {
             return Ok(DisplayExposure::Metered);
         }
         match text.parse::<f32>() {
-            Ok(ev) if ev.is_finite() && ev.abs() <= 13.0 => Ok(DisplayExposure::Stops(ev)),
-            _ => bail!("--display-exposure {text}: expected metered or stops in [-13, 13]"),
+            Ok(ev) if ev.is_finite() && ev.abs() <= EXPOSURE_STOPS => {
+                Ok(DisplayExposure::Stops(ev))
+            }
+            _ => bail!(
+                "--display-exposure {text}: expected metered or stops within ±{EXPOSURE_STOPS}"
+            ),
         }
     }
 
