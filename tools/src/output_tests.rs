@@ -1,19 +1,11 @@
 use super::*;
+use fovea_test_kit::file_names as names;
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fovea-output-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn names(d: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 fn mkfifo(path: &Path) {

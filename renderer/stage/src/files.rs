@@ -154,15 +154,7 @@ pub fn check_regular_input(path: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn names(d: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(d)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
+    use fovea_test_kit::file_names as names;
 
     #[test]
     fn a_failed_write_keeps_the_old_file_and_leaves_no_temporary() {
