@@ -1,4 +1,5 @@
-//! ReSTIR DI (`--resampling di`, docs/design/resampling.md) against answers known in advance: the
+//! ReSTIR DI and GI (`--resampling di`, `di+gi`; docs/design/resampling.md) against answers
+//! known in advance: the
 //! furnace's geometric series and the Cornell box's converged reference (the mean of many
 //! real-time frames of a still camera), a lower error than next-event estimation alone at one
 //! sample per texel around the gaze (Cartesian and Visual-Polar), references that resampling
@@ -72,7 +73,11 @@ fn furnace_converges_with_resampling() {
     let size = 64;
     let pose = CameraPose::from_scene_camera(&scene.cameras[0], size, size);
     let expected = 1.75;
-    for mode in [ResamplingMode::Off, ResamplingMode::Di] {
+    for mode in [
+        ResamplingMode::Off,
+        ResamplingMode::Di,
+        ResamplingMode::DiGi,
+    ] {
         let space = Box::new(Cartesian::new(UVec2::splat(size)));
         let mut r = renderer(&ctx, &scene, space, mode);
         let mean = mean_over_frames(&mut r, pose, None, 64, |_, _| {});
@@ -142,6 +147,7 @@ fn cornell_box_converges_to_the_reference() {
     for (mode, whole_bound, block_bound) in [
         (ResamplingMode::Off, 0.01, 0.03),
         (ResamplingMode::Di, 0.01, 0.06),
+        (ResamplingMode::DiGi, 0.01, 0.06),
     ] {
         let mut r = renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode);
         let mean = mean_image(&mut r, pose, FRAMES);
@@ -205,9 +211,10 @@ fn error_around(frame: &[[f32; 4]], reference: &[[f32; 4]], gaze: Vec2, radius: 
 /// against the converged image (frames 4–11, each measured, averaged) falls below next-event
 /// estimation's, in Cartesian and in Visual-Polar space: for the direct light alone (max depth
 /// 2, the light it resamples) to under half, and with the real-time path's bounce (depth 3,
-/// whose indirect light it leaves as it is) clearly.
+/// whose indirect light `di` leaves as it is) clearly, and with `di+gi` again below `di`.
 #[test]
 fn resampling_lowers_the_error_at_one_sample() {
+    const GI_RMSE_BOUND: f64 = 0.8;
     let ctx = gpu();
     let (scene, pose) = cornell();
     // Off the centre, on the back wall and the tall box.
@@ -231,7 +238,15 @@ fn resampling_lowers_the_error_at_one_sample() {
         .unwrap();
         for (name, make) in spaces {
             let mut errors = Vec::new();
-            for mode in [ResamplingMode::Off, ResamplingMode::Di] {
+            let modes: &[ResamplingMode] = match max_depth {
+                2 => &[ResamplingMode::Off, ResamplingMode::Di],
+                _ => &[
+                    ResamplingMode::Off,
+                    ResamplingMode::Di,
+                    ResamplingMode::DiGi,
+                ],
+            };
+            for &mode in modes {
                 let settings = RenderSettings {
                     max_depth,
                     ..settings(mode)
@@ -265,6 +280,17 @@ fn resampling_lowers_the_error_at_one_sample() {
                 off.0,
                 off.1
             );
+            // The bounce resampled too: the rest of the real-time path's noise falls.
+            if let Some(gi) = errors.get(2) {
+                assert!(
+                    gi.0 < GI_RMSE_BOUND * di.0 && gi.1 < di.1,
+                    "{name}, max depth {max_depth}: resampling di+gi RMSE {:.4} / FLIP {:.4} vs di {:.4} / {:.4}",
+                    gi.0,
+                    gi.1,
+                    di.0,
+                    di.1
+                );
+            }
         }
     }
     assert_clean(&ctx);
@@ -276,22 +302,26 @@ fn resampling_lowers_the_error_at_one_sample() {
 fn references_ignore_resampling() {
     let ctx = gpu();
     let (scene, pose) = cornell();
-    let images: Vec<Vec<[f32; 4]>> = [ResamplingMode::Off, ResamplingMode::Di]
-        .into_iter()
-        .map(|mode| {
-            renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode)
-                .render_reference(&pose, 4, 3, |_| {})
-                .unwrap()
-        })
-        .collect();
+    let images: Vec<Vec<[f32; 4]>> = [
+        ResamplingMode::Off,
+        ResamplingMode::Di,
+        ResamplingMode::DiGi,
+    ]
+    .into_iter()
+    .map(|mode| {
+        renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode)
+            .render_reference(&pose, 4, 3, |_| {})
+            .unwrap()
+    })
+    .collect();
     assert!(
-        images[0] == images[1],
+        images[0] == images[1] && images[0] == images[2],
         "a reference changed with resampling"
     );
     assert_clean(&ctx);
 }
 
-/// Each eye keeps its own reservoirs: the left eye of a stereo renderer draws exactly the frames
+/// Each eye keeps its own reservoirs (DI's and GI's): the left eye of a stereo renderer draws exactly the frames
 /// of a mono renderer (its seed is the mono one's), whatever the right eye sees, also with a
 /// denoiser after the resampling.
 #[test]
@@ -300,7 +330,7 @@ fn each_eye_resamples_on_its_own() {
     let (scene, pose) = cornell();
     let settings = RenderSettings {
         denoiser: DenoiserSettings::parse("svgf").unwrap(),
-        ..settings(ResamplingMode::Di)
+        ..settings(ResamplingMode::DiGi)
     };
     let vp = |gaze: Vec2| -> Box<dyn SamplingSpace> {
         Box::new(VisualPolar::new(SIZE, gaze, VisualPolarParams::default()).unwrap())

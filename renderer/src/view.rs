@@ -173,7 +173,8 @@ impl View {
                 &format!("{}_gradients", space.trace_variant()),
             )?),
         };
-        let resampled = settings.resampling.mode == ResamplingMode::Di;
+        let resampled = settings.resampling.mode != ResamplingMode::Off;
+        let resampled_gi = settings.resampling.mode.resamples_gi();
         if resampled && gradients {
             // A-SVGF re-shades last frame's paths to measure how the light changed; the
             // resampled paths' direct light comes from reservoirs the re-shading cannot replay.
@@ -188,12 +189,16 @@ impl View {
             true => Some(Resampling::new(ctx, space.as_ref(), settings.resampling)?),
             false => None,
         };
-        let trace_resampled = match resampled {
-            true => Some(TracePass::new(
+        let trace_resampled = match (resampled, resampled_gi) {
+            (true, false) => Some(TracePass::new(
                 ctx,
                 &format!("{}_resampled", space.trace_variant()),
             )?),
-            false => None,
+            (true, true) => Some(TracePass::new(
+                ctx,
+                &format!("{}_resampled_gi", space.trace_variant()),
+            )?),
+            (false, _) => None,
         };
         let mut gbuffer = if gradients {
             GBuffer::with_visibility(ctx, grid)?
@@ -202,6 +207,9 @@ impl View {
         };
         if resampled {
             gbuffer.add_primary_hit(ctx)?;
+        }
+        if resampled_gi {
+            gbuffer.add_gi_samples(ctx)?;
         }
         let taa = match grid_taa {
             Some(s) => Some(Taa::new(ctx, grid, space.shader_variant(), s)?),
@@ -255,7 +263,7 @@ impl View {
         // 26: the idle tiles' clear is one of them.
         26 + extra_samples
             + self.denoiser.as_ref().map_or(0, |d| d.max_passes())
-            + self.resampling.as_ref().map_or(0, |_| Resampling::PASSES)
+            + self.resampling.as_ref().map_or(0, |r| r.passes())
             + self.back.extra_passes()
     }
 

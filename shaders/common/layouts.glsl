@@ -408,6 +408,9 @@ struct AsvgfGradientPush {
 // paths' streams use sample indices): candidate generation, and the reuse decisions.
 const uint RESAMPLING_SALT_CANDIDATES = 0x72697363u;
 const uint RESAMPLING_SALT_REUSE = 0x72657573u;
+// ReSTIR GI's passes: the temporal decision, and the spatial pass's neighbours and decisions.
+const uint RESAMPLING_SALT_GI_TEMPORAL = 0x67697465u;
+const uint RESAMPLING_SALT_GI_REUSE = 0x67697275u;
 // Most grid neighbours the spatial pass combines per sample (it keeps their taps for the
 // normalisation).
 const uint RESAMPLING_MAX_NEIGHBOURS = 16u;
@@ -425,13 +428,35 @@ struct ReservoirGpu {
     vec4 position;              // xyz the owner's shading point (world space; W is for its visibility), w unused
 };
 
+// The bounce the tracer's `*_resampled_gi` kernel traced from a primary hit (ReSTIR GI's initial
+// sample): the secondary hit and the radiance the rest of the path gathered there.
+struct GiSampleGpu {
+    vec4 point;                 // xyz the secondary hit (world space), w the bounce direction's solid-angle density at
+                                //   the primary hit (0: no sample: the bounce escaped, was a mirror's or ended)
+    vec4 normal;                // xyz the secondary hit's geometric normal, facing the primary hit; w unused
+    vec4 radiance;              // rgb radiance leaving the secondary hit toward the primary hit (its emission excluded:
+                                //   next-event estimation at the primary hit counts that), a unused
+};
+
+// One texel's ReSTIR GI reservoir: the chosen secondary hit with its radiance, its weights and the
+// surface (primary hit) it belongs to. Reused at another primary hit by reconnection: the
+// secondary hit stays, the direction to it changes (a Jacobian converts the densities).
+struct GiReservoirGpu {
+    vec4 point;                 // xyz the chosen secondary hit (world space), w W (unbiased contribution weight, per
+                                //   solid angle at the owner)
+    vec4 normal;                // xyz its geometric normal, w M (candidates it stands for)
+    vec4 radiance;              // rgb its outgoing radiance, a p̂ of the sample at the owner's surface (0: empty)
+    uvec4 surface;              // the owner's surface (denoise/svgf.glsl svgf_pack_surface; key 0: no sample)
+    vec4 position;              // xyz the owner's shading point (world space), w unused
+};
+
 // Push constants of the first resampling pass (initial candidates, visibility, temporal reuse),
 // 128 bytes like SvgfTemporalPush.
 struct ResampleTemporalPush {
     SamplingParams space;       // this frame's space
     SamplingFrame prev;         // the previous frame's (its grid = space.grid)
-    vec4 params;                // x light candidates per texel, y M cap of the previous reservoir (× this frame's
-                                //   candidates), z 1 = no usable history, w unused
+    vec4 params;                // x light candidates per texel (ReSTIR GI: 1, the traced bounce), y M cap of the
+                                //   previous reservoir (× this frame's candidates), z 1 = no usable history, w unused
 };
 
 // Push constants of the second resampling pass (spatial reuse and the final shading).

@@ -8,6 +8,15 @@
 uint shadow_rays = 0u;
 uint continuation_rays = 0u;
 
+#if defined(RESAMPLED_GI)
+// ReSTIR GI's initial sample (GiSampleGpu), which shade_path fills instead of adding the bounce's
+// light: the secondary hit, its normal facing the primary hit, the bounce's density (0: none) and
+// the radiance the rest of the path gathered there.
+vec4 gi_point = vec4(0.0);
+vec3 gi_normal = vec3(0.0);
+vec3 gi_radiance = vec3(0.0);
+#endif
+
 bool visible(vec3 p, vec3 n, LightSample ls) {
     Hit h;
     shadow_rays++;
@@ -48,6 +57,10 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
     vec3 v = -dir;
     Hit hit;
     float min_pdf = 1e30;   // smallest bounce density so far (regularise)
+#if defined(RESAMPLED_GI)
+    // The colour gathered before the bounce's secondary hit; -1: the path was not split there.
+    vec3 before_bounce = vec3(-1.0);
+#endif
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
 #if defined(RESAMPLED_DI)
         // The primary hit's direct light is the resampling passes' (shaders/passes/resample_*).
@@ -82,8 +95,27 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         regularise(s, min_pdf, frame.data.path.x);
         // A mirror bounce cannot be found by next-event estimation: count what it sees.
         if (delta) color += throughput * s.emission;
+#if defined(RESAMPLED_GI)
+        // A non-mirror bounce from the primary hit is ReSTIR GI's sample: what the path gathers
+        // from here on is the radiance leaving the secondary hit toward the primary one (the
+        // resampling passes weigh it by the primary hit's BRDF). Escaping rays and mirror
+        // bounces stay the path's (the environment keeps its MIS share with next-event estimation).
+        if (depth_i == 1u && !delta) {
+            before_bounce = color;
+            throughput = vec3(1.0);
+            gi_point = vec4(s.position, pdf);
+            gi_normal = s.geometric_normal;
+        }
+#endif
         v = -l;
     }
+#if defined(RESAMPLED_GI)
+    if (before_bounce.x >= 0.0) {
+        gi_radiance = color - before_bounce;
+        if (any(isnan(gi_radiance)) || any(isinf(gi_radiance))) gi_point.w = 0.0;
+        return before_bounce;
+    }
+#endif
     return color;
 }
 

@@ -8,11 +8,14 @@
 // next projection reads. Plain rendering keeps the variants without them and pays nothing.
 // The *_resampled variants (RESAMPLED_DI) leave the primary hit's next-event estimation to the
 // resampling passes (ReSTIR DI, docs/design/resampling.md) and write the primary hit's
-// barycentrics and ray-cone width, from which those passes re-fetch the surface.
+// barycentrics and ray-cone width, from which those passes re-fetch the surface. The
+// *_resampled_gi variants (RESAMPLED_GI too) also leave the primary hit's bounce to them (ReSTIR
+// GI): they write the bounce's secondary hit and the radiance gathered there instead of adding it.
 // Its variants are the sampling spaces of shaders/sampling/trace_spaces.txt.
 //! variants per trace space
 //! variants per gradient trace space _gradients: TRACE_GRADIENTS
 //! variants per resampling trace space _resampled: RESAMPLED_DI
+//! variants per resampling trace space _resampled_gi: RESAMPLED_DI RESAMPLED_GI
 //! traversals
 
 #include "../common/scene.glsl"
@@ -53,6 +56,9 @@ layout(set = 0, binding = 23, rgba32f) uniform writeonly image2D out_gradient;  
 #endif
 #if defined(RESAMPLED_DI)
 layout(set = 0, binding = 21, rgba32f) uniform writeonly image2D out_primary_hit;  // barycentrics u, v, ray-cone width, 0
+#endif
+#if defined(RESAMPLED_GI)
+layout(std430, set = 0, binding = 22) writeonly buffer OutGiSamples { GiSampleGpu data[]; } out_gi_samples;
 #endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
@@ -140,6 +146,9 @@ void main() {
 #if defined(RESAMPLED_DI)
         imageStore(out_primary_hit, texel, vec4(0.0));
 #endif
+#if defined(RESAMPLED_GI)
+        out_gi_samples.data[uint(texel.y) * sampling.data.grid.x + uint(texel.x)] = GiSampleGpu(vec4(0.0), vec4(0.0), vec4(0.0));
+#endif
         return;
     }
     if (any(lessThan(screen, vec2(0.0))) || any(greaterThanEqual(screen, frame.data.screen.xy))) atomicAdd(ray_counters.data[3], 1u);
@@ -217,6 +226,9 @@ void main() {
     }
 #if defined(RESAMPLED_DI)
     imageStore(out_primary_hit, texel, primary_hit);
+#endif
+#if defined(RESAMPLED_GI)
+    out_gi_samples.data[uint(texel.y) * sampling.data.grid.x + uint(texel.x)] = GiSampleGpu(gi_point, vec4(gi_normal, 0.0), vec4(gi_radiance, 0.0));
 #endif
     atomicAdd(ray_counters.data[0], 1u);
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);

@@ -36,6 +36,10 @@ pub struct GBuffer {
     /// variants): the primary hit's barycentrics (x, y) and ray-cone width (z), from which the
     /// resampling passes re-fetch the surface the tracer shaded.
     pub primary_hit: Option<Image>,
+    /// Only for ReSTIR GI (`GBuffer::add_gi_samples`; written by the `*_resampled_gi` kernel
+    /// variants): per texel the bounce's secondary hit and the radiance gathered there
+    /// (`GiSampleGpu`), which the tracer leaves out of `color`.
+    pub gi_samples: Option<Buffer>,
 }
 
 impl GBuffer {
@@ -52,6 +56,7 @@ impl GBuffer {
             motion: image("gbuffer.motion", vk::Format::R32G32_SFLOAT)?,
             visibility: None,
             primary_hit: None,
+            gi_samples: None,
         })
     }
 
@@ -76,6 +81,21 @@ impl GBuffer {
             self.size.x,
             self.size.y,
             vk::Format::R32G32B32A32_SFLOAT,
+        )?);
+        Ok(())
+    }
+
+    /// Adds the bounce samples ReSTIR GI's passes read.
+    pub fn add_gi_samples(&mut self, ctx: &Arc<Context>) -> Result<()> {
+        let bytes = self.size.x as u64
+            * self.size.y as u64
+            * std::mem::size_of::<crate::layouts::GiSampleGpu>() as u64;
+        self.gi_samples = Some(Buffer::new(
+            ctx,
+            "gbuffer.gi_samples",
+            bytes,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            gpu_allocator::MemoryLocation::GpuOnly,
         )?);
         Ok(())
     }

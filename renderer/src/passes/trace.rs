@@ -1,6 +1,7 @@
 //! The path-tracing pass: one sample per sampling-grid texel, writing the per-sample G-buffer.
 //! Its `*_gradients` kernel variants also re-shade A-SVGF's gradient samples (denoise/asvgf), its
-//! `*_resampled` variants leave the primary hit's direct light to the resampling passes.
+//! `*_resampled` variants leave the primary hit's direct light to the resampling passes, its
+//! `*_resampled_gi` variants its bounce too.
 
 use super::grid::{GradientTargets, GridFrame};
 use super::trace_clear::TraceClearPass;
@@ -78,10 +79,16 @@ impl TracePass {
             .primary_hit
             .as_ref()
             .map(|h| write_image("out_primary_hit", h));
-        let (extra, extra_count) = match (gradient_binds, primary_hit) {
-            (Some(g), _) => (g, 3),
-            (None, Some(h)) => ([h, s.bvh_nodes, s.bvh_nodes], 1),
-            (None, None) => ([s.bvh_nodes; 3], 0),
+        // The `*_resampled_gi` variants also write the bounce's sample (ReSTIR GI).
+        let gi_samples = out
+            .gi_samples
+            .as_ref()
+            .map(|b| write_buffer("out_gi_samples", b));
+        let (extra, extra_count) = match (gradient_binds, primary_hit, gi_samples) {
+            (Some(g), _, _) => (g, 3),
+            (None, Some(h), Some(gi)) => ([h, gi, s.bvh_nodes], 2),
+            (None, Some(h), None) => ([h, s.bvh_nodes, s.bvh_nodes], 1),
+            (None, None, _) => ([s.bvh_nodes; 3], 0),
         };
         let g = out.write_binds();
         let binds = scene_then!(s;

@@ -3,15 +3,20 @@
 //! the primary hit's next-event estimation out and writes the primary hit's barycentrics; two
 //! passes in the sampling grid then draw light candidates per sample, reuse the previous frame's
 //! reservoir and the neighbours' (`temporal`, `spatial`) and add the chosen sample's direct light
-//! to the G-buffer's colour and radiance before any denoiser runs. Per view: the reservoirs are
-//! history, like a denoiser's.
+//! to the G-buffer's colour and radiance before any denoiser runs. With `di+gi` the tracer's
+//! `*_resampled_gi` variant also leaves the primary hit's bounce out and writes its secondary hit
+//! and the radiance gathered there; two more passes (`gi_temporal`, `gi_spatial`; Ouyang et al.
+//! 2021, ReSTIR GI) reuse those between frames and neighbours by reconnection. Per view: the
+//! reservoirs are history, like a denoiser's.
 
+mod gi_spatial;
+mod gi_temporal;
 mod reservoirs;
 mod settings;
 mod spatial;
 mod temporal;
 
-pub use reservoirs::Reservoirs;
+pub use reservoirs::{GiReservoirs, Reservoirs};
 pub use settings::{
     ResamplingMode, ResamplingSettings, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_TEMPORAL_CAP,
     RADIUS_RANGE,
@@ -20,7 +25,7 @@ pub use settings::{
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::graph::FrameRecorder;
-use crate::layouts::ReservoirGpu;
+use crate::layouts::{GiReservoirGpu, ReservoirGpu};
 use crate::passes::grid::GridFrame;
 use crate::passes::Pass;
 use crate::sampling::SamplingSpace;
@@ -29,13 +34,21 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
 
-/// A view's resampling: its two passes, its reservoirs and how many frames they hold.
+/// A view's resampling: its passes, its reservoirs and how many frames they hold.
 pub struct Resampling {
     pub settings: ResamplingSettings,
     temporal: Pass<temporal::Temporal>,
     spatial: Pass<spatial::Spatial>,
     reservoirs: Reservoirs,
+    gi: Option<GiResampling>,
     frames: u64,
+}
+
+/// ReSTIR GI's two passes and reservoirs (`di+gi`).
+struct GiResampling {
+    temporal: Pass<gi_temporal::GiTemporal>,
+    spatial: Pass<gi_spatial::GiSpatial>,
+    reservoirs: GiReservoirs,
 }
 
 impl Resampling {
@@ -57,38 +70,62 @@ impl Resampling {
             )));
         }
         let grid = space.grid_size();
-        let bytes = grid.x as u64 * grid.y as u64 * std::mem::size_of::<ReservoirGpu>() as u64;
-        let buffer = |name: &str| {
+        let texels = grid.x as u64 * grid.y as u64;
+        let buffer = |name: &str, texel_bytes: usize| {
             Buffer::new(
                 ctx,
                 name,
-                bytes,
+                texels * texel_bytes as u64,
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::GpuOnly,
             )
         };
         let variant = space.shader_variant();
+        let reservoir = std::mem::size_of::<ReservoirGpu>();
+        let gi_reservoir = std::mem::size_of::<GiReservoirGpu>();
+        let gi = match settings.mode.resamples_gi() {
+            true => Some(GiResampling {
+                temporal: Pass::new(ctx, variant)?,
+                spatial: Pass::new(ctx, variant)?,
+                reservoirs: GiReservoirs {
+                    history: buffer("resampling.gi_history", gi_reservoir)?,
+                    fresh: buffer("resampling.gi_fresh", gi_reservoir)?,
+                },
+            }),
+            false => None,
+        };
         Ok(Resampling {
             settings,
             temporal: Pass::new(ctx, variant)?,
             spatial: Pass::new(ctx, variant)?,
             reservoirs: Reservoirs {
-                history: buffer("resampling.history")?,
-                fresh: buffer("resampling.fresh")?,
+                history: buffer("resampling.history", reservoir)?,
+                fresh: buffer("resampling.fresh", reservoir)?,
             },
+            gi,
             frames: 0,
         })
     }
 
-    /// GPU bytes carried between frames (and the first pass's output).
+    /// GPU bytes carried between frames (and the first passes' output).
     pub fn history_bytes(&self) -> u64 {
-        self.reservoirs.history.size + self.reservoirs.fresh.size
+        let gi = self.gi.as_ref().map_or(0, |gi| {
+            gi.reservoirs.history.size + gi.reservoirs.fresh.size
+        });
+        self.reservoirs.history.size + self.reservoirs.fresh.size + gi
     }
 
     /// Passes one frame records.
-    pub const PASSES: u32 = 2;
+    pub fn passes(&self) -> u32 {
+        if self.gi.is_some() {
+            4
+        } else {
+            2
+        }
+    }
 
-    /// Records both passes after the trace (`*_resampled` variant) wrote `frame.gbuffer`; the
+    /// Records the passes after the trace (`*_resampled` or `*_resampled_gi` variant) wrote
+    /// `frame.gbuffer`; the
     /// first frame, and any frame without `frame.previous`, starts without history.
     pub fn record(
         &mut self,
@@ -111,6 +148,20 @@ impl Resampling {
         )?;
         self.spatial
             .record(rec, frame, shared, &self.reservoirs, &self.settings)?;
+        if let Some(gi) = &self.gi {
+            let samples = frame.gbuffer.gi_samples.as_ref().ok_or_else(|| {
+                Error::Invalid("ReSTIR GI needs the G-buffer's bounce samples".into())
+            })?;
+            gi.temporal.record(
+                rec,
+                frame,
+                shared,
+                (samples, &gi.reservoirs, fresh_start),
+                &self.settings,
+            )?;
+            gi.spatial
+                .record(rec, frame, shared, &gi.reservoirs, &self.settings)?;
+        }
         self.frames += 1;
         Ok(())
     }

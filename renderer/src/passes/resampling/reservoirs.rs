@@ -10,3 +10,9 @@ pub struct Reservoirs {
     pub history: Buffer,
     pub fresh: Buffer,
 }
+
+/// ReSTIR GI's reservoirs (`GiReservoirGpu` per grid texel), used as [`Reservoirs`]' are.
+pub struct GiReservoirs {
+    pub history: Buffer,
+    pub fresh: Buffer,
+}

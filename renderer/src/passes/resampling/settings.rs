@@ -12,16 +12,21 @@ pub enum ResamplingMode {
     /// ReSTIR DI at the primary hit: reservoirs of light samples reused over time and over grid
     /// neighbours (docs/design/resampling.md).
     Di,
+    /// ReSTIR DI and ReSTIR GI: the primary hit's bounce (its secondary hit and the radiance
+    /// gathered there) resampled too, reconnected between primary hits.
+    #[serde(rename = "di+gi")]
+    DiGi,
 }
 
 impl ResamplingMode {
     /// The names `parse` accepts.
-    pub const NAMES: &'static [&'static str] = &["off", "di"];
+    pub const NAMES: &'static [&'static str] = &["off", "di", "di+gi"];
 
     pub fn parse(name: &str) -> Result<ResamplingMode> {
         match name {
             "off" => Ok(ResamplingMode::Off),
             "di" => Ok(ResamplingMode::Di),
+            "di+gi" => Ok(ResamplingMode::DiGi),
             other => Err(Error::Invalid(format!(
                 "resampling '{other}': expected one of {}",
                 Self::NAMES.join(", ")
@@ -33,7 +38,13 @@ impl ResamplingMode {
         match self {
             ResamplingMode::Off => "off",
             ResamplingMode::Di => "di",
+            ResamplingMode::DiGi => "di+gi",
         }
+    }
+
+    /// Whether the primary hit's bounce is resampled too (ReSTIR GI).
+    pub fn resamples_gi(self) -> bool {
+        self == ResamplingMode::DiGi
     }
 }
 
@@ -46,9 +57,10 @@ pub struct ResamplingSettings {
     /// Light candidates drawn per sample and frame (RIS).
     pub candidates: u32,
     /// The previous frame's reservoir counts at most this many times this frame's candidates
-    /// (Bitterli et al. 2020 use 20); 0 turns temporal reuse off.
+    /// (Bitterli et al. 2020 use 20; ReSTIR GI's one traced bounce per frame: this many
+    /// frames); 0 turns temporal reuse off.
     pub temporal_cap: f32,
-    /// Grid neighbours combined per sample (0: no spatial reuse).
+    /// Grid neighbours combined per sample, by ReSTIR DI and GI alike (0: no spatial reuse).
     pub neighbours: u32,
     /// Radius of the neighbours' disc, in grid texels.
     pub radius: f32,
@@ -121,7 +133,7 @@ mod tests {
             assert_eq!(ResamplingMode::parse(name).unwrap().name(), *name);
         }
         let e = ResamplingMode::parse("gi").unwrap_err().to_string();
-        assert!(e.contains("'gi'") && e.contains("off, di"), "{e}");
+        assert!(e.contains("'gi'") && e.contains("off, di, di+gi"), "{e}");
     }
 
     #[test]

@@ -1,0 +1,64 @@
+//! ReSTIR GI's second pass (`shaders/passes/resample_gi_spatial.comp`): grid neighbours'
+//! secondary hits reconnected and combined, the chosen one's light added to the G-buffer's colour
+//! and demodulated radiance.
+
+use super::reservoirs::GiReservoirs;
+use super::settings::ResamplingSettings;
+use crate::error::Result;
+use crate::gpu_scene::scene_then;
+use crate::gpu_scene::GpuScene;
+use crate::graph::{
+    read_buffer, read_image, read_texels, write_buffer, write_image, FrameRecorder,
+};
+use crate::layouts::ResampleSpatialPush;
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
+use crate::vk::{Buffer, Image};
+use glam::Vec4;
+
+pub struct GiSpatial;
+
+impl Kernel for GiSpatial {
+    const SHADER: &'static str = "passes/resample_gi_spatial";
+    type Push = ResampleSpatialPush;
+}
+
+impl Pass<GiSpatial> {
+    /// Reads `reservoirs.fresh`, writes `reservoirs.history` (next frame's) and adds the bounce's
+    /// light to `frame.gbuffer`'s colour and radiance, for every texel of the grid.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        frame: &GridFrame,
+        (scene, ray_counters, primary_hit): (&GpuScene, &Buffer, &Image),
+        reservoirs: &GiReservoirs,
+        settings: &ResamplingSettings,
+    ) -> Result<()> {
+        let g = frame.gbuffer;
+        let binds = scene_then!(scene.binds();
+            read_buffer("frame", frame.frame_data),
+            write_image("color", &g.color),
+            write_image("radiance", &g.radiance),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            read_image("ids", &g.ids),
+            read_image("primary_hit", primary_hit),
+            read_buffer("fresh", &reservoirs.fresh),
+            write_buffer("history", &reservoirs.history),
+            write_buffer("ray_counters", ray_counters),
+            read_texels("grid_columns", frame.sampling_table),
+        );
+        let push = ResampleSpatialPush {
+            space: frame.current,
+            params: Vec4::new(settings.neighbours as f32, settings.radius, 0.0, 0.0),
+        };
+        let size = g.size;
+        self.dispatch(
+            rec,
+            "resample_gi_spatial",
+            &binds,
+            &push,
+            [size.x, size.y, 1],
+        )
+    }
+}

@@ -1,0 +1,71 @@
+//! ReSTIR GI's first pass (`shaders/passes/resample_gi_temporal.comp`): the traced bounce as a
+//! reservoir of one candidate, and the previous frame's reservoir reconnected into it.
+
+use super::reservoirs::GiReservoirs;
+use super::settings::ResamplingSettings;
+use crate::error::Result;
+use crate::gpu_scene::scene_then;
+use crate::gpu_scene::GpuScene;
+use crate::graph::{read_buffer, read_image, read_texels, write_buffer, FrameRecorder};
+use crate::layouts::ResampleTemporalPush;
+use crate::passes::grid::GridFrame;
+use crate::passes::{Kernel, Pass};
+use crate::vk::{Buffer, Image};
+use glam::Vec4;
+
+pub struct GiTemporal;
+
+impl Kernel for GiTemporal {
+    const SHADER: &'static str = "passes/resample_gi_temporal";
+    type Push = ResampleTemporalPush;
+}
+
+impl Pass<GiTemporal> {
+    /// Reads the tracer's bounce samples (`gi_samples`) and `reservoirs.history` (last frame's,
+    /// unless `frame.previous` is `None` or `fresh_start`), writes `reservoirs.fresh`.
+    pub fn record(
+        &self,
+        rec: &mut FrameRecorder,
+        frame: &GridFrame,
+        (scene, ray_counters, primary_hit): (&GpuScene, &Buffer, &Image),
+        (gi_samples, reservoirs, fresh_start): (&Buffer, &GiReservoirs, bool),
+        settings: &ResamplingSettings,
+    ) -> Result<()> {
+        let g = frame.gbuffer;
+        let binds = scene_then!(scene.binds();
+            read_buffer("frame", frame.frame_data),
+            read_image("normal_depth", &g.normal_depth),
+            read_image("position", &g.position),
+            read_image("ids", &g.ids),
+            read_image("motion", &g.motion),
+            read_image("primary_hit", primary_hit),
+            read_buffer("gi_samples", gi_samples),
+            read_buffer("history", &reservoirs.history),
+            write_buffer("fresh", &reservoirs.fresh),
+            write_buffer("ray_counters", ray_counters),
+            read_texels("grid_columns", frame.sampling_table),
+        );
+        let current = &frame.current;
+        let previous = frame.previous.filter(|_| !fresh_start);
+        let p = previous.as_ref().unwrap_or(current);
+        // One candidate per frame (the traced bounce): the cap is temporal_cap frames.
+        let push = ResampleTemporalPush {
+            space: *current,
+            prev: p.frame(),
+            params: Vec4::new(
+                1.0,
+                settings.temporal_cap,
+                if previous.is_none() { 1.0 } else { 0.0 },
+                0.0,
+            ),
+        };
+        let size = g.size;
+        self.dispatch(
+            rec,
+            "resample_gi_temporal",
+            &binds,
+            &push,
+            [size.x, size.y, 1],
+        )
+    }
+}
