@@ -639,11 +639,12 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// ReSTIR DI (`--resampling di`) on every space whose grid runs the temporal filters (its reuse
-/// addresses the grid as they do: φ wraps, clipped texels hold nothing, the previous gaze's grid
-/// for the temporal step): no validation message, every pixel finite and non-negative, the mean
-/// over frames like next-event estimation's, and BMFR after it; every other space refuses it by
-/// name, and A-SVGF (whose re-shading cannot replay reservoirs) refuses it on every space.
+/// ReSTIR DI and GI (`--resampling di`, `di+gi`) on every space whose grid runs the temporal
+/// filters (their reuse addresses the grid as they do: φ wraps, clipped texels hold nothing, the
+/// previous gaze's grid for the temporal step): no validation message, every pixel finite and
+/// non-negative, the mean over frames like next-event estimation's, and BMFR after it; every
+/// other space refuses them by name, and A-SVGF (whose re-shading cannot replay reservoirs)
+/// refuses them on every space.
 #[test]
 fn resampling_on_every_space_that_supports_it() {
     use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
@@ -651,10 +652,11 @@ fn resampling_on_every_space_that_supports_it() {
     let scene = owned_scene("cornell-box");
     let start = CameraPose::from_scene_camera(&scene.cameras[0], SIZE.x, SIZE.y);
     let gaze = SIZE.as_vec2() * 0.5;
-    let with_di = |settings: RenderSettings| RenderSettings {
-        resampling: ResamplingSettings::default().with_mode(ResamplingMode::Di),
+    let with = |mode: ResamplingMode, settings: RenderSettings| RenderSettings {
+        resampling: ResamplingSettings::default().with_mode(mode),
         ..settings
     };
+    let modes = [ResamplingMode::Di, ResamplingMode::DiGi];
     let plain = settings(DenoiserSettings::None, TaaMode::Off);
     let refusal = |make: &MakeSpace, settings: RenderSettings| {
         Renderer::new(&ctx, &scene, make(), settings)
@@ -664,19 +666,25 @@ fn resampling_on_every_space_that_supports_it() {
     };
     for (space_name, make) in spaces(SIZE) {
         if !make().capabilities().temporal_filters {
-            let err = refusal(&make, with_di(plain));
-            assert!(
-                err.contains(space_name) && err.contains("resampling"),
-                "{space_name} + resampling: {err}"
-            );
+            for mode in modes {
+                let err = refusal(&make, with(mode, plain));
+                assert!(
+                    err.contains(space_name) && err.contains("resampling"),
+                    "{space_name} + resampling {}: {err}",
+                    mode.name()
+                );
+            }
             continue;
         }
         let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
-        let err = refusal(&make, with_di(asvgf));
-        assert!(
-            err.contains("asvgf") && err.contains("resampling"),
-            "{space_name} + asvgf + resampling: {err}"
-        );
+        for mode in modes {
+            let err = refusal(&make, with(mode, asvgf));
+            assert!(
+                err.contains("asvgf") && err.contains("resampling"),
+                "{space_name} + asvgf + resampling {}: {err}",
+                mode.name()
+            );
+        }
         let check = |what: &str| {
             let what = what.to_string();
             move |f: u32, hdr: &[[f32; 4]]| {
@@ -686,20 +694,26 @@ fn resampling_on_every_space_that_supports_it() {
         let frames = 24;
         let mut r = Renderer::new(&ctx, &scene, make(), plain).unwrap();
         let off = fovea_tests::mean_over_frames(&mut r, start, Some(gaze), frames, check("nee"));
-        let mut r = Renderer::new(&ctx, &scene, make(), with_di(plain)).unwrap();
-        let di = fovea_tests::mean_over_frames(&mut r, start, Some(gaze), frames, check("di"));
-        let bmfr = settings(DenoiserSettings::parse("bmfr").unwrap(), TaaMode::Off);
-        let mut r = Renderer::new(&ctx, &scene, make(), with_di(bmfr)).unwrap();
-        fovea_tests::mean_over_frames(&mut r, start, Some(gaze), 4, check("di + bmfr"));
-        println!("{space_name}: mean of {frames} frames, resampling di {di:?} vs off {off:?}");
-        for c in 0..3 {
-            assert!(
-                (di[c] / off[c] - 1.0).abs() < 0.02,
-                "{space_name}: channel {c}, resampling di {} vs off {}",
-                di[c],
-                off[c]
+        for mode in modes {
+            let name = mode.name();
+            let mut r = Renderer::new(&ctx, &scene, make(), with(mode, plain)).unwrap();
+            let mean =
+                fovea_tests::mean_over_frames(&mut r, start, Some(gaze), frames, check(name));
+            println!(
+                "{space_name}: mean of {frames} frames, resampling {name} {mean:?} vs off {off:?}"
             );
+            for c in 0..3 {
+                assert!(
+                    (mean[c] / off[c] - 1.0).abs() < 0.02,
+                    "{space_name}: channel {c}, resampling {name} {} vs off {}",
+                    mean[c],
+                    off[c]
+                );
+            }
         }
+        let bmfr = settings(DenoiserSettings::parse("bmfr").unwrap(), TaaMode::Off);
+        let mut r = Renderer::new(&ctx, &scene, make(), with(ResamplingMode::DiGi, bmfr)).unwrap();
+        fovea_tests::mean_over_frames(&mut r, start, Some(gaze), 4, check("di+gi + bmfr"));
         assert_clean(&ctx);
     }
 }
