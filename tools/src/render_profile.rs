@@ -1437,6 +1437,8 @@ gradient_sigma_normal = 64
             (p.resampling.mode, p.resampling.candidates),
             (ResamplingMode::Off, 16)
         );
+        let gi = load_str("resampling_gi.toml", "[resampling]\nmode = \"di+gi\"\n").unwrap();
+        assert_eq!(gi.resampling.mode, ResamplingMode::DiGi);
         let err = format!(
             "{:#}",
             load_str("resampling_bad.toml", "[resampling]\ncandidates = 0\n").unwrap_err()

@@ -74,6 +74,8 @@ pub struct VpFrameReport {
     /// ReSTIR DI (`--resampling di`, its default parameters) at the same sizes and gaze, no
     /// denoiser.
     pub resampling: ResamplingCost,
+    /// ReSTIR DI and GI (`--resampling di+gi`), likewise, in an interleaved run of its own.
+    pub resampling_gi: ResamplingCost,
     /// Every other method of `--method` (the comparators, VP's variants, fixed foveation)
     /// in the same interleaved run as the VP and Cartesian frames above, no denoiser, each with
     /// its paper's defaults (`comparator_spaces`; `linear-falloff`'s samples: the expected count).
@@ -132,15 +134,17 @@ pub struct DenoiserCost {
     pub vp_history_bytes: u64,
 }
 
-/// ReSTIR DI's cost in VP and Cartesian space: frames with it and without it in one interleaved
-/// run.
+/// A resampling mode's cost in VP and Cartesian space: frames with it and without it in one
+/// interleaved run.
 #[derive(Serialize)]
 pub struct ResamplingCost {
-    /// The trace (its `*_resampled` variant: no next-event estimation at the primary hit) and
-    /// the two resampling passes, median ms per frame.
+    /// `di` or `di+gi`.
+    pub mode: &'static str,
+    /// The trace (its `*_resampled` or `*_resampled_gi` variant) and the resampling passes,
+    /// median ms per frame.
     pub cartesian_passes_ms: BTreeMap<String, f64>,
     pub vp_passes_ms: BTreeMap<String, f64>,
-    /// The two resampling passes.
+    /// The resampling passes together.
     pub cartesian_ms: f64,
     pub vp_ms: f64,
     /// Their share of the whole frame with resampling.
@@ -154,8 +158,13 @@ pub struct ResamplingCost {
     pub vp_history_bytes: u64,
 }
 
-/// The resampling passes' names (`passes/resampling`).
-const RESAMPLING_PASSES: [&str; 2] = ["resample_temporal", "resample_spatial"];
+/// The resampling passes' names (`passes/resampling`; the last two with `di+gi` only).
+const RESAMPLING_PASSES: [&str; 4] = [
+    "resample_temporal",
+    "resample_spatial",
+    "resample_gi_temporal",
+    "resample_gi_spatial",
+];
 
 /// A comparator method's whole frames against the Cartesian ones of the same run.
 #[derive(Serialize)]
@@ -475,7 +484,8 @@ pub fn measure(
             vp_history_bytes,
         });
     }
-    let resampling = resampling_cost(screen, &vp, &measure)?;
+    let resampling = resampling_cost(screen, &vp, ResamplingMode::Di, &measure)?;
+    let resampling_gi = resampling_cost(screen, &vp, ResamplingMode::DiGi, &measure)?;
     let vp_frame_ms = frame_ms(&vp_passes_ms);
     let to_screen = |passes: &BTreeMap<String, f64>| -> f64 {
         TO_SCREEN_PASSES.iter().filter_map(|p| passes.get(*p)).sum()
@@ -520,6 +530,7 @@ pub fn measure(
         vp_frame_ms,
         denoisers: costs,
         resampling,
+        resampling_gi,
         comparators,
         vp_order_mrays_per_s: rate(ordered_ms),
         shuffled_mrays_per_s: rate(shuffled_ms),
@@ -587,9 +598,10 @@ pub fn measure(
             mib(d.cartesian_history_bytes)
         );
     }
-    let r = &report.resampling;
-    println!(
-        "  resampling di: {:.1} ms VP vs {:.1} ms Cartesian ({:.1} % vs {:.1} % of the frame); whole frame with it / without {:.3} VP, {:.3} Cartesian; reservoirs {:.1} vs {:.1} MiB",
+    for r in [&report.resampling, &report.resampling_gi] {
+        println!(
+        "  resampling {}: {:.1} ms VP vs {:.1} ms Cartesian ({:.1} % vs {:.1} % of the frame); whole frame with it / without {:.3} VP, {:.3} Cartesian; reservoirs {:.1} vs {:.1} MiB",
+        r.mode,
         r.vp_ms,
         r.cartesian_ms,
         100.0 * r.vp_share,
@@ -599,6 +611,7 @@ pub fn measure(
         mib(r.vp_history_bytes),
         mib(r.cartesian_history_bytes)
     );
+    }
     Ok(report)
 }
 
@@ -610,10 +623,15 @@ type MeasureFn<'a> = dyn Fn(
     ) -> Result<Vec<(FrameMedians, u64)>>
     + 'a;
 
-/// ReSTIR DI against plain frames, Cartesian and VP, in one interleaved run.
-fn resampling_cost(screen: UVec2, vp: &VisualPolar, measure: &MeasureFn) -> Result<ResamplingCost> {
+/// Resampling in `mode` against plain frames, Cartesian and VP, in one interleaved run.
+fn resampling_cost(
+    screen: UVec2,
+    vp: &VisualPolar,
+    mode: ResamplingMode,
+    measure: &MeasureFn,
+) -> Result<ResamplingCost> {
     let resampled = RenderSettings {
-        resampling: ResamplingSettings::default().with_mode(ResamplingMode::Di),
+        resampling: ResamplingSettings::default().with_mode(mode),
         ..Default::default()
     };
     let plain = RenderSettings::default();
@@ -639,6 +657,7 @@ fn resampling_cost(screen: UVec2, vp: &VisualPolar, measure: &MeasureFn) -> Resu
     };
     let (cart_frame, vp_frame) = (frame_ms(&cart.passes), frame_ms(&vp_di.passes));
     Ok(ResamplingCost {
+        mode: mode.name(),
         cartesian_ms: own(&cart.passes),
         vp_ms: own(&vp_di.passes),
         cartesian_share: own(&cart.passes) / cart_frame,

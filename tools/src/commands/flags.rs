@@ -88,9 +88,10 @@ pub struct SceneFlags {
     #[arg(long)]
     pub offscreen_samples: Option<String>,
     /// Light-sample reuse before the denoiser: off (the default: next-event estimation at every
-    /// hit) or di (ReSTIR DI at the primary hit: light candidates resampled per sample, reused
-    /// from the previous frame and from grid neighbours; spaces with temporal filters only, not
-    /// with --denoiser asvgf); parameters from the profile's [resampling].
+    /// hit), di (ReSTIR DI at the primary hit: light candidates resampled per sample, reused
+    /// from the previous frame and from grid neighbours) or di+gi (ReSTIR GI too: the primary
+    /// hit's bounce reused the same way by reconnection); spaces with temporal filters only, not
+    /// with --denoiser asvgf; parameters from the profile's [resampling].
     #[arg(long)]
     pub resampling: Option<String>,
     /// How the two eyes' random numbers relate in a stereo run (docs/design/random-numbers.md):

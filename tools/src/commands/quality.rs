@@ -237,7 +237,7 @@ struct Report<'a> {
     eval_frames: u32,
     reference_spp: u32,
     blur_sigma_at_30: f32,
-    /// `off` or `di`: every run's `--resampling`.
+    /// `off`, `di` or `di+gi`: every run's `--resampling`.
     resampling: &'static str,
     /// FLIP's pixels per degree: the width over the headset eye's horizontal FOV.
     flip_ppd: f32,
