@@ -431,20 +431,22 @@ struct ReservoirGpu {
 // The bounce the tracer's `*_resampled_gi` kernel traced from a primary hit (ReSTIR GI's initial
 // sample): the secondary hit and the radiance the rest of the path gathered there.
 struct GiSampleGpu {
-    vec4 point;                 // xyz the secondary hit (world space), w the bounce direction's solid-angle density at
-                                //   the primary hit (0: no sample: the bounce escaped, was a mirror's or ended)
-    vec4 normal;                // xyz the secondary hit's geometric normal, facing the primary hit; w unused
+    vec4 point;                 // xyz the secondary hit (world space) or, for a bounce that escaped, its direction; w the
+                                //   bounce direction's solid-angle density at the primary hit (0: no sample: a mirror's
+                                //   bounce, or the path ended)
+    vec4 normal;                // xyz the secondary hit's geometric normal, facing the primary hit (zero: the
+                                //   environment); w unused
     vec4 radiance;              // rgb radiance leaving the secondary hit toward the primary hit (its emission excluded:
-                                //   next-event estimation at the primary hit counts that), a unused
+                                //   next-event estimation at the primary hit counts that), or the environment's; a unused
 };
 
 // One texel's ReSTIR GI reservoir: the chosen secondary hit with its radiance, its weights and the
 // surface (primary hit) it belongs to. Reused at another primary hit by reconnection: the
 // secondary hit stays, the direction to it changes (a Jacobian converts the densities).
 struct GiReservoirGpu {
-    vec4 point;                 // xyz the chosen secondary hit (world space), w W (unbiased contribution weight, per
-                                //   solid angle at the owner)
-    vec4 normal;                // xyz its geometric normal, w M (candidates it stands for)
+    vec4 point;                 // xyz the chosen secondary hit (world space; the environment: a direction), w W
+                                //   (unbiased contribution weight, per solid angle at the owner)
+    vec4 normal;                // xyz its geometric normal (zero: the environment), w M (candidates it stands for)
     vec4 radiance;              // rgb its outgoing radiance, a p̂ of the sample at the owner's surface (0: empty)
     uvec4 surface;              // the owner's surface (denoise/svgf.glsl svgf_pack_surface; key 0: no sample)
     vec4 position;              // xyz the owner's shading point (world space), w unused

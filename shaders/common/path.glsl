@@ -11,7 +11,8 @@ uint continuation_rays = 0u;
 #if defined(RESAMPLED_GI)
 // ReSTIR GI's initial sample (GiSampleGpu), which shade_path fills instead of adding the bounce's
 // light: the secondary hit, its normal facing the primary hit, the bounce's density (0: none) and
-// the radiance the rest of the path gathered there.
+// the radiance the rest of the path gathered there; for a bounce that escaped, its direction, a
+// zero normal and the environment's radiance along it.
 vec4 gi_point = vec4(0.0);
 vec3 gi_normal = vec3(0.0);
 vec3 gi_radiance = vec3(0.0);
@@ -82,6 +83,17 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         continuation_rays++;
         // At the last vertex only escaping matters: the cheaper any-hit test answers that.
         if (!bvh_trace(o, l, 0.0, 1e30, last, hit)) {
+#if defined(RESAMPLED_GI)
+            // The primary hit's bounce escaped: ReSTIR GI's sample is the environment along l
+            // (its MIS weight against next-event estimation is taken where the sample is used).
+            if (depth_i == 1u && !delta && !last) {
+                gi_point = vec4(l, pdf);
+                gi_normal = vec3(0.0);
+                gi_radiance = sky_radiance(l);
+                if (any(isnan(gi_radiance)) || any(isinf(gi_radiance))) gi_point.w = 0.0;
+                break;
+            }
+#endif
             // Next-event estimation samples the environment too (when light selection can pick
             // it): weigh this estimate against it. A mirror bounce is this ray's alone.
             float light_pdf = delta ? 0.0 : frame.data.environment.w * env_pdf(frame.data.environment, frame.data.environment_map, l);
@@ -98,8 +110,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
 #if defined(RESAMPLED_GI)
         // A non-mirror bounce from the primary hit is ReSTIR GI's sample: what the path gathers
         // from here on is the radiance leaving the secondary hit toward the primary one (the
-        // resampling passes weigh it by the primary hit's BRDF). Escaping rays and mirror
-        // bounces stay the path's (the environment keeps its MIS share with next-event estimation).
+        // resampling passes weigh it by the primary hit's BRDF). Mirror bounces stay the path's.
         if (depth_i == 1u && !delta) {
             before_bounce = color;
             throughput = vec3(1.0);

@@ -5,12 +5,17 @@
 #ifndef FOVEA_RESAMPLING_GI_GLSL
 #define FOVEA_RESAMPLING_GI_GLSL
 
-// A secondary hit with the radiance it sends toward the primary hits that reuse it.
+// A secondary hit with the radiance it sends toward the primary hits that reuse it, or the
+// environment along a direction (a bounce that escaped: `normal` zero, `point` the direction).
 struct GiSample {
     vec3 point;
-    vec3 normal;     // geometric, facing the primary hit that traced it
+    vec3 normal;     // geometric, facing the primary hit that traced it; zero: the environment
     vec3 radiance;
 };
+
+bool gi_is_environment(GiSample y) {
+    return y.normal == vec3(0.0);
+}
 
 struct GiReservoir {
     GiSample y;
@@ -47,6 +52,15 @@ bool gi_reservoir_update(inout GiReservoir r, GiSample y, float w, float target,
 // the surface or faces away from it. The radiance is taken to leave the secondary hit alike toward
 // every primary hit (exact for diffuse secondary surfaces, ReSTIR GI's approximation otherwise).
 vec3 gi_contribution(Surface s, vec3 v, GiSample y) {
+    if (gi_is_environment(y)) {
+        // The environment's BRDF-sampled share: the power heuristic against next-event
+        // estimation's density for this direction, at this surface (as the path weighs it).
+        vec3 l = y.point;
+        float light_pdf = frame.data.environment.w * env_pdf(frame.data.environment, frame.data.environment_map, l);
+        float w = light_pdf > 0.0 ? mis_power(brdf_pdf(s, v, l), light_pdf) : 1.0;
+        vec3 c = brdf_eval_cos(s, v, l) * y.radiance * w;
+        return (any(isnan(c)) || any(isinf(c))) ? vec3(0.0) : c;
+    }
     vec3 to = y.point - s.position;
     float d2 = dot(to, to);
     if (d2 <= 0.0) return vec3(0.0);
@@ -58,8 +72,10 @@ vec3 gi_contribution(Surface s, vec3 v, GiSample y) {
 
 // |∂ω_to/∂ω_from| of the reconnection shift: the secondary hit `y` seen from the primary hit
 // `from`, reused at `to` (the ratio of the solid angles one patch of the secondary surface spans
-// from the two). Zero where either primary hit lies behind the secondary surface.
+// from the two). Zero where either primary hit lies behind the secondary surface; 1 for the
+// environment (the direction stays).
 float gi_jacobian(vec3 from, vec3 to, GiSample y) {
+    if (gi_is_environment(y)) return 1.0;
     vec3 a = from - y.point, b = to - y.point;
     float da2 = dot(a, a), db2 = dot(b, b);
     if (da2 <= 0.0 || db2 <= 0.0) return 0.0;
@@ -71,11 +87,15 @@ float gi_jacobian(vec3 from, vec3 to, GiSample y) {
 // Is the segment from the primary hit `p` (normal `n`) to the secondary hit unoccluded?
 bool gi_visible(vec3 p, vec3 n, GiSample y) {
     vec3 o = offset_ray(p, n);
+    Hit h;
+    if (gi_is_environment(y)) {
+        shadow_rays++;
+        return !bvh_trace(o, y.point, 0.0, 1e30, true, h);
+    }
     vec3 e = offset_ray(y.point, y.normal);
     vec3 d = e - o;
     float len = length(d);
     if (!(len > 0.0)) return false;
-    Hit h;
     shadow_rays++;
     return !bvh_trace(o, d / len, 0.0, len * (1.0 - 1e-3), true, h);
 }
@@ -84,6 +104,7 @@ bool gi_visible(vec3 p, vec3 n, GiSample y) {
 // `y`: does its bounce reach the secondary hit's front side from its upper hemisphere, without an
 // occluder? For the 1/Z normalisation (the point's BRDF itself is not needed).
 bool gi_sample_reaches(vec3 p, vec3 n, vec3 v, GiSample y) {
+    if (gi_is_environment(y)) return dot(n, y.point) > 0.0 && dot(n, v) > 0.0 && gi_visible(p, n, y);
     vec3 l = y.point - p;
     return dot(n, l) > 0.0 && dot(n, v) > 0.0 && dot(y.normal, -l) > 0.0 && gi_visible(p, n, y);
 }
