@@ -8,7 +8,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, EnvironmentMap, Scene, Sky, Triangle, Vertex};
 use fovea_stage::look::{self, EnvironmentOptions, NO_CAMERA_FLAGS};
-use fovea_tests::scenes::{add_quad, lambert};
+use fovea_tests::scenes::{add_quad, lambert, white_sphere};
 use fovea_tests::{assert_clean, gpu, mean_rgb, save_preview, shared_data};
 use glam::{UVec2, Vec2, Vec3, Vec4};
 use std::sync::Arc;
@@ -48,62 +48,6 @@ fn reference_seeded(
     .unwrap()
 }
 
-/// A flat-shaded UV sphere (convex: a ray leaving a facet never meets the sphere again), white
-/// Lambertian, radius 1 at the origin.
-fn sphere_scene() -> Scene {
-    let mut scene = Scene {
-        materials: vec![lambert(1.0, 0.0)],
-        mesh_names: vec!["sphere".into()],
-        ..Default::default()
-    };
-    let (rings, segments) = (24, 48);
-    let point = |i: u32, j: u32| {
-        let (theta, phi) = (
-            std::f32::consts::PI * i as f32 / rings as f32,
-            std::f32::consts::TAU * j as f32 / segments as f32,
-        );
-        Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        )
-    };
-    let mut push = |a: Vec3, b: Vec3, c: Vec3| {
-        let normal = (b - a).cross(c - a);
-        if normal.length() < 1e-9 {
-            return; // the poles' degenerate halves
-        }
-        let base = scene.vertices.len() as u32;
-        for p in [a, b, c] {
-            scene.vertices.push(Vertex {
-                position: p,
-                normal: normal.normalize(),
-                uv: Vec2::ZERO,
-                tangent: Vec4::X,
-            });
-        }
-        scene.triangles.push(Triangle {
-            indices: [base, base + 1, base + 2],
-            material: 0,
-            mesh: 0,
-        });
-    };
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b, c, d) = (
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            );
-            // Counter-clockwise seen from outside.
-            push(a, c, b);
-            push(a, d, c);
-        }
-    }
-    scene
-}
-
 /// Per-pixel means of `k` renders with seeds 1..=k, and the standard error of one such mean
 /// pooled over `pixels` (green channel): the spread between the renders, from the samples alone.
 fn means_and_error(
@@ -141,9 +85,9 @@ fn means_and_error(
 fn furnace_white_sphere_in_a_uniform_environment_has_its_radiance_at_every_depth() {
     let ctx = gpu();
     let l = 0.7f32;
-    let mut sky = sphere_scene();
+    let mut sky = white_sphere();
     sky.sky = Sky::uniform(Vec3::splat(l));
-    let mut map = sphere_scene();
+    let mut map = white_sphere();
     let mut env = EnvironmentMap::new(8, 4, vec![Vec3::splat(l / 2.0); 32]).unwrap();
     (env.rotation, env.intensity) = (37f32.to_radians(), 2.0);
     map.environment = Some(env);

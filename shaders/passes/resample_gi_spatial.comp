@@ -6,7 +6,8 @@
 // shift). One ray tests that this point sees a neighbour's chosen secondary hit and, where it
 // does, one from each other neighbour that could have produced it (the unbiased 1/Z
 // normalisation); f·cos·L·W joins the tracer's colour and demodulated radiance before any
-// denoiser runs. The combined reservoir is next frame's history.
+// denoiser runs. The combined reservoir shades this frame only: next frame's history is the
+// first pass's.
 //! variants per space
 //! traversals
 #include "../common/scene.glsl"
@@ -29,7 +30,6 @@ layout(set = 0, binding = 13, rgba32f) uniform readonly image2D position;      /
 layout(set = 0, binding = 14, rg32ui) uniform readonly uimage2D ids;
 layout(set = 0, binding = 15, rgba32f) uniform readonly image2D primary_hit;   // barycentrics, ray-cone width
 layout(std430, set = 0, binding = 16) readonly buffer Fresh { GiReservoirGpu data[]; } fresh;
-layout(std430, set = 0, binding = 17) writeonly buffer History { GiReservoirGpu data[]; } history;
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 19) buffer RayCounters { uint data[]; } ray_counters;
 
@@ -50,10 +50,7 @@ void main() {
     uint index = uint(t.y) * uint(g.size.x) + uint(t.x);
     GiReservoirGpu own = fresh.data[index];
     // The first pass left no surface where there is no sample to shade.
-    if (own.surface.w == 0u) {
-        history.data[index] = gi_reservoir_none();
-        return;
-    }
+    if (own.surface.w == 0u) return;
     uvec2 id = imageLoad(ids, t).xy;
     vec4 pos = imageLoad(position, t);
     vec3 dir;
@@ -118,7 +115,6 @@ void main() {
         }
     }
     float w = seen && z > 0.0 && combined.target > 0.0 ? combined.weight_sum / (z * combined.target) : 0.0;
-    history.data[index] = gi_reservoir_pack(combined, w, own.surface, s.position);
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);
     if (w <= 0.0) return;
     vec3 bounce = contribution * w;

@@ -5,8 +5,8 @@
 // clipped texels hold none) that lie on a similar surface, re-evaluating p̂ of theirs here; one
 // shadow ray to the chosen light point and, where it is lit, one from each neighbour that could
 // have produced it (the unbiased 1/Z normalisation); its contribution f·Le·G·W joins the
-// tracer's colour and demodulated radiance before any denoiser runs. The combined reservoir is
-// next frame's history.
+// tracer's colour and demodulated radiance before any denoiser runs. The combined reservoir
+// shades this frame only: next frame's history is the first pass's (ReservoirPair).
 //! variants per space
 //! traversals
 #include "../common/scene.glsl"
@@ -28,7 +28,6 @@ layout(set = 0, binding = 13, rgba32f) uniform readonly image2D position;      /
 layout(set = 0, binding = 14, rg32ui) uniform readonly uimage2D ids;
 layout(set = 0, binding = 15, rgba32f) uniform readonly image2D primary_hit;   // barycentrics, ray-cone width
 layout(std430, set = 0, binding = 16) readonly buffer Fresh { ReservoirGpu data[]; } fresh;
-layout(std430, set = 0, binding = 17) writeonly buffer History { ReservoirGpu data[]; } history;
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 19) buffer RayCounters { uint data[]; } ray_counters;
 
@@ -51,10 +50,7 @@ void main() {
     ReservoirGpu own = fresh.data[index];
     // The first pass left no surface where there is no sample to shade (a miss, a clipped or
     // untraced texel, max depth 1).
-    if (own.surface.w == 0u) {
-        history.data[index] = reservoir_none();
-        return;
-    }
+    if (own.surface.w == 0u) return;
     uvec2 id = imageLoad(ids, t).xy;
     vec4 pos = imageLoad(position, t);
     vec3 dir;
@@ -123,9 +119,6 @@ void main() {
         }
     }
     float w = lit && z > 0.0 && combined.target > 0.0 ? combined.weight_sum / (z * combined.target) : 0.0;
-    // Next frame's history: W with this normalisation (0 where this surface does not see the
-    // sample, as the first pass's visibility reuse), M all candidates seen.
-    history.data[index] = reservoir_pack(combined, w, own.surface, s.position);
     atomicAdd(ray_counters.data[1], shadow_rays);
     if (w <= 0.0) return;
     vec3 direct = contribution * w;

@@ -98,3 +98,59 @@ pub fn furnace(albedo: f32, emission: f32) -> Scene {
     });
     scene
 }
+
+/// A flat-shaded UV sphere (convex: a ray leaving a facet never meets the sphere again), white
+/// Lambertian, radius 1 at the origin.
+pub fn white_sphere() -> Scene {
+    let mut scene = Scene {
+        materials: vec![lambert(1.0, 0.0)],
+        mesh_names: vec!["sphere".into()],
+        ..Default::default()
+    };
+    let (rings, segments) = (24, 48);
+    let point = |i: u32, j: u32| {
+        let (theta, phi) = (
+            std::f32::consts::PI * i as f32 / rings as f32,
+            std::f32::consts::TAU * j as f32 / segments as f32,
+        );
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
+    };
+    let mut push = |a: Vec3, b: Vec3, c: Vec3| {
+        let normal = (b - a).cross(c - a);
+        if normal.length() < 1e-9 {
+            return; // the poles' degenerate halves
+        }
+        let base = scene.vertices.len() as u32;
+        for p in [a, b, c] {
+            scene.vertices.push(Vertex {
+                position: p,
+                normal: normal.normalize(),
+                uv: Vec2::ZERO,
+                tangent: Vec4::X,
+            });
+        }
+        scene.triangles.push(Triangle {
+            indices: [base, base + 1, base + 2],
+            material: 0,
+            mesh: 0,
+        });
+    };
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            // Counter-clockwise seen from outside.
+            push(a, c, b);
+            push(a, d, c);
+        }
+    }
+    scene
+}

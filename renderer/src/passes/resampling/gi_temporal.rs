@@ -1,7 +1,6 @@
 //! ReSTIR GI's first pass (`shaders/passes/resample_gi_temporal.comp`): the traced bounce as a
 //! reservoir of one candidate, and the previous frame's reservoir reconnected into it.
 
-use super::reservoirs::GiReservoirs;
 use super::settings::ResamplingSettings;
 use crate::error::Result;
 use crate::gpu_scene::scene_then;
@@ -21,14 +20,14 @@ impl Kernel for GiTemporal {
 }
 
 impl Pass<GiTemporal> {
-    /// Reads the tracer's bounce samples (`gi_samples`) and `reservoirs.history` (last frame's,
-    /// unless `frame.previous` is `None` or `fresh_start`), writes `reservoirs.fresh`.
+    /// Reads the tracer's bounce samples (`gi_samples`) and `history` (last frame's reservoirs,
+    /// unless `frame.previous` is `None` or `fresh_start`), writes `fresh`.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
         frame: &GridFrame,
         (scene, ray_counters, primary_hit): (&GpuScene, &Buffer, &Image),
-        (gi_samples, reservoirs, fresh_start): (&Buffer, &GiReservoirs, bool),
+        (gi_samples, history, fresh, fresh_start): (&Buffer, &Buffer, &Buffer, bool),
         settings: &ResamplingSettings,
     ) -> Result<()> {
         let g = frame.gbuffer;
@@ -40,8 +39,8 @@ impl Pass<GiTemporal> {
             read_image("motion", &g.motion),
             read_image("primary_hit", primary_hit),
             read_buffer("gi_samples", gi_samples),
-            read_buffer("history", &reservoirs.history),
-            write_buffer("fresh", &reservoirs.fresh),
+            read_buffer("history", history),
+            write_buffer("fresh", fresh),
             write_buffer("ray_counters", ray_counters),
             read_texels("grid_columns", frame.sampling_table),
         );

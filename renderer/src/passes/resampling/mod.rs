@@ -16,7 +16,7 @@ mod settings;
 mod spatial;
 mod temporal;
 
-pub use reservoirs::{GiReservoirs, Reservoirs};
+pub use reservoirs::ReservoirPair;
 pub use settings::{
     ResamplingMode, ResamplingSettings, MAX_CANDIDATES, MAX_NEIGHBOURS, MAX_TEMPORAL_CAP,
     RADIUS_RANGE,
@@ -39,7 +39,7 @@ pub struct Resampling {
     pub settings: ResamplingSettings,
     temporal: Pass<temporal::Temporal>,
     spatial: Pass<spatial::Spatial>,
-    reservoirs: Reservoirs,
+    reservoirs: ReservoirPair,
     gi: Option<GiResampling>,
     frames: u64,
 }
@@ -48,7 +48,7 @@ pub struct Resampling {
 struct GiResampling {
     temporal: Pass<gi_temporal::GiTemporal>,
     spatial: Pass<gi_spatial::GiSpatial>,
-    reservoirs: GiReservoirs,
+    reservoirs: ReservoirPair,
 }
 
 impl Resampling {
@@ -87,10 +87,10 @@ impl Resampling {
             true => Some(GiResampling {
                 temporal: Pass::new(ctx, variant)?,
                 spatial: Pass::new(ctx, variant)?,
-                reservoirs: GiReservoirs {
-                    history: buffer("resampling.gi_history", gi_reservoir)?,
-                    fresh: buffer("resampling.gi_fresh", gi_reservoir)?,
-                },
+                reservoirs: ReservoirPair::new([
+                    buffer("resampling.gi_reservoirs_a", gi_reservoir)?,
+                    buffer("resampling.gi_reservoirs_b", gi_reservoir)?,
+                ]),
             }),
             false => None,
         };
@@ -98,21 +98,19 @@ impl Resampling {
             settings,
             temporal: Pass::new(ctx, variant)?,
             spatial: Pass::new(ctx, variant)?,
-            reservoirs: Reservoirs {
-                history: buffer("resampling.history", reservoir)?,
-                fresh: buffer("resampling.fresh", reservoir)?,
-            },
+            reservoirs: ReservoirPair::new([
+                buffer("resampling.reservoirs_a", reservoir)?,
+                buffer("resampling.reservoirs_b", reservoir)?,
+            ]),
             gi,
             frames: 0,
         })
     }
 
-    /// GPU bytes carried between frames (and the first passes' output).
+    /// GPU bytes of the reservoirs (last frame's and this frame's).
     pub fn history_bytes(&self) -> u64 {
-        let gi = self.gi.as_ref().map_or(0, |gi| {
-            gi.reservoirs.history.size + gi.reservoirs.fresh.size
-        });
-        self.reservoirs.history.size + self.reservoirs.fresh.size + gi
+        let gi = self.gi.as_ref().map_or(0, |gi| gi.reservoirs.bytes());
+        self.reservoirs.bytes() + gi
     }
 
     /// Passes one frame records.
@@ -139,28 +137,30 @@ impl Resampling {
         })?;
         let shared = (scene, ray_counters, primary_hit);
         let fresh_start = self.frames == 0;
+        let (history, fresh) = self.reservoirs.for_frame(self.frames);
         self.temporal.record(
             rec,
             frame,
             shared,
-            (&self.reservoirs, fresh_start),
+            (history, fresh, fresh_start),
             &self.settings,
         )?;
         self.spatial
-            .record(rec, frame, shared, &self.reservoirs, &self.settings)?;
+            .record(rec, frame, shared, fresh, &self.settings)?;
         if let Some(gi) = &self.gi {
             let samples = frame.gbuffer.gi_samples.as_ref().ok_or_else(|| {
                 Error::Invalid("ReSTIR GI needs the G-buffer's bounce samples".into())
             })?;
+            let (history, fresh) = gi.reservoirs.for_frame(self.frames);
             gi.temporal.record(
                 rec,
                 frame,
                 shared,
-                (samples, &gi.reservoirs, fresh_start),
+                (samples, history, fresh, fresh_start),
                 &self.settings,
             )?;
             gi.spatial
-                .record(rec, frame, shared, &gi.reservoirs, &self.settings)?;
+                .record(rec, frame, shared, fresh, &self.settings)?;
         }
         self.frames += 1;
         Ok(())

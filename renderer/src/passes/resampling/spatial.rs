@@ -2,7 +2,6 @@
 //! combined, one shadow ray to the chosen light point, its contribution added to the G-buffer's
 //! colour and demodulated radiance.
 
-use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
 use crate::error::Result;
 use crate::gpu_scene::scene_then;
@@ -24,14 +23,14 @@ impl Kernel for Spatial {
 }
 
 impl Pass<Spatial> {
-    /// Reads `reservoirs.fresh`, writes `reservoirs.history` (next frame's) and adds the direct
-    /// light to `frame.gbuffer`'s colour and radiance, for every texel of the grid.
+    /// Reads this frame's reservoirs (`fresh`) and adds the direct light to `frame.gbuffer`'s
+    /// colour and radiance, for every texel of the grid.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
         frame: &GridFrame,
         (scene, ray_counters, primary_hit): (&GpuScene, &Buffer, &Image),
-        reservoirs: &Reservoirs,
+        fresh: &Buffer,
         settings: &ResamplingSettings,
     ) -> Result<()> {
         let g = frame.gbuffer;
@@ -43,8 +42,7 @@ impl Pass<Spatial> {
             read_image("position", &g.position),
             read_image("ids", &g.ids),
             read_image("primary_hit", primary_hit),
-            read_buffer("fresh", &reservoirs.fresh),
-            write_buffer("history", &reservoirs.history),
+            read_buffer("fresh", fresh),
             write_buffer("ray_counters", ray_counters),
             read_texels("grid_columns", frame.sampling_table),
         );

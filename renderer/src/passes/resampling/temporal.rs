@@ -1,7 +1,6 @@
 //! ReSTIR DI's first pass (`shaders/passes/resample_temporal.comp`): initial candidates, the
 //! chosen one's visibility, and the previous frame's reservoir reprojected into this frame's.
 
-use super::reservoirs::Reservoirs;
 use super::settings::ResamplingSettings;
 use crate::error::Result;
 use crate::gpu_scene::scene_then;
@@ -21,14 +20,14 @@ impl Kernel for Temporal {
 }
 
 impl Pass<Temporal> {
-    /// Reads `reservoirs.history` (last frame's, unless `frame.previous` is `None` or `fresh_start`)
-    /// and writes `reservoirs.fresh` for every texel of the grid.
+    /// Reads `history` (last frame's reservoirs, unless `frame.previous` is `None` or
+    /// `fresh_start`) and writes `fresh` for every texel of the grid.
     pub fn record(
         &self,
         rec: &mut FrameRecorder,
         frame: &GridFrame,
         (scene, ray_counters, primary_hit): (&GpuScene, &Buffer, &Image),
-        (reservoirs, fresh_start): (&Reservoirs, bool),
+        (history, fresh, fresh_start): (&Buffer, &Buffer, bool),
         settings: &ResamplingSettings,
     ) -> Result<()> {
         let g = frame.gbuffer;
@@ -39,8 +38,8 @@ impl Pass<Temporal> {
             read_image("ids", &g.ids),
             read_image("motion", &g.motion),
             read_image("primary_hit", primary_hit),
-            read_buffer("history", &reservoirs.history),
-            write_buffer("fresh", &reservoirs.fresh),
+            read_buffer("history", history),
+            write_buffer("fresh", fresh),
             write_buffer("ray_counters", ray_counters),
             read_texels("grid_columns", frame.sampling_table),
         );
