@@ -180,7 +180,7 @@ impl View {
             // resampled paths' direct light comes from reservoirs the re-shading cannot replay.
             return Err(Error::Invalid(format!(
                 "resampling '{}' with denoiser '{}': A-SVGF's gradient samples re-shade paths \
-                 whose direct light the reservoirs give; use svgf or bmfr",
+                 whose light the reservoirs give; use svgf or bmfr",
                 settings.resampling.mode.name(),
                 settings.denoiser.name()
             )));

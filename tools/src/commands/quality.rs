@@ -317,7 +317,7 @@ fn resampled(args: &QualityArgs) -> bool {
 fn resampling_refusal(args: &QualityArgs, combination: &Combination) -> Option<RefusedRun> {
     (resampled(args) && combination.denoiser == "asvgf").then(|| {
         combination.refused(format!(
-            "asvgf cannot run after resampling {}: its gradient samples re-shade paths whose direct light the reservoirs give",
+            "asvgf cannot run after resampling {}: its gradient samples re-shade paths whose light the reservoirs give",
             args.profile.resampling.mode.name()
         ))
     })
