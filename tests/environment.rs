@@ -6,11 +6,11 @@ use fovea_renderer::frame::{CameraPose, RenderSettings};
 use fovea_renderer::passes::tonemap::ToneCurve;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
-use fovea_scene::{Camera, EnvironmentMap, Scene, Sky, Triangle, Vertex};
+use fovea_scene::{Camera, EnvironmentMap, Scene, Sky};
 use fovea_stage::look::{self, EnvironmentOptions, NO_CAMERA_FLAGS};
 use fovea_tests::scenes::{add_quad, lambert, white_sphere};
 use fovea_tests::{assert_clean, gpu, mean_rgb, save_preview, shared_data};
-use glam::{UVec2, Vec2, Vec3, Vec4};
+use glam::{UVec2, Vec2, Vec3};
 use std::sync::Arc;
 
 fn reference(
