@@ -19,6 +19,7 @@
 #include "../common/resampling_gi.glsl"
 #include "../denoise/grid.glsl"
 #include "../denoise/svgf.glsl"
+#include "../common/resampling_reuse.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { ResampleSpatialPush p; } push;
@@ -32,16 +33,6 @@ layout(set = 0, binding = 15, rgba32f) uniform readonly image2D primary_hit;   /
 layout(std430, set = 0, binding = 16) readonly buffer Fresh { GiReservoirGpu data[]; } fresh;
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 19) buffer RayCounters { uint data[]; } ray_counters;
-
-// A neighbour's reservoir is reused on a surface within this relative depth and angle of the
-// sample's own (as ReSTIR DI's spatial pass).
-const float RESAMPLING_NEIGHBOUR_DEPTH = 0.1;
-const float RESAMPLING_NEIGHBOUR_NORMAL_COS = 0.9;
-
-bool similar_surface(SvgfSurface a, SvgfSurface b) {
-    return b.key != 0u && abs(a.depth - b.depth) <= RESAMPLING_NEIGHBOUR_DEPTH * a.depth
-        && dot(a.normal, b.normal) >= RESAMPLING_NEIGHBOUR_NORMAL_COS;
-}
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);

@@ -19,6 +19,7 @@
 #include "../common/resampling_gi.glsl"
 #include "../denoise/grid.glsl"
 #include "../denoise/svgf.glsl"
+#include "../common/resampling_reuse.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { ResampleTemporalPush p; } push;
@@ -33,10 +34,6 @@ layout(std430, set = 0, binding = 16) readonly buffer History { GiReservoirGpu d
 layout(std430, set = 0, binding = 17) writeonly buffer Fresh { GiReservoirGpu data[]; } fresh;
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 19) buffer RayCounters { uint data[]; } ray_counters;
-
-// How far (in pixels at the sample's depth) last frame's primary hit may lie from this one for
-// its reservoir to be reused (as ReSTIR DI's, resample_temporal.comp).
-const float RESAMPLING_TEMPORAL_PIXELS = 2.0;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
@@ -77,8 +74,7 @@ void main() {
         ivec2 pt = grid_nearest(prev, p);
         if (grid_holds_sample(prev, pt)) {
             GiReservoirGpu q = history.data[uint(pt.y) * uint(g.size.x) + uint(pt.x)];
-            float pixel = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z * here.depth;
-            bool near = distance(q.position.xyz, s.position) <= RESAMPLING_TEMPORAL_PIXELS * pixel;
+            bool near = resampling_near_previous(q.position.xyz, s.position, here.depth);
             SvgfSurface there = svgf_unpack_surface(q.surface);
             if (near && svgf_same_surface(here, there)) {
                 float m_q = min(q.normal.w, push.p.params.y);

@@ -17,6 +17,7 @@
 #include "../common/resampling.glsl"
 #include "../denoise/grid.glsl"
 #include "../denoise/svgf.glsl"
+#include "../common/resampling_reuse.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { ResampleTemporalPush p; } push;
@@ -30,10 +31,6 @@ layout(std430, set = 0, binding = 15) readonly buffer History { ReservoirGpu dat
 layout(std430, set = 0, binding = 16) writeonly buffer Fresh { ReservoirGpu data[]; } fresh;
 // [1]: shadow rays (the tracer's counters, passes/trace.comp).
 layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_counters;
-
-// How far (in pixels at the sample's depth) last frame's shading point may lie from this one for
-// its reservoir to be reused.
-const float RESAMPLING_TEMPORAL_PIXELS = 2.0;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
@@ -87,8 +84,7 @@ void main() {
             // a shading point within a few pixels of this one: in the Visual-Polar periphery a
             // texel spans many pixels and its jittered sample crosses it from frame to frame, and
             // a reservoir drawn for a point that far away is a poor proposal here.
-            float pixel = (frame.data.fov_tan.y - frame.data.fov_tan.x) * frame.data.screen.z * here.depth;
-            bool near = distance(q.position.xyz, s.position) <= RESAMPLING_TEMPORAL_PIXELS * pixel;
+            bool near = resampling_near_previous(q.position.xyz, s.position, here.depth);
             if (near && svgf_same_surface(here, svgf_unpack_surface(q.surface))) {
                 float m_q = min(q.weights.y, push.p.params.y * r.m);
                 float u = rng_next(rng);
