@@ -5,12 +5,10 @@
 //! reservoir and the neighbours' (`temporal`, `spatial`) and add the chosen sample's direct light
 //! to the G-buffer's colour and radiance before any denoiser runs. With `di+gi` the tracer's
 //! `*_resampled_gi` variant also leaves the primary hit's bounce out and writes its secondary hit
-//! and the radiance gathered there; two more passes (`gi_temporal`, `gi_spatial`; Ouyang et al.
-//! 2021, ReSTIR GI) reuse those between frames and neighbours by reconnection. Per view: the
+//! and the radiance gathered there; two more passes (ReSTIR GI, Ouyang et al. 2021; the GI
+//! kernels of `temporal` and `spatial`) reuse those between frames and neighbours by reconnection. Per view: the
 //! reservoirs are history, like a denoiser's.
 
-mod gi_spatial;
-mod gi_temporal;
 mod reservoirs;
 mod settings;
 mod spatial;
@@ -46,8 +44,8 @@ pub struct Resampling {
 
 /// ReSTIR GI's two passes and reservoirs (`di+gi`).
 struct GiResampling {
-    temporal: Pass<gi_temporal::GiTemporal>,
-    spatial: Pass<gi_spatial::GiSpatial>,
+    temporal: Pass<temporal::GiTemporal>,
+    spatial: Pass<spatial::GiSpatial>,
     reservoirs: ReservoirPair,
 }
 
@@ -138,29 +136,39 @@ impl Resampling {
         let shared = (scene, ray_counters, primary_hit);
         let fresh_start = self.frames == 0;
         let (history, fresh) = self.reservoirs.for_frame(self.frames);
-        self.temporal.record(
+        self.temporal.record_temporal(
             rec,
             frame,
             shared,
-            (history, fresh, fresh_start),
+            (
+                temporal::Candidates::Drawn(self.settings.candidates),
+                history,
+                fresh,
+                fresh_start,
+            ),
             &self.settings,
         )?;
         self.spatial
-            .record(rec, frame, shared, fresh, &self.settings)?;
+            .record_spatial(rec, frame, shared, fresh, &self.settings)?;
         if let Some(gi) = &self.gi {
             let samples = frame.gbuffer.gi_samples.as_ref().ok_or_else(|| {
                 Error::Invalid("ReSTIR GI needs the G-buffer's bounce samples".into())
             })?;
             let (history, fresh) = gi.reservoirs.for_frame(self.frames);
-            gi.temporal.record(
+            gi.temporal.record_temporal(
                 rec,
                 frame,
                 shared,
-                (samples, history, fresh, fresh_start),
+                (
+                    temporal::Candidates::Traced(samples),
+                    history,
+                    fresh,
+                    fresh_start,
+                ),
                 &self.settings,
             )?;
             gi.spatial
-                .record(rec, frame, shared, fresh, &self.settings)?;
+                .record_spatial(rec, frame, shared, fresh, &self.settings)?;
         }
         self.frames += 1;
         Ok(())

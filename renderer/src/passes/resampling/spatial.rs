@@ -1,6 +1,7 @@
-//! ReSTIR DI's second pass (`shaders/passes/resample_spatial.comp`): grid neighbours' reservoirs
-//! combined, one shadow ray to the chosen light point, its contribution added to the G-buffer's
-//! colour and demodulated radiance.
+//! The spatial passes (`shaders/passes/resample_spatial.comp` for ReSTIR DI,
+//! `resample_gi_spatial.comp` for GI): grid neighbours' reservoirs combined, one visibility ray
+//! to the chosen sample, its light added to the G-buffer's colour and demodulated radiance. Both
+//! bind the same resources under the same names.
 
 use super::settings::ResamplingSettings;
 use crate::error::Result;
@@ -15,6 +16,7 @@ use crate::passes::{Kernel, Pass};
 use crate::vk::{Buffer, Image};
 use glam::Vec4;
 
+/// ReSTIR DI's: light points.
 pub struct Spatial;
 
 impl Kernel for Spatial {
@@ -22,10 +24,18 @@ impl Kernel for Spatial {
     type Push = ResampleSpatialPush;
 }
 
-impl Pass<Spatial> {
-    /// Reads this frame's reservoirs (`fresh`) and adds the direct light to `frame.gbuffer`'s
-    /// colour and radiance, for every texel of the grid.
-    pub fn record(
+/// ReSTIR GI's: secondary hits, reconnected.
+pub struct GiSpatial;
+
+impl Kernel for GiSpatial {
+    const SHADER: &'static str = "passes/resample_gi_spatial";
+    type Push = ResampleSpatialPush;
+}
+
+impl<K: Kernel<Push = ResampleSpatialPush>> Pass<K> {
+    /// Reads this frame's reservoirs (`fresh`) and adds their light to `frame.gbuffer`'s colour
+    /// and radiance, for every texel of the grid.
+    pub fn record_spatial(
         &self,
         rec: &mut FrameRecorder,
         frame: &GridFrame,
@@ -51,6 +61,7 @@ impl Pass<Spatial> {
             params: Vec4::new(settings.neighbours as f32, settings.radius, 0.0, 0.0),
         };
         let size = g.size;
-        self.dispatch(rec, "resample_spatial", &binds, &push, [size.x, size.y, 1])
+        let name = K::SHADER.trim_start_matches("passes/");
+        self.dispatch(rec, name, &binds, &push, [size.x, size.y, 1])
     }
 }
