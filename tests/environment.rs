@@ -8,7 +8,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::Cartesian;
 use fovea_scene::{Camera, EnvironmentMap, Scene, Sky};
 use fovea_stage::look::{self, EnvironmentOptions, NO_CAMERA_FLAGS};
-use fovea_tests::scenes::{add_quad, lambert, white_sphere};
+use fovea_tests::scenes::{add_floor, lambert, white_sphere};
 use fovea_tests::{assert_clean, gpu, mean_rgb, save_preview, shared_data};
 use glam::{UVec2, Vec2, Vec3};
 use std::sync::Arc;
@@ -175,17 +175,7 @@ fn default_sun_lights_an_upward_plane_with_cos_theta_times_its_illuminance() {
             mesh_names: vec!["floor".into()],
             ..Default::default()
         };
-        let s = 50.0;
-        add_quad(
-            &mut scene,
-            [
-                Vec3::new(-s, 0.0, -s),
-                Vec3::new(-s, 0.0, s),
-                Vec3::new(s, 0.0, s),
-                Vec3::new(s, 0.0, -s),
-            ],
-            0,
-        );
+        add_floor(&mut scene, 50.0, 0);
         let env = EnvironmentOptions {
             sun: Some([azimuth, elevation]),
             sun_intensity: Some(intensity),
@@ -233,17 +223,7 @@ fn preetham_and_gradient_skies_light_an_upward_plane_alike() {
             mesh_names: vec!["floor".into()],
             ..Default::default()
         };
-        let s = 50.0;
-        add_quad(
-            &mut scene,
-            [
-                Vec3::new(-s, 0.0, -s),
-                Vec3::new(-s, 0.0, s),
-                Vec3::new(s, 0.0, s),
-                Vec3::new(s, 0.0, -s),
-            ],
-            0,
-        );
+        add_floor(&mut scene, 50.0, 0);
         let env = EnvironmentOptions {
             sun: Some([40.0, 25.0]),
             sun_intensity: Some(0.0),

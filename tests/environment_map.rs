@@ -12,7 +12,7 @@ use fovea_renderer::sampling::Cartesian;
 use fovea_renderer::vk::{Buffer, ComputePipeline};
 use fovea_scene::environment::{direction_to_uv, pdf_solid_angle, texel_index, uv_to_direction};
 use fovea_scene::{Camera, EnvironmentDistribution, EnvironmentMap, Material, Scene};
-use fovea_tests::scenes::{add_quad, lambert};
+use fovea_tests::scenes::{add_floor, lambert};
 use fovea_tests::{assert_clean, gpu};
 use glam::{UVec2, UVec4, Vec2, Vec3, Vec4};
 use std::f32::consts::PI;
@@ -195,17 +195,7 @@ fn plane_samples(
         environment: Some(map.clone()),
         ..Default::default()
     };
-    let s = 100.0;
-    add_quad(
-        &mut scene,
-        [
-            Vec3::new(-s, 0.0, -s),
-            Vec3::new(-s, 0.0, s),
-            Vec3::new(s, 0.0, s),
-            Vec3::new(s, 0.0, -s),
-        ],
-        0,
-    );
+    add_floor(&mut scene, 100.0, 0);
     // Looking down at 60° so that a glossy plane reflects part of the sky toward the camera.
     let camera = Camera::look_at(
         Vec3::new(0.0, 2.0, 0.0),

@@ -14,7 +14,7 @@ use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace, VisualPolar, VisualPolarParams};
 use fovea_renderer::vk::Context;
 use fovea_scene::{Camera, Scene, Sky};
-use fovea_tests::scenes::{add_quad, furnace, lambert, white_sphere};
+use fovea_tests::scenes::{add_floor, add_quad, furnace, lambert, white_sphere};
 use fovea_tests::{assert_clean, gpu, mean_over_frames, mean_rgb, owned_scene, rmse};
 use glam::{UVec2, Vec2, Vec3};
 use std::sync::Arc;
@@ -179,27 +179,43 @@ fn mean_differences(image: &[[f32; 4]], reference: &[[f32; 4]]) -> ([f64; 3], f6
 fn cornell_box_converges_to_the_reference() {
     let ctx = gpu();
     let (scene, pose) = cornell();
-    let reference = renderer(
+    let label = format!("Cornell box {}×{}", SIZE.x, SIZE.y);
+    assert_converges(
         &ctx,
-        &scene,
+        (&scene, pose, &label),
+        256,
+        &[
+            (ResamplingMode::Off, 0.01, 0.03),
+            (ResamplingMode::Di, 0.01, 0.06),
+            (ResamplingMode::DiGi, 0.01, 0.06),
+        ],
+    );
+    assert_clean(&ctx);
+}
+
+/// The mean of `frames` still frames with each mode against a 512-spp reference, printed: the
+/// whole image's per-channel difference under its case's first bound, every 4×4 block's under
+/// the second.
+fn assert_converges(
+    ctx: &Arc<Context>,
+    (scene, pose, label): (&Scene, CameraPose, &str),
+    frames: u32,
+    cases: &[(ResamplingMode, f64, f64)],
+) {
+    let reference = renderer(
+        ctx,
+        scene,
         Box::new(Cartesian::new(SIZE)),
         ResamplingMode::Off,
     )
     .render_reference(&pose, 512, 3, |_| {})
     .unwrap();
-    const FRAMES: u32 = 256;
-    for (mode, whole_bound, block_bound) in [
-        (ResamplingMode::Off, 0.01, 0.03),
-        (ResamplingMode::Di, 0.01, 0.06),
-        (ResamplingMode::DiGi, 0.01, 0.06),
-    ] {
-        let mut r = renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode);
-        let mean = mean_image(&mut r, pose, FRAMES);
+    for &(mode, whole_bound, block_bound) in cases {
+        let mut r = renderer(ctx, scene, Box::new(Cartesian::new(SIZE)), mode);
+        let mean = mean_image(&mut r, pose, frames);
         let (whole, worst) = mean_differences(&mean, &reference);
         println!(
-            "Cornell box {}×{}, resampling {}: mean of {FRAMES} frames vs 512 spp: {:+.4} {:+.4} {:+.4} per channel, worst 4×4 block {:.4}",
-            SIZE.x,
-            SIZE.y,
+            "{label}, resampling {}: mean of {frames} frames vs 512 spp: {:+.4} {:+.4} {:+.4} per channel, worst 4×4 block {:.4}",
             mode.name(),
             whole[0],
             whole[1],
@@ -208,16 +224,15 @@ fn cornell_box_converges_to_the_reference() {
         );
         assert!(
             whole.iter().all(|d| d.abs() < whole_bound),
-            "resampling {}: mean off by {whole:?} (bound {whole_bound})",
+            "{label}, resampling {}: mean off by {whole:?} (bound {whole_bound})",
             mode.name()
         );
         assert!(
             worst < block_bound,
-            "resampling {}: a 4×4 block's mean off by {worst:.4} (bound {block_bound})",
+            "{label}, resampling {}: a 4×4 block's mean off by {worst:.4} (bound {block_bound})",
             mode.name()
         );
     }
-    assert_clean(&ctx);
 }
 
 /// A floor lit by 64 small area lights of four strengths, a wall casting their shadows: the light
@@ -235,17 +250,7 @@ fn many_lights_converge_to_the_reference() {
     // Emitting downward only: the camera above sees their dark backs, the image is the light
     // they cast.
     scene.materials.extend(strengths.map(|e| lambert(0.0, e)));
-    let s = 1.5;
-    add_quad(
-        &mut scene,
-        [
-            Vec3::new(-s, 0.0, -s),
-            Vec3::new(-s, 0.0, s),
-            Vec3::new(s, 0.0, s),
-            Vec3::new(s, 0.0, -s),
-        ],
-        0,
-    );
+    add_floor(&mut scene, 1.5, 0);
     // A wall across the middle: half the lights reach each side of it only past its edge.
     add_quad(
         &mut scene,
@@ -279,42 +284,16 @@ fn many_lights_converge_to_the_reference() {
         "test",
     );
     let pose = CameraPose::from_scene_camera(&camera, SIZE.x, SIZE.y);
-    let reference = renderer(
+    assert_converges(
         &ctx,
-        &scene,
-        Box::new(Cartesian::new(SIZE)),
-        ResamplingMode::Off,
-    )
-    .render_reference(&pose, 512, 3, |_| {})
-    .unwrap();
-    const FRAMES: u32 = 128;
-    for mode in [
-        ResamplingMode::Off,
-        ResamplingMode::Di,
-        ResamplingMode::DiGi,
-    ] {
-        let mut r = renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode);
-        let mean = mean_image(&mut r, pose, FRAMES);
-        let (whole, worst) = mean_differences(&mean, &reference);
-        println!(
-            "64 lights, resampling {}: mean of {FRAMES} frames vs 512 spp: {:+.4} {:+.4} {:+.4} per channel, worst 4×4 block {:.4}",
-            mode.name(),
-            whole[0],
-            whole[1],
-            whole[2],
-            worst
-        );
-        assert!(
-            whole.iter().all(|d| d.abs() < 0.01),
-            "resampling {}: mean off by {whole:?}",
-            mode.name()
-        );
-        assert!(
-            worst < 0.06,
-            "resampling {}: a 4×4 block's mean off by {worst:.4}",
-            mode.name()
-        );
-    }
+        (&scene, pose, "64 lights"),
+        128,
+        &[
+            (ResamplingMode::Off, 0.01, 0.06),
+            (ResamplingMode::Di, 0.01, 0.06),
+            (ResamplingMode::DiGi, 0.01, 0.06),
+        ],
+    );
     assert_clean(&ctx);
 }
 

@@ -30,6 +30,21 @@ pub fn add_quad(scene: &mut Scene, corners: [Vec3; 4], material: u32) {
     });
 }
 
+/// Appends a square floor facing up (+Y) at y = 0, reaching `half` from the origin along X and Z.
+pub fn add_floor(scene: &mut Scene, half: f32, material: u32) {
+    let s = half;
+    add_quad(
+        scene,
+        [
+            Vec3::new(-s, 0.0, -s),
+            Vec3::new(-s, 0.0, s),
+            Vec3::new(s, 0.0, s),
+            Vec3::new(s, 0.0, -s),
+        ],
+        material,
+    );
+}
+
 /// A Lambertian material of the given albedo (specular factor 0: exactly base_color / π).
 pub fn lambert(albedo: f32, emission: f32) -> Material {
     Material {
