@@ -11,9 +11,10 @@ use fovea_scene::bvh::compressed::Bvh8;
 use fovea_scene::bvh::wide::Bvh4;
 use fovea_scene::bvh::{Bvh, BvhBuilder, TraceState};
 use fovea_scene::intersect::{brute_force, Ray};
-use fovea_scene::{Material, Scene, Triangle, Vertex};
+use fovea_scene::{Material, Scene};
+use fovea_tests::scenes::add_flat_triangle;
 use fovea_tests::{assert_clean, gpu};
-use glam::{Vec2, Vec3, Vec4};
+use glam::Vec3;
 
 /// A deterministic generator (no external RNG needed for the test data).
 struct Lcg(u64);
@@ -45,21 +46,7 @@ fn scene_from_triangles(tris: &[[Vec3; 3]]) -> Scene {
         ..Default::default()
     };
     for t in tris {
-        let base = scene.vertices.len() as u32;
-        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-        for p in t {
-            scene.vertices.push(Vertex {
-                position: *p,
-                normal: n,
-                uv: Vec2::ZERO,
-                tangent: Vec4::X,
-            });
-        }
-        scene.triangles.push(Triangle {
-            indices: [base, base + 1, base + 2],
-            material: 0,
-            mesh: 0,
-        });
+        add_flat_triangle(&mut scene, *t, 0);
     }
     scene
 }

@@ -30,6 +30,26 @@ pub fn add_quad(scene: &mut Scene, corners: [Vec3; 4], material: u32) {
     });
 }
 
+/// Appends a triangle with its face normal at each corner (zero for a degenerate one).
+pub fn add_flat_triangle(scene: &mut Scene, corners: [Vec3; 3], material: u32) {
+    let [a, b, c] = corners;
+    let normal = (b - a).cross(c - a).normalize_or_zero();
+    let base = scene.vertices.len() as u32;
+    for position in corners {
+        scene.vertices.push(Vertex {
+            position,
+            normal,
+            uv: Vec2::ZERO,
+            tangent: Vec4::X,
+        });
+    }
+    scene.triangles.push(Triangle {
+        indices: [base, base + 1, base + 2],
+        material,
+        mesh: 0,
+    });
+}
+
 /// Appends a square floor facing up (+Y) at y = 0, reaching `half` from the origin along X and Z.
 pub fn add_floor(scene: &mut Scene, half: f32, material: u32) {
     let s = half;
@@ -135,24 +155,9 @@ pub fn white_sphere() -> Scene {
         )
     };
     let mut push = |a: Vec3, b: Vec3, c: Vec3| {
-        let normal = (b - a).cross(c - a);
-        if normal.length() < 1e-9 {
-            return; // the poles' degenerate halves
+        if (b - a).cross(c - a).length() >= 1e-9 {
+            add_flat_triangle(&mut scene, [a, b, c], 0); // not the poles' degenerate halves
         }
-        let base = scene.vertices.len() as u32;
-        for p in [a, b, c] {
-            scene.vertices.push(Vertex {
-                position: p,
-                normal: normal.normalize(),
-                uv: Vec2::ZERO,
-                tangent: Vec4::X,
-            });
-        }
-        scene.triangles.push(Triangle {
-            indices: [base, base + 1, base + 2],
-            material: 0,
-            mesh: 0,
-        });
     };
     for i in 0..rings {
         for j in 0..segments {
