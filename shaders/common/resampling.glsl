@@ -175,12 +175,18 @@ Reservoir reservoir_empty() {
     return r;
 }
 
+// Weighted reservoir sampling's step, for DI's and GI's reservoirs alike: adds a candidate's
+// weight `w` to the running sum; whether it replaces the chosen sample (`u` uniform in [0, 1)).
+bool reservoir_accepts(inout float weight_sum, float w, float u) {
+    if (!(w > 0.0)) return false;
+    weight_sum += w;
+    return u * weight_sum < w;
+}
+
 // Streams one candidate of weight `w` (and p̂ here `target`) into `r`; `u` uniform in [0, 1).
 // Returns whether it became the chosen sample.
 bool reservoir_update(inout Reservoir r, LightPoint y, float w, float target, float u) {
-    if (!(w > 0.0)) return false;
-    r.weight_sum += w;
-    if (u * r.weight_sum >= w) return false;
+    if (!reservoir_accepts(r.weight_sum, w, u)) return false;
     r.y = y;
     r.target = target;
     r.full = true;

@@ -37,10 +37,9 @@ GiReservoir gi_reservoir_empty() {
     return r;
 }
 
+// As reservoir_update (resampling.glsl), for a secondary hit.
 bool gi_reservoir_update(inout GiReservoir r, GiSample y, float w, float target, float u) {
-    if (!(w > 0.0)) return false;
-    r.weight_sum += w;
-    if (u * r.weight_sum >= w) return false;
+    if (!reservoir_accepts(r.weight_sum, w, u)) return false;
     r.y = y;
     r.target = target;
     r.full = true;
