@@ -56,6 +56,9 @@ pub struct RenderSettings {
     /// two in world units). Larger cells share more samples between the eyes and make coarser
     /// noise within each.
     pub surface_cell: f32,
+    /// With two views (the eyes): each eye's samples also take the other eye's sample of the
+    /// same surface this frame before the filters (passes/cross_eye.rs). Ignored with one view.
+    pub cross_eye_reuse: bool,
     /// Texture filtering of frames (references always read level 0: point samples converge to
     /// the box-filtered pixel).
     pub texture_lod: TextureLod,
@@ -98,6 +101,7 @@ impl Default for RenderSettings {
             taa: TaaMode::Off,
             stereo_noise: StereoNoise::default(),
             surface_cell: DEFAULT_SURFACE_CELL,
+            cross_eye_reuse: false,
             environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
             path_regularisation: DEFAULT_PATH_REGULARISATION,

@@ -16,6 +16,7 @@ use crate::layouts::{
     FRAME_FLAG_REFERENCE, FRAME_FLAG_SURFACE_NOISE, FRAME_FLAG_TEXTURE_LOD,
 };
 use crate::passes::accumulate::AccumulatePass;
+use crate::passes::cross_eye::CrossEye;
 use crate::passes::denoise::Denoiser;
 use crate::passes::exposure::{Exposure, ExposurePass};
 use crate::passes::grid::{GridFrame, TileList};
@@ -29,6 +30,28 @@ use crate::way_back::{ScreenOut, WayBackFrame};
 use ash::vk;
 use glam::{UVec2, UVec4, Vec2, Vec4};
 use std::sync::Arc;
+
+/// A view's `GridFrame` for this slot (a macro, not a function: `record_samples` and
+/// `record_filters` hold the view's denoiser mutably beside it).
+macro_rules! grid_frame {
+    ($view:expr, $slot:expr, $scene:expr, $camera:expr) => {
+        GridFrame {
+            gbuffer: &$view.gbuffer,
+            frame_data: &$slot.frame_data,
+            sampling: &$slot.sampling,
+            current: $view.space.params(),
+            previous: $view.prev_sampling,
+            sampling_table: &$slot.sampling_table,
+            tiles: TileList::new(&$slot.trace_tiles, &$view.tiles),
+            camera_origin: $camera.world_from_view.w_axis.truncate(),
+            materials: &$scene.materials,
+        }
+    };
+}
+
+/// How much the other eye's sample of a surface weighs in cross-eye reuse against the eye's own
+/// (both one sample of the same pixel's worth of surface).
+const CROSS_EYE_WEIGHT: f32 = 1.0;
 
 /// Passes one reference submission may hold (trace + accumulate per sample).
 const REFERENCE_SAMPLES_PER_SUBMIT: u32 = 8;
@@ -53,6 +76,8 @@ pub struct Renderer {
     pub scene: GpuScene,
     pub settings: RenderSettings,
     views: Vec<View>,
+    /// Cross-eye reuse between the two views (`RenderSettings::cross_eye_reuse` with two views).
+    cross_eye: Option<CrossEye>,
     ring: FrameRing,
     accumulate: AccumulatePass,
     tonemap: TonemapPass,
@@ -113,7 +138,8 @@ impl Renderer {
             return Err(Error::Invalid("frames in flight must be at least 1".into()));
         }
         let views = build_views(ctx, spaces, &settings, frames_in_flight)?;
-        let ring = FrameRing::new(ctx, frames_in_flight, max_passes(&views))?;
+        let cross_eye = build_cross_eye(ctx, &views, &settings)?;
+        let ring = FrameRing::new(ctx, frames_in_flight, max_passes(&views, &cross_eye))?;
         Ok(Renderer {
             accumulate: AccumulatePass::single(ctx)?,
             tonemap: TonemapPass::new(ctx)?,
@@ -122,6 +148,7 @@ impl Renderer {
             scene,
             settings,
             views,
+            cross_eye,
             ring,
             last_waited: None,
         })
@@ -141,14 +168,17 @@ impl Renderer {
             )));
         }
         let views = build_views(&self.ctx, spaces, &settings, self.ring.slots())?;
-        if max_passes(&views) > max_passes(&self.views) {
+        let cross_eye = build_cross_eye(&self.ctx, &views, &settings)?;
+        let passes = max_passes(&views, &cross_eye);
+        if passes > max_passes(&self.views, &self.cross_eye) {
             // Timestamp pools are sized for the old views: a new ring, the old one drained.
             self.ring.finish()?;
-            self.ring = FrameRing::new(&self.ctx, self.ring.slots(), max_passes(&views))?;
+            self.ring = FrameRing::new(&self.ctx, self.ring.slots(), passes)?;
             self.last_waited = None;
         }
         let old = std::mem::replace(&mut self.views, views);
-        self.ring.defer_release(Box::new(old));
+        let old_cross_eye = std::mem::replace(&mut self.cross_eye, cross_eye);
+        self.ring.defer_release(Box::new((old, old_cross_eye)));
         self.settings = settings;
         Ok(())
     }
@@ -343,9 +373,21 @@ impl Renderer {
         // eyes share it), then every view's display image.
         // A fixed array, not a Vec: the render loop makes no host allocation (tests/host_alloc.rs).
         let mut screens: [Option<_>; MAX_VIEWS] = std::array::from_fn(|_| None);
+        // Every view's samples before any view's filters: cross-eye reuse reads both eyes'.
         for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
             rec.set_view(v as u32);
-            screens[v] = Some(record_view(rec, view, slot, &shared, view_input)?);
+            record_samples(rec, view, slot, &shared, view_input)?;
+        }
+        if let (Some(cross_eye), [left, right]) = (&self.cross_eye, &self.views[..]) {
+            let frames = [
+                grid_frame!(left, &left.slots[slot], self.scene, inputs[0].camera),
+                grid_frame!(right, &right.slots[slot], self.scene, inputs[1].camera),
+            ];
+            cross_eye.record(rec, [&frames[0], &frames[1]], CROSS_EYE_WEIGHT)?;
+        }
+        for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
+            rec.set_view(v as u32);
+            screens[v] = Some(record_filters(rec, view, slot, &shared, view_input)?);
         }
         if let Exposure::Auto(auto) = &self.settings.exposure {
             for (v, screen) in screens.iter().flatten().enumerate() {
@@ -661,10 +703,24 @@ fn build_views(
         .collect()
 }
 
+/// Cross-eye reuse when the settings ask for it and there are two views (the eyes).
+fn build_cross_eye(
+    ctx: &Arc<Context>,
+    views: &[View],
+    settings: &RenderSettings,
+) -> Result<Option<CrossEye>> {
+    match views {
+        [left, _] if settings.cross_eye_reuse => Ok(Some(CrossEye::new(ctx, left.space.as_ref())?)),
+        _ => Ok(None),
+    }
+}
+
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
-fn max_passes(views: &[View]) -> u32 {
+fn max_passes(views: &[View], cross_eye: &Option<CrossEye>) -> u32 {
     // Each view's passes and its exposure meter, and the frame's one exposure adaptation.
-    let frame: u32 = views.iter().map(|v| v.max_passes() + 1).sum::<u32>() + 1;
+    let frame: u32 = views.iter().map(|v| v.max_passes() + 1).sum::<u32>()
+        + 1
+        + cross_eye.as_ref().map_or(0, |_| CrossEye::PASSES);
     // A reference batch: trace and accumulate per sample, the idle tiles' clear, the copy.
     frame.max(2 * REFERENCE_SAMPLES_PER_SUBMIT + 2) + 2
 }
@@ -720,37 +776,22 @@ fn pixels_per_degree(camera: &CameraPose, width: u32) -> f32 {
     width as f32 / span.to_degrees().max(1e-3)
 }
 
-/// Records one view's frame up to its screen radiance: trace → resampling → denoiser → TAA → the
-/// way back to the screen (a pending foveated blur left to `record_display`).
-fn record_view<'a>(
+/// Records one view's samples of a frame: trace → resampling (→ each texel's mean where a space
+/// traces several), into the view's G-buffer.
+fn record_samples(
     rec: &mut FrameRecorder,
-    view: &'a mut View,
+    view: &mut View,
     slot: usize,
-    shared: &FrameShared<'a>,
+    shared: &FrameShared,
     view_input: &ViewInput,
-) -> Result<ViewScreen<'a>> {
+) -> Result<()> {
     let FrameShared {
-        scene,
-        accumulate,
-        settings,
-        input,
-        ..
+        scene, accumulate, ..
     } = *shared;
-    let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
     let s = &view.slots[slot];
     rec.fill_buffer("clear_counters", &s.ray_counters, 0)?;
     // Denoisers work in the sampling grid (Cartesian samples are the screen).
-    let frame = GridFrame {
-        gbuffer: &view.gbuffer,
-        frame_data: &s.frame_data,
-        sampling: &s.sampling,
-        current: view.space.params(),
-        previous: view.prev_sampling,
-        sampling_table: &s.sampling_table,
-        tiles: TileList::new(&s.trace_tiles, &view.tiles),
-        camera_origin: view_input.camera.world_from_view.w_axis.truncate(),
-        materials: &scene.materials,
-    };
+    let frame = grid_frame!(view, s, scene, view_input.camera);
     if let Some(d) = &mut view.denoiser {
         d.record_before_trace(rec, &frame)?;
     }
@@ -767,17 +808,35 @@ fn record_view<'a>(
     }
     // Spaces tracing several samples in some texels: sample k where k < the texel's count, each
     // texel's mean kept (no denoiser or TAA runs on them).
-    let traced = match &view.sample_mean {
-        Some(mean) => {
-            accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
-            for k in 1..view.space.samples_per_texel() {
-                trace.record(rec, &frame, scene, &s.ray_counters, k, None)?;
-                accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
-            }
-            mean
+    if let Some(mean) = &view.sample_mean {
+        accumulate.record_traced(rec, &view.gbuffer.color, mean, 0)?;
+        for k in 1..view.space.samples_per_texel() {
+            trace.record(rec, &frame, scene, &s.ray_counters, k, None)?;
+            accumulate.record_traced(rec, &view.gbuffer.color, mean, k)?;
         }
-        None => &view.gbuffer.color,
-    };
+    }
+    Ok(())
+}
+
+/// Records one view's frame from its samples to its screen radiance: denoiser → TAA → the way
+/// back to the screen (a pending foveated blur left to `record_display`).
+fn record_filters<'a>(
+    rec: &mut FrameRecorder,
+    view: &'a mut View,
+    slot: usize,
+    shared: &FrameShared<'a>,
+    view_input: &ViewInput,
+) -> Result<ViewScreen<'a>> {
+    let FrameShared {
+        scene,
+        settings,
+        input,
+        ..
+    } = *shared;
+    let jitter = settings.taa.settings().map(|t| t.jitter(input.frame_index));
+    let s = &view.slots[slot];
+    let frame = grid_frame!(view, s, scene, view_input.camera);
+    let traced = view.sample_mean.as_ref().unwrap_or(&view.gbuffer.color);
     let denoised = match &mut view.denoiser {
         Some(d) => d.record(rec, &frame)?,
         None => traced,

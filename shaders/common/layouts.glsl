@@ -467,6 +467,14 @@ struct ResampleSpatialPush {
     vec4 params;                // x neighbours, y radius (grid texels), zw unused
 };
 
+// Push constants of the cross-eye merge (passes/cross_eye.comp): the other eye's space (its grid
+// is this eye's size; its gaze and shape its own).
+struct CrossEyePush {
+    SamplingParams other;       // the other eye's space this frame
+    vec4 params;                // x weight of the other eye's sample (1: as this eye's own), y 0 (a column index
+                                //   lavapipe cannot fold, see cross_eye.comp), zw unused
+};
+
 const uint TONEMAP_CLAMP = 0u;
 const uint TONEMAP_ACES = 1u;
 const uint TONEMAP_NEUTRAL = 2u;

@@ -58,6 +58,9 @@ pub struct RenderProfile {
     /// `[trace] surface_cell`: the surface noise's cell edge in sample footprints
     /// (`RenderSettings::surface_cell`); `None`: the engine's default.
     pub surface_cell: Option<f32>,
+    /// `[trace] cross_eye_reuse`: with both eyes, each eye's samples also take the other eye's
+    /// sample of the same surface before the filters (`--cross-eye-reuse`).
+    pub cross_eye_reuse: bool,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: fovea_stage::gaze::GazeTiming,
 }
@@ -99,6 +102,7 @@ impl Default for RenderProfile {
             resampling: Default::default(),
             stereo_noise: Default::default(),
             surface_cell: None,
+            cross_eye_reuse: false,
             gaze_timing: Default::default(),
         }
     }
@@ -210,6 +214,7 @@ struct TraceSection {
     offscreen: Option<String>,
     stereo_noise: Option<String>,
     surface_cell: Option<f32>,
+    cross_eye_reuse: Option<bool>,
 }
 
 #[derive(Deserialize, Default)]
@@ -305,6 +310,8 @@ pub struct ProfileOverrides {
     pub resampling: Option<String>,
     /// `--stereo-noise`.
     pub stereo_noise: Option<String>,
+    /// `--cross-eye-reuse`.
+    pub cross_eye_reuse: Option<String>,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (all absent: no latency model).
     pub gaze_timing: fovea_stage::gaze::GazeTiming,
 }
@@ -551,6 +558,9 @@ impl RenderProfile {
             }
             profile.surface_cell = Some(cell);
         }
+        if let Some(reuse) = trace.cross_eye_reuse {
+            profile.cross_eye_reuse = reuse;
+        }
         if let Some(resampling) = file.resampling {
             resampling.validate().with_context(|| at("resampling"))?;
             profile.resampling = resampling;
@@ -623,6 +633,9 @@ impl RenderProfile {
         if let Some(mode) = &o.stereo_noise {
             self.stereo_noise = StereoNoise::parse(mode).context("--stereo-noise")?;
         }
+        if let Some(reuse) = &o.cross_eye_reuse {
+            self.cross_eye_reuse = parse_on_off(reuse).context("--cross-eye-reuse")?;
+        }
         if let Some(mode) = &o.resampling {
             let mode = ResamplingMode::parse(mode).context("--resampling")?;
             self.resampling = self.resampling.with_mode(mode);
@@ -642,6 +655,15 @@ impl RenderProfile {
     pub fn path_regularisation(&self) -> f32 {
         self.path_regularisation
             .unwrap_or(DEFAULT_PATH_REGULARISATION)
+    }
+}
+
+/// `on` or `off`.
+fn parse_on_off(value: &str) -> Result<bool> {
+    match value {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        other => bail!("'{other}': expected on or off"),
     }
 }
 

@@ -3,6 +3,7 @@
 //! back to the screen are `crate::way_back`'s.
 
 pub mod accumulate;
+pub mod cross_eye;
 pub mod denoise;
 pub mod exposure;
 pub mod grid;

@@ -101,6 +101,12 @@ pub struct SceneFlags {
     /// comma-separated list and renders each.
     #[arg(long)]
     pub stereo_noise: Option<String>,
+    /// With both eyes: on (each eye's samples also take the other eye's sample of the same
+    /// surface this frame, found through the depth, before the denoiser; where a glossy lobe is
+    /// narrower than the angle between the eyes, less) or off (the default); spaces with
+    /// temporal filters only.
+    #[arg(long)]
+    pub cross_eye_reuse: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
     /// vertices' glossy lobes are widened so sunlight focused through them stops making
     /// fireflies; biased, 0 = off (the unbiased estimator).

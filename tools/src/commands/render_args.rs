@@ -242,6 +242,7 @@ impl RenderOpts {
             offscreen_samples: self.look.offscreen_samples.clone(),
             resampling: self.look.resampling.clone(),
             stereo_noise: self.look.stereo_noise.clone(),
+            cross_eye_reuse: self.look.cross_eye_reuse.clone(),
             gaze_timing: self.latency.timing()?,
         })
     }

@@ -362,6 +362,7 @@ pub fn render_settings(
         resampling: args.profile.resampling,
         stereo_noise: args.profile.stereo_noise,
         surface_cell: args.profile.surface_cell(),
+        cross_eye_reuse: args.profile.cross_eye_reuse,
         ..Default::default()
     }
 }

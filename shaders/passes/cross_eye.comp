@@ -1,0 +1,87 @@
+#version 460
+// Cross-eye reuse, first pass (docs/design/binocular.md): each sample of this eye finds the
+// sample of the other eye that looked at the same surface this frame — its primary hit projected
+// into the other eye's camera and grid (its own gaze and shape), accepted on the same mesh at the
+// same depth and normal as the denoisers' reprojection tests — and averages the two demodulated
+// radiances. Where the surface's BRDF lobe is narrower than the angle between the eyes' views,
+// the other eye saw other light (a reflection moves with the eye) and its sample weighs less,
+// down to nothing. Writes the merged radiance into `merged` (w: 1 where merged); the resolve pass
+// writes it back once both eyes have read each other's samples.
+//! variants per space
+#include "../common/layouts.glsl"
+#include "../common/frame.glsl"
+#include "../common/camera.glsl"
+#include "../denoise/grid.glsl"
+#include "../denoise/svgf.glsl"
+
+layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
+layout(push_constant) uniform Push { CrossEyePush p; } push;
+
+// The other eye's frame data (its camera), as binding 8 holds this eye's; an array of one, read
+// at a push-constant index (see main).
+layout(std140, set = 0, binding = 9) uniform OtherFrameBuffer { FrameData data[1]; } other_frame;
+layout(set = 0, binding = 10, rgba32f) uniform readonly image2D radiance;
+layout(set = 0, binding = 11, rgba32f) uniform readonly image2D normal_depth;
+layout(set = 0, binding = 12, rgba32f) uniform readonly image2D position;      // camera-relative, w: depth gradient per texel
+layout(set = 0, binding = 13, rg32ui) uniform readonly uimage2D ids;
+layout(set = 0, binding = 14, rgba32f) uniform readonly image2D other_radiance;
+layout(set = 0, binding = 15, rgba32f) uniform readonly image2D other_normal_depth;
+layout(set = 0, binding = 16, rgba32f) uniform readonly image2D other_position;
+layout(set = 0, binding = 17, rg32ui) uniform readonly uimage2D other_ids;
+layout(set = 0, binding = 18, rgba32f) uniform writeonly image2D merged;
+layout(std430, set = 0, binding = 19) readonly buffer Materials { MaterialGpu data[]; } materials;
+
+// The other eye's sample weighs fully where the lobe (GGX α = roughness²) is at least twice
+// this multiple of the angle between the two views, nothing below once that multiple.
+const float CROSS_EYE_LOBE_MARGIN = 2.0;
+
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(t, imageSize(merged)))) return;
+    uvec2 id = imageLoad(ids, t).xy;
+    // No sample here, or the environment seen directly (noise-free): nothing to merge.
+    if (id.x == 0u) {
+        imageStore(merged, t, vec4(0.0));
+        return;
+    }
+    vec4 pos = imageLoad(position, t);
+    // The cameras and frusta through an index lavapipe cannot fold (push constant params.y,
+    // always 0), as the tracer reads its own: lavapipe specialises kernels on the uniform values
+    // that decide branches and would recompile this one per eye and whenever a camera moves.
+    uint c0 = uint(push.p.params.y);
+    FrameData other_eye = other_frame.data[c0];
+    vec3 world = frame.data.world_from_view[c0 + 3u].xyz + pos.xyz;
+    vec3 from_other = world - other_eye.world_from_view[3].xyz;
+    vec3 local = inverse(mat3(other_eye.world_from_view)) * from_other;
+    vec2 size = vec2(push.p.other.grid.zw);
+    vec2 screen, p;
+    Grid other = grid_make(push.p.other);
+    bool seen = project_view(local, other_eye.fov_tan, size, screen)
+             && all(greaterThanEqual(screen, vec2(0.0))) && all(lessThan(screen, size))
+             && grid_from_screen(other, screen, p);
+    ivec2 o = seen ? grid_nearest(other, p) : ivec2(0);
+    seen = seen && grid_holds_sample(other, o);
+    uvec2 other_id = seen ? imageLoad(other_ids, o).xy : uvec2(0u);
+    float weight = 0.0;
+    if (other_id.x != 0u) {
+        // This sample's surface as the other eye sees it (its depth along the other camera's
+        // axis) against what the other eye hit there.
+        vec4 nd = imageLoad(normal_depth, t);
+        SvgfSurface here = svgf_surface(vec4(nd.xyz, -local.z), pos.w, id);
+        SvgfSurface there = svgf_surface(imageLoad(other_normal_depth, o), imageLoad(other_position, o).w, other_id);
+        if (svgf_same_surface(here, there)) {
+            float roughness = materials.data[id.y & 0xffffu].surface.y;
+            float parallax = acos(clamp(dot(normalize(-pos.xyz), normalize(-from_other)), -1.0, 1.0));
+            float lobe = roughness * roughness / max(CROSS_EYE_LOBE_MARGIN * parallax, 1e-6);
+            weight = push.p.params.x * smoothstep(1.0, 2.0, lobe);
+        }
+    }
+    if (weight <= 0.0) {
+        imageStore(merged, t, vec4(0.0));
+        return;
+    }
+    vec3 mine = imageLoad(radiance, t).rgb;
+    vec3 theirs = imageLoad(other_radiance, o).rgb;
+    if (any(isnan(theirs)) || any(isinf(theirs))) theirs = mine;
+    imageStore(merged, t, vec4((mine + weight * theirs) / (1.0 + weight), 1.0));
+}
