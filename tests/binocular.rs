@@ -135,8 +135,8 @@ fn show(v: &[f64]) -> String {
 }
 
 /// Both eyes at one position on a still scene: with shared noise (screen or surface seeds) the
-/// denoised eyes are identical and the measure is 0 everywhere (every pixel seen by both);
-/// independent noise gives a difference the measure sees.
+/// denoised eyes are identical, with cross-eye reuse too, and the measure is 0 everywhere (every
+/// pixel seen by both); independent noise gives a difference the measure sees.
 #[test]
 fn both_eyes_at_one_position_give_identical_denoised_images_and_a_zero_measure() {
     let ctx = gpu();
@@ -144,11 +144,18 @@ fn both_eyes_at_one_position_give_identical_denoised_images_and_a_zero_measure()
     let warp = warp(&scene, &head, 0.0);
     let n = (SCREEN.x * SCREEN.y) as usize;
     assert!((0..n).all(|i| warp.covers(i)), "one eye sees what it sees");
-    for noise in [StereoNoise::Screen, StereoNoise::Surface] {
-        let (left, right) = stereo_pair(&ctx, &scene, &head, svgf(noise), 0.0);
+    let modes = [StereoNoise::Screen, StereoNoise::Surface]
+        .into_iter()
+        .flat_map(|noise| [(noise, false), (noise, true)]);
+    for (noise, reuse) in modes {
+        let settings = RenderSettings {
+            cross_eye_reuse: reuse,
+            ..svgf(noise)
+        };
+        let (left, right) = stereo_pair(&ctx, &scene, &head, settings, 0.0);
         assert_pictures_equal(
             &format!(
-                "{} noise, SVGF, one eye position: right eye against left",
+                "{} noise, SVGF, cross-eye reuse {reuse}, one eye position: right eye against left",
                 noise.name()
             ),
             &Picture::rgba8(SCREEN.x, SCREEN.y, &right),
@@ -408,5 +415,130 @@ fn surface_noise_keeps_each_eyes_flip() {
             denoiser.name()
         );
     }
+    assert_clean(&ctx);
+}
+
+/// Cross-eye reuse (`RenderSettings::cross_eye_reuse`): with independent noise at the FOVE 0's
+/// eye distance, each eye's samples taking the other eye's sample of the same surface bring the
+/// two eyes' displayed frames together (the binocular difference over the frame) and lower each
+/// eye's own error (left-eye FLIP against its converged reference), raw and after SVGF, in
+/// Cartesian space and in the screen-clipped Visual-Polar grid (each eye its own gaze, so the
+/// other eye's sample is found through its own grid). Means over frames 4–7 of still runs.
+#[test]
+fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
+    use fovea_renderer::sampling::{VisualPolar, VisualPolarParams, VpLayout};
+    const FIRST: u32 = 4;
+    const LAST: u32 = 8;
+    let ctx = gpu();
+    let (scene, head) = cornell();
+    let warp = warp(&scene, &head, HALF_IPD);
+    let (reference, reference_right) = reference_pair(&ctx, &scene, &head);
+    println!(
+        "converged pair's difference: {:.4}",
+        mean(&difference_map(&reference, &reference_right, &warp)).unwrap()
+    );
+    let ppd = SCREEN.x as f32 / 90.0;
+    let cartesian = |_: f32| -> Box<dyn SamplingSpace> { Box::new(Cartesian::new(SCREEN)) };
+    let visual_polar = |x: f32| -> Box<dyn SamplingSpace> {
+        let params = VisualPolarParams {
+            layout: VpLayout::ScreenClipped,
+            ..Default::default()
+        };
+        let gaze = SCREEN.as_vec2() * glam::Vec2::new(x, 0.5);
+        Box::new(VisualPolar::new(SCREEN, gaze, params).unwrap())
+    };
+    // (difference over the frame, left-eye FLIP), means over the measured frames.
+    let run = |space: &dyn Fn(f32) -> Box<dyn SamplingSpace>, denoiser, reuse| {
+        let settings = RenderSettings {
+            denoiser,
+            stereo_noise: StereoNoise::Independent,
+            cross_eye_reuse: reuse,
+            ..Default::default()
+        };
+        let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+        // The eyes converge a little: each gaze slightly toward the nose.
+        let spaces = vec![space(0.52), space(0.48)];
+        let mut r = Renderer::with_views(&ctx, gpu_scene, spaces, settings, 1).unwrap();
+        let views = [-HALF_IPD, HALF_IPD].map(|dx| ViewInput {
+            camera: eye(&head, dx),
+            gaze: None,
+        });
+        let (mut difference, mut flip) = (0.0, 0.0);
+        for f in 0..LAST {
+            let frame = r
+                .submit(&FrameInput::views(&views, f).unwrap(), None)
+                .unwrap();
+            r.wait_frame(frame).unwrap();
+            if f >= FIRST {
+                let (mut left, mut right) = (Vec::new(), Vec::new());
+                r.read_view_ldr(frame, 0, &mut left).unwrap();
+                r.read_view_ldr(frame, 1, &mut right).unwrap();
+                difference += mean(&difference_map(&left, &right, &warp)).unwrap();
+                let map =
+                    fovea_tools::eval::flip::flip_map(&reference, &left, SCREEN.x, SCREEN.y, ppd);
+                flip += mean(&map).unwrap();
+            }
+        }
+        let n = (LAST - FIRST) as f64;
+        (difference / n, flip / n)
+    };
+    type SpaceFn<'a> = &'a dyn Fn(f32) -> Box<dyn SamplingSpace>;
+    let spaces: [(&str, SpaceFn); 2] = [("Cartesian", &cartesian), ("VP", &visual_polar)];
+    for (name, space) in spaces {
+        for denoiser in [
+            DenoiserSettings::None,
+            DenoiserSettings::Svgf(SvgfSettings::default()),
+        ] {
+            let (d_off, f_off) = run(space, denoiser, false);
+            let (d_on, f_on) = run(space, denoiser, true);
+            println!(
+                "{name} + {}: difference {d_off:.4} → {d_on:.4} ({:.2}×), left-eye FLIP {f_off:.4} → {f_on:.4}",
+                denoiser.name(),
+                d_on / d_off
+            );
+            let what = format!("{name} + {}", denoiser.name());
+            // Raw, the merged samples agree by construction where both eyes see the surface;
+            // SVGF's own spatial filter leaves less to bring together.
+            let bound = if denoiser == DenoiserSettings::None {
+                0.6
+            } else {
+                0.95
+            };
+            assert!(d_on < bound * d_off, "{what}: difference {d_off} → {d_on}");
+            assert!(f_on < f_off, "{what}: left-eye FLIP {f_off} → {f_on}");
+        }
+    }
+    assert_clean(&ctx);
+}
+
+/// Cross-eye reuse needs a grid the filters address: a space without temporal filters refuses it
+/// by name; one view ignores it.
+#[test]
+fn cross_eye_reuse_is_refused_by_name_where_the_grid_has_no_filters() {
+    use fovea_renderer::sampling::{
+        FalloffShape, LinearFalloff, VisualPolarParams, FALLOFF_BUDGET_OF_VP,
+    };
+    let ctx = gpu();
+    let (scene, _) = cornell();
+    let settings = RenderSettings {
+        cross_eye_reuse: true,
+        ..Default::default()
+    };
+    let falloff = || -> Box<dyn SamplingSpace> {
+        let params = VisualPolarParams::default();
+        let shape = FalloffShape::default();
+        Box::new(LinearFalloff::new(SCREEN, params, shape, FALLOFF_BUDGET_OF_VP).unwrap())
+    };
+    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+    let error = Renderer::with_views(&ctx, gpu_scene, vec![falloff(), falloff()], settings, 1)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.contains("cross-eye reuse") && error.contains("linear-falloff"),
+        "{error}"
+    );
+    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+    Renderer::with_views(&ctx, gpu_scene, vec![falloff()], settings, 1).expect("one view");
     assert_clean(&ctx);
 }

@@ -59,29 +59,43 @@ void main() {
     bool seen = project_view(local, other_eye.fov_tan, size, screen)
              && all(greaterThanEqual(screen, vec2(0.0))) && all(lessThan(screen, size))
              && grid_from_screen(other, screen, p);
-    ivec2 o = seen ? grid_nearest(other, p) : ivec2(0);
-    seen = seen && grid_holds_sample(other, o);
-    uvec2 other_id = seen ? imageLoad(other_ids, o).xy : uvec2(0u);
-    float weight = 0.0;
-    if (other_id.x != 0u) {
-        // This sample's surface as the other eye sees it (its depth along the other camera's
-        // axis) against what the other eye hit there.
+    // The other eye's radiance at this point: its samples around it on the same surface,
+    // bilinearly weighted (one sample's worth, as this eye's own).
+    vec3 theirs = vec3(0.0);
+    float found = 0.0;
+    if (seen) {
         vec4 nd = imageLoad(normal_depth, t);
+        // This sample's surface as the other eye sees it (its depth along the other camera's
+        // axis), against what the other eye hit around it.
         SvgfSurface here = svgf_surface(vec4(nd.xyz, -local.z), pos.w, id);
-        SvgfSurface there = svgf_surface(imageLoad(other_normal_depth, o), imageLoad(other_position, o).w, other_id);
-        if (svgf_same_surface(here, there)) {
-            float roughness = materials.data[id.y & 0xffffu].surface.y;
-            float parallax = acos(clamp(dot(normalize(-pos.xyz), normalize(-from_other)), -1.0, 1.0));
-            float lobe = roughness * roughness / max(CROSS_EYE_LOBE_MARGIN * parallax, 1e-6);
-            weight = push.p.params.x * smoothstep(1.0, 2.0, lobe);
+        ivec2 taps[4];
+        vec4 w;
+        grid_bilinear(other, p, taps, w);
+        for (int k = 0; k < 4; ++k) {
+            ivec2 o = taps[k];
+            if (w[k] <= 0.0 || !grid_holds_sample(other, o)) continue;
+            uvec2 other_id = imageLoad(other_ids, o).xy;
+            if (other_id.x == 0u) continue;
+            SvgfSurface there = svgf_surface(imageLoad(other_normal_depth, o), imageLoad(other_position, o).w, other_id);
+            if (!svgf_same_surface(here, there)) continue;
+            vec3 r = imageLoad(other_radiance, o).rgb;
+            if (any(isnan(r)) || any(isinf(r))) continue;
+            theirs += w[k] * r;
+            found += w[k];
         }
+    }
+    float weight = 0.0;
+    if (found > 0.0) {
+        theirs /= found;
+        float roughness = materials.data[id.y & 0xffffu].surface.y;
+        float parallax = acos(clamp(dot(normalize(-pos.xyz), normalize(-from_other)), -1.0, 1.0));
+        float lobe = roughness * roughness / max(CROSS_EYE_LOBE_MARGIN * parallax, 1e-6);
+        weight = push.p.params.x * smoothstep(1.0, 2.0, lobe);
     }
     if (weight <= 0.0) {
         imageStore(merged, t, vec4(0.0));
         return;
     }
     vec3 mine = imageLoad(radiance, t).rgb;
-    vec3 theirs = imageLoad(other_radiance, o).rgb;
-    if (any(isnan(theirs)) || any(isinf(theirs))) theirs = mine;
     imageStore(merged, t, vec4((mine + weight * theirs) / (1.0 + weight), 1.0));
 }

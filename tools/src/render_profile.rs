@@ -1432,6 +1432,49 @@ gradient_sigma_normal = 64
         assert!(err.contains("--stereo-noise"), "{err}");
     }
 
+    /// `[trace] cross_eye_reuse` and `--cross-eye-reuse on|off` reach the profile; a bad flag
+    /// value is refused naming the flag and the accepted values, a bad file value naming the key.
+    #[test]
+    fn cross_eye_reuse_from_file_and_flag() {
+        assert!(!RenderProfile::default().cross_eye_reuse);
+        let p = load_str("stereo.toml", "[trace]\ncross_eye_reuse = true\n").unwrap();
+        assert!(p.cross_eye_reuse);
+        let flag = |value: &str| ProfileOverrides {
+            cross_eye_reuse: Some(value.into()),
+            ..Default::default()
+        };
+        assert!(
+            !p.clone()
+                .override_with(&flag("off"))
+                .unwrap()
+                .cross_eye_reuse
+        );
+        assert!(
+            RenderProfile::default()
+                .override_with(&flag("on"))
+                .unwrap()
+                .cross_eye_reuse
+        );
+        let err = format!(
+            "{:#}",
+            RenderProfile::default()
+                .override_with(&flag("yes"))
+                .unwrap_err()
+        );
+        assert!(
+            err.contains("--cross-eye-reuse") && err.contains("on or off"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str("bad.toml", "[trace]\ncross_eye_reuse = \"on\"\n").unwrap_err()
+        );
+        assert!(
+            err.contains("bad.toml") && err.contains("cross_eye_reuse"),
+            "{err}"
+        );
+    }
+
     /// `[resampling]`: the mode and parameters onto the engine's defaults, checked by name;
     /// `--resampling` sets the mode and keeps the section's parameters.
     #[test]

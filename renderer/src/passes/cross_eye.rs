@@ -43,19 +43,15 @@ impl CrossEye {
     pub const PASSES: u32 = 4;
 
     /// The passes for a stereo pair of `space`'s grids; an error naming the space where its grid
-    /// has no per-sample G-buffer to match surfaces in (no temporal filters) or several samples
-    /// per texel.
+    /// is not one the filters address (no temporal filters: no per-sample G-buffer to find the
+    /// other eye's sample in).
     pub fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace) -> Result<CrossEye> {
         let caps = space.capabilities();
-        if !caps.temporal_filters || space.samples_per_texel() > 1 {
+        if !caps.temporal_filters {
             return Err(Error::Invalid(format!(
                 "cross-eye reuse: the {} space cannot match its samples between the eyes {}",
                 space.name(),
-                if caps.temporal_filters {
-                    "(it traces several samples per texel)"
-                } else {
-                    caps.filters_note
-                }
+                caps.filters_note
             )));
         }
         let grid = space.grid_size();

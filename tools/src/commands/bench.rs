@@ -573,11 +573,12 @@ pub struct BenchCommand {
     #[arg(long, default_value_t = 2)]
     pub frames: u32,
     /// Per-eye size WxH of the real-time loop figures: Cornell box, both eyes, VP + SVGF, 1 vs 2
-    /// frames in flight, stereo vs two mono renders ("" skips them).
+    /// frames in flight, stereo vs two mono renders, stereo with cross-eye reuse ("" skips them).
     #[arg(long, default_value = "320x360")]
     pub loop_size: String,
     /// Timed frames of each run of the real-time loop and of the headset loop (after 2 warm-up
-    /// frames; at least 2). Each run is made twice (order A B C C B A).
+    /// frames; at least 2). Each run is made twice (real-time loop: order A B C D D C B A; headset
+    /// loop: A B C C B A).
     #[arg(long, default_value_t = 5)]
     pub loop_frames: u32,
     /// Scenes of the headset loop: both eyes at each --loop-headsets size, the head on the

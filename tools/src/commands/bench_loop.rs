@@ -2,10 +2,11 @@
 //! Visual-Polar space with SVGF, driven the way `fovea render --eyes both` drives them (free the
 //! slot's frame, then record and submit the next), three times on one device:
 //! one stereo renderer with 1 and with 2 frames in flight, and two mono renderers (one scene
-//! upload each) submitting one eye each per frame. Per run: frames/s over the steady state,
+//! upload each) submitting one eye each per frame; then the stereo renderer with 2 in flight and
+//! cross-eye reuse (`--cross-eye-reuse on`), for the share of its passes. Per run: frames/s over the steady state,
 //! per-pass GPU ms, host ms spent recording + submitting, process CPU time, submits and fence
-//! waits per frame, GPU bytes. Each run is made twice, in the order A B C C B A, so that a drift
-//! of the machine's speed (other work on a shared CPU device) hits the three alike.
+//! waits per frame, GPU bytes. Each run is made twice, in the order A B C D D C B A, so that a drift
+//! of the machine's speed (other work on a shared CPU device) hits the four alike.
 
 use super::setup::{filters, space_for};
 use crate::cpu_time::{CpuTimes, CpuUse};
@@ -48,7 +49,7 @@ pub struct LoopReport {
     pub warmup_frames: u32,
     /// Timed frames each time a run is made (after its own warm-up frames).
     pub frames: u32,
-    /// Times each run is made (order A B C C B A); every figure is over all of them.
+    /// Times each run is made (order A B C D D C B A); every figure is over all of them.
     pub repeats: u32,
     pub stereo_in_flight_1: LoopRun,
     pub stereo_in_flight_2: LoopRun,
@@ -60,6 +61,12 @@ pub struct LoopReport {
     pub stereo_vs_two_mono_frame_time: f64,
     pub stereo_vs_two_mono_gpu_ms: f64,
     pub stereo_vs_two_mono_bytes: f64,
+    /// The stereo renderer, 2 in flight, with cross-eye reuse.
+    pub stereo_cross_eye_in_flight_2: LoopRun,
+    /// Its cross-eye passes (`cross_eye`, `cross_eye_resolve`) / its GPU ms per frame.
+    pub cross_eye_share: f64,
+    /// GPU ms per frame with cross-eye reuse / without (both stereo, 2 in flight).
+    pub cross_eye_vs_stereo_gpu_ms: f64,
 }
 
 #[derive(Serialize)]
@@ -105,6 +112,8 @@ type Spec = &'static [Eye];
 pub(super) struct Config {
     specs: &'static [Spec],
     in_flight: usize,
+    /// `RenderSettings::cross_eye_reuse` for this run.
+    cross_eye: bool,
 }
 
 const STEREO: &[Spec] = &[&[Eye::Left, Eye::Right]];
@@ -113,23 +122,30 @@ const TWO_MONO: &[Spec] = &[&[Eye::Left], &[Eye::Right]];
 pub(super) const STEREO_2: Config = Config {
     specs: STEREO,
     in_flight: 2,
+    cross_eye: false,
 };
-const CONFIGS: [Config; 3] = [
+const CONFIGS: [Config; 4] = [
     Config {
         specs: STEREO,
         in_flight: 1,
+        cross_eye: false,
+    },
+    STEREO_2,
+    Config {
+        specs: TWO_MONO,
+        in_flight: 2,
+        cross_eye: false,
     },
     Config {
         specs: STEREO,
         in_flight: 2,
-    },
-    Config {
-        specs: TWO_MONO,
-        in_flight: 2,
+        cross_eye: true,
     },
 ];
 /// Forwards, then backwards.
-const ORDER: [usize; 6] = [0, 1, 2, 2, 1, 0];
+const ORDER: [usize; 8] = [0, 1, 2, 3, 3, 2, 1, 0];
+/// The cross-eye reuse passes' names in the timings.
+const CROSS_EYE_PASSES: [&str; 2] = ["cross_eye", "cross_eye_resolve"];
 
 /// A scene with its world tree, built once for every loop run over it (each run uploads it).
 pub struct LoopScene {
@@ -198,11 +214,15 @@ pub fn measure(ctx: &Arc<Context>, (width, height): (u32, u32), frames: u32) -> 
     let scene = LoopScene::load(LOOP_SCENE)?;
     let hmd = HmdDescription::resolve(HEADSET).with_context(|| format!("headset {HEADSET}"))?;
     let setup = LoopSetup::new(&scene, hmd, (width, height), (METHOD, DENOISER), None)?;
-    let mut sums: [Sums; 3] = Default::default();
+    let mut sums: [Sums; 4] = Default::default();
     for i in ORDER {
         sums[i].add(run(ctx, &setup, &CONFIGS[i], frames)?);
     }
-    let [stereo_1, stereo_2, mono_2] = sums.map(Sums::report);
+    let [stereo_1, stereo_2, mono_2, cross_eye_2] = sums.map(Sums::report);
+    let cross_eye_ms: f64 = CROSS_EYE_PASSES
+        .iter()
+        .filter_map(|p| cross_eye_2.passes_ms.get(*p))
+        .sum();
     let report = LoopReport {
         scene: LOOP_SCENE.to_string(),
         width,
@@ -217,9 +237,12 @@ pub fn measure(ctx: &Arc<Context>, (width, height): (u32, u32), frames: u32) -> 
         stereo_vs_two_mono_frame_time: stereo_2.wall_ms_per_frame / mono_2.wall_ms_per_frame,
         stereo_vs_two_mono_gpu_ms: stereo_2.gpu_ms_per_frame / mono_2.gpu_ms_per_frame,
         stereo_vs_two_mono_bytes: stereo_2.gpu_bytes as f64 / mono_2.gpu_bytes as f64,
+        cross_eye_share: cross_eye_ms / cross_eye_2.gpu_ms_per_frame,
+        cross_eye_vs_stereo_gpu_ms: cross_eye_2.gpu_ms_per_frame / stereo_2.gpu_ms_per_frame,
         stereo_in_flight_1: stereo_1,
         stereo_in_flight_2: stereo_2,
         two_mono_in_flight_2: mono_2,
+        stereo_cross_eye_in_flight_2: cross_eye_2,
     };
     print_summary(&report, &ctx.info.name);
     Ok(report)
@@ -295,6 +318,7 @@ impl<'a> LoopSetup<'a> {
         ctx: &Arc<Context>,
         eyes: Spec,
         in_flight: usize,
+        cross_eye: bool,
     ) -> Result<(Renderer, i64)> {
         let spaces = eyes
             .iter()
@@ -305,7 +329,16 @@ impl<'a> LoopSetup<'a> {
         let scene = GpuScene::upload_with_bvh(ctx, &s.scene, &s.positions, &s.bvh)?;
         let scene_bytes = ctx.allocated_bytes() - before;
         Ok((
-            Renderer::with_views(ctx, scene, spaces, self.settings, in_flight)?,
+            Renderer::with_views(
+                ctx,
+                scene,
+                spaces,
+                RenderSettings {
+                    cross_eye_reuse: cross_eye,
+                    ..self.settings
+                },
+                in_flight,
+            )?,
             scene_bytes,
         ))
     }
@@ -470,7 +503,7 @@ pub(super) fn run(
     let bytes_before = ctx.allocated_bytes();
     let (mut renderers, scene_bytes): (Vec<Renderer>, Vec<i64>) = specs
         .iter()
-        .map(|eyes| setup.renderer(ctx, eyes, in_flight))
+        .map(|eyes| setup.renderer(ctx, eyes, in_flight, config.cross_eye))
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .unzip();
@@ -566,7 +599,7 @@ fn collect(tally: &mut Tally, renderer: &Renderer, done: u64, last_renderer: boo
 /// The loop figures as a Markdown table (ready for docs/performance.md) and the ratios.
 fn print_summary(r: &LoopReport, device: &str) {
     println!(
-        "loop {} 2 × {}×{} ({} + {}; each run {} × {} timed frames after {} warm-up, order A B C C B A) on {device}:",
+        "loop {} 2 × {}×{} ({} + {}; each run {} × {} timed frames after {} warm-up, order A B C D D C B A) on {device}:",
         r.scene, r.width, r.height, r.method, r.denoiser, r.repeats, r.frames, r.warmup_frames
     );
     println!("| run | frames in flight | scene uploads | submits/frame | frames/s | wall ms/frame | GPU ms/frame | host ms/frame | process CPU ms/frame | others' CPU ms/frame | GPU MiB |");
@@ -575,6 +608,10 @@ fn print_summary(r: &LoopReport, device: &str) {
         ("stereo (1 renderer, 2 views)", &r.stereo_in_flight_1),
         ("stereo (1 renderer, 2 views)", &r.stereo_in_flight_2),
         ("2 × mono (2 renderers)", &r.two_mono_in_flight_2),
+        (
+            "stereo, cross-eye reuse (1 renderer)",
+            &r.stereo_cross_eye_in_flight_2,
+        ),
     ];
     let ms = |v: Option<f64>| v.map_or("n/a".to_string(), |ms| format!("{ms:.0}"));
     for (name, run) in runs {
@@ -595,6 +632,11 @@ fn print_summary(r: &LoopReport, device: &str) {
     println!(
         "2 vs 1 in flight: {:.3}× frames/s; stereo / (2 × mono): frame time {:.3}, GPU ms {:.3}, GPU bytes {:.3}",
         r.in_flight_2_vs_1_fps, r.stereo_vs_two_mono_frame_time, r.stereo_vs_two_mono_gpu_ms, r.stereo_vs_two_mono_bytes
+    );
+    println!(
+        "cross-eye reuse: its passes {:.1} % of the stereo frame; GPU ms {:.3}× the stereo frame without it",
+        100.0 * r.cross_eye_share,
+        r.cross_eye_vs_stereo_gpu_ms
     );
 }
 

@@ -362,6 +362,17 @@ impl Combination<'_> {
     }
 }
 
+/// How a run's eyes relate, as its tables name it: the stereo noise, and `+ cross-eye` where
+/// each eye's samples took the other eye's (`--cross-eye-reuse on`).
+fn stereo_label(profile: &RenderProfile) -> String {
+    let noise = profile.stereo_noise.name();
+    if profile.cross_eye_reuse {
+        format!("{noise} + cross-eye")
+    } else {
+        noise.to_string()
+    }
+}
+
 /// The stereo noises of the grid: `--stereo-noise`'s, or only the profile's (`None`).
 pub fn stereo_noises(args: &QualityArgs) -> Vec<Option<StereoNoise>> {
     match args.stereo_noises {
@@ -560,7 +571,7 @@ pub fn run_combination(
     };
     let what = format!(
         "{camera} camera, {method} + {denoiser}, taa {taa}, stereo noise {}",
-        profile.stereo_noise.name()
+        stereo_label(&profile)
     );
     render::run(&render_args).with_context(|| what.clone())?;
     let evaluated = &prepared.evaluated;
@@ -609,7 +620,7 @@ pub fn run_combination(
         method.to_string(),
         denoiser.to_string(),
         taa.to_string(),
-        profile.stereo_noise.name().to_string(),
+        stereo_label(&profile),
     );
     Ok(q)
 }
@@ -1477,6 +1488,7 @@ impl QualityCommand {
             path_regularisation: look.path_regularisation,
             offscreen_samples: look.offscreen_samples.clone(),
             resampling: look.resampling.clone(),
+            cross_eye_reuse: look.cross_eye_reuse.clone(),
             gaze_timing: latency.timing()?,
             ..Default::default()
         })?;
