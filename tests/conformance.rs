@@ -717,3 +717,86 @@ fn resampling_on_every_space_that_supports_it() {
         assert_clean(&ctx);
     }
 }
+
+/// Cross-eye reuse (`--cross-eye-reuse on`) on every space whose grid runs the temporal filters
+/// (it finds the other eye's sample through the other eye's grid as they address it): both eyes
+/// 63 mm apart, no validation message, every pixel finite and non-negative, each eye's mean over
+/// frames like each eye's own without it (the Cornell box is diffuse: both eyes' samples of a
+/// surface estimate one radiance), and with SVGF after it; every other space refuses it by name.
+#[test]
+fn cross_eye_reuse_on_every_space_that_supports_it() {
+    use fovea_renderer::frame::ViewInput;
+    use glam::Vec3;
+    let ctx = gpu();
+    let scene = owned_scene("cornell-box");
+    let head = CameraPose::from_scene_camera(&scene.cameras[0], SIZE.x, SIZE.y);
+    let eyes = [-0.0315, 0.0315].map(|dx| ViewInput {
+        camera: CameraPose {
+            world_from_view: head.world_from_view * Mat4::from_translation(Vec3::new(dx, 0.0, 0.0)),
+            fov_tan: head.fov_tan,
+        },
+        gaze: Some(SIZE.as_vec2() * 0.5),
+    });
+    let stereo = |make: &MakeSpace, settings: RenderSettings| {
+        let gpu_scene = fovea_renderer::gpu_scene::GpuScene::upload(&ctx, &scene).unwrap();
+        Renderer::with_views(&ctx, gpu_scene, vec![make(), make()], settings, 1)
+    };
+    let with_reuse = |settings: RenderSettings| RenderSettings {
+        cross_eye_reuse: true,
+        ..settings
+    };
+    let plain = settings(DenoiserSettings::None, TaaMode::Off);
+    let frames = 12;
+    // Each eye's mean colour over `frames` frames, every frame checked.
+    let means = |r: &mut Renderer, what: &str| {
+        let mut sum = [[0.0f64; 3]; 2];
+        let mut hdr = Vec::new();
+        for f in 0..frames {
+            let input = FrameInput::views(&eyes, f).unwrap().with_hdr(true);
+            let frame = r.submit(&input, None).unwrap();
+            r.wait_frame(frame).unwrap();
+            for (eye, eye_sum) in sum.iter_mut().enumerate() {
+                r.read_view_hdr(frame, eye, &mut hdr).unwrap();
+                assert_finite_non_negative(&format!("{what}, eye {eye}, frame {f}"), &hdr);
+                let m = fovea_tests::mean_rgb(&hdr);
+                (0..3).for_each(|c| eye_sum[c] += m[c] / frames as f64);
+            }
+        }
+        sum
+    };
+    for (space_name, make) in spaces(SIZE) {
+        if !make().capabilities().temporal_filters {
+            let err = stereo(&make, with_reuse(plain))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(
+                err.contains(space_name) && err.contains("cross-eye"),
+                "{space_name} + cross-eye reuse: {err}"
+            );
+            continue;
+        }
+        let off = means(&mut stereo(&make, plain).unwrap(), space_name);
+        let on = means(
+            &mut stereo(&make, with_reuse(plain)).unwrap(),
+            &format!("{space_name} + cross-eye"),
+        );
+        println!(
+            "{space_name}: mean of {frames} frames per eye, cross-eye reuse {on:?} vs off {off:?}"
+        );
+        for eye in 0..2 {
+            for c in 0..3 {
+                assert!(
+                    (on[eye][c] / off[eye][c] - 1.0).abs() < 0.02,
+                    "{space_name}: eye {eye}, channel {c}, cross-eye {} vs off {}",
+                    on[eye][c],
+                    off[eye][c]
+                );
+            }
+        }
+        let svgf = settings(DenoiserSettings::parse("svgf").unwrap(), TaaMode::Off);
+        let mut r = stereo(&make, with_reuse(svgf)).unwrap();
+        means(&mut r, &format!("{space_name} + cross-eye + svgf"));
+        assert_clean(&ctx);
+    }
+}
