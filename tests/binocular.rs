@@ -4,7 +4,9 @@
 //! (`StereoNoise::Surface`): its random numbers are uniform in every ring of eccentricity and
 //! independent between neighbouring cells, and one eye's quality is not worse for it.
 
-use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, StereoNoise, ViewInput};
+use fovea_renderer::frame::{
+    CameraPose, CrossEyeReuse, FrameInput, RenderSettings, StereoNoise, ViewInput,
+};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
@@ -149,7 +151,11 @@ fn both_eyes_at_one_position_give_identical_denoised_images_and_a_zero_measure()
         .flat_map(|noise| [(noise, false), (noise, true)]);
     for (noise, reuse) in modes {
         let settings = RenderSettings {
-            cross_eye_reuse: reuse,
+            cross_eye_reuse: if reuse {
+                CrossEyeReuse::On
+            } else {
+                CrossEyeReuse::Off
+            },
             ..svgf(noise)
         };
         let (left, right) = stereo_pair(&ctx, &scene, &head, settings, 0.0);
@@ -452,7 +458,11 @@ fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
         let settings = RenderSettings {
             denoiser,
             stereo_noise: StereoNoise::Independent,
-            cross_eye_reuse: reuse,
+            cross_eye_reuse: if reuse {
+                CrossEyeReuse::On
+            } else {
+                CrossEyeReuse::Off
+            },
             ..Default::default()
         };
         let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
@@ -511,8 +521,8 @@ fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
     assert_clean(&ctx);
 }
 
-/// Cross-eye reuse needs a grid the filters address: a space without temporal filters refuses it
-/// by name; one view ignores it.
+/// Cross-eye reuse needs a grid the filters address: a space without temporal filters refuses
+/// `on` by name and runs without it under `auto`; one view ignores it.
 #[test]
 fn cross_eye_reuse_is_refused_by_name_where_the_grid_has_no_filters() {
     use fovea_renderer::sampling::{
@@ -521,7 +531,7 @@ fn cross_eye_reuse_is_refused_by_name_where_the_grid_has_no_filters() {
     let ctx = gpu();
     let (scene, _) = cornell();
     let settings = RenderSettings {
-        cross_eye_reuse: true,
+        cross_eye_reuse: CrossEyeReuse::On,
         ..Default::default()
     };
     let falloff = || -> Box<dyn SamplingSpace> {
@@ -539,6 +549,17 @@ fn cross_eye_reuse_is_refused_by_name_where_the_grid_has_no_filters() {
         "{error}"
     );
     let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
-    Renderer::with_views(&ctx, gpu_scene, vec![falloff()], settings, 1).expect("one view");
+    let mono = Renderer::with_views(&ctx, gpu_scene, vec![falloff()], settings, 1).unwrap();
+    assert!(!mono.reuses_across_eyes());
+    let auto = RenderSettings {
+        cross_eye_reuse: CrossEyeReuse::Auto,
+        ..settings
+    };
+    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+    let r = Renderer::with_views(&ctx, gpu_scene, vec![falloff(), falloff()], auto, 1).unwrap();
+    assert!(
+        !r.reuses_across_eyes(),
+        "auto: off where the eyes cannot share"
+    );
     assert_clean(&ctx);
 }

@@ -720,12 +720,15 @@ fn resampling_on_every_space_that_supports_it() {
 
 /// Cross-eye reuse (`--cross-eye-reuse on`) on every space whose grid runs the temporal filters
 /// (it finds the other eye's sample through the other eye's grid as they address it): both eyes
-/// 63 mm apart, no validation message, every pixel finite and non-negative, each eye's mean over
-/// frames like each eye's own without it (the Cornell box is diffuse: both eyes' samples of a
-/// surface estimate one radiance), and with SVGF after it; every other space refuses it by name.
+/// 63 mm apart with independent noise, no validation message, every pixel finite and
+/// non-negative, each eye's mean over frames like each eye's own without it (the Cornell box is
+/// diffuse: both eyes' samples of a surface estimate one radiance) and each pixel's variance over
+/// the frames lower (the other eye's sample was found and taken), and with SVGF and BMFR after
+/// it; every other space refuses it by name, and A-SVGF refuses it on every space (`auto` runs
+/// without it there).
 #[test]
 fn cross_eye_reuse_on_every_space_that_supports_it() {
-    use fovea_renderer::frame::ViewInput;
+    use fovea_renderer::frame::{CrossEyeReuse, ViewInput};
     use glam::Vec3;
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
@@ -741,15 +744,24 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
         let gpu_scene = fovea_renderer::gpu_scene::GpuScene::upload(&ctx, &scene).unwrap();
         Renderer::with_views(&ctx, gpu_scene, vec![make(), make()], settings, 1)
     };
-    let with_reuse = |settings: RenderSettings| RenderSettings {
-        cross_eye_reuse: true,
+    let with = |reuse, settings: RenderSettings| RenderSettings {
+        cross_eye_reuse: reuse,
         ..settings
     };
-    let plain = settings(DenoiserSettings::None, TaaMode::Off);
+    let with_reuse = |settings| with(CrossEyeReuse::On, settings);
+    let plain = RenderSettings {
+        stereo_noise: fovea_renderer::frame::StereoNoise::Independent,
+        ..settings(DenoiserSettings::None, TaaMode::Off)
+    };
     let frames = 12;
-    // Each eye's mean colour over `frames` frames, every frame checked.
+    // Each eye's mean colour over `frames` frames and the median over its pixels of the variance
+    // of their luminance over the frames (the median: the light's rim, where a pixel's jitter
+    // crosses from the emitter to the ceiling, varies by orders of magnitude more than noise),
+    // every frame checked.
     let means = |r: &mut Renderer, what: &str| {
         let mut sum = [[0.0f64; 3]; 2];
+        let n = (SIZE.x * SIZE.y) as usize;
+        let mut moments = [vec![(0.0f64, 0.0f64); n], vec![(0.0f64, 0.0f64); n]];
         let mut hdr = Vec::new();
         for f in 0..frames {
             let input = FrameInput::views(&eyes, f).unwrap().with_hdr(true);
@@ -760,9 +772,22 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
                 assert_finite_non_negative(&format!("{what}, eye {eye}, frame {f}"), &hdr);
                 let m = fovea_tests::mean_rgb(&hdr);
                 (0..3).for_each(|c| eye_sum[c] += m[c] / frames as f64);
+                for (p, px) in moments[eye].iter_mut().zip(&hdr) {
+                    let l = (0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2]) as f64;
+                    *p = (p.0 + l, p.1 + l * l);
+                }
             }
         }
-        sum
+        let k = frames as f64;
+        let variance = moments.map(|eye| {
+            let mut v: Vec<f64> = eye
+                .iter()
+                .map(|(s, s2)| (s2 / k - (s / k).powi(2)).max(0.0))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        });
+        (sum, variance)
     };
     for (space_name, make) in spaces(SIZE) {
         if !make().capabilities().temporal_filters {
@@ -774,17 +799,38 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
                 err.contains(space_name) && err.contains("cross-eye"),
                 "{space_name} + cross-eye reuse: {err}"
             );
+            let auto = stereo(&make, with(CrossEyeReuse::Auto, plain)).unwrap();
+            assert!(!auto.reuses_across_eyes(), "{space_name} + auto");
             continue;
         }
-        let off = means(&mut stereo(&make, plain).unwrap(), space_name);
-        let on = means(
+        let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
+        let err = stereo(&make, with_reuse(asvgf))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            err.contains("asvgf") && err.contains("cross-eye"),
+            "{space_name} + asvgf + cross-eye reuse: {err}"
+        );
+        // `auto`: on where the eyes can share, off with A-SVGF.
+        let auto = |settings| stereo(&make, with(CrossEyeReuse::Auto, settings)).unwrap();
+        assert!(!auto(asvgf).reuses_across_eyes(), "{space_name} + asvgf");
+        assert!(auto(plain).reuses_across_eyes(), "{space_name}");
+        let (off, off_variance) = means(&mut stereo(&make, plain).unwrap(), space_name);
+        let (on, on_variance) = means(
             &mut stereo(&make, with_reuse(plain)).unwrap(),
             &format!("{space_name} + cross-eye"),
         );
-        println!(
-            "{space_name}: mean of {frames} frames per eye, cross-eye reuse {on:?} vs off {off:?}"
-        );
+        println!("{space_name}: mean of {frames} frames per eye, cross-eye reuse {on:?} vs off {off:?}; pixel variance {on_variance:?} vs {off_variance:?}");
         for eye in 0..2 {
+            // Where both eyes see a surface each pixel averages two independent samples: about
+            // half the variance.
+            assert!(
+                on_variance[eye] < 0.7 * off_variance[eye],
+                "{space_name}: eye {eye}, pixel variance with cross-eye reuse {} vs off {}",
+                on_variance[eye],
+                off_variance[eye]
+            );
             for c in 0..3 {
                 assert!(
                     (on[eye][c] / off[eye][c] - 1.0).abs() < 0.02,
@@ -794,9 +840,11 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
                 );
             }
         }
-        let svgf = settings(DenoiserSettings::parse("svgf").unwrap(), TaaMode::Off);
-        let mut r = stereo(&make, with_reuse(svgf)).unwrap();
-        means(&mut r, &format!("{space_name} + cross-eye + svgf"));
+        for denoiser in ["svgf", "bmfr"] {
+            let filtered = settings(DenoiserSettings::parse(denoiser).unwrap(), TaaMode::Off);
+            let mut r = stereo(&make, with_reuse(filtered)).unwrap();
+            means(&mut r, &format!("{space_name} + cross-eye + {denoiser}"));
+        }
         assert_clean(&ctx);
     }
 }

@@ -56,9 +56,10 @@ pub struct RenderSettings {
     /// two in world units). Larger cells share more samples between the eyes and make coarser
     /// noise within each.
     pub surface_cell: f32,
-    /// With two views (the eyes): each eye's samples also take the other eye's sample of the
-    /// same surface this frame before the filters (passes/cross_eye.rs). Ignored with one view.
-    pub cross_eye_reuse: bool,
+    /// With two views (the eyes): whether each eye's samples also take the other eye's sample
+    /// of the same surface this frame before the filters (passes/cross_eye.rs). Ignored with
+    /// one view.
+    pub cross_eye_reuse: CrossEyeReuse,
     /// Texture filtering of frames (references always read level 0: point samples converge to
     /// the box-filtered pixel).
     pub texture_lod: TextureLod,
@@ -101,7 +102,7 @@ impl Default for RenderSettings {
             taa: TaaMode::Off,
             stereo_noise: StereoNoise::default(),
             surface_cell: DEFAULT_SURFACE_CELL,
-            cross_eye_reuse: false,
+            cross_eye_reuse: CrossEyeReuse::Off,
             environment_sampling: EnvironmentSampling::default(),
             texture_lod: TextureLod::default(),
             path_regularisation: DEFAULT_PATH_REGULARISATION,
@@ -226,6 +227,42 @@ impl StereoNoise {
             StereoNoise::Independent => "independent",
             StereoNoise::Screen => "screen",
             StereoNoise::Surface => "surface",
+        }
+    }
+}
+
+/// `RenderSettings::cross_eye_reuse`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum CrossEyeReuse {
+    #[default]
+    Off,
+    /// Always; a renderer whose eyes cannot share (a space without temporal filters, A-SVGF)
+    /// is refused with the reason.
+    On,
+    /// Where the eyes can share (see `On`), off elsewhere.
+    Auto,
+}
+
+impl CrossEyeReuse {
+    pub const NAMES: &'static str = "off, on, auto";
+
+    pub fn parse(name: &str) -> Result<CrossEyeReuse> {
+        match name {
+            "off" => Ok(CrossEyeReuse::Off),
+            "on" => Ok(CrossEyeReuse::On),
+            "auto" => Ok(CrossEyeReuse::Auto),
+            other => Err(Error::Invalid(format!(
+                "cross-eye reuse '{other}' is not one of {}",
+                Self::NAMES
+            ))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            CrossEyeReuse::Off => "off",
+            CrossEyeReuse::On => "on",
+            CrossEyeReuse::Auto => "auto",
         }
     }
 }

@@ -5,8 +5,9 @@
 
 use crate::error::{Error, Result};
 use crate::frame::{
-    CameraPose, EnvironmentSampling, FrameInput, FrameStats, FrameTarget, OffscreenSamples,
-    RenderSettings, StereoNoise, TextureLod, ViewInput, MAX_VIEWS, SURFACE_CELL_RANGE,
+    CameraPose, CrossEyeReuse, EnvironmentSampling, FrameInput, FrameStats, FrameTarget,
+    OffscreenSamples, RenderSettings, StereoNoise, TextureLod, ViewInput, MAX_VIEWS,
+    SURFACE_CELL_RANGE,
 };
 use crate::frames::FrameRing;
 use crate::gpu_scene::GpuScene;
@@ -185,6 +186,12 @@ impl Renderer {
 
     pub fn views(&self) -> &[View] {
         &self.views
+    }
+
+    /// Whether the eyes share their samples (`RenderSettings::cross_eye_reuse` on, or `auto`
+    /// where they can).
+    pub fn reuses_across_eyes(&self) -> bool {
+        self.cross_eye.is_some()
     }
 
     pub fn view(&self, index: usize) -> &View {
@@ -703,21 +710,31 @@ fn build_views(
         .collect()
 }
 
-/// Cross-eye reuse when the settings ask for it and there are two views (the eyes).
+/// Cross-eye reuse when the settings ask for it (`auto`: where the eyes can share) and there are
+/// two views (the eyes).
 fn build_cross_eye(
     ctx: &Arc<Context>,
     views: &[View],
     settings: &RenderSettings,
 ) -> Result<Option<CrossEye>> {
-    match views {
-        [left, _] if settings.cross_eye_reuse => Ok(Some(CrossEye::new(ctx, left.space.as_ref())?)),
-        _ => Ok(None),
-    }
+    let [left, right] = views else {
+        return Ok(None);
+    };
+    let spaces = [left.space.as_ref(), right.space.as_ref()];
+    let build = match settings.cross_eye_reuse {
+        CrossEyeReuse::Off => false,
+        CrossEyeReuse::On => true,
+        CrossEyeReuse::Auto => CrossEye::refusal(spaces, settings).is_none(),
+    };
+    build
+        .then(|| CrossEye::new(ctx, spaces, settings))
+        .transpose()
 }
 
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
 fn max_passes(views: &[View], cross_eye: &Option<CrossEye>) -> u32 {
-    // Each view's passes and its exposure meter, and the frame's one exposure adaptation.
+    // Each view's passes and its exposure meter, the frame's one exposure adaptation, and the
+    // cross-eye passes between the views' samples and their filters.
     let frame: u32 = views.iter().map(|v| v.max_passes() + 1).sum::<u32>()
         + 1
         + cross_eye.as_ref().map_or(0, |_| CrossEye::PASSES);

@@ -5,8 +5,9 @@
 // same depth and normal as the denoisers' reprojection tests — and averages the two demodulated
 // radiances. Where the surface's BRDF lobe is narrower than the angle between the eyes' views,
 // the other eye saw other light (a reflection moves with the eye) and its sample weighs less,
-// down to nothing. Writes the merged radiance into `merged` (w: 1 where merged); the resolve pass
-// writes it back once both eyes have read each other's samples.
+// down to nothing (the roughness is the tracer's, in the radiance's w). Writes the merged radiance
+// into `merged` (w: the roughness; −1 where nothing merged); the resolve pass writes it back once
+// both eyes have read each other's samples.
 //! variants per space
 #include "../common/layouts.glsl"
 #include "../common/frame.glsl"
@@ -29,11 +30,12 @@ layout(set = 0, binding = 15, rgba32f) uniform readonly image2D other_normal_dep
 layout(set = 0, binding = 16, rgba32f) uniform readonly image2D other_position;
 layout(set = 0, binding = 17, rg32ui) uniform readonly uimage2D other_ids;
 layout(set = 0, binding = 18, rgba32f) uniform writeonly image2D merged;
-layout(std430, set = 0, binding = 19) readonly buffer Materials { MaterialGpu data[]; } materials;
 
 // The other eye's sample weighs fully where the lobe (GGX α = roughness²) is at least twice
 // this multiple of the angle between the two views, nothing below once that multiple.
 const float CROSS_EYE_LOBE_MARGIN = 2.0;
+// As SVGF's reprojection: below this total bilinear weight the other eye has no sample here.
+const float CROSS_EYE_MIN_TAP_WEIGHT = 0.01;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
@@ -41,7 +43,7 @@ void main() {
     uvec2 id = imageLoad(ids, t).xy;
     // No sample here, or the environment seen directly (noise-free): nothing to merge.
     if (id.x == 0u) {
-        imageStore(merged, t, vec4(0.0));
+        imageStore(merged, t, vec4(-1.0));
         return;
     }
     vec4 pos = imageLoad(position, t);
@@ -50,9 +52,10 @@ void main() {
     // that decide branches and would recompile this one per eye and whenever a camera moves.
     uint c0 = uint(push.p.params.y);
     FrameData other_eye = other_frame.data[c0];
-    vec3 world = frame.data.world_from_view[c0 + 3u].xyz + pos.xyz;
-    vec3 from_other = world - other_eye.world_from_view[3].xyz;
-    vec3 local = inverse(mat3(other_eye.world_from_view)) * from_other;
+    // The point relative to the other camera, from camera-relative values (no large world
+    // coordinates); the cameras are rigid: the transpose inverts their rotation.
+    vec3 from_other = pos.xyz + (frame.data.world_from_view[c0 + 3u].xyz - other_eye.world_from_view[3].xyz);
+    vec3 local = transpose(mat3(other_eye.world_from_view)) * from_other;
     vec2 size = vec2(push.p.other.grid.zw);
     vec2 screen, p;
     Grid other = grid_make(push.p.other);
@@ -84,18 +87,21 @@ void main() {
             found += w[k];
         }
     }
+    vec4 mine = imageLoad(radiance, t);
     float weight = 0.0;
-    if (found > 0.0) {
+    // Taps of a negligible bilinear weight alone are not a sample of this point.
+    if (found > CROSS_EYE_MIN_TAP_WEIGHT) {
         theirs /= found;
-        float roughness = materials.data[id.y & 0xffffu].surface.y;
-        float parallax = acos(clamp(dot(normalize(-pos.xyz), normalize(-from_other)), -1.0, 1.0));
+        float roughness = mine.w;
+        // The angle between the two views of the point (atan2: exact for small angles too).
+        vec3 a = normalize(pos.xyz), b = normalize(from_other);
+        float parallax = atan(length(cross(a, b)), dot(a, b));
         float lobe = roughness * roughness / max(CROSS_EYE_LOBE_MARGIN * parallax, 1e-6);
         weight = push.p.params.x * smoothstep(1.0, 2.0, lobe);
     }
     if (weight <= 0.0) {
-        imageStore(merged, t, vec4(0.0));
+        imageStore(merged, t, vec4(-1.0));
         return;
     }
-    vec3 mine = imageLoad(radiance, t).rgb;
-    imageStore(merged, t, vec4((mine + weight * theirs) / (1.0 + weight), 1.0));
+    imageStore(merged, t, vec4((mine.rgb + weight * theirs) / (1.0 + weight), mine.w));
 }

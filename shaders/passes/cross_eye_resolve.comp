@@ -15,7 +15,7 @@ void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, imageSize(merged)))) return;
     vec4 m = imageLoad(merged, t);
-    if (m.w == 0.0) return;
+    if (m.w < 0.0) return;
     imageStore(color, t, vec4(m.rgb * imageLoad(albedo, t).rgb, 1.0));
-    imageStore(radiance, t, vec4(m.rgb, 1.0));
+    imageStore(radiance, t, vec4(m.rgb, m.w));
 }

@@ -35,7 +35,7 @@ layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { TracePush p; } push;
 
 layout(set = 0, binding = 10, rgba32f) uniform writeonly image2D out_color;        // full radiance
-layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D out_radiance;     // radiance / albedo
+layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D out_radiance;     // radiance / albedo, w the primary hit's roughness (cross_eye.comp)
 layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_albedo;
 layout(set = 0, binding = 13, rgba32f) uniform writeonly image2D out_normal_depth; // normal, linear depth (0: miss)
 layout(set = 0, binding = 14, rgba32f) uniform writeonly image2D out_position;     // camera-relative position, depth change per grid texel
@@ -176,6 +176,7 @@ void main() {
     Hit hit;
     vec3 color = vec3(0.0);
     vec3 albedo = vec3(1.0);
+    float roughness = 0.0;
     vec4 normal_depth = vec4(0.0);
     vec4 position = vec4(0.0);
     uvec2 ids = uvec2(0u);
@@ -217,6 +218,7 @@ void main() {
         float depth_gradient = depth * pixel_tan * footprint
                              * sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view;
         albedo = max(s.base_color, vec3(0.01));
+        roughness = s.roughness;
         normal_depth = vec4(s.normal, depth);
         position = vec4(p_rel, depth_gradient);
         ids = uvec2(hit.triangle + 1u, s.material | (s.mesh << 16u));
@@ -236,7 +238,7 @@ void main() {
     // Never let a NaN/Inf from a degenerate triangle poison the accumulators downstream.
     if (any(isnan(color)) || any(isinf(color))) color = vec3(0.0);
     imageStore(out_color, texel, vec4(color, 1.0));
-    imageStore(out_radiance, texel, vec4(color / albedo, 1.0));
+    imageStore(out_radiance, texel, vec4(color / albedo, roughness));
     imageStore(out_albedo, texel, vec4(albedo, 1.0));
     imageStore(out_normal_depth, texel, normal_depth);
     imageStore(out_position, texel, position);

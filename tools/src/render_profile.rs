@@ -10,8 +10,8 @@
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::frame::{
-    OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION, DEFAULT_SURFACE_CELL,
-    SURFACE_CELL_RANGE,
+    CrossEyeReuse, OffscreenSamples, StereoNoise, TextureLod, DEFAULT_PATH_REGULARISATION,
+    DEFAULT_SURFACE_CELL, SURFACE_CELL_RANGE,
 };
 use fovea_renderer::passes::denoise::{DenoiserProfile, DenoiserSettings};
 use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
@@ -58,9 +58,10 @@ pub struct RenderProfile {
     /// `[trace] surface_cell`: the surface noise's cell edge in sample footprints
     /// (`RenderSettings::surface_cell`); `None`: the engine's default.
     pub surface_cell: Option<f32>,
-    /// `[trace] cross_eye_reuse`: with both eyes, each eye's samples also take the other eye's
-    /// sample of the same surface before the filters (`--cross-eye-reuse`).
-    pub cross_eye_reuse: bool,
+    /// `[trace] cross_eye_reuse`: with both eyes, whether each eye's samples also take the other
+    /// eye's sample of the same surface before the filters (`--cross-eye-reuse`); `auto` by
+    /// default (docs/quality.md#cross-eye-reuse).
+    pub cross_eye_reuse: CrossEyeReuse,
     /// `--latency-ms`, `--tracker-hz`, `--gaze-predict` (flags only): which gaze each frame sees.
     pub gaze_timing: fovea_stage::gaze::GazeTiming,
 }
@@ -102,7 +103,7 @@ impl Default for RenderProfile {
             resampling: Default::default(),
             stereo_noise: Default::default(),
             surface_cell: None,
-            cross_eye_reuse: false,
+            cross_eye_reuse: CrossEyeReuse::Auto,
             gaze_timing: Default::default(),
         }
     }
@@ -214,7 +215,7 @@ struct TraceSection {
     offscreen: Option<String>,
     stereo_noise: Option<String>,
     surface_cell: Option<f32>,
-    cross_eye_reuse: Option<bool>,
+    cross_eye_reuse: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
@@ -559,7 +560,8 @@ impl RenderProfile {
             profile.surface_cell = Some(cell);
         }
         if let Some(reuse) = trace.cross_eye_reuse {
-            profile.cross_eye_reuse = reuse;
+            profile.cross_eye_reuse = CrossEyeReuse::parse(&reuse)
+                .with_context(|| format!("{}.cross_eye_reuse", at("trace")))?;
         }
         if let Some(resampling) = file.resampling {
             resampling.validate().with_context(|| at("resampling"))?;
@@ -634,7 +636,7 @@ impl RenderProfile {
             self.stereo_noise = StereoNoise::parse(mode).context("--stereo-noise")?;
         }
         if let Some(reuse) = &o.cross_eye_reuse {
-            self.cross_eye_reuse = parse_on_off(reuse).context("--cross-eye-reuse")?;
+            self.cross_eye_reuse = CrossEyeReuse::parse(reuse).context("--cross-eye-reuse")?;
         }
         if let Some(mode) = &o.resampling {
             let mode = ResamplingMode::parse(mode).context("--resampling")?;
@@ -655,15 +657,6 @@ impl RenderProfile {
     pub fn path_regularisation(&self) -> f32 {
         self.path_regularisation
             .unwrap_or(DEFAULT_PATH_REGULARISATION)
-    }
-}
-
-/// `on` or `off`.
-fn parse_on_off(value: &str) -> Result<bool> {
-    match value {
-        "on" => Ok(true),
-        "off" => Ok(false),
-        other => bail!("'{other}': expected on or off"),
     }
 }
 
@@ -1432,29 +1425,23 @@ gradient_sigma_normal = 64
         assert!(err.contains("--stereo-noise"), "{err}");
     }
 
-    /// `[trace] cross_eye_reuse` and `--cross-eye-reuse on|off` reach the profile; a bad flag
-    /// value is refused naming the flag and the accepted values, a bad file value naming the key.
+    /// `[trace] cross_eye_reuse` and `--cross-eye-reuse off|on|auto` reach the profile (`auto` by
+    /// default); bad values are refused naming the flag or the file and key, and the accepted
+    /// values.
     #[test]
     fn cross_eye_reuse_from_file_and_flag() {
-        assert!(!RenderProfile::default().cross_eye_reuse);
-        let p = load_str("stereo.toml", "[trace]\ncross_eye_reuse = true\n").unwrap();
-        assert!(p.cross_eye_reuse);
+        assert_eq!(
+            RenderProfile::default().cross_eye_reuse,
+            CrossEyeReuse::Auto
+        );
+        let p = load_str("stereo.toml", "[trace]\ncross_eye_reuse = \"on\"\n").unwrap();
+        assert_eq!(p.cross_eye_reuse, CrossEyeReuse::On);
         let flag = |value: &str| ProfileOverrides {
             cross_eye_reuse: Some(value.into()),
             ..Default::default()
         };
-        assert!(
-            !p.clone()
-                .override_with(&flag("off"))
-                .unwrap()
-                .cross_eye_reuse
-        );
-        assert!(
-            RenderProfile::default()
-                .override_with(&flag("on"))
-                .unwrap()
-                .cross_eye_reuse
-        );
+        let off = p.clone().override_with(&flag("off")).unwrap();
+        assert_eq!(off.cross_eye_reuse, CrossEyeReuse::Off);
         let err = format!(
             "{:#}",
             RenderProfile::default()
@@ -1462,15 +1449,15 @@ gradient_sigma_normal = 64
                 .unwrap_err()
         );
         assert!(
-            err.contains("--cross-eye-reuse") && err.contains("on or off"),
+            err.contains("--cross-eye-reuse") && err.contains("off, on, auto"),
             "{err}"
         );
         let err = format!(
             "{:#}",
-            load_str("bad.toml", "[trace]\ncross_eye_reuse = \"on\"\n").unwrap_err()
+            load_str("bad.toml", "[trace]\ncross_eye_reuse = \"always\"\n").unwrap_err()
         );
         assert!(
-            err.contains("bad.toml") && err.contains("cross_eye_reuse"),
+            err.contains("bad.toml") && err.contains("cross_eye_reuse") && err.contains("auto"),
             "{err}"
         );
     }

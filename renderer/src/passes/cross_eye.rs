@@ -7,6 +7,7 @@
 //! G-buffer (colour = radiance × this eye's albedo) once both merges have run.
 
 use crate::error::{Error, Result};
+use crate::frame::RenderSettings;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::CrossEyePush;
 use crate::passes::grid::GridFrame;
@@ -42,18 +43,55 @@ impl CrossEye {
     /// Timestamped passes per frame: a merge and a resolve per eye.
     pub const PASSES: u32 = 4;
 
-    /// The passes for a stereo pair of `space`'s grids; an error naming the space where its grid
-    /// is not one the filters address (no temporal filters: no per-sample G-buffer to find the
-    /// other eye's sample in).
-    pub fn new(ctx: &Arc<Context>, space: &dyn SamplingSpace) -> Result<CrossEye> {
-        let caps = space.capabilities();
+    /// Why the eyes of `spaces` cannot share their samples under `settings`, if they cannot: a
+    /// space whose grid the filters do not address (no per-sample G-buffer to find the other
+    /// eye's sample in), two eyes of different spaces or sizes, or A-SVGF.
+    pub fn refusal(
+        [left, right]: [&dyn SamplingSpace; 2],
+        settings: &RenderSettings,
+    ) -> Option<String> {
+        let caps = left.capabilities();
         if !caps.temporal_filters {
-            return Err(Error::Invalid(format!(
+            return Some(format!(
                 "cross-eye reuse: the {} space cannot match its samples between the eyes {}",
-                space.name(),
+                left.name(),
                 caps.filters_note
-            )));
+            ));
         }
+        let shape = |s: &dyn SamplingSpace| (s.shader_variant(), s.grid_size(), s.screen_size());
+        if shape(left) != shape(right) {
+            return Some(format!(
+                "cross-eye reuse: the eyes' spaces differ ({} {:?} against {} {:?}); both eyes \
+                 need one space at one size",
+                left.name(),
+                shape(left),
+                right.name(),
+                shape(right)
+            ));
+        }
+        // A-SVGF measures how the light changed against last frame's samples as traced; merged,
+        // they would read as change.
+        if settings.denoiser.needs_gradients() {
+            return Some(format!(
+                "cross-eye reuse with denoiser '{}': A-SVGF's temporal gradients compare each \
+                 eye's own samples between frames; use svgf or bmfr",
+                settings.denoiser.name()
+            ));
+        }
+        None
+    }
+
+    /// The passes for the eyes' spaces (`settings` the renderer's); an error with the
+    /// [`refusal`](Self::refusal) where they cannot share.
+    pub fn new(
+        ctx: &Arc<Context>,
+        spaces: [&dyn SamplingSpace; 2],
+        settings: &RenderSettings,
+    ) -> Result<CrossEye> {
+        if let Some(reason) = Self::refusal(spaces, settings) {
+            return Err(Error::Invalid(reason));
+        }
+        let space = spaces[0];
         let grid = space.grid_size();
         let image = |name| Image::new(ctx, name, grid.x, grid.y, vk::Format::R32G32B32A32_SFLOAT);
         Ok(CrossEye {
@@ -89,7 +127,6 @@ impl CrossEye {
                 read_image("other_position", &o.position),
                 read_image("other_ids", &o.ids),
                 write_image("merged", merged),
-                read_buffer("materials", mine.materials),
                 // The other eye's grid addressing (the screen-clipped layout's arcs).
                 read_texels("grid_columns", theirs.sampling_table),
             ];

@@ -15,7 +15,8 @@ pub struct GBuffer {
     pub size: UVec2,
     /// Full radiance (what a viewer sees without a denoiser).
     pub color: Image,
-    /// Radiance divided by albedo (demodulated; exactly `color / albedo`).
+    /// Radiance divided by albedo (demodulated; exactly `color / albedo`); w: the primary hit's
+    /// roughness, textures applied (cross-eye reuse's test of view dependence).
     pub radiance: Image,
     pub albedo: Image,
     /// Shading normal (xyz) and linear view depth (w, 0 where nothing was hit).

@@ -13,7 +13,7 @@ use crate::cpu_time::{CpuTimes, CpuUse};
 use crate::render_profile::RenderProfile;
 use anyhow::{bail, Context as _, Result};
 use fovea_hal::{Eye, HmdDescription};
-use fovea_renderer::frame::{CameraPose, FrameInput, RenderSettings, ViewInput};
+use fovea_renderer::frame::{CameraPose, CrossEyeReuse, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::scene::bvh::Bvh;
@@ -334,7 +334,11 @@ impl<'a> LoopSetup<'a> {
                 scene,
                 spaces,
                 RenderSettings {
-                    cross_eye_reuse: cross_eye,
+                    cross_eye_reuse: if cross_eye {
+                        CrossEyeReuse::On
+                    } else {
+                        CrossEyeReuse::Off
+                    },
                     ..self.settings
                 },
                 in_flight,

@@ -101,10 +101,11 @@ pub struct SceneFlags {
     /// comma-separated list and renders each.
     #[arg(long)]
     pub stereo_noise: Option<String>,
-    /// With both eyes: on (each eye's samples also take the other eye's sample of the same
-    /// surface this frame, found through the depth, before the denoiser; where a glossy lobe is
-    /// narrower than the angle between the eyes, less) or off (the default); spaces with
-    /// temporal filters only.
+    /// With both eyes, whether each eye's samples also take the other eye's samples of the same
+    /// surface this frame, found through the depth, before the denoiser (where a glossy lobe is
+    /// narrower than the angle between the eyes, less): auto (the default: where the method's
+    /// space has temporal filters and the denoiser is not asvgf), on (refused where it cannot)
+    /// or off.
     #[arg(long)]
     pub cross_eye_reuse: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later

@@ -140,6 +140,10 @@ pub struct RunQuality {
     taa: String,
     /// How the eyes' random numbers related (`--stereo-noise`).
     stereo_noise: String,
+    /// Whether each eye's samples took the other eye's (`--cross-eye-reuse`; the run's
+    /// report.json).
+    #[serde(default)]
+    cross_eye_reuse: bool,
     /// The exposure multiplier its frames and references were displayed at
     /// (`--display-exposure`).
     #[serde(default = "unit_exposure")]
@@ -363,10 +367,9 @@ impl Combination<'_> {
 }
 
 /// How a run's eyes relate, as its tables name it: the stereo noise, and `+ cross-eye` where
-/// each eye's samples took the other eye's (`--cross-eye-reuse on`).
-fn stereo_label(profile: &RenderProfile) -> String {
-    let noise = profile.stereo_noise.name();
-    if profile.cross_eye_reuse {
+/// each eye's samples took the other eye's (its report.json).
+fn stereo_label(noise: &str, cross_eye_reuse: bool) -> String {
+    if cross_eye_reuse {
         format!("{noise} + cross-eye")
     } else {
         noise.to_string()
@@ -570,8 +573,9 @@ pub fn run_combination(
         camera: args.camera,
     };
     let what = format!(
-        "{camera} camera, {method} + {denoiser}, taa {taa}, stereo noise {}",
-        stereo_label(&profile)
+        "{camera} camera, {method} + {denoiser}, taa {taa}, stereo noise {}, cross-eye reuse {}",
+        profile.stereo_noise.name(),
+        profile.cross_eye_reuse.name()
     );
     render::run(&render_args).with_context(|| what.clone())?;
     let evaluated = &prepared.evaluated;
@@ -620,7 +624,7 @@ pub fn run_combination(
         method.to_string(),
         denoiser.to_string(),
         taa.to_string(),
-        stereo_label(&profile),
+        profile.stereo_noise.name().to_string(),
     );
     Ok(q)
 }
@@ -1158,6 +1162,7 @@ fn measure(
         denoiser: String::new(),
         taa: String::new(),
         stereo_noise: String::new(),
+        cross_eye_reuse: report["cross_eye_reuse"].as_bool().unwrap_or(false),
         frame_gpu_ms: report["frame_gpu_ms"].as_f64().unwrap_or(0.0),
         samples_traced: report["samples_traced"].as_u64().unwrap_or(0),
         rays_traced: report["rays_traced"].as_u64().unwrap_or(0),
@@ -1205,7 +1210,10 @@ fn label(r: &Report, q: &RunQuality) -> String {
     match noises_differ || r.eyes == "both" {
         true => format!(
             "{} + {}, {}, {}",
-            q.method, q.denoiser, q.taa, q.stereo_noise
+            q.method,
+            q.denoiser,
+            q.taa,
+            stereo_label(&q.stereo_noise, q.cross_eye_reuse)
         ),
         false => format!("{} + {}, {}", q.method, q.denoiser, q.taa),
     }
@@ -1345,6 +1353,7 @@ fn markdown(r: &Report) -> String {
                     && q.denoiser == vp.denoiser
                     && q.taa == vp.taa
                     && q.stereo_noise == vp.stereo_noise
+                    && q.cross_eye_reuse == vp.cross_eye_reuse
             });
             if let (Some(c), Some(v_rmse)) = (cartesian, vp.rings[0].rmse) {
                 if let Some(c_rmse) = c.rings[0].rmse {

@@ -39,7 +39,8 @@ struct Report {
     /// `surface` noise: its cells' edge in sample footprints.
     #[serde(skip_serializing_if = "Option::is_none")]
     surface_cell: Option<f32>,
-    /// With both eyes: whether each eye's samples took the other eye's (`--cross-eye-reuse`).
+    /// Whether each eye's samples took the other eye's (`--cross-eye-reuse`: with both eyes,
+    /// `auto` where they can).
     cross_eye_reuse: bool,
     scene: String,
     headset: String,
@@ -290,7 +291,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         stereo_noise: args.profile.stereo_noise.name(),
         surface_cell: (args.profile.stereo_noise == fovea_renderer::frame::StereoNoise::Surface)
             .then(|| args.profile.surface_cell()),
-        cross_eye_reuse: args.profile.cross_eye_reuse,
+        cross_eye_reuse: renderer.reuses_across_eyes(),
         scene: setup.scene.source.display().to_string(),
         headset: setup.hmd.id.clone(),
         projection: args.camera.projection.name(),
