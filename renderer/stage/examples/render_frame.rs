@@ -13,7 +13,7 @@
 
 use anyhow::{Context as _, Result};
 use fovea_hal::{Eye, HmdDescription};
-use fovea_renderer::frame::{FrameInput, RenderSettings, ViewInput};
+use fovea_renderer::frame::{CrossEyeReuse, FrameInput, RenderSettings, ViewInput};
 use fovea_renderer::passes::denoise::{bmfr::BmfrSettings, DenoiserSettings};
 use fovea_renderer::passes::exposure::Exposure;
 use fovea_renderer::passes::taa::{TaaMode, TaaSettings};
@@ -93,6 +93,8 @@ pub fn render(options: &Options) -> Result<Rendered> {
             sigma_at_30: 0.0,
             ..Default::default()
         },
+        // The renderer's default is off; fovea's profile lets the eyes share where they can.
+        cross_eye_reuse: CrossEyeReuse::Auto,
         ..Default::default()
     };
     let gpu_scene = fovea_renderer::gpu_scene::GpuScene::upload(&ctx, &scene)?;
