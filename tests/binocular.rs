@@ -563,3 +563,43 @@ fn cross_eye_reuse_is_refused_by_name_where_the_grid_has_no_filters() {
     );
     assert_clean(&ctx);
 }
+
+/// A renderer replacing one view by two (`Renderer::replace_views`, as `fovea view` does) starts
+/// sharing between the eyes: its frame ring grows for the cross-eye passes' timestamps and the
+/// stereo frames run without a validation message.
+#[test]
+fn replacing_one_view_by_two_starts_cross_eye_reuse() {
+    let ctx = gpu();
+    let (scene, head) = cornell();
+    let settings = RenderSettings {
+        cross_eye_reuse: CrossEyeReuse::On,
+        ..svgf(StereoNoise::Screen)
+    };
+    let cartesian = || -> Box<dyn SamplingSpace> { Box::new(Cartesian::new(SCREEN)) };
+    let gpu_scene = GpuScene::upload(&ctx, &scene).unwrap();
+    let mut r = Renderer::with_views(&ctx, gpu_scene, vec![cartesian()], settings, 2).unwrap();
+    assert!(!r.reuses_across_eyes());
+    r.render_frame(&FrameInput::mono(head, 0, None)).unwrap();
+    r.replace_views(vec![cartesian(), cartesian()], settings)
+        .unwrap();
+    assert!(r.reuses_across_eyes());
+    let views = [-HALF_IPD, HALF_IPD].map(|dx| ViewInput {
+        camera: eye(&head, dx),
+        gaze: None,
+    });
+    for f in 1..4 {
+        r.submit(&FrameInput::views(&views, f).unwrap(), None)
+            .unwrap();
+    }
+    r.finish().unwrap();
+    let names: Vec<(&str, u32)> = r.timings().iter().map(|p| (p.name, p.view)).collect();
+    for pass in ["cross_eye", "cross_eye_resolve"] {
+        for view in 0..2 {
+            assert!(
+                names.contains(&(pass, view)),
+                "{pass} of view {view}: {names:?}"
+            );
+        }
+    }
+    assert_clean(&ctx);
+}
