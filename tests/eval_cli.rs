@@ -578,6 +578,8 @@ fn quality_of_both_eyes_adds_the_binocular_measure() {
     let noise_of = |r: &serde_json::Value| r["stereo_noise"].as_str().unwrap().to_string();
     assert_eq!(noise_of(&runs[0]), "independent");
     assert_eq!(noise_of(&runs[1]), "surface");
+    // The default profile's cross-eye reuse (`auto`) runs with SVGF: each run's report says so.
+    assert!(runs.iter().all(|r| r["cross_eye_reuse"] == true), "{runs:?}");
     for name in [
         "reference_still_left_0000.exr",
         "reference_still_right_0000.exr",
@@ -589,7 +591,7 @@ fn quality_of_both_eyes_adds_the_binocular_measure() {
     let table = std::fs::read_to_string(out.join("quality.md")).unwrap();
     assert!(
         table.contains("Binocular difference")
-            && table.contains("| cartesian + svgf, off, surface |")
+            && table.contains("| cartesian + svgf, off, surface + cross-eye |")
             && table.contains("flicker of the difference"),
         "{table}"
     );

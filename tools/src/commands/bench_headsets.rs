@@ -1,6 +1,7 @@
 //! `fovea bench`'s headset loop (`--loop-scenes`, `--loop-headsets`): both eyes of real scenes at
 //! the built-in headset profiles' recommended per-eye sizes, the head on the default orbit and the
-//! simulated gaze, one stereo renderer with 2 frames in flight, as `fovea render --eyes both` runs.
+//! simulated gaze, one stereo renderer with 2 frames in flight and the default profile's cross-eye
+//! reuse, as `fovea render --eyes both` runs.
 //! Per scene and size three runs, VP + SVGF, VP + A-SVGF and Cartesian + SVGF, each made twice in
 //! the order A B C C B A: frames/s, per-pass GPU ms, and the VP / Cartesian ratio of the whole
 //! stereo frame (how the saving changes with resolution).

@@ -112,34 +112,40 @@ type Spec = &'static [Eye];
 pub(super) struct Config {
     specs: &'static [Spec],
     in_flight: usize,
-    /// `RenderSettings::cross_eye_reuse` for this run.
-    cross_eye: bool,
+    /// `RenderSettings::cross_eye_reuse` for this run; `None`: the default profile's.
+    cross_eye: Option<CrossEyeReuse>,
 }
 
 const STEREO: &[Spec] = &[&[Eye::Left, Eye::Right]];
 const TWO_MONO: &[Spec] = &[&[Eye::Left], &[Eye::Right]];
-/// The stereo renderer with 2 frames in flight (the headset loop's one run shape).
+/// The stereo renderer with 2 frames in flight and the default profile's settings (the headset
+/// loop's one run shape).
 pub(super) const STEREO_2: Config = Config {
     specs: STEREO,
     in_flight: 2,
-    cross_eye: false,
+    cross_eye: None,
 };
+/// The real-time loop's runs: the engine's shapes without cross-eye reuse, then with it.
 const CONFIGS: [Config; 4] = [
     Config {
         specs: STEREO,
         in_flight: 1,
-        cross_eye: false,
-    },
-    STEREO_2,
-    Config {
-        specs: TWO_MONO,
-        in_flight: 2,
-        cross_eye: false,
+        cross_eye: Some(CrossEyeReuse::Off),
     },
     Config {
         specs: STEREO,
         in_flight: 2,
-        cross_eye: true,
+        cross_eye: Some(CrossEyeReuse::Off),
+    },
+    Config {
+        specs: TWO_MONO,
+        in_flight: 2,
+        cross_eye: Some(CrossEyeReuse::Off),
+    },
+    Config {
+        specs: STEREO,
+        in_flight: 2,
+        cross_eye: Some(CrossEyeReuse::On),
     },
 ];
 /// Forwards, then backwards.
@@ -264,6 +270,7 @@ impl<'a> LoopSetup<'a> {
             blur: profile.blur,
             denoiser,
             taa,
+            cross_eye_reuse: profile.cross_eye_reuse,
             ..Default::default()
         };
         let Some(camera) = scene.scene.default_camera() else {
@@ -318,7 +325,7 @@ impl<'a> LoopSetup<'a> {
         ctx: &Arc<Context>,
         eyes: Spec,
         in_flight: usize,
-        cross_eye: bool,
+        cross_eye: Option<CrossEyeReuse>,
     ) -> Result<(Renderer, i64)> {
         let spaces = eyes
             .iter()
@@ -334,11 +341,7 @@ impl<'a> LoopSetup<'a> {
                 scene,
                 spaces,
                 RenderSettings {
-                    cross_eye_reuse: if cross_eye {
-                        CrossEyeReuse::On
-                    } else {
-                        CrossEyeReuse::Off
-                    },
+                    cross_eye_reuse: cross_eye.unwrap_or(self.settings.cross_eye_reuse),
                     ..self.settings
                 },
                 in_flight,
