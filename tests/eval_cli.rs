@@ -579,7 +579,10 @@ fn quality_of_both_eyes_adds_the_binocular_measure() {
     assert_eq!(noise_of(&runs[0]), "independent");
     assert_eq!(noise_of(&runs[1]), "surface");
     // The default profile's cross-eye reuse (`auto`) runs with SVGF: each run's report says so.
-    assert!(runs.iter().all(|r| r["cross_eye_reuse"] == true), "{runs:?}");
+    assert!(
+        runs.iter().all(|r| r["cross_eye_reuse"] == true),
+        "{runs:?}"
+    );
     for name in [
         "reference_still_left_0000.exr",
         "reference_still_right_0000.exr",
