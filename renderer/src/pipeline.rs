@@ -50,10 +50,6 @@ macro_rules! grid_frame {
     };
 }
 
-/// How much the other eye's sample of a surface weighs in cross-eye reuse against the eye's own
-/// (both one sample of the same pixel's worth of surface).
-const CROSS_EYE_WEIGHT: f32 = 1.0;
-
 /// Passes one reference submission may hold (trace + accumulate per sample).
 const REFERENCE_SAMPLES_PER_SUBMIT: u32 = 8;
 
@@ -390,7 +386,7 @@ impl Renderer {
                 grid_frame!(left, &left.slots[slot], self.scene, inputs[0].camera),
                 grid_frame!(right, &right.slots[slot], self.scene, inputs[1].camera),
             ];
-            cross_eye.record(rec, [&frames[0], &frames[1]], CROSS_EYE_WEIGHT)?;
+            cross_eye.record(rec, [&frames[0], &frames[1]])?;
         }
         for (v, (view, view_input)) in self.views.iter_mut().zip(inputs).enumerate() {
             rec.set_view(v as u32);

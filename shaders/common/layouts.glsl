@@ -471,8 +471,7 @@ struct ResampleSpatialPush {
 // is this eye's size; its gaze and shape its own).
 struct CrossEyePush {
     SamplingParams other;       // the other eye's space this frame
-    vec4 params;                // x weight of the other eye's sample (1: as this eye's own), y 0 (a column index
-                                //   lavapipe cannot fold, see cross_eye.comp), zw unused
+    uvec4 config;               // x 0 (a column index lavapipe cannot fold, see cross_eye.comp), yzw unused
 };
 
 const uint TONEMAP_CLAMP = 0u;

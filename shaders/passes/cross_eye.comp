@@ -47,10 +47,10 @@ void main() {
         return;
     }
     vec4 pos = imageLoad(position, t);
-    // The cameras and frusta through an index lavapipe cannot fold (push constant params.y,
+    // The cameras and frusta through an index lavapipe cannot fold (push constant config.x,
     // always 0), as the tracer reads its own: lavapipe specialises kernels on the uniform values
     // that decide branches and would recompile this one per eye and whenever a camera moves.
-    uint c0 = uint(push.p.params.y);
+    uint c0 = push.p.config.x;
     FrameData other_eye = other_frame.data[c0];
     // The point relative to the other camera, from camera-relative values (no large world
     // coordinates); the cameras are rigid: the transpose inverts their rotation.
@@ -81,9 +81,8 @@ void main() {
             if (other_id.x == 0u) continue;
             SvgfSurface there = svgf_surface(imageLoad(other_normal_depth, o), imageLoad(other_position, o).w, other_id);
             if (!svgf_same_surface(here, there)) continue;
-            vec3 r = imageLoad(other_radiance, o).rgb;
-            if (any(isnan(r)) || any(isinf(r))) continue;
-            theirs += w[k] * r;
+            // Finite: the tracer and the resampling passes write no NaN or Inf.
+            theirs += w[k] * imageLoad(other_radiance, o).rgb;
             found += w[k];
         }
     }
@@ -97,7 +96,8 @@ void main() {
         vec3 a = normalize(pos.xyz), b = normalize(from_other);
         float parallax = atan(length(cross(a, b)), dot(a, b));
         float lobe = roughness * roughness / max(CROSS_EYE_LOBE_MARGIN * parallax, 1e-6);
-        weight = push.p.params.x * smoothstep(1.0, 2.0, lobe);
+        // Up to one sample's worth, as this eye's own.
+        weight = smoothstep(1.0, 2.0, lobe);
     }
     if (weight <= 0.0) {
         imageStore(merged, t, vec4(-1.0));

@@ -15,7 +15,7 @@ use crate::passes::{Kernel, Pass};
 use crate::sampling::SamplingSpace;
 use crate::vk::{Context, Image};
 use ash::vk;
-use glam::Vec4;
+use glam::UVec4;
 use std::sync::Arc;
 
 struct Merge;
@@ -106,12 +106,7 @@ impl CrossEye {
 
     /// Merges the two eyes' samples of this frame into both eyes' G-buffers (`eyes[0]` the
     /// first view's frame, `eyes[1]` the second's).
-    pub fn record(
-        &self,
-        rec: &mut FrameRecorder,
-        eyes: [&GridFrame; 2],
-        weight: f32,
-    ) -> Result<()> {
+    pub fn record(&self, rec: &mut FrameRecorder, eyes: [&GridFrame; 2]) -> Result<()> {
         for (e, merged) in self.merged.iter().enumerate() {
             let (mine, theirs) = (eyes[e], eyes[1 - e]);
             let (g, o) = (mine.gbuffer, theirs.gbuffer);
@@ -132,7 +127,7 @@ impl CrossEye {
             ];
             let push = CrossEyePush {
                 other: theirs.current,
-                params: Vec4::new(weight, 0.0, 0.0, 0.0),
+                config: UVec4::ZERO,
             };
             let size = g.size;
             rec.set_view(e as u32);
