@@ -95,6 +95,9 @@ pub struct GpuScene {
     /// Instance count and the bytes instancing keeps off the GPU (`fovea bench`).
     pub instancing_stats: InstancingStats,
     pub light_count: u32,
+    /// Light entries that are emissive triangles (the table's first): without any, ReSTIR DI's
+    /// BRDF candidates could find nothing and are not drawn.
+    pub triangle_light_count: u32,
     pub triangle_count: u32,
     pub material_count: u32,
     pub texture_count: u32,
@@ -210,6 +213,7 @@ impl GpuScene {
             texels: Buffer::device_local(ctx, "texels", &texels, storage)?,
             lights: Buffer::with_data(ctx, "lights", &lights, storage)?,
             light_count: lights.len() as u32,
+            triangle_light_count: triangle_lights(&lights),
             triangle_count: triangles.len() as u32,
             material_count: materials.len() as u32,
             texture_count: textures.len() as u32,
@@ -270,6 +274,7 @@ impl GpuScene {
             self.lights.write(&lights)?;
         }
         self.light_count = lights.len() as u32;
+        self.triangle_light_count = triangle_lights(&lights);
         self.environment_slots = self.environment.frame_slots(&lights);
         Ok(())
     }
@@ -608,6 +613,13 @@ fn material_gpu(
             m.alpha_cutoff.unwrap_or(0.0).to_bits(),
         ),
     }
+}
+
+fn triangle_lights(lights: &[LightGpu]) -> u32 {
+    lights
+        .iter()
+        .filter(|l| l.kind_index.x == LIGHT_KIND_TRIANGLE)
+        .count() as u32
 }
 
 fn light_entries(scene: &Scene, emission_scale: &[f32]) -> Vec<LightGpu> {

@@ -21,6 +21,7 @@ use crate::passes::cross_eye::CrossEye;
 use crate::passes::denoise::Denoiser;
 use crate::passes::exposure::{Exposure, ExposurePass};
 use crate::passes::grid::{GridFrame, TileList};
+use crate::passes::resampling::ResamplingMode;
 use crate::passes::taa::Taa;
 use crate::passes::tonemap::{LdrTarget, ToneTarget, TonemapPass};
 use crate::sampling::SamplingSpace;
@@ -299,7 +300,13 @@ impl Renderer {
             path: Vec4::new(
                 self.settings.path_regularisation,
                 self.settings.surface_cell,
-                0.0,
+                if self.settings.resampling.mode == ResamplingMode::Off
+                    || self.scene.triangle_light_count == 0
+                {
+                    0.0
+                } else {
+                    self.settings.resampling.brdf_candidates as f32
+                },
                 0.0,
             ),
             instancing: self.scene.instancing_slots,

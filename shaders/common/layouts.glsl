@@ -71,7 +71,7 @@ struct FrameData {
     vec4 jitter;                // xy sub-texel sample offset in [0, 1)² (FRAME_FLAG_HALTON_JITTER), zw unused
     vec4 environment;           // what escaping rays see (Scene::environment_map): x cos, y sin of the map's rotation about +Y, z radiance scale, w probability that light selection picks it (0: not sampled)
     uvec4 environment_map;      // x width, y height (texels), z 1 when there is an environment (0: escaping rays see black), w unused
-    vec4 path;                  // x path regularisation strength (RenderSettings::path_regularisation; 0: off), y footprints per surface-noise cell (RenderSettings::surface_cell), zw unused
+    vec4 path;                  // x path regularisation strength (RenderSettings::path_regularisation; 0: off), y footprints per surface-noise cell (RenderSettings::surface_cell), z BRDF candidates of ReSTIR DI's reservoirs (ResamplingSettings::brdf_candidates; 0 with resampling off or no emissive triangle in the light table), w unused
     uvec4 instancing;           // x instances (0: none, the instance level is skipped), y flattened triangles (placed ids below are theirs), z top-level root node, w first bvh_triangles texel of its leaf entries
 };
 

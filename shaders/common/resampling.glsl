@@ -79,14 +79,18 @@ vec3 emitter_radiance(PlacedTriangle placed, vec2 bary, vec3 dir) {
 // own measure (a triangle: emitted radiance × cos at the light / distance², per area; the
 // environment: radiance per solid angle; a punctual or directional light: its intensity with
 // attenuation); `source_pdf`: the density draw_light_point gives it in that measure (selection ×
-// point); `ls`: direction, distance and the MIS density (environment) as sample_light's.
-bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 radiance, out float source_pdf) {
+// point); `ls`: direction, distance and the MIS density (environment) as sample_light's;
+// `solid_angle_to_measure`: what turns a solid-angle density at p into the light's measure
+// (cos at the light / distance² for a triangle, 1 for the environment, 0 for punctual and
+// directional lights, which no BRDF-sampled ray finds).
+bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 radiance, out float source_pdf, out float solid_angle_to_measure) {
     ls.direction = vec3(0.0, 1.0, 0.0);
     ls.distance = 0.0;
     ls.radiance_over_pdf = vec3(0.0);
     ls.mis_pdf = 0.0;
     radiance = vec3(0.0);
     source_pdf = 0.0;
+    solid_angle_to_measure = 0.0;
     LightGpu l = lights.data[lp.light];
     float select_pdf = l.sampling.y;
     if (select_pdf <= 0.0) return false;
@@ -103,7 +107,8 @@ bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 ra
         ls.distance = sqrt(d2);
         ls.direction = to / ls.distance;
         float cos_light = abs(dot(cr / (2.0 * area), ls.direction));
-        radiance = emitter_radiance(placed, lp.data, ls.direction) * cos_light / d2;
+        solid_angle_to_measure = cos_light / d2;
+        radiance = emitter_radiance(placed, lp.data, ls.direction) * solid_angle_to_measure;
         source_pdf = select_pdf / area;
     } else if (kind == LIGHT_KIND_ENVIRONMENT) {
         if (frame.data.environment.w == 0.0) return false;
@@ -112,6 +117,7 @@ bool evaluate_light_point(vec3 p, LightPoint lp, out LightSample ls, out vec3 ra
         radiance = env_radiance(frame.data.environment, frame.data.environment_map, ls.direction);
         source_pdf = select_pdf * env_pdf(frame.data.environment, frame.data.environment_map, ls.direction);
         ls.mis_pdf = source_pdf;
+        solid_angle_to_measure = 1.0;
     } else if (kind == LIGHT_KIND_DIRECTIONAL) {
         ls.direction = -l.direction.xyz;
         ls.distance = 1e30;
@@ -145,13 +151,78 @@ float resampling_luminance(vec3 c) {
 // measure: f·cos · radiance, weighted for the environment by next-event estimation's MIS share
 // against the BRDF-sampled ray that the path still traces (path.glsl), so that the two strategies
 // still sum to one. Zero where the light does not reach the surface's upper side.
-vec3 light_point_contribution(Surface s, vec3 v, LightPoint lp, out LightSample ls, out float source_pdf) {
+// `brdf_pdf_here`: the density of a BRDF candidate for the light point in the light's measure
+// (zero for the environment and punctual lights, which BRDF candidates never take).
+vec3 light_point_terms(Surface s, vec3 v, LightPoint lp, out LightSample ls, out float source_pdf, out float brdf_pdf_here) {
     vec3 radiance;
-    if (!evaluate_light_point(s.position, lp, ls, radiance, source_pdf)) return vec3(0.0);
+    float to_measure;
+    brdf_pdf_here = 0.0;
+    if (!evaluate_light_point(s.position, lp, ls, radiance, source_pdf, to_measure)) return vec3(0.0);
     vec3 f = brdf_eval_cos(s, v, ls.direction);
-    float w = ls.mis_pdf > 0.0 ? mis_power(ls.mis_pdf, brdf_pdf(s, v, ls.direction)) : 1.0;
+    float p_brdf = to_measure > 0.0 ? brdf_pdf(s, v, ls.direction) : 0.0;
+    brdf_pdf_here = p_brdf * to_measure;
+    float w = 1.0;
+    if (ls.mis_pdf > 0.0) {
+        // The environment: its BRDF-sampled share stays the path's, not a BRDF candidate's.
+        w = mis_power(ls.mis_pdf, p_brdf);
+        brdf_pdf_here = 0.0;
+    }
     vec3 c = f * radiance * w;
     return (any(isnan(c)) || any(isinf(c))) ? vec3(0.0) : c;
+}
+
+vec3 light_point_contribution(Surface s, vec3 v, LightPoint lp, out LightSample ls, out float source_pdf) {
+    float brdf_pdf_here;
+    return light_point_terms(s, v, lp, ls, source_pdf, brdf_pdf_here);
+}
+
+// A candidate's resampling weight and p̂ (`target`) among `n_light` candidates drawn from the
+// light table and `n_brdf` drawn by sampling the BRDF: MIS-weighted RIS with the balance
+// heuristic, p̂·M / (N_L·p_L + N_B·p_B) with both densities in the light's measure and
+// M = N_L + N_B, so that dividing the stream's weight sum by M·p̂ gives W as without BRDF
+// candidates (Talbot et al. 2005; Bitterli et al. 2020, §4.1).
+float light_point_candidate(Surface s, vec3 v, LightPoint lp, float n_light, float n_brdf, out LightSample ls, out float target) {
+    float source_pdf, p_brdf;
+    target = resampling_luminance(light_point_terms(s, v, lp, ls, source_pdf, p_brdf));
+    float density = n_light * source_pdf + n_brdf * p_brdf;
+    return (target > 0.0 && density > 0.0) ? target * (n_light + n_brdf) / density : 0.0;
+}
+
+// The light table entry of the emissive placed triangle `id`: the table lists emissive
+// triangles first, by ascending placed id (fovea_scene::lights::build_light_table_scaled), so a
+// binary search over that prefix finds it; false where the triangle is not in the table.
+bool triangle_light_entry(uint id, out uint entry) {
+    uint lo = 0u, hi = frame.data.counts.x;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1u;
+        uvec4 k = lights.data[mid].kind_index;
+        if (k.x == LIGHT_KIND_TRIANGLE && k.y < id) lo = mid + 1u; else hi = mid;
+    }
+    entry = lo;
+    if (lo >= frame.data.counts.x) return false;
+    uvec4 k = lights.data[lo].kind_index;
+    return k.x == LIGHT_KIND_TRIANGLE && k.y == id;
+}
+
+// A BRDF candidate: the point of an emissive triangle of the light table that a ray sampled
+// from the BRDF at `s` reaches first; false where it finds none: another surface, the
+// environment (its BRDF-sampled share is the path's own bounce, which ReSTIR GI resamples and
+// reuses), a mirror lobe (next-event estimation cannot weigh it; the path keeps it), no
+// direction. Draws 3 numbers and traces one ray; the point found is visible from `s`.
+bool draw_brdf_light_point(Surface s, vec3 v, inout uint rng, out LightPoint lp) {
+    lp.light = 0u;
+    lp.data = vec2(0.0);
+    vec3 u3 = vec3(rng_next2(rng), rng_next(rng));
+    vec3 l, weight;
+    bool delta;
+    float pdf;
+    if (!brdf_sample(s, v, u3, l, weight, delta, pdf) || delta) return false;
+    Hit h;
+    continuation_rays++;
+    if (!bvh_trace(offset_ray(s.position, s.geometric_normal), l, 0.0, 1e30, false, h)) return false;
+    if (!triangle_light_entry(h.triangle, lp.light)) return false;
+    lp.data = vec2(h.u, h.v);
+    return true;
 }
 
 // A weighted reservoir (Chao's streaming resampling): the chosen sample, the sum of the weights
@@ -218,8 +289,8 @@ ReservoirGpu reservoir_none() {
 bool light_point_reaches(vec3 p, vec3 n, vec3 v, LightPoint y) {
     LightSample ls;
     vec3 radiance;
-    float source_pdf;
-    if (!evaluate_light_point(p, y, ls, radiance, source_pdf)) return false;
+    float source_pdf, to_measure;
+    if (!evaluate_light_point(p, y, ls, radiance, source_pdf, to_measure)) return false;
     return dot(n, ls.direction) > 0.0 && dot(n, v) > 0.0 && visible(p, n, ls);
 }
 

@@ -1,7 +1,7 @@
 #version 460
 // ReSTIR DI, first pass (Bitterli et al. 2020, Alg. 5; docs/design/resampling.md): per sample of
-// the grid, N light candidates drawn as next-event estimation draws them and resampled by
-// p̂ = luminance of the unshadowed contribution (RIS); the previous frame's reservoir, found
+// the grid, N light candidates drawn as next-event estimation draws them and N_B drawn by
+// sampling the BRDF, resampled by p̂ = luminance of the unshadowed contribution (MIS-weighted RIS); the previous frame's reservoir, found
 // through the tracer's previous screen position in the previous gaze's grid and kept only on the
 // same surface, joins with its M capped and p̂ re-evaluated here; then one shadow ray to the
 // chosen sample (occluded, it keeps its M with W = 0: visibility reuse) and, where the previous
@@ -53,19 +53,34 @@ void main() {
     uint rng = rng_seed(uvec2(t), frame.data.frame.x, frame.data.frame.y, RESAMPLING_SALT_CANDIDATES);
     Reservoir r = reservoir_empty();
     LightSample chosen;
+    // Whether the chosen sample is known to be visible: a BRDF candidate's ray found it.
+    bool chosen_seen = false;
     uint candidates = uint(push.p.params.x);
+    uint brdf_candidates = uint(frame.data.path.z);
+    float n_light = float(candidates), n_brdf = float(brdf_candidates);
     for (uint i = 0u; i < candidates; ++i) {
         LightPoint lp;
         LightSample ls;
         float w = 0.0, target = 0.0;
-        if (draw_light_point(rng, lp)) {
-            float source_pdf;
-            target = resampling_luminance(light_point_contribution(s, v, lp, ls, source_pdf));
-            w = source_pdf > 0.0 ? target / source_pdf : 0.0;
+        if (draw_light_point(rng, lp)) w = light_point_candidate(s, v, lp, n_light, n_brdf, ls, target);
+        if (reservoir_update(r, lp, w, target, rng_next(rng))) {
+            chosen = ls;
+            chosen_seen = false;
         }
-        if (reservoir_update(r, lp, w, target, rng_next(rng))) chosen = ls;
     }
-    r.m = float(candidates);
+    // BRDF candidates find what light sampling rarely draws: large emitters and the environment
+    // seen through a glossy lobe.
+    for (uint i = 0u; i < brdf_candidates; ++i) {
+        LightPoint lp;
+        LightSample ls;
+        float w = 0.0, target = 0.0;
+        if (draw_brdf_light_point(s, v, rng, lp)) w = light_point_candidate(s, v, lp, n_light, n_brdf, ls, target);
+        if (reservoir_update(r, lp, w, target, rng_next(rng))) {
+            chosen = ls;
+            chosen_seen = true;
+        }
+    }
+    r.m = n_light + n_brdf;
     // In the combination each reservoir weighs p̂_here(y)·W·M; this frame's own is its Σw.
     Reservoir combined = reservoir_empty();
     reservoir_update(combined, r.y, r.weight_sum, r.target, 0.0);
@@ -93,7 +108,10 @@ void main() {
                     LightSample ls;
                     float source_pdf;
                     float target = resampling_luminance(light_point_contribution(s, v, y, ls, source_pdf));
-                    if (reservoir_update(combined, y, target * q.weights.x * m_q, target, u)) chosen = ls;
+                    if (reservoir_update(combined, y, target * q.weights.x * m_q, target, u)) {
+                        chosen = ls;
+                        chosen_seen = false;
+                    }
                 }
                 combined.m += m_q;
                 m_prev = m_q;
@@ -108,11 +126,12 @@ void main() {
     // the texel, or moved with the camera) reaches the chosen sample; 1/M would count previous
     // candidates that the penumbra there hid, and darken the penumbra here.
     float w = 0.0;
-    if (combined.full && combined.target > 0.0 && visible(s.position, s.geometric_normal, chosen)) {
+    if (combined.full && combined.target > 0.0 && (chosen_seen || visible(s.position, s.geometric_normal, chosen))) {
         float z = r.m;
         if (m_prev > 0.0 && light_point_reaches(prev_position, s.normal, v, combined.y)) z += m_prev;
         w = combined.weight_sum / (z * combined.target);
     }
     if (shadow_rays > 0u) atomicAdd(ray_counters.data[1], shadow_rays);
+    if (continuation_rays > 0u) atomicAdd(ray_counters.data[2], continuation_rays);
     fresh.data[index] = reservoir_pack(combined, w, packed_here, s.position);
 }

@@ -1468,17 +1468,18 @@ gradient_sigma_normal = 64
     fn resampling_section_and_flag() {
         let p = load_str(
             "resampling.toml",
-            "[resampling]\nmode = \"di\"\ncandidates = 16\nradius = 4.0\n",
+            "[resampling]\nmode = \"di\"\ncandidates = 16\nbrdf_candidates = 2\nradius = 4.0\n",
         )
         .unwrap();
         assert_eq!(p.resampling.mode, ResamplingMode::Di);
         assert_eq!(
             (
                 p.resampling.candidates,
+                p.resampling.brdf_candidates,
                 p.resampling.radius,
                 p.resampling.neighbours
             ),
-            (16, 4.0, ResamplingSettings::default().neighbours)
+            (16, 2, 4.0, ResamplingSettings::default().neighbours)
         );
         let off = ProfileOverrides {
             resampling: Some("off".into()),
@@ -1497,6 +1498,18 @@ gradient_sigma_normal = 64
         );
         assert!(
             err.contains("[resampling]") && err.contains("candidates"),
+            "{err}"
+        );
+        let err = format!(
+            "{:#}",
+            load_str(
+                "resampling_brdf.toml",
+                "[resampling]\nbrdf_candidates = 9\n"
+            )
+            .unwrap_err()
+        );
+        assert!(
+            err.contains("[resampling]") && err.contains("brdf_candidates"),
             "{err}"
         );
         let err = format!(

@@ -248,3 +248,53 @@ fn emission_scale_dims_or_drops_a_materials_triangles() {
         .entries
         .is_empty());
 }
+
+/// The shaders find an emissive triangle's entry by binary search over the table's first entries
+/// and the environment's as the last (resampling.glsl: `triangle_light_entry`,
+/// `draw_brdf_light_point`): emissive triangles first by ascending placed id, then punctual
+/// lights, the environment last.
+#[test]
+fn triangles_come_first_by_placed_id_and_the_environment_last() {
+    let v = |p: Vec3| Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    };
+    let triangle = |material| Triangle {
+        indices: [0, 1, 2],
+        material,
+        mesh: 0,
+    };
+    let mut scene = Scene {
+        vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
+        triangles: [1, 0, 1, 1, 0, 0, 1].map(triangle).to_vec(),
+        materials: vec![
+            Material::default(),
+            Material {
+                emissive: Vec3::ONE,
+                ..Material::default()
+            },
+        ],
+        ..Scene::default()
+    };
+    scene.punctual_lights = vec![PunctualLight::Point {
+        position: Vec3::ONE,
+        intensity: Vec3::ONE,
+        range: None,
+    }];
+    scene.sky = crate::Sky::uniform(Vec3::ONE);
+    let table = build_light_table(&scene);
+    let kinds: Vec<_> = table.entries.iter().map(|e| (e.kind, e.index)).collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (LightKind::EmissiveTriangle, 0),
+            (LightKind::EmissiveTriangle, 2),
+            (LightKind::EmissiveTriangle, 3),
+            (LightKind::EmissiveTriangle, 6),
+            (LightKind::Point, 0),
+            (LightKind::Environment, 0),
+        ]
+    );
+}

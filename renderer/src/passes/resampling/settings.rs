@@ -56,6 +56,10 @@ pub struct ResamplingSettings {
     pub mode: ResamplingMode,
     /// Light candidates drawn per sample and frame (RIS).
     pub candidates: u32,
+    /// Candidates drawn per sample and frame by sampling the BRDF (one ray each: the emitter or
+    /// the environment it reaches), weighed against the light candidates by MIS; 0 leaves the
+    /// environment's BRDF-sampled share to the path's own bounce.
+    pub brdf_candidates: u32,
     /// The previous frame's reservoir counts at most this many times this frame's candidates
     /// (Bitterli et al. 2020 use 20; ReSTIR GI's one traced bounce per frame: this many
     /// frames); 0 turns temporal reuse off.
@@ -71,6 +75,7 @@ impl Default for ResamplingSettings {
         ResamplingSettings {
             mode: ResamplingMode::Off,
             candidates: 8,
+            brdf_candidates: 1,
             temporal_cap: 20.0,
             neighbours: 3,
             radius: 8.0,
@@ -81,6 +86,7 @@ impl Default for ResamplingSettings {
 /// The ranges `validate` accepts: more candidates or neighbours than these cost more than they
 /// gain at one sample per texel; a wider disc leaves the surface the sample stands on.
 pub const MAX_CANDIDATES: u32 = 64;
+pub const MAX_BRDF_CANDIDATES: u32 = 8;
 pub const MAX_TEMPORAL_CAP: f32 = 100.0;
 pub const MAX_NEIGHBOURS: u32 = crate::layouts::RESAMPLING_MAX_NEIGHBOURS;
 pub const RADIUS_RANGE: (f32, f32) = (1.0, 64.0);
@@ -97,6 +103,12 @@ impl ResamplingSettings {
             return bad(format!(
                 "candidates must be in 1..={MAX_CANDIDATES}, got {}",
                 self.candidates
+            ));
+        }
+        if self.brdf_candidates > MAX_BRDF_CANDIDATES {
+            return bad(format!(
+                "brdf_candidates must be in 0..={MAX_BRDF_CANDIDATES}, got {}",
+                self.brdf_candidates
             ));
         }
         if !(self.temporal_cap.is_finite() && (0.0..=MAX_TEMPORAL_CAP).contains(&self.temporal_cap))
@@ -146,6 +158,13 @@ mod tests {
                     ..Default::default()
                 },
                 "candidates",
+            ),
+            (
+                ResamplingSettings {
+                    brdf_candidates: 9,
+                    ..Default::default()
+                },
+                "brdf_candidates",
             ),
             (
                 ResamplingSettings {
