@@ -526,6 +526,52 @@ fn resampling_lowers_the_error_at_one_sample() {
     assert_clean(&ctx);
 }
 
+/// A light switched off (`Renderer::set_emission_scale`) leaves no light behind with resampling:
+/// the reservoirs' history (DI's light-table entries, GI's radiance gathered at secondary hits)
+/// is dropped when the light table is rebuilt, so the very next frame of the Cornell box, whose
+/// only light it is, is black; switched on again, the next frame is lit as the first frame was.
+#[test]
+fn a_light_switched_off_leaves_no_light_behind() {
+    let ctx = gpu();
+    let (scene, pose) = cornell();
+    let light = fovea_tests::light_material(&scene);
+    for mode in [ResamplingMode::Di, ResamplingMode::DiGi] {
+        let mut r = renderer(&ctx, &scene, Box::new(Cartesian::new(SIZE)), mode);
+        let mut hdr = Vec::new();
+        let mut render = |r: &mut Renderer, f: u32| {
+            r.render_frame(&FrameInput::mono(pose, f, Some(SIZE.as_vec2() * 0.5)).with_hdr(true))
+                .unwrap();
+            r.read_hdr(&mut hdr).unwrap();
+            mean_rgb(&hdr)
+        };
+        let lit: Vec<[f64; 3]> = (0..6).map(|f| render(&mut r, f)).collect();
+        r.set_emission_scale(&scene, light, 0.0).unwrap();
+        let off = render(&mut r, 6);
+        assert_eq!(
+            off,
+            [0.0; 3],
+            "resampling {}: light left behind after switching off",
+            mode.name()
+        );
+        r.set_emission_scale(&scene, light, 1.0).unwrap();
+        let on = render(&mut r, 7);
+        let ratio = on[1] / lit[0][1];
+        println!(
+            "resampling {}: first frame {:.4}, after switching off {:?}, back on {:.4} ({ratio:.3}×)",
+            mode.name(),
+            lit[0][1],
+            off,
+            on[1]
+        );
+        assert!(
+            (ratio - 1.0).abs() < 0.05,
+            "resampling {}: back on, the frame's mean is {ratio}× the first frame's",
+            mode.name()
+        );
+    }
+    assert_clean(&ctx);
+}
+
 /// References trace every sample with next-event estimation at every hit: the resampling
 /// setting changes none of their bytes.
 #[test]

@@ -95,6 +95,10 @@ pub struct GpuScene {
     /// Instance count and the bytes instancing keeps off the GPU (`fovea bench`).
     pub instancing_stats: InstancingStats,
     pub light_count: u32,
+    /// Counts the light-table rebuilds (`set_emission_scale`): history that stores light-table
+    /// entries or light gathered at surfaces (ReSTIR DI's and GI's reservoirs) is dropped when it
+    /// changes.
+    pub lights_version: u64,
     /// Light entries that are emissive triangles (the table's first): without any, ReSTIR DI's
     /// BRDF candidates could find nothing and are not drawn.
     pub triangle_light_count: u32,
@@ -213,6 +217,7 @@ impl GpuScene {
             texels: Buffer::device_local(ctx, "texels", &texels, storage)?,
             lights: Buffer::with_data(ctx, "lights", &lights, storage)?,
             light_count: lights.len() as u32,
+            lights_version: 0,
             triangle_light_count: triangle_lights(&lights),
             triangle_count: triangles.len() as u32,
             material_count: materials.len() as u32,
@@ -274,6 +279,7 @@ impl GpuScene {
             self.lights.write(&lights)?;
         }
         self.light_count = lights.len() as u32;
+        self.lights_version += 1;
         self.triangle_light_count = triangle_lights(&lights);
         self.environment_slots = self.environment.frame_slots(&lights);
         Ok(())

@@ -40,6 +40,8 @@ pub struct Resampling {
     reservoirs: ReservoirPair,
     gi: Option<GiResampling>,
     frames: u64,
+    /// `GpuScene::lights_version` of the previous frame.
+    lights_version: u64,
 }
 
 /// ReSTIR GI's two passes and reservoirs (`di+gi`).
@@ -102,6 +104,7 @@ impl Resampling {
             ]),
             gi,
             frames: 0,
+            lights_version: 0,
         })
     }
 
@@ -134,7 +137,11 @@ impl Resampling {
             Error::Invalid("resampling needs the G-buffer's primary-hit image".into())
         })?;
         let shared = (scene, ray_counters, primary_hit);
-        let fresh_start = self.frames == 0;
+        // A rebuilt light table renumbers its entries (a light switched off leaves it) and
+        // changes the light that reached the GI samples' secondary hits: neither reservoir's
+        // history stands for this frame's lights.
+        let fresh_start = self.frames == 0 || self.lights_version != scene.lights_version;
+        self.lights_version = scene.lights_version;
         let (history, fresh) = self.reservoirs.for_frame(self.frames);
         self.temporal.record_temporal(
             rec,
