@@ -10,6 +10,7 @@ use fovea_renderer::frame::{
 use fovea_renderer::gpu_scene::GpuScene;
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{Cartesian, SamplingSpace};
 use fovea_renderer::scene::bvh::instanced::SceneBvh;
@@ -429,7 +430,8 @@ fn surface_noise_keeps_each_eyes_flip() {
 /// two eyes' displayed frames together (the binocular difference over the frame) and lower each
 /// eye's own error (left-eye FLIP against its converged reference), raw and after SVGF, in
 /// Cartesian space and in the screen-clipped Visual-Polar grid (each eye its own gaze, so the
-/// other eye's sample is found through its own grid). Means over frames 4–7 of still runs.
+/// other eye's sample is found through its own grid), and in VP after ReSTIR DI and GI (each eye
+/// shares its resampled samples). Means over frames 4–7 of still runs.
 #[test]
 fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
     use fovea_renderer::sampling::{VisualPolar, VisualPolarParams, VpLayout};
@@ -454,9 +456,10 @@ fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
         Box::new(VisualPolar::new(SCREEN, gaze, params).unwrap())
     };
     // (difference over the frame, left-eye FLIP), means over the measured frames.
-    let run = |space: &dyn Fn(f32) -> Box<dyn SamplingSpace>, denoiser, reuse| {
+    let run = |space: &dyn Fn(f32) -> Box<dyn SamplingSpace>, denoiser, resampling, reuse| {
         let settings = RenderSettings {
             denoiser,
+            resampling: ResamplingSettings::default().with_mode(resampling),
             stereo_noise: StereoNoise::Independent,
             cross_eye_reuse: if reuse {
                 CrossEyeReuse::On
@@ -494,29 +497,35 @@ fn cross_eye_reuse_brings_the_eyes_together_and_lowers_each_eyes_error() {
     };
     type SpaceFn<'a> = &'a dyn Fn(f32) -> Box<dyn SamplingSpace>;
     let spaces: [(&str, SpaceFn); 2] = [("Cartesian", &cartesian), ("VP", &visual_polar)];
-    for (name, space) in spaces {
-        for denoiser in [
-            DenoiserSettings::None,
-            DenoiserSettings::Svgf(SvgfSettings::default()),
-        ] {
-            let (d_off, f_off) = run(space, denoiser, false);
-            let (d_on, f_on) = run(space, denoiser, true);
-            println!(
-                "{name} + {}: difference {d_off:.4} → {d_on:.4} ({:.2}×), left-eye FLIP {f_off:.4} → {f_on:.4}",
-                denoiser.name(),
-                d_on / d_off
-            );
-            let what = format!("{name} + {}", denoiser.name());
-            // Raw, the merged samples agree by construction where both eyes see the surface;
-            // SVGF's own spatial filter leaves less to bring together.
-            let bound = if denoiser == DenoiserSettings::None {
-                0.6
-            } else {
-                0.95
-            };
-            assert!(d_on < bound * d_off, "{what}: difference {d_off} → {d_on}");
-            assert!(f_on < f_off, "{what}: left-eye FLIP {f_off} → {f_on}");
-        }
+    let svgf = DenoiserSettings::Svgf(SvgfSettings::default());
+    let cases = spaces
+        .into_iter()
+        .flat_map(|(name, space)| {
+            [DenoiserSettings::None, svgf].map(|d| (name, space, d, ResamplingMode::Off))
+        })
+        // Resampling runs before the reuse: each eye's resampled samples are what it shares.
+        .chain([("VP", spaces[1].1, svgf, ResamplingMode::DiGi)]);
+    for (name, space, denoiser, resampling) in cases {
+        let (d_off, f_off) = run(space, denoiser, resampling, false);
+        let (d_on, f_on) = run(space, denoiser, resampling, true);
+        let what = format!(
+            "{name} + {}, resampling {}",
+            denoiser.name(),
+            resampling.name()
+        );
+        println!(
+            "{what}: difference {d_off:.4} → {d_on:.4} ({:.2}×), left-eye FLIP {f_off:.4} → {f_on:.4}",
+            d_on / d_off
+        );
+        // Raw, the merged samples agree by construction where both eyes see the surface;
+        // SVGF's own spatial filter leaves less to bring together.
+        let bound = if denoiser == DenoiserSettings::None {
+            0.6
+        } else {
+            0.95
+        };
+        assert!(d_on < bound * d_off, "{what}: difference {d_off} → {d_on}");
+        assert!(f_on < f_off, "{what}: left-eye FLIP {f_off} → {f_on}");
     }
     assert_clean(&ctx);
 }
