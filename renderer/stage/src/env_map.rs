@@ -2,8 +2,9 @@
 //! Radiance `.hdr` through `image`) into a checked [`EnvironmentMap`]. Every error names the file
 //! and the reason: missing or not a regular file, an extension other than .exr/.hdr, a file that
 //! does not decode, a size of zero or above `MAX_ENVIRONMENT_SIZE` (checked from the header,
-//! before the texels are decoded), a non-finite or negative texel, a texel whose radiance ×
-//! the intensity exceeds `MAX_ENVIRONMENT_RADIANCE` (the frame would be black).
+//! before the texels are decoded), a non-finite texel, a texel whose radiance × the intensity
+//! exceeds `MAX_ENVIRONMENT_RADIANCE` (the frame would be black). Negative channels, which lossy
+//! OpenEXR compression (DWAA/DWAB, B44) leaves around dark texels, are read as 0 with a warning.
 
 use anyhow::{bail, Context, Result};
 use fovea_renderer::scene::environment::{check_size, EnvironmentMap, MAX_ENVIRONMENT_SIZE};
@@ -40,6 +41,12 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
         Format::Hdr => read_hdr(path),
     }
     .with_context(|| format!("environment map {name}"))?;
+    let mut texels = texels;
+    if let Some((count, lowest)) = clamp_negative(&mut texels) {
+        eprintln!(
+            "warning: environment map {name}: {count} texels with negative channels (lowest {lowest}) read as 0 (radiance cannot be negative; lossy OpenEXR compression leaves such values)"
+        );
+    }
     let mut map = EnvironmentMap::new(width, height, texels)
         .map_err(|e| anyhow::anyhow!("environment map {name}: {e}"))?;
     map.rotation = rotation_deg.to_radians();
@@ -48,6 +55,21 @@ pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<Environmen
         anyhow::anyhow!("environment map {name}: {e}; lower --env-intensity (or the profile's env_intensity) or scale the map")
     })?;
     Ok(map)
+}
+
+/// Sets finite negative channels to 0; how many texels had one and the lowest value, if any.
+/// Non-finite channels stay for `EnvironmentMap::new` to refuse.
+fn clamp_negative(texels: &mut [Vec3]) -> Option<(usize, f32)> {
+    let mut count = 0;
+    let mut lowest = 0.0f32;
+    for t in texels.iter_mut() {
+        if t.is_finite() && t.min_element() < 0.0 {
+            count += 1;
+            lowest = lowest.min(t.min_element());
+            *t = t.max(Vec3::ZERO);
+        }
+    }
+    (count > 0).then_some((count, lowest))
 }
 
 /// Most texels a map file may declare (the supported 8192 × 4096), checked from its header.
