@@ -376,19 +376,8 @@ fn brdf_candidates_converge_and_lower_the_error_on_glossy_surfaces() {
     for brdf_candidates in [0, 1] {
         let case = (ResamplingMode::Di, brdf_candidates);
         let mut r = renderer_with_brdf(&ctx, &scene, Box::new(Cartesian::new(SIZE)), case);
-        let (mut rmse_sum, mut flip_sum) = (0.0, 0.0);
-        let mut hdr = Vec::new();
-        let measured = 4..12;
-        for f in 0..measured.end {
-            r.render_frame(&FrameInput::mono(pose, f, Some(centre)).with_hdr(true))
-                .unwrap();
-            if measured.contains(&f) {
-                r.read_hdr(&mut hdr).unwrap();
-                let (e, flip) = error_around(&hdr, &reference, centre, SIZE.x as f32);
-                rmse_sum += e / measured.len() as f64;
-                flip_sum += flip / measured.len() as f64;
-            }
-        }
+        let (rmse_sum, flip_sum) =
+            error_over_frames(&mut r, pose, &reference, (centre, SIZE.x as f32));
         println!(
             "glossy floor, resampling {}: RMSE {rmse_sum:.4}, FLIP {flip_sum:.4} over the view (frames 4–11)",
             case_name(case)
@@ -404,6 +393,30 @@ fn brdf_candidates_converge_and_lower_the_error_on_glossy_surfaces() {
         errors[0].1
     );
     assert_clean(&ctx);
+}
+
+/// `error_around` (within `radius` pixels of `gaze`) of frames 4–11 of a still camera looking
+/// at `gaze`, averaged: the reservoirs have gathered a few frames' candidates by then.
+fn error_over_frames(
+    r: &mut Renderer,
+    pose: CameraPose,
+    reference: &[[f32; 4]],
+    (gaze, radius): (Vec2, f32),
+) -> (f64, f64) {
+    let (mut rmse_sum, mut flip_sum) = (0.0, 0.0);
+    let mut hdr = Vec::new();
+    let measured = 4..12;
+    for f in 0..measured.end {
+        r.render_frame(&FrameInput::mono(pose, f, Some(gaze)).with_hdr(true))
+            .unwrap();
+        if measured.contains(&f) {
+            r.read_hdr(&mut hdr).unwrap();
+            let (e, flip) = error_around(&hdr, reference, gaze, radius);
+            rmse_sum += e / measured.len() as f64;
+            flip_sum += flip / measured.len() as f64;
+        }
+    }
+    (rmse_sum, flip_sum)
 }
 
 /// RMSE and mean FLIP of one frame against the reference over the screen pixels within `radius`
@@ -482,19 +495,8 @@ fn resampling_lowers_the_error_at_one_sample() {
                     ..settings(mode)
                 };
                 let mut r = Renderer::new(&ctx, &scene, make(gaze), settings).unwrap();
-                let (mut rmse_sum, mut flip_sum) = (0.0, 0.0);
-                let mut hdr = Vec::new();
-                let measured = 4..12;
-                for f in 0..measured.end {
-                    r.render_frame(&FrameInput::mono(pose, f, Some(gaze)).with_hdr(true))
-                        .unwrap();
-                    if measured.contains(&f) {
-                        r.read_hdr(&mut hdr).unwrap();
-                        let (e, flip) = error_around(&hdr, &reference, gaze, radius);
-                        rmse_sum += e / measured.len() as f64;
-                        flip_sum += flip / measured.len() as f64;
-                    }
-                }
+                let (rmse_sum, flip_sum) =
+                    error_over_frames(&mut r, pose, &reference, (gaze, radius));
                 println!(
                     "{name}, max depth {max_depth}, resampling {}: RMSE {rmse_sum:.4}, FLIP {flip_sum:.4} within {radius} px of the gaze (frames 4–11)",
                     mode.name()

@@ -1,11 +1,12 @@
 #version 460
 // ReSTIR DI, first pass (Bitterli et al. 2020, Alg. 5; docs/design/resampling.md): per sample of
 // the grid, N light candidates drawn as next-event estimation draws them and N_B drawn by
-// sampling the BRDF, resampled by p̂ = luminance of the unshadowed contribution (MIS-weighted RIS); the previous frame's reservoir, found
-// through the tracer's previous screen position in the previous gaze's grid and kept only on the
-// same surface, joins with its M capped and p̂ re-evaluated here; then one shadow ray to the
-// chosen sample (occluded, it keeps its M with W = 0: visibility reuse) and, where the previous
-// reservoir joined, one from the previous frame's point (the unbiased 1/Z normalisation).
+// sampling the BRDF, resampled by p̂ = luminance of the unshadowed contribution (MIS-weighted
+// RIS); the previous frame's reservoir, found through the tracer's previous screen position in
+// the previous gaze's grid and kept only on the same surface, joins with its M capped and p̂
+// re-evaluated here; then one shadow ray to the chosen sample (occluded, it keeps its M with
+// W = 0: visibility reuse) and, where the previous reservoir joined, one from the previous
+// frame's point (the unbiased 1/Z normalisation).
 // Writes this frame's reservoirs, which the spatial pass reads.
 //! variants per space
 //! traversals
@@ -68,8 +69,8 @@ void main() {
             chosen_seen = false;
         }
     }
-    // BRDF candidates find what light sampling rarely draws: large emitters and the environment
-    // seen through a glossy lobe.
+    // BRDF candidates find what light sampling rarely draws: the part of a large emitter that a
+    // glossy lobe reflects.
     for (uint i = 0u; i < brdf_candidates; ++i) {
         LightPoint lp;
         LightSample ls;

@@ -3,6 +3,16 @@ use crate::test_util::TestRng;
 use crate::{Material, Triangle, Vertex};
 use glam::{Vec2, Vec4};
 
+/// A vertex at `p` facing +Z (the light table reads positions only).
+fn vertex(p: Vec3) -> Vertex {
+    Vertex {
+        position: p,
+        normal: Vec3::Z,
+        uv: Vec2::ZERO,
+        tangent: Vec4::X,
+    }
+}
+
 fn random_weights(rng: &mut TestRng, n: usize) -> Vec<f64> {
     // A wide dynamic range, with a few tiny ones, as real scenes have.
     (0..n)
@@ -75,17 +85,11 @@ fn empty_scene_gives_empty_table() {
 
 #[test]
 fn powers_follow_the_documented_formulas() {
-    let v = |p: Vec3| Vertex {
-        position: p,
-        normal: Vec3::Z,
-        uv: Vec2::ZERO,
-        tangent: Vec4::X,
-    };
     let mut scene = Scene {
         vertices: vec![
-            v(Vec3::ZERO),
-            v(Vec3::new(2.0, 0.0, 0.0)),
-            v(Vec3::new(0.0, 1.0, 0.0)),
+            vertex(Vec3::ZERO),
+            vertex(Vec3::new(2.0, 0.0, 0.0)),
+            vertex(Vec3::new(0.0, 1.0, 0.0)),
         ],
         triangles: vec![
             Triangle {
@@ -163,14 +167,8 @@ fn powers_follow_the_documented_formulas() {
 
 #[test]
 fn emissive_texture_mean_scales_triangle_power() {
-    let v = |p: Vec3| Vertex {
-        position: p,
-        normal: Vec3::Z,
-        uv: Vec2::ZERO,
-        tangent: Vec4::X,
-    };
     let scene = Scene {
-        vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
+        vertices: vec![vertex(Vec3::ZERO), vertex(Vec3::X), vertex(Vec3::Y)],
         triangles: vec![Triangle {
             indices: [0, 1, 2],
             material: 0,
@@ -195,14 +193,8 @@ fn emissive_texture_mean_scales_triangle_power() {
 
 #[test]
 fn emission_scale_dims_or_drops_a_materials_triangles() {
-    let v = |p: Vec3| Vertex {
-        position: p,
-        normal: Vec3::Z,
-        uv: Vec2::ZERO,
-        tangent: Vec4::X,
-    };
     let scene = Scene {
-        vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
+        vertices: vec![vertex(Vec3::ZERO), vertex(Vec3::X), vertex(Vec3::Y)],
         triangles: vec![
             Triangle {
                 indices: [0, 1, 2],
@@ -255,19 +247,13 @@ fn emission_scale_dims_or_drops_a_materials_triangles() {
 /// lights, the environment last.
 #[test]
 fn triangles_come_first_by_placed_id_and_the_environment_last() {
-    let v = |p: Vec3| Vertex {
-        position: p,
-        normal: Vec3::Z,
-        uv: Vec2::ZERO,
-        tangent: Vec4::X,
-    };
     let triangle = |material| Triangle {
         indices: [0, 1, 2],
         material,
         mesh: 0,
     };
     let mut scene = Scene {
-        vertices: vec![v(Vec3::ZERO), v(Vec3::X), v(Vec3::Y)],
+        vertices: vec![vertex(Vec3::ZERO), vertex(Vec3::X), vertex(Vec3::Y)],
         triangles: [1, 0, 1, 1, 0, 0, 1].map(triangle).to_vec(),
         materials: vec![
             Material::default(),

@@ -36,12 +36,11 @@ fn format_of(path: &Path) -> Result<Format> {
 /// The map in `path`, turned `rotation_deg` about +Y and scaled by `intensity`.
 pub fn load(path: &Path, rotation_deg: f32, intensity: f32) -> Result<EnvironmentMap> {
     let name = path.display();
-    let (width, height, texels) = match format_of(path)? {
+    let (width, height, mut texels) = match format_of(path)? {
         Format::Exr => read_exr(path),
         Format::Hdr => read_hdr(path),
     }
     .with_context(|| format!("environment map {name}"))?;
-    let mut texels = texels;
     if let Some((count, lowest)) = clamp_negative(&mut texels) {
         eprintln!(
             "warning: environment map {name}: {count} texels with negative channels (lowest {lowest}) read as 0 (radiance cannot be negative; lossy OpenEXR compression leaves such values)"

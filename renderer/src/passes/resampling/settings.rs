@@ -56,9 +56,9 @@ pub struct ResamplingSettings {
     pub mode: ResamplingMode,
     /// Light candidates drawn per sample and frame (RIS).
     pub candidates: u32,
-    /// Candidates drawn per sample and frame by sampling the BRDF (one ray each: the emitter or
-    /// the environment it reaches), weighed against the light candidates by MIS; 0 leaves the
-    /// environment's BRDF-sampled share to the path's own bounce.
+    /// Candidates drawn per sample and frame by sampling the BRDF (one ray each: the emissive
+    /// triangle it reaches first, if any), weighed against the light candidates by MIS; the
+    /// environment's BRDF-sampled share stays the path's own bounce either way.
     pub brdf_candidates: u32,
     /// The previous frame's reservoir counts at most this many times this frame's candidates
     /// (Bitterli et al. 2020 use 20; ReSTIR GI's one traced bounce per frame: this many
