@@ -10,6 +10,7 @@ use fovea_renderer::layouts::{AsvgfGradientSample, ASVGF_NO_LUMINANCE};
 use fovea_renderer::passes::denoise::asvgf::{Asvgf, AsvgfSettings};
 use fovea_renderer::passes::denoise::svgf::SvgfSettings;
 use fovea_renderer::passes::denoise::DenoiserSettings;
+use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
 use fovea_renderer::pipeline::Renderer;
 use fovea_renderer::sampling::{
     Cartesian, SamplingSpace, VisualPolar, VisualPolarParams, VpLayout,
@@ -43,6 +44,18 @@ fn settings(denoiser: DenoiserSettings) -> RenderSettings {
         },
         denoiser,
         ..Default::default()
+    }
+}
+
+/// Resampling off and with both passes: with resampling the gradient compares plain path
+/// estimates the tracer keeps beside the resampled sample (trace.comp), which must repeat last
+/// frame's path as exactly as the plain kernel's gradient samples do.
+const RESAMPLING: [ResamplingMode; 2] = [ResamplingMode::Off, ResamplingMode::DiGi];
+
+fn with_resampling(settings: RenderSettings, mode: ResamplingMode) -> RenderSettings {
+    RenderSettings {
+        resampling: ResamplingSettings::default().with_mode(mode),
+        ..settings
     }
 }
 
@@ -85,15 +98,26 @@ fn reshaded(r: &Renderer) -> (Vec<(f32, f32)>, usize) {
 /// an unchanged scene gives the same path and δ = 0; the light at half its emission gives exactly
 /// half the radiance (δ < 0), and back at full twice that (δ > 0) — all light in the box is the
 /// ceiling light's, and every path is the same one; the reconstructed λ = |δ̂| / max f̂ follows (0,
-/// ½, ½). Then the same with the camera moving.
+/// ½, ½). Then the same with the camera moving; all of it without and with resampling.
 #[test]
 fn gradient_samples_reshade_last_frames_path() {
     let ctx = gpu();
     let scene = owned_scene("cornell-box");
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    for name in SPACES {
-        let mut r = Renderer::new(&ctx, &scene, space(name, SCREEN), settings(asvgf())).unwrap();
+    for (space_name, mode) in SPACES
+        .into_iter()
+        .flat_map(|s| RESAMPLING.map(|m| (s, m)))
+    {
+        let name = format!("{space_name}, resampling {}", mode.name());
+        let name = name.as_str();
+        let mut r = Renderer::new(
+            &ctx,
+            &scene,
+            space(space_name, SCREEN),
+            with_resampling(settings(asvgf()), mode),
+        )
+        .unwrap();
         let Some(a) = r.denoiser().and_then(|d| d.downcast_ref::<Asvgf>()) else {
             panic!()
         };
@@ -214,7 +238,8 @@ fn lag(after: &[f64], before: f64, level: f64) -> Option<usize> {
 
 /// Still camera, the ceiling light switched off after 10 frames: the mean screen luminance of
 /// A-SVGF's output reaches its new level (0: nothing else lights the box) within a few frames,
-/// where SVGF's history (α = 0.2) decays over about ten.
+/// where SVGF's history (α = 0.2) decays over about ten; without and with resampling (whose
+/// reservoirs start afresh when the lights change, while SVGF's history does not).
 #[test]
 fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
     let ctx = gpu();
@@ -222,11 +247,15 @@ fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     let (on, off) = (10u32, 14u32);
-    for name in SPACES {
+    for (space_name, mode) in SPACES
+        .into_iter()
+        .flat_map(|s| RESAMPLING.map(|m| (s, m)))
+    {
+        let name = format!("{space_name}, resampling {}", mode.name());
         let mut lags = Vec::new();
         for (label, denoiser) in [("svgf", svgf()), ("asvgf", asvgf())] {
-            let mut r =
-                Renderer::new(&ctx, &scene, space(name, SCREEN), settings(denoiser)).unwrap();
+            let settings = with_resampling(settings(denoiser), mode);
+            let mut r = Renderer::new(&ctx, &scene, space(space_name, SCREEN), settings).unwrap();
             let mut hdr = Vec::new();
             let mut levels = Vec::new();
             for f in 0..on + off {

@@ -240,7 +240,8 @@ fn path_states(r: &Renderer, space_screens: &[Option<glam::Vec2>]) -> Vec<Option
         .zip(&ids)
         .zip(space_screens)
         .map(|((v, id), screen)| {
-            let keep = id[0] != 0 && v[3] == 0;
+            // Sign bit of w: a source sample, not a gradient sample re-shading last frame's path.
+            let keep = id[0] != 0 && v[3] & 0x8000_0000 != 0;
             Some(PathState {
                 state: v[2],
                 screen: (*screen)?,

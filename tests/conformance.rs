@@ -642,9 +642,8 @@ fn every_grid_filter_follows_a_moving_gaze_through_the_previous_frames_arcs() {
 /// ReSTIR DI and GI (`--resampling di`, `di+gi`) on every space whose grid runs the temporal
 /// filters (their reuse addresses the grid as they do: φ wraps, clipped texels hold nothing, the
 /// previous gaze's grid for the temporal step): no validation message, every pixel finite and
-/// non-negative, the mean over frames like next-event estimation's, and BMFR after it; every
-/// other space refuses them by name, and A-SVGF (whose re-shading cannot replay reservoirs)
-/// refuses them on every space.
+/// non-negative, the mean over frames like next-event estimation's, and BMFR and A-SVGF after
+/// it; every other space refuses them by name.
 #[test]
 fn resampling_on_every_space_that_supports_it() {
     use fovea_renderer::passes::resampling::{ResamplingMode, ResamplingSettings};
@@ -676,15 +675,6 @@ fn resampling_on_every_space_that_supports_it() {
             }
             continue;
         }
-        let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
-        for mode in modes {
-            let err = refusal(&make, with(mode, asvgf));
-            assert!(
-                err.contains("asvgf") && err.contains("resampling"),
-                "{space_name} + asvgf + resampling {}: {err}",
-                mode.name()
-            );
-        }
         let check = |what: &str| {
             let what = what.to_string();
             move |f: u32, hdr: &[[f32; 4]]| {
@@ -714,6 +704,12 @@ fn resampling_on_every_space_that_supports_it() {
         let bmfr = settings(DenoiserSettings::parse("bmfr").unwrap(), TaaMode::Off);
         let mut r = Renderer::new(&ctx, &scene, make(), with(ResamplingMode::DiGi, bmfr)).unwrap();
         fovea_tests::mean_over_frames(&mut r, start, Some(gaze), 4, check("di+gi + bmfr"));
+        let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
+        for mode in modes {
+            let what = format!("{} + asvgf", mode.name());
+            let mut r = Renderer::new(&ctx, &scene, make(), with(mode, asvgf)).unwrap();
+            fovea_tests::mean_over_frames(&mut r, start, Some(gaze), 4, check(&what));
+        }
         assert_clean(&ctx);
     }
 }
@@ -724,8 +720,8 @@ fn resampling_on_every_space_that_supports_it() {
 /// non-negative, each eye's mean over frames like each eye's own without it (the Cornell box is
 /// diffuse: both eyes' samples of a surface estimate one radiance) and each pixel's variance over
 /// the frames lower (the other eye's sample was found and taken), and with SVGF and BMFR after
-/// it; every other space refuses it by name, and A-SVGF refuses it on every space (`auto` runs
-/// without it there).
+/// it, and A-SVGF (its gradients compare the tracer's own estimates, which the merge leaves
+/// alone); every other space refuses it by name.
 #[test]
 fn cross_eye_reuse_on_every_space_that_supports_it() {
     use fovea_renderer::frame::{CrossEyeReuse, ViewInput};
@@ -804,17 +800,8 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
             continue;
         }
         let asvgf = settings(DenoiserSettings::parse("asvgf").unwrap(), TaaMode::Off);
-        let err = stereo(&make, with_reuse(asvgf))
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
-        assert!(
-            err.contains("asvgf") && err.contains("cross-eye"),
-            "{space_name} + asvgf + cross-eye reuse: {err}"
-        );
-        // `auto`: on where the eyes can share, off with A-SVGF.
         let auto = |settings| stereo(&make, with(CrossEyeReuse::Auto, settings)).unwrap();
-        assert!(!auto(asvgf).reuses_across_eyes(), "{space_name} + asvgf");
+        assert!(auto(asvgf).reuses_across_eyes(), "{space_name} + asvgf");
         assert!(auto(plain).reuses_across_eyes(), "{space_name}");
         let (off, off_variance) = means(&mut stereo(&make, plain).unwrap(), space_name);
         let (on, on_variance) = means(
@@ -840,7 +827,7 @@ fn cross_eye_reuse_on_every_space_that_supports_it() {
                 );
             }
         }
-        for denoiser in ["svgf", "bmfr"] {
+        for denoiser in ["svgf", "asvgf", "bmfr"] {
             let filtered = settings(DenoiserSettings::parse(denoiser).unwrap(), TaaMode::Off);
             let mut r = stereo(&make, with_reuse(filtered)).unwrap();
             means(&mut r, &format!("{space_name} + cross-eye + {denoiser}"));

@@ -236,8 +236,8 @@ impl StereoNoise {
 pub enum CrossEyeReuse {
     #[default]
     Off,
-    /// Always; a renderer whose eyes cannot share (a space without temporal filters, A-SVGF)
-    /// is refused with the reason.
+    /// Always; a renderer whose eyes cannot share (a space without temporal filters, two eyes
+    /// of different spaces) is refused with the reason.
     On,
     /// Where the eyes can share (see `On`), off elsewhere.
     Auto,

@@ -727,10 +727,10 @@ fn build_cross_eye(
     let build = match settings.cross_eye_reuse {
         CrossEyeReuse::Off => false,
         CrossEyeReuse::On => true,
-        CrossEyeReuse::Auto => CrossEye::refusal(spaces, settings).is_none(),
+        CrossEyeReuse::Auto => CrossEye::refusal(spaces).is_none(),
     };
     build
-        .then(|| CrossEye::new(ctx, spaces, settings))
+        .then(|| CrossEye::new(ctx, spaces))
         .transpose()
 }
 

@@ -105,11 +105,11 @@ pub struct View {
     pub space: Box<dyn SamplingSpace>,
     pub gbuffer: GBuffer,
     pub(crate) trace: TracePass,
-    /// The tracer's gradient variant, which real-time frames use when the denoiser is A-SVGF
-    /// (references keep `trace`).
+    /// The tracer's gradient variant (its resampled one with resampling), which real-time frames
+    /// use when the denoiser is A-SVGF (references keep `trace`).
     pub(crate) trace_gradients: Option<TracePass>,
-    /// The tracer's resampled variant and the resampling passes after it, which real-time frames
-    /// use with `--resampling di` (references keep `trace`).
+    /// The tracer's resampled variant (without A-SVGF) and the resampling passes after it, which
+    /// real-time frames use with `--resampling di` (references keep `trace`).
     pub(crate) trace_resampled: Option<TracePass>,
     pub(crate) resampling: Option<Resampling>,
     /// The passes of the space's way back to the screen.
@@ -166,39 +166,30 @@ impl View {
         let back = way_back::build(ctx, space.as_ref(), screen_taa, settings.blur.space)?;
         let denoiser = settings.denoiser.build(ctx, grid, space.shader_variant())?;
         let gradients = settings.denoiser.needs_gradients();
-        let trace_gradients = match gradients {
-            false => None,
-            true => Some(TracePass::new(
-                ctx,
-                &format!("{}_gradients", space.trace_variant()),
-            )?),
-        };
         let resampled = settings.resampling.mode != ResamplingMode::Off;
         let resampled_gi = settings.resampling.mode.resamples_gi();
-        if resampled && gradients {
-            // A-SVGF re-shades last frame's paths to measure how the light changed; the
-            // resampled paths' direct light comes from reservoirs the re-shading cannot replay.
-            return Err(Error::Invalid(format!(
-                "resampling '{}' with denoiser '{}': A-SVGF's gradient samples re-shade paths \
-                 whose light the reservoirs give; use svgf or bmfr",
-                settings.resampling.mode.name(),
-                settings.denoiser.name()
-            )));
-        }
         let resampling = match resampled {
             true => Some(Resampling::new(ctx, space.as_ref(), settings.resampling)?),
             false => None,
         };
-        let trace_resampled = match (resampled, resampled_gi) {
-            (true, false) => Some(TracePass::new(
-                ctx,
-                &format!("{}_resampled", space.trace_variant()),
-            )?),
-            (true, true) => Some(TracePass::new(
-                ctx,
-                &format!("{}_resampled_gi", space.trace_variant()),
-            )?),
-            (false, _) => None,
+        // The tracer's real-time variant: A-SVGF's gradients and resampling combine (with
+        // resampling the gradient compares plain path estimates, trace.comp).
+        let suffix = match (resampled, resampled_gi) {
+            (false, _) => "",
+            (true, false) => "_resampled",
+            (true, true) => "_resampled_gi",
+        };
+        let variant = |gradients_suffix: &str| {
+            let name = format!("{}{suffix}{gradients_suffix}", space.trace_variant());
+            TracePass::new(ctx, &name)
+        };
+        let trace_gradients = match gradients {
+            true => Some(variant("_gradients")?),
+            false => None,
+        };
+        let trace_resampled = match resampled && !gradients {
+            true => Some(variant("")?),
+            false => None,
         };
         let mut gbuffer = if gradients {
             GBuffer::with_visibility(ctx, grid)?

@@ -4,6 +4,15 @@
 #ifndef FOVEA_PATH_GLSL
 #define FOVEA_PATH_GLSL
 
+// Whether the path leaves the primary hit's direct light (RESAMPLED_DI) and bounce (RESAMPLED_GI)
+// to the resampling passes. A variable only where A-SVGF's gradient samples also need the plain
+// path's estimate (trace.comp's `plain_path_estimate`); a constant everywhere else.
+#if defined(RESAMPLED_DI) && defined(TRACE_GRADIENTS)
+bool path_defers_to_resampling = true;
+#elif defined(RESAMPLED_DI)
+const bool path_defers_to_resampling = true;
+#endif
+
 // Rays traced by this invocation, for the tracer's exact counters.
 uint shadow_rays = 0u;
 uint continuation_rays = 0u;
@@ -65,7 +74,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
     for (uint depth_i = 1u; depth_i < max_depth; ++depth_i) {
 #if defined(RESAMPLED_DI)
         // The primary hit's direct light is the resampling passes' (shaders/passes/resample_*).
-        if (depth_i > 1u)
+        if (depth_i > 1u || !path_defers_to_resampling)
 #endif
         color += throughput * direct_light(s, v, rng);
         // The environment's second strategy: at the last vertex a BRDF ray still looks for it
@@ -86,7 +95,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
 #if defined(RESAMPLED_GI)
             // The primary hit's bounce escaped: ReSTIR GI's sample is the environment along l
             // (its MIS weight against next-event estimation is taken where the sample is used).
-            if (depth_i == 1u && !delta && !last) {
+            if (depth_i == 1u && !delta && !last && path_defers_to_resampling) {
                 gi_point = vec4(l, pdf);
                 gi_normal = vec3(0.0);
                 gi_radiance = sky_radiance(l);
@@ -111,7 +120,7 @@ vec3 shade_path(Surface s, vec3 dir, uint max_depth, vec2 cone, inout uint rng) 
         // A non-mirror bounce from the primary hit is ReSTIR GI's sample: what the path gathers
         // from here on is the radiance leaving the secondary hit toward the primary one (the
         // resampling passes weigh it by the primary hit's BRDF). Mirror bounces stay the path's.
-        if (depth_i == 1u && !delta) {
+        if (depth_i == 1u && !delta && path_defers_to_resampling) {
             before_bounce = color;
             throughput = vec3(1.0);
             gi_point = vec4(s.position, pdf);

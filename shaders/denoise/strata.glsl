@@ -17,6 +17,22 @@ uint asvgf_stratum_index(ivec2 texel, int grid_width) {
     return uint((texel.y / STRATUM) * width + texel.x / STRATUM);
 }
 
+// The G-buffer visibility's w: the luminance of a sample the next frame's forward projection may
+// carry as its stratum's gradient source (asvgf_forward.comp), with the sign bit set; 0 for a
+// sample it may not (a gradient sample, a miss, a texel not traced, and with resampling every
+// texel but the stratum's source).
+uint asvgf_source_bits(float luminance) {
+    return luminance < 0.0 ? 0u : (floatBitsToUint(luminance) | 0x80000000u);
+}
+
+bool asvgf_is_source(uint bits) {
+    return (bits & 0x80000000u) != 0u;
+}
+
+float asvgf_source_luminance(uint bits) {
+    return uintBitsToFloat(bits & 0x7fffffffu);
+}
+
 ivec2 strata_size(Grid g) {
     return (g.size + STRATUM - 1) / STRATUM;
 }

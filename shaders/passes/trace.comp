@@ -4,8 +4,13 @@
 // G-buffer that the denoisers read, sized to the sampling grid.
 // The *_gradients variants serve A-SVGF (Schied et al. 2018): a texel that the forward projection
 // of last frame's samples chose (asvgf_forward.comp) re-shades that frame's surface with that
-// frame's random state, and every texel writes the visibility (barycentrics, random state) the
-// next projection reads. Plain rendering keeps the variants without them and pays nothing.
+// frame's random state, and every texel writes the visibility (barycentrics, random state, and
+// the luminance a next projection compares against) the next projection reads. Plain rendering
+// keeps the variants without them and pays nothing. With resampling (*_resampled_gradients,
+// *_resampled_gi_gradients) the texel's own sample is resampled as usual and the gradient compares
+// plain path estimates instead: one texel per stratum (the stratum's source) and the gradient
+// sample also trace the path as the plain kernel would (`plain_path_estimate`), with the same
+// random state in both frames, so δ is the change of the light and never the reservoirs' noise.
 // The *_resampled variants (RESAMPLED_DI) leave the primary hit's next-event estimation to the
 // resampling passes (ReSTIR DI, docs/design/resampling.md) and write the primary hit's
 // barycentrics and ray-cone width, from which those passes re-fetch the surface. The
@@ -16,6 +21,8 @@
 //! variants per gradient trace space _gradients: TRACE_GRADIENTS
 //! variants per resampling trace space _resampled: RESAMPLED_DI
 //! variants per resampling trace space _resampled_gi: RESAMPLED_DI RESAMPLED_GI
+//! variants per resampling trace space _resampled_gradients: RESAMPLED_DI TRACE_GRADIENTS
+//! variants per resampling trace space _resampled_gi_gradients: RESAMPLED_DI RESAMPLED_GI TRACE_GRADIENTS
 //! traversals
 
 #include "../common/scene.glsl"
@@ -50,15 +57,15 @@ layout(std430, set = 0, binding = 17) buffer RayCounters { uint data[]; } ray_co
 #include "../common/tiles.glsl"
 #if defined(TRACE_GRADIENTS)
 // From 21: binding 18 is the VP sampling table (sampling/visual_polar.glsl).
-layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, 1: gradient sample
+layout(set = 0, binding = 21, rgba32ui) uniform writeonly uimage2D out_visibility; // barycentrics (float bits), RNG state after the jitter, source luminance (asvgf_source_bits)
 layout(std430, set = 0, binding = 22) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
 layout(set = 0, binding = 23, rgba32f) uniform writeonly image2D out_gradient;      // per stratum: δ, max f, 1
 #endif
 #if defined(RESAMPLED_DI)
-layout(set = 0, binding = 21, rgba32f) uniform writeonly image2D out_primary_hit;  // barycentrics u, v, ray-cone width, 0
+layout(set = 0, binding = 27, rgba32f) uniform writeonly image2D out_primary_hit;  // barycentrics u, v, ray-cone width, 0
 #endif
 #if defined(RESAMPLED_GI)
-layout(std430, set = 0, binding = 22) writeonly buffer OutGiSamples { GiSampleGpu data[]; } out_gi_samples;
+layout(std430, set = 0, binding = 28) writeonly buffer OutGiSamples { GiSampleGpu data[]; } out_gi_samples;
 #endif
 
 // Screen pixels between this sample and the same jitter in a neighbouring texel (the larger of the
@@ -95,6 +102,30 @@ bool far_off_screen(ivec2 texel, vec2 jitter, vec2 screen) {
     float margin = OFFSCREEN_CULL_FOOTPRINTS * texel_footprint(texel, jitter, screen) + OFFSCREEN_CULL_PIXELS;
     return max(outside.x, outside.y) > margin;
 }
+
+#if defined(TRACE_GRADIENTS) && defined(RESAMPLED_DI)
+// The texel of `texel`'s stratum whose plain path estimate this frame keeps for the next frame's
+// gradient: one of the nine by a hash of the stratum and the frame (Schied et al.'s random pick;
+// the plain kernel picks the brightest, which needs every texel's plain estimate), moved on by
+// one where it is the stratum's gradient sample (`gradient_texel`, which re-estimates anyway).
+// A pick that holds no sample or hits nothing leaves its stratum without a source this frame.
+bool is_gradient_source(ivec2 texel, uint stratum, ivec2 gradient_texel) {
+    uint k = pcg_hash(stratum * 9781u + frame.data.frame.x * 6271u + 1u) % 9u;
+    ivec2 origin = (texel / STRATUM) * STRATUM;
+    ivec2 pick = origin + ivec2(int(k % 3u), int(k / 3u));
+    if (pick == gradient_texel) pick = origin + ivec2(int((k + 1u) % 9u % 3u), int((k + 1u) % 9u / 3u));
+    return pick == texel;
+}
+
+// The path from the primary hit `s` as the plain kernel traces it (its own next-event estimation
+// and bounce), demodulated luminance: what A-SVGF's gradient compares between two frames.
+float plain_path_estimate(Surface s, vec3 dir, uint max_depth, vec2 cone, uint rng, vec3 albedo) {
+    path_defers_to_resampling = false;
+    vec3 c = shade_path(s, dir, max_depth, cone, rng);
+    path_defers_to_resampling = true;
+    return svgf_luminance(svgf_sanitize(c / albedo));
+}
+#endif
 
 // This invocation's texel: the workgroup's tile (from the list of live tiles: lavapipe runs
 // masked-off lanes at nearly full cost, so tiles without a sample to trace are not dispatched)
@@ -198,9 +229,21 @@ void main() {
     if (gradient) {
         hit.u = gradient_bary.x;
         hit.v = gradient_bary.y;
+#if !defined(RESAMPLED_DI)
+        // The texel's sample is last frame's path again. Resampled, it keeps its own random
+        // numbers; only the plain estimate below repeats last frame's.
         rng = gs.shading.y;
+#endif
     }
     uint path_rng = rng;
+    // The luminance the next frame's gradient compares against, if this texel is its stratum's
+    // source (asvgf_forward.comp): -1 where it is not.
+    float source_luminance = -1.0;
+#if defined(RESAMPLED_DI)
+    float plain_current = 0.0;
+    ivec2 gradient_texel = gs.surface.x != 0u ? ivec2(int(gs.shading.x & 0xffffu), int(gs.shading.x >> 16u)) : ivec2(-1);
+    bool source = found && !gradient && is_gradient_source(texel, stratum, gradient_texel);
+#endif
 #endif
     if (!found) {
         // Nothing hit: the environment (black without one); the previous position is the same direction.
@@ -225,6 +268,10 @@ void main() {
         project_view((prev_view_from_world * vec4(s.position, 1.0)).xyz, frame.data.prev_fov_tan, frame.data.screen.xy, prev_screen);
         color = shade_path(s, dir, max_depth, cone, rng);
         primary_hit = vec4(hit.u, hit.v, cone.x, 0.0);
+#if defined(TRACE_GRADIENTS) && defined(RESAMPLED_DI)
+        if (gradient) plain_current = plain_path_estimate(s, dir, max_depth, cone, gs.shading.y, albedo);
+        if (source) source_luminance = plain_path_estimate(s, dir, max_depth, cone, path_rng, albedo);
+#endif
     }
 #if defined(RESAMPLED_DI)
     imageStore(out_primary_hit, texel, primary_hit);
@@ -245,9 +292,15 @@ void main() {
     imageStore(out_ids, texel, uvec4(ids, 0u, 0u));
     imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
 #if defined(TRACE_GRADIENTS)
-    imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, gradient ? 1u : 0u));
+#if defined(RESAMPLED_DI)
+    float current = plain_current;
+#else
+    // A gradient sample repeats a path: it is never the next frame's source.
+    float current = svgf_luminance(svgf_sanitize(color / albedo));
+    if (found && !gradient) source_luminance = current;
+#endif
+    imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, asvgf_source_bits(source_luminance)));
     if (gradient) {
-        float current = svgf_luminance(svgf_sanitize(color / albedo));
         float previous = uintBitsToFloat(gs.shading.z);
         gradient_samples.data[stratum].shading.w = floatBitsToUint(current);
         imageStore(out_gradient, texel / int(ASVGF_STRATUM), vec4(current - previous, max(current, previous), 1.0, 0.0));

@@ -7,7 +7,6 @@
 //! G-buffer (colour = radiance × this eye's albedo) once both merges have run.
 
 use crate::error::{Error, Result};
-use crate::frame::RenderSettings;
 use crate::graph::{read_buffer, read_image, read_texels, write_image, FrameRecorder};
 use crate::layouts::CrossEyePush;
 use crate::passes::grid::GridFrame;
@@ -43,13 +42,12 @@ impl CrossEye {
     /// Timestamped passes per frame: a merge and a resolve per eye.
     pub const PASSES: u32 = 4;
 
-    /// Why the eyes of `spaces` cannot share their samples under `settings`, if they cannot: a
+    /// Why the eyes of `spaces` cannot share their samples, if they cannot: a
     /// space whose grid the filters do not address (no per-sample G-buffer to find the other
-    /// eye's sample in), two eyes of different spaces or sizes, or A-SVGF.
-    pub fn refusal(
-        [left, right]: [&dyn SamplingSpace; 2],
-        settings: &RenderSettings,
-    ) -> Option<String> {
+    /// eye's sample in), or two eyes of different spaces or sizes. A-SVGF shares too: its
+    /// gradients compare the tracer's own estimates (the visibility image), which the merge leaves
+    /// alone.
+    pub fn refusal([left, right]: [&dyn SamplingSpace; 2]) -> Option<String> {
         let caps = left.capabilities();
         if !caps.temporal_filters {
             return Some(format!(
@@ -69,26 +67,13 @@ impl CrossEye {
                 shape(right)
             ));
         }
-        // A-SVGF measures how the light changed against last frame's samples as traced; merged,
-        // they would read as change.
-        if settings.denoiser.needs_gradients() {
-            return Some(format!(
-                "cross-eye reuse with denoiser '{}': A-SVGF's temporal gradients compare each \
-                 eye's own samples between frames; use svgf or bmfr",
-                settings.denoiser.name()
-            ));
-        }
         None
     }
 
-    /// The passes for the eyes' spaces (`settings` the renderer's); an error with the
-    /// [`refusal`](Self::refusal) where they cannot share.
-    pub fn new(
-        ctx: &Arc<Context>,
-        spaces: [&dyn SamplingSpace; 2],
-        settings: &RenderSettings,
-    ) -> Result<CrossEye> {
-        if let Some(reason) = Self::refusal(spaces, settings) {
+    /// The passes for the eyes' spaces; an error with the [`refusal`](Self::refusal) where they
+    /// cannot share.
+    pub fn new(ctx: &Arc<Context>, spaces: [&dyn SamplingSpace; 2]) -> Result<CrossEye> {
+        if let Some(reason) = Self::refusal(spaces) {
             return Err(Error::Invalid(reason));
         }
         let space = spaces[0];

@@ -65,31 +65,27 @@ impl TracePass {
             return Ok(());
         }
         let s = scene.binds();
-        // A fixed array sliced to what this kernel binds: no host allocation per frame.
-        let gradient_binds = match (gradients, &out.visibility) {
-            (Some(g), Some(visibility)) => Some([
-                write_buffer("gradient_samples", g.samples),
-                write_image("out_gradient", g.gradient),
-                write_image("out_visibility", visibility),
-            ]),
-            _ => None,
+        // A fixed array sliced to what this kernel binds: no host allocation per frame. The
+        // `*_gradients` variants write A-SVGF's gradient samples and visibility, the `*_resampled`
+        // variants the primary hit (the G-buffer has its image only then), the `*_resampled_gi`
+        // variants also the bounce's sample (ReSTIR GI); a variant may do all three.
+        let mut extra = [s.bvh_nodes; 5];
+        let mut extra_count = 0;
+        let mut bind = |b| {
+            extra[extra_count] = b;
+            extra_count += 1;
         };
-        // The `*_resampled` variants write the primary hit (the G-buffer has its image only then).
-        let primary_hit = out
-            .primary_hit
-            .as_ref()
-            .map(|h| write_image("out_primary_hit", h));
-        // The `*_resampled_gi` variants also write the bounce's sample (ReSTIR GI).
-        let gi_samples = out
-            .gi_samples
-            .as_ref()
-            .map(|b| write_buffer("out_gi_samples", b));
-        let (extra, extra_count) = match (gradient_binds, primary_hit, gi_samples) {
-            (Some(g), _, _) => (g, 3),
-            (None, Some(h), Some(gi)) => ([h, gi, s.bvh_nodes], 2),
-            (None, Some(h), None) => ([h, s.bvh_nodes, s.bvh_nodes], 1),
-            (None, None, _) => ([s.bvh_nodes; 3], 0),
-        };
+        if let (Some(g), Some(visibility)) = (gradients, &out.visibility) {
+            bind(write_buffer("gradient_samples", g.samples));
+            bind(write_image("out_gradient", g.gradient));
+            bind(write_image("out_visibility", visibility));
+        }
+        if let Some(h) = &out.primary_hit {
+            bind(write_image("out_primary_hit", h));
+        }
+        if let Some(b) = &out.gi_samples {
+            bind(write_buffer("out_gi_samples", b));
+        }
         let g = out.write_binds();
         let binds = scene_then!(s;
             read_buffer("frame", frame.frame_data),
@@ -107,8 +103,10 @@ impl TracePass {
             extra[0],
             extra[1],
             extra[2],
+            extra[3],
+            extra[4],
         );
-        let binds = &binds[..binds.len() - 3 + extra_count];
+        let binds = &binds[..binds.len() - extra.len() + extra_count];
         // y = 0: the cameras' column base, a value lavapipe cannot fold (see trace.comp).
         let push = TracePush {
             config: UVec4::new(sample_index, 0, 0, 0),

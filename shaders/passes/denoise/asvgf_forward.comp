@@ -1,11 +1,14 @@
 #version 460
 // A-SVGF forward projection (Schied et al. 2018, §4.1): per stratum of last frame's grid, the
-// brightest sample that hit a surface (brightest: a moving penumbra shows up there first) and was
-// not itself a gradient sample (a path repeated again and again — the brightest at that — would
-// stay in the image as a fixed bright sample) is
-// carried to this frame — world position → this frame's screen → this frame's grid — and claims
-// the stratum it lands in (the first claim wins). The tracer's gradient variant then re-shades that
-// surface with that sample's random state in the texel it landed in. Runs before the tracer, so
+// brightest sample that the tracer marked as a possible source (its luminance in the visibility's
+// w, asvgf_source_bits: without resampling every sample that hit a surface and was not itself a
+// gradient sample — a path repeated again and again, the brightest at that, would stay in the
+// image as a fixed bright sample — so the brightest: a moving penumbra shows up there first; with
+// resampling the one texel whose plain path estimate the tracer kept) is carried to this frame —
+// world position → this frame's screen → this frame's grid — and claims the stratum it lands in
+// (the first claim wins). The tracer's gradient variant then re-shades that surface with that
+// sample's random state in the texel it landed in. The luminance is the tracer's own, before
+// resampling or another eye's samples change the G-buffer's radiance. Runs before the tracer, so
 // the G-buffer still holds last frame. Each invocation also clears its stratum of the gradient
 // image, where the tracer writes the strata that got a gradient sample (the strata grids of both
 // frames are one). Strata in the Visual-Polar grid: shaders/denoise/strata.glsl.
@@ -13,15 +16,13 @@
 #include "../../common/layouts.glsl"
 #include "../../common/camera.glsl"
 #include "../../denoise/strata.glsl"
-#include "../../denoise/svgf.glsl"
 
 layout(local_size_x = WORKGROUP_2D, local_size_y = WORKGROUP_2D) in;
 layout(push_constant) uniform Push { AsvgfForwardPush p; } push;
 layout(std140, set = 0, binding = 0) uniform FrameBuffer { FrameData data; } frame;
-layout(set = 0, binding = 1, rgba32f) uniform readonly image2D radiance;      // last frame's, demodulated
 layout(set = 0, binding = 2, rg32ui) uniform readonly uimage2D ids;           // x triangle + 1 (0: miss)
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D position;      // camera-relative (last camera)
-layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state, 1: gradient sample
+layout(set = 0, binding = 4, rgba32ui) uniform readonly uimage2D visibility;  // barycentrics, RNG state, source luminance
 layout(std430, set = 0, binding = 5) buffer GradientSamples { AsvgfGradientSample data[]; } gradient_samples;
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D gradient;   // per stratum: δ, max f, 1 (written by the tracer)
 
@@ -43,8 +44,9 @@ void main() {
     for (int j = 0; j < STRATUM; ++j) {
         for (int i = 0; i < STRATUM; ++i) {
             ivec2 t = STRATUM * s + ivec2(i, j);
-            if (!grid_holds_sample(g, t) || imageLoad(ids, t).x == 0u || imageLoad(visibility, t).w != 0u) continue;
-            float l = svgf_luminance(svgf_sanitize(imageLoad(radiance, t).rgb));
+            uint source = imageLoad(visibility, t).w;
+            if (!grid_holds_sample(g, t) || imageLoad(ids, t).x == 0u || !asvgf_is_source(source)) continue;
+            float l = asvgf_source_luminance(source);
             if (l > brightest) {
                 brightest = l;
                 picked = t;

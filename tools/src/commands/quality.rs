@@ -317,16 +317,6 @@ fn resampled(args: &QualityArgs) -> bool {
     args.profile.resampling.mode != ResamplingMode::Off
 }
 
-/// Why a combination cannot run after resampling, if it cannot (A-SVGF's re-shading).
-fn resampling_refusal(args: &QualityArgs, combination: &Combination) -> Option<RefusedRun> {
-    (resampled(args) && combination.denoiser == "asvgf").then(|| {
-        combination.refused(format!(
-            "asvgf cannot run after resampling {}: its gradient samples re-shade paths whose light the reservoirs give",
-            args.profile.resampling.mode.name()
-        ))
-    })
-}
-
 /// One cell of the grid: a camera (`still` or `moving`), a method, a denoiser, a TAA mode and,
 /// where `--stereo-noise` is given, how the eyes' random numbers relate.
 pub struct Combination<'a> {
@@ -482,7 +472,7 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         let needs_filters = resampled(args) || combination.filtered();
                         let refused = match (&refusal, needs_filters) {
                             (Some(reason), true) => Some(combination.refused(reason.clone())),
-                            _ => resampling_refusal(args, &combination),
+                            _ => None,
                         };
                         outcomes.push(match refused {
                             Some(refused) => Outcome::Refused(refused),
@@ -508,9 +498,6 @@ pub fn refusal(
     prepared: &Prepared,
     combination: &Combination,
 ) -> Result<Option<RefusedRun>> {
-    if let Some(refused) = resampling_refusal(args, combination) {
-        return Ok(Some(refused));
-    }
     if !(combination.filtered() || resampled(args)) {
         return Ok(None);
     }

@@ -1,4 +1,5 @@
-//! A-SVGF forward projection: last frame's brightest sample per 3×3 stratum, carried into this
+//! A-SVGF forward projection: last frame's brightest source sample per 3×3 stratum (as the tracer
+//! marked them in the visibility image), carried into this
 //! frame's grid, claims the stratum it lands in for the tracer to re-shade; also clears the
 //! strata's gradient image the tracer writes.
 
@@ -36,7 +37,6 @@ impl Pass<Forward> {
             .ok_or_else(|| Error::Invalid("A-SVGF needs a G-buffer with visibility".into()))?;
         let binds = [
             read_buffer("frame", frame.frame_data),
-            read_image("radiance", &g.radiance),
             read_image("ids", &g.ids),
             read_image("position", &g.position),
             read_image("visibility", visibility),
