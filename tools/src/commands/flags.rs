@@ -90,8 +90,8 @@ pub struct SceneFlags {
     /// Light-sample reuse before the denoiser: off (the default: next-event estimation at every
     /// hit), di (ReSTIR DI at the primary hit: light candidates resampled per sample, reused
     /// from the previous frame and from grid neighbours) or di+gi (ReSTIR GI too: the primary
-    /// hit's bounce reused the same way by reconnection); spaces with temporal filters only, not
-    /// with --denoiser asvgf; parameters from the profile's [resampling].
+    /// hit's bounce reused the same way by reconnection); spaces with temporal filters only;
+    /// parameters from the profile's [resampling].
     #[arg(long)]
     pub resampling: Option<String>,
     /// How the two eyes' random numbers relate in a stereo run (docs/design/random-numbers.md):
@@ -104,8 +104,7 @@ pub struct SceneFlags {
     /// With both eyes, whether each eye's samples also take the other eye's samples of the same
     /// surface this frame, found through the depth, before the denoiser (where a glossy lobe is
     /// narrower than the angle between the eyes, less): auto (the default: where the method's
-    /// space has temporal filters and the denoiser is not asvgf), on (refused where it cannot)
-    /// or off.
+    /// space has temporal filters), on (refused where it cannot) or off.
     #[arg(long)]
     pub cross_eye_reuse: Option<String>,
     /// Path regularisation strength in [0, 100] (default 1): after a low-density bounce, later
