@@ -105,10 +105,7 @@ fn gradient_samples_reshade_last_frames_path() {
     let scene = owned_scene("cornell-box");
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
-    for (space_name, mode) in SPACES
-        .into_iter()
-        .flat_map(|s| RESAMPLING.map(|m| (s, m)))
-    {
+    for (space_name, mode) in SPACES.into_iter().flat_map(|s| RESAMPLING.map(|m| (s, m))) {
         let name = format!("{space_name}, resampling {}", mode.name());
         let name = name.as_str();
         let mut r = Renderer::new(
@@ -247,10 +244,7 @@ fn a_light_switched_off_reaches_the_asvgf_output_faster_than_svgf() {
     let light = light_material(&scene);
     let camera = CameraPose::from_scene_camera(&scene.cameras[0], SCREEN.x, SCREEN.y);
     let (on, off) = (10u32, 14u32);
-    for (space_name, mode) in SPACES
-        .into_iter()
-        .flat_map(|s| RESAMPLING.map(|m| (s, m)))
-    {
+    for (space_name, mode) in SPACES.into_iter().flat_map(|s| RESAMPLING.map(|m| (s, m))) {
         let name = format!("{space_name}, resampling {}", mode.name());
         let mut lags = Vec::new();
         for (label, denoiser) in [("svgf", svgf()), ("asvgf", asvgf())] {

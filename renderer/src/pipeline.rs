@@ -729,9 +729,7 @@ fn build_cross_eye(
         CrossEyeReuse::On => true,
         CrossEyeReuse::Auto => CrossEye::refusal(spaces).is_none(),
     };
-    build
-        .then(|| CrossEye::new(ctx, spaces))
-        .transpose()
+    build.then(|| CrossEye::new(ctx, spaces)).transpose()
 }
 
 /// Timestamped passes one frame may hold: every view's passes, or a reference submission.
