@@ -117,12 +117,19 @@ bool is_gradient_source(ivec2 texel, uint stratum, ivec2 gradient_texel) {
     return pick == texel;
 }
 
+#endif
+
+#if defined(TRACE_GRADIENTS)
 // The path from the primary hit `s` as the plain kernel traces it (its own next-event estimation
 // and bounce), demodulated luminance: what A-SVGF's gradient compares between two frames.
 float plain_path_estimate(Surface s, vec3 dir, uint max_depth, vec2 cone, uint rng, vec3 albedo) {
+#if defined(RESAMPLED_DI)
     path_defers_to_resampling = false;
+#endif
     vec3 c = shade_path(s, dir, max_depth, cone, rng);
+#if defined(RESAMPLED_DI)
     path_defers_to_resampling = true;
+#endif
     return svgf_luminance(svgf_sanitize(c / albedo));
 }
 #endif
@@ -188,19 +195,22 @@ void main() {
     vec3 dir = normalize(mat3(world_from_view) * view_dir);
     uint max_depth = frame.data.frame.z;
 #if defined(TRACE_GRADIENTS)
-    // A gradient sample: this texel looks at the surface the forward projection put here instead
-    // of along its jitter (the surface lies inside the texel) and, if it is still visible, shades
-    // it with last frame's random state.
+    // A gradient sample: besides its own sample along its jitter, this texel looks at the
+    // surface the forward projection put here (it lies inside the texel) and, if it is still
+    // visible, traces last frame's path there again with last frame's random state
+    // (`plain_path_estimate`). That path only measures the gradient: shown in the image, last
+    // frame's brightest sample of the stratum, again and at its bright point, would bias it up.
     uint stratum = asvgf_stratum_index(texel, int(sampling.data.grid.x));
     AsvgfGradientSample gs = gradient_samples.data[stratum];
     bool gradient = gs.surface.x != 0u && gs.shading.x == (uint(texel.x) | (uint(texel.y) << 16u));
     vec2 gradient_bary = uintBitsToFloat(gs.surface.zw);
+    vec3 gradient_dir = dir;
     if (gradient) {
         PlacedTriangle placed = placed_triangle(gs.surface.y - 1u); // placed id: world space also for instances
         vec3 p = (1.0 - gradient_bary.x - gradient_bary.y) * placed.a.position_u.xyz
                + gradient_bary.x * placed.b.position_u.xyz
                + gradient_bary.y * placed.c.position_u.xyz;
-        dir = normalize(p - org);
+        gradient_dir = normalize(p - org);
     }
 #endif
 
@@ -225,24 +235,14 @@ void main() {
     if (found && (frame.data.frame.w & FRAME_FLAG_SURFACE_NOISE) != 0u)
         rng = surface_rng_seed(org + dir * hit.t, spread * hit.t * frame.data.path.y, frame.data.frame.x, frame.data.frame.y, push.p.config.x);
 #if defined(TRACE_GRADIENTS)
-    gradient = gradient && found && hit.triangle == gs.surface.y - 1u;
-    if (gradient) {
-        hit.u = gradient_bary.x;
-        hit.v = gradient_bary.y;
-#if !defined(RESAMPLED_DI)
-        // The texel's sample is last frame's path again. Resampled, it keeps its own random
-        // numbers; only the plain estimate below repeats last frame's.
-        rng = gs.shading.y;
-#endif
-    }
     uint path_rng = rng;
     // The luminance the next frame's gradient compares against, if this texel is its stratum's
     // source (asvgf_forward.comp): -1 where it is not.
     float source_luminance = -1.0;
-#if defined(RESAMPLED_DI)
     float plain_current = 0.0;
+#if defined(RESAMPLED_DI)
     ivec2 gradient_texel = gs.surface.x != 0u ? ivec2(int(gs.shading.x & 0xffffu), int(gs.shading.x >> 16u)) : ivec2(-1);
-    bool source = found && !gradient && is_gradient_source(texel, stratum, gradient_texel);
+    bool source = found && is_gradient_source(texel, stratum, gradient_texel);
 #endif
 #endif
     if (!found) {
@@ -269,10 +269,27 @@ void main() {
         color = shade_path(s, dir, max_depth, cone, rng);
         primary_hit = vec4(hit.u, hit.v, cone.x, 0.0);
 #if defined(TRACE_GRADIENTS) && defined(RESAMPLED_DI)
-        if (gradient) plain_current = plain_path_estimate(s, dir, max_depth, cone, gs.shading.y, albedo);
         if (source) source_luminance = plain_path_estimate(s, dir, max_depth, cone, path_rng, albedo);
 #endif
     }
+#if defined(TRACE_GRADIENTS)
+    if (gradient) {
+        Hit gh;
+        gradient = bvh_trace(org, gradient_dir, 0.0, 1e30, false, gh) && gh.triangle == gs.surface.y - 1u;
+        if (gradient) {
+            atomicAdd(ray_counters.data[0], 1u);
+            gh.u = gradient_bary.x;
+            gh.v = gradient_bary.y;
+            vec2 g_cone = vec2(0.0);
+            if ((frame.data.frame.w & FRAME_FLAG_TEXTURE_LOD) != 0u) {
+                float g_spread = pixel_tan * texel_footprint(texel, jitter, screen) / length(view_dir);
+                g_cone = vec2(g_spread * gh.t, g_spread);
+            }
+            Surface g_s = fetch_surface(gh, gradient_dir, g_cone.x);
+            plain_current = plain_path_estimate(g_s, gradient_dir, max_depth, g_cone, gs.shading.y, max(g_s.base_color, vec3(0.01)));
+        }
+    }
+#endif
 #if defined(RESAMPLED_DI)
     imageStore(out_primary_hit, texel, primary_hit);
 #endif
@@ -292,12 +309,10 @@ void main() {
     imageStore(out_ids, texel, uvec4(ids, 0u, 0u));
     imageStore(out_motion, texel, vec4(prev_screen, 0.0, 0.0));
 #if defined(TRACE_GRADIENTS)
-#if defined(RESAMPLED_DI)
     float current = plain_current;
-#else
-    // A gradient sample repeats a path: it is never the next frame's source.
-    float current = svgf_luminance(svgf_sanitize(color / albedo));
-    if (found && !gradient) source_luminance = current;
+#if !defined(RESAMPLED_DI)
+    // Every sample is a plain estimate: each may be its stratum's source.
+    if (found) source_luminance = svgf_luminance(svgf_sanitize(color / albedo));
 #endif
     imageStore(out_visibility, texel, uvec4(floatBitsToUint(vec2(hit.u, hit.v)), path_rng, asvgf_source_bits(source_luminance)));
     if (gradient) {
