@@ -3,14 +3,15 @@
 // hit, BRDF-sampled continuation (real-time: depth 3 = one indirect bounce). Writes the per-sample
 // G-buffer that the denoisers read, sized to the sampling grid.
 // The *_gradients variants serve A-SVGF (Schied et al. 2018): a texel that the forward projection
-// of last frame's samples chose (asvgf_forward.comp) re-shades that frame's surface with that
-// frame's random state, and every texel writes the visibility (barycentrics, random state, and
-// the luminance a next projection compares against) the next projection reads. Plain rendering
-// keeps the variants without them and pays nothing. With resampling (*_resampled_gradients,
-// *_resampled_gi_gradients) the texel's own sample is resampled as usual and the gradient compares
-// plain path estimates instead: one texel per stratum (the stratum's source) and the gradient
-// sample also trace the path as the plain kernel would (`plain_path_estimate`), with the same
-// random state in both frames, so δ is the change of the light and never the reservoirs' noise.
+// of last frame's samples chose (asvgf_forward.comp) also traces that frame's path again on that
+// frame's surface with that frame's random state (apart from its own sample), and every texel
+// writes the visibility (barycentrics, random state, and the luminance a next projection compares
+// against) the next projection reads. Plain rendering keeps the variants without them and pays
+// nothing. With resampling (*_resampled_gradients, *_resampled_gi_gradients) the texel's own
+// sample is resampled as usual and the gradient compares plain path estimates instead: one texel
+// per stratum (the stratum's source) and the gradient sample also trace the path as the plain
+// kernel would (`plain_path_estimate`), with the same random state in both frames, so δ is the
+// change of the light and never the reservoirs' noise.
 // The *_resampled variants (RESAMPLED_DI) leave the primary hit's next-event estimation to the
 // resampling passes (ReSTIR DI, docs/design/resampling.md) and write the primary hit's
 // barycentrics and ray-cone width, from which those passes re-fetch the surface. The
