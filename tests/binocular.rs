@@ -222,8 +222,7 @@ fn at_the_fove0_eye_distance_the_converged_pair_differs_less_than_independent_no
 
 /// The first number each traced sample's path draws after the primary hit, from the A-SVGF
 /// G-buffer's random state (`GBuffer::visibility`, z), with the texel's screen position; texels
-/// that missed (their path keeps the screen seed), hold no sample or re-shade last frame's path
-/// are left out.
+/// that missed (their path keeps the screen seed) or hold no sample are left out.
 struct PathState {
     state: u32,
     screen: glam::Vec2,
@@ -240,7 +239,8 @@ fn path_states(r: &Renderer, space_screens: &[Option<glam::Vec2>]) -> Vec<Option
         .zip(&ids)
         .zip(space_screens)
         .map(|((v, id), screen)| {
-            // Sign bit of w: a source sample, not a gradient sample re-shading last frame's path.
+            // Sign bit of w: a sample that hit a surface (without resampling every such sample
+            // may be its stratum's gradient source).
             let keep = id[0] != 0 && v[3] & 0x8000_0000 != 0;
             Some(PathState {
                 state: v[2],

@@ -19,8 +19,8 @@ uint asvgf_stratum_index(ivec2 texel, int grid_width) {
 
 // The G-buffer visibility's w: the luminance of a sample the next frame's forward projection may
 // carry as its stratum's gradient source (asvgf_forward.comp), with the sign bit set; 0 for a
-// sample it may not (a gradient sample, a miss, a texel not traced, and with resampling every
-// texel but the stratum's source).
+// sample it may not (a miss, a texel not traced, and with resampling every texel but the
+// stratum's source).
 uint asvgf_source_bits(float luminance) {
     return luminance < 0.0 ? 0u : (floatBitsToUint(luminance) | 0x80000000u);
 }

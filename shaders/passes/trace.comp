@@ -283,7 +283,8 @@ void main() {
             gh.v = gradient_bary.y;
             vec2 g_cone = vec2(0.0);
             if ((frame.data.frame.w & FRAME_FLAG_TEXTURE_LOD) != 0u) {
-                float g_spread = pixel_tan * texel_footprint(texel, jitter, screen) / length(view_dir);
+                // The texel's own spread (its footprint is computed only when its own ray hit).
+                float g_spread = found ? spread : pixel_tan * texel_footprint(texel, jitter, screen) / length(view_dir);
                 g_cone = vec2(g_spread * gh.t, g_spread);
             }
             Surface g_s = fetch_surface(gh, gradient_dir, g_cone.x);

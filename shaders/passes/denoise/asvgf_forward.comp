@@ -1,13 +1,12 @@
 #version 460
 // A-SVGF forward projection (Schied et al. 2018, §4.1): per stratum of last frame's grid, the
 // brightest sample that the tracer marked as a possible source (its luminance in the visibility's
-// w, asvgf_source_bits: without resampling every sample that hit a surface and was not itself a
-// gradient sample — a path repeated again and again, the brightest at that, would stay in the
-// image as a fixed bright sample — so the brightest: a moving penumbra shows up there first; with
-// resampling the one texel whose plain path estimate the tracer kept) is carried to this frame —
-// world position → this frame's screen → this frame's grid — and claims the stratum it lands in
-// (the first claim wins). The tracer's gradient variant then re-shades that surface with that
-// sample's random state in the texel it landed in. The luminance is the tracer's own, before
+// w, asvgf_source_bits: without resampling every sample that hit a surface, so the brightest — a
+// moving penumbra shows up there first; with resampling the one texel whose plain path estimate
+// the tracer kept) is carried to this frame — world position → this frame's screen → this
+// frame's grid — and claims the stratum it lands in (the first claim wins). The tracer's gradient
+// variant then traces that sample's path on that surface again, with its random state, from the
+// texel it landed in. The luminance is the tracer's own, before
 // resampling or another eye's samples change the G-buffer's radiance. Runs before the tracer, so
 // the G-buffer still holds last frame. Each invocation also clears its stratum of the gradient
 // image, where the tracer writes the strata that got a gradient sample (the strata grids of both

@@ -470,10 +470,10 @@ pub fn run(args: &QualityArgs) -> Result<()> {
                         };
                         let dir = args.out.join(combination.run_dir_name());
                         let needs_filters = resampled(args) || combination.filtered();
-                        let refused = match (&refusal, needs_filters) {
-                            (Some(reason), true) => Some(combination.refused(reason.clone())),
-                            _ => None,
-                        };
+                        let refused = refusal
+                            .as_ref()
+                            .filter(|_| needs_filters)
+                            .map(|reason| combination.refused(reason.clone()));
                         outcomes.push(match refused {
                             Some(refused) => Outcome::Refused(refused),
                             None => Outcome::Run(Box::new(run_combination(

@@ -1,7 +1,8 @@
 //! A-SVGF — SVGF with temporal gradients (Schied, Peters, Dachsbacher 2018; denoisers.md) on the
-//! sampling grid. Per 3×3 stratum one sample of last frame (the brightest) is forward-projected
-//! into this frame's grid (`forward`), where the tracer's gradient variant re-shades that surface
-//! with that sample's random state: δ = f_i − f_{i−1} is then the change of the lighting alone.
+//! sampling grid. Per 3×3 stratum one sample of last frame (the brightest; with resampling one the
+//! tracer picked) is forward-projected into this frame's grid (`forward`), where the tracer's
+//! gradient variant traces that sample's path on that surface again with its random state, apart
+//! from the texel's own sample: δ = f_i − f_{i−1} is then the change of the lighting alone.
 //! The gradients are reconstructed at 1/3 resolution by joint-bilateral à-trous iterations
 //! (`gradient`), and SVGF's temporal accumulation uses α_i = (1 − λ)·α + λ with
 //! λ = |δ̂| / max(f_i, f_{i−1}) (its `*_adaptive` kernel variant); the rest is SVGF's.
